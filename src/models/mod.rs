@@ -1,0 +1,296 @@
+//! Forward models: one trait, one file per model of the paper, plus regime limits and energy.
+//!
+//! Every evaluation returns either a steady state (regime B) or the reason there is none:
+//! the bead stops (regime A, with where), lifts off or runs away (regime C), or a
+//! model-specific failure. No evaluation returns NaN or panics on a valid [`Scene`].
+
+pub mod energy;
+pub mod jaeger;
+pub mod jan;
+pub mod regimes;
+pub mod slip;
+pub mod stick;
+pub mod stickslip;
+
+use crate::error::{Error, Result};
+use crate::scene::Scene;
+use std::fmt;
+use std::str::FromStr;
+
+/// The paper's three regimes (§3.5): A the bead stops, B steady, C lift-off / jumps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Regime {
+    /// δ < δ_m: the bead stops.
+    A,
+    /// δ_m < δ < δ_d: a steady mean velocity exists.
+    B,
+    /// δ > δ_d: the bead lifts off (or accelerates without bound).
+    C,
+}
+
+impl fmt::Display for Regime {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let s = match self {
+            Regime::A => "A",
+            Regime::B => "B",
+            Regime::C => "C",
+        };
+        f.write_str(s)
+    }
+}
+
+/// A steady state (regime B) and its diagnostics. Velocities are dimensionless
+/// (units sqrt(g (R+r))), angles in radians, times in units 1/ω0 (MODEL.md §1).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Steady {
+    /// Mean velocity v̄ = 2 sin α / τ (eq 10).
+    pub mean_velocity: f64,
+    /// Steady velocity Θ̇f just before each collision.
+    pub final_velocity: f64,
+    /// Steady velocity Θ̇0 just after each collision.
+    pub initial_velocity: f64,
+    /// Contact time τ on one row bead.
+    pub contact_time: f64,
+    /// Squared velocity at the top Θ = 0 (when the contact crosses it; otherwise the value
+    /// the rolling law extrapolates to).
+    pub top_velocity_sq: Option<f64>,
+    /// Angle Θ_G where rolling gives way to slip (eq 36), stick/slip model.
+    pub theta_g: Option<f64>,
+    /// Slope of the final-velocity map at the fixed point (stable when |slope| < 1).
+    pub map_slope: Option<f64>,
+    /// Another fixed point of the final-velocity map found above the returned one (unstable
+    /// when the returned one is stable): the scene is bistable.
+    pub other_fixed_point: Option<f64>,
+    /// Which phases the steady contact goes through.
+    pub phases: Phases,
+}
+
+/// The phase sequence of a steady contact.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Phases {
+    /// Pure rolling over the whole contact.
+    Roll,
+    /// Slip over the whole contact.
+    Slip,
+    /// Rolling, then forward slip after Θ_G.
+    RollSlip,
+    /// No contact mechanics: a phenomenological law (Jan, Jaeger).
+    None,
+}
+
+impl fmt::Display for Phases {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Phases::Roll => "roll",
+            Phases::Slip => "slip",
+            Phases::RollSlip => "roll>slip",
+            Phases::None => "",
+        })
+    }
+}
+
+impl Steady {
+    pub(crate) fn basic(mean_velocity: f64, final_velocity: f64, initial_velocity: f64, tau: f64) -> Self {
+        Steady {
+            mean_velocity,
+            final_velocity,
+            initial_velocity,
+            contact_time: tau,
+            top_velocity_sq: None,
+            theta_g: None,
+            map_slope: None,
+            other_fixed_point: None,
+            phases: Phases::None,
+        }
+    }
+}
+
+/// Why a scene has no steady state under a model.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum NotSteady {
+    /// Regime A: the bead stops at this angle Θ (radians) on a row bead.
+    Stops {
+        /// Angle where the velocity vanishes.
+        angle: f64,
+    },
+    /// Regime C: the normal force vanishes at this angle Θ (radians).
+    LiftOff {
+        /// Angle where N = 0 (eq 30a).
+        angle: f64,
+    },
+    /// Regime C: the final-velocity map has no fixed point; the velocity grows without bound
+    /// (K ≥ 1 for rolling, K² e^{4fα} ≥ 1 for slip, …).
+    Runaway,
+    /// The model's own integrand or approximation is not valid here.
+    Invalid {
+        /// Why.
+        reason: &'static str,
+    },
+    /// The final-velocity map is discontinuous where it changes sign: no true fixed point.
+    MapJump {
+        /// Velocity at the jump.
+        at: f64,
+    },
+}
+
+impl NotSteady {
+    /// The regime this failure belongs to, when it is one of the paper's.
+    pub fn regime(&self) -> Option<Regime> {
+        match self {
+            NotSteady::Stops { .. } => Some(Regime::A),
+            NotSteady::LiftOff { .. } | NotSteady::Runaway => Some(Regime::C),
+            _ => None,
+        }
+    }
+
+    /// A short machine-readable status word.
+    pub fn status(&self) -> &'static str {
+        match self {
+            NotSteady::Stops { .. } => "stops",
+            NotSteady::LiftOff { .. } => "lift-off",
+            NotSteady::Runaway => "no-steady-state",
+            NotSteady::Invalid { .. } => "invalid",
+            NotSteady::MapJump { .. } => "no-fixed-point",
+        }
+    }
+}
+
+impl fmt::Display for NotSteady {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            NotSteady::Stops { angle } => {
+                write!(f, "bead stops at Theta = {:.6} deg", angle.to_degrees())
+            }
+            NotSteady::LiftOff { angle } => {
+                write!(f, "normal force vanishes at Theta = {:.6} deg", angle.to_degrees())
+            }
+            NotSteady::Runaway => write!(f, "no fixed point: the velocity grows without bound"),
+            NotSteady::Invalid { reason } => f.write_str(reason),
+            NotSteady::MapJump { at } => write!(
+                f,
+                "final-velocity map jumps across the diagonal at {at:.6}: no fixed point"
+            ),
+        }
+    }
+}
+
+/// Result of one forward evaluation.
+pub type Outcome = std::result::Result<Steady, NotSteady>;
+
+/// Regime of an outcome (B when steady).
+pub fn regime_of(o: &Outcome) -> Option<Regime> {
+    match o {
+        Ok(_) => Some(Regime::B),
+        Err(e) => e.regime(),
+    }
+}
+
+/// A forward model: scene → steady mean velocity or the reason there is none.
+pub trait ForwardModel: Sync {
+    /// The model's name as used on the command line.
+    fn name(&self) -> &'static str;
+    /// Evaluates the steady state of one scene.
+    fn evaluate(&self, scene: &Scene) -> Outcome;
+}
+
+/// Which branch of Jaeger's quadratic (eq 84) to return when it has two positive roots.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum JaegerBranch {
+    /// The larger root (default).
+    Upper,
+    /// The smaller root.
+    Lower,
+}
+
+/// Every forward model by name, with its own parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Model {
+    /// Pure rolling, exact (eqs 11–27 corrected).
+    Stick,
+    /// Pure rolling with F(Ω,k) ≈ asinh(tan Ω) (eq 29).
+    StickApprox,
+    /// Slip over the whole contact, exact quadrature (§4.3).
+    Slip,
+    /// Slip with the second-order exponential (eqs 54–59).
+    SlipApprox,
+    /// Roll then slip after Θ_G (§4.4).
+    StickSlip,
+    /// Jan's energy balance (eq 74).
+    Jan(jan::Jan),
+    /// Jaeger's heuristic law (eqs 80–89).
+    Jaeger(jaeger::Jaeger),
+}
+
+impl Model {
+    /// Names accepted on the command line.
+    pub const NAMES: [&'static str; 7] = [
+        "stick",
+        "stick-approx",
+        "slip",
+        "slip-approx",
+        "stickslip",
+        "jan",
+        "jaeger",
+    ];
+}
+
+impl ForwardModel for Model {
+    fn name(&self) -> &'static str {
+        match self {
+            Model::Stick => "stick",
+            Model::StickApprox => "stick-approx",
+            Model::Slip => "slip",
+            Model::SlipApprox => "slip-approx",
+            Model::StickSlip => "stickslip",
+            Model::Jan(_) => "jan",
+            Model::Jaeger(_) => "jaeger",
+        }
+    }
+
+    fn evaluate(&self, scene: &Scene) -> Outcome {
+        match self {
+            Model::Stick => stick::steady(scene),
+            Model::StickApprox => stick::steady_approx(scene),
+            Model::Slip => slip::steady(scene),
+            Model::SlipApprox => slip::steady_approx(scene),
+            Model::StickSlip => stickslip::steady(scene),
+            Model::Jan(m) => m.evaluate(scene),
+            Model::Jaeger(m) => m.evaluate(scene),
+        }
+    }
+}
+
+/// The kind of model named on the command line (parameters of jan/jaeger supplied apart).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ModelKind {
+    /// See [`Model::Stick`].
+    Stick,
+    /// See [`Model::StickApprox`].
+    StickApprox,
+    /// See [`Model::Slip`].
+    Slip,
+    /// See [`Model::SlipApprox`].
+    SlipApprox,
+    /// See [`Model::StickSlip`].
+    StickSlip,
+    /// See [`Model::Jan`].
+    Jan,
+    /// See [`Model::Jaeger`].
+    Jaeger,
+}
+
+impl FromStr for ModelKind {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        Ok(match s {
+            "stick" => ModelKind::Stick,
+            "stick-approx" => ModelKind::StickApprox,
+            "slip" => ModelKind::Slip,
+            "slip-approx" => ModelKind::SlipApprox,
+            "stickslip" => ModelKind::StickSlip,
+            "jan" => ModelKind::Jan,
+            "jaeger" => ModelKind::Jaeger,
+            _ => return Err(Error::UnknownModel(s.to_string())),
+        })
+    }
+}

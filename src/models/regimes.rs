@@ -1,0 +1,93 @@
+//! Regime limits and derived quantities of the rolling model: δ_m (eq 32), δ_d (eq 31), the
+//! smallest ξ with a steady regime, Θ_G (eq 36), H (eq 35) and the bulk friction μ (eq 79).
+
+use crate::scene::{CollisionLaw, Scene};
+use crate::special::root::brent;
+
+/// Lower limit of the steady regime, δ_m = 2 atan(tan(α/2) (1−K)/(1+K)) (eq 32), radians.
+pub fn delta_m(alpha: f64, k: f64) -> f64 {
+    2.0 * ((0.5 * alpha).tan() * (1.0 - k) / (1.0 + k)).atan()
+}
+
+/// Upper limit (lift-off at Θf), δ_d = atan((1+ρ)(1−K²) / (tan α (4 + (1+ρ)(1−K²)))) (eq 31),
+/// radians.
+pub fn delta_d(alpha: f64, k: f64, rho: f64) -> f64 {
+    let c = (1.0 + rho) * (1.0 - k) * (1.0 + k);
+    (c / (alpha.tan() * (4.0 + c))).atan()
+}
+
+/// Bulk friction of the rolling model, μ = lim_{v→0} tan δ
+/// = (1 − K²) sin α / ((1 + K²) cos α + 2K) (eqs 78–79). Equals tan δ_m exactly.
+pub fn bulk_friction(alpha: f64, k: f64) -> f64 {
+    (1.0 - k) * (1.0 + k) * alpha.sin() / ((1.0 + k * k) * alpha.cos() + 2.0 * k)
+}
+
+/// α = asin(1/(1+ξ)) (eq 2).
+pub fn alpha_of_xi(xi: f64) -> f64 {
+    (1.0 / (1.0 + xi)).asin()
+}
+
+/// δ_m and δ_d (radians) at radius ratio ξ for a collision law.
+pub fn limits(xi: f64, law: CollisionLaw, rho: f64) -> (f64, f64) {
+    let a = alpha_of_xi(xi);
+    let k = law.k(a, rho);
+    (delta_m(a, k), delta_d(a, k, rho))
+}
+
+/// Smallest ξ with a steady regime (δ_m < δ_d) for a law, where δ_m(ξ) = δ_d(ξ); `None` if the
+/// limits do not cross for ξ in [1e-4, 1e4]. The paper quotes ≈ 0.62 for its fitted law.
+pub fn critical_xi(law: CollisionLaw, rho: f64) -> Option<f64> {
+    let h = |lx: f64| {
+        let (m, d) = limits(lx.exp(), law, rho);
+        d - m
+    };
+    // Scan in log ξ for the first sign change from below (no steady regime) to above.
+    let n = 400;
+    let (lo, hi) = ((1e-4f64).ln(), (1e4f64).ln());
+    let mut x0 = lo;
+    let mut f0 = h(x0);
+    for i in 1..=n {
+        let x1 = lo + (hi - lo) * i as f64 / n as f64;
+        let f1 = h(x1);
+        if f0 < 0.0 && f1 >= 0.0 {
+            let r = brent(h, x0, x1, f0, f1, 1e-15, 200)?;
+            return Some(r.x.exp());
+        }
+        x0 = x1;
+        f0 = f1;
+    }
+    None
+}
+
+/// ϑ = 2 cos Θ0 + (1+ρ) Θ̇0² (eq 36).
+#[inline]
+pub fn vartheta(scene: &Scene, w0sq: f64) -> f64 {
+    2.0 * scene.sc_0.c + (1.0 + scene.rho) * w0sq
+}
+
+/// Friction demand H(Θ) = T/N = ρ sin Θ / ((3+ρ) cos Θ − ϑ) of rolling from Θ0 with squared
+/// speed `w0sq` (eq 35). Rolling holds while |H| ≤ f.
+pub fn friction_demand(scene: &Scene, w0sq: f64, theta: f64) -> f64 {
+    scene.rho * theta.sin() / ((3.0 + scene.rho) * theta.cos() - vartheta(scene, w0sq))
+}
+
+/// Θ_G: the angle where rolling from Θ0 with squared speed `w0sq` first needs more friction
+/// than f (eq 36), radians, in the rationalised form that keeps its digits as f → 0:
+/// tan(Θ_G/2) = f (3+ρ−ϑ) / (ρ + sqrt(ρ² + f² ((3+ρ)² − ϑ²))) (MODEL.md §3).
+/// `None` when no real Θ_G exists ((3+ρ)² < ϑ²: the normal force is negative everywhere), or
+/// when ρ = f = 0 (no friction is ever needed).
+pub fn theta_g(scene: &Scene, w0sq: f64) -> Option<f64> {
+    let rho = scene.rho;
+    let f = scene.f;
+    let th = vartheta(scene, w0sq);
+    let p = 3.0 + rho;
+    let disc = rho * rho + f * f * (p - th) * (p + th);
+    if disc < 0.0 || p - th < 0.0 {
+        return None;
+    }
+    let den = rho + disc.sqrt();
+    if den == 0.0 {
+        return None;
+    }
+    Some(2.0 * (f * (p - th) / den).atan())
+}

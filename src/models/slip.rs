@@ -1,0 +1,256 @@
+//! Slip over the whole contact (§4.3, eqs 37–53 corrected) and its elliptic approximation
+//! (eqs 54–59), plus the forward-slip phase shared with the stick/slip model.
+
+use super::{NotSteady, Outcome, Phases, Steady};
+use crate::scene::Scene;
+use crate::special::elliptic::cos_integral;
+use crate::special::quad::{integrate, QuadOptions};
+use crate::special::root::brent;
+use crate::special::SinCos;
+
+/// Coefficients of the slip first integral Θ̇² = a e^{2fΘ} + b sin Θ + c cos Θ (eq 39):
+/// b = −6f/(1+4f²), c = (4f² − 2)/(1+4f²).
+#[inline]
+pub fn slip_coefficients(f: f64) -> (f64, f64) {
+    let d = 1.0 + 4.0 * f * f;
+    (-6.0 * f / d, (4.0 * f * f - 2.0) / d)
+}
+
+/// A forward-slip phase (friction T = f N opposing the motion, eq 37) that starts at angle
+/// `theta_s` with squared speed `ws_sq`.
+#[derive(Debug, Clone, Copy)]
+pub struct SlipPhase {
+    /// Angle where the slip starts.
+    pub theta_s: f64,
+    /// Squared speed there.
+    pub ws_sq: f64,
+    /// Friction coefficient.
+    pub f: f64,
+    b: f64,
+    c: f64,
+    sin_s: f64,
+    cos_s: f64,
+}
+
+impl SlipPhase {
+    /// A phase starting at `theta_s` with squared speed `ws_sq`.
+    pub fn new(theta_s: f64, ws_sq: f64, f: f64) -> Self {
+        let (b, c) = slip_coefficients(f);
+        let (sin_s, cos_s) = theta_s.sin_cos();
+        SlipPhase {
+            theta_s,
+            ws_sq,
+            f,
+            b,
+            c,
+            sin_s,
+            cos_s,
+        }
+    }
+
+    /// Θ̇²(θ) = a e^{2f(θ−Θs)} + b sin θ + c cos θ with a = Θ̇s² − b sin Θs − c cos Θs
+    /// (eqs 38, 40), written as Θ̇s² E + b (sin θ − sin Θs E) + c (cos θ − cos Θs E),
+    /// E = e^{2f(θ−Θs)}, with the differences taken in product form so that small f and
+    /// θ near Θs keep their digits.
+    #[inline]
+    pub fn speed_sq(&self, theta: f64) -> f64 {
+        let d = theta - self.theta_s;
+        let em1 = (2.0 * self.f * d).exp_m1();
+        let (sh, _) = (0.5 * d).sin_cos();
+        let (sm, cm) = (0.5 * (theta + self.theta_s)).sin_cos();
+        let dsin = 2.0 * cm * sh;
+        let dcos = -2.0 * sm * sh;
+        self.ws_sq * (1.0 + em1) + self.b * (dsin - self.sin_s * em1)
+            + self.c * (dcos - self.cos_s * em1)
+    }
+
+    /// d(Θ̇²)/dθ = 2 Θ̈ = 2 (sin θ − f (cos θ − Θ̇²)) (eq 37).
+    #[inline]
+    pub fn speed_sq_slope(&self, theta: f64) -> f64 {
+        let (s, c) = theta.sin_cos();
+        2.0 * (s - self.f * (c - self.speed_sq(theta)))
+    }
+
+    /// Time to slip from Θs to `theta_end`, or where the bead stops.
+    pub fn time_to(&self, theta_end: f64, tol: f64) -> Result<f64, NotSteady> {
+        slip_time(self, self.theta_s, theta_end, tol)
+    }
+}
+
+/// ∫_{θa}^{θb} dθ / sqrt(Θ̇²(θ)) along a slip phase. The interval is split at the minimum of
+/// Θ̇² and each side is integrated after θ = θm ± h sinh t with h = sqrt(Θ̇²(θm)/q),
+/// q = ½ d²Θ̇²/dθ² at θm, which turns the near-singular peak (a bead crawling over the top)
+/// into an almost constant integrand.
+pub fn slip_time(ph: &SlipPhase, a: f64, b: f64, tol: f64) -> Result<f64, NotSteady> {
+    if b <= a {
+        return Ok(0.0);
+    }
+    let ga = ph.speed_sq_slope(a);
+    let gb = ph.speed_sq_slope(b);
+    let tm = if ga >= 0.0 {
+        a
+    } else if gb <= 0.0 {
+        b
+    } else {
+        match brent(|t| ph.speed_sq_slope(t), a, b, ga, gb, 1e-15, 200) {
+            Some(r) => r.x,
+            None => {
+                return Err(NotSteady::Invalid {
+                    reason: "slip speed minimum not found",
+                })
+            }
+        }
+    };
+    let m = ph.speed_sq(tm);
+    if !(m > 0.0) {
+        // Stops where Θ̇² first reaches 0 before the minimum.
+        let ya = ph.speed_sq(a);
+        let angle = brent(|t| ph.speed_sq(t), a, tm, ya, m, 1e-15, 200)
+            .map(|r| r.x)
+            .unwrap_or(a);
+        return Err(NotSteady::Stops { angle });
+    }
+    let q = (tm.cos() + ph.f * tm.sin()).max(1e-3);
+    let h = (m / q).sqrt();
+    let opts = QuadOptions {
+        rel_tol: tol,
+        abs_tol: 0.0,
+        max_panels: 128,
+    };
+    let mut total = 0.0;
+    for (lo, dir) in [(a, -1.0), (b, 1.0)] {
+        let span = (lo - tm).abs();
+        if span == 0.0 {
+            continue;
+        }
+        let tmax = (span / h).asinh();
+        let r = integrate(
+            |t: f64| {
+                let th = tm + dir * h * t.sinh();
+                let g = ph.speed_sq(th);
+                if g > 0.0 {
+                    h * t.cosh() / g.sqrt()
+                } else {
+                    f64::INFINITY
+                }
+            },
+            0.0,
+            tmax,
+            opts,
+        );
+        total += r.value;
+    }
+    if total.is_finite() && total > 0.0 {
+        Ok(total)
+    } else {
+        Err(NotSteady::Invalid {
+            reason: "slip integrand not positive",
+        })
+    }
+}
+
+/// Steady final velocity squared of the slip model (eq 50 corrected):
+/// L'² = (b sin Θf + c cos Θf − (b sin Θ0 + c cos Θ0) e^{4fα}) / (1 − K² e^{4fα}), with the
+/// differences in product form (e^{4fα} − 1 by expm1). `Err(Runaway)` when K² e^{4fα} ≥ 1.
+pub fn final_velocity_sq(scene: &Scene) -> Result<f64, NotSteady> {
+    let (b, c) = slip_coefficients(scene.f);
+    let em1 = (4.0 * scene.f * scene.alpha).exp_m1();
+    let k2 = scene.k * scene.k;
+    let den = scene.one_minus_k2() - k2 * em1;
+    if !(den > 0.0) {
+        return Err(NotSteady::Runaway);
+    }
+    let sa = scene.sin_alpha;
+    let dsin = 2.0 * scene.sc_delta.c * sa - scene.sc_0.s * em1;
+    let dcos = -2.0 * scene.sc_delta.s * sa - scene.sc_0.c * em1;
+    Ok((b * dsin + c * dcos) / den)
+}
+
+fn slip_state(scene: &Scene) -> Result<f64, NotSteady> {
+    let l2 = final_velocity_sq(scene)?;
+    if !(l2 > 0.0) {
+        return Err(NotSteady::Stops {
+            angle: scene.theta_0,
+        });
+    }
+    if scene.sc_f.c - l2 < 0.0 {
+        return Err(NotSteady::LiftOff {
+            angle: scene.theta_f,
+        });
+    }
+    Ok(l2)
+}
+
+/// Steady slip over the whole contact (§4.3): τ' = ∫ dθ / G(θ) (eq 51) by adaptive
+/// Gauss–Kronrod to relative tolerance 1e-14.
+pub fn steady(scene: &Scene) -> Outcome {
+    steady_tol(scene, 1e-14)
+}
+
+/// [`steady`] with a chosen quadrature tolerance.
+pub fn steady_tol(scene: &Scene, tol: f64) -> Outcome {
+    let l2 = slip_state(scene)?;
+    let w0sq = scene.k * scene.k * l2;
+    let ph = SlipPhase::new(scene.theta_0, w0sq, scene.f);
+    let tau = slip_time(&ph, scene.theta_0, scene.theta_f, tol)?;
+    let l = l2.sqrt();
+    let mut s = Steady::basic(2.0 * scene.sin_alpha / tau, l, scene.k * l, tau);
+    s.map_slope = Some(scene.k * scene.k * (4.0 * scene.f * scene.alpha).exp());
+    s.phases = Phases::Slip;
+    Ok(s)
+}
+
+/// Steady slip with the paper's approximation e^{2fθ} ≈ 1 + 4f² + 2f sin θ − 4f² cos θ
+/// (eqs 54–56 as used): Θ̇² ≈ a' + b' sin θ + c' cos θ = a' + p cos(θ − θ*), whose time is an
+/// elliptic integral (eqs 57–59), evaluated by [`cos_integral`].
+pub fn steady_approx(scene: &Scene) -> Outcome {
+    let l2 = slip_state(scene)?;
+    let (b, c) = slip_coefficients(scene.f);
+    let f = scene.f;
+    let w0sq = scene.k * scene.k * l2;
+    let a_inf = w0sq - b * scene.sc_0.s - c * scene.sc_0.c; // eq 53
+    let e = a_inf * (-2.0 * f * scene.theta_0).exp();
+    let a1 = e * (1.0 + 4.0 * f * f); // eq 56a
+    let b1 = b + 2.0 * f * e; // eq 56b
+    let c1 = c - 4.0 * f * f * e; // eq 56c
+    let p = b1.hypot(c1); // eq 58c
+    let star = b1.atan2(c1);
+    // a' + p cos(θ − θ*) = a' − p cos ψ with ψ = θ − θ* − π, brought into (−π, π].
+    let wrap = |x: f64| {
+        let t = std::f64::consts::TAU;
+        let mut y = x % t;
+        if y <= -std::f64::consts::PI {
+            y += t;
+        } else if y > std::f64::consts::PI {
+            y -= t;
+        }
+        y
+    };
+    let psi0 = wrap(scene.theta_0 - star - std::f64::consts::PI);
+    let psif = psi0 + 2.0 * scene.alpha;
+    if psif >= std::f64::consts::PI {
+        return Err(NotSteady::Invalid {
+            reason: "approximate slip integrand: contact spans the speed maximum",
+        });
+    }
+    let vsq = |th: f64| a1 + b1 * th.sin() + c1 * th.cos();
+    let w0 = vsq(scene.theta_0);
+    let wf = vsq(scene.theta_f);
+    let wt = a1 - p;
+    if !(w0 > 0.0 && wf > 0.0) || (psi0 < 0.0 && psif > 0.0 && !(wt > 0.0)) {
+        return Err(NotSteady::Invalid {
+            reason: "approximate slip integrand not positive",
+        });
+    }
+    let den = (0.5 * (psif + psi0)).sin() * scene.sin_alpha;
+    let tau = cos_integral(SinCos::of(0.5 * psi0), SinCos::of(0.5 * psif), w0, wf, wt, den);
+    if !(tau.is_finite() && tau > 0.0) {
+        return Err(NotSteady::Invalid {
+            reason: "approximate slip time not finite",
+        });
+    }
+    let l = l2.sqrt();
+    let mut s = Steady::basic(2.0 * scene.sin_alpha / tau, l, scene.k * l, tau);
+    s.phases = Phases::Slip;
+    Ok(s)
+}

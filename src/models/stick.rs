@@ -1,0 +1,146 @@
+//! Pure rolling ("stick" model, §3): exact closed form and the asinh approximation (eq 29).
+
+use super::{NotSteady, Outcome, Phases, Steady};
+use crate::scene::Scene;
+use crate::special::dd::Dd;
+use crate::special::elliptic::cos_integral;
+
+/// Steady final velocity squared L² = 4 sin δ sin α / ((1+ρ)(1−K²)) (eq 19).
+#[inline]
+pub fn final_velocity_sq(scene: &Scene) -> f64 {
+    scene.b * 2.0 * scene.sin_delta_sin_alpha() / scene.one_minus_k2()
+}
+
+/// P = sin(Θ0/2) + K sin(Θf/2) = cos(δ/2) cos(α/2) [(1+K) tan(δ/2) − (1−K) tan(α/2)]:
+/// the factor of the squared top velocity that vanishes at δ = δ_m (eq 32). The bracket is
+/// recomputed in double-double when it cancels, so P keeps its relative accuracy for δ as close
+/// to δ_m as the double inputs allow.
+pub fn lower_limit_factor(scene: &Scene) -> f64 {
+    let k = scene.k;
+    let (sd, cd) = (scene.sc_half_delta.s, scene.sc_half_delta.c);
+    let ta = scene.tan_half_alpha.to_f64();
+    let td = sd / cd;
+    let up = (1.0 + k) * td;
+    let mut bracket = up - (1.0 - k) * ta;
+    if bracket.abs() < 1e-3 * up.abs() {
+        let (s, c) = Dd::sin_cos(0.5 * scene.delta);
+        let one = Dd::from(1.0);
+        let kd = Dd::from(k);
+        let b = (one + kd) * (s / c) - (one - kd) * scene.tan_half_alpha;
+        bracket = b.to_f64();
+    }
+    cd * scene.sc_half_alpha.c * bracket
+}
+
+/// Squared velocity at the top Θ = 0 in the steady rolling state:
+/// Θ̇_top² = A − B = 2B (K sin(Θf/2) + sin(Θ0/2)) (K sin(Θf/2) − sin(Θ0/2)) / (1 − K²)
+/// (eq 9 at Θ = 0 with eqs 19–20, factored so that no digits cancel).
+pub fn top_velocity_sq(scene: &Scene) -> f64 {
+    let p = lower_limit_factor(scene);
+    let q = scene.k * scene.sc_half_f.s - scene.sc_half_0.s;
+    2.0 * scene.b * p * q / scene.one_minus_k2()
+}
+
+/// Angle where a bead rolling up from Θ0 with squared speed `w0sq` stops (Θ̇ = 0), from
+/// sin²(Θ/2) = sin²(Θ0/2) − Θ̇0²/(2B) (eq 9).
+pub fn stop_angle(scene: &Scene, w0sq: f64) -> f64 {
+    let s0 = scene.sc_half_0.s;
+    let r = (s0 * s0 - w0sq / (2.0 * scene.b)).max(0.0).sqrt();
+    -2.0 * r.min(1.0).asin()
+}
+
+struct RollingState {
+    l2: f64,
+    w0sq: f64,
+    wtsq: f64,
+}
+
+fn rolling_state(scene: &Scene) -> Result<RollingState, NotSteady> {
+    if scene.k >= 1.0 {
+        return Err(NotSteady::Runaway);
+    }
+    let l2 = final_velocity_sq(scene);
+    let w0sq = scene.k * scene.k * l2;
+    let wtsq = top_velocity_sq(scene);
+    if scene.theta_0 < 0.0 && wtsq <= 0.0 || l2 == 0.0 {
+        return Err(NotSteady::Stops {
+            angle: stop_angle(scene, w0sq),
+        });
+    }
+    if scene.sc_f.c - l2 < 0.0 {
+        return Err(NotSteady::LiftOff {
+            angle: scene.theta_f,
+        });
+    }
+    Ok(RollingState { l2, w0sq, wtsq })
+}
+
+/// Steady pure rolling, exact: τ = ∫_{Θ0}^{Θf} dθ / sqrt(A − B cos θ) (eq 11) in Carlson's
+/// form (see [`cos_integral`]; equal to eqs 21–27 with MODEL.md's corrections), v̄ = 2 sin α / τ
+/// (eq 27).
+pub fn steady(scene: &Scene) -> Outcome {
+    let st = rolling_state(scene)?;
+    let tau = cos_integral(
+        scene.sc_half_0,
+        scene.sc_half_f,
+        st.w0sq,
+        st.l2,
+        st.wtsq,
+        scene.sin_delta_sin_alpha(),
+    );
+    if !(tau.is_finite() && tau > 0.0) {
+        return Err(NotSteady::Invalid {
+            reason: "rolling time not finite",
+        });
+    }
+    let l = st.l2.sqrt();
+    let mut s = Steady::basic(2.0 * scene.sin_alpha / tau, l, scene.k * l, tau);
+    s.top_velocity_sq = Some(st.wtsq);
+    s.map_slope = Some(scene.k * scene.k);
+    s.phases = Phases::Roll;
+    Ok(s)
+}
+
+/// Steady pure rolling with the paper's approximation F(Ω, k) ≈ asinh(tan Ω) (eqs 28–29):
+/// τ̃ = γ [asinh(tan Ω_f) − sgn(Θ0) asinh(tan Ω(|Θ0|))], γ = 2/sqrt(A+B),
+/// tan Ω(Θ) = sqrt(A+B) |sin(Θ/2)| / (Θ̇_top cos(Θ/2)) (eq 14 corrected). Needs A > B.
+pub fn steady_approx(scene: &Scene) -> Outcome {
+    let st = rolling_state(scene)?;
+    if st.wtsq <= 0.0 {
+        return Err(NotSteady::Invalid {
+            reason: "asinh approximation needs A > B (eq 28)",
+        });
+    }
+    let apb = st.wtsq + 2.0 * scene.b;
+    let root = apb.sqrt();
+    let wt = st.wtsq.sqrt();
+    let t = |h: crate::scene::SinCos| (root * h.s.abs() / (wt * h.c)).asinh();
+    let sgn0 = if scene.sc_half_0.s < 0.0 { 1.0 } else { -1.0 };
+    let tau = 2.0 / root * (t(scene.sc_half_f) + sgn0 * t(scene.sc_half_0));
+    if !(tau.is_finite() && tau > 0.0) {
+        return Err(NotSteady::Invalid {
+            reason: "approximate rolling time not positive",
+        });
+    }
+    let l = st.l2.sqrt();
+    let mut s = Steady::basic(2.0 * scene.sin_alpha / tau, l, scene.k * l, tau);
+    s.top_velocity_sq = Some(st.wtsq);
+    s.phases = Phases::Roll;
+    Ok(s)
+}
+
+/// Time to roll from Θa to Θb (Θa ≤ Θb, both on the row bead) starting with squared speed
+/// `wa_sq` at Θa; `None` if the bead stops before Θb. Used by the stick/slip model.
+pub fn rolling_time(b: f64, theta_a: f64, theta_b: f64, wa_sq: f64) -> Option<f64> {
+    use crate::special::SinCos;
+    let ha = SinCos::of(0.5 * theta_a);
+    let hb = SinCos::of(0.5 * theta_b);
+    // Θ̇² = Θ̇a² + B (cos Θa − cos θ) = Θ̇a² + 2B (sin²(θ/2) − sin²(Θa/2)).
+    let den = (0.5 * (theta_b + theta_a)).sin() * (0.5 * (theta_b - theta_a)).sin();
+    let wb_sq = wa_sq + 2.0 * b * den;
+    let wt_sq = wa_sq - 2.0 * b * ha.s * ha.s;
+    if wb_sq < 0.0 || (theta_a < 0.0 && theta_b > 0.0 && wt_sq <= 0.0) {
+        return None;
+    }
+    Some(cos_integral(ha, hb, wa_sq, wb_sq, wt_sq, den))
+}

@@ -1,0 +1,293 @@
+//! Stick/slip model (§4.4, eqs 64–68): after each collision the bead rolls from Θ0 until the
+//! friction demand reaches f at Θ_G (eq 36), then slips forward to Θf (eqs 66–67). The steady
+//! state is a fixed point of the final-velocity map, found by following the map from the
+//! rolling steady state (MODEL.md §3): the map is not smooth and need not have a unique fixed
+//! point, so every root is checked for continuity and stability, and a second fixed point is
+//! looked for where the map's asymptotic slope K e^{2fα} is near or above 1.
+
+use super::regimes::theta_g;
+use super::slip::{slip_time, SlipPhase};
+use super::stick;
+use super::{NotSteady, Outcome, Phases, Steady};
+use crate::scene::Scene;
+use crate::special::root::brent;
+
+/// Which phases one contact goes through under the stick/slip model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Branch {
+    /// Θ_G ≥ Θf: rolls over the whole contact.
+    NoSlip,
+    /// Θ0 < Θ_G < Θf: rolls, then slips.
+    RollSlip,
+    /// Θ_G ≤ Θ0: slips from the start.
+    SlipFromStart,
+}
+
+/// One application of the final-velocity map.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MapStep {
+    /// Final velocity on this bead.
+    pub final_velocity: f64,
+    /// Phases of this contact.
+    pub branch: Branch,
+    /// Θ_G of this contact (radians).
+    pub theta_g: f64,
+}
+
+/// The final-velocity map H: final velocity `x` on the previous bead → final velocity on this
+/// one (collision Θ̇0 = K x, rolling restarts, eqs 64–67).
+pub fn map(scene: &Scene, x: f64) -> Result<MapStep, NotSteady> {
+    let w0sq = scene.k * scene.k * x * x;
+    let b = scene.b;
+    let s0 = scene.sc_half_0.s;
+    let Some(tg) = theta_g(scene, w0sq) else {
+        return Err(NotSteady::LiftOff {
+            angle: scene.theta_0,
+        });
+    };
+    if scene.theta_0 < 0.0 && tg > 0.0 && w0sq - 2.0 * b * s0 * s0 <= 0.0 {
+        return Err(NotSteady::Stops {
+            angle: stick::stop_angle(scene, w0sq),
+        });
+    }
+    let (xf_sq, branch, phase) = if tg >= scene.theta_f {
+        (
+            w0sq + 2.0 * b * scene.sin_delta_sin_alpha(),
+            Branch::NoSlip,
+            None,
+        )
+    } else if tg <= scene.theta_0 {
+        let ph = SlipPhase::new(scene.theta_0, w0sq, scene.f);
+        (ph.speed_sq(scene.theta_f), Branch::SlipFromStart, Some(ph))
+    } else {
+        // Θ̇_G² = Θ̇0² + B (cos Θ0 − cos Θ_G) (eq 9), in product form.
+        let wg_sq = w0sq + 2.0 * b * (0.5 * (tg + scene.theta_0)).sin() * (0.5 * (tg - scene.theta_0)).sin();
+        let ph = SlipPhase::new(tg, wg_sq, scene.f);
+        (ph.speed_sq(scene.theta_f), Branch::RollSlip, Some(ph))
+    };
+    if let Some(ph) = phase {
+        // With strong friction the slip may decelerate the bead to a stop before Θf.
+        if ph.speed_sq_slope(ph.theta_s) < 0.0 {
+            check_slip_positive(&ph, scene.theta_f)?;
+        }
+    }
+    if !(xf_sq > 0.0) {
+        return Err(NotSteady::Stops {
+            angle: scene.theta_f,
+        });
+    }
+    if scene.sc_f.c - xf_sq < 0.0 {
+        return Err(NotSteady::LiftOff {
+            angle: scene.theta_f,
+        });
+    }
+    Ok(MapStep {
+        final_velocity: xf_sq.sqrt(),
+        branch,
+        theta_g: tg,
+    })
+}
+
+fn check_slip_positive(ph: &SlipPhase, end: f64) -> Result<(), NotSteady> {
+    let a = ph.theta_s;
+    let ga = ph.speed_sq_slope(a);
+    let gb = ph.speed_sq_slope(end);
+    let tm = if gb <= 0.0 {
+        end
+    } else {
+        brent(|t| ph.speed_sq_slope(t), a, end, ga, gb, 1e-15, 200)
+            .map(|r| r.x)
+            .unwrap_or(end)
+    };
+    let m = ph.speed_sq(tm);
+    if m > 0.0 {
+        Ok(())
+    } else {
+        let angle = brent(|t| ph.speed_sq(t), a, tm, ph.ws_sq, m, 1e-15, 200)
+            .map(|r| r.x)
+            .unwrap_or(a);
+        Err(NotSteady::Stops { angle })
+    }
+}
+
+/// g(x) = H(x) − x with the map's failures mapped to the side they belong to: a bead that
+/// stops is "slower than any fixed point", one that lifts off "faster".
+fn excess(scene: &Scene, x: f64) -> f64 {
+    match map(scene, x) {
+        Ok(m) => m.final_velocity - x,
+        Err(NotSteady::Stops { .. }) => -x.max(1e-300),
+        Err(_) => f64::INFINITY,
+    }
+}
+
+/// A continuous root of g in [a, b] (g(a), g(b) of opposite signs), or the jump it straddles.
+fn refine(scene: &Scene, a: f64, b: f64, ga: f64, gb: f64) -> Result<f64, NotSteady> {
+    let (lo, hi, glo, ghi) = if a < b { (a, b, ga, gb) } else { (b, a, gb, ga) };
+    let glo = glo.clamp(-1e300, 1e300);
+    let ghi = ghi.clamp(-1e300, 1e300);
+    let r = brent(|x| excess(scene, x).clamp(-1e300, 1e300), lo, hi, glo, ghi, 0.0, 200)
+        .ok_or(NotSteady::Invalid {
+            reason: "fixed-point bracket lost",
+        })?;
+    // A true fixed point has g → 0; a jump of the map leaves |g| finite at the "root".
+    if r.fx.abs() <= 1e-9 * r.x.max(1e-3) {
+        Ok(r.x)
+    } else {
+        Err(NotSteady::MapJump { at: r.x })
+    }
+}
+
+/// Fixed point of the final-velocity map reached from `x0` (the way a bead launched there
+/// evolves), with the bracket search accelerated by Aitken extrapolation.
+pub fn fixed_point_from(scene: &Scene, x0: f64) -> Result<f64, NotSteady> {
+    let x_hi = scene.sc_f.c.max(0.0).sqrt();
+    let mut x = x0;
+    let mut gx = excess(scene, x);
+    if gx == 0.0 {
+        return Ok(x);
+    }
+    let up = gx > 0.0;
+    for _ in 0..60 {
+        // Two plain steps of the map, then an Aitken estimate of the limit.
+        let x1 = x + gx;
+        let g1 = excess(scene, x1);
+        if (g1 > 0.0) != up || g1 == 0.0 {
+            return refine(scene, x, x1, gx, g1);
+        }
+        if !g1.is_finite() || x1 > x_hi {
+            return Err(map(scene, x1).err().unwrap_or(NotSteady::Runaway));
+        }
+        if x1 <= 0.0 {
+            return Err(map(scene, x1.max(1e-300)).err().unwrap_or(NotSteady::Stops {
+                angle: scene.theta_0,
+            }));
+        }
+        let x2 = x1 + g1;
+        let d2 = g1 - gx; // (x2 − x1) − (x1 − x)
+        let mut xe = if d2 != 0.0 && (up && d2 < 0.0 || !up && d2 > 0.0) {
+            x - gx * gx / d2
+        } else {
+            x2 + 2.0 * g1
+        };
+        if !(xe.is_finite()) || xe <= 0.0 {
+            xe = x2;
+        }
+        let ge = excess(scene, xe);
+        if (ge > 0.0) != up || ge == 0.0 {
+            // Bracket between the last same-side point and the estimate.
+            let g2 = excess(scene, x2);
+            if (g2 > 0.0) != up || g2 == 0.0 {
+                return refine(scene, x1, x2, g1, g2);
+            }
+            return refine(scene, x2, xe, g2, ge);
+        }
+        x = xe;
+        gx = ge;
+        if !gx.is_finite() || x > x_hi {
+            return Err(map(scene, x).err().unwrap_or(NotSteady::Runaway));
+        }
+    }
+    Err(NotSteady::Runaway)
+}
+
+fn slope_at(scene: &Scene, x: f64) -> Option<f64> {
+    let h = 1e-6 * x;
+    let a = map(scene, x - h).ok()?.final_velocity;
+    let b = map(scene, x + h).ok()?.final_velocity;
+    Some((b - a) / (2.0 * h))
+}
+
+/// Looks for another (continuous) fixed point above `x` up to lift-off.
+fn other_fixed_point(scene: &Scene, x: f64) -> Option<f64> {
+    let x_hi = scene.sc_f.c.max(0.0).sqrt();
+    if x_hi <= x {
+        return None;
+    }
+    let n = 64;
+    let mut a = x * (1.0 + 1e-6);
+    let mut ga = excess(scene, a);
+    for i in 1..=n {
+        let b = a + (x_hi - x) / n as f64 * if i == 1 { 1.0 - 1e-6 } else { 1.0 };
+        let gb = excess(scene, b);
+        if ga.is_finite() && gb.is_finite() && (ga > 0.0) != (gb > 0.0) {
+            if let Ok(r) = refine(scene, a, b, ga, gb) {
+                return Some(r);
+            }
+        }
+        a = b;
+        ga = gb;
+    }
+    None
+}
+
+/// Steady stick/slip state: mean velocity v̄'' = 2 sin α / τ'' (eq 68), τ'' = rolling time to
+/// Θ_G (eq 64, Carlson form) + slip time to Θf (eq 65, quadrature to 1e-14).
+pub fn steady(scene: &Scene) -> Outcome {
+    steady_tol(scene, 1e-14)
+}
+
+/// [`steady`] with a chosen quadrature tolerance for the slip phase.
+pub fn steady_tol(scene: &Scene, tol: f64) -> Outcome {
+    let x_hi = scene.sc_f.c.max(0.0).sqrt();
+    // Start from the rolling steady state when it exists.
+    let rolling = stick::steady(scene);
+    let x0 = match &rolling {
+        Ok(s) => {
+            let tg = theta_g(scene, s.initial_velocity * s.initial_velocity);
+            if let Some(tg) = tg {
+                if tg >= scene.theta_f {
+                    // No slip at the rolling steady state: it is the stick/slip fixed point,
+                    // and the two models agree exactly.
+                    let mut out = *s;
+                    out.theta_g = Some(tg);
+                    return Ok(out);
+                }
+            }
+            s.final_velocity
+        }
+        Err(_) => 0.5 * x_hi,
+    };
+    let xs = fixed_point_from(scene, x0.min(x_hi))?;
+    let step = map(scene, xs)?;
+    let slope = slope_at(scene, xs);
+    let asym = scene.k * (2.0 * scene.f * scene.alpha).exp();
+    let other = if asym >= 0.95 {
+        other_fixed_point(scene, xs)
+    } else {
+        None
+    };
+    let w0sq = scene.k * scene.k * xs * xs;
+    let tau = match step.branch {
+        Branch::NoSlip => stick::rolling_time(scene.b, scene.theta_0, scene.theta_f, w0sq),
+        Branch::SlipFromStart => {
+            SlipPhase::new(scene.theta_0, w0sq, scene.f).time_to(scene.theta_f, tol).ok()
+        }
+        Branch::RollSlip => {
+            let tg = step.theta_g;
+            let t1 = stick::rolling_time(scene.b, scene.theta_0, tg, w0sq);
+            let wg_sq = w0sq
+                + 2.0 * scene.b * (0.5 * (tg + scene.theta_0)).sin() * (0.5 * (tg - scene.theta_0)).sin();
+            let ph = SlipPhase::new(tg, wg_sq, scene.f);
+            let t2 = slip_time(&ph, tg, scene.theta_f, tol).ok();
+            t1.zip(t2).map(|(a, b)| a + b)
+        }
+    };
+    let Some(tau) = tau.filter(|t| t.is_finite() && *t > 0.0) else {
+        return Err(NotSteady::Invalid {
+            reason: "stick/slip contact time not finite",
+        });
+    };
+    let mut s = Steady::basic(2.0 * scene.sin_alpha / tau, xs, scene.k * xs, tau);
+    s.theta_g = Some(step.theta_g);
+    s.map_slope = slope;
+    s.other_fixed_point = other;
+    s.phases = match step.branch {
+        Branch::NoSlip => Phases::Roll,
+        Branch::RollSlip => Phases::RollSlip,
+        Branch::SlipFromStart => Phases::Slip,
+    };
+    if scene.theta_0 < 0.0 {
+        s.top_velocity_sq = Some(w0sq - 2.0 * scene.b * scene.sc_half_0.s * scene.sc_half_0.s);
+    }
+    Ok(s)
+}

@@ -1,0 +1,257 @@
+//! A scene: the mobile bead on the row (ξ, δ, ρ, f) and the collision law K; derived geometry.
+
+use crate::error::{Error, Result};
+use crate::special::dd::Dd;
+pub use crate::special::SinCos;
+use std::f64::consts::FRAC_PI_2;
+use std::fmt;
+use std::str::FromStr;
+
+/// The collisional parameter K (eq 1): a number, or a law K(α).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum CollisionLaw {
+    /// A fixed value of K.
+    Value(f64),
+    /// The smooth collision K = cos 2α (§3.4.2).
+    Cos2a,
+    /// The paper's fitted law K = cos 2α + ½ sin²α sin 2α (§3.6.1).
+    Adjusted,
+    /// No-slip impact conserving angular momentum about the new contact point:
+    /// K = (cos 2α + ρ)/(1 + ρ) (MODEL.md §4).
+    Impact,
+    /// K = cos 2α + c sin²α sin 2α with a free coefficient c (the form of §3.6.1).
+    C(f64),
+}
+
+impl CollisionLaw {
+    /// Evaluates K at the contact angle α (radians) and gyration parameter ρ.
+    pub fn k(&self, alpha: f64, rho: f64) -> f64 {
+        let c2 = (2.0 * alpha).cos();
+        let s = alpha.sin();
+        let s2 = (2.0 * alpha).sin();
+        match *self {
+            CollisionLaw::Value(k) => k,
+            CollisionLaw::Cos2a => c2,
+            CollisionLaw::Adjusted => c2 + 0.5 * s * s * s2,
+            CollisionLaw::Impact => (c2 + rho) / (1.0 + rho),
+            CollisionLaw::C(c) => c2 + c * s * s * s2,
+        }
+    }
+
+    /// True when the law is a plain number.
+    pub fn is_value(&self) -> bool {
+        matches!(self, CollisionLaw::Value(_))
+    }
+}
+
+impl FromStr for CollisionLaw {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        let t = s.trim();
+        match t.to_ascii_lowercase().as_str() {
+            "cos2a" => return Ok(CollisionLaw::Cos2a),
+            "adjusted" => return Ok(CollisionLaw::Adjusted),
+            "impact" => return Ok(CollisionLaw::Impact),
+            _ => {}
+        }
+        if let Some(rest) = t.strip_prefix("c=") {
+            return match rest.trim().parse::<f64>() {
+                Ok(c) if c.is_finite() => Ok(CollisionLaw::C(c)),
+                _ => Err(Error::UnknownLaw(t.to_string())),
+            };
+        }
+        match t.parse::<f64>() {
+            Ok(k) => Ok(CollisionLaw::Value(k)),
+            Err(_) => Err(Error::UnknownLaw(t.to_string())),
+        }
+    }
+}
+
+impl fmt::Display for CollisionLaw {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            CollisionLaw::Value(k) => write!(f, "{k}"),
+            CollisionLaw::Cos2a => write!(f, "cos2a"),
+            CollisionLaw::Adjusted => write!(f, "adjusted"),
+            CollisionLaw::Impact => write!(f, "impact"),
+            CollisionLaw::C(c) => write!(f, "c={c}"),
+        }
+    }
+}
+
+/// A validated scene with its derived geometry. Angles are in radians internally; every
+/// velocity is dimensionless (units sqrt(g (R + r)), MODEL.md §1).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Scene {
+    /// Radius ratio ξ = r/R of the mobile bead to the row beads.
+    pub xi: f64,
+    /// Slope δ of the row (radians).
+    pub delta: f64,
+    /// Gyration parameter ρ (moment of inertia m ρ r²): 2/5 sphere, 1/2 cylinder.
+    pub rho: f64,
+    /// Coulomb friction coefficient f at the contact.
+    pub f: f64,
+    /// The collision law as given.
+    pub law: CollisionLaw,
+    /// The collisional parameter K evaluated from the law (eq 1).
+    pub k: f64,
+    /// α = asin(1/(1+ξ)) (eq 2).
+    pub alpha: f64,
+    /// sin α.
+    pub sin_alpha: f64,
+    /// cos α.
+    pub cos_alpha: f64,
+    /// ε = (1+ξ)/ξ (eq 4).
+    pub eps: f64,
+    /// Θ0 = δ − α: angle just after the collision.
+    pub theta_0: f64,
+    /// Θf = δ + α: angle at the next collision.
+    pub theta_f: f64,
+    /// sin, cos of δ.
+    pub sc_delta: SinCos,
+    /// sin, cos of δ/2.
+    pub sc_half_delta: SinCos,
+    /// sin, cos of α/2.
+    pub sc_half_alpha: SinCos,
+    /// sin, cos of Θ0/2.
+    pub sc_half_0: SinCos,
+    /// sin, cos of Θf/2.
+    pub sc_half_f: SinCos,
+    /// sin, cos of Θ0.
+    pub sc_0: SinCos,
+    /// sin, cos of Θf.
+    pub sc_f: SinCos,
+    /// tan(α/2) = 1/(1 + ξ + sqrt(ξ(2+ξ))) in double-double precision (for the δ_m cancellation).
+    pub tan_half_alpha: Dd,
+    /// B = 2/(1+ρ) (eq 9).
+    pub b: f64,
+}
+
+fn check(field: &'static str, value: f64, ok: bool, reason: &'static str) -> Result<()> {
+    if value.is_finite() && ok {
+        Ok(())
+    } else {
+        Err(Error::InvalidParameter {
+            field,
+            value: value.to_string(),
+            reason,
+        })
+    }
+}
+
+impl Scene {
+    /// Builds a scene from δ in degrees (the unit of the command line and of the CSV files).
+    pub fn new(xi: f64, delta_deg: f64, rho: f64, f: f64, law: CollisionLaw) -> Result<Self> {
+        check(
+            "delta_deg",
+            delta_deg,
+            (0.0..90.0).contains(&delta_deg),
+            "slope must be in [0, 90) degrees",
+        )?;
+        Self::from_radians(xi, delta_deg.to_radians(), rho, f, law)
+    }
+
+    /// Builds a scene from δ in radians.
+    pub fn from_radians(xi: f64, delta: f64, rho: f64, f: f64, law: CollisionLaw) -> Result<Self> {
+        check("xi", xi, xi > 0.0, "radius ratio must be > 0")?;
+        check(
+            "delta",
+            delta,
+            (0.0..FRAC_PI_2).contains(&delta),
+            "slope must be in [0, 90) degrees",
+        )?;
+        check("rho", rho, rho >= 0.0, "gyration parameter must be >= 0")?;
+        check("f", f, f >= 0.0, "friction coefficient must be >= 0")?;
+        if let CollisionLaw::C(c) = law {
+            check("K", c, true, "law coefficient must be finite")?;
+        }
+        let alpha = (1.0 / (1.0 + xi)).asin();
+        let k = law.k(alpha, rho);
+        check("K", k, k > 0.0, "collisional parameter must be > 0")?;
+        let theta_0 = delta - alpha;
+        let theta_f = delta + alpha;
+        let sc_half_delta = SinCos::of(0.5 * delta);
+        let sc_half_alpha = SinCos::of(0.5 * alpha);
+        // Half angles of Θ0 and Θf by the addition formulas: no rounding of δ − α enters.
+        let (sd, cd, sa, ca) = (
+            sc_half_delta.s,
+            sc_half_delta.c,
+            sc_half_alpha.s,
+            sc_half_alpha.c,
+        );
+        let sc_half_0 = SinCos {
+            s: sd.mul_add(ca, -cd * sa),
+            c: cd.mul_add(ca, sd * sa),
+        };
+        let sc_half_f = SinCos {
+            s: sd.mul_add(ca, cd * sa),
+            c: cd.mul_add(ca, -sd * sa),
+        };
+        let sc_0 = SinCos {
+            s: 2.0 * sc_half_0.s * sc_half_0.c,
+            c: 1.0 - 2.0 * sc_half_0.s * sc_half_0.s,
+        };
+        let sc_f = SinCos {
+            s: 2.0 * sc_half_f.s * sc_half_f.c,
+            c: 1.0 - 2.0 * sc_half_f.s * sc_half_f.s,
+        };
+        // tan(α/2) = sin α / (1 + cos α) = 1 / (1 + ξ + sqrt(ξ (2 + ξ))).
+        let one_xi = Dd::from(1.0) + Dd::from(xi);
+        let root = (Dd::from(xi) * (Dd::from(2.0) + Dd::from(xi))).sqrt();
+        let tan_half_alpha = Dd::from(1.0) / (one_xi + root);
+        Ok(Scene {
+            xi,
+            delta,
+            rho,
+            f,
+            law,
+            k,
+            alpha,
+            sin_alpha: 1.0 / (1.0 + xi),
+            cos_alpha: alpha.cos(),
+            eps: (1.0 + xi) / xi,
+            theta_0,
+            theta_f,
+            sc_delta: SinCos::of(delta),
+            sc_half_delta,
+            sc_half_alpha,
+            sc_half_0,
+            sc_half_f,
+            sc_0,
+            sc_f,
+            tan_half_alpha,
+            b: 2.0 / (1.0 + rho),
+        })
+    }
+
+    /// The same scene with another collisional parameter K (a number).
+    pub fn with_k(&self, k: f64) -> Result<Self> {
+        check("K", k, k > 0.0, "collisional parameter must be > 0")?;
+        let mut s = *self;
+        s.k = k;
+        s.law = CollisionLaw::Value(k);
+        Ok(s)
+    }
+
+    /// The same scene at another slope δ (radians).
+    pub fn with_delta(&self, delta: f64) -> Result<Self> {
+        Self::from_radians(self.xi, delta, self.rho, self.f, self.law)
+    }
+
+    /// Slope in degrees.
+    pub fn delta_deg(&self) -> f64 {
+        self.delta.to_degrees()
+    }
+
+    /// 1 − K² computed as (1 − K)(1 + K), without cancellation near K = 1.
+    #[inline]
+    pub fn one_minus_k2(&self) -> f64 {
+        (1.0 - self.k) * (1.0 + self.k)
+    }
+
+    /// sin δ sin α = sin²(Θf/2) − sin²(Θ0/2), the denominator of the Carlson form.
+    #[inline]
+    pub fn sin_delta_sin_alpha(&self) -> f64 {
+        self.sc_delta.s * self.sin_alpha
+    }
+}

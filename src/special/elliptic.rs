@@ -1,0 +1,117 @@
+//! Elliptic integrals in Carlson's symmetric form, and the one integral every rolling phase
+//! needs: T = ∫ dψ / sqrt(A − B cos ψ), written so that no argument is formed by cancellation.
+//!
+//! Carlson's R_F comes from the `ellip` crate (a port of Boost.Math, ≤ 4.5e-16 relative on
+//! Boost's test data); `tests/reference_special.rs` holds it against mpmath near its log
+//! singularity, where the physics evaluates it.
+
+use super::SinCos;
+
+/// Carlson's symmetric integral R_F(x, y, z) = ½ ∫₀^∞ dt / sqrt((t+x)(t+y)(t+z)).
+/// Returns +∞ where at least two arguments are zero (the integral diverges) and NaN only for
+/// negative or NaN arguments (callers never pass them).
+#[inline]
+pub fn rf(x: f64, y: f64, z: f64) -> f64 {
+    let zeros = (x == 0.0) as u8 + (y == 0.0) as u8 + (z == 0.0) as u8;
+    if zeros >= 2 {
+        return f64::INFINITY;
+    }
+    ellip::elliprf(x, y, z).unwrap_or(f64::NAN)
+}
+
+/// Legendre's incomplete integral of the first kind F(φ, k) from sin φ, cos φ and the
+/// complementary parameter k'² = 1 − k² (which may be negative for k > 1), as
+/// F = sin φ · R_F(cos² φ, cos² φ + k'² sin² φ, 1). Passing cos φ and k'² computed without
+/// cancellation keeps full relative accuracy as k → 1 and φ → π/2.
+pub fn legendre_f(sc: SinCos, kc2: f64) -> f64 {
+    let (s, c) = (sc.s, sc.c);
+    if s == 0.0 {
+        return 0.0;
+    }
+    let c2 = c * c;
+    s * rf(c2, c2 + kc2 * s * s, 1.0)
+}
+
+/// Time T = ∫_{ψ0}^{ψ1} dψ / sqrt(A − B cos ψ) with B > 0, −π < ψ0 ≤ ψ1 < π, from:
+/// the half-angle sines and cosines `h0`, `h1`; the squared speeds at both ends
+/// `w0sq = A − B cos ψ0`, `w1sq = A − B cos ψ1`; the squared speed at the top
+/// `wtsq = A − B` (used only when ψ0 < 0 < ψ1, and then it must be > 0); and
+/// `den = sin²(ψ1/2) − sin²(ψ0/2) = sin((ψ1+ψ0)/2) sin((ψ1−ψ0)/2)` computed by the caller
+/// in product form.
+///
+/// With u = sin(ψ/2), v = u², the integral is ∫ dv / sqrt(v (1−v) (A − B + 2B v)), a cubic
+/// case of Carlson's reduction (DLMF 19.29.4–19.29.8): on one side of the top
+/// T = 2 R_F(U₁₂², U₁₃², U₂₃²), where every U is a sum of positive products of s, c and w, so
+/// no cancellation. Across the top the integral splits at ψ = 0 and each half is
+/// 2 |s| R_F(c² w_t², w², w_t²): the log singularity as w_t → 0 comes out of R_F with full
+/// relative accuracy in its tiny arguments. MODEL.md §2 form (eqs 12–15, corrected) is the
+/// same integral in Legendre's form; this one needs no sign cases beyond the top.
+pub fn cos_integral(h0: SinCos, h1: SinCos, w0sq: f64, w1sq: f64, wtsq: f64, den: f64) -> f64 {
+    if h1.s <= 0.0 {
+        // Both ends at or before the top: reflect ψ → −ψ.
+        if h0.s == h1.s {
+            return 0.0;
+        }
+        return same_side(h1.neg(), h0.neg(), w1sq, w0sq, -den);
+    }
+    if h0.s >= 0.0 {
+        return same_side(h0, h1, w0sq, w1sq, den);
+    }
+    // Across the top.
+    let wt2 = wtsq;
+    let half = |h: SinCos, wsq: f64| -> f64 { h.s.abs() * rf(h.c * h.c * wt2, wsq, wt2) };
+    2.0 * (half(h1, w1sq) + half(h0, w0sq))
+}
+
+#[inline]
+fn same_side(h0: SinCos, h1: SinCos, w0sq: f64, w1sq: f64, den: f64) -> f64 {
+    if den <= 0.0 {
+        return 0.0;
+    }
+    let w0 = w0sq.max(0.0).sqrt();
+    let w1 = w1sq.max(0.0).sqrt();
+    let u12 = (h1.s * h1.c * w0 + h0.s * h0.c * w1) / den;
+    let u13 = (h1.s * h0.c * w1 + h0.s * h1.c * w0) / den;
+    let u23 = (h0.s * h1.c * w1 + h1.s * h0.c * w0) / den;
+    2.0 * rf(u12 * u12, u13 * u13, u23 * u23)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::special::quad::{integrate, QuadOptions};
+
+    fn by_quadrature(a: f64, b: f64, p0: f64, p1: f64) -> f64 {
+        let f = |x: f64| 1.0 / (a - b * x.cos()).sqrt();
+        let opts = QuadOptions {
+            rel_tol: 1e-15,
+            ..Default::default()
+        };
+        if p0 < 0.0 && p1 > 0.0 {
+            integrate(f, p0, 0.0, opts).value + integrate(f, 0.0, p1, opts).value
+        } else {
+            integrate(f, p0, p1, opts).value
+        }
+    }
+
+    #[test]
+    fn cos_integral_matches_quadrature_on_both_sides_and_across_the_top() {
+        // Independent check: adaptive Gauss–Kronrod on the defining integral.
+        for &(a, b, p0, p1) in &[
+            (1.5, 1.0, -0.3, 0.8),
+            (1.5, 1.0, 0.2, 0.8),
+            (1.5, 1.0, -0.9, -0.1),
+            (0.9, 1.0, 0.5, 1.2), // A < B: only reachable on one side
+            (3.0, 1.4, -1.0, 0.0),
+            (3.0, 1.4, 0.0, 1.0),
+        ] {
+            let h0 = SinCos::of(0.5 * p0);
+            let h1 = SinCos::of(0.5 * p1);
+            let w = |p: f64| a - b * p.cos();
+            let den = (0.5 * (p1 + p0)).sin() * (0.5 * (p1 - p0)).sin();
+            let t = cos_integral(h0, h1, w(p0), w(p1), a - b, den);
+            let q = by_quadrature(a, b, p0, p1);
+            assert!((t - q).abs() <= 1e-14 * q, "{a} {b} {p0} {p1}: {t} vs {q}");
+        }
+    }
+}

@@ -1,0 +1,121 @@
+//! Bracketed one-dimensional root finding (Brent 1973, the `zeroin` algorithm).
+//!
+//! Written by hand rather than through argmin's `BrentRoot`: it is called inside every
+//! stick/slip evaluation, where the executor's state and observer machinery would cost more
+//! than the map it solves; this version allocates nothing and reports its iteration count.
+
+/// A root with the bracket it came from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Root {
+    /// The root.
+    pub x: f64,
+    /// f at the root.
+    pub fx: f64,
+    /// Function evaluations used.
+    pub evals: usize,
+}
+
+/// Finds x in [a, b] with f(x) = 0, given f(a) and f(b) of opposite signs (or zero), to an
+/// absolute tolerance `xtol` plus 2 ulp. Returns `None` when the bracket is not a bracket or a
+/// value is NaN.
+pub fn brent<F: FnMut(f64) -> f64>(
+    mut f: F,
+    a: f64,
+    b: f64,
+    fa: f64,
+    fb: f64,
+    xtol: f64,
+    max_evals: usize,
+) -> Option<Root> {
+    let (mut a, mut b, mut fa, mut fb) = (a, b, fa, fb);
+    if fa.is_nan() || fb.is_nan() || fa * fb > 0.0 {
+        return None;
+    }
+    if fa == 0.0 {
+        return Some(Root { x: a, fx: fa, evals: 0 });
+    }
+    if fb == 0.0 {
+        return Some(Root { x: b, fx: fb, evals: 0 });
+    }
+    let mut c = a;
+    let mut fc = fa;
+    let mut d = b - a;
+    let mut e = d;
+    let mut evals = 0;
+    loop {
+        if fb.signum() == fc.signum() {
+            c = a;
+            fc = fa;
+            d = b - a;
+            e = d;
+        }
+        if fc.abs() < fb.abs() {
+            a = b;
+            b = c;
+            c = a;
+            fa = fb;
+            fb = fc;
+            fc = fa;
+        }
+        let tol = 2.0 * f64::EPSILON * b.abs() + 0.5 * xtol;
+        let m = 0.5 * (c - b);
+        if m.abs() <= tol || fb == 0.0 || evals >= max_evals {
+            return Some(Root { x: b, fx: fb, evals });
+        }
+        if e.abs() >= tol && fa.abs() > fb.abs() {
+            let s = fb / fa;
+            let (mut p, mut q);
+            if a == c {
+                p = 2.0 * m * s;
+                q = 1.0 - s;
+            } else {
+                let qq = fa / fc;
+                let r = fb / fc;
+                p = s * (2.0 * m * qq * (qq - r) - (b - a) * (r - 1.0));
+                q = (qq - 1.0) * (r - 1.0) * (s - 1.0);
+            }
+            if p > 0.0 {
+                q = -q;
+            } else {
+                p = -p;
+            }
+            if 2.0 * p < (3.0 * m * q - (tol * q).abs()).min((e * q).abs()) {
+                e = d;
+                d = p / q;
+            } else {
+                d = m;
+                e = m;
+            }
+        } else {
+            d = m;
+            e = m;
+        }
+        a = b;
+        fa = fb;
+        b += if d.abs() > tol { d } else { tol.copysign(m) };
+        fb = f(b);
+        evals += 1;
+        if fb.is_nan() {
+            return None;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn finds_cube_root_of_two_to_full_precision() {
+        let f = |x: f64| x * x * x - 2.0;
+        let r = brent(f, 0.0, 2.0, f(0.0), f(2.0), 0.0, 200).unwrap();
+        assert!((r.x - 2f64.cbrt()).abs() <= 4.0 * f64::EPSILON, "{r:?}");
+        assert!(r.evals < 20);
+    }
+
+    #[test]
+    fn refuses_a_non_bracket() {
+        let f = |x: f64| x * x + 1.0;
+        assert!(brent(f, -1.0, 1.0, f(-1.0), f(1.0), 0.0, 100).is_none());
+    }
+}

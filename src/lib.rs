@@ -24,3 +24,5 @@ pub mod special;
 pub use error::{Error, Result};
 pub use models::{ForwardModel, Model, ModelKind, NotSteady, Outcome, Regime, Steady};
 pub use scene::{CollisionLaw, Scene};
+pub mod cli;
+pub mod io;

@@ -1056,21 +1056,24 @@ def derived_rows(log):
 
 def rf_quad(x, y, z):
     """R_F by quadrature, t = e^s: 1/2 int e^s ds / sqrt((e^s+x)(e^s+y)(e^s+z))."""
+    # scale invariance R_F(lx,ly,lz) = R_F(x,y,z)/sqrt(l): quad's tolerance is absolute
     x, y, z = mpf(x), mpf(y), mpf(z)
+    lam = max(x, y, z)
+    x, y, z = x / lam, y / lam, z / lam
     f = lambda s: mpmath.exp(s) / sqrt((mpmath.exp(s) + x) * (mpmath.exp(s) + y) * (mpmath.exp(s) + z)) / 2
     logs = [mpmath.log(v) for v in (x, y, z) if v > 0]
     pts = set()
     for L in logs:
-        for k in range(-12, 13, 2):
+        for k in range(-8, 9, 4):
             pts.add(L + k)
     pts = sorted(pts)
     filled = [pts[0]]
     for p in pts[1:]:
-        while p - filled[-1] > 6:
-            filled.append(filled[-1] + 4)
+        while p - filled[-1] > 10:
+            filled.append(filled[-1] + 8)
         filled.append(p)
     pts = [-mpmath.inf] + filled + [mpmath.inf]
-    return mpmath.quad(f, pts, maxdegree=12)
+    return mpmath.quad(f, pts, maxdegree=12) / sqrt(lam)
 
 
 def F_quad(phi, m):
@@ -1079,10 +1082,12 @@ def F_quad(phi, m):
     if phi == 0:
         return mpf(0)
     one_m = 1 - m   # exact at this precision (m is a double)
+    if one_m == 0:
+        return mpmath.asinh(mpmath.tan(phi))   # F(phi|1) = gd^-1(phi), closed form
     if m <= 0 or one_m > mpf('0.25') or phi < 1:
         # theta = phi t, t in [0,1] (scale free, also for tiny phi)
-        f = lambda t: phi / sqrt(1 - m * mpmath.sin(phi * t) ** 2)
-        return mpmath.quad(f, [0, 1], maxdegree=12)
+        f = lambda t: 1 / sqrt(1 - m * mpmath.sin(phi * t) ** 2)
+        return phi * mpmath.quad(f, [0, 1], maxdegree=12)
     # theta = pi/2 - s; 1 - m sin^2 = cos^2 theta + (1-m) sin^2 theta = sin^2 s + (1-m) cos^2 s
     w = sqrt(one_m) if one_m > 0 else mpf(10) ** (-mp.dps)
     hp = mpmath.pi / 2
@@ -1136,6 +1141,7 @@ def elliptic_rows(log):
     phis += [math.pi / 2 - 10.0 ** (-j) for j in range(1, 17)]
     ms = [0.0, 1e-16, 0.1, 0.5, 0.9, -1.0, -10.0, 1.0]
     ms += [1.0 - 10.0 ** (-k) for k in range(1, 17)]
+    phis = sorted(set(phis))
     for phi in phis:
         for m in ms:
             if m == 1.0 and phi >= math.pi / 2:

@@ -1,0 +1,134 @@
+//! The command line: one module per subcommand. Errors are rendered here, once.
+
+pub mod forward;
+pub mod regimes;
+pub mod simulate;
+
+use crate::io::{write_atomic, InputError};
+use clap::{Parser, Subcommand};
+use std::path::Path;
+
+/// The shipped default data set (synthetic; provenance in data/README.md).
+pub const DEFAULT_DATA: &str = include_str!("../../data/default.csv");
+/// Name used for the default data set in messages.
+pub const DEFAULT_DATA_NAME: &str = "<embedded default data: data/default.csv>";
+
+/// fitbead: a bead rolling down a row of beads (Ancey, Evesque & Coussot 1996) — forward
+/// models, regime limits and synthetic data. Velocities are dimensionless (units
+/// sqrt(g (R + r))), slopes in degrees.
+#[derive(Debug, Parser)]
+#[command(name = "fitbead", version, about, long_about = None)]
+pub struct Cli {
+    /// The subcommand.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// Subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Mean velocity, regime and diagnostics of scenes under one forward model.
+    Forward(forward::Args),
+    /// Regime limits δ_m (eq 32) and δ_d (eq 31) per ξ, and the critical ξ, for a law.
+    Regimes(regimes::Args),
+    /// Synthetic measurements inside regime B, reproducible from a seed.
+    Simulate(simulate::Args),
+}
+
+/// Why a command failed: bad input (exit 2) or an I/O failure (exit 2 as well: nothing was
+/// written).
+#[derive(Debug)]
+pub enum CliError {
+    /// Bad input, located.
+    Input(InputError),
+    /// Any other failure, with a message.
+    Other(String),
+}
+
+impl From<InputError> for CliError {
+    fn from(e: InputError) -> Self {
+        CliError::Input(e)
+    }
+}
+
+impl std::fmt::Display for CliError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            CliError::Input(e) => write!(f, "{e}"),
+            CliError::Other(s) => f.write_str(s),
+        }
+    }
+}
+
+/// Runs the parsed command line; returns the process exit code.
+pub fn run(cli: Cli) -> i32 {
+    let r = match cli.command {
+        Command::Forward(a) => forward::run(a),
+        Command::Regimes(a) => regimes::run(a),
+        Command::Simulate(a) => simulate::run(a),
+    };
+    match r {
+        Ok(()) => 0,
+        Err(e) => {
+            eprintln!("fitbead: error: {e}");
+            2
+        }
+    }
+}
+
+/// Reads an input file (or the embedded default data when `path` is `None`).
+pub fn read_input(path: Option<&Path>) -> Result<(String, Vec<u8>), CliError> {
+    match path {
+        None => Ok((DEFAULT_DATA_NAME.to_string(), DEFAULT_DATA.as_bytes().to_vec())),
+        Some(p) => {
+            let name = p.display().to_string();
+            std::fs::read(p)
+                .map(|b| (name.clone(), b))
+                .map_err(|e| CliError::Input(InputError::file(&name, format!("cannot read: {e}"))))
+        }
+    }
+}
+
+/// Writes output bytes to a file atomically, or to stdout.
+pub fn emit(output: Option<&Path>, bytes: &[u8]) -> Result<(), CliError> {
+    match output {
+        Some(p) => write_atomic(p, bytes)
+            .map_err(|e| CliError::Other(format!("{}: cannot write: {e}", p.display()))),
+        None => {
+            use std::io::Write;
+            let mut out = std::io::stdout().lock();
+            out.write_all(bytes)
+                .and_then(|_| out.flush())
+                .map_err(|e| CliError::Other(format!("<stdout>: {e}")))
+        }
+    }
+}
+
+/// Parses a comma-separated list of numbers given on the command line.
+pub fn parse_list(flag: &str, s: &str) -> Result<Vec<f64>, CliError> {
+    s.split(',')
+        .map(|t| {
+            let t = t.trim();
+            t.parse::<f64>().ok().filter(|v| v.is_finite()).ok_or_else(|| {
+                CliError::Input(InputError {
+                    file: "<command line>".into(),
+                    line: None,
+                    column: Some(flag.to_string()),
+                    value: Some(t.to_string()),
+                    message: "not a finite number".into(),
+                })
+            })
+        })
+        .collect()
+}
+
+/// An error about a command-line flag value.
+pub fn flag_error(flag: &str, value: &str, message: impl Into<String>) -> CliError {
+    CliError::Input(InputError {
+        file: "<command line>".into(),
+        line: None,
+        column: Some(flag.to_string()),
+        value: Some(value.to_string()),
+        message: message.into(),
+    })
+}

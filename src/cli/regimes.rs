@@ -1,0 +1,67 @@
+//! `fitbead regimes`: δ_m (eq 32) and δ_d (eq 31) per ξ, the bulk friction μ (eq 79) and the
+//! critical ξ below which no steady regime exists.
+
+use super::{emit, CliError};
+use crate::io::fmt_f64;
+use crate::models::regimes::{alpha_of_xi, bulk_friction, critical_xi, delta_d, delta_m};
+use crate::scene::CollisionLaw;
+use std::path::PathBuf;
+
+/// Arguments of `fitbead regimes`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Collision law: a number, cos2a, adjusted, impact or c=VALUE.
+    #[arg(long, default_value = "adjusted")]
+    pub law: String,
+    /// Gyration parameter ρ.
+    #[arg(long, default_value_t = 0.4)]
+    pub rho: f64,
+    /// Radius ratios ξ (comma-separated, or the flag repeated).
+    #[arg(long, value_delimiter = ',', default_values_t = vec![0.8, 1.0, 1.6, 2.0])]
+    pub xi: Vec<f64>,
+    /// Output CSV (written atomically); stdout when absent.
+    #[arg(long)]
+    pub output: Option<PathBuf>,
+}
+
+/// Runs `fitbead regimes`.
+pub fn run(a: Args) -> Result<(), CliError> {
+    let law: CollisionLaw = a
+        .law
+        .parse()
+        .map_err(|e: crate::Error| super::flag_error("--law", &a.law, e.to_string()))?;
+    if !(a.rho.is_finite() && a.rho >= 0.0) {
+        return Err(super::flag_error("--rho", &a.rho.to_string(), "must be >= 0"));
+    }
+    let xc = critical_xi(law, a.rho);
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let io = |e: csv::Error| CliError::Other(e.to_string());
+    w.write_record([
+        "xi", "alpha_deg", "K", "delta_m_deg", "delta_d_deg", "mu_eq79", "steady_range", "critical_xi",
+    ])
+    .map_err(io)?;
+    for &xi in &a.xi {
+        if !(xi.is_finite() && xi > 0.0) {
+            return Err(super::flag_error("--xi", &xi.to_string(), "radius ratio must be > 0"));
+        }
+        let al = alpha_of_xi(xi);
+        let k = law.k(al, a.rho);
+        if !(k.is_finite() && k > 0.0) {
+            return Err(super::flag_error("--law", &a.law, format!("K = {k} at xi = {xi}: must be > 0")));
+        }
+        let (dm, dd) = (delta_m(al, k), delta_d(al, k, a.rho));
+        w.write_record([
+            fmt_f64(xi),
+            fmt_f64(al.to_degrees()),
+            fmt_f64(k),
+            fmt_f64(dm.to_degrees()),
+            fmt_f64(dd.to_degrees()),
+            fmt_f64(bulk_friction(al, k)),
+            (if dm < dd { "yes" } else { "no" }).to_string(),
+            xc.map(fmt_f64).unwrap_or_default(),
+        ])
+        .map_err(io)?;
+    }
+    let bytes = w.into_inner().map_err(|e| CliError::Other(e.to_string()))?;
+    emit(a.output.as_deref(), &bytes)
+}

@@ -16,6 +16,9 @@
 //! assert!((v - 0.39120827).abs() < 1e-8); // MODEL.md §2
 //! ```
 
+// `!(x > 0.0)` is deliberate throughout: a NaN must land in the failure branch.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod error;
 pub mod models;
 pub mod scene;

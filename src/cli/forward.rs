@@ -108,10 +108,13 @@ fn scene_error(t: &Table, row: usize, e: Error, cols: &[(&str, Option<usize>)]) 
 
 /// Runs `fitbead forward`.
 pub fn run(a: Args) -> Result<(), CliError> {
-    let kind: ModelKind = a
-        .model
-        .parse()
-        .map_err(|_| super::flag_error("--model", &a.model, format!("unknown model; expected one of {}", Model::NAMES.join(", "))))?;
+    let kind: ModelKind = a.model.parse().map_err(|_| {
+        super::flag_error(
+            "--model",
+            &a.model,
+            format!("unknown model; expected one of {}", Model::NAMES.join(", ")),
+        )
+    })?;
     let branch = match a.branch.as_str() {
         "upper" => JaegerBranch::Upper,
         "lower" => JaegerBranch::Lower,
@@ -123,7 +126,11 @@ pub fn run(a: Args) -> Result<(), CliError> {
             format!("xi,delta_deg\n{},{}\n", fmt_f64(xi), fmt_f64(d)).into_bytes(),
         )
     } else if a.xi.is_some() || a.delta_deg.is_some() {
-        return Err(super::flag_error("--xi/--delta-deg", "", "a single scene needs both --xi and --delta-deg"));
+        return Err(super::flag_error(
+            "--xi/--delta-deg",
+            "",
+            "a single scene needs both --xi and --delta-deg",
+        ));
     } else {
         read_input(a.input.as_deref())?
     };
@@ -136,10 +143,9 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let c_lambda = t.col("lambda");
     let c_mu = t.col("mu");
     let c_a = [t.col("a1"), t.col("a2"), t.col("a3")];
-    let flag_law: CollisionLaw = a
-        .k
-        .parse()
-        .map_err(|e: Error| super::flag_error("--K", &a.k, e.to_string()))?;
+    let flag_law: CollisionLaw =
+        a.k.parse()
+            .map_err(|e: Error| super::flag_error("--K", &a.k, e.to_string()))?;
     let cols = [
         ("xi", Some(c_xi)),
         ("delta_deg", Some(c_d)),
@@ -179,7 +185,10 @@ pub fn run(a: Args) -> Result<(), CliError> {
             ModelKind::StickSlip => Model::StickSlip,
             ModelKind::Jan => {
                 let paper = Jan::paper_fit(scene.alpha);
-                let lambda = t.opt_number(r, c_lambda)?.or(a.lambda).unwrap_or(paper.lambda);
+                let lambda = t
+                    .opt_number(r, c_lambda)?
+                    .or(a.lambda)
+                    .unwrap_or(paper.lambda);
                 let mu = t.opt_number(r, c_mu)?.or(a.mu).unwrap_or(paper.mu);
                 Model::Jan(Jan::new(lambda, mu).map_err(|e| scene_error(&t, r, e, &cols))?)
             }
@@ -199,13 +208,17 @@ pub fn run(a: Args) -> Result<(), CliError> {
                     };
                 }
                 Model::Jaeger(
-                    Jaeger::new(v[0], v[1], v[2], branch).map_err(|e| scene_error(&t, r, e, &cols))?,
+                    Jaeger::new(v[0], v[1], v[2], branch)
+                        .map_err(|e| scene_error(&t, r, e, &cols))?,
                 )
             }
         };
         jobs.push(Job { scene, model });
     }
-    let outcomes: Vec<Outcome> = jobs.par_iter().map(|j| j.model.evaluate(&j.scene)).collect();
+    let outcomes: Vec<Outcome> = jobs
+        .par_iter()
+        .map(|j| j.model.evaluate(&j.scene))
+        .collect();
     let bytes = render(&t, &jobs, &outcomes, kind).map_err(|e| CliError::Other(e.to_string()))?;
     emit(a.output.as_deref(), &bytes)
 }
@@ -235,7 +248,11 @@ fn render(t: &Table, jobs: &[Job], outcomes: &[Outcome], kind: ModelKind) -> csv
                 out.push(fmt_f64(s.mean_velocity));
                 out.push(regime);
                 out.push("ok".into());
-                out.push(if contact { fmt_f64(job.scene.k) } else { String::new() });
+                out.push(if contact {
+                    fmt_f64(job.scene.k)
+                } else {
+                    String::new()
+                });
                 if contact {
                     out.push(fmt_f64(s.final_velocity));
                     out.push(fmt_f64(s.initial_velocity));
@@ -262,7 +279,11 @@ fn render(t: &Table, jobs: &[Job], outcomes: &[Outcome], kind: ModelKind) -> csv
                 out.push(String::new());
                 out.push(regime);
                 out.push(e.status().into());
-                out.push(if contact { fmt_f64(job.scene.k) } else { String::new() });
+                out.push(if contact {
+                    fmt_f64(job.scene.k)
+                } else {
+                    String::new()
+                });
                 for _ in 0..7 {
                     out.push(String::new());
                 }

@@ -79,7 +79,10 @@ pub fn run(cli: Cli) -> i32 {
 /// Reads an input file (or the embedded default data when `path` is `None`).
 pub fn read_input(path: Option<&Path>) -> Result<(String, Vec<u8>), CliError> {
     match path {
-        None => Ok((DEFAULT_DATA_NAME.to_string(), DEFAULT_DATA.as_bytes().to_vec())),
+        None => Ok((
+            DEFAULT_DATA_NAME.to_string(),
+            DEFAULT_DATA.as_bytes().to_vec(),
+        )),
         Some(p) => {
             let name = p.display().to_string();
             std::fs::read(p)
@@ -109,15 +112,18 @@ pub fn parse_list(flag: &str, s: &str) -> Result<Vec<f64>, CliError> {
     s.split(',')
         .map(|t| {
             let t = t.trim();
-            t.parse::<f64>().ok().filter(|v| v.is_finite()).ok_or_else(|| {
-                CliError::Input(InputError {
-                    file: "<command line>".into(),
-                    line: None,
-                    column: Some(flag.to_string()),
-                    value: Some(t.to_string()),
-                    message: "not a finite number".into(),
+            t.parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| {
+                    CliError::Input(InputError {
+                        file: "<command line>".into(),
+                        line: None,
+                        column: Some(flag.to_string()),
+                        value: Some(t.to_string()),
+                        message: "not a finite number".into(),
+                    })
                 })
-            })
         })
         .collect()
 }

@@ -31,23 +31,42 @@ pub fn run(a: Args) -> Result<(), CliError> {
         .parse()
         .map_err(|e: crate::Error| super::flag_error("--law", &a.law, e.to_string()))?;
     if !(a.rho.is_finite() && a.rho >= 0.0) {
-        return Err(super::flag_error("--rho", &a.rho.to_string(), "must be >= 0"));
+        return Err(super::flag_error(
+            "--rho",
+            &a.rho.to_string(),
+            "must be >= 0",
+        ));
     }
     let xc = critical_xi(law, a.rho);
     let mut w = csv::Writer::from_writer(Vec::new());
     let io = |e: csv::Error| CliError::Other(e.to_string());
     w.write_record([
-        "xi", "alpha_deg", "K", "delta_m_deg", "delta_d_deg", "mu_eq79", "steady_range", "critical_xi",
+        "xi",
+        "alpha_deg",
+        "K",
+        "delta_m_deg",
+        "delta_d_deg",
+        "mu_eq79",
+        "steady_range",
+        "critical_xi",
     ])
     .map_err(io)?;
     for &xi in &a.xi {
         if !(xi.is_finite() && xi > 0.0) {
-            return Err(super::flag_error("--xi", &xi.to_string(), "radius ratio must be > 0"));
+            return Err(super::flag_error(
+                "--xi",
+                &xi.to_string(),
+                "radius ratio must be > 0",
+            ));
         }
         let al = alpha_of_xi(xi);
         let k = law.k(al, a.rho);
         if !(k.is_finite() && k > 0.0) {
-            return Err(super::flag_error("--law", &a.law, format!("K = {k} at xi = {xi}: must be > 0")));
+            return Err(super::flag_error(
+                "--law",
+                &a.law,
+                format!("K = {k} at xi = {xi}: must be > 0"),
+            ));
         }
         let (dm, dd) = (delta_m(al, k), delta_d(al, k, a.rho));
         w.write_record([

@@ -46,7 +46,13 @@ pub struct Args {
 
 /// The slopes (radians) where `model` has a steady state at this ξ: the longest run of a
 /// 2000-point scan of (0°, 89°), its ends refined by bisection to 1e-12 rad.
-pub fn regime_b_interval(model: &Model, xi: f64, rho: f64, f: f64, law: CollisionLaw) -> Option<(f64, f64)> {
+pub fn regime_b_interval(
+    model: &Model,
+    xi: f64,
+    rho: f64,
+    f: f64,
+    law: CollisionLaw,
+) -> Option<(f64, f64)> {
     let ok = |d: f64| {
         Scene::from_radians(xi, d, rho, f, law)
             .map(|s| model.evaluate(&s).is_ok())
@@ -87,8 +93,16 @@ pub fn regime_b_interval(model: &Model, xi: f64, rho: f64, f: f64, law: Collisio
         }
         good
     };
-    let lo = if best.0 == 0 { grid[0] } else { bisect(grid[best.0], grid[best.0 - 1]) };
-    let hi = if best.1 >= grid.len() { grid[grid.len() - 1] } else { bisect(grid[best.1 - 1], grid[best.1]) };
+    let lo = if best.0 == 0 {
+        grid[0]
+    } else {
+        bisect(grid[best.0], grid[best.0 - 1])
+    };
+    let hi = if best.1 >= grid.len() {
+        grid[grid.len() - 1]
+    } else {
+        bisect(grid[best.1 - 1], grid[best.1])
+    };
     Some((lo, hi))
 }
 
@@ -104,17 +118,27 @@ pub fn run(a: Args) -> Result<(), CliError> {
         .map_err(|e: crate::Error| super::flag_error("--law", &a.law, e.to_string()))?;
     let series = parse_list("--series", &a.series)?;
     if a.points == 0 {
-        return Err(super::flag_error("--points", "0", "need at least one point per series"));
+        return Err(super::flag_error(
+            "--points",
+            "0",
+            "need at least one point per series",
+        ));
     }
     if !(a.noise.is_finite() && (0.0..0.5).contains(&a.noise)) {
-        return Err(super::flag_error("--noise", &a.noise.to_string(), "must be in [0, 0.5)"));
+        return Err(super::flag_error(
+            "--noise",
+            &a.noise.to_string(),
+            "must be in [0, 0.5)",
+        ));
     }
     let mut rng = ChaCha8Rng::seed_from_u64(a.seed);
     let mut w = csv::Writer::from_writer(Vec::new());
     let io = |e: csv::Error| CliError::Other(e.to_string());
-    w.write_record(["series", "xi", "delta_deg", "v", "sigma_v", "v_true"]).map_err(io)?;
+    w.write_record(["series", "xi", "delta_deg", "v", "sigma_v", "v_true"])
+        .map_err(io)?;
     for &xi in &series {
-        Scene::from_radians(xi, 0.1, a.rho, a.f, law).map_err(|e| super::flag_error("--series", &xi.to_string(), e.to_string()))?;
+        Scene::from_radians(xi, 0.1, a.rho, a.f, law)
+            .map_err(|e| super::flag_error("--series", &xi.to_string(), e.to_string()))?;
         let alpha = (1.0 / (1.0 + xi)).asin();
         let model = match kind {
             ModelKind::Stick => Model::Stick,
@@ -124,18 +148,31 @@ pub fn run(a: Args) -> Result<(), CliError> {
             ModelKind::StickSlip => Model::StickSlip,
             ModelKind::Jan => Model::Jan(Jan::paper_fit(alpha)),
             ModelKind::Jaeger => {
-                return Err(super::flag_error("--model", "jaeger", "simulate does not support jaeger"))
+                return Err(super::flag_error(
+                    "--model",
+                    "jaeger",
+                    "simulate does not support jaeger",
+                ))
             }
         };
         let Some((lo, hi)) = regime_b_interval(&model, xi, a.rho, a.f, law) else {
-            return Err(super::flag_error("--series", &xi.to_string(), "no steady regime for this xi under this model and law"));
+            return Err(super::flag_error(
+                "--series",
+                &xi.to_string(),
+                "no steady regime for this xi under this model and law",
+            ));
         };
         for j in 0..a.points {
-            let frac = if a.points == 1 { 0.5 } else { 0.05 + 0.9 * j as f64 / (a.points - 1) as f64 };
+            let frac = if a.points == 1 {
+                0.5
+            } else {
+                0.05 + 0.9 * j as f64 / (a.points - 1) as f64
+            };
             let d = lo + (hi - lo) * frac;
             // Round the slope to 1e-4 degree, as a measured slope would be written.
             let d_deg = (d.to_degrees() * 1e4).round() / 1e4;
-            let scene = Scene::new(xi, d_deg, a.rho, a.f, law).map_err(|e| CliError::Other(e.to_string()))?;
+            let scene = Scene::new(xi, d_deg, a.rho, a.f, law)
+                .map_err(|e| CliError::Other(e.to_string()))?;
             let v_true = match model.evaluate(&scene) {
                 Ok(s) => s.mean_velocity,
                 Err(e) => return Err(CliError::Other(format!("xi {xi}, delta {d_deg} deg: {e}"))),

@@ -34,7 +34,13 @@ impl InputError {
     }
 
     /// An error about one cell.
-    pub fn cell(file: &str, line: u64, column: &str, value: &str, message: impl Into<String>) -> Self {
+    pub fn cell(
+        file: &str,
+        line: u64,
+        column: &str,
+        value: &str,
+        message: impl Into<String>,
+    ) -> Self {
         InputError {
             file: file.to_string(),
             line: Some(line),

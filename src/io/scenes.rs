@@ -22,7 +22,10 @@ impl Table {
     /// Parses CSV text. Fails on an empty input, a ragged row or a header without rows.
     pub fn parse(source: &str, text: &[u8]) -> Result<Table, InputError> {
         if text.iter().all(|b| b.is_ascii_whitespace()) {
-            return Err(InputError::file(source, "file is empty: expected a header line"));
+            return Err(InputError::file(
+                source,
+                "file is empty: expected a header line",
+            ));
         }
         let mut rdr = csv::ReaderBuilder::new()
             .has_headers(true)
@@ -99,7 +102,10 @@ impl Table {
             line: Some(1),
             column: Some(name.to_string()),
             value: None,
-            message: format!("missing required column (header has: {})", self.headers.join(",")),
+            message: format!(
+                "missing required column (header has: {})",
+                self.headers.join(",")
+            ),
         })
     }
 

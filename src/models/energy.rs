@@ -24,7 +24,10 @@ pub struct EnergyPartition {
 impl EnergyPartition {
     /// Relative closure (potential drop − losses)/potential drop; zero up to round-off.
     pub fn closure(&self) -> f64 {
-        (self.potential_drop - self.collision_translation - self.collision_spin - self.friction_work)
+        (self.potential_drop
+            - self.collision_translation
+            - self.collision_spin
+            - self.friction_work)
             / self.potential_drop
     }
 
@@ -56,7 +59,8 @@ pub fn stickslip(scene: &Scene, s: &Steady) -> Result<EnergyPartition, NotSteady
     let w0sq = scene.k * scene.k * x * x;
     let drop = 2.0 * scene.sin_delta_sin_alpha();
     let omk2 = scene.one_minus_k2();
-    let rolling_spin = |spin_f: f64| 0.5 * scene.rho * (spin_f * spin_f - scene.k * scene.k * x * x);
+    let rolling_spin =
+        |spin_f: f64| 0.5 * scene.rho * (spin_f * spin_f - scene.k * scene.k * x * x);
     let (ts, ws_sq) = match step.branch {
         Branch::NoSlip => {
             return Ok(EnergyPartition {

@@ -72,7 +72,10 @@ impl Jaeger {
                 }
             }
         }
-        let mut pos: Vec<f64> = r.into_iter().filter(|x| x.is_finite() && *x > 0.0).collect();
+        let mut pos: Vec<f64> = r
+            .into_iter()
+            .filter(|x| x.is_finite() && *x > 0.0)
+            .collect();
         pos.sort_by(|a, b| a.total_cmp(b));
         pos.dedup();
         JaegerRoots {

@@ -90,7 +90,12 @@ impl fmt::Display for Phases {
 }
 
 impl Steady {
-    pub(crate) fn basic(mean_velocity: f64, final_velocity: f64, initial_velocity: f64, tau: f64) -> Self {
+    pub(crate) fn basic(
+        mean_velocity: f64,
+        final_velocity: f64,
+        initial_velocity: f64,
+        tau: f64,
+    ) -> Self {
         Steady {
             mean_velocity,
             final_velocity,
@@ -162,7 +167,11 @@ impl fmt::Display for NotSteady {
                 write!(f, "bead stops at Theta = {:.6} deg", angle.to_degrees())
             }
             NotSteady::LiftOff { angle } => {
-                write!(f, "normal force vanishes at Theta = {:.6} deg", angle.to_degrees())
+                write!(
+                    f,
+                    "normal force vanishes at Theta = {:.6} deg",
+                    angle.to_degrees()
+                )
             }
             NotSteady::Runaway => write!(f, "no fixed point: the velocity grows without bound"),
             NotSteady::Invalid { reason } => f.write_str(reason),

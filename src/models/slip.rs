@@ -60,7 +60,8 @@ impl SlipPhase {
         let (sm, cm) = (0.5 * (theta + self.theta_s)).sin_cos();
         let dsin = 2.0 * cm * sh;
         let dcos = -2.0 * sm * sh;
-        self.ws_sq * (1.0 + em1) + self.b * (dsin - self.sin_s * em1)
+        self.ws_sq * (1.0 + em1)
+            + self.b * (dsin - self.sin_s * em1)
             + self.c * (dcos - self.cos_s * em1)
     }
 
@@ -243,7 +244,14 @@ pub fn steady_approx(scene: &Scene) -> Outcome {
         });
     }
     let den = (0.5 * (psif + psi0)).sin() * scene.sin_alpha;
-    let tau = cos_integral(SinCos::of(0.5 * psi0), SinCos::of(0.5 * psif), w0, wf, wt, den);
+    let tau = cos_integral(
+        SinCos::of(0.5 * psi0),
+        SinCos::of(0.5 * psif),
+        w0,
+        wf,
+        wt,
+        den,
+    );
     if !(tau.is_finite() && tau > 0.0) {
         return Err(NotSteady::Invalid {
             reason: "approximate slip time not finite",

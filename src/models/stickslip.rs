@@ -61,7 +61,8 @@ pub fn map(scene: &Scene, x: f64) -> Result<MapStep, NotSteady> {
         (ph.speed_sq(scene.theta_f), Branch::SlipFromStart, Some(ph))
     } else {
         // Θ̇_G² = Θ̇0² + B (cos Θ0 − cos Θ_G) (eq 9), in product form.
-        let wg_sq = w0sq + 2.0 * b * (0.5 * (tg + scene.theta_0)).sin() * (0.5 * (tg - scene.theta_0)).sin();
+        let wg_sq = w0sq
+            + 2.0 * b * (0.5 * (tg + scene.theta_0)).sin() * (0.5 * (tg - scene.theta_0)).sin();
         let ph = SlipPhase::new(tg, wg_sq, scene.f);
         (ph.speed_sq(scene.theta_f), Branch::RollSlip, Some(ph))
     };
@@ -122,13 +123,25 @@ fn excess(scene: &Scene, x: f64) -> f64 {
 
 /// A continuous root of g in [a, b] (g(a), g(b) of opposite signs), or the jump it straddles.
 fn refine(scene: &Scene, a: f64, b: f64, ga: f64, gb: f64) -> Result<f64, NotSteady> {
-    let (lo, hi, glo, ghi) = if a < b { (a, b, ga, gb) } else { (b, a, gb, ga) };
+    let (lo, hi, glo, ghi) = if a < b {
+        (a, b, ga, gb)
+    } else {
+        (b, a, gb, ga)
+    };
     let glo = glo.clamp(-1e300, 1e300);
     let ghi = ghi.clamp(-1e300, 1e300);
-    let r = brent(|x| excess(scene, x).clamp(-1e300, 1e300), lo, hi, glo, ghi, 0.0, 200)
-        .ok_or(NotSteady::Invalid {
-            reason: "fixed-point bracket lost",
-        })?;
+    let r = brent(
+        |x| excess(scene, x).clamp(-1e300, 1e300),
+        lo,
+        hi,
+        glo,
+        ghi,
+        0.0,
+        200,
+    )
+    .ok_or(NotSteady::Invalid {
+        reason: "fixed-point bracket lost",
+    })?;
     // A true fixed point has g → 0; a jump of the map leaves |g| finite at the "root".
     if r.fx.abs() <= 1e-9 * r.x.max(1e-3) {
         Ok(r.x)
@@ -158,9 +171,11 @@ pub fn fixed_point_from(scene: &Scene, x0: f64) -> Result<f64, NotSteady> {
             return Err(map(scene, x1).err().unwrap_or(NotSteady::Runaway));
         }
         if x1 <= 0.0 {
-            return Err(map(scene, x1.max(1e-300)).err().unwrap_or(NotSteady::Stops {
-                angle: scene.theta_0,
-            }));
+            return Err(map(scene, x1.max(1e-300))
+                .err()
+                .unwrap_or(NotSteady::Stops {
+                    angle: scene.theta_0,
+                }));
         }
         let x2 = x1 + g1;
         let d2 = g1 - gx; // (x2 − x1) − (x1 − x)
@@ -259,14 +274,17 @@ pub fn steady_tol(scene: &Scene, tol: f64) -> Outcome {
     let w0sq = scene.k * scene.k * xs * xs;
     let tau = match step.branch {
         Branch::NoSlip => stick::rolling_time(scene.b, scene.theta_0, scene.theta_f, w0sq),
-        Branch::SlipFromStart => {
-            SlipPhase::new(scene.theta_0, w0sq, scene.f).time_to(scene.theta_f, tol).ok()
-        }
+        Branch::SlipFromStart => SlipPhase::new(scene.theta_0, w0sq, scene.f)
+            .time_to(scene.theta_f, tol)
+            .ok(),
         Branch::RollSlip => {
             let tg = step.theta_g;
             let t1 = stick::rolling_time(scene.b, scene.theta_0, tg, w0sq);
             let wg_sq = w0sq
-                + 2.0 * scene.b * (0.5 * (tg + scene.theta_0)).sin() * (0.5 * (tg - scene.theta_0)).sin();
+                + 2.0
+                    * scene.b
+                    * (0.5 * (tg + scene.theta_0)).sin()
+                    * (0.5 * (tg - scene.theta_0)).sin();
             let ph = SlipPhase::new(tg, wg_sq, scene.f);
             let t2 = slip_time(&ph, tg, scene.theta_f, tol).ok();
             t1.zip(t2).map(|(a, b)| a + b)

@@ -52,7 +52,7 @@ pub fn cos_integral(h0: SinCos, h1: SinCos, w0sq: f64, w1sq: f64, wtsq: f64, den
         if h0.s == h1.s {
             return 0.0;
         }
-        return same_side(h1.neg(), h0.neg(), w1sq, w0sq, -den);
+        return same_side(h1.reflected(), h0.reflected(), w1sq, w0sq, -den);
     }
     if h0.s >= 0.0 {
         return same_side(h0, h1, w0sq, w1sq, den);

@@ -22,9 +22,9 @@ impl SinCos {
         SinCos { s, c }
     }
 
-    /// The angle's negative.
+    /// sin and cos of the negated angle.
     #[inline]
-    pub fn neg(self) -> Self {
+    pub fn reflected(self) -> Self {
         SinCos {
             s: -self.s,
             c: self.c,

@@ -32,10 +32,18 @@ pub fn brent<F: FnMut(f64) -> f64>(
         return None;
     }
     if fa == 0.0 {
-        return Some(Root { x: a, fx: fa, evals: 0 });
+        return Some(Root {
+            x: a,
+            fx: fa,
+            evals: 0,
+        });
     }
     if fb == 0.0 {
-        return Some(Root { x: b, fx: fb, evals: 0 });
+        return Some(Root {
+            x: b,
+            fx: fb,
+            evals: 0,
+        });
     }
     let mut c = a;
     let mut fc = fa;
@@ -60,7 +68,11 @@ pub fn brent<F: FnMut(f64) -> f64>(
         let tol = 2.0 * f64::EPSILON * b.abs() + 0.5 * xtol;
         let m = 0.5 * (c - b);
         if m.abs() <= tol || fb == 0.0 || evals >= max_evals {
-            return Some(Root { x: b, fx: fb, evals });
+            return Some(Root {
+                x: b,
+                fx: fb,
+                evals,
+            });
         }
         if e.abs() >= tol && fa.abs() > fb.abs() {
             let s = fb / fa;

@@ -1,0 +1,228 @@
+//! Command-line contracts: column names, exit codes, located errors, atomic output.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_fitbead"))
+}
+
+fn tmpdir() -> tempfile::TempDir {
+    tempfile::tempdir().unwrap()
+}
+
+fn write(dir: &tempfile::TempDir, name: &str, text: &str) -> PathBuf {
+    let p = dir.path().join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+#[test]
+fn forward_single_scene_reports_v_regime_status() {
+    let out = bin()
+        .args([
+            "forward",
+            "--model",
+            "stick",
+            "--xi",
+            "1",
+            "--delta-deg",
+            "12",
+            "--K",
+            "adjusted",
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let s = String::from_utf8(out.stdout).unwrap();
+    let mut lines = s.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    for c in [
+        "xi",
+        "delta_deg",
+        "v",
+        "regime",
+        "status",
+        "final_velocity",
+        "theta_G_deg",
+    ] {
+        assert!(header.contains(&c), "missing column {c}: {header:?}");
+    }
+    let row: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let v: f64 = row[header.iter().position(|h| *h == "v").unwrap()]
+        .parse()
+        .unwrap();
+    // MODEL.md §2: v̄ = 0.39120827… at ξ = 1, δ = 12°, ρ = 0.4, fitted K.
+    assert!((v - 0.39120827).abs() < 1e-8, "{v}");
+    assert_eq!(
+        row[header.iter().position(|h| *h == "regime").unwrap()],
+        "B"
+    );
+}
+
+#[test]
+fn forward_file_passes_extra_columns_and_keeps_order() {
+    let d = tmpdir();
+    let inp = write(
+        &d,
+        "s.csv",
+        "id,xi,delta_deg,K,rho,f\na,1,12,adjusted,0.4,0.1\nb,1,3,0.6,0.4,0.1\nc,1,60,0.6,0.4,0.1\n",
+    );
+    let outp = d.path().join("o.csv");
+    let st = bin()
+        .args(["forward", "--model", "stickslip", "--input"])
+        .arg(&inp)
+        .arg("--output")
+        .arg(&outp)
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let s = std::fs::read_to_string(&outp).unwrap();
+    let rows: Vec<Vec<String>> = s
+        .lines()
+        .map(|l| l.split(',').map(String::from).collect())
+        .collect();
+    let h = &rows[0];
+    let reg = h.iter().position(|x| x == "regime").unwrap();
+    assert_eq!(rows[1][0], "a");
+    assert_eq!(rows[2][0], "b");
+    assert_eq!(rows[3][0], "c");
+    assert_eq!(rows[1][reg], "B");
+    assert_eq!(rows[2][reg], "A", "3 degrees is below delta_m");
+    assert_eq!(rows[3][reg], "C", "60 degrees lifts off");
+}
+
+fn expect_error(args: &[&str], input: &str, must_contain: &[&str]) {
+    let d = tmpdir();
+    let inp = write(&d, "bad.csv", input);
+    let outp = d.path().join("out.csv");
+    std::fs::write(&outp, "precious").unwrap();
+    let out = bin()
+        .args(args)
+        .arg("--input")
+        .arg(&inp)
+        .arg("--output")
+        .arg(&outp)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2), "exit code for {input:?}");
+    let err = String::from_utf8(out.stderr).unwrap();
+    for m in must_contain {
+        assert!(err.contains(m), "stderr {err:?} lacks {m:?}");
+    }
+    assert!(err.contains("bad.csv"), "{err}");
+    assert_eq!(
+        std::fs::read_to_string(&outp).unwrap(),
+        "precious",
+        "output touched"
+    );
+    let leftovers: Vec<_> = std::fs::read_dir(d.path()).unwrap().collect();
+    assert_eq!(leftovers.len(), 2, "temporary files left behind");
+}
+
+#[test]
+fn bad_inputs_exit_2_with_file_line_column_value() {
+    let f = ["forward", "--model", "stick"];
+    expect_error(&f, "xi,K\n1,0.6\n", &["line 1", "delta_deg", "missing"]);
+    expect_error(
+        &f,
+        "xi,delta_deg\n1,abc\n",
+        &["line 2", "delta_deg", "'abc'"],
+    );
+    expect_error(
+        &f,
+        "xi,delta_deg\n1,10\n1,NaN\n",
+        &["line 3", "delta_deg", "NaN"],
+    );
+    expect_error(&f, "xi,delta_deg\n1,inf\n", &["line 2", "inf"]);
+    expect_error(&f, "xi,delta_deg\n-1,10\n", &["line 2", "'xi'", "-1"]);
+    expect_error(&f, "xi,delta_deg\n1,95\n", &["line 2", "delta_deg", "95"]);
+    expect_error(&f, "", &["empty"]);
+    expect_error(&f, "xi,delta_deg\n", &["no data rows"]);
+    expect_error(
+        &f,
+        "xi,delta_deg,K\n1,10,smooth\n",
+        &["line 2", "'K'", "smooth", "unknown collision law"],
+    );
+    expect_error(&f, "xi,delta_deg,K\n1,10,-0.5\n", &["line 2", "'K'"]);
+    expect_error(
+        &f,
+        "xi,delta_deg,rho\n1,10,-2\n",
+        &["line 2", "'rho'", "-2"],
+    );
+}
+
+#[test]
+fn regimes_reports_the_critical_xi() {
+    let out = bin()
+        .args(["regimes", "--law", "adjusted", "--xi", "1"])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let s = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        s.starts_with("xi,alpha_deg,K,delta_m_deg,delta_d_deg"),
+        "{s}"
+    );
+    let row: Vec<f64> = s
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .filter_map(|x| x.parse().ok())
+        .collect();
+    assert!((row[3] - 7.469).abs() < 5e-4, "delta_m {row:?}");
+    assert!(
+        (row[row.len() - 1] - 0.6215).abs() < 1e-4,
+        "critical xi {row:?}"
+    );
+}
+
+#[test]
+fn simulate_is_reproducible_from_its_seed_and_stays_in_regime_b() {
+    let run = |seed: &str| {
+        let o = bin()
+            .args([
+                "simulate", "--model", "stick", "--law", "adjusted", "--series", "0.8,2",
+                "--points", "5", "--noise", "0.02", "--seed", seed,
+            ])
+            .output()
+            .unwrap();
+        assert!(o.status.success());
+        String::from_utf8(o.stdout).unwrap()
+    };
+    let a = run("7");
+    assert_eq!(a, run("7"));
+    assert_ne!(a, run("8"));
+    assert!(a.starts_with("series,xi,delta_deg,v,sigma_v"));
+    assert_eq!(a.lines().count(), 11);
+    // Every simulated slope is steady under the model that made it.
+    let d = tmpdir();
+    let p = write(&d, "sim.csv", &a);
+    let o = bin()
+        .args(["forward", "--model", "stick", "--input"])
+        .arg(&p)
+        .output()
+        .unwrap();
+    let s = String::from_utf8(o.stdout).unwrap();
+    assert_eq!(
+        s.lines().skip(1).filter(|l| l.contains(",B,ok,")).count(),
+        10,
+        "{s}"
+    );
+}
+
+#[test]
+fn forward_without_input_runs_on_the_embedded_default_data() {
+    let o = bin()
+        .args(["forward", "--model", "stickslip"])
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    let s = String::from_utf8(o.stdout).unwrap();
+    assert!(
+        s.lines().next().unwrap().contains("in_v"),
+        "measured v passes through as in_v"
+    );
+    assert_eq!(s.lines().count(), 37);
+}

@@ -174,12 +174,18 @@ fn slip_state(scene: &Scene) -> Result<f64, NotSteady> {
             angle: scene.theta_0,
         });
     }
+    Ok(l2)
+}
+
+/// Lift-off check at Θf (eq 30a), made after the stop check: a bead that stops on the way
+/// never reaches Θf (regime A takes precedence).
+fn check_lift_off(scene: &Scene, l2: f64) -> Result<(), NotSteady> {
     if scene.sc_f.c - l2 < 0.0 {
         return Err(NotSteady::LiftOff {
             angle: scene.theta_f,
         });
     }
-    Ok(l2)
+    Ok(())
 }
 
 /// Steady slip over the whole contact (§4.3): τ' = ∫ dθ / G(θ) (eq 51) by adaptive
@@ -194,6 +200,7 @@ pub fn steady_tol(scene: &Scene, tol: f64) -> Outcome {
     let w0sq = scene.k * scene.k * l2;
     let ph = SlipPhase::new(scene.theta_0, w0sq, scene.f);
     let tau = slip_time(&ph, scene.theta_0, scene.theta_f, tol)?;
+    check_lift_off(scene, l2)?;
     let l = l2.sqrt();
     let mut s = Steady::basic(2.0 * scene.sin_alpha / tau, l, scene.k * l, tau);
     s.map_slope = Some(scene.k * scene.k * (4.0 * scene.f * scene.alpha).exp());
@@ -239,10 +246,18 @@ pub fn steady_approx(scene: &Scene) -> Outcome {
     let wf = vsq(scene.theta_f);
     let wt = a1 - p;
     if !(w0 > 0.0 && wf > 0.0) || (psi0 < 0.0 && psif > 0.0 && !(wt > 0.0)) {
-        return Err(NotSteady::Invalid {
-            reason: "approximate slip integrand not positive",
+        // The approximate speed² vanishes on the way: under this model the bead stops where
+        // a' − p cos ψ = 0 before the top (ψ < 0).
+        let psi_stop = -(a1 / p).clamp(-1.0, 1.0).acos();
+        return Err(NotSteady::Stops {
+            angle: psi_stop + star + std::f64::consts::PI
+                - std::f64::consts::TAU
+                    * ((psi_stop + star + std::f64::consts::PI - scene.theta_0)
+                        / std::f64::consts::TAU)
+                        .floor(),
         });
     }
+    check_lift_off(scene, l2)?;
     let den = (0.5 * (psif + psi0)).sin() * scene.sin_alpha;
     let tau = cos_integral(
         SinCos::of(0.5 * psi0),

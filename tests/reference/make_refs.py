@@ -447,7 +447,10 @@ def ss_map(x, P, ns):
         y = roll_y
         roll_end = tf
     else:
-        tg = 2 * ns.atan(f * (3 + rho - vt) / (rho + ns.sqrt(disc)))
+        den = rho + ns.sqrt(disc)
+        # den = 0 only when rho = 0 and vt = 3 (N = 0 at the top); then the
+        # numerator f(3 - vt) is 0 too and the limit vt -> 3- is Theta_G -> 0
+        tg = 2 * ns.atan(f * (3 + rho - vt) / den) if den != 0 else 0 * vt
         if tg >= tf:
             branch, y, roll_end = 'noslip', roll_y, tf
         elif tg <= t0:
@@ -546,8 +549,27 @@ def ss_fixed_points(sc, nscan=4000):
             if abs(roots[j] - x) < 1e-8:
                 att = j
         if att is None:
-            r, ok = refine(x * (1 - 1e-9), x * (1 + 1e-9))
-            if r is not None and ok:
+            # not seen by the scan (e.g. squeezed against the point where the
+            # bead stops at the top): secant at full precision from the iterate
+            def hs(x):
+                hv = Hm(x)[0]
+                if hv is None:
+                    raise ValueError('map undefined')
+                return hv - x
+            r = None
+            try:
+                r = mpmath.findroot(hs, (mpf(x), mpf(x) * (1 + mpf(10) ** -12)), solver='secant')
+                if abs(hs(r)) >= mpf(10) ** -30:
+                    r = None
+            except (ValueError, ZeroDivisionError):
+                r = None
+            if r is None:
+                for rel in (1e-9, 1e-11, 1e-13):
+                    r, ok = refine(x * (1 - rel), x * (1 + rel))
+                    if r is not None and ok:
+                        break
+                    r = None
+            if r is not None:
                 roots.append(r)
                 att = len(roots) - 1
     order = sorted(range(len(roots)), key=lambda k: roots[k])
@@ -841,8 +863,20 @@ def build_hard_tasks():
         # slip from the start: Theta0 > 0 (delta > alpha), small f
         add('slip from start (Theta_G<=Theta0)', 10.0, math.radians(7.0), 0.9, 0.4, 0.01, ('stick', 'stickslip'))
         add('slip from start (Theta_G<=Theta0)', 4.0, math.radians(13.0), 0.8, 0.4, 0.01, ('stick', 'stickslip'))
-        # bistable scene
+        # bistable scene, with K = 0.9842 as MODEL.md states it, and with the
+        # fitted law at xi = 10 (0.98421927813...) that 0.9842 rounds
         add('bistable (MODEL.md 3)', 10.0, math.radians(5.767), 0.9842, 1.0, 0.2, ('stick', 'stickslip'))
+        add('bistable with K=Kfit(xi=10) unrounded', 10.0, math.radians(5.767), K_law_double('Kfit', 10.0), 1.0, 0.2,
+            ('stick', 'stickslip'))
+        # slip and stick/slip with K e^{2 f alpha} = 1 - 1e-6 in regime B: the
+        # slope where the steady final velocity^2 is half cos(Thetaf)
+        for xi in (1.0, 2.0, 10.0):
+            for f in (0.1, 0.01):
+                a = alpha_of(xi)
+                Kslip = float(mpmath.exp(-2 * mpf(f) * a) * (1 - mpf('1e-6')))
+                d = slip_delta_for_Lp2(xi, Kslip, f, mpf('0.5'))
+                if d is not None:
+                    add('K e^{2f alpha}=1-1e-6 regime B', xi, float(d), Kslip, 0.4, f, ('slip', 'slip-approx', 'stickslip'))
         # Fig 7 scenes
         for xi, deg in ((2.0, 5.73), (1.0, 11.53)):
             K = K_law_double('Kfit', xi)
@@ -871,6 +905,25 @@ def slip_min_G2(xi, delta, K, f):
     return g_minimum(g, dg, sc.th0, sc.thf)[0]
 
 
+def slip_delta_for_Lp2(xi, K, f, frac):
+    """Slope at which the slip model's Lp2 equals frac * cos(Thetaf) (bisection)."""
+    a = alpha_of(xi)
+    f = mpf(f)
+    K = mpf(K)
+    b = -6 * f / (1 + 4 * f * f)
+    c = (4 * f * f - 2) / (1 + 4 * f * f)
+    E = mpmath.exp(4 * f * a)
+
+    def h(d):
+        s0 = b * mpmath.sin(d - a) + c * mpmath.cos(d - a)
+        sf = b * mpmath.sin(d + a) + c * mpmath.cos(d + a)
+        return (sf - s0 * E) - frac * mpmath.cos(d + a) * (1 - K * K * E)
+    lo, hi = mpf('1e-6'), mpmath.pi / 2 - a - mpf('1e-6')
+    if not (h(lo) < 0 < h(hi)):
+        return None
+    return bisect_root(h, lo, hi)
+
+
 def slip_stop_delta(xi, K, f):
     """Slope where the slip model's min G^2 crosses 0 (bisection on delta)."""
     a = alpha_of(xi)
@@ -895,7 +948,9 @@ def compute_task(task):
     for i, p in enumerate(prim):
         c = chk[i] if i < len(chk) else None
         q = pert[i] if i < len(pert) else None
-        row = dict(case=case, model=model, xi=R(xi), delta_rad=R(d), K=R(K),
+        with mp.workdps(PRIMARY_DPS):
+            th0 = mpf(d) - alpha_of(xi)
+        row = dict(case=case, model=model, xi=R(xi), delta_rad=R(d), K=R(K), theta0_rad=S(th0),
                    rho=R(rho), f=R(f), v=S(p['v']), final_velocity=S(p['final_velocity']),
                    regime=p['regime'], extra=S(p['extra']), extra_name=p['extra_name'] if p['extra'] is not None else '',
                    note=p['note'],
@@ -928,7 +983,7 @@ def compute_task(task):
 
 FORWARD_COLS = ['case', 'model', 'xi', 'delta_rad', 'K', 'rho', 'f', 'v', 'final_velocity', 'regime',
                 'extra', 'note', 'extra_name', 'fixed_point_index', 'slope', 'stable', 'from_L',
-                'v_check', 'rel_diff', 'fv_rel_diff', 'sens_alpha_ulp']
+                'v_check', 'rel_diff', 'fv_rel_diff', 'sens_alpha_ulp', 'theta0_rad']
 
 
 # ----------------------------------------------------------------------------
@@ -953,7 +1008,8 @@ def bistable_map_rows():
                                  H2=S(y)))
                 continue
             h = sqrt(y) if y > 0 else None
-            rows.append(dict(x=R(x), H=S(h) if h is not None else '',
+            nmin = min(mpmath.cos(sc.th0) - (sc.K * x) ** 2, mpmath.cos(sc.thf) - y)
+            rows.append(dict(x=R(x), N_min=S(nmin), H=S(h) if h is not None else '',
                              H_minus_x=S(h - mpf(x)) if h is not None else '',
                              branch=br, theta_G_deg=S(tg * 180 / mpmath.pi) if tg is not None else '',
                              H2=S(y)))
@@ -1213,7 +1269,7 @@ def main():
         t = time.time()
         rows = bistable_map_rows()
         write_csv(os.path.join(HERE, 'stickslip_map_bistable.csv'),
-                  ['x', 'H', 'H_minus_x', 'branch', 'theta_G_deg', 'H2'], rows)
+                  ['x', 'H', 'H_minus_x', 'branch', 'theta_G_deg', 'H2', 'N_min'], rows)
         log('bistable map: %d rows, %.1f s' % (len(rows), time.time() - t))
 
     if 'forward' in only:

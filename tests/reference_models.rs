@@ -1,0 +1,227 @@
+//! Forward models against independent references: tests/reference/forward_refs.csv, made by
+//! tests/reference/make_refs.py with mpmath at 40 digits by direct quadrature of the defining
+//! integrals (eqs 11, 46, 65) at exactly the double-precision inputs listed in the file
+//! (δ in radians as a double, K as a double). Regenerate with
+//! `python3 tests/reference/make_refs.py`.
+
+use fitbead::models::{stick, NotSteady, Regime};
+use fitbead::{CollisionLaw, ForwardModel, Model, Scene};
+
+struct Row {
+    case: String,
+    model: String,
+    scene: Scene,
+    v: Option<f64>,
+    final_velocity: Option<f64>,
+    regime: String,
+    extra: Option<f64>,
+    extra_name: String,
+    fixed_point_index: Option<u32>,
+    note: String,
+}
+
+fn rows() -> Vec<Row> {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/reference/forward_refs.csv"
+    );
+    let mut rdr = csv::Reader::from_path(path).expect("reference table present");
+    let h = rdr.headers().unwrap().clone();
+    let col = |n: &str| {
+        h.iter()
+            .position(|x| x == n)
+            .unwrap_or_else(|| panic!("column {n}"))
+    };
+    let (c_case, c_model, c_xi, c_d, c_k, c_rho, c_f) = (
+        col("case"),
+        col("model"),
+        col("xi"),
+        col("delta_rad"),
+        col("K"),
+        col("rho"),
+        col("f"),
+    );
+    let (c_v, c_fv, c_reg, c_extra, c_en, c_fpi) = (
+        col("v"),
+        col("final_velocity"),
+        col("regime"),
+        col("extra"),
+        col("extra_name"),
+        col("fixed_point_index"),
+    );
+    let num = |s: &str| s.trim().parse::<f64>().ok();
+    rdr.records()
+        .map(|r| {
+            let r = r.unwrap();
+            let f = num(&r[c_f]).unwrap_or(0.1);
+            let scene = Scene::from_radians(
+                num(&r[c_xi]).unwrap(),
+                num(&r[c_d]).unwrap(),
+                num(&r[c_rho]).unwrap_or(0.4), // the slip model does not depend on ρ
+                f,
+                CollisionLaw::Value(num(&r[c_k]).unwrap()),
+            )
+            .unwrap();
+            Row {
+                case: r[c_case].to_string(),
+                model: r[c_model].to_string(),
+                scene,
+                v: num(&r[c_v]),
+                final_velocity: num(&r[c_fv]),
+                regime: r[c_reg].to_string(),
+                extra: num(&r[c_extra]),
+                extra_name: r[c_en].to_string(),
+                fixed_point_index: r[c_fpi].trim().parse().ok(),
+                note: r[col("note")].to_string(),
+            }
+        })
+        .collect()
+}
+
+fn model(name: &str) -> Model {
+    match name {
+        "stick" => Model::Stick,
+        "stick-approx" => Model::StickApprox,
+        "slip" => Model::Slip,
+        "slip-approx" => Model::SlipApprox,
+        "stickslip" => Model::StickSlip,
+        m => panic!("unknown model {m}"),
+    }
+}
+
+/// Relative error bound of the mean velocities (issue: ≤ 1e-12 across regime B and on the hard
+/// cases, the near-δ_m ones at the exact double inputs).
+const TOL: f64 = 1e-12;
+
+#[test]
+fn mean_velocities_match_mpmath_quadrature_to_1e_12() {
+    let mut worst: Vec<(f64, String)> = Vec::new();
+    let mut checked = 0;
+    let mut failures = Vec::new();
+    for r in rows() {
+        if r.fixed_point_index.unwrap_or(0) > 0 {
+            continue; // other fixed points: see the bistability test
+        }
+        if r.case.starts_with("slip stop limit") {
+            continue; // held apart: see slip_near_its_stop_limit_at_1e_12 (open)
+        }
+        let m = model(&r.model);
+        let out = m.evaluate(&r.scene);
+        match (r.regime.as_str(), r.v, &out) {
+            ("B", Some(v), Ok(s)) => {
+                let e = (s.mean_velocity - v).abs() / v;
+                let fe = r
+                    .final_velocity
+                    .map(|f| (s.final_velocity - f).abs() / f)
+                    .unwrap_or(0.0);
+                worst.push((e, format!("{} {}", r.case, r.model)));
+                if e > TOL || fe > TOL {
+                    failures.push(format!(
+                        "{} {}: v {} vs {} (rel {e:.2e}), final rel {fe:.2e}",
+                        r.case, r.model, s.mean_velocity, v
+                    ));
+                }
+                checked += 1;
+            }
+            ("B", _, Err(e)) => failures.push(format!(
+                "{} {}: reference steady, fitbead says {e}",
+                r.case, r.model
+            )),
+            (reg, _, Ok(s)) if reg == "A" || reg == "C" => failures.push(format!(
+                "{} {}: reference regime {reg}, fitbead steady v {}",
+                r.case, r.model, s.mean_velocity
+            )),
+            (_, _, Ok(_)) => {} // reference has no verdict (e.g. model-specific invalid)
+            (reg, _, Err(e)) => {
+                let ours = e.regime().map(|g| g.to_string()).unwrap_or_default();
+                // No steady state either way; where the reference itself saw the bead launched
+                // at the rolling steady state stop, "stops" (A) is the same verdict as ours even
+                // when it labels the lift-off of a faster fixed point (C).
+                let both_seen = ours == "A" && r.note.contains("stops");
+                if (reg == "A" || reg == "C") && ours != reg && !both_seen {
+                    failures.push(format!(
+                        "{} {}: reference regime {reg}, fitbead {ours} ({e})",
+                        r.case, r.model
+                    ));
+                }
+            }
+        }
+    }
+    worst.sort_by(|a, b| b.0.total_cmp(&a.0));
+    eprintln!("checked {checked} steady rows; largest relative errors:");
+    for w in worst.iter().take(8) {
+        eprintln!("  {:.2e}  {}", w.0, w.1);
+    }
+    assert!(checked > 0);
+    assert!(
+        failures.is_empty(),
+        "{} failures:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
+}
+
+#[test]
+fn squared_top_velocity_keeps_its_digits_near_delta_m() {
+    // The reference's `extra` for stick rows is the squared velocity at the top (A − B), which
+    // vanishes at δ_m; the double-double factor must keep it to 1e-12 relative.
+    let mut n = 0;
+    for r in rows() {
+        if r.model != "stick"
+            || r.extra_name != "min_velocity2"
+            || r.regime != "B"
+            || r.scene.theta_0 >= 0.0
+        {
+            continue;
+        }
+        let want = r.extra.unwrap();
+        let got = stick::top_velocity_sq(&r.scene);
+        assert!(
+            (got - want).abs() <= TOL * want.abs(),
+            "{}: {got} vs {want}",
+            r.case
+        );
+        n += 1;
+    }
+    assert!(n > 0);
+}
+
+#[test]
+fn regimes_a_and_c_are_reported_with_a_location() {
+    for r in rows() {
+        if r.regime == "A" || r.regime == "C" {
+            if let Err(e) = model(&r.model).evaluate(&r.scene) {
+                match e {
+                    NotSteady::Stops { angle } | NotSteady::LiftOff { angle } => {
+                        assert!(angle.is_finite())
+                    }
+                    NotSteady::Runaway => assert_eq!(e.regime(), Some(Regime::C)),
+                    _ => {}
+                }
+            }
+        }
+    }
+}
+
+/// Open work: the slip model within 1e-6 / 1e-9 (relative) of its own stop limit. The squared
+/// speed at the minimum cancels there like A − B does at δ_m for rolling; fitbead evaluates it
+/// in double precision and measured 6.9e-12 / 2.7e-12 (1e-6 cases) and 3.0e-9 / 1.7e-8 (1e-9
+/// cases) against the reference. Run with `cargo test --release --test reference_models --
+/// --ignored` once the double-double minimum is in.
+#[test]
+#[ignore = "open: slip near its stop limit needs a double-double speed minimum"]
+fn slip_near_its_stop_limit_at_1e_12() {
+    for r in rows() {
+        if !r.case.starts_with("slip stop limit") || r.regime != "B" || r.model != "slip" {
+            continue;
+        }
+        let s = model(&r.model).evaluate(&r.scene).unwrap();
+        let v = r.v.unwrap();
+        assert!(
+            (s.mean_velocity - v).abs() <= TOL * v,
+            "{}: {} vs {v}",
+            r.case,
+            s.mean_velocity
+        );
+    }
+}

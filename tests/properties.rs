@@ -1,0 +1,95 @@
+//! Property tests: no valid input panics or yields NaN; every invalid input is an error; the
+//! energy balance closes (eqs 70–72).
+
+use fitbead::models::{energy, stick, stickslip};
+use fitbead::{CollisionLaw, ForwardModel, Model, Scene};
+use proptest::prelude::*;
+
+fn models() -> [Model; 5] {
+    [
+        Model::Stick,
+        Model::StickApprox,
+        Model::Slip,
+        Model::SlipApprox,
+        Model::StickSlip,
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(400))]
+
+    #[test]
+    fn valid_scenes_never_panic_or_give_nan(
+        xi in 0.05f64..50.0, d in 0.0f64..89.99, rho in 0.0f64..1.5,
+        f in prop_oneof![Just(0.0), 1e-8f64..3.0], k in 0.01f64..1.2,
+    ) {
+        let s = Scene::new(xi, d, rho, f, CollisionLaw::Value(k)).unwrap();
+        for m in models() {
+            if let Ok(st) = m.evaluate(&s) {
+                prop_assert!(st.mean_velocity.is_finite() && st.mean_velocity > 0.0, "{} {:?}", m.name(), st);
+                prop_assert!(st.final_velocity.is_finite() && st.contact_time.is_finite());
+            }
+        }
+    }
+
+    #[test]
+    fn invalid_scenes_are_errors(
+        bad in prop_oneof![Just(f64::NAN), Just(f64::INFINITY), Just(-1.0), Just(0.0), Just(-1e-300)],
+        which in 0usize..5,
+    ) {
+        let mut p = [1.0, 10.0, 0.4, 0.1, 0.6];
+        p[which] = bad;
+        let r = Scene::new(p[0], p[1], p[2], p[3], CollisionLaw::Value(p[4]));
+        // δ = 0, ρ = 0 and f = 0 are valid; every other case must be refused.
+        let valid_zero = bad == 0.0 && (which == 1 || which == 2 || which == 3);
+        prop_assert_eq!(r.is_ok(), valid_zero, "field {} = {}", which, bad);
+    }
+
+    #[test]
+    fn rolling_energy_balance_closes(xi in 0.65f64..10.0, frac in 0.02f64..0.98, rho in 0.0f64..1.0) {
+        let a = (1.0 / (1.0 + xi)).asin();
+        let law = CollisionLaw::Adjusted;
+        let k = law.k(a, rho);
+        let (dm, dd) = (fitbead::models::regimes::delta_m(a, k), fitbead::models::regimes::delta_d(a, k, rho));
+        prop_assume!(dm < dd);
+        let s = Scene::from_radians(xi, dm + frac * (dd - dm), rho, 0.1, law).unwrap();
+        let st = stick::steady(&s).unwrap();
+        let e = energy::rolling(&s, &st);
+        prop_assert!(e.closure().abs() < 1e-12, "closure {}", e.closure());
+    }
+}
+
+#[test]
+fn stickslip_energy_balance_closes_to_1e_12() {
+    // Friction work by its own (nested) quadrature; closure = potential drop − losses.
+    let mut n = 0;
+    for &(xi, d, f) in &[
+        (1.0, 11.53, 0.1),
+        (2.0, 5.73, 0.1),
+        (1.6, 8.0, 0.05),
+        (0.8, 12.0, 0.2),
+        (4.0, 4.0, 0.1),
+    ] {
+        let s = Scene::new(xi, d, 0.4, f, CollisionLaw::Adjusted).unwrap();
+        let st = stickslip::steady(&s).unwrap();
+        let e = energy::stickslip(&s, &st).unwrap();
+        assert!(
+            e.closure().abs() < 1e-12,
+            "xi {xi} delta {d}: closure {:e} {e:?}",
+            e.closure()
+        );
+        assert!(e.friction_work > 0.0);
+        n += 1;
+    }
+    assert_eq!(n, 5);
+}
+
+#[test]
+fn stickslip_equals_stick_exactly_when_friction_prevents_slip() {
+    for &(xi, d) in &[(1.0, 10.0), (2.0, 6.0), (4.0, 4.0)] {
+        let s = Scene::new(xi, d, 0.4, 10.0, CollisionLaw::Adjusted).unwrap();
+        let a = stick::steady(&s).unwrap().mean_velocity;
+        let b = stickslip::steady(&s).unwrap().mean_velocity;
+        assert_eq!(a, b);
+    }
+}

@@ -178,11 +178,11 @@ pub fn run(a: Args) -> Result<(), CliError> {
         let f = t.opt_number(r, c_f)?.unwrap_or(a.f);
         let scene = Scene::new(xi, d, rho, f, law).map_err(|e| scene_error(&t, r, e, &cols))?;
         let model = match kind {
-            ModelKind::Stick => Model::Stick,
-            ModelKind::StickApprox => Model::StickApprox,
-            ModelKind::Slip => Model::Slip,
-            ModelKind::SlipApprox => Model::SlipApprox,
-            ModelKind::StickSlip => Model::StickSlip,
+            ModelKind::Stick
+            | ModelKind::StickApprox
+            | ModelKind::Slip
+            | ModelKind::SlipApprox
+            | ModelKind::StickSlip => kind.contact_model().expect("contact model"),
             ModelKind::Jan => {
                 let paper = Jan::paper_fit(scene.alpha);
                 let lambda = t

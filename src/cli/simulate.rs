@@ -141,11 +141,11 @@ pub fn run(a: Args) -> Result<(), CliError> {
             .map_err(|e| super::flag_error("--series", &xi.to_string(), e.to_string()))?;
         let alpha = (1.0 / (1.0 + xi)).asin();
         let model = match kind {
-            ModelKind::Stick => Model::Stick,
-            ModelKind::StickApprox => Model::StickApprox,
-            ModelKind::Slip => Model::Slip,
-            ModelKind::SlipApprox => Model::SlipApprox,
-            ModelKind::StickSlip => Model::StickSlip,
+            ModelKind::Stick
+            | ModelKind::StickApprox
+            | ModelKind::Slip
+            | ModelKind::SlipApprox
+            | ModelKind::StickSlip => kind.contact_model().expect("contact model"),
             ModelKind::Jan => Model::Jan(Jan::paper_fit(alpha)),
             ModelKind::Jaeger => {
                 return Err(super::flag_error(

@@ -288,6 +288,21 @@ pub enum ModelKind {
     Jaeger,
 }
 
+impl ModelKind {
+    /// The model for the five contact models, which need no parameters beyond the scene;
+    /// `None` for jan and jaeger.
+    pub fn contact_model(self) -> Option<Model> {
+        Some(match self {
+            ModelKind::Stick => Model::Stick,
+            ModelKind::StickApprox => Model::StickApprox,
+            ModelKind::Slip => Model::Slip,
+            ModelKind::SlipApprox => Model::SlipApprox,
+            ModelKind::StickSlip => Model::StickSlip,
+            ModelKind::Jan | ModelKind::Jaeger => return None,
+        })
+    }
+}
+
 impl FromStr for ModelKind {
     type Err = Error;
     fn from_str(s: &str) -> Result<Self> {

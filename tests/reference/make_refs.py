@@ -85,6 +85,10 @@ e) stickslip (section 4.4, eqs 64-68): final-velocity map H(x) of MODEL.md
    by mpmath.diff.  tau'' = rolling quadrature on [T0, Theta_G] + slip
    quadrature on [Theta_G, Tf].  The check re-finds x* at dps 50 with the secant
    method and re-does both quadratures by the Gauss-Legendre/sinh route.
+
+A third route (ode_spot_check, printed at the end of the run, writes nothing):
+the equations of motion (eq 9, eq 37) integrated by mpmath.odefun for a few
+rows of forward_refs.csv.
 """
 
 import argparse
@@ -1221,6 +1225,50 @@ def elliptic_rows(log):
 # main
 # ----------------------------------------------------------------------------
 
+def ode_spot_check(log):
+    """Third, independent route for a few rows: integrate the equations of
+    motion themselves (eq 9 rolling, eq 37 slipping) with mpmath.odefun
+    (Taylor series) from Theta0 with the reference initial velocity K*x, and
+    compare the time and the final velocity with forward_refs.csv."""
+    rows = list(csv.DictReader(open(os.path.join(HERE, 'forward_refs.csv'))))
+    picks = [('Fig7 xi=2.0 delta=5.73deg', 'stickslip'), ('Fig7 xi=1.0 delta=11.53deg', 'stickslip'),
+             ('f=1e-06', 'slip'), ('Theta0=0 (delta=double(alpha))', 'slip'),
+             ('MODEL.md 2 check (v=0.39120827...)', 'stick'), ('slip from start (Theta_G<=Theta0)', 'stickslip')]
+    worst = mpf(0)
+    with mp.workdps(20):
+        for case, model in picks:
+            r = [q for q in rows if q['case'] == case and q['model'] == model and q['regime'] == 'B'][0]
+            a = alpha_of(float(r['xi']))
+            d, K = mpf(float(r['delta_rad'])), mpf(float(r['K']))
+            t0, tf = d - a, d + a
+            x = mpf(r['final_velocity'])
+            f = mpf(float(r['f'])) if r['f'] else None
+            roll = (lambda B: lambda th, y: [B * mpmath.sin(th), 1 / sqrt(y[0])])
+            slipf = (lambda f: lambda th, y: [2 * (mpmath.sin(th) - f * (mpmath.cos(th) - y[0])), 1 / sqrt(y[0])])
+            y = [(K * x) ** 2, mpf(0)]
+            th = t0
+            if model in ('stick', 'stickslip'):
+                B = 2 / (1 + mpf(float(r['rho'])))
+                end = tf
+                if model == 'stickslip' and r['extra']:
+                    end = min(tf, max(t0, mpf(r['extra']) * mpmath.pi / 180))
+                if end > t0:
+                    if t0 < 0 < end:    # integrate through the top in two legs
+                        y = mpmath.odefun(roll(B), th, y)(mpf(0))
+                        th = mpf(0)
+                    y = mpmath.odefun(roll(B), th, y)(end)
+                    th = end
+            if th < tf:
+                y = mpmath.odefun(slipf(f), th, y)(tf)
+            v = 2 * mpmath.sin(a) / y[1]
+            dv = abs(v - mpf(r['v'])) / mpf(r['v'])
+            dx = abs(sqrt(y[0]) - x) / x
+            worst = max(worst, dv, dx)
+            log('  ODE check %-36s %-9s v=%s (table %s) rel %s; final velocity rel %s' % (
+                case, model, mpmath.nstr(v, 18), r['v'][:20], mpmath.nstr(dv, 3), mpmath.nstr(dx, 3)))
+    log('ODE spot check: worst relative difference %s (odefun at dps 20)' % mpmath.nstr(worst, 3))
+
+
 def write_csv(path, cols, rows):
     with open(path, 'w', newline='') as fh:
         w = csv.DictWriter(fh, fieldnames=cols, lineterminator='\n')
@@ -1236,10 +1284,10 @@ def _init_worker():
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
     ap.add_argument('--jobs', type=int, default=os.cpu_count() or 1)
-    ap.add_argument('--only', default='', help='comma list: forward,bistable,derived,elliptic')
+    ap.add_argument('--only', default='', help='comma list: forward,bistable,derived,elliptic,ode')
     ap.add_argument('--limit', type=int, default=0, help='debug: first N forward tasks only')
     args = ap.parse_args()
-    only = set(args.only.split(',')) if args.only else {'forward', 'bistable', 'derived', 'elliptic'}
+    only = set(args.only.split(',')) if args.only else {'forward', 'bistable', 'derived', 'elliptic', 'ode'}
     mp.dps = PRIMARY_DPS
     t_start = time.time()
     log = lambda *a: print(*a, flush=True)
@@ -1308,6 +1356,8 @@ def main():
             log('  %-12s rows=%4d regimes=%s max rel diff v: %s  final velocity: %s' % (
                 model, len(rr), regs, mpmath.nstr(max(rd), 3) if rd else '-', mpmath.nstr(max(fd), 3) if fd else '-'))
         log('forward: %d rows, slowest task %.1f s, %.1f s' % (len(rows), slow, time.time() - t))
+    if 'ode' in only:
+        ode_spot_check(log)
     log('total %.1f s' % (time.time() - t_start))
 
 

@@ -177,13 +177,9 @@ pub fn run(a: Args) -> Result<(), CliError> {
         let rho = t.opt_number(r, c_rho)?.unwrap_or(a.rho);
         let f = t.opt_number(r, c_f)?.unwrap_or(a.f);
         let scene = Scene::new(xi, d, rho, f, law).map_err(|e| scene_error(&t, r, e, &cols))?;
-        let model = match kind {
-            ModelKind::Stick
-            | ModelKind::StickApprox
-            | ModelKind::Slip
-            | ModelKind::SlipApprox
-            | ModelKind::StickSlip => kind.contact_model().expect("contact model"),
-            ModelKind::Jan => {
+        let model = match (kind, kind.contact_model()) {
+            (_, Some(m)) => m,
+            (ModelKind::Jan, None) => {
                 let paper = Jan::paper_fit(scene.alpha);
                 let lambda = t
                     .opt_number(r, c_lambda)?
@@ -192,7 +188,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
                 let mu = t.opt_number(r, c_mu)?.or(a.mu).unwrap_or(paper.mu);
                 Model::Jan(Jan::new(lambda, mu).map_err(|e| scene_error(&t, r, e, &cols))?)
             }
-            ModelKind::Jaeger => {
+            _ => {
                 let mut v = [0.0; 3];
                 let flags = [a.a1, a.a2, a.a3];
                 for i in 0..3 {

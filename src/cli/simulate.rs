@@ -137,17 +137,13 @@ pub fn run(a: Args) -> Result<(), CliError> {
     w.write_record(["series", "xi", "delta_deg", "v", "sigma_v", "v_true"])
         .map_err(io)?;
     for &xi in &series {
-        Scene::from_radians(xi, 0.1, a.rho, a.f, law)
-            .map_err(|e| super::flag_error("--series", &xi.to_string(), e.to_string()))?;
-        let alpha = (1.0 / (1.0 + xi)).asin();
-        let model = match kind {
-            ModelKind::Stick
-            | ModelKind::StickApprox
-            | ModelKind::Slip
-            | ModelKind::SlipApprox
-            | ModelKind::StickSlip => kind.contact_model().expect("contact model"),
-            ModelKind::Jan => Model::Jan(Jan::paper_fit(alpha)),
-            ModelKind::Jaeger => {
+        let alpha = Scene::from_radians(xi, 0.1, a.rho, a.f, law)
+            .map_err(|e| super::flag_error("--series", &xi.to_string(), e.to_string()))?
+            .alpha;
+        let model = match (kind, kind.contact_model()) {
+            (_, Some(m)) => m,
+            (ModelKind::Jan, None) => Model::Jan(Jan::paper_fit(alpha)),
+            _ => {
                 return Err(super::flag_error(
                     "--model",
                     "jaeger",

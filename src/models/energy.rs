@@ -3,6 +3,7 @@
 //! spin) plus the friction work.
 
 use super::slip::SlipPhase;
+use super::stick;
 use super::stickslip::{map, Branch};
 use super::{NotSteady, Steady};
 use crate::scene::Scene;
@@ -75,10 +76,7 @@ pub fn stickslip(scene: &Scene, s: &Steady) -> Result<EnergyPartition, NotSteady
             let tg = step.theta_g;
             (
                 tg,
-                w0sq + 2.0
-                    * scene.b
-                    * (0.5 * (tg + scene.theta_0)).sin()
-                    * (0.5 * (tg - scene.theta_0)).sin(),
+                stick::rolling_speed_sq(scene.b, scene.theta_0, w0sq, tg),
             )
         }
     };

@@ -129,6 +129,14 @@ pub fn steady_approx(scene: &Scene) -> Outcome {
     Ok(s)
 }
 
+/// Squared speed at θ of a bead rolling from Θa with squared speed `wa_sq`:
+/// Θ̇² = Θ̇a² + B (cos Θa − cos θ) (eq 9), with the difference in product form
+/// 2B sin((θ+Θa)/2) sin((θ−Θa)/2) so that θ near Θa keeps its digits.
+#[inline]
+pub fn rolling_speed_sq(b: f64, theta_a: f64, wa_sq: f64, theta: f64) -> f64 {
+    wa_sq + 2.0 * b * (0.5 * (theta + theta_a)).sin() * (0.5 * (theta - theta_a)).sin()
+}
+
 /// Time to roll from Θa to Θb (Θa ≤ Θb, both on the row bead) starting with squared speed
 /// `wa_sq` at Θa; `None` if the bead stops before Θb. Used by the stick/slip model.
 pub fn rolling_time(b: f64, theta_a: f64, theta_b: f64, wa_sq: f64) -> Option<f64> {

@@ -60,9 +60,7 @@ pub fn map(scene: &Scene, x: f64) -> Result<MapStep, NotSteady> {
         let ph = SlipPhase::new(scene.theta_0, w0sq, scene.f);
         (ph.speed_sq(scene.theta_f), Branch::SlipFromStart, Some(ph))
     } else {
-        // Θ̇_G² = Θ̇0² + B (cos Θ0 − cos Θ_G) (eq 9), in product form.
-        let wg_sq = w0sq
-            + 2.0 * b * (0.5 * (tg + scene.theta_0)).sin() * (0.5 * (tg - scene.theta_0)).sin();
+        let wg_sq = stick::rolling_speed_sq(b, scene.theta_0, w0sq, tg);
         let ph = SlipPhase::new(tg, wg_sq, scene.f);
         (ph.speed_sq(scene.theta_f), Branch::RollSlip, Some(ph))
     };
@@ -282,11 +280,7 @@ pub fn steady_tol(scene: &Scene, tol: f64) -> Outcome {
         Branch::RollSlip => {
             let tg = step.theta_g;
             let t1 = stick::rolling_time(scene.b, scene.theta_0, tg, w0sq);
-            let wg_sq = w0sq
-                + 2.0
-                    * scene.b
-                    * (0.5 * (tg + scene.theta_0)).sin()
-                    * (0.5 * (tg - scene.theta_0)).sin();
+            let wg_sq = stick::rolling_speed_sq(scene.b, scene.theta_0, w0sq, tg);
             let ph = SlipPhase::new(tg, wg_sq, scene.f);
             let t2 = slip_time(&ph, tg, scene.theta_f, tol).ok();
             t1.zip(t2).map(|(a, b)| a + b)

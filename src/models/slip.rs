@@ -54,10 +54,16 @@ impl SlipPhase {
     /// θ near Θs keep their digits.
     #[inline]
     pub fn speed_sq(&self, theta: f64) -> f64 {
-        let d = theta - self.theta_s;
+        self.speed_sq_offset(theta - self.theta_s)
+    }
+
+    /// [`Self::speed_sq`] at θ = Θs + d, for offsets d below the resolution of θ itself (a
+    /// bead launched almost at rest has a boundary layer of width Θ̇s²/|dΘ̇²/dθ|).
+    #[inline]
+    pub fn speed_sq_offset(&self, d: f64) -> f64 {
         let em1 = (2.0 * self.f * d).exp_m1();
         let (sh, _) = (0.5 * d).sin_cos();
-        let (sm, cm) = (0.5 * (theta + self.theta_s)).sin_cos();
+        let (sm, cm) = (self.theta_s + 0.5 * d).sin_cos();
         let dsin = 2.0 * cm * sh;
         let dcos = -2.0 * sm * sh;
         self.ws_sq * (1.0 + em1)
@@ -119,16 +125,50 @@ pub fn slip_time(ph: &SlipPhase, a: f64, b: f64, tol: f64) -> Result<f64, NotSte
         max_panels: 128,
     };
     let mut total = 0.0;
+    // Minimum at an end with a nonzero slope g there (the bead launched slowly just past the
+    // top): Θ̇² ≈ m + |g| u grows linearly away from it, and the layer has width m/|g|, not
+    // sqrt(m/q). Then w = sqrt(m + |g| u) is the variable that makes the integrand flat:
+    // dθ/Θ̇ = (2w/|g|) dw / Θ̇ ≈ 2 dw/|g|.
+    let g_end = if tm == a && ga > 0.0 {
+        ga
+    } else if tm == b && gb < 0.0 {
+        gb
+    } else {
+        0.0
+    };
+    let linear_layer = g_end != 0.0 && g_end.abs() > (m * q).sqrt();
+    if linear_layer {
+        let gl = g_end.abs();
+        let dir = g_end.signum();
+        let w0 = m.sqrt();
+        let w1 = (m + gl * (b - a)).sqrt();
+        let d0 = tm - ph.theta_s;
+        let span = b - a;
+        let r = integrate(
+            |w: f64| {
+                let u = ((w - w0) * (w + w0) / gl).min(span);
+                let g = ph.speed_sq_offset(d0 + dir * u);
+                if g > 0.0 {
+                    2.0 * w / (gl * g.sqrt())
+                } else {
+                    f64::INFINITY
+                }
+            },
+            w0,
+            w1,
+            opts,
+        );
+        total = r.value;
+    }
     for (lo, dir) in [(a, -1.0), (b, 1.0)] {
         let span = (lo - tm).abs();
-        if span == 0.0 {
+        if span == 0.0 || linear_layer {
             continue;
         }
         let tmax = (span / h).asinh();
         let r = integrate(
             |t: f64| {
-                let th = tm + dir * h * t.sinh();
-                let g = ph.speed_sq(th);
+                let g = ph.speed_sq_offset((tm - ph.theta_s) + dir * h * t.sinh());
                 if g > 0.0 {
                     h * t.cosh() / g.sqrt()
                 } else {

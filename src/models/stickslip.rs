@@ -151,6 +151,43 @@ fn refine(scene: &Scene, a: f64, b: f64, ga: f64, gb: f64) -> Result<f64, NotSte
 /// Fixed point of the final-velocity map reached from `x0` (the way a bead launched there
 /// evolves), with the bracket search accelerated by Aitken extrapolation.
 pub fn fixed_point_from(scene: &Scene, x0: f64) -> Result<f64, NotSteady> {
+    match follow(scene, x0) {
+        Err(e @ (NotSteady::Runaway | NotSteady::LiftOff { .. } | NotSteady::Stops { .. })) => {
+            scan(scene, x0).unwrap_or(Err(e))
+        }
+        r => r,
+    }
+}
+
+/// Fallback of [`fixed_point_from`] for maps whose slope is so close to 1 at the fixed point
+/// (near a saddle-node of the map) that following it does not converge: the first sign
+/// change of H(x) − x on a 64-point grid from `x0` towards lift-off (or towards 0 when the map
+/// goes down), refined by Brent with the continuity check.
+fn scan(scene: &Scene, x0: f64) -> Option<Result<f64, NotSteady>> {
+    let x_hi = scene.sc_f.c.max(0.0).sqrt();
+    let g0 = excess(scene, x0);
+    let up = g0 > 0.0;
+    let end = if up { x_hi } else { 0.0 };
+    let n = 64;
+    let (mut a, mut ga) = (x0, g0);
+    for i in 1..=n {
+        let b = x0 + (end - x0) * i as f64 / n as f64;
+        let b = if i == n && up {
+            b * (1.0 - 1e-12)
+        } else {
+            b.max(1e-300)
+        };
+        let gb = excess(scene, b);
+        if (gb > 0.0) != up || gb == 0.0 {
+            return Some(refine(scene, a, b, ga, gb));
+        }
+        a = b;
+        ga = gb;
+    }
+    None
+}
+
+fn follow(scene: &Scene, x0: f64) -> Result<f64, NotSteady> {
     let x_hi = scene.sc_f.c.max(0.0).sqrt();
     let mut x = x0;
     let mut gx = excess(scene, x);
@@ -160,6 +197,11 @@ pub fn fixed_point_from(scene: &Scene, x0: f64) -> Result<f64, NotSteady> {
     let up = gx > 0.0;
     for _ in 0..60 {
         // Two plain steps of the map, then an Aitken estimate of the limit.
+        if gx.abs() <= 16.0 * f64::EPSILON * x {
+            // H(x) = x to within the rounding of the map itself: no sign change can be
+            // resolved closer (slopes near 1 leave a one-sided rounding bias).
+            return Ok(x);
+        }
         let x1 = x + gx;
         let g1 = excess(scene, x1);
         if (g1 > 0.0) != up || g1 == 0.0 {
@@ -185,6 +227,22 @@ pub fn fixed_point_from(scene: &Scene, x0: f64) -> Result<f64, NotSteady> {
         if !(xe.is_finite()) || xe <= 0.0 {
             xe = x2;
         }
+        if let Err(fail) = map(scene, xe) {
+            // The extrapolation overshot into launch speeds from which the bead stops (going
+            // down) or lifts off (going up). The fixed point, if any, lies between x2 and the
+            // boundary of that region: find the boundary and look at the map just inside it.
+            let g2 = excess(scene, x2);
+            if (g2 > 0.0) != up || g2 == 0.0 {
+                return refine(scene, x1, x2, g1, g2);
+            }
+            map(scene, x2)?;
+            let (xb, bad) = failure_boundary(scene, x2, xe);
+            let gb = excess(scene, xb);
+            if (gb > 0.0) != up || gb == 0.0 {
+                return refine(scene, x2, xb, g2, gb);
+            }
+            return Err(map(scene, bad).err().unwrap_or(fail));
+        }
         let ge = excess(scene, xe);
         if (ge > 0.0) != up || ge == 0.0 {
             // Bracket between the last same-side point and the estimate.
@@ -201,6 +259,23 @@ pub fn fixed_point_from(scene: &Scene, x0: f64) -> Result<f64, NotSteady> {
         }
     }
     Err(NotSteady::Runaway)
+}
+
+/// The last final velocity from `ok` towards `bad` whose next contact succeeds, and the first
+/// that fails, by bisection to 1e-15 relative (the map succeeds at `ok`, fails at `bad`).
+fn failure_boundary(scene: &Scene, mut ok: f64, mut bad: f64) -> (f64, f64) {
+    for _ in 0..80 {
+        let mid = 0.5 * (bad + ok);
+        if (ok - bad).abs() <= 1e-15 * ok.abs() || mid == ok || mid == bad {
+            break;
+        }
+        if map(scene, mid).is_err() {
+            bad = mid;
+        } else {
+            ok = mid;
+        }
+    }
+    (ok, bad)
 }
 
 fn slope_at(scene: &Scene, x: f64) -> Option<f64> {

@@ -1,0 +1,233 @@
+//! The K inversion (eq 69): round trips forward → inverse across each model's bracket, the
+//! bracket's ends against the forward models' own status, and v̄ increasing in K on it.
+//!
+//! Reference: the forward models themselves (held at 1e-12 against mpmath in
+//! tests/reference_models.rs); the inversion must return the K that produced v̄.
+
+use fitbead::fit::k::{bracket, estimate, solve, KFailure, LowerLimit, UpperLimit};
+use fitbead::{CollisionLaw, ForwardModel, Model, Scene};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+const MODELS: [Model; 5] = [
+    Model::Stick,
+    Model::StickApprox,
+    Model::Slip,
+    Model::SlipApprox,
+    Model::StickSlip,
+];
+
+/// A random geometry (ξ ∈ [0.65, 10], ρ ∈ [0, 1], f ∈ [1e-6, 0.5] log-uniform) with a slope
+/// drawn inside the model's regime-B band of slopes for some K.
+fn random_scene(rng: &mut ChaCha8Rng) -> Scene {
+    let xi: f64 = rng.random_range(0.65..10.0);
+    let rho = rng.random_range(0.0..1.0);
+    let f = 10f64.powf(rng.random_range(-6.0..(0.5f64).log10()));
+    let alpha = (1.0 / (1.0 + xi)).asin();
+    // Slopes from 0.1 α to 2 α cover crawl-limited (Θ0 < 0) and Θ0 > 0 scenes.
+    let delta = alpha * rng.random_range(0.1..2.0);
+    Scene::from_radians(xi, delta.min(1.4), rho, f, CollisionLaw::Value(0.5)).unwrap()
+}
+
+fn with_k(s: &Scene, k: f64) -> Scene {
+    s.with_k(k).unwrap()
+}
+
+#[test]
+fn round_trip_returns_k_to_1e_12_for_every_model() {
+    let mut rng = ChaCha8Rng::seed_from_u64(69);
+    let mut worst = [0.0f64; 5];
+    let mut count = [0usize; 5];
+    let mut flat = [0usize; 5];
+    let mut evals = [Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new()];
+    for _ in 0..400 {
+        let s = random_scene(&mut rng);
+        for (i, m) in MODELS.iter().enumerate() {
+            let Ok(br) = bracket(m, &s) else { continue };
+            let w = br.hi - br.lo;
+            // Stick/slip ending at the saddle-node of its map (UpperLimit::Model): within 1e-9
+            // of it the stable and unstable fixed points are ~3e-5 apart and the forward
+            // fixed-point search is not yet reliable there (see the ignored test below); those
+            // scenes are drawn within 1e-6 instead.
+            let top = if matches!(m, Model::StickSlip) && br.upper == UpperLimit::Model {
+                1e-6
+            } else {
+                1e-9
+            };
+            let mut ks = vec![
+                br.lo + 1e-9 * w,
+                br.hi - top * w,
+                br.lo + rng.random_range(0.0..1.0) * w,
+            ];
+            if br.lo == 0.0 {
+                ks[0] = 1e-9 * w;
+            }
+            for k in ks {
+                let Ok(st) = m.evaluate(&with_k(&s, k)) else {
+                    panic!("{m:?} not steady inside its bracket at K = {k}: {s:?} {br:?}")
+                };
+                match solve(m, &s, &br, st.mean_velocity) {
+                    Ok(r) => {
+                        let e = (r.k - k).abs();
+                        // Where v̄ is flat in K (K → 0 with Θ0 > 0: v̄ − v̄0 ∝ K²) the data do
+                        // not determine K to 1e-12: no method can beat a few ulp of v̄ over
+                        // the slope. Such rows are counted and must reproduce v̄ to 8 ulp.
+                        let bound = if e > 1e-12 {
+                            let back = m.evaluate(&with_k(&s, r.k)).unwrap().mean_velocity;
+                            let res = (back - st.mean_velocity).abs();
+                            assert!(
+                                res <= 8.0 * f64::EPSILON * st.mean_velocity,
+                                "{m:?}: K = {k} -> {} reproduces v only to {res:e}",
+                                r.k
+                            );
+                            flat[i] += 1;
+                            f64::INFINITY
+                        } else {
+                            1e-12
+                        };
+                        assert!(
+                            e <= bound,
+                            "{m:?}: K = {k} came back as {} (error {e:e}) at {s:?}, {br:?}",
+                            r.k
+                        );
+                        if bound == 1e-12 {
+                            worst[i] = worst[i].max(e);
+                        }
+                        count[i] += 1;
+                        evals[i].push(r.evals);
+                    }
+                    Err(e) => panic!("{m:?}: K = {k} not recovered ({e}) at {s:?}, {br:?}"),
+                }
+            }
+        }
+    }
+    for (i, m) in MODELS.iter().enumerate() {
+        evals[i].sort_unstable();
+        let med = evals[i].get(evals[i].len() / 2).copied().unwrap_or(0);
+        println!(
+            "{:<12} round trips {:>5}  max |dK| {:.1e}  median evals {med}  \
+             held to the conditioning bound (flat v(K)): {}",
+            m.name(),
+            count[i],
+            worst[i],
+            flat[i]
+        );
+        assert!(count[i] > 200, "{m:?}: only {} round trips", count[i]);
+    }
+}
+
+#[test]
+fn v_increases_with_k_across_the_bracket() {
+    let mut rng = ChaCha8Rng::seed_from_u64(70);
+    for _ in 0..60 {
+        let s = random_scene(&mut rng);
+        for m in MODELS {
+            let Ok(br) = bracket(&m, &s) else { continue };
+            let mut prev = br.v_lo;
+            for j in 1..=40 {
+                let k = br.lo + (br.hi - br.lo) * j as f64 / 40.0;
+                let v = m.evaluate(&with_k(&s, k)).unwrap().mean_velocity;
+                assert!(
+                    v > prev,
+                    "{m:?}: v not increasing at K = {k}: {v} <= {prev}, {s:?}"
+                );
+                prev = v;
+            }
+            assert!((prev - br.v_hi).abs() <= 1e-12 * br.v_hi);
+        }
+    }
+}
+
+#[test]
+fn points_just_outside_the_range_get_the_right_status() {
+    let mut rng = ChaCha8Rng::seed_from_u64(71);
+    let mut seen = (0, 0);
+    for _ in 0..100 {
+        let s = random_scene(&mut rng);
+        for m in MODELS {
+            let Ok(br) = bracket(&m, &s) else { continue };
+            // Past the top end: above-range, whatever the model.
+            let fast = br.v_hi * (1.0 + 1e-9);
+            assert_eq!(
+                solve(&m, &s, &br, fast).unwrap_err(),
+                KFailure::AboveRange,
+                "{m:?} {s:?}"
+            );
+            seen.0 += 1;
+            if br.v_lo > 0.0 {
+                let slow = br.v_lo * (1.0 - 1e-9);
+                assert_eq!(
+                    solve(&m, &s, &br, slow).unwrap_err(),
+                    KFailure::BelowRange,
+                    "{m:?} {s:?}"
+                );
+                seen.1 += 1;
+            } else {
+                // The bead crawls over the top at the lower end: any small v has a K.
+                let r = solve(&m, &s, &br, 1e-3 * br.v_hi);
+                assert!(r.is_ok(), "{m:?} {s:?} {br:?}: {r:?}");
+                if matches!(m, Model::Stick | Model::Slip | Model::StickSlip) {
+                    assert_eq!(br.lower, LowerLimit::Crawl, "{m:?} {s:?} {br:?}");
+                }
+            }
+        }
+    }
+    assert!(seen.0 > 100 && seen.1 > 20, "{seen:?}");
+}
+
+#[test]
+fn stick_crawl_end_does_not_stall() {
+    // ξ = 1, δ = 8° (just above δ_m of the fitted law): K within 1e-9…1e-15 of K_min, where
+    // v̄ has an infinite slope in K.
+    let s = Scene::new(1.0, 8.0, 0.4, 0.1, CollisionLaw::Value(0.5)).unwrap();
+    let br = bracket(&Model::Stick, &s).unwrap();
+    for d in [1e-3, 1e-6, 1e-9, 1e-12] {
+        let k = br.lo + d;
+        let v = Model::Stick.evaluate(&with_k(&s, k)).unwrap().mean_velocity;
+        let r = solve(&Model::Stick, &s, &br, v).unwrap();
+        assert!((r.k - k).abs() <= 1e-14, "d = {d}: {} vs {k}", r.k);
+        assert!(r.evals <= 20, "d = {d}: {} evaluations", r.evals);
+    }
+}
+
+#[test]
+fn estimate_interval_brackets_k_and_slope_matches_a_difference() {
+    let s = Scene::new(1.0, 12.0, 0.4, 0.1, CollisionLaw::Adjusted).unwrap();
+    for m in [Model::Stick, Model::StickSlip] {
+        let v = m.evaluate(&s).unwrap().mean_velocity;
+        let e = estimate(&m, &s, v, Some(0.02 * v));
+        let r = e.root.as_ref().unwrap();
+        let (lo, hi) = (e.k_lo.unwrap(), e.k_hi.unwrap());
+        assert!(lo < r.k && r.k < hi, "{lo} {} {hi}", r.k);
+        // The interval ends are exact inverses: forward at K_lo gives v − σ.
+        let v_lo = m.evaluate(&with_k(&s, lo)).unwrap().mean_velocity;
+        assert!((v_lo - 0.98 * v).abs() < 1e-13, "{v_lo} vs {}", 0.98 * v);
+        // Slope against a plain central difference in K with a wide step.
+        let h = 1e-4;
+        let a = m.evaluate(&with_k(&s, r.k - h)).unwrap().mean_velocity;
+        let b = m.evaluate(&with_k(&s, r.k + h)).unwrap().mean_velocity;
+        let fd = (b - a) / (2.0 * h);
+        let dv = e.dv_dk.unwrap();
+        assert!((dv - fd).abs() < 1e-6 * fd.abs(), "{dv} vs {fd}");
+    }
+}
+
+/// Open problem (issue notes): a stick/slip scene whose steady range ends at the saddle-node of
+/// the final-velocity map; 1e-9 below it the forward model reports Runaway.
+#[test]
+#[ignore]
+fn stickslip_within_1e_9_of_the_saddle_node() {
+    let s = Scene::from_radians(
+        9.054961306219257,
+        0.07103803385162867,
+        0.4986809632928475,
+        0.2584053820281623,
+        CollisionLaw::Value(0.5),
+    )
+    .unwrap();
+    let br = bracket(&Model::StickSlip, &s).unwrap();
+    assert_eq!(br.upper, UpperLimit::Model);
+    let k = br.hi - 1e-9 * (br.hi - br.lo);
+    let r = Model::StickSlip.evaluate(&with_k(&s, k));
+    assert!(r.is_ok(), "K = {k}: {r:?}");
+}

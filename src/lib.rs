@@ -22,6 +22,7 @@
 pub mod error;
 pub mod fit;
 pub mod models;
+pub mod report;
 pub mod scene;
 pub mod special;
 

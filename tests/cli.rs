@@ -226,3 +226,192 @@ fn forward_without_input_runs_on_the_embedded_default_data() {
     );
     assert_eq!(s.lines().count(), 37);
 }
+
+fn k_table(out: &std::process::Output) -> (Vec<String>, Vec<Vec<String>>) {
+    let s = String::from_utf8(out.stdout.clone()).unwrap();
+    let mut rdr = csv::Reader::from_reader(s.as_bytes());
+    let header = rdr.headers().unwrap().iter().map(String::from).collect();
+    let rows = rdr
+        .records()
+        .map(|r| r.unwrap().iter().map(String::from).collect())
+        .collect();
+    (header, rows)
+}
+
+#[test]
+fn k_on_default_data_has_the_contract_columns_and_exact_round_trip() {
+    let out = bin().args(["k", "--model", "stick"]).output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (h, rows) = k_table(&out);
+    let contract = "series,xi,delta_deg,v,sigma_v,model,K,K_lo,K_hi,dv_dK,final_velocity,\
+                    theta_G_deg,K_cos2a,K_adjusted,K_impact,regime,status,iterations";
+    assert_eq!(h[..18].join(","), contract);
+    assert_eq!(rows.len(), 36);
+    let col = |n: &str| h.iter().position(|x| x == n).unwrap();
+    for r in &rows {
+        assert_eq!(r[col("status")], "ok", "{r:?}");
+        // Forward with the K found gives back v (the library's round trip, through the CLI).
+        let fwd = bin()
+            .args([
+                "forward",
+                "--model",
+                "stick",
+                "--xi",
+                &r[col("xi")],
+                "--delta-deg",
+                &r[col("delta_deg")],
+                "--K",
+                &r[col("K")],
+            ])
+            .output()
+            .unwrap();
+        let (fh, frows) = k_table(&fwd);
+        let v: f64 = frows[0][fh.iter().position(|x| x == "v").unwrap()]
+            .parse()
+            .unwrap();
+        let v0: f64 = r[col("v")].parse().unwrap();
+        assert!((v - v0).abs() <= 1e-14 * v0, "{v} vs {v0}");
+        let k: f64 = r[col("K")].parse().unwrap();
+        let lo: f64 = r[col("K_lo")].parse().unwrap();
+        let hi: f64 = r[col("K_hi")].parse().unwrap();
+        assert!(lo < k && k < hi);
+    }
+}
+
+#[test]
+fn k_dimensional_input_matches_dimensionless() {
+    let dir = tmpdir();
+    // ξ = 1, R = 3 mm, g = 9.81: v_m_s = v · sqrt(g R (1 + ξ)).
+    let v = 0.39120827263;
+    let scale = (9.81f64 * 0.003 * 2.0).sqrt();
+    let a = write(
+        &dir,
+        "a.csv",
+        &format!("series,xi,delta_deg,v\ns,1,12,{v}\n"),
+    );
+    let b = write(
+        &dir,
+        "b.csv",
+        &format!(
+            "series,xi,delta_deg,v_m_s,R_m\ns,1,12,{},0.003\n",
+            v * scale
+        ),
+    );
+    let ka = bin()
+        .args(["k", "--model", "stick"])
+        .arg(&a)
+        .output()
+        .unwrap();
+    let kb = bin()
+        .args(["k", "--model", "stick", "--input"])
+        .arg(&b)
+        .output()
+        .unwrap();
+    let (ha, ra) = k_table(&ka);
+    let (hb, rb) = k_table(&kb);
+    let k = |h: &[String], r: &[Vec<String>]| -> f64 {
+        r[0][h.iter().position(|x| x == "K").unwrap()]
+            .parse()
+            .unwrap()
+    };
+    // MODEL.md §2: v̄ = 0.39120827… at the paper's fitted law, K = cos 60° + ½ sin²30° sin 60°.
+    let k_paper = 0.5 + 0.0625 * 3f64.sqrt();
+    assert!((k(&ha, &ra) - k_paper).abs() < 1e-8, "{}", k(&ha, &ra));
+    assert!((k(&ha, &ra) - k(&hb, &rb)).abs() < 1e-13);
+    assert!(hb.contains(&"v_m_s".to_string()) && hb.contains(&"R_m".to_string()));
+}
+
+#[test]
+fn k_reports_out_of_range_points_with_a_status() {
+    let dir = tmpdir();
+    // ξ = 4, δ = 15° (Θ0 = 3.46° > 0): v far above the lift-off speed, and below the K → 0
+    // limit (the bead launched at rest past the top is already faster).
+    let p = write(
+        &dir,
+        "m.csv",
+        "series,xi,delta_deg,v,sigma_v\na,4,15,5,0.1\na,4,15,0.01,0.001\nb,1,12,0.39,0.01\n",
+    );
+    let out = bin()
+        .args(["k", "--model", "stickslip", "--input"])
+        .arg(&p)
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let (h, rows) = k_table(&out);
+    let st = h.iter().position(|x| x == "status").unwrap();
+    let k = h.iter().position(|x| x == "K").unwrap();
+    assert_eq!(rows[0][st], "above-range");
+    assert_eq!(rows[1][st], "below-range");
+    assert_eq!(rows[2][st], "ok");
+    assert!(rows[0][k].is_empty() && rows[1][k].is_empty());
+    assert_eq!(rows[0][h.iter().position(|x| x == "regime").unwrap()], "C");
+    assert_eq!(rows[1][h.iter().position(|x| x == "regime").unwrap()], "A");
+}
+
+#[test]
+fn k_bad_input_exits_2_with_location_and_leaves_output_untouched() {
+    let dir = tmpdir();
+    let out_path = write(&dir, "out.csv", "precious\n");
+    let cases = [
+        (
+            "series,xi,delta_deg,v,sigma_v\na,1,12,0.3,0\n",
+            "line 2",
+            "sigma_v",
+        ),
+        (
+            "series,xi,delta_deg,v,sigma_v\na,1,12,-0.3,0.01\n",
+            "line 2",
+            "'v'",
+        ),
+        (
+            "series,xi,delta_deg,v\na,1,12,0.3\na,2,12,0.3\n",
+            "line 3",
+            "mixes xi",
+        ),
+        ("series,xi,delta_deg\na,1,12\n", "line 1", "'v'"),
+        (
+            "series,xi,delta_deg,v\na,1,12,abc\n",
+            "value 'abc'",
+            "not a number",
+        ),
+        ("series,xi,delta_deg,v_m_s\na,1,12,0.3\n", "R_m", "missing"),
+    ];
+    for (text, want1, want2) in cases {
+        let p = write(&dir, "bad.csv", text);
+        let out = bin()
+            .args(["k", "--model", "stick", "--input"])
+            .arg(&p)
+            .arg("--output")
+            .arg(&out_path)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{text}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("bad.csv"), "{err}");
+        assert!(err.contains(want1) && err.contains(want2), "{text}: {err}");
+        assert_eq!(std::fs::read_to_string(&out_path).unwrap(), "precious\n");
+    }
+}
+
+#[test]
+fn k_plot_writes_an_svg() {
+    let dir = tmpdir();
+    let svg = dir.path().join("k.svg");
+    let out = bin()
+        .args(["k", "--model", "stick", "--plot"])
+        .arg(&svg)
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let s = std::fs::read_to_string(&svg).unwrap();
+    assert!(
+        s.starts_with("<svg") && s.contains("cos 2alpha"),
+        "{}",
+        &s[..200]
+    );
+    assert!(s.matches("<circle").count() >= 36);
+}

@@ -1,6 +1,7 @@
 //! The command line: one module per subcommand. Errors are rendered here, once.
 
 pub mod forward;
+pub mod k;
 pub mod regimes;
 pub mod simulate;
 
@@ -29,6 +30,8 @@ pub struct Cli {
 pub enum Command {
     /// Mean velocity, regime and diagnostics of scenes under one forward model.
     Forward(forward::Args),
+    /// The collisional parameter K of every measured point (eq 69), with its interval.
+    K(k::Args),
     /// Regime limits δ_m (eq 32) and δ_d (eq 31) per ξ, and the critical ξ, for a law.
     Regimes(regimes::Args),
     /// Synthetic measurements inside regime B, reproducible from a seed.
@@ -64,6 +67,7 @@ impl std::fmt::Display for CliError {
 pub fn run(cli: Cli) -> i32 {
     let r = match cli.command {
         Command::Forward(a) => forward::run(a),
+        Command::K(a) => k::run(a),
         Command::Regimes(a) => regimes::run(a),
         Command::Simulate(a) => simulate::run(a),
     };

@@ -296,9 +296,17 @@ pub fn bracket(model: &Model, scene: &Scene) -> Result<KBracket, KFailure> {
             "no K gives a steady state at this xi and slope (the bead stops or lifts off)".into(),
         )
     };
-    let (lo, hi, mut lower) = candidate(model, scene).ok_or_else(none)?;
+    let (lo, hi, mut lower) = candidate(model, scene).ok_or_else(|| {
+        KFailure::Invalid(
+            "no K gives a steady state: the bead lifts off at this xi and slope even as K -> 0"
+                .into(),
+        )
+    })?;
     if !(lo < hi) {
-        return Err(none());
+        return Err(KFailure::Invalid(format!(
+            "no K gives a steady state: the lowest K that carries the bead over the top \
+             ({lo:.6}) already makes it lift off (K_d = {hi:.6})"
+        )));
     }
     let tiny = (hi - lo) * 1e-9;
     let hi_in = hi * (1.0 - 4.0 * f64::EPSILON);

@@ -1,0 +1,366 @@
+//! `fitbead k`: the collisional parameter K of every measured point (eq 69), its interval at
+//! v ± σ, and why where there is none.
+
+use super::{emit, read_input, CliError};
+use crate::fit::k::{estimate, KEstimate, KFailure, LowerLimit, UpperLimit};
+use crate::io::scenes::Table;
+use crate::io::{fmt_f64, write_atomic, InputError};
+use crate::models::{Model, ModelKind};
+use crate::report::figures::{scatter_svg, PointSeries, Scatter};
+use crate::scene::{CollisionLaw, Scene};
+use rayon::prelude::*;
+use std::path::PathBuf;
+
+/// Arguments of `fitbead k`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Contact model: stick, stick-approx, slip, slip-approx, stickslip.
+    #[arg(long)]
+    pub model: String,
+    /// Measurements CSV: series,xi,delta_deg,v[,sigma_v] (v dimensionless), or dimensional
+    /// v_m_s,R_m[,g][,sigma_v_m_s] instead of v. Without it: the embedded default data set.
+    #[arg(long)]
+    pub input: Option<PathBuf>,
+    /// The measurements CSV given as a plain argument (same as --input).
+    #[arg(value_name = "DATA.csv", conflicts_with = "input")]
+    pub data: Option<PathBuf>,
+    /// Gyration parameter ρ (2/5 sphere, 1/2 cylinder), for rows without a rho column.
+    #[arg(long, default_value_t = 0.4)]
+    pub rho: f64,
+    /// Coulomb friction coefficient f, for rows without an f column.
+    #[arg(long, default_value_t = 0.1)]
+    pub f: f64,
+    /// Gravity g in m/s² for dimensional rows without a g column.
+    #[arg(long, default_value_t = 9.81)]
+    pub g: f64,
+    /// Output CSV (written atomically); stdout when absent.
+    #[arg(long)]
+    pub output: Option<PathBuf>,
+    /// SVG of K against the steady final velocity, one colour per series, with the cos 2α
+    /// lines (as the paper's Fig. 5).
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
+}
+
+/// The contract columns, in order.
+pub const COLUMNS: [&str; 18] = [
+    "series",
+    "xi",
+    "delta_deg",
+    "v",
+    "sigma_v",
+    "model",
+    "K",
+    "K_lo",
+    "K_hi",
+    "dv_dK",
+    "final_velocity",
+    "theta_G_deg",
+    "K_cos2a",
+    "K_adjusted",
+    "K_impact",
+    "regime",
+    "status",
+    "iterations",
+];
+
+/// Columns added after the contract ones.
+pub const EXTRA_COLUMNS: [&str; 5] = ["K_min", "K_max", "lower_limit", "upper_limit", "message"];
+
+/// One measurement, validated.
+#[derive(Debug, Clone)]
+pub struct Row {
+    /// Series label (empty when the file has none).
+    pub series: String,
+    /// The scene (its K is a placeholder).
+    pub scene: Scene,
+    /// Dimensionless mean velocity.
+    pub v: f64,
+    /// Its standard deviation, when given.
+    pub sigma_v: Option<f64>,
+}
+
+fn positive(t: &Table, r: usize, c: usize, what: &str) -> Result<f64, InputError> {
+    let x = t.number(r, c)?;
+    if x > 0.0 {
+        Ok(x)
+    } else {
+        Err(t.err(r, c, format!("{what} must be > 0")))
+    }
+}
+
+/// Reads and validates the measurements (dimensional input converted with
+/// v = v_m_s / sqrt(g R (1 + ξ))).
+pub fn read_rows(t: &Table, rho: f64, f: f64, g: f64) -> Result<Vec<Row>, CliError> {
+    let c_xi = t.require("xi")?;
+    let c_d = t.require("delta_deg")?;
+    let c_series = t.col("series");
+    let c_v = t.col("v");
+    let c_vms = t.col("v_m_s");
+    let c_sigma = t.col("sigma_v");
+    let c_sigma_ms = t.col("sigma_v_m_s");
+    let c_r = t.col("R_m");
+    let c_g = t.col("g");
+    let c_rho = t.col("rho");
+    let c_f = t.col("f");
+    if c_v.is_none() && c_vms.is_none() {
+        return Err(t.require("v").unwrap_err().into());
+    }
+    if c_v.is_none() && c_r.is_none() {
+        return Err(t.require("R_m").unwrap_err().into());
+    }
+    if !(g > 0.0 && g.is_finite()) {
+        return Err(super::flag_error("--g", &g.to_string(), "g must be > 0"));
+    }
+    let mut first_xi: std::collections::HashMap<String, (f64, u64)> = Default::default();
+    let mut rows = Vec::with_capacity(t.rows.len());
+    for r in 0..t.rows.len() {
+        let xi = t.number(r, c_xi)?;
+        let d = t.number(r, c_d)?;
+        let rho = t.opt_number(r, c_rho)?.unwrap_or(rho);
+        let f = t.opt_number(r, c_f)?.unwrap_or(f);
+        let scene = Scene::new(xi, d, rho, f, CollisionLaw::Value(0.5)).map_err(|e| {
+            let col = match &e {
+                crate::Error::InvalidParameter { field, .. } => match *field {
+                    "xi" => Some(c_xi),
+                    "delta" | "delta_deg" => Some(c_d),
+                    "rho" => c_rho,
+                    "f" => c_f,
+                    _ => None,
+                },
+                _ => None,
+            };
+            match col {
+                Some(c) => CliError::Input(t.err(r, c, e.to_string())),
+                None => CliError::Other(format!("{}, line {}: {e}", t.source, t.lines[r])),
+            }
+        })?;
+        let (v, sigma_v) = match c_v {
+            Some(c) => {
+                let v = positive(t, r, c, "v")?;
+                let s = match c_sigma {
+                    Some(cs) if !t.cell(r, cs).is_empty() => Some(positive(t, r, cs, "sigma_v")?),
+                    _ => None,
+                };
+                (v, s)
+            }
+            None => {
+                let (c, cr) = (c_vms.unwrap_or(0), c_r.unwrap_or(0));
+                let vms = positive(t, r, c, "v_m_s")?;
+                let radius = positive(t, r, cr, "R_m")?;
+                let gg = match c_g {
+                    Some(cg) if !t.cell(r, cg).is_empty() => positive(t, r, cg, "g")?,
+                    _ => g,
+                };
+                let scale = (gg * radius * (1.0 + xi)).sqrt();
+                let s = match (c_sigma_ms, c_sigma) {
+                    (Some(cs), _) if !t.cell(r, cs).is_empty() => {
+                        Some(positive(t, r, cs, "sigma_v_m_s")? / scale)
+                    }
+                    (_, Some(cs)) if !t.cell(r, cs).is_empty() => {
+                        Some(positive(t, r, cs, "sigma_v")?)
+                    }
+                    _ => None,
+                };
+                (vms / scale, s)
+            }
+        };
+        let series = c_series
+            .map(|c| t.cell(r, c).to_string())
+            .unwrap_or_default();
+        if let Some(c) = c_series {
+            match first_xi.get(&series) {
+                Some(&(x0, line)) if x0 != xi => {
+                    return Err(t
+                        .err(
+                            r,
+                            c_xi,
+                            format!(
+                                "series '{series}' mixes xi values: {} on line {line}, {} here",
+                                fmt_f64(x0),
+                                fmt_f64(xi)
+                            ),
+                        )
+                        .into());
+                }
+                Some(_) => {}
+                None => {
+                    first_xi.insert(series.clone(), (xi, t.lines[r]));
+                }
+            }
+            let _ = c;
+        }
+        rows.push(Row {
+            series,
+            scene,
+            v,
+            sigma_v,
+        });
+    }
+    Ok(rows)
+}
+
+/// Parses the model flag of `k` (the five contact models).
+pub fn parse_model(name: &str) -> Result<Model, CliError> {
+    let err = || {
+        super::flag_error(
+            "--model",
+            name,
+            "expected one of stick, stick-approx, slip, slip-approx, stickslip",
+        )
+    };
+    let kind: ModelKind = name.parse().map_err(|_| err())?;
+    kind.contact_model().ok_or_else(err)
+}
+
+/// Runs `fitbead k`.
+pub fn run(a: Args) -> Result<(), CliError> {
+    let model = parse_model(&a.model)?;
+    let input = a.input.as_deref().or(a.data.as_deref());
+    let (source, text) = read_input(input)?;
+    let t = Table::parse(&source, &text)?;
+    let rows = read_rows(&t, a.rho, a.f, a.g)?;
+    let results: Vec<KEstimate> = rows
+        .par_iter()
+        .map(|r| estimate(&model, &r.scene, r.v, r.sigma_v))
+        .collect();
+    let bytes =
+        render(&t, &rows, &results, &a.model).map_err(|e| CliError::Other(e.to_string()))?;
+    if let Some(p) = &a.plot {
+        let svg = plot(&rows, &results, &a.model).map_err(CliError::Other)?;
+        write_atomic(p, svg.as_bytes())
+            .map_err(|e| CliError::Other(format!("{}: cannot write: {e}", p.display())))?;
+    }
+    emit(a.output.as_deref(), &bytes)
+}
+
+fn lower_name(l: LowerLimit) -> &'static str {
+    match l {
+        LowerLimit::Crawl => "crawl-over-top",
+        LowerLimit::Zero => "K=0",
+        LowerLimit::Model => "model-limit",
+    }
+}
+
+fn upper_name(u: UpperLimit) -> &'static str {
+    match u {
+        UpperLimit::LiftOff => "lift-off",
+        UpperLimit::Model => "model-limit",
+    }
+}
+
+fn render(t: &Table, rows: &[Row], res: &[KEstimate], model: &str) -> csv::Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::with_capacity(rows.len() * 260));
+    let own: Vec<&str> = COLUMNS
+        .iter()
+        .chain(EXTRA_COLUMNS.iter())
+        .copied()
+        .collect();
+    let input_own = ["series", "xi", "delta_deg", "v", "sigma_v"];
+    let pass: Vec<usize> = (0..t.headers.len())
+        .filter(|&i| !input_own.contains(&t.headers[i].as_str()))
+        .collect();
+    let mut header: Vec<String> = own.iter().map(|s| s.to_string()).collect();
+    for &i in &pass {
+        let h = &t.headers[i];
+        header.push(if own.contains(&h.as_str()) {
+            format!("in_{h}")
+        } else {
+            h.clone()
+        });
+    }
+    w.write_record(&header)?;
+    let opt = |x: Option<f64>| x.map(fmt_f64).unwrap_or_default();
+    for (i, (row, e)) in rows.iter().zip(res).enumerate() {
+        let s = &row.scene;
+        let mut out: Vec<String> = Vec::with_capacity(header.len());
+        out.push(row.series.clone());
+        out.push(fmt_f64(s.xi));
+        out.push(t.cell(i, t.col("delta_deg").unwrap_or(0)).to_string());
+        out.push(fmt_f64(row.v));
+        out.push(opt(row.sigma_v));
+        out.push(model.to_string());
+        let (k, fv, iters) = match &e.root {
+            Ok(r) => (
+                Some(r.k),
+                Some(r.steady.final_velocity),
+                Some(r.evals as f64),
+            ),
+            Err(_) => (None, None, None),
+        };
+        out.push(opt(k));
+        out.push(opt(e.k_lo));
+        out.push(opt(e.k_hi));
+        out.push(opt(e.dv_dk));
+        out.push(opt(fv));
+        out.push(opt(e.theta_g.map(f64::to_degrees)));
+        out.push(fmt_f64(CollisionLaw::Cos2a.k(s.alpha, s.rho)));
+        out.push(fmt_f64(CollisionLaw::Adjusted.k(s.alpha, s.rho)));
+        out.push(fmt_f64(CollisionLaw::Impact.k(s.alpha, s.rho)));
+        let (regime, status) = match &e.root {
+            Ok(_) => ("B", "ok"),
+            Err(KFailure::BelowRange) => ("A", "below-range"),
+            Err(KFailure::AboveRange) => ("C", "above-range"),
+            Err(KFailure::Invalid(_)) => ("", "invalid"),
+        };
+        out.push(regime.into());
+        out.push(status.into());
+        out.push(opt(iters));
+        match &e.bracket {
+            Some(b) => {
+                out.push(fmt_f64(b.lo));
+                out.push(fmt_f64(b.hi));
+                out.push(lower_name(b.lower).into());
+                out.push(upper_name(b.upper).into());
+            }
+            None => out.extend(std::iter::repeat_n(String::new(), 4)),
+        }
+        let mut msg: Vec<String> = Vec::new();
+        if let Err(f) = &e.root {
+            msg.push(f.to_string());
+        }
+        msg.extend(e.notes.iter().map(|s| s.to_string()));
+        out.push(msg.join("; "));
+        for &c in &pass {
+            out.push(t.cell(i, c).to_string());
+        }
+        w.write_record(&out)?;
+    }
+    w.into_inner().map_err(|e| csv::Error::from(e.into_error()))
+}
+
+fn plot(rows: &[Row], res: &[KEstimate], model: &str) -> Result<String, String> {
+    let mut series: Vec<PointSeries> = Vec::new();
+    for (row, e) in rows.iter().zip(res) {
+        let Ok(r) = &e.root else { continue };
+        let label = if row.series.is_empty() {
+            format!("xi = {}", fmt_f64(row.scene.xi))
+        } else {
+            format!("series {}", row.series)
+        };
+        let idx = match series.iter().position(|s| s.label == label) {
+            Some(i) => i,
+            None => {
+                let c2 = CollisionLaw::Cos2a.k(row.scene.alpha, row.scene.rho);
+                series.push(PointSeries {
+                    label: label.clone(),
+                    points: Vec::new(),
+                    reference: Some((c2, format!("cos 2alpha = {c2:.4}"))),
+                });
+                series.len() - 1
+            }
+        };
+        series[idx].points.push((
+            r.steady.final_velocity,
+            r.k,
+            e.k_lo.unwrap_or(r.k),
+            e.k_hi.unwrap_or(r.k),
+        ));
+    }
+    scatter_svg(&Scatter {
+        title: format!("K per measurement (eq 69), {model} model"),
+        x_label: "steady final velocity (units sqrt(g(R+r)))".into(),
+        y_label: "K".into(),
+        series,
+    })
+}

@@ -1,0 +1,3 @@
+//! Reports: figures (SVG) and, in later issues, uncertainty tables and model comparison.
+
+pub mod figures;

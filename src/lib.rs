@@ -20,6 +20,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod error;
+pub mod inverse;
 pub mod models;
 pub mod scene;
 pub mod special;

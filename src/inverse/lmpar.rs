@@ -18,6 +18,9 @@
 //! The matrices here are tiny (n × n with n the number of free parameters), stored column-major
 //! in plain slices: `r[i + j * n]`.
 
+// Index loops mirror the subscripts of the published algorithm (MINPACK-1).
+#![allow(clippy::needless_range_loop)]
+
 /// Workspace and result of one subproblem solve.
 #[derive(Debug, Clone)]
 pub(crate) struct Subproblem {

@@ -880,3 +880,79 @@ fn double_double_helpers() {
     assert_eq!(parse_dd("-2.5E+00").unwrap().to_f64(), -2.5);
     assert_eq!(parse_dd("0.000000000000E+00").unwrap().to_f64(), 0.0);
 }
+
+/// Profile-likelihood intervals on every StRD problem (from start 2), next to the covariance
+/// intervals. With s² scaling the F-based profile threshold makes the two agree for nearly
+/// linear problems; the strongly nonlinear ones show how far apart they drift.
+#[test]
+fn nist_profile_intervals() {
+    let opts = options();
+    println!(
+        "{:<9} {:>3} {:>14} {:>10} {:>10} {:>7}",
+        "problem", "b", "estimate", "lo/Wald", "hi/Wald", "fits"
+    );
+    let mut found = 0;
+    let mut total = 0;
+    let mut agree = 0;
+    for p in problems() {
+        let d = data(&p);
+        let f = run(&p, 1, &opts);
+        assert!(f.converged());
+        let ci = fitbead::inverse::confidence_intervals(&d, &f, 0.95, &opts).unwrap();
+        let wald = ci.covariance.as_ref().unwrap();
+        for (k, pi) in ci.profile.iter().enumerate() {
+            total += 2;
+            let b = f.params[k];
+            let half = b - wald[k].lower;
+            let rel = |e: fitbead::inverse::ProfileEnd| match e {
+                fitbead::inverse::ProfileEnd::Found(v) => format!("{:.4}", (v - b).abs() / half),
+                other => format!("{other:?}"),
+            };
+            println!(
+                "{:<9} {:>3} {:>14.6e} {:>10} {:>10} {:>7}",
+                p.name,
+                k + 1,
+                b,
+                rel(pi.lower),
+                rel(pi.upper),
+                pi.fits
+            );
+            for e in [pi.lower, pi.upper] {
+                if let Some(v) = e.value() {
+                    found += 1;
+                    // Re-check the end independently: Δχ² there equals the threshold.
+                    let mut lower = vec![f64::NEG_INFINITY; f.params.len()];
+                    let mut upper = vec![f64::INFINITY; f.params.len()];
+                    lower[k] = v;
+                    upper[k] = v;
+                    let mut start = f.params.clone();
+                    start[k] = v;
+                    let o = LsqOptions {
+                        lower: Some(lower),
+                        upper: Some(upper),
+                        ..opts.clone()
+                    };
+                    // The independent fit starts cold (the other parameters at the optimum),
+                    // so it may stop in a worse local minimum than the profile's continuation;
+                    // it must never find a lower one.
+                    let g = fit(&d, &start, &o).unwrap();
+                    let dchi2 = g.chi2 - f.chi2;
+                    assert!(
+                        dchi2 >= ci.threshold * (1.0 - 1e-5),
+                        "{} b{}: Δχ² {dchi2:e} below the threshold {:e}",
+                        p.name,
+                        k + 1,
+                        ci.threshold
+                    );
+                    if (dchi2 - ci.threshold).abs() <= 1e-5 * ci.threshold {
+                        agree += 1;
+                    }
+                }
+            }
+        }
+    }
+    println!(
+        "{found} of {total} profile ends found; {agree} confirmed by an independent cold-started fit"
+    );
+    assert!(found * 10 >= total * 9 && agree * 10 >= found * 9);
+}

@@ -573,6 +573,7 @@ impl<'a, R: Residuals + ?Sized> Evaluator<'a, R> {
             None => {
                 self.differenced = true;
                 self.differences(x, f, jac)
+                    && (0..self.n).all(|j| (0..self.m).all(|i| jac[(i, j)].is_finite()))
             }
         }
     }

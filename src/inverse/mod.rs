@@ -22,5 +22,5 @@ pub use lsq::{
 };
 pub use profile::{
     confidence_intervals, covariance_intervals, profile_interval, ConfidenceIntervals, Interval,
-    ProfileEnd, ProfileInterval,
+    ProfileEnd, ProfileInterval, DEFAULT_LEVEL,
 };

@@ -22,6 +22,9 @@ use super::lsq::{
 };
 use crate::special::root::brent;
 
+/// The customary confidence level, 0.95.
+pub const DEFAULT_LEVEL: f64 = 0.95;
+
 /// A closed interval [lower, upper].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Interval {
@@ -265,8 +268,8 @@ pub fn profile_interval<R: Residuals + ?Sized>(
     })
 }
 
-/// Covariance and profile-likelihood intervals of every parameter at `level` (0.95 is the
-/// usual choice).
+/// Covariance and profile-likelihood intervals of every parameter at `level`
+/// ([`DEFAULT_LEVEL`] = 0.95 is the usual choice).
 ///
 /// ```
 /// use fitbead::inverse::{confidence_intervals, fit, Infeasible, LsqOptions, Model, WeightedData};
@@ -368,6 +371,9 @@ impl<R: Residuals + ?Sized> Profiler<'_, R> {
             let at_bound = if step > 0.0 { v >= bound } else { v <= bound };
             if at_bound {
                 v = bound;
+            }
+            if !v.is_finite() {
+                return ProfileEnd::NotFound;
             }
             let Some((g, x)) = self.eval(v, &inside.2) else {
                 return ProfileEnd::NotFound;

@@ -21,6 +21,7 @@
 
 pub mod error;
 pub mod fit;
+pub mod inverse;
 pub mod models;
 pub mod report;
 pub mod scene;

@@ -1,0 +1,26 @@
+//! Inverse problems: a generic weighted nonlinear least-squares solver that knows nothing of
+//! beads.
+//!
+//! * [`fit`] — Levenberg–Marquardt with Moré's scaling (J. J. Moré, "The Levenberg–Marquardt
+//!   algorithm: implementation and theory", Lecture Notes in Mathematics 630, 1978) on any
+//!   [`Residuals`], with box bounds, infeasible regions, analytic or finite-difference
+//!   Jacobians, and the covariance from the SVD of the Jacobian at the optimum;
+//! * [`confidence_intervals`] — covariance (Student-t / normal) and profile-likelihood
+//!   intervals;
+//! * [`WeightedData`] — a [`Model`] y = f(x; p) with data (x, y, σ) seen as residuals.
+//!
+//! The solver is validated on the 27 nonlinear problems of the NIST Statistical Reference
+//! Datasets (StRD), from both starting points (`tests/nist.rs`).
+
+mod lmpar;
+pub mod lsq;
+pub mod profile;
+
+pub use lsq::{
+    fit, Covariance, Fit, Infeasible, LsqError, LsqOptions, Model, Residuals, SigmaKind,
+    Termination, WeightedData,
+};
+pub use profile::{
+    confidence_intervals, covariance_intervals, profile_interval, ConfidenceIntervals, Interval,
+    ProfileEnd, ProfileInterval, DEFAULT_LEVEL,
+};

@@ -349,6 +349,22 @@ fn k_reports_out_of_range_points_with_a_status() {
     assert_eq!(rows[2][st], "ok");
     assert!(rows[0][k].is_empty() && rows[1][k].is_empty());
     assert_eq!(rows[0][h.iter().position(|x| x == "regime").unwrap()], "C");
+    let msg = h.iter().position(|x| x == "message").unwrap();
+    assert!(
+        rows[0][msg].contains("K_hi is the bracket's upper end: v + sigma_v"),
+        "{}",
+        rows[0][msg]
+    );
+    assert!(
+        rows[0][msg].contains("K_lo is the bracket's upper end: v - sigma_v"),
+        "{}",
+        rows[0][msg]
+    );
+    assert!(
+        rows[1][msg].contains("K_lo is the bracket's lower end: v - sigma_v"),
+        "{}",
+        rows[1][msg]
+    );
     assert_eq!(rows[1][h.iter().position(|x| x == "regime").unwrap()], "A");
 }
 

@@ -146,6 +146,17 @@ fn points_just_outside_the_range_get_the_right_status() {
         let s = random_scene(&mut rng);
         for m in MODELS {
             let Ok(br) = bracket(&m, &s) else { continue };
+            // The bracket is the model's own steady range: just outside it the forward model
+            // itself is not steady (lift-off ends and analytic lower ends).
+            let w = br.hi - br.lo;
+            if br.upper == UpperLimit::LiftOff {
+                let r = m.evaluate(&with_k(&s, br.hi + 1e-9 * w));
+                assert!(r.is_err(), "{m:?} steady above K_max: {s:?} {br:?}");
+            }
+            if br.lower != LowerLimit::Zero && br.lo > 1e-9 * w {
+                let r = m.evaluate(&with_k(&s, br.lo - 1e-9 * w));
+                assert!(r.is_err(), "{m:?} steady below K_min: {s:?} {br:?}");
+            }
             // Past the top end: above-range, whatever the model.
             let fast = br.v_hi * (1.0 + 1e-9);
             assert_eq!(

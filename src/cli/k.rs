@@ -109,6 +109,15 @@ pub fn read_rows(t: &Table, rho: f64, f: f64, g: f64) -> Result<Vec<Row>, CliErr
     if c_v.is_none() && c_r.is_none() {
         return Err(t.require("R_m").unwrap_err().into());
     }
+    for (flag, x) in [("--rho", rho), ("--f", f)] {
+        if !(x >= 0.0 && x.is_finite()) {
+            return Err(super::flag_error(
+                flag,
+                &x.to_string(),
+                "must be a finite number >= 0",
+            ));
+        }
+    }
     if !(g > 0.0 && g.is_finite()) {
         return Err(super::flag_error("--g", &g.to_string(), "g must be > 0"));
     }
@@ -168,7 +177,7 @@ pub fn read_rows(t: &Table, rho: f64, f: f64, g: f64) -> Result<Vec<Row>, CliErr
         let series = c_series
             .map(|c| t.cell(r, c).to_string())
             .unwrap_or_default();
-        if let Some(c) = c_series {
+        if let (Some(c), false) = (c_series, series.is_empty()) {
             match first_xi.get(&series) {
                 Some(&(x0, line)) if x0 != xi => {
                     return Err(t
@@ -319,7 +328,7 @@ fn render(t: &Table, rows: &[Row], res: &[KEstimate], model: &str) -> csv::Resul
         if let Err(f) = &e.root {
             msg.push(f.to_string());
         }
-        msg.extend(e.notes.iter().map(|s| s.to_string()));
+        msg.extend(e.notes.iter().cloned());
         out.push(msg.join("; "));
         for &c in &pass {
             out.push(t.cell(i, c).to_string());

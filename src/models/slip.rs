@@ -119,12 +119,18 @@ pub fn slip_time(ph: &SlipPhase, a: f64, b: f64, tol: f64) -> Result<f64, NotSte
     }
     let q = (tm.cos() + ph.f * tm.sin()).max(1e-3);
     let h = (m / q).sqrt();
-    // Θ̇² near its minimum carries an absolute rounding error of a few ulp of its O(1) terms,
-    // i.e. a relative error ~ε/m there: no quadrature can resolve the integral better than
-    // that, and asking for more only exhausts the panels (a bead crawling over the top, m → 0).
-    // The tolerance is floored at that inherent level.
+    // At an interior minimum Θ̇² carries an absolute rounding error of a few ulp of its O(1)
+    // terms, i.e. a relative error ~ε/m there: no quadrature can resolve the integral better
+    // than that, and asking for more only exhausts the panels (a bead crawling over the top,
+    // m → 0). The tolerance is floored at that inherent level. At an end (a bead launched
+    // slowly, m = its launch speed²) Θ̇² keeps its relative precision: no floor.
+    let interior = tm != a && tm != b;
     let opts = QuadOptions {
-        rel_tol: tol.max(8.0 * f64::EPSILON / m.min(1.0)),
+        rel_tol: if interior {
+            tol.max(8.0 * f64::EPSILON / m.min(1.0))
+        } else {
+            tol
+        },
         abs_tol: 0.0,
         max_panels: 128,
     };

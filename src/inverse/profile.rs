@@ -11,8 +11,8 @@
 //! ([`ProfileEnd::Edge`]).
 //!
 //! The profile is only as global as the constrained fits: each is a local minimisation, so on a
-//! problem with several basins a profile can miss a lower branch (never report one that is too
-//! low).
+//! problem with several basins a constrained fit can stop in a higher local minimum and make the
+//! interval too short on that side.
 //!
 //! The threshold is the one that makes the profile interval of a linear model coincide with
 //! the covariance interval:

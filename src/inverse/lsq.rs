@@ -26,10 +26,21 @@
 //!   stays honest. Projection was chosen over reflection because it keeps a parameter exactly on
 //!   its bound when the optimum is there (a reflective transform only approaches it). A start
 //!   outside the box is projected onto it.
-//! * **Restarts.** After convergence the iteration is restarted once (by default) from the point
-//!   reached, with the scaling D recomputed from the Jacobian there and a fresh radius: Moré's
-//!   running-maximum scaling remembers column norms from far-away starting points, which can
-//!   make the last stretch of a difficult problem (NIST MGH10, Bennett5) crawl.
+//! * **Convergence** as in MINPACK: relative reduction (actual and predicted reductions of
+//!   ‖f‖² both ≤ `ftol`), step size (Δ ≤ `xtol`·‖D p‖) or gradient (largest cosine between f and
+//!   a column of J ≤ `gtol`); tolerances below ε count as ε (MINPACK's "tolerance too small"
+//!   exits are these tests at ε). While the radius is held small by infeasible trial points a
+//!   met test is reported as [`Termination::Stalled`] instead: the iteration is pressed against
+//!   the edge of the feasible region, not at a minimum.
+//! * **Gauss–Newton polish** (on by default). χ² is flat to rounding well before the parameters
+//!   of an ill-conditioned problem are: once the relative reduction per step is below ε the
+//!   ratio test cannot tell good steps from bad and the radius collapses, leaving the estimate
+//!   ~√ε·cond away from the minimiser. A converged point is therefore refined by full
+//!   Gauss–Newton steps (rank-revealing QR) as long as they contract and do not raise ‖f‖: the
+//!   step is computed from Jᵀf, which still resolves the minimiser. On the NIST problems this
+//!   lifts the worst parameter LRE from 6.6 to 7.8.
+//! * **Restarts** (optional, off by default): after convergence, run again from the point
+//!   reached with the scaling and radius recomputed there.
 //!
 //! Jacobians are analytic when [`Residuals::jacobian`] provides them, else central differences
 //! with step h = ε^{1/3}·max(|p|, typical) — second-order one-sided differences next to a bound or
@@ -247,8 +258,8 @@ pub enum SigmaKind {
     Relative,
 }
 
-/// Solver settings. `Default` gives tolerances of 10⁻¹², at most 1000 iterations and one
-/// restart.
+/// Solver settings. `Default` gives tolerances of 10⁻¹², at most 1000 iterations, no restart,
+/// the Gauss–Newton polish, absolute σ and no bounds.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LsqOptions {
     /// Relative-reduction tolerance: converged when both the actual and the predicted relative
@@ -272,11 +283,12 @@ pub struct LsqOptions {
     /// Typical magnitude of each parameter, used for finite-difference steps near zero;
     /// default |p₀| (1 where p₀ = 0).
     pub typical: Option<Vec<f64>>,
-    /// How many times the iteration is restarted from a converged point with fresh scaling.
+    /// How many times the iteration is restarted from a converged point with fresh scaling and
+    /// radius (default 0: on the NIST problems restarts change no result).
     pub restarts: usize,
     /// Scaling convention of the covariance.
     pub sigma: SigmaKind,
-    /// Refine a converged point by a few Gauss–Newton steps (see [`fit`]).
+    /// Refine a converged point by Gauss–Newton steps (see the module docs).
     pub polish: bool,
 }
 
@@ -292,7 +304,7 @@ impl Default for LsqOptions {
             lower: None,
             upper: None,
             typical: None,
-            restarts: 1,
+            restarts: 0,
             sigma: SigmaKind::Absolute,
             polish: true,
         }
@@ -359,7 +371,7 @@ pub struct Covariance {
 pub struct Fit {
     /// Estimated parameters.
     pub params: Vec<f64>,
-    /// Residuals at the estimate.
+    /// Residuals at the estimate (empty if the start was infeasible).
     pub residuals: Vec<f64>,
     /// χ² = Σ rᵢ² at the estimate (+∞ if the start was infeasible).
     pub chi2: f64,
@@ -383,7 +395,8 @@ pub struct Fit {
     /// Bayesian information criterion, as `aic` with the penalty 2k (2(k + 1)) replaced by
     /// k ln m ((k + 1) ln m).
     pub bic: f64,
-    /// Accepted steps (all runs).
+    /// Accepted steps: Levenberg–Marquardt steps of every run, plus Gauss–Newton polish
+    /// steps.
     pub iterations: usize,
     /// Residual evaluations, finite-difference ones included.
     pub residual_evals: usize,
@@ -619,7 +632,7 @@ impl<'a, R: Residuals + ?Sized> Evaluator<'a, R> {
                 // A box narrower than the step: difference across the wider side.
                 h0 = room_up.max(room_dn);
             }
-            // Steps exactly representable as differences of doubles.
+            // The divisors below are the differences of the points actually used.
             let up = xj + h0;
             let dn = xj - h0;
             let ok_up = self.probe(x, j, up, false);
@@ -692,7 +705,14 @@ fn lm_run<R: Residuals + ?Sized>(
         iterations: it,
     };
     if !ev.residuals(&x, &mut f) {
-        return done(x, f, f64::INFINITY, Termination::InfeasibleStart, 0);
+        // Whatever the problem wrote there is not a residual vector.
+        return done(
+            x,
+            Vec::new(),
+            f64::INFINITY,
+            Termination::InfeasibleStart,
+            0,
+        );
     }
     let mut fnorm = norm2(&f);
     if fnorm == 0.0 {
@@ -1023,6 +1043,7 @@ fn polish<R: Residuals + ?Sized>(
         sol.x.copy_from_slice(&trial);
         std::mem::swap(&mut sol.f, &mut ft);
         sol.fnorm = fnorm1;
+        sol.iterations += 1;
         previous = snorm;
     }
     sol
@@ -1535,7 +1556,7 @@ mod tests {
         let g = fit(&data, &[3.0, 1.0], &LsqOptions::default()).unwrap();
         assert_eq!(g.termination, Termination::InfeasibleStart);
         assert!(!g.converged() && g.chi2 == f64::INFINITY && g.covariance.is_none());
-        assert!(g.params.iter().all(|v| v.is_finite()));
+        assert!(g.params.iter().all(|v| v.is_finite()) && g.residuals.is_empty());
     }
 
     /// r = p + 1 wants p = −1, but p < 0 is infeasible: the solver must not claim convergence
@@ -1695,5 +1716,34 @@ mod tests {
         let ci = confidence_intervals(&data, &f, 0.95, &opts).unwrap();
         assert_eq!(ci.profile[0].upper, ProfileEnd::Bound(0.8));
         assert!(ci.profile[0].lower.value().is_some());
+
+        // An infeasible region inside the interval: the end is the edge reached.
+        struct Capped(WeightedData<f64, Exp1>, f64);
+        impl Residuals for Capped {
+            fn n_params(&self) -> usize {
+                1
+            }
+            fn n_residuals(&self) -> usize {
+                self.0.n_residuals()
+            }
+            fn residuals(&self, p: &[f64], out: &mut [f64]) -> Result<(), Infeasible> {
+                if p[0] > self.1 {
+                    return Err(Infeasible);
+                }
+                self.0.residuals(p, out)
+            }
+        }
+        let free = fit(&data, &[0.1], &LsqOptions::default()).unwrap();
+        let ci = confidence_intervals(&data, &free, 0.95, &LsqOptions::default()).unwrap();
+        let hi = ci.profile[0].upper.value().unwrap();
+        let cap = free.params[0] + 0.5 * (hi - free.params[0]);
+        let capped = Capped(data, cap);
+        let f = fit(&capped, &[0.1], &LsqOptions::default()).unwrap();
+        assert!(f.converged());
+        let ci = confidence_intervals(&capped, &f, 0.95, &LsqOptions::default()).unwrap();
+        match ci.profile[0].upper {
+            ProfileEnd::Edge(v) => assert!(v <= cap && v > cap - 0.01 * (hi - f.params[0])),
+            other => panic!("{other:?}"),
+        }
     }
 }

@@ -2,9 +2,17 @@
 //!
 //! For parameter k the profile is χ²ₖ(v) = min over the other parameters of χ²(p | pₖ = v),
 //! each point computed by the same Levenberg–Marquardt solver, warm-started from the nearest
-//! point already profiled. The interval ends are the two roots of
-//! Δχ²(v) = χ²ₖ(v) − χ²_min = threshold, each bracketed by stepping outward from the estimate
-//! (doubling steps, starting from the covariance half-width) and then refined by Brent's method.
+//! point already profiled on the estimate's side of the end (continuation from the optimum).
+//! The interval ends are the two roots of Δχ²(v) = χ²ₖ(v) − χ²_min = threshold, each bracketed
+//! by stepping outward from the estimate (doubling steps, starting from the covariance
+//! half-width; bisecting back towards the last good point where a constrained fit fails) and
+//! then refined by Brent's method. The ends can also be a bound of the box
+//! ([`ProfileEnd::Bound`]) or the edge of the region where the constrained fits succeed
+//! ([`ProfileEnd::Edge`]).
+//!
+//! The profile is only as global as the constrained fits: each is a local minimisation, so on a
+//! problem with several basins a constrained fit can stop in a higher local minimum and make the
+//! interval too short on that side.
 //!
 //! The threshold is the one that makes the profile interval of a linear model coincide with
 //! the covariance interval:
@@ -42,8 +50,12 @@ pub enum ProfileEnd {
     /// Δχ² stays below the threshold all the way to this bound of the box: the interval reaches
     /// (at least) the bound.
     Bound(f64),
-    /// Not determined: Δχ² did not reach the threshold within 60 doublings of the step, or a
-    /// profile fit failed (infeasible or not converged) on the way.
+    /// Δχ² is still below the threshold at this value, but the constrained fits fail
+    /// (infeasible or not converging) beyond it — located by bisection to 10⁻⁶ of the initial
+    /// step: the interval reaches at least here.
+    Edge(f64),
+    /// Not determined: Δχ² did not reach the threshold within the step doublings, or a
+    /// constrained fit failed during the final root search.
     NotFound,
 }
 
@@ -366,8 +378,19 @@ impl<R: Residuals + ?Sized> Profiler<'_, R> {
         let mut inside = (p_hat, -self.threshold, self.others.clone());
         let mut w = step;
         let mut outside = None;
-        for _ in 0..60 {
-            let mut v = p_hat + w;
+        // The nearest point where the constrained fit failed (infeasible or not converging):
+        // once there is one, the search bisects between it and the last good point.
+        let mut failed_at: Option<f64> = None;
+        for _ in 0..200 {
+            let mut v = match failed_at {
+                Some(vf) => {
+                    if (vf - inside.0).abs() <= 1e-6 * step.abs() {
+                        return ProfileEnd::Edge(inside.0);
+                    }
+                    0.5 * (inside.0 + vf)
+                }
+                None => p_hat + w,
+            };
             let at_bound = if step > 0.0 { v >= bound } else { v <= bound };
             if at_bound {
                 v = bound;
@@ -376,7 +399,8 @@ impl<R: Residuals + ?Sized> Profiler<'_, R> {
                 return ProfileEnd::NotFound;
             }
             let Some((g, x)) = self.eval(v, &inside.2) else {
-                return ProfileEnd::NotFound;
+                failed_at = Some(v);
+                continue;
             };
             if g >= 0.0 {
                 outside = Some((v, g));
@@ -393,18 +417,27 @@ impl<R: Residuals + ?Sized> Profiler<'_, R> {
         };
         let (va, ga, warm) = inside;
         let mut failed = false;
-        let mut warm_x = warm;
+        // Constrained optima on the near side of the end (Δχ² below the threshold): each
+        // Brent evaluation is warm-started from the one nearest to it. Far-side optima are
+        // never used: beyond the end the other parameters may have wandered into another basin,
+        // and starting from there could stop the fit in a higher local minimum.
+        let mut near: Vec<(f64, Vec<f64>)> = vec![(va, warm)];
         let xtol = 1e-11 * (vb - va).abs();
         let root = brent(
             |v| {
                 if failed {
                     return 0.0;
                 }
-                match self.eval(v, &warm_x) {
+                let warm = near
+                    .iter()
+                    .min_by(|a, b| (a.0 - v).abs().total_cmp(&(b.0 - v).abs()))
+                    .map(|w| w.1.clone())
+                    .unwrap_or_default();
+                match self.eval(v, &warm) {
                     Some((g, x)) => {
-                        // Brent's iterates close in on the root: the latest constrained
-                        // optimum is the best warm start for the next.
-                        warm_x = x;
+                        if g < 0.0 {
+                            near.push((v, x));
+                        }
                         g
                     }
                     None => {

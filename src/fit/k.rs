@@ -25,7 +25,7 @@
 use crate::models::regimes::theta_g;
 use crate::models::slip::SlipPhase;
 use crate::models::{stickslip, ForwardModel, Model, NotSteady, Steady};
-use crate::scene::{CollisionLaw, Scene};
+use crate::scene::Scene;
 use crate::special::root::brent;
 use std::fmt;
 
@@ -115,21 +115,14 @@ pub fn invertible(model: &Model) -> bool {
     )
 }
 
-fn at_k(scene: &Scene, k: f64) -> Scene {
-    let mut s = *scene;
-    s.k = k;
-    s.law = CollisionLaw::Value(k);
-    s
-}
-
 fn eval(model: &Model, scene: &Scene, k: f64, evals: &mut usize) -> Result<Steady, NotSteady> {
     *evals += 1;
-    if !(k > 0.0 && k.is_finite()) {
-        return Err(NotSteady::Invalid {
+    match scene.with_k(k) {
+        Ok(s) if k.is_finite() => model.evaluate(&s),
+        _ => Err(NotSteady::Invalid {
             reason: "K out of range",
-        });
+        }),
     }
-    model.evaluate(&at_k(scene, k))
 }
 
 /// Squared speed at Θf of one slip contact launched at Θ0 with squared speed `w0sq` (eq 38
@@ -193,7 +186,7 @@ fn candidate(model: &Model, scene: &Scene) -> Option<(f64, f64, LowerLimit)> {
             Some((lo, hi, kind))
         }
         Model::StickSlip => {
-            let unit = at_k(scene, 1.0);
+            let unit = scene.with_k(1.0).ok()?;
             let phi = |w0: f64| stickslip::map(&unit, w0).map(|m| m.final_velocity);
             // Lower end: rolling over the top needs w0² > 2B sin²(Θ0/2) (when slip starts
             // after the top); the contact from there is K-independent.
@@ -633,7 +626,7 @@ pub fn estimate(model: &Model, scene: &Scene, v: f64, sigma_v: Option<f64>) -> K
                 Model::StickSlip => r.steady.theta_g,
                 Model::Stick | Model::StickApprox => {
                     let w0 = r.steady.initial_velocity;
-                    theta_g(&at_k(scene, r.k), w0 * w0)
+                    scene.with_k(r.k).ok().and_then(|s| theta_g(&s, w0 * w0))
                 }
                 _ => None,
             },
@@ -676,6 +669,7 @@ fn slope(model: &Model, scene: &Scene, br: &KBracket, r: &KRoot) -> Option<f64> 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::CollisionLaw;
 
     fn scene(xi: f64, delta_deg: f64) -> Scene {
         Scene::new(xi, delta_deg, 0.4, 0.1, CollisionLaw::Adjusted).unwrap()

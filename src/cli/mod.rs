@@ -1,7 +1,9 @@
 //! The command line: one module per subcommand. Errors are rendered here, once.
 
+pub mod fitargs;
 pub mod forward;
 pub mod k;
+pub mod klaw;
 pub mod regimes;
 pub mod simulate;
 
@@ -32,6 +34,9 @@ pub enum Command {
     Forward(forward::Args),
     /// The collisional parameter K of every measured point (eq 69), with its interval.
     K(k::Args),
+    /// A law K(α) fitted to all series at once (law c or one K per series), with the impact
+    /// law scored beside it.
+    Klaw(klaw::Args),
     /// Regime limits δ_m (eq 32) and δ_d (eq 31) per ξ, and the critical ξ, for a law.
     Regimes(regimes::Args),
     /// Synthetic measurements inside regime B, reproducible from a seed.
@@ -68,6 +73,7 @@ pub fn run(cli: Cli) -> i32 {
     let r = match cli.command {
         Command::Forward(a) => forward::run(a),
         Command::K(a) => k::run(a),
+        Command::Klaw(a) => klaw::run(a),
         Command::Regimes(a) => regimes::run(a),
         Command::Simulate(a) => simulate::run(a),
     };

@@ -1,4 +1,7 @@
-//! The bead problems posed to the solvers: K per measurement (eq 69), and (in later issues)
-//! the K(α) laws, Jan's λ/μ and Jaeger's a1–a3. Nothing here reads CSV or knows the CLI.
+//! The bead problems posed to the solvers: K per measurement (eq 69), the K(α) laws across
+//! series, Jan's λ/μ and Jaeger's a1–a3. Nothing here reads CSV or knows the CLI.
 
+pub mod data;
 pub mod k;
+pub mod klaw;
+pub mod summary;

@@ -1,0 +1,107 @@
+//! Measurements grouped in series, as the fits across series see them.
+
+use crate::inverse::SigmaKind;
+use crate::scene::Scene;
+
+/// One measured point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Point {
+    /// Index of its series in [`Dataset::labels`].
+    pub series: usize,
+    /// The scene (ξ, δ, ρ, f; its K is a placeholder).
+    pub scene: Scene,
+    /// Measured dimensionless mean velocity v̄.
+    pub v: f64,
+    /// Its standard deviation (1 when the data carry none: see [`Dataset::sigma`]).
+    pub sigma: f64,
+}
+
+/// Points grouped in series (in order of first appearance).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Dataset {
+    /// Series labels.
+    pub labels: Vec<String>,
+    /// The points.
+    pub points: Vec<Point>,
+    /// [`SigmaKind::Absolute`] when every point carries σ; [`SigmaKind::Relative`] when none
+    /// does (unit weights, the common scale estimated from the scatter).
+    pub sigma: SigmaKind,
+}
+
+/// Why measurements cannot form a [`Dataset`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DataError {
+    /// No points.
+    Empty,
+    /// Some points carry σ and this one (index) does not.
+    MixedSigma(usize),
+}
+
+impl Dataset {
+    /// Groups `(series label, scene, v, σ)` rows; rows without a label are grouped by ξ.
+    pub fn new(
+        rows: impl IntoIterator<Item = (String, Scene, f64, Option<f64>)>,
+    ) -> Result<Self, DataError> {
+        let rows: Vec<_> = rows.into_iter().collect();
+        if rows.is_empty() {
+            return Err(DataError::Empty);
+        }
+        let with_sigma = rows.iter().filter(|r| r.3.is_some()).count();
+        if with_sigma != 0 && with_sigma != rows.len() {
+            let i = rows.iter().position(|r| r.3.is_none()).unwrap_or(0);
+            return Err(DataError::MixedSigma(i));
+        }
+        let sigma = if with_sigma == 0 {
+            SigmaKind::Relative
+        } else {
+            SigmaKind::Absolute
+        };
+        let mut labels: Vec<String> = Vec::new();
+        let mut points = Vec::with_capacity(rows.len());
+        for (label, scene, v, s) in rows {
+            let label = if label.is_empty() {
+                format!("xi={}", crate::io::fmt_f64(scene.xi))
+            } else {
+                label
+            };
+            let series = match labels.iter().position(|l| *l == label) {
+                Some(i) => i,
+                None => {
+                    labels.push(label);
+                    labels.len() - 1
+                }
+            };
+            points.push(Point {
+                series,
+                scene,
+                v,
+                sigma: s.unwrap_or(1.0),
+            });
+        }
+        Ok(Dataset {
+            labels,
+            points,
+            sigma,
+        })
+    }
+
+    /// The points of series `s`.
+    pub fn series(&self, s: usize) -> impl Iterator<Item = &Point> {
+        self.points.iter().filter(move |p| p.series == s)
+    }
+
+    /// The sub-dataset of series `s` alone (its label kept, index 0).
+    pub fn only(&self, s: usize) -> Dataset {
+        Dataset {
+            labels: vec![self.labels[s].clone()],
+            points: self
+                .series(s)
+                .map(|p| Point {
+                    series: 0,
+                    ..p.clone()
+                })
+                .collect(),
+            sigma: self.sigma,
+        }
+    }
+}

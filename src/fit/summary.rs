@@ -1,0 +1,396 @@
+//! What every bead fit reports: one row per parameter (value, standard error, confidence
+//! interval and how it was obtained) and one row of fit statistics, and their CSV forms.
+//!
+//! The interval in `ci_low`/`ci_high` is the profile-likelihood one when both of its ends were
+//! found (`ci_method = profile`); otherwise the covariance (Wald) interval
+//! (`ci_method = covariance`), with the profile's state in the extra columns and the note; with
+//! neither, the cells are empty and `ci_method = none`.
+
+use crate::inverse::{
+    confidence_intervals, Fit, LsqOptions, ProfileEnd, Residuals, SigmaKind, Termination,
+};
+use crate::io::fmt_f64;
+
+/// The contract columns of the parameter report, in order.
+pub const PARAM_COLUMNS: [&str; 9] = [
+    "fit",
+    "series",
+    "parameter",
+    "value",
+    "stderr",
+    "ci_low",
+    "ci_high",
+    "ci_method",
+    "unit",
+];
+
+/// Columns of the parameter report after the contract ones.
+pub const PARAM_EXTRA_COLUMNS: [&str; 11] = [
+    "level",
+    "cov_low",
+    "cov_high",
+    "profile_low",
+    "profile_high",
+    "profile_low_status",
+    "profile_high_status",
+    "at_bound",
+    "paper_value",
+    "paper_source",
+    "note",
+];
+
+/// Columns of the statistics report.
+pub const STATS_COLUMNS: [&str; 16] = [
+    "fit",
+    "series",
+    "n_points",
+    "n_params",
+    "chi2",
+    "dof",
+    "reduced_chi2",
+    "aic",
+    "bic",
+    "termination",
+    "converged",
+    "iterations",
+    "residual_evals",
+    "sigma",
+    "condition",
+    "note",
+];
+
+/// One fitted parameter.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParamRow {
+    /// Name of the fit (e.g. `klaw-c`, `jan-series`, `jan-global`, `jaeger`).
+    pub fit: String,
+    /// Series label, or `all` for a fit across series.
+    pub series: String,
+    /// Parameter name.
+    pub parameter: String,
+    /// Estimate.
+    pub value: f64,
+    /// Standard error from the covariance, if it exists.
+    pub stderr: Option<f64>,
+    /// Confidence level of the intervals.
+    pub level: f64,
+    /// Covariance (Wald) interval.
+    pub cov: Option<(f64, f64)>,
+    /// Profile-likelihood ends.
+    pub profile: Option<(ProfileEnd, ProfileEnd)>,
+    /// Unit of the parameter.
+    pub unit: &'static str,
+    /// True when the estimate sits on a bound of its box.
+    pub at_bound: bool,
+    /// The paper's value of the same parameter, for comparison.
+    pub paper_value: Option<f64>,
+    /// Where `paper_value` comes from.
+    pub paper_source: &'static str,
+    /// Anything the user should know about this parameter.
+    pub note: String,
+}
+
+impl ParamRow {
+    /// The reported interval and its method: profile when both ends were found, else
+    /// covariance, else none.
+    pub fn interval(&self) -> (Option<(f64, f64)>, &'static str) {
+        if let Some((ProfileEnd::Found(a), ProfileEnd::Found(b))) = self.profile {
+            return (Some((a, b)), "profile");
+        }
+        match self.cov {
+            Some(c) => (Some(c), "covariance"),
+            None => (None, "none"),
+        }
+    }
+}
+
+/// Statistics of one fit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StatsRow {
+    /// Name of the fit.
+    pub fit: String,
+    /// Series label, or `all`.
+    pub series: String,
+    /// Number of data points.
+    pub n_points: usize,
+    /// Number of fitted parameters.
+    pub n_params: usize,
+    /// χ² at the estimate.
+    pub chi2: f64,
+    /// Degrees of freedom.
+    pub dof: usize,
+    /// χ²/dof.
+    pub reduced_chi2: f64,
+    /// AIC (see [`Fit::aic`]).
+    pub aic: f64,
+    /// BIC (see [`Fit::bic`]).
+    pub bic: f64,
+    /// Termination reason (`scored` for a parameter-free law).
+    pub termination: String,
+    /// Whether the solver converged.
+    pub converged: bool,
+    /// Solver iterations.
+    pub iterations: usize,
+    /// Residual evaluations, profiles included.
+    pub residual_evals: usize,
+    /// `given` (σ absolute) or `estimated` (unit weights, covariance scaled by χ²/dof).
+    pub sigma: SigmaKind,
+    /// Condition number of the column-equilibrated Jacobian, if known.
+    pub condition: Option<f64>,
+    /// Anything the user should know about this fit.
+    pub note: String,
+}
+
+/// The rows of one fit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FitSummary {
+    /// One row per parameter.
+    pub params: Vec<ParamRow>,
+    /// The statistics.
+    pub stats: StatsRow,
+}
+
+/// A parameter's name, unit and the paper's value (with its source) if there is one.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ParamSpec {
+    /// Name.
+    pub name: &'static str,
+    /// Unit.
+    pub unit: &'static str,
+    /// The paper's value.
+    pub paper_value: Option<f64>,
+    /// Where the paper's value comes from.
+    pub paper_source: &'static str,
+}
+
+fn termination_name(t: Termination) -> &'static str {
+    match t {
+        Termination::ExactFit => "exact_fit",
+        Termination::RelativeReduction => "relative_reduction",
+        Termination::StepSize => "step_size",
+        Termination::Gradient => "gradient",
+        Termination::MaxIterations => "max_iterations",
+        Termination::MaxEvaluations => "max_evaluations",
+        Termination::InfeasibleStart => "infeasible_start",
+        Termination::JacobianFailed => "jacobian_failed",
+        Termination::Stalled => "stalled_at_feasibility_edge",
+    }
+}
+
+/// Builds the summary of a finished fit: covariance intervals, and profile intervals when
+/// `profile` is set and the fit converged.
+#[allow(clippy::too_many_arguments)]
+pub fn summarise<R: Residuals + ?Sized>(
+    fit_name: &str,
+    series: &str,
+    specs: &[ParamSpec],
+    problem: &R,
+    f: &Fit,
+    level: f64,
+    opts: &LsqOptions,
+    profile: bool,
+) -> FitSummary {
+    let mut note = String::new();
+    let ci = if f.converged() && f.chi2.is_finite() {
+        if profile {
+            confidence_intervals(problem, f, level, opts).ok()
+        } else {
+            None
+        }
+    } else {
+        note = format!(
+            "not converged ({}): values are where the solver stopped, no intervals",
+            termination_name(f.termination)
+        );
+        None
+    };
+    let wald = if f.converged() {
+        crate::inverse::covariance_intervals(f, level)
+            .ok()
+            .flatten()
+    } else {
+        None
+    };
+    if f.converged() && f.covariance.is_none() {
+        note = "Jacobian rank deficient at the estimate: no covariance".into();
+    }
+    let mut evals = f.residual_evals;
+    let params = specs
+        .iter()
+        .enumerate()
+        .map(|(j, s)| {
+            let prof = ci
+                .as_ref()
+                .map(|c| (c.profile[j].lower, c.profile[j].upper));
+            if let Some(c) = &ci {
+                evals += c.profile[j].residual_evals;
+            }
+            let mut pnote = String::new();
+            if f.at_bound.get(j).copied().unwrap_or(false) {
+                pnote.push_str("on a bound of its box; the covariance ignores the bound. ");
+            }
+            if let Some((lo, hi)) = prof {
+                for (end, which) in [(lo, "lower"), (hi, "upper")] {
+                    match end {
+                        ProfileEnd::Found(_) => {}
+                        ProfileEnd::Bound(b) => pnote.push_str(&format!(
+                            "profile {which} end reaches the bound {}. ",
+                            fmt_f64(b)
+                        )),
+                        ProfileEnd::Edge(e) => pnote.push_str(&format!(
+                            "profile {which} end reaches at least {} where the model leaves its \
+                             regime. ",
+                            fmt_f64(e)
+                        )),
+                        ProfileEnd::NotFound => {
+                            pnote.push_str(&format!("profile {which} end not found. "))
+                        }
+                    }
+                }
+            }
+            ParamRow {
+                fit: fit_name.to_string(),
+                series: series.to_string(),
+                parameter: s.name.to_string(),
+                value: f.params[j],
+                stderr: if f.converged() {
+                    f.std_errors().map(|se| se[j])
+                } else {
+                    None
+                },
+                level,
+                cov: wald.as_ref().map(|w| (w[j].lower, w[j].upper)),
+                profile: prof,
+                unit: s.unit,
+                at_bound: f.at_bound.get(j).copied().unwrap_or(false),
+                paper_value: s.paper_value,
+                paper_source: s.paper_source,
+                note: pnote.trim_end().to_string(),
+            }
+        })
+        .collect();
+    FitSummary {
+        params,
+        stats: StatsRow {
+            fit: fit_name.to_string(),
+            series: series.to_string(),
+            n_points: f.residuals.len().max(f.dof + specs.len()),
+            n_params: specs.len(),
+            chi2: f.chi2,
+            dof: f.dof,
+            reduced_chi2: f.reduced_chi2,
+            aic: f.aic,
+            bic: f.bic,
+            termination: termination_name(f.termination).to_string(),
+            converged: f.converged(),
+            iterations: f.iterations,
+            residual_evals: evals,
+            sigma: f.sigma,
+            condition: f.covariance.as_ref().map(|c| c.condition),
+            note,
+        },
+    }
+}
+
+/// AIC and BIC of a parameter-free model with residuals `r` (conventions of [`Fit::aic`]).
+pub fn information_criteria(r: &[f64], sigma: SigmaKind) -> (f64, f64) {
+    let m = r.len() as f64;
+    let chi2: f64 = r.iter().map(|x| x * x).sum();
+    match sigma {
+        SigmaKind::Absolute => (chi2, chi2),
+        SigmaKind::Relative => {
+            let m2ll = m * ((2.0 * std::f64::consts::PI * chi2 / m).ln() + 1.0);
+            (m2ll + 2.0, m2ll + m.ln())
+        }
+    }
+}
+
+fn end_value(e: ProfileEnd) -> Option<f64> {
+    match e {
+        ProfileEnd::Found(v) | ProfileEnd::Bound(v) | ProfileEnd::Edge(v) => Some(v),
+        ProfileEnd::NotFound => None,
+    }
+}
+
+fn end_status(e: ProfileEnd) -> &'static str {
+    match e {
+        ProfileEnd::Found(_) => "found",
+        ProfileEnd::Bound(_) => "bound",
+        ProfileEnd::Edge(_) => "edge",
+        ProfileEnd::NotFound => "not_found",
+    }
+}
+
+fn opt(x: Option<f64>) -> String {
+    x.map(fmt_f64).unwrap_or_default()
+}
+
+/// The parameter report as CSV: the contract columns, then [`PARAM_EXTRA_COLUMNS`].
+pub fn params_csv(rows: &[ParamRow]) -> csv::Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(PARAM_COLUMNS.iter().chain(PARAM_EXTRA_COLUMNS.iter()))?;
+    for r in rows {
+        let (ci, method) = r.interval();
+        let (pl, ph) = match r.profile {
+            Some((a, b)) => (
+                (opt(end_value(a)), end_status(a)),
+                (opt(end_value(b)), end_status(b)),
+            ),
+            None => ((String::new(), "none"), (String::new(), "none")),
+        };
+        w.write_record([
+            r.fit.clone(),
+            r.series.clone(),
+            r.parameter.clone(),
+            fmt_f64(r.value),
+            opt(r.stderr),
+            opt(ci.map(|c| c.0)),
+            opt(ci.map(|c| c.1)),
+            method.to_string(),
+            r.unit.to_string(),
+            fmt_f64(r.level),
+            opt(r.cov.map(|c| c.0)),
+            opt(r.cov.map(|c| c.1)),
+            pl.0,
+            ph.0,
+            pl.1.to_string(),
+            ph.1.to_string(),
+            r.at_bound.to_string(),
+            opt(r.paper_value),
+            r.paper_source.to_string(),
+            r.note.clone(),
+        ])?;
+    }
+    w.into_inner().map_err(|e| e.into_error().into())
+}
+
+/// The statistics report as CSV ([`STATS_COLUMNS`]).
+pub fn stats_csv(rows: &[StatsRow]) -> csv::Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(STATS_COLUMNS)?;
+    for r in rows {
+        w.write_record([
+            r.fit.clone(),
+            r.series.clone(),
+            r.n_points.to_string(),
+            r.n_params.to_string(),
+            fmt_f64(r.chi2),
+            r.dof.to_string(),
+            fmt_f64(r.reduced_chi2),
+            fmt_f64(r.aic),
+            fmt_f64(r.bic),
+            r.termination.clone(),
+            r.converged.to_string(),
+            r.iterations.to_string(),
+            r.residual_evals.to_string(),
+            match r.sigma {
+                SigmaKind::Absolute => "given",
+                SigmaKind::Relative => "estimated",
+            }
+            .to_string(),
+            opt(r.condition),
+            r.note.clone(),
+        ])?;
+    }
+    w.into_inner().map_err(|e| e.into_error().into())
+}

@@ -431,3 +431,105 @@ fn k_plot_writes_an_svg() {
     );
     assert!(s.matches("<circle").count() >= 36);
 }
+
+const FIT_COLUMNS: [&str; 9] = [
+    "fit",
+    "series",
+    "parameter",
+    "value",
+    "stderr",
+    "ci_low",
+    "ci_high",
+    "ci_method",
+    "unit",
+];
+
+#[test]
+fn fit_commands_write_the_contract_reports() {
+    let dir = tmpdir();
+    for (cmd, extra, fits, rows) in [
+        (
+            "klaw",
+            vec!["--model", "stickslip"],
+            vec!["klaw-c", "klaw-impact"],
+            1,
+        ),
+        (
+            "klaw",
+            vec!["--model", "stick", "--law", "free-per-series"],
+            vec!["klaw-free-per-series", "klaw-impact"],
+            4,
+        ),
+        ("jan", vec![], vec!["jan-series", "jan-global"], 12),
+        ("jaeger", vec![], vec!["jaeger"], 12),
+    ] {
+        let rep = dir.path().join(format!("{cmd}.csv"));
+        let st = dir.path().join(format!("{cmd}-stats.csv"));
+        let out = bin()
+            .arg(cmd)
+            .args(&extra)
+            .arg("--output")
+            .arg(&rep)
+            .arg("--output-stats")
+            .arg(&st)
+            .arg("--level")
+            .arg("0.9")
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{cmd}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let text = std::fs::read_to_string(&rep).unwrap();
+        let mut r = csv::Reader::from_reader(text.as_bytes());
+        let h: Vec<String> = r.headers().unwrap().iter().map(String::from).collect();
+        assert_eq!(&h[..9], &FIT_COLUMNS[..], "{cmd}");
+        let recs: Vec<csv::StringRecord> = r.records().map(|x| x.unwrap()).collect();
+        assert_eq!(recs.len(), rows, "{cmd} {extra:?}");
+        let level = h.iter().position(|c| c == "level").unwrap();
+        for rec in &recs {
+            assert!(rec[3].parse::<f64>().unwrap().is_finite());
+            assert_eq!(&rec[level], "0.9");
+            if let (Ok(lo), Ok(hi)) = (rec[5].parse::<f64>(), rec[6].parse::<f64>()) {
+                let v: f64 = rec[3].parse().unwrap();
+                assert!(lo <= v && v <= hi, "{cmd}: {rec:?}");
+            }
+        }
+        let stats = std::fs::read_to_string(&st).unwrap();
+        let mut r = csv::Reader::from_reader(stats.as_bytes());
+        let h: Vec<String> = r.headers().unwrap().iter().map(String::from).collect();
+        for c in ["chi2", "dof", "aic", "bic", "termination"] {
+            assert!(h.iter().any(|x| x == c), "{cmd}: stats lacks {c}");
+        }
+        let names: Vec<String> = r.records().map(|x| x.unwrap()[0].to_string()).collect();
+        for f in &fits {
+            assert!(names.iter().any(|n| n == f), "{cmd}: {names:?} lacks {f}");
+        }
+    }
+}
+
+#[test]
+fn fit_commands_reject_bad_input_with_exit_2() {
+    let mixed = "series,xi,delta_deg,v,sigma_v\na,1,10,0.3,0.01\na,1,11,0.35,\na,1,12,0.4,0.01\n";
+    expect_error(&["jan"], mixed, &["line 3", "sigma_v", "every row"]);
+    let dir = tmpdir();
+    let outp = write(&dir, "out.csv", "precious");
+    for (args, flag) in [
+        (vec!["klaw", "--model", "stick", "--law", "cubic"], "--law"),
+        (vec!["klaw", "--model", "jan"], "--model"),
+        (vec!["jaeger", "--branch", "middle"], "--branch"),
+        (vec!["jan", "--level", "95"], "--level"),
+    ] {
+        let out = bin()
+            .args(&args)
+            .arg("--output")
+            .arg(&outp)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(flag), "{args:?}: {err}");
+        assert_eq!(std::fs::read_to_string(&outp).unwrap(), "precious");
+    }
+}

@@ -2,6 +2,8 @@
 
 pub mod fitargs;
 pub mod forward;
+pub mod jaeger;
+pub mod jan;
 pub mod k;
 pub mod klaw;
 pub mod regimes;
@@ -37,6 +39,10 @@ pub enum Command {
     /// A law K(α) fitted to all series at once (law c or one K per series), with the impact
     /// law scored beside it.
     Klaw(klaw::Args),
+    /// Jan's λ and μ per series (eq 74) and the global laws of eqs 75–76, fitted on v̄.
+    Jan(jan::Args),
+    /// Jaeger's a1, a2, a3 per series (eqs 80–84), with the branch and the bistable band.
+    Jaeger(jaeger::Args),
     /// Regime limits δ_m (eq 32) and δ_d (eq 31) per ξ, and the critical ξ, for a law.
     Regimes(regimes::Args),
     /// Synthetic measurements inside regime B, reproducible from a seed.
@@ -74,6 +80,8 @@ pub fn run(cli: Cli) -> i32 {
         Command::Forward(a) => forward::run(a),
         Command::K(a) => k::run(a),
         Command::Klaw(a) => klaw::run(a),
+        Command::Jan(a) => jan::run(a),
+        Command::Jaeger(a) => jaeger::run(a),
         Command::Regimes(a) => regimes::run(a),
         Command::Simulate(a) => simulate::run(a),
     };

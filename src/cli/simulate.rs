@@ -3,8 +3,9 @@
 
 use super::{emit, parse_list, CliError};
 use crate::io::fmt_f64;
+use crate::models::jaeger::Jaeger;
 use crate::models::jan::Jan;
-use crate::models::{ForwardModel, Model, ModelKind};
+use crate::models::{ForwardModel, JaegerBranch, Model, ModelKind};
 use crate::scene::{CollisionLaw, Scene};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -14,8 +15,8 @@ use std::path::PathBuf;
 /// Arguments of `fitbead simulate`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Forward model that makes the data: stick, stick-approx, slip, slip-approx, stickslip, jan
-    /// (jan with the paper's fits, eqs 75–76).
+    /// Forward model that makes the data: stick, stick-approx, slip, slip-approx, stickslip,
+    /// jan (see --jan), jaeger (see --jaeger).
     #[arg(long, default_value = "stickslip")]
     pub model: String,
     /// Collision law: a number, cos2a, adjusted, impact or c=VALUE.
@@ -39,6 +40,22 @@ pub struct Args {
     /// Coulomb friction coefficient f.
     #[arg(long, default_value_t = 0.1)]
     pub f: f64,
+    /// Jan's global laws λ0,λ1,μ0,μ1 (λ = λ0 e^{λ1 sin α}, μ = μ0 e^{μ1 sin α}) for
+    /// --model jan; default the paper's eqs 75–76 (0.063,4.96,0.0025,7.46).
+    #[arg(long)]
+    pub jan: Option<String>,
+    /// Jaeger's a1,a2,a3 (Jaeger units, eq 81) for --model jaeger, used for every series;
+    /// default the paper's Fig. 9 values of the series' ξ (0.8, 1, 1.6 or 2).
+    #[arg(long)]
+    pub jaeger: Option<String>,
+    /// Branch of eq 84 for --model jaeger: upper or lower.
+    #[arg(long, default_value = "upper")]
+    pub branch: String,
+    /// Slopes LO,HI in degrees to spread the points over (kept inside the model's steady
+    /// range). Default: 5 %–95 % of the steady range for the contact models; for jan and
+    /// jaeger, whose steady range has no upper end, the onset to the onset + 12°.
+    #[arg(long)]
+    pub delta_range: Option<String>,
     /// Output CSV (written atomically); stdout when absent.
     #[arg(long)]
     pub output: Option<PathBuf>,
@@ -131,6 +148,49 @@ pub fn run(a: Args) -> Result<(), CliError> {
             "must be in [0, 0.5)",
         ));
     }
+    let jan = a
+        .jan
+        .as_deref()
+        .map(|s| parse_list("--jan", s))
+        .transpose()?;
+    if jan.as_ref().is_some_and(|p| p.len() != 4) {
+        return Err(super::flag_error(
+            "--jan",
+            a.jan.as_deref().unwrap_or(""),
+            "expected four numbers lambda0,lambda1,mu0,mu1",
+        ));
+    }
+    let jaeger = a
+        .jaeger
+        .as_deref()
+        .map(|s| parse_list("--jaeger", s))
+        .transpose()?;
+    if jaeger.as_ref().is_some_and(|p| p.len() != 3) {
+        return Err(super::flag_error(
+            "--jaeger",
+            a.jaeger.as_deref().unwrap_or(""),
+            "expected three numbers a1,a2,a3",
+        ));
+    }
+    let branch = match a.branch.as_str() {
+        "upper" => JaegerBranch::Upper,
+        "lower" => JaegerBranch::Lower,
+        b => return Err(super::flag_error("--branch", b, "expected upper or lower")),
+    };
+    let range = match a.delta_range.as_deref() {
+        None => None,
+        Some(s) => {
+            let r = parse_list("--delta-range", s)?;
+            if r.len() != 2 || !(r[0] < r[1]) {
+                return Err(super::flag_error(
+                    "--delta-range",
+                    s,
+                    "expected LO,HI in degrees with LO < HI",
+                ));
+            }
+            Some((r[0], r[1]))
+        }
+    };
     let mut rng = ChaCha8Rng::seed_from_u64(a.seed);
     let mut w = csv::Writer::from_writer(Vec::new());
     let io = |e: csv::Error| CliError::Other(e.to_string());
@@ -142,13 +202,32 @@ pub fn run(a: Args) -> Result<(), CliError> {
             .alpha;
         let model = match (kind, kind.contact_model()) {
             (_, Some(m)) => m,
-            (ModelKind::Jan, None) => Model::Jan(Jan::paper_fit(alpha)),
+            (ModelKind::Jan, None) => match &jan {
+                None => Model::Jan(Jan::paper_fit(alpha)),
+                Some(p) => {
+                    let s = alpha.sin();
+                    Model::Jan(
+                        Jan::new(p[0] * (p[1] * s).exp(), p[2] * (p[3] * s).exp())
+                            .map_err(|e| super::flag_error("--jan", "", e.to_string()))?,
+                    )
+                }
+            },
             _ => {
-                return Err(super::flag_error(
-                    "--model",
-                    "jaeger",
-                    "simulate does not support jaeger",
-                ))
+                let p = match &jaeger {
+                    Some(p) => [p[0], p[1], p[2]],
+                    None => crate::fit::jaeger::paper_values(xi).ok_or_else(|| {
+                        super::flag_error(
+                            "--series",
+                            &xi.to_string(),
+                            "the paper gives Jaeger's a1, a2, a3 for xi = 0.8, 1, 1.6, 2 only: \
+                             give --jaeger A1,A2,A3",
+                        )
+                    })?,
+                };
+                Model::Jaeger(
+                    Jaeger::new(p[0], p[1], p[2], branch)
+                        .map_err(|e| super::flag_error("--jaeger", "", e.to_string()))?,
+                )
             }
         };
         let Some((lo, hi)) = regime_b_interval(&model, xi, a.rho, a.f, law) else {
@@ -158,11 +237,31 @@ pub fn run(a: Args) -> Result<(), CliError> {
                 "no steady regime for this xi under this model and law",
             ));
         };
+        let open_ended = matches!(kind, ModelKind::Jan | ModelKind::Jaeger);
+        let (lo, hi, f0, f1) = match range {
+            Some((l, h)) => {
+                let (l, h) = (l.to_radians().max(lo), h.to_radians().min(hi));
+                if !(l < h) {
+                    return Err(super::flag_error(
+                        "--delta-range",
+                        a.delta_range.as_deref().unwrap_or(""),
+                        format!(
+                            "no steady state in this range at xi = {xi} (steady from {} to {} deg)",
+                            fmt_f64(lo.to_degrees()),
+                            fmt_f64(hi.to_degrees())
+                        ),
+                    ));
+                }
+                (l, h, 0.0, 1.0)
+            }
+            None if open_ended => (lo, (lo + 12f64.to_radians()).min(hi), 0.05, 0.95),
+            None => (lo, hi, 0.05, 0.95),
+        };
         for j in 0..a.points {
             let frac = if a.points == 1 {
                 0.5
             } else {
-                0.05 + 0.9 * j as f64 / (a.points - 1) as f64
+                f0 + (f1 - f0) * j as f64 / (a.points - 1) as f64
             };
             let d = lo + (hi - lo) * frac;
             // Round the slope to 1e-4 degree, as a measured slope would be written.

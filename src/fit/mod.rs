@@ -2,6 +2,8 @@
 //! series, Jan's λ/μ and Jaeger's a1–a3. Nothing here reads CSV or knows the CLI.
 
 pub mod data;
+pub mod jaeger;
+pub mod jan;
 pub mod k;
 pub mod klaw;
 pub mod summary;

@@ -2,7 +2,11 @@
 //! interval and how it was obtained) and one row of fit statistics, and their CSV forms.
 //!
 //! The interval in `ci_low`/`ci_high` is the profile-likelihood one when both of its ends were
-//! found (`ci_method = profile`); otherwise the covariance (Wald) interval
+//! determined (`ci_method = profile`): an end is where Δχ² reaches its threshold (`found`) or
+//! the bound of the parameter's box (`bound`: no value beyond is admissible). An end marked
+//! `edge` is where the constrained fits stop converging inside the feasible region (their
+//! optimum lies against the region's edge, or the warm start left the region); the profile
+//! there is not determined, so the covariance (Wald) interval is reported instead
 //! (`ci_method = covariance`), with the profile's state in the extra columns and the note; with
 //! neither, the cells are empty and `ci_method = none`.
 
@@ -91,11 +95,13 @@ pub struct ParamRow {
 }
 
 impl ParamRow {
-    /// The reported interval and its method: profile when both ends were found, else
-    /// covariance, else none.
+    /// The reported interval and its method: profile when both ends were determined, else
+    /// covariance, else none (module docs).
     pub fn interval(&self) -> (Option<(f64, f64)>, &'static str) {
-        if let Some((ProfileEnd::Found(a), ProfileEnd::Found(b))) = self.profile {
-            return (Some((a, b)), "profile");
+        if let Some((lo, hi)) = self.profile {
+            if let (Some(a), Some(b)) = (closed_end(lo), closed_end(hi)) {
+                return (Some((a, b)), "profile");
+            }
         }
         match self.cov {
             Some(c) => (Some(c), "covariance"),
@@ -238,8 +244,8 @@ pub fn summarise<R: Residuals + ?Sized>(
                             fmt_f64(b)
                         )),
                         ProfileEnd::Edge(e) => pnote.push_str(&format!(
-                            "profile {which} end reaches at least {} where the model leaves its \
-                             regime. ",
+                            "profile {which} end undetermined beyond {}: the constrained fits \
+                             there do not converge inside the model's feasible region. ",
                             fmt_f64(e)
                         )),
                         ProfileEnd::NotFound => {
@@ -302,6 +308,14 @@ pub fn information_criteria(r: &[f64], sigma: SigmaKind) -> (f64, f64) {
             let m2ll = m * ((2.0 * std::f64::consts::PI * chi2 / m).ln() + 1.0);
             (m2ll + 2.0, m2ll + m.ln())
         }
+    }
+}
+
+/// An end that closes the profile interval: Δχ² reached its threshold, or the box ends there.
+fn closed_end(e: ProfileEnd) -> Option<f64> {
+    match e {
+        ProfileEnd::Found(v) | ProfileEnd::Bound(v) => Some(v),
+        _ => None,
     }
 }
 

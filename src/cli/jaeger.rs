@@ -1,0 +1,49 @@
+//! `fitbead jaeger`: Jaeger's a1, a2, a3 per series (Jaeger units, eq 81), the branch used and
+//! the points in the bistable band (eq 90), beside the paper's Fig. 9 values.
+
+use super::fitargs::FitArgs;
+use super::CliError;
+use crate::fit::jaeger::fit_jaeger;
+use crate::models::JaegerBranch;
+
+/// Arguments of `fitbead jaeger`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Root of eq 84 to fit where there are two: upper (default) or lower.
+    #[arg(long, default_value = "upper")]
+    pub branch: String,
+    /// Input, output and interval flags.
+    #[command(flatten)]
+    pub io: FitArgs,
+}
+
+/// Runs `fitbead jaeger`.
+pub fn run(a: Args) -> Result<(), CliError> {
+    let branch = match a.branch.as_str() {
+        "upper" => JaegerBranch::Upper,
+        "lower" => JaegerBranch::Lower,
+        _ => {
+            return Err(super::flag_error(
+                "--branch",
+                &a.branch,
+                "expected upper or lower",
+            ))
+        }
+    };
+    let (_t, _rows, ds) = a.io.read()?;
+    let fits = fit_jaeger(&ds, branch, a.io.level, !a.io.no_profile);
+    for n in &fits.notes {
+        eprintln!("fitbead jaeger: {n}");
+    }
+    let (mut params, mut stats) = (Vec::new(), Vec::new());
+    for f in fits.series.iter().flatten() {
+        params.extend(f.summary.params.iter().cloned());
+        stats.push(f.summary.stats.clone());
+    }
+    if params.is_empty() {
+        return Err(CliError::Other(
+            "jaeger: no fit could be made (see the notes above)".into(),
+        ));
+    }
+    a.io.write(&params, &stats)
+}

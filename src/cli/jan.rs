@@ -1,0 +1,35 @@
+//! `fitbead jan`: Jan's λ and μ per series (eq 74, fitted on v̄) and the global laws
+//! λ = λ0 e^{λ1 sin α}, μ = μ0 e^{μ1 sin α} (form of eqs 75–76), beside the paper's values.
+
+use super::fitargs::FitArgs;
+use super::CliError;
+use crate::fit::jan::fit_jan;
+
+/// Arguments of `fitbead jan`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Input, output and interval flags.
+    #[command(flatten)]
+    pub io: FitArgs,
+}
+
+/// Runs `fitbead jan`.
+pub fn run(a: Args) -> Result<(), CliError> {
+    let (_t, _rows, ds) = a.io.read()?;
+    let fits = fit_jan(&ds, a.io.level, !a.io.no_profile);
+    for n in &fits.notes {
+        eprintln!("fitbead jan: {n}");
+    }
+    let all = fits.series.iter().flatten().chain(fits.global.iter());
+    let (mut params, mut stats) = (Vec::new(), Vec::new());
+    for s in all {
+        params.extend(s.params.iter().cloned());
+        stats.push(s.stats.clone());
+    }
+    if params.is_empty() {
+        return Err(CliError::Other(
+            "jan: no fit could be made (see the notes above)".into(),
+        ));
+    }
+    a.io.write(&params, &stats)
+}

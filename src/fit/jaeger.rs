@@ -1,0 +1,274 @@
+//! Jaeger's law fitted per series on the measured velocities: a1, a2, a3 in Jaeger's velocity
+//! units (eq 81), the branch of eq 84 used, and the points of the series that fall in the
+//! bistable band of eq 90 at the fitted values.
+//!
+//! v̄ = sqrt(2 cos δ X/ε) with X the chosen positive root of
+//! F(X) = a2 a3 X² + (a3 − a2 tan δ) X + a1 − tan δ = 0 (eq 84). The gradient is analytic by
+//! implicit differentiation: ∂X/∂a_k = −(∂F/∂a_k)/(∂F/∂X) with ∂F/∂a1 = 1,
+//! ∂F/∂a2 = a3 X² − X tan δ, ∂F/∂a3 = a2 X² + X, ∂F/∂X = 2 a2 a3 X + a3 − a2 tan δ, and
+//! ∂v̄/∂X = v̄/(2X). Where the branch has no root (the slope is below the band, or the lower
+//! branch is asked for outside the band) the point is [`Infeasible`].
+//!
+//! The start is derived: with u² = X_i computed from each measured v̄_i, eq 83 reads
+//! tan δ_i = a3 X_i + a1/(1 + a2 X_i), linear in (a1, a3) for fixed a2. A log grid of a2 over
+//! 10⁻²…10⁴ (and a2 = 0) gives one linear fit each; the candidate of least χ² in v̄ starts
+//! Levenberg–Marquardt.
+
+use super::data::Dataset;
+use super::summary::{summarise, FitSummary, ParamSpec};
+use crate::inverse::{fit, Infeasible, LsqOptions, Model, WeightedData};
+use crate::models::jaeger::Jaeger;
+use crate::models::JaegerBranch;
+
+/// The paper's Fig. 9 values (ξ, a1, a2, a3), Jaeger units.
+pub const PAPER_FIG9: [(f64, f64, f64, f64); 4] = [
+    (0.8, 0.19, 3.83, 1.28),
+    (1.0, 0.131, 18.57, 1.41),
+    (1.6, 0.06, 20.71, 0.8987),
+    (2.0, 0.042, 27.67, 0.78),
+];
+
+/// The paper's Fig. 9 values (a1, a2, a3) at ξ, if ξ is one of its four series.
+pub fn paper_values(xi: f64) -> Option<[f64; 3]> {
+    PAPER_FIG9
+        .iter()
+        .find(|r| (r.0 - xi).abs() < 1e-9)
+        .map(|r| [r.1, r.2, r.3])
+}
+
+/// What Jaeger's formula needs of a point: (tan δ, cos δ, ε).
+pub type JaegerX = (f64, f64, f64);
+
+/// Jaeger's model on one branch, p = (a1, a2, a3).
+#[derive(Debug, Clone, Copy)]
+pub struct JaegerModel(pub JaegerBranch);
+
+impl JaegerModel {
+    fn root(&self, x: &JaegerX, p: &[f64]) -> Result<f64, Infeasible> {
+        if !(p[0] >= 0.0 && p[1] >= 0.0 && p[2] > 0.0) {
+            return Err(Infeasible);
+        }
+        let m = Jaeger {
+            a1: p[0],
+            a2: p[1],
+            a3: p[2],
+            branch: self.0,
+        };
+        let r = m.roots(x.0);
+        match self.0 {
+            JaegerBranch::Upper => r.upper,
+            JaegerBranch::Lower => r.lower,
+        }
+        .filter(|x| x.is_finite() && *x > 0.0)
+        .ok_or(Infeasible)
+    }
+}
+
+impl Model<JaegerX> for JaegerModel {
+    fn n_params(&self) -> usize {
+        3
+    }
+    fn value(&self, x: &JaegerX, p: &[f64]) -> Result<f64, Infeasible> {
+        let r = self.root(x, p)?;
+        Ok((2.0 * x.1 * r / x.2).sqrt())
+    }
+    fn gradient(&self, x: &JaegerX, p: &[f64], g: &mut [f64]) -> Option<Result<(), Infeasible>> {
+        let r = match self.root(x, p) {
+            Ok(r) => r,
+            Err(e) => return Some(Err(e)),
+        };
+        let (a2, a3, t) = (p[1], p[2], x.0);
+        let fx = 2.0 * a2 * a3 * r + a3 - a2 * t;
+        let v = (2.0 * x.1 * r / x.2).sqrt();
+        let dv_dx = v / (2.0 * r);
+        let parts = [1.0, a3 * r * r - r * t, a2 * r * r + r];
+        for k in 0..3 {
+            g[k] = -parts[k] / fx * dv_dx;
+        }
+        Some(if g.iter().all(|d| d.is_finite()) {
+            Ok(())
+        } else {
+            Err(Infeasible)
+        })
+    }
+}
+
+/// One series' fit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JaegerFit {
+    /// Reports (parameter rows carry the paper's Fig. 9 values where ξ matches).
+    pub summary: FitSummary,
+    /// Branch used.
+    pub branch: JaegerBranch,
+    /// Points of the series inside the bistable band (eq 90) at the fitted values.
+    pub bistable_points: usize,
+    /// Whether a1 a2 > a3 (eq 82: the resistance has a minimum).
+    pub has_minimum: bool,
+}
+
+/// Jaeger's fits of every series.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JaegerFits {
+    /// Per series, in the dataset's order (`None` with fewer than 4 points).
+    pub series: Vec<Option<JaegerFit>>,
+    /// Why a fit was not made.
+    pub notes: Vec<String>,
+}
+
+fn chi2(model: &JaegerModel, x: &[JaegerX], y: &[f64], s: &[f64], p: &[f64]) -> f64 {
+    let mut c = 0.0;
+    for i in 0..x.len() {
+        match model.value(&x[i], p) {
+            Ok(v) => c += ((y[i] - v) / s[i]).powi(2),
+            Err(_) => return f64::INFINITY,
+        }
+    }
+    c
+}
+
+/// The derived start (module docs).
+pub fn start(model: &JaegerModel, x: &[JaegerX], y: &[f64], s: &[f64]) -> Option<[f64; 3]> {
+    let xx: Vec<f64> = x
+        .iter()
+        .zip(y)
+        .map(|(q, v)| v * v * q.2 / (2.0 * q.1))
+        .collect();
+    let mut best: Option<([f64; 3], f64)> = None;
+    let grid =
+        std::iter::once(0.0).chain((0..=60).map(|i| 10f64.powf(-2.0 + 6.0 * i as f64 / 60.0)));
+    for a2 in grid {
+        // tan δ = a1 · 1/(1 + a2 X) + a3 · X: normal equations of the 2 × 2 problem.
+        let (mut s11, mut s12, mut s22, mut b1, mut b2) = (0.0, 0.0, 0.0, 0.0, 0.0);
+        for (q, &xi) in x.iter().zip(&xx) {
+            let (c1, c2) = (1.0 / (1.0 + a2 * xi), xi);
+            s11 += c1 * c1;
+            s12 += c1 * c2;
+            s22 += c2 * c2;
+            b1 += c1 * q.0;
+            b2 += c2 * q.0;
+        }
+        let d = s11 * s22 - s12 * s12;
+        if !(d.abs() > 0.0) {
+            continue;
+        }
+        let a1 = ((s22 * b1 - s12 * b2) / d).max(0.0);
+        let a3 = (s11 * b2 - s12 * b1) / d;
+        if !(a3 > 0.0) {
+            continue;
+        }
+        let p = [a1, a2, a3];
+        let c = chi2(model, x, y, s, &p);
+        if c.is_finite() && best.is_none_or(|b| c < b.1) {
+            best = Some((p, c));
+        }
+    }
+    best.map(|b| b.0)
+}
+
+/// Fits Jaeger's law to every series on `branch`, with intervals at `level`.
+pub fn fit_jaeger(data: &Dataset, branch: JaegerBranch, level: f64, profile: bool) -> JaegerFits {
+    let model = JaegerModel(branch);
+    let mut notes = Vec::new();
+    let mut out = Vec::new();
+    for (s, label) in data.labels.iter().enumerate() {
+        let pts: Vec<_> = data.series(s).collect();
+        if pts.len() < 4 {
+            notes.push(format!(
+                "series '{label}': {} points, need at least 4 for a1, a2, a3",
+                pts.len()
+            ));
+            out.push(None);
+            continue;
+        }
+        let x: Vec<JaegerX> = pts
+            .iter()
+            .map(|p| {
+                let (sd, cd) = p.scene.delta.sin_cos();
+                (sd / cd, cd, p.scene.eps)
+            })
+            .collect();
+        let y: Vec<f64> = pts.iter().map(|p| p.v).collect();
+        let sg: Vec<f64> = pts.iter().map(|p| p.sigma).collect();
+        let Some(p0) = start(&model, &x, &y, &sg) else {
+            notes.push(format!(
+                "series '{label}': no start with every point on the {} branch",
+                branch_name(branch)
+            ));
+            out.push(None);
+            continue;
+        };
+        let problem = match WeightedData::new(model, x.clone(), y, Some(sg)) {
+            Ok(p) => p,
+            Err(e) => {
+                notes.push(format!("series '{label}': {e}"));
+                out.push(None);
+                continue;
+            }
+        };
+        let opts = LsqOptions {
+            lower: Some(vec![0.0, 0.0, 0.0]),
+            sigma: data.sigma,
+            ..Default::default()
+        };
+        let f = match fit(&problem, &p0, &opts) {
+            Ok(f) => f,
+            Err(e) => {
+                notes.push(format!("series '{label}': {e}"));
+                out.push(None);
+                continue;
+            }
+        };
+        let paper = paper_values(pts[0].scene.xi);
+        let src = if paper.is_some() { "paper Fig. 9" } else { "" };
+        let specs = ["a1", "a2", "a3"].map(|name| ParamSpec {
+            name,
+            unit: "1 (Jaeger units, eq 81)",
+            paper_value: None,
+            paper_source: src,
+        });
+        let mut specs = specs;
+        if let Some(pv) = paper {
+            for k in 0..3 {
+                specs[k].paper_value = Some(pv[k]);
+            }
+        }
+        let mut summary = summarise("jaeger", label, &specs, &problem, &f, level, &opts, profile);
+        let m = Jaeger {
+            a1: f.params[0],
+            a2: f.params[1],
+            a3: f.params[2],
+            branch,
+        };
+        let bistable_points = x.iter().filter(|q| m.bistable(q.0)).count();
+        let has_minimum = m.a1 * m.a2 > m.a3;
+        let mut extra = format!("branch {}", branch_name(branch));
+        if bistable_points > 0 {
+            extra.push_str(&format!(
+                "; {bistable_points} point(s) in the bistable band of eq 90"
+            ));
+        }
+        if !has_minimum {
+            extra.push_str("; a1 a2 <= a3: no minimum of the resistance (eq 82)");
+        }
+        summary.stats.note = if summary.stats.note.is_empty() {
+            extra
+        } else {
+            format!("{}; {extra}", summary.stats.note)
+        };
+        out.push(Some(JaegerFit {
+            summary,
+            branch,
+            bistable_points,
+            has_minimum,
+        }));
+    }
+    JaegerFits { series: out, notes }
+}
+
+/// `upper` or `lower`.
+pub fn branch_name(b: JaegerBranch) -> &'static str {
+    match b {
+        JaegerBranch::Upper => "upper",
+        JaegerBranch::Lower => "lower",
+    }
+}

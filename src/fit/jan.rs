@@ -1,0 +1,307 @@
+//! Jan's energy balance fitted on the measured velocities (eq 74), not on the linearised plot
+//! v̄²/cos δ against tan δ (Fig. 8): per series λ and μ, and across series the laws
+//! λ = λ0 e^{λ1 sin α}, μ = μ0 e^{μ1 sin α} (the form of eqs 75–76).
+//!
+//! v̄ = sqrt((2 sin α/λ)(sin δ − μ cos δ)) has the analytic gradient
+//! ∂v̄/∂λ = −v̄/(2λ), ∂v̄/∂μ = −sin α cos δ/(λ v̄). A point with tan δ ≤ μ has no motion in this
+//! model (regime A), so μ is boxed to [0, min tan δ) and a trial μ beyond a point's slope is
+//! [`Infeasible`].
+//!
+//! The per-series start is the weighted straight line of the linearised plot
+//! (v̄²/cos δ = (2 sin α/λ)(tan δ − μ)); the global start is the straight lines of ln λ and
+//! ln μ against sin α through the per-series fits (the paper's values where those fail).
+
+use super::data::Dataset;
+use super::summary::{summarise, FitSummary, ParamSpec};
+use crate::inverse::{fit, Infeasible, LsqOptions, Model, WeightedData};
+
+/// The paper's global values (λ0, λ1, μ0, μ1), eqs 75–76.
+pub const PAPER_GLOBAL: [f64; 4] = [0.063, 4.96, 0.0025, 7.46];
+
+/// What Jan's formula needs of a point: (sin α, sin δ, cos δ).
+pub type JanX = (f64, f64, f64);
+
+/// v̄ and (∂v̄/∂λ, ∂v̄/∂μ) at (λ, μ), or infeasible where sin δ − μ cos δ ≤ 0 or λ ≤ 0.
+pub fn velocity(x: &JanX, lambda: f64, mu: f64) -> Result<(f64, f64, f64), Infeasible> {
+    let (sa, sd, cd) = *x;
+    let drive = sd - mu * cd;
+    if !(drive > 0.0 && lambda > 0.0) {
+        return Err(Infeasible);
+    }
+    let v = (2.0 * sa / lambda * drive).sqrt();
+    Ok((v, -v / (2.0 * lambda), -sa * cd / (lambda * v)))
+}
+
+/// Per-series model: p = (λ, μ).
+#[derive(Debug, Clone, Copy)]
+pub struct JanSeries;
+
+impl Model<JanX> for JanSeries {
+    fn n_params(&self) -> usize {
+        2
+    }
+    fn value(&self, x: &JanX, p: &[f64]) -> Result<f64, Infeasible> {
+        velocity(x, p[0], p[1]).map(|r| r.0)
+    }
+    fn gradient(&self, x: &JanX, p: &[f64], g: &mut [f64]) -> Option<Result<(), Infeasible>> {
+        Some(velocity(x, p[0], p[1]).map(|(_, dl, dm)| {
+            g[0] = dl;
+            g[1] = dm;
+        }))
+    }
+}
+
+/// Global model: p = (λ0, λ1, μ0, μ1).
+#[derive(Debug, Clone, Copy)]
+pub struct JanGlobal;
+
+impl Model<JanX> for JanGlobal {
+    fn n_params(&self) -> usize {
+        4
+    }
+    fn value(&self, x: &JanX, p: &[f64]) -> Result<f64, Infeasible> {
+        let (l, m) = (p[0] * (p[1] * x.0).exp(), p[2] * (p[3] * x.0).exp());
+        velocity(x, l, m).map(|r| r.0)
+    }
+    fn gradient(&self, x: &JanX, p: &[f64], g: &mut [f64]) -> Option<Result<(), Infeasible>> {
+        let (el, em) = ((p[1] * x.0).exp(), (p[3] * x.0).exp());
+        let (l, m) = (p[0] * el, p[2] * em);
+        Some(velocity(x, l, m).map(|(_, dl, dm)| {
+            g[0] = dl * el;
+            g[1] = dl * l * x.0;
+            g[2] = dm * em;
+            g[3] = dm * m * x.0;
+        }))
+    }
+}
+
+/// The fits of `fitbead jan`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JanFits {
+    /// Per series (λ, μ), in the dataset's series order; `None` where the series has fewer
+    /// than 3 points (no degree of freedom left for the scatter).
+    pub series: Vec<Option<FitSummary>>,
+    /// The global laws; `None` with fewer than two distinct α.
+    pub global: Option<FitSummary>,
+    /// Why a fit was not made.
+    pub notes: Vec<String>,
+}
+
+fn xs(data: &Dataset, s: Option<usize>) -> (Vec<JanX>, Vec<f64>, Vec<f64>) {
+    let mut x = Vec::new();
+    let mut y = Vec::new();
+    let mut sg = Vec::new();
+    for p in data
+        .points
+        .iter()
+        .filter(|p| s.is_none_or(|s| p.series == s))
+    {
+        let sc = &p.scene;
+        let (sd, cd) = sc.delta.sin_cos();
+        x.push((sc.sin_alpha, sd, cd));
+        y.push(p.v);
+        sg.push(p.sigma);
+    }
+    (x, y, sg)
+}
+
+/// Weighted straight line y = a + b x (weights 1/σ²); `None` if degenerate.
+fn line(x: &[f64], y: &[f64], sigma: &[f64]) -> Option<(f64, f64)> {
+    let (mut sw, mut sx, mut sy, mut sxx, mut sxy) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    for ((&xi, &yi), &si) in x.iter().zip(y).zip(sigma) {
+        let w = 1.0 / (si * si);
+        sw += w;
+        sx += w * xi;
+        sy += w * yi;
+        sxx += w * xi * xi;
+        sxy += w * xi * yi;
+    }
+    let d = sw * sxx - sx * sx;
+    if !(d.abs() > 0.0) {
+        return None;
+    }
+    let b = (sw * sxy - sx * sy) / d;
+    let a = (sy - b * sx) / sw;
+    (a.is_finite() && b.is_finite()).then_some((a, b))
+}
+
+/// Fits Jan's model per series and globally, with intervals at `level`.
+pub fn fit_jan(data: &Dataset, level: f64, profile: bool) -> JanFits {
+    let mut notes = Vec::new();
+    let mut per = Vec::new();
+    let mut lam_pts: Vec<(f64, f64, f64)> = Vec::new(); // (sin α, ln λ, weight σ of ln λ)
+    let mut mu_pts: Vec<(f64, f64, f64)> = Vec::new();
+    for (s, label) in data.labels.iter().enumerate() {
+        let (x, y, sg) = xs(data, Some(s));
+        if x.len() < 3 {
+            notes.push(format!(
+                "series '{label}': {} points, need at least 3 for λ and μ",
+                x.len()
+            ));
+            per.push(None);
+            continue;
+        }
+        let sa = x[0].0;
+        let tmin = x.iter().map(|p| p.1 / p.2).fold(f64::INFINITY, f64::min);
+        // Linearised start: v̄²/cos δ = A (tan δ − μ), σ of v̄²/cos δ = 2 v̄ σ / cos δ.
+        let lx: Vec<f64> = x.iter().map(|p| p.1 / p.2).collect();
+        let ly: Vec<f64> = x.iter().zip(&y).map(|(p, v)| v * v / p.2).collect();
+        let ls: Vec<f64> = x
+            .iter()
+            .zip(&y)
+            .zip(&sg)
+            .map(|((p, v), s)| 2.0 * v * s / p.2)
+            .collect();
+        let (lam0, mu0) = match line(&lx, &ly, &ls) {
+            Some((a, b)) if b > 0.0 => (2.0 * sa / b, (-a / b).clamp(0.0, 0.999 * tmin)),
+            _ => (crate::models::jan::Jan::paper_fit(sa.asin()).lambda, 0.0),
+        };
+        let problem = match WeightedData::new(JanSeries, x, y, Some(sg)) {
+            Ok(p) => p,
+            Err(e) => {
+                notes.push(format!("series '{label}': {e}"));
+                per.push(None);
+                continue;
+            }
+        };
+        let opts = LsqOptions {
+            lower: Some(vec![0.0, 0.0]),
+            upper: Some(vec![f64::INFINITY, tmin]),
+            sigma: data.sigma,
+            ..Default::default()
+        };
+        let f = match fit(&problem, &[lam0, mu0], &opts) {
+            Ok(f) => f,
+            Err(e) => {
+                notes.push(format!("series '{label}': {e}"));
+                per.push(None);
+                continue;
+            }
+        };
+        let paper = crate::models::jan::Jan::paper_fit(sa.asin());
+        let specs = [
+            ParamSpec {
+                name: "lambda",
+                unit: "1",
+                paper_value: Some(paper.lambda),
+                paper_source: "paper eq 75 at this alpha",
+            },
+            ParamSpec {
+                name: "mu",
+                unit: "1",
+                paper_value: Some(paper.mu),
+                paper_source: "paper eq 76 at this alpha",
+            },
+        ];
+        let sum = summarise(
+            "jan-series",
+            label,
+            &specs,
+            &problem,
+            &f,
+            level,
+            &opts,
+            profile,
+        );
+        if f.converged() {
+            let se = f.std_errors().map(|s| s.to_vec()).unwrap_or(vec![1.0; 2]);
+            if f.params[0] > 0.0 {
+                lam_pts.push((sa, f.params[0].ln(), se[0] / f.params[0]));
+            }
+            if f.params[1] > 0.0 {
+                mu_pts.push((sa, f.params[1].ln(), se[1] / f.params[1]));
+            }
+        }
+        per.push(Some(sum));
+    }
+    let mut alphas: Vec<f64> = data.points.iter().map(|p| p.scene.sin_alpha).collect();
+    alphas.sort_by(|a, b| a.total_cmp(b));
+    alphas.dedup();
+    let global = if alphas.len() < 2 {
+        notes.push("global laws need series at two or more contact angles".into());
+        None
+    } else {
+        let fit_line = |pts: &[(f64, f64, f64)], paper: (f64, f64)| {
+            let (x, y, s): (Vec<f64>, Vec<f64>, Vec<f64>) = (
+                pts.iter().map(|p| p.0).collect(),
+                pts.iter().map(|p| p.1).collect(),
+                pts.iter()
+                    .map(|p| {
+                        if p.2 > 0.0 && p.2.is_finite() {
+                            p.2
+                        } else {
+                            1.0
+                        }
+                    })
+                    .collect(),
+            );
+            match (pts.len() >= 2).then(|| line(&x, &y, &s)).flatten() {
+                Some((a, b)) => (a.exp(), b),
+                None => paper,
+            }
+        };
+        let (l0, l1) = fit_line(&lam_pts, (PAPER_GLOBAL[0], PAPER_GLOBAL[1]));
+        let (m0, m1) = fit_line(&mu_pts, (PAPER_GLOBAL[2], PAPER_GLOBAL[3]));
+        let (x, y, sg) = xs(data, None);
+        let problem = WeightedData::new(JanGlobal, x.clone(), y, Some(sg)).ok();
+        let opts = LsqOptions {
+            lower: Some(vec![0.0, f64::NEG_INFINITY, 0.0, f64::NEG_INFINITY]),
+            sigma: data.sigma,
+            ..Default::default()
+        };
+        let feasible = |p: &[f64]| x.iter().all(|q| JanGlobal.value(q, p).is_ok());
+        // The start must keep μ(α) below every slope; shrink μ0 until it does.
+        let mut start = [l0, l1, m0, m1];
+        let mut tries = 0;
+        while !feasible(&start) && tries < 60 {
+            start[2] *= 0.5;
+            tries += 1;
+        }
+        problem.and_then(|problem| {
+            let f = fit(&problem, &start, &opts).ok()?;
+            let src75 = "paper eq 75";
+            let src76 = "paper eq 76";
+            let specs = [
+                ParamSpec {
+                    name: "lambda0",
+                    unit: "1",
+                    paper_value: Some(PAPER_GLOBAL[0]),
+                    paper_source: src75,
+                },
+                ParamSpec {
+                    name: "lambda1",
+                    unit: "1",
+                    paper_value: Some(PAPER_GLOBAL[1]),
+                    paper_source: src75,
+                },
+                ParamSpec {
+                    name: "mu0",
+                    unit: "1",
+                    paper_value: Some(PAPER_GLOBAL[2]),
+                    paper_source: src76,
+                },
+                ParamSpec {
+                    name: "mu1",
+                    unit: "1",
+                    paper_value: Some(PAPER_GLOBAL[3]),
+                    paper_source: src76,
+                },
+            ];
+            Some(summarise(
+                "jan-global",
+                "all",
+                &specs,
+                &problem,
+                &f,
+                level,
+                &opts,
+                profile,
+            ))
+        })
+    };
+    JanFits {
+        series: per,
+        global,
+        notes,
+    }
+}

@@ -21,11 +21,11 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 
-const XIS: [f64; 4] = [0.8, 1.0, 1.6, 2.0];
+pub const XIS: [f64; 4] = [0.8, 1.0, 1.6, 2.0];
 
 /// Points spread over 5 %–95 % of [lo, hi] per series, v = v_true (1 + noise z), σ = noise·v_true
 /// (σ = 0.01 v_true when noise = 0, so that the fits have weights).
-fn simulate(
+pub fn simulate(
     model_of: impl Fn(f64, f64) -> Model,
     range_of: impl Fn(&Model, f64) -> (f64, f64),
     law: CollisionLaw,
@@ -56,26 +56,26 @@ fn simulate(
     Dataset::new(rows).unwrap()
 }
 
-fn regime_b(law: CollisionLaw) -> impl Fn(&Model, f64) -> (f64, f64) {
+pub fn regime_b(law: CollisionLaw) -> impl Fn(&Model, f64) -> (f64, f64) {
     move |m, xi| regime_b_interval(m, xi, 0.4, 0.1, law).unwrap()
 }
 
 /// Onset to onset + 12° (the open-ended models of §5).
-fn open_range(law: CollisionLaw) -> impl Fn(&Model, f64) -> (f64, f64) {
+pub fn open_range(law: CollisionLaw) -> impl Fn(&Model, f64) -> (f64, f64) {
     move |m, xi| {
         let (lo, _) = regime_b_interval(m, xi, 0.4, 0.1, law).unwrap();
         (lo, lo + 12f64.to_radians())
     }
 }
 
-fn jan_model(p: [f64; 4]) -> impl Fn(f64, f64) -> Model {
+pub fn jan_model(p: [f64; 4]) -> impl Fn(f64, f64) -> Model {
     move |_, alpha| {
         let s = alpha.sin();
         Model::Jan(Jan::new(p[0] * (p[1] * s).exp(), p[2] * (p[3] * s).exp()).unwrap())
     }
 }
 
-fn jaeger_model(xi: f64, _alpha: f64) -> Model {
+pub fn jaeger_model(xi: f64, _alpha: f64) -> Model {
     let p = paper_values(xi).unwrap();
     Model::Jaeger(Jaeger::new(p[0], p[1], p[2], fitbead::models::JaegerBranch::Upper).unwrap())
 }
@@ -85,7 +85,7 @@ fn covers(r: &ParamRow, truth: f64) -> Option<bool> {
     ci.map(|(a, b)| a <= truth && truth <= b)
 }
 
-const PAPER_JAN: [f64; 4] = [0.063, 4.96, 0.0025, 7.46];
+pub const PAPER_JAN: [f64; 4] = [0.063, 4.96, 0.0025, 7.46];
 
 #[test]
 fn klaw_c_recovers_the_adjusted_law_from_exact_data() {

@@ -4,7 +4,10 @@
 use super::fitargs::FitArgs;
 use super::k::parse_model;
 use super::CliError;
-use crate::fit::klaw::{fit_law, KLaw};
+use crate::fit::k::bracket;
+use crate::fit::klaw::{fit_law, KLaw, KLawError};
+use crate::io::fmt_f64;
+use rayon::prelude::*;
 
 /// Arguments of `fitbead klaw`.
 #[derive(Debug, clap::Args)]
@@ -16,6 +19,10 @@ pub struct Args {
     /// only) or free-per-series (one K per series). The impact law is always scored as well.
     #[arg(long, default_value = "c")]
     pub law: String,
+    /// Leave out (and list on stderr) the points that no K can make steady under the model,
+    /// instead of stopping with an error.
+    #[arg(long)]
+    pub skip_unsteady: bool,
     /// Input, output and interval flags.
     #[command(flatten)]
     pub io: FitArgs,
@@ -28,13 +35,84 @@ pub fn run(a: Args) -> Result<(), CliError> {
         .law
         .parse()
         .map_err(|e: String| super::flag_error("--law", &a.law, e))?;
-    let (_t, _rows, ds) = a.io.read()?;
-    let fail = |e: crate::fit::klaw::KLawError| CliError::Other(format!("klaw: {e}"));
+    let (t, _rows, ds) = a.io.read()?;
+    // Points that no K makes steady: an error naming them, or left out with --skip-unsteady.
+    let unsteady: Vec<(usize, String)> = ds
+        .points
+        .par_iter()
+        .enumerate()
+        .filter_map(|(i, p)| bracket(&model, &p.scene).err().map(|e| (i, e.to_string())))
+        .collect();
+    let locate = |d: &crate::fit::data::Dataset, i: usize| {
+        let p = &d.points[i];
+        format!(
+            "{}, line {} (series '{}', xi {}, delta_deg {})",
+            t.source,
+            t.lines[i],
+            d.labels[p.series],
+            fmt_f64(p.scene.xi),
+            fmt_f64(p.scene.delta_deg()),
+        )
+    };
+    let describe = |i: usize, why: &str| format!("{}: {why}", locate(&ds, i));
+    let mut skipped_note = String::new();
+    let all = ds.clone();
+    let (ds, orig) = if unsteady.is_empty() {
+        let n = ds.points.len();
+        (ds, (0..n).collect::<Vec<_>>())
+    } else if a.skip_unsteady {
+        for (i, why) in &unsteady {
+            eprintln!("fitbead klaw: left out: {}", describe(*i, why));
+        }
+        skipped_note = format!(
+            "{} point(s) with no steady state for any K left out (--skip-unsteady)",
+            unsteady.len()
+        );
+        let out: std::collections::HashSet<usize> = unsteady.iter().map(|u| u.0).collect();
+        ds.filter(|i| !out.contains(&i))
+    } else {
+        let (i, why) = &unsteady[0];
+        return Err(CliError::Other(format!(
+            "{} (and {} more such point(s)); no K of the {} model makes this point steady: \
+             use another model, or --skip-unsteady to leave such points out",
+            describe(*i, why),
+            unsteady.len() - 1,
+            a.model
+        )));
+    };
+    if ds.points.is_empty() {
+        return Err(CliError::Other("klaw: no point is left to fit".to_string()));
+    }
+    let fail = |e: KLawError| match e {
+        KLawError::EmptyBox {
+            param,
+            lower,
+            upper,
+        } => CliError::Other(format!(
+            "klaw: no value of {param} keeps every point in regime B: {} needs {param} > {} \
+             (below, the bead stops), while {} needs {param} <= {} (above, it lifts off or runs \
+             away)",
+            locate(&all, orig[lower.1]),
+            fmt_f64(lower.0),
+            locate(&all, orig[upper.1]),
+            fmt_f64(upper.0)
+        )),
+        e => CliError::Other(format!("klaw: {e}")),
+    };
     let main = fit_law(model, &ds, law, a.io.level, !a.io.no_profile).map_err(fail)?;
     let mut stats = vec![main.summary.stats.clone()];
     if law != KLaw::Impact {
         let imp = fit_law(model, &ds, KLaw::Impact, a.io.level, false).map_err(fail)?;
         stats.push(imp.summary.stats);
+    }
+    if !skipped_note.is_empty() {
+        for s in stats.iter_mut() {
+            s.note = if s.note.is_empty() {
+                skipped_note.clone()
+            } else {
+                format!("{}; {skipped_note}", s.note)
+            };
+        }
     }
     a.io.write(&main.summary.params, &stats)
 }

@@ -104,4 +104,38 @@ impl Dataset {
             sigma: self.sigma,
         }
     }
+
+    /// The points whose index passes `keep`, series without points dropped (labels kept in
+    /// order). Returns the dataset and, for each kept point, its index in `self`.
+    pub fn filter(&self, keep: impl Fn(usize) -> bool) -> (Dataset, Vec<usize>) {
+        let mut labels: Vec<String> = Vec::new();
+        let mut points = Vec::new();
+        let mut index = Vec::new();
+        for (i, p) in self.points.iter().enumerate() {
+            if !keep(i) {
+                continue;
+            }
+            let label = &self.labels[p.series];
+            let series = match labels.iter().position(|l| l == label) {
+                Some(j) => j,
+                None => {
+                    labels.push(label.clone());
+                    labels.len() - 1
+                }
+            };
+            points.push(Point {
+                series,
+                ..p.clone()
+            });
+            index.push(i);
+        }
+        (
+            Dataset {
+                labels,
+                points,
+                sigma: self.sigma,
+            },
+            index,
+        )
+    }
 }

@@ -9,7 +9,7 @@ use fitbead::fit::klaw::{fit_law, KLaw};
 use fitbead::models::JaegerBranch;
 use fitbead::{CollisionLaw, Model};
 
-#[allow(dead_code)]
+#[allow(dead_code, unused_imports)]
 #[path = "../tests/fits.rs"]
 mod fits;
 

@@ -395,6 +395,11 @@ fn k_bad_input_exits_2_with_location_and_leaves_output_untouched() {
             "not a number",
         ),
         ("series,xi,delta_deg,v_m_s\na,1,12,0.3\n", "R_m", "missing"),
+        (
+            "series,xi,delta_deg,v,sigma_v_m_s\na,1,12,0.3,0.01\n",
+            "line 1",
+            "sigma_v_m_s",
+        ),
     ];
     for (text, want1, want2) in cases {
         let p = write(&dir, "bad.csv", text);

@@ -106,6 +106,18 @@ pub fn read_rows(t: &Table, rho: f64, f: f64, g: f64) -> Result<Vec<Row>, CliErr
     if c_v.is_none() && c_vms.is_none() {
         return Err(t.require("v").unwrap_err().into());
     }
+    if let (Some(_), Some(cs)) = (c_v, c_sigma_ms) {
+        return Err(InputError {
+            file: t.source.clone(),
+            line: Some(1),
+            column: Some(t.headers[cs].clone()),
+            value: None,
+            message: "sigma_v_m_s is in m/s but v is dimensionless: give v_m_s and R_m with \
+                      sigma_v_m_s, or sigma_v with v"
+                .into(),
+        }
+        .into());
+    }
     if c_v.is_none() && c_r.is_none() {
         return Err(t.require("R_m").unwrap_err().into());
     }

@@ -538,3 +538,91 @@ fn fit_commands_reject_bad_input_with_exit_2() {
         assert_eq!(std::fs::read_to_string(&outp).unwrap(), "precious");
     }
 }
+
+#[test]
+fn fit_reports_are_not_written_when_one_target_fails() {
+    let dir = tmpdir();
+    let stats = write(&dir, "stats.csv", "precious");
+    let out = bin()
+        .args([
+            "jan",
+            "--output",
+            "/nonexistent-dir/x.csv",
+            "--output-stats",
+        ])
+        .arg(&stats)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("nonexistent-dir"));
+    assert_eq!(std::fs::read_to_string(&stats).unwrap(), "precious");
+}
+
+#[test]
+fn klaw_names_or_skips_points_that_no_k_makes_steady() {
+    // The default data (stick/slip) holds points that the slip model cannot make steady.
+    let out = bin().args(["klaw", "--model", "slip"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("line 20") && err.contains("--skip-unsteady"),
+        "{err}"
+    );
+    let out = bin()
+        .args([
+            "klaw",
+            "--model",
+            "slip",
+            "--law",
+            "free-per-series",
+            "--skip-unsteady",
+        ])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("left out") && err.contains("line 20"), "{err}");
+}
+
+#[test]
+fn simulate_jan_and_jaeger_with_their_flags() {
+    for args in [
+        vec!["--model", "jan", "--jan", "0.063,4.96,0.0025,7.46"],
+        vec![
+            "--model",
+            "jaeger",
+            "--jaeger",
+            "0.131,18.57,1.41",
+            "--series",
+            "1",
+        ],
+        vec!["--model", "jaeger", "--branch", "lower", "--series", "1"],
+        vec!["--model", "stick", "--series", "1", "--delta-range", "0,30"],
+        vec!["--model", "jaeger", "--delta-range", "0,30"],
+    ] {
+        let out = bin().arg("simulate").args(&args).output().unwrap();
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let text = String::from_utf8(out.stdout).unwrap();
+        let mut r = csv::Reader::from_reader(text.as_bytes());
+        let n = r.records().count();
+        assert!(n >= 9, "{args:?}: {n} rows");
+    }
+    for (args, flag) in [
+        (vec!["--model", "jan", "--jan", "1,2,3"], "--jan"),
+        (vec!["--model", "jaeger", "--series", "3"], "--series"),
+        (
+            vec!["--model", "stick", "--delta-range", "20,10"],
+            "--delta-range",
+        ),
+    ] {
+        let out = bin().arg("simulate").args(&args).output().unwrap();
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        assert!(
+            String::from_utf8_lossy(&out.stderr).contains(flag),
+            "{args:?}"
+        );
+    }
+}

@@ -5,7 +5,7 @@ use super::{emit, read_input, CliError};
 use crate::fit::data::{DataError, Dataset};
 use crate::fit::summary::{params_csv, stats_csv, ParamRow, StatsRow};
 use crate::io::scenes::Table;
-use crate::io::{fmt_f64, write_atomic};
+use crate::io::{fmt_f64, write_atomic_all};
 use std::path::PathBuf;
 
 /// Flags common to every fit command.
@@ -83,36 +83,49 @@ impl FitArgs {
         Ok((t, rows, ds))
     }
 
-    /// Writes the reports (both atomically; the statistics go to stderr as a table when
-    /// `--output-stats` is absent).
+    /// Writes the reports: the files given are staged and renamed together (a failure leaves
+    /// all of them untouched); the report goes to stdout without `--output`, the statistics to
+    /// stderr as a table without `--output-stats`.
     pub fn write(&self, params: &[ParamRow], stats: &[StatsRow]) -> Result<(), CliError> {
-        let p = params_csv(params).map_err(|e| CliError::Other(e.to_string()))?;
+        let p_csv = params_csv(params).map_err(|e| CliError::Other(e.to_string()))?;
         let s = stats_csv(stats).map_err(|e| CliError::Other(e.to_string()))?;
-        match &self.output_stats {
-            Some(path) => write_atomic(path, &s)
-                .map_err(|e| CliError::Other(format!("{}: cannot write: {e}", path.display())))?,
-            None => {
-                for r in stats {
-                    eprintln!(
-                        "{} [{}]: chi2 {} dof {} reduced {} AIC {} BIC {} ({}){}",
-                        r.fit,
-                        r.series,
-                        fmt_sig(r.chi2),
-                        r.dof,
-                        fmt_sig(r.reduced_chi2),
-                        fmt_sig(r.aic),
-                        fmt_sig(r.bic),
-                        r.termination,
-                        if r.note.is_empty() {
-                            String::new()
-                        } else {
-                            format!(" — {}", r.note)
-                        }
-                    );
-                }
+        let files: Vec<(&std::path::Path, &[u8])> = self
+            .output
+            .iter()
+            .map(|p| (p.as_path(), p_csv.as_slice()))
+            .chain(
+                self.output_stats
+                    .iter()
+                    .map(|q| (q.as_path(), s.as_slice())),
+            )
+            .collect();
+        if !files.is_empty() {
+            write_atomic_all(&files).map_err(|e| CliError::Other(format!("cannot write: {e}")))?;
+        }
+        if self.output_stats.is_none() {
+            for r in stats {
+                eprintln!(
+                    "{} [{}]: chi2 {} dof {} reduced {} AIC {} BIC {} ({}){}",
+                    r.fit,
+                    r.series,
+                    fmt_sig(r.chi2),
+                    r.dof,
+                    fmt_sig(r.reduced_chi2),
+                    fmt_sig(r.aic),
+                    fmt_sig(r.bic),
+                    r.termination,
+                    if r.note.is_empty() {
+                        String::new()
+                    } else {
+                        format!(" — {}", r.note)
+                    }
+                );
             }
         }
-        emit(self.output.as_deref(), &p)
+        if self.output.is_none() {
+            emit(None, &p_csv)?;
+        }
+        Ok(())
     }
 }
 

@@ -88,7 +88,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
             param,
             lower,
             upper,
-        } => CliError::Other(format!(
+        } if lower.0.is_finite() && upper.0.is_finite() => CliError::Other(format!(
             "klaw: no value of {param} keeps every point in regime B: {} needs {param} > {} \
              (below, the bead stops), while {} needs {param} <= {} (above, it lifts off or runs \
              away)",

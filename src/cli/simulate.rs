@@ -51,8 +51,8 @@ pub struct Args {
     /// Branch of eq 84 for --model jaeger: upper or lower.
     #[arg(long, default_value = "upper")]
     pub branch: String,
-    /// Slopes LO,HI in degrees to spread the points over (kept inside the model's steady
-    /// range). Default: 5 %–95 % of the steady range for the contact models; for jan and
+    /// Slopes LO,HI in degrees: the range is cut to the model's steady range and the points
+    /// spread over 5 %–95 % of it. Default: 5 %–95 % of the steady range for the contact models; for jan and
     /// jaeger, whose steady range has no upper end, the onset to the onset + 12°.
     #[arg(long)]
     pub delta_range: Option<String>,
@@ -252,7 +252,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
                         ),
                     ));
                 }
-                (l, h, 0.0, 1.0)
+                (l, h, 0.05, 0.95)
             }
             None if open_ended => (lo, (lo + 12f64.to_radians()).min(hi), 0.05, 0.95),
             None => (lo, hi, 0.05, 0.95),

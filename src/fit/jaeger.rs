@@ -6,8 +6,8 @@
 //! F(X) = a2 a3 X² + (a3 − a2 tan δ) X + a1 − tan δ = 0 (eq 84). The gradient is analytic by
 //! implicit differentiation: ∂X/∂a_k = −(∂F/∂a_k)/(∂F/∂X) with ∂F/∂a1 = 1,
 //! ∂F/∂a2 = a3 X² − X tan δ, ∂F/∂a3 = a2 X² + X, ∂F/∂X = 2 a2 a3 X + a3 − a2 tan δ, and
-//! ∂v̄/∂X = v̄/(2X). Where the branch has no root (the slope is below the band, or the lower
-//! branch is asked for outside the band) the point is [`Infeasible`].
+//! ∂v̄/∂X = v̄/(2X). Where eq 84 has no positive root (the slope is below the band) the point
+//! is [`Infeasible`]; where it has one, both branches return it.
 //!
 //! The start is derived: with u² = X_i computed from each measured v̄_i, eq 83 reads
 //! tan δ_i = a3 X_i + a1/(1 + a2 X_i), linear in (a1, a3) for fixed a2. A log grid of a2 over
@@ -249,6 +249,13 @@ pub fn fit_jaeger(data: &Dataset, branch: JaegerBranch, level: f64, profile: boo
         }
         if !has_minimum {
             extra.push_str("; a1 a2 <= a3: no minimum of the resistance (eq 82)");
+        }
+        for row in summary.params.iter_mut() {
+            row.note = if row.note.is_empty() {
+                extra.clone()
+            } else {
+                format!("{} {extra}", row.note)
+            };
         }
         summary.stats.note = if summary.stats.note.is_empty() {
             extra

@@ -257,8 +257,18 @@ pub fn fit_jan(data: &Dataset, level: f64, profile: bool) -> JanFits {
             start[2] *= 0.5;
             tries += 1;
         }
+        let problem = problem.or_else(|| {
+            notes.push("global laws: the data cannot form a weighted problem".into());
+            None
+        });
         problem.and_then(|problem| {
-            let f = fit(&problem, &start, &opts).ok()?;
+            let f = match fit(&problem, &start, &opts) {
+                Ok(f) => f,
+                Err(e) => {
+                    notes.push(format!("global laws: {e}"));
+                    return None;
+                }
+            };
             let src75 = "paper eq 75";
             let src76 = "paper eq 76";
             let specs = [

@@ -85,6 +85,8 @@ pub enum KLawError {
         /// Smallest upper end (and the point that sets it).
         upper: (f64, usize),
     },
+    /// The least-squares solver refused the problem (malformed input to it).
+    Solver(String),
 }
 
 impl fmt::Display for KLawError {
@@ -101,6 +103,17 @@ impl fmt::Display for KLawError {
                 param,
                 lower,
                 upper,
+            } if !(lower.0.is_finite() && upper.0.is_finite()) => write!(
+                f,
+                "the points cannot constrain {param}: the law's dependence on it vanishes at \
+                 their contact angles (points {} and {})",
+                lower.1 + 1,
+                upper.1 + 1
+            ),
+            KLawError::EmptyBox {
+                param,
+                lower,
+                upper,
             } => write!(
                 f,
                 "no value of {param} keeps every point in regime B: point {} needs {param} > {} \
@@ -111,6 +124,7 @@ impl fmt::Display for KLawError {
                 upper.1 + 1,
                 crate::io::fmt_f64(upper.0)
             ),
+            KLawError::Solver(s) => write!(f, "least-squares solver: {s}"),
         }
     }
 }
@@ -444,10 +458,7 @@ pub fn fit_law(
         sigma: data.sigma,
         ..Default::default()
     };
-    let f = fit(&problem, &start, &opts).map_err(|e| KLawError::NoBracket {
-        index: 0,
-        reason: e.to_string(),
-    })?;
+    let f = fit(&problem, &start, &opts).map_err(|e| KLawError::Solver(e.to_string()))?;
     let specs: Vec<ParamSpec> = (0..problem.n)
         .map(|_| ParamSpec {
             name: problem.param_name(),

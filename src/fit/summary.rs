@@ -28,7 +28,8 @@ pub const PARAM_COLUMNS: [&str; 9] = [
     "unit",
 ];
 
-/// Columns of the parameter report after the contract ones.
+/// Columns of the parameter report after the contract ones (`cov_low`/`cov_high` are the
+/// uncut covariance interval).
 pub const PARAM_EXTRA_COLUMNS: [&str; 11] = [
     "level",
     "cov_low",
@@ -92,6 +93,8 @@ pub struct ParamRow {
     pub paper_source: &'static str,
     /// Anything the user should know about this parameter.
     pub note: String,
+    /// The parameter's box (lower, upper); a covariance interval is cut to it.
+    pub bounds: (f64, f64),
 }
 
 impl ParamRow {
@@ -104,7 +107,10 @@ impl ParamRow {
             }
         }
         match self.cov {
-            Some(c) => (Some(c), "covariance"),
+            Some((a, b)) => (
+                Some((a.max(self.bounds.0), b.min(self.bounds.1))),
+                "covariance",
+            ),
             None => (None, "none"),
         }
     }
@@ -218,7 +224,12 @@ pub fn summarise<R: Residuals + ?Sized>(
         None
     };
     if f.converged() && f.covariance.is_none() {
-        note = "Jacobian rank deficient at the estimate: no covariance".into();
+        note = if f.sigma == SigmaKind::Relative && f.dof == 0 {
+            "no degree of freedom left to estimate the scatter (no sigma given): no covariance"
+                .into()
+        } else {
+            "Jacobian rank deficient at the estimate: no covariance".into()
+        };
     }
     let mut evals = f.residual_evals;
     let params = specs
@@ -231,7 +242,19 @@ pub fn summarise<R: Residuals + ?Sized>(
             if let Some(c) = &ci {
                 evals += c.profile[j].residual_evals;
             }
+            let bounds = (
+                opts.lower.as_ref().map_or(f64::NEG_INFINITY, |l| l[j]),
+                opts.upper.as_ref().map_or(f64::INFINITY, |u| u[j]),
+            );
             let mut pnote = String::new();
+            let profile_closed = ci.as_ref().is_some_and(|c| {
+                closed_end(c.profile[j].lower).is_some() && closed_end(c.profile[j].upper).is_some()
+            });
+            if let Some((a, b)) = wald.as_ref().map(|w| (w[j].lower, w[j].upper)) {
+                if !profile_closed && (a < bounds.0 || b > bounds.1) {
+                    pnote.push_str("covariance interval cut to the parameter's box. ");
+                }
+            }
             if f.at_bound.get(j).copied().unwrap_or(false) {
                 pnote.push_str("on a bound of its box; the covariance ignores the bound. ");
             }
@@ -272,6 +295,7 @@ pub fn summarise<R: Residuals + ?Sized>(
                 paper_value: s.paper_value,
                 paper_source: s.paper_source,
                 note: pnote.trim_end().to_string(),
+                bounds,
             }
         })
         .collect();

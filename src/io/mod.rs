@@ -86,6 +86,33 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     Ok(())
 }
 
+/// Writes several files atomically as a group: every temporary file is written and synced
+/// first, and only then are they renamed into place — a failure while writing (missing
+/// directory, full disk) leaves every target untouched.
+pub fn write_atomic_all(files: &[(&Path, &[u8])]) -> std::io::Result<()> {
+    let mut staged = Vec::with_capacity(files.len());
+    for (path, bytes) in files {
+        let dir: PathBuf = match path.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        let mut tmp = tempfile::Builder::new()
+            .prefix(".fitbead-")
+            .suffix(".tmp")
+            .tempfile_in(&dir)
+            .map_err(|e| std::io::Error::new(e.kind(), format!("{}: {e}", path.display())))?;
+        tmp.write_all(bytes)?;
+        tmp.as_file().sync_all()?;
+        staged.push((tmp, *path));
+    }
+    for (tmp, path) in staged {
+        tmp.persist(path).map_err(|e| {
+            std::io::Error::new(e.error.kind(), format!("{}: {}", path.display(), e.error))
+        })?;
+    }
+    Ok(())
+}
+
 /// Shortest decimal that reads back as the same double (ryu).
 pub fn fmt_f64(x: f64) -> String {
     if x.is_finite() {

@@ -549,14 +549,12 @@ impl<'a, D: LogDensity + ?Sized> EnsembleSampler<'a, D> {
         out.tau_max = tau_max;
         let burn = (o.burn_in_tau * tau_max).ceil();
         let post = n as f64 - burn;
-        if !(burn.is_finite() && post >= 8.0 && post >= o.tau_reliability * tau_max) {
-            // τ not yet trustworthy: report the slowest parameter, keep half the run.
-            if burn.is_finite() && post >= 8.0 {
-                out.burn = burn as usize;
-            }
+        if !(burn.is_finite() && post >= 8.0) {
+            // τ unusable: report the slowest parameter, keep the second half of the run.
             out.failing = Some(k_tau);
             return out;
         }
+        let reliable = post >= o.tau_reliability * tau_max;
         out.burn = burn as usize;
         let kept: Vec<Vec<Vec<f64>>> = chains.iter().map(|c| c[out.burn..].to_vec()).collect();
         let dim = self.target.dim();
@@ -585,10 +583,12 @@ impl<'a, D: LogDensity + ?Sized> EnsembleSampler<'a, D> {
                         (kb, sb)
                     }
                 });
-        if worst <= 1.0 {
-            out.converged = true;
-        } else {
+        if worst > 1.0 {
             out.failing = Some(k_worst);
+        } else if !reliable {
+            out.failing = Some(k_tau);
+        } else {
+            out.converged = true;
         }
         out
     }

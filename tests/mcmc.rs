@@ -26,14 +26,15 @@ struct Gaussian {
 
 impl Gaussian {
     fn covariance(&self) -> Vec<Vec<f64>> {
-        let n = self.mu.len();
-        let mut c = vec![vec![0.0; n]; n];
-        for i in 0..n {
-            for j in 0..n {
-                c[i][j] = (0..n).map(|k| self.l[i][k] * self.l[j][k]).sum();
-            }
-        }
-        c
+        self.l
+            .iter()
+            .map(|li| {
+                self.l
+                    .iter()
+                    .map(|lj| li.iter().zip(lj).map(|(a, b)| a * b).sum())
+                    .collect()
+            })
+            .collect()
     }
 }
 
@@ -336,7 +337,7 @@ fn diagnostics_iid_and_ar1() {
     let (rh, eb, et, em) = (rhat(&iid), ess_bulk(&iid), ess_tail(&iid), ess_mean(&iid));
     let tau = integrated_time(&iid, SOKAL_C);
     println!("iid: R̂ {rh:.5}, ESS bulk {eb:.0} tail {et:.0} mean {em:.0} (S = {s}), τ {tau:.3}");
-    assert!(rh <= 1.01 && rh >= 0.99);
+    assert!((0.99..=1.01).contains(&rh));
     for e in [eb, et, em] {
         assert!((e - s).abs() <= 0.2 * s, "ESS {e}");
     }

@@ -231,7 +231,7 @@ impl<'a, D: LogDensity + ?Sized> EnsembleSampler<'a, D> {
             return Err(McmcError::ZeroDimension);
         }
         let walkers = options.walkers.unwrap_or((2 * dim + 2).max(32));
-        if walkers % 2 != 0 {
+        if !walkers.is_multiple_of(2) {
             return Err(McmcError::OddWalkers(walkers));
         }
         if walkers <= dim || walkers < 4 {
@@ -459,14 +459,14 @@ impl<'a, D: LogDensity + ?Sized> EnsembleSampler<'a, D> {
                 }
             }
             steps += 1;
-            if steps % o.thin == 0 {
+            if steps.is_multiple_of(o.thin) {
                 for w in 0..nw {
                     chains[w].push(pos[w].clone());
                     lps[w].push(lp[w]);
                 }
             }
             progress(steps, o.max_steps);
-            if steps % o.check_every == 0 {
+            if steps.is_multiple_of(o.check_every) {
                 let assessment = self.assess(&chains);
                 let done = assessment.converged;
                 last = Some(assessment);

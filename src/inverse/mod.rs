@@ -7,18 +7,29 @@
 //!   Jacobians, and the covariance from the SVD of the Jacobian at the optimum;
 //! * [`confidence_intervals`] — covariance (Student-t / normal) and profile-likelihood
 //!   intervals;
-//! * [`WeightedData`] — a [`Model`] y = f(x; p) with data (x, y, σ) seen as residuals.
+//! * [`WeightedData`] — a [`Model`] y = f(x; p) with data (x, y, σ) seen as residuals;
+//! * [`EnsembleSampler`] — Bayesian sampling of any [`LogDensity`] with the affine-invariant
+//!   stretch move (J. Goodman & J. Weare, "Ensemble samplers with affine invariance", Comm.
+//!   App. Math. Comp. Sci. 5, 2010; emcee's split-half parallel form, Foreman-Mackey et al.
+//!   2013), reproducible for a seed whatever the thread count, run until the rank-normalised
+//!   split-R̂ and bulk/tail effective sample sizes of Vehtari et al. (2021) meet their
+//!   thresholds; the diagnostics ([`mcmc::diagnostics`]) work on any chains.
 //!
 //! The solver is validated on the 27 nonlinear problems of the NIST Statistical Reference
 //! Datasets (StRD), from both starting points (`tests/nist.rs`).
 
 mod lmpar;
 pub mod lsq;
+pub mod mcmc;
 pub mod profile;
 
 pub use lsq::{
     fit, Covariance, Fit, Infeasible, LsqError, LsqOptions, Model, Residuals, SigmaKind,
     Termination, WeightedData,
+};
+pub use mcmc::{
+    EnsembleSampler, LogDensity, McmcError, McmcOptions, McmcResult, ParameterDiagnostics,
+    StopReason,
 };
 pub use profile::{
     confidence_intervals, covariance_intervals, profile_interval, ConfidenceIntervals, Interval,

@@ -3,10 +3,16 @@
 use super::k::{read_rows, Row};
 use super::{emit, read_input, CliError};
 use crate::fit::data::{DataError, Dataset};
-use crate::fit::summary::{params_csv, stats_csv, ParamRow, StatsRow};
+use crate::fit::posterior::{McmcSettings, Method, Prior, SCALE_NAME};
+use crate::fit::summary::{params_csv, stats_csv, FitSummary, ParamRow, StatsRow};
+use crate::inverse::mcmc::McmcOptions;
 use crate::io::scenes::Table;
 use crate::io::{fmt_f64, write_atomic_all};
+use crate::report::figures::{corner_svg, CornerBlock};
+use std::io::IsTerminal;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 /// Flags common to every fit command.
 #[derive(Debug, clap::Args)]
@@ -43,9 +49,168 @@ pub struct FitArgs {
     /// Printed to stderr as a table when absent.
     #[arg(long)]
     pub output_stats: Option<PathBuf>,
+    /// Estimation method: lsq (least squares) or mcmc (posterior sampling by an affine-invariant
+    /// ensemble sampler started from the least-squares optimum; value = posterior median,
+    /// ci_low/ci_high = central posterior interval at --level, ci_method = posterior).
+    #[arg(long, default_value = "lsq")]
+    pub method: String,
+    /// MCMC: seed of every random stream (default 1); a run is bit-identical for a seed,
+    /// whatever the number of threads.
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// MCMC: number of walkers, even (default max(2·dim + 2, 32)).
+    #[arg(long)]
+    pub walkers: Option<usize>,
+    /// MCMC: run until every parameter's bulk and tail ESS reach this (default 1000) and its
+    /// rank-normalised split-R̂ is ≤ 1.01.
+    #[arg(long)]
+    pub min_ess: Option<f64>,
+    /// MCMC: stop after this many steps even if not converged, with a warning naming the
+    /// failing parameter (default 100000).
+    #[arg(long)]
+    pub max_steps: Option<usize>,
+    /// MCMC: keep one step in THIN (default 1).
+    #[arg(long)]
+    pub thin: Option<usize>,
+    /// MCMC: prior of a parameter, NAME=DIST, repeatable; DIST is flat, jeffreys,
+    /// uniform(a,b), normal(mean,sd), lognormal(mu,sigma) or halfnormal(scale). Defaults:
+    /// flat on the parameter's feasible box (every point in regime B), jeffreys for
+    /// sigma_scale. The support is always cut to the feasible region.
+    #[arg(long = "prior", value_name = "NAME=DIST")]
+    pub priors: Vec<String>,
+    /// MCMC: also sample an error scale sigma_scale multiplying every sigma_v (for data whose
+    /// sigma is underestimated). Always sampled when no sigma_v is given.
+    #[arg(long)]
+    pub fit_scatter: bool,
+    /// MCMC: write the kept draws (after burn-in and thinning) to this CSV: fit,series,walker,
+    /// step, one column per parameter, log_posterior.
+    #[arg(long)]
+    pub draws: Option<PathBuf>,
+    /// MCMC: corner plot (SVG) of every posterior: marginal histograms and pairwise scatter.
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
+}
+
+/// The estimation method asked for on the command line, with the stop flag raised by Ctrl-C
+/// during a posterior run.
+pub struct MethodChoice {
+    /// The method.
+    pub method: Method,
+    /// Raised when the user presses Ctrl-C (MCMC only).
+    pub stop: Option<Arc<AtomicBool>>,
 }
 
 impl FitArgs {
+    /// The method from `--method` and the MCMC flags; `params` are the names `--prior` may
+    /// use (the fit's parameters and sigma_scale). MCMC flags without `--method mcmc` are an
+    /// error. For MCMC, installs a Ctrl-C handler that stops the sampler cleanly.
+    pub fn method(&self, params: &[&str]) -> Result<MethodChoice, CliError> {
+        let mcmc_flags = [
+            ("--seed", self.seed.is_some()),
+            ("--walkers", self.walkers.is_some()),
+            ("--min-ess", self.min_ess.is_some()),
+            ("--max-steps", self.max_steps.is_some()),
+            ("--thin", self.thin.is_some()),
+            ("--prior", !self.priors.is_empty()),
+            ("--fit-scatter", self.fit_scatter),
+            ("--draws", self.draws.is_some()),
+            ("--plot", self.plot.is_some()),
+        ];
+        match self.method.as_str() {
+            "lsq" => {
+                if let Some((flag, _)) = mcmc_flags.iter().find(|f| f.1) {
+                    return Err(super::flag_error(flag, "", "applies to --method mcmc only"));
+                }
+                return Ok(MethodChoice {
+                    method: Method::Lsq {
+                        profile: !self.no_profile,
+                    },
+                    stop: None,
+                });
+            }
+            "mcmc" => {}
+            m => return Err(super::flag_error("--method", m, "expected lsq or mcmc")),
+        }
+        let mut options = McmcOptions::default();
+        if let Some(s) = self.seed {
+            options.seed = s;
+        } else {
+            options.seed = 1;
+        }
+        options.walkers = self.walkers;
+        if let Some(w) = self.walkers {
+            if w < 4 || w % 2 == 1 {
+                return Err(super::flag_error(
+                    "--walkers",
+                    &w.to_string(),
+                    "must be even and at least 4 (and more than the parameters)",
+                ));
+            }
+        }
+        if let Some(e) = self.min_ess {
+            if !(e >= 0.0 && e.is_finite()) {
+                return Err(super::flag_error(
+                    "--min-ess",
+                    &e.to_string(),
+                    "must be a finite number >= 0",
+                ));
+            }
+            options.min_ess = e;
+        }
+        if let Some(m) = self.max_steps {
+            if m == 0 {
+                return Err(super::flag_error("--max-steps", "0", "must be >= 1"));
+            }
+            options.max_steps = m;
+        }
+        if let Some(t) = self.thin {
+            if t == 0 {
+                return Err(super::flag_error("--thin", "0", "must be >= 1"));
+            }
+            options.thin = t;
+        }
+        let mut priors = Vec::new();
+        for p in &self.priors {
+            let Some((name, dist)) = p.split_once('=') else {
+                return Err(super::flag_error(
+                    "--prior",
+                    p,
+                    "expected NAME=DIST, e.g. c=normal(0.5,0.5)",
+                ));
+            };
+            let name = name.trim();
+            if name != SCALE_NAME && !params.contains(&name) {
+                return Err(super::flag_error(
+                    "--prior",
+                    p,
+                    format!(
+                        "no parameter '{name}' in this fit; expected one of {}, {SCALE_NAME}",
+                        params.join(", ")
+                    ),
+                ));
+            }
+            let prior: Prior = dist
+                .parse()
+                .map_err(|e: String| super::flag_error("--prior", p, e))?;
+            priors.push((name.to_string(), prior));
+        }
+        let stop = Arc::new(AtomicBool::new(false));
+        let flag = stop.clone();
+        // A second handler cannot be installed in the same process; the first one (set by an
+        // earlier command run in-process) keeps working, so the error is ignored.
+        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
+        options.stop = Some(stop.clone());
+        Ok(MethodChoice {
+            method: Method::Mcmc(Box::new(McmcSettings {
+                options,
+                priors,
+                fit_scatter: self.fit_scatter,
+                progress: std::io::stderr().is_terminal(),
+            })),
+            stop: Some(stop),
+        })
+    }
+
     /// Validates the flags and reads the measurements.
     pub fn read(&self) -> Result<(Table, Vec<Row>, Dataset), CliError> {
         if !(self.level > 0.0 && self.level < 1.0) {
@@ -86,9 +251,28 @@ impl FitArgs {
     /// Writes the reports: the files given are staged and renamed together (a failure leaves
     /// all of them untouched); the report goes to stdout without `--output`, the statistics to
     /// stderr as a table without `--output-stats`.
-    pub fn write(&self, params: &[ParamRow], stats: &[StatsRow]) -> Result<(), CliError> {
+    ///
+    /// `posteriors` are the fits sampled by MCMC: their draws go to `--draws` and their corner
+    /// plots to `--plot`, in the same atomic group. A run stopped by Ctrl-C writes everything
+    /// and then returns [`CliError::Interrupted`].
+    pub fn write(
+        &self,
+        params: &[ParamRow],
+        stats: &[StatsRow],
+        posteriors: &[&FitSummary],
+    ) -> Result<(), CliError> {
         let p_csv = params_csv(params).map_err(|e| CliError::Other(e.to_string()))?;
         let s = stats_csv(stats).map_err(|e| CliError::Other(e.to_string()))?;
+        let d_csv = match &self.draws {
+            Some(_) => draws_csv(posteriors).map_err(|e| CliError::Other(e.to_string()))?,
+            None => Vec::new(),
+        };
+        let corner = match &self.plot {
+            Some(_) => corner_svg(&corner_blocks(posteriors))
+                .map_err(|e| CliError::Other(format!("corner plot: {e}")))?
+                .into_bytes(),
+            None => Vec::new(),
+        };
         let files: Vec<(&std::path::Path, &[u8])> = self
             .output
             .iter()
@@ -98,6 +282,8 @@ impl FitArgs {
                     .iter()
                     .map(|q| (q.as_path(), s.as_slice())),
             )
+            .chain(self.draws.iter().map(|q| (q.as_path(), d_csv.as_slice())))
+            .chain(self.plot.iter().map(|q| (q.as_path(), corner.as_slice())))
             .collect();
         if !files.is_empty() {
             write_atomic_all(&files).map_err(|e| CliError::Other(format!("cannot write: {e}")))?;
@@ -125,8 +311,96 @@ impl FitArgs {
         if self.output.is_none() {
             emit(None, &p_csv)?;
         }
+        // Warnings of the posterior runs go to stderr even when the statistics go to a file.
+        if self.output_stats.is_some() {
+            for r in stats.iter().filter(|r| r.mcmc.is_some() && !r.converged) {
+                eprintln!("fitbead: warning: {} [{}]: {}", r.fit, r.series, r.note);
+            }
+        }
+        if posteriors
+            .iter()
+            .any(|p| p.draws.as_ref().is_some_and(|d| d.interrupted))
+        {
+            return Err(CliError::Interrupted);
+        }
         Ok(())
     }
+}
+
+/// The column naming a parameter in the draws file: its name, with the series appended where
+/// a fit across series has one parameter per series (`K[series]`).
+fn draws_column(fit: &FitSummary, row: &ParamRow) -> String {
+    if row.series == fit.stats.series {
+        row.parameter.clone()
+    } else {
+        format!("{}[{}]", row.parameter, row.series)
+    }
+}
+
+/// The draws of every posterior as one CSV: fit, series, walker, step, the union of the
+/// parameter columns (empty where a fit has no such parameter), log_posterior.
+pub fn draws_csv(posteriors: &[&FitSummary]) -> csv::Result<Vec<u8>> {
+    let mut columns: Vec<String> = Vec::new();
+    for p in posteriors {
+        for r in &p.params {
+            let c = draws_column(p, r);
+            if !columns.contains(&c) {
+                columns.push(c);
+            }
+        }
+    }
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let mut header: Vec<String> = ["fit", "series", "walker", "step"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    header.extend(columns.iter().cloned());
+    header.push("log_posterior".into());
+    w.write_record(&header)?;
+    for p in posteriors {
+        let Some(d) = &p.draws else { continue };
+        let idx: Vec<usize> = p
+            .params
+            .iter()
+            .map(|r| {
+                let c = draws_column(p, r);
+                columns.iter().position(|x| *x == c).unwrap_or(0)
+            })
+            .collect();
+        for (wk, chain) in d.chains.iter().enumerate() {
+            for (k, x) in chain.iter().enumerate() {
+                let mut rec = vec![String::new(); header.len()];
+                rec[0] = p.stats.fit.clone();
+                rec[1] = p.stats.series.clone();
+                rec[2] = wk.to_string();
+                rec[3] = d.step(k).to_string();
+                for (j, v) in x.iter().enumerate() {
+                    rec[4 + idx[j]] = fmt_f64(*v);
+                }
+                rec[header.len() - 1] = fmt_f64(d.log_posterior[wk][k]);
+                w.write_record(&rec)?;
+            }
+        }
+    }
+    w.into_inner().map_err(|e| e.into_error().into())
+}
+
+fn corner_blocks(posteriors: &[&FitSummary]) -> Vec<CornerBlock> {
+    posteriors
+        .iter()
+        .filter_map(|p| {
+            let d = p.draws.as_ref()?;
+            let n = p.params.len();
+            let draws: Vec<Vec<f64>> = (0..n)
+                .map(|j| d.chains.iter().flatten().map(|x| x[j]).collect())
+                .collect();
+            (draws.first().is_some_and(|v| !v.is_empty())).then(|| CornerBlock {
+                title: format!("{} [{}]", p.stats.fit, p.stats.series),
+                names: p.params.iter().map(|r| draws_column(p, r)).collect(),
+                draws,
+            })
+        })
+        .collect()
 }
 
 /// Six significant digits for the terminal (the CSV files keep every digit).

@@ -3,7 +3,8 @@
 
 use super::fitargs::FitArgs;
 use super::CliError;
-use crate::fit::jaeger::fit_jaeger;
+use crate::fit::jaeger::fit_jaeger_with;
+use crate::fit::summary::FitSummary;
 use crate::models::JaegerBranch;
 
 /// Arguments of `fitbead jaeger`.
@@ -31,7 +32,8 @@ pub fn run(a: Args) -> Result<(), CliError> {
         }
     };
     let (_t, _rows, ds) = a.io.read()?;
-    let fits = fit_jaeger(&ds, branch, a.io.level, !a.io.no_profile);
+    let choice = a.io.method(&["a1", "a2", "a3"])?;
+    let fits = fit_jaeger_with(&ds, branch, a.io.level, &choice.method);
     for n in &fits.notes {
         eprintln!("fitbead jaeger: {n}");
     }
@@ -45,5 +47,12 @@ pub fn run(a: Args) -> Result<(), CliError> {
             "jaeger: no fit could be made (see the notes above)".into(),
         ));
     }
-    a.io.write(&params, &stats)
+    let posteriors: Vec<&FitSummary> = fits
+        .series
+        .iter()
+        .flatten()
+        .map(|f| &f.summary)
+        .filter(|s| s.draws.is_some())
+        .collect();
+    a.io.write(&params, &stats, &posteriors)
 }

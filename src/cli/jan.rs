@@ -3,7 +3,8 @@
 
 use super::fitargs::FitArgs;
 use super::CliError;
-use crate::fit::jan::fit_jan;
+use crate::fit::jan::fit_jan_with;
+use crate::fit::summary::FitSummary;
 
 /// Arguments of `fitbead jan`.
 #[derive(Debug, clap::Args)]
@@ -16,20 +17,28 @@ pub struct Args {
 /// Runs `fitbead jan`.
 pub fn run(a: Args) -> Result<(), CliError> {
     let (_t, _rows, ds) = a.io.read()?;
-    let fits = fit_jan(&ds, a.io.level, !a.io.no_profile);
+    let choice =
+        a.io.method(&["lambda", "mu", "lambda0", "lambda1", "mu0", "mu1"])?;
+    let fits = fit_jan_with(&ds, a.io.level, &choice.method);
     for n in &fits.notes {
         eprintln!("fitbead jan: {n}");
     }
-    let all = fits.series.iter().flatten().chain(fits.global.iter());
+    let all: Vec<&FitSummary> = fits
+        .series
+        .iter()
+        .flatten()
+        .chain(fits.global.iter())
+        .collect();
     let (mut params, mut stats) = (Vec::new(), Vec::new());
-    for s in all {
+    for s in &all {
         params.extend(s.params.iter().cloned());
         stats.push(s.stats.clone());
     }
+    let posteriors: Vec<&FitSummary> = all.into_iter().filter(|s| s.draws.is_some()).collect();
     if params.is_empty() {
         return Err(CliError::Other(
             "jan: no fit could be made (see the notes above)".into(),
         ));
     }
-    a.io.write(&params, &stats)
+    a.io.write(&params, &stats, &posteriors)
 }

@@ -5,7 +5,9 @@ use super::fitargs::FitArgs;
 use super::k::parse_model;
 use super::CliError;
 use crate::fit::k::bracket;
-use crate::fit::klaw::{fit_law, KLaw, KLawError};
+use crate::fit::klaw::{fit_law, fit_law_with, KLaw, KLawError};
+use crate::fit::posterior::Method;
+use crate::fit::summary::FitSummary;
 use crate::io::fmt_f64;
 use rayon::prelude::*;
 
@@ -36,6 +38,19 @@ pub fn run(a: Args) -> Result<(), CliError> {
         .parse()
         .map_err(|e: String| super::flag_error("--law", &a.law, e))?;
     let (t, _rows, ds) = a.io.read()?;
+    let names: &[&str] = match law {
+        KLaw::C => &["c"],
+        KLaw::FreePerSeries => &["K"],
+        KLaw::Impact => &[],
+    };
+    let choice = a.io.method(names)?;
+    if law == KLaw::Impact && matches!(choice.method, Method::Mcmc(_)) {
+        return Err(super::flag_error(
+            "--method",
+            "mcmc",
+            "the impact law has no parameter to sample; use --law c or free-per-series",
+        ));
+    }
     // Points that no K makes steady: an error naming them, or left out with --skip-unsteady.
     let unsteady: Vec<(usize, String)> = ds
         .points
@@ -99,7 +114,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         )),
         e => CliError::Other(format!("klaw: {e}")),
     };
-    let main = fit_law(model, &ds, law, a.io.level, !a.io.no_profile).map_err(fail)?;
+    let main = fit_law_with(model, &ds, law, a.io.level, &choice.method).map_err(fail)?;
     let mut stats = vec![main.summary.stats.clone()];
     if law != KLaw::Impact {
         let imp = fit_law(model, &ds, KLaw::Impact, a.io.level, false).map_err(fail)?;
@@ -114,5 +129,9 @@ pub fn run(a: Args) -> Result<(), CliError> {
             };
         }
     }
-    a.io.write(&main.summary.params, &stats)
+    let posteriors: Vec<&FitSummary> = [&main.summary]
+        .into_iter()
+        .filter(|s| s.draws.is_some())
+        .collect();
+    a.io.write(&main.summary.params, &stats, &posteriors)
 }

@@ -49,14 +49,16 @@ pub enum Command {
     Simulate(simulate::Args),
 }
 
-/// Why a command failed: bad input (exit 2) or an I/O failure (exit 2 as well: nothing was
-/// written).
+/// Why a command failed: bad input (exit 2), an I/O failure (exit 2 as well: nothing was
+/// written), or an interruption by Ctrl-C after the outputs were written (exit 130).
 #[derive(Debug)]
 pub enum CliError {
     /// Bad input, located.
     Input(InputError),
     /// Any other failure, with a message.
     Other(String),
+    /// Stopped by Ctrl-C after writing what there was (exit 130).
+    Interrupted,
 }
 
 impl From<InputError> for CliError {
@@ -70,6 +72,9 @@ impl std::fmt::Display for CliError {
         match self {
             CliError::Input(e) => write!(f, "{e}"),
             CliError::Other(s) => f.write_str(s),
+            CliError::Interrupted => f.write_str(
+                "interrupted (Ctrl-C): the outputs hold the draws so far, marked interrupted",
+            ),
         }
     }
 }
@@ -87,6 +92,10 @@ pub fn run(cli: Cli) -> i32 {
     };
     match r {
         Ok(()) => 0,
+        Err(CliError::Interrupted) => {
+            eprintln!("fitbead: {}", CliError::Interrupted);
+            130
+        }
         Err(e) => {
             eprintln!("fitbead: error: {e}");
             2

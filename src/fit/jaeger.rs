@@ -15,7 +15,8 @@
 //! Levenberg–Marquardt.
 
 use super::data::Dataset;
-use super::summary::{summarise, FitSummary, ParamSpec};
+use super::posterior::{summarise_with, Method};
+use super::summary::{FitSummary, ParamSpec};
 use crate::inverse::{fit, Infeasible, LsqOptions, Model, WeightedData};
 use crate::models::jaeger::Jaeger;
 use crate::models::JaegerBranch;
@@ -167,6 +168,18 @@ pub fn start(model: &JaegerModel, x: &[JaegerX], y: &[f64], s: &[f64]) -> Option
 
 /// Fits Jaeger's law to every series on `branch`, with intervals at `level`.
 pub fn fit_jaeger(data: &Dataset, branch: JaegerBranch, level: f64, profile: bool) -> JaegerFits {
+    fit_jaeger_with(data, branch, level, &Method::Lsq { profile })
+}
+
+/// As [`fit_jaeger`], with the parameters estimated by `method` (least squares, or a
+/// posterior run per series started from its least-squares optimum; see
+/// [`super::posterior`]). The branch notes are those of the least-squares optimum.
+pub fn fit_jaeger_with(
+    data: &Dataset,
+    branch: JaegerBranch,
+    level: f64,
+    method: &Method,
+) -> JaegerFits {
     let model = JaegerModel(branch);
     let mut notes = Vec::new();
     let mut out = Vec::new();
@@ -232,7 +245,8 @@ pub fn fit_jaeger(data: &Dataset, branch: JaegerBranch, level: f64, profile: boo
                 specs[k].paper_value = Some(pv[k]);
             }
         }
-        let mut summary = summarise("jaeger", label, &specs, &problem, &f, level, &opts, profile);
+        let mut summary =
+            summarise_with(method, "jaeger", label, &specs, &problem, &f, level, &opts);
         let m = Jaeger {
             a1: f.params[0],
             a2: f.params[1],

@@ -12,7 +12,8 @@
 //! ln μ against sin α through the per-series fits (the paper's values where those fail).
 
 use super::data::Dataset;
-use super::summary::{summarise, FitSummary, ParamSpec};
+use super::posterior::{summarise_with, Method};
+use super::summary::{FitSummary, ParamSpec};
 use crate::inverse::{fit, Infeasible, LsqOptions, Model, WeightedData};
 
 /// The paper's global values (λ0, λ1, μ0, μ1), eqs 75–76.
@@ -127,6 +128,13 @@ fn line(x: &[f64], y: &[f64], sigma: &[f64]) -> Option<(f64, f64)> {
 
 /// Fits Jan's model per series and globally, with intervals at `level`.
 pub fn fit_jan(data: &Dataset, level: f64, profile: bool) -> JanFits {
+    fit_jan_with(data, level, &Method::Lsq { profile })
+}
+
+/// As [`fit_jan`], with the parameters estimated by `method` (least squares, or a posterior
+/// run per fit started from its least-squares optimum; see [`super::posterior`]). The global
+/// fit starts from the per-series least-squares optima either way.
+pub fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFits {
     let mut notes = Vec::new();
     let mut per = Vec::new();
     let mut lam_pts: Vec<(f64, f64, f64)> = Vec::new(); // (sin α, ln λ, weight σ of ln λ)
@@ -193,7 +201,8 @@ pub fn fit_jan(data: &Dataset, level: f64, profile: bool) -> JanFits {
                 paper_source: "paper eq 76 at this alpha",
             },
         ];
-        let sum = summarise(
+        let sum = summarise_with(
+            method,
             "jan-series",
             label,
             &specs,
@@ -201,7 +210,6 @@ pub fn fit_jan(data: &Dataset, level: f64, profile: bool) -> JanFits {
             &f,
             level,
             &opts,
-            profile,
         );
         if f.converged() {
             let se = f.std_errors().map(|s| s.to_vec()).unwrap_or(vec![1.0; 2]);
@@ -297,7 +305,8 @@ pub fn fit_jan(data: &Dataset, level: f64, profile: bool) -> JanFits {
                     paper_source: src76,
                 },
             ];
-            Some(summarise(
+            Some(summarise_with(
+                method,
                 "jan-global",
                 "all",
                 &specs,
@@ -305,7 +314,6 @@ pub fn fit_jan(data: &Dataset, level: f64, profile: bool) -> JanFits {
                 &f,
                 level,
                 &opts,
-                profile,
             ))
         })
     };

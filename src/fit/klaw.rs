@@ -22,7 +22,8 @@
 
 use super::data::Dataset;
 use super::k::{bracket, estimate, KBracket};
-use super::summary::{information_criteria, summarise, FitSummary, ParamSpec, StatsRow};
+use super::posterior::{summarise_with, Method};
+use super::summary::{information_criteria, FitSummary, ParamSpec, StatsRow};
 use crate::inverse::{fit, Infeasible, LsqOptions, Residuals};
 use crate::models::{ForwardModel, Model};
 use faer::MatMut;
@@ -391,6 +392,19 @@ pub fn fit_law(
     level: f64,
     profile: bool,
 ) -> Result<KLawFit, KLawError> {
+    fit_law_with(model, data, law, level, &Method::Lsq { profile })
+}
+
+/// As [`fit_law`], with the parameters estimated by `method` (least squares, or a posterior
+/// run started from the least-squares optimum; see [`super::posterior`]). The impact law has
+/// nothing to sample and is scored either way.
+pub fn fit_law_with(
+    model: Model,
+    data: &Dataset,
+    law: KLaw,
+    level: f64,
+    method: &Method,
+) -> Result<KLawFit, KLawError> {
     let problem = KLawProblem::new(model, data, law)?;
     let fit_name = format!("klaw-{}", law.name());
     let m = data.points.len();
@@ -445,7 +459,9 @@ pub fn fit_law(
                     sigma: data.sigma,
                     condition: None,
                     note,
+                    mcmc: None,
                 },
+                draws: None,
             },
             k,
         });
@@ -471,11 +487,9 @@ pub fn fit_law(
             },
         })
         .collect();
-    let mut summary = summarise(
-        &fit_name, "all", &specs, &problem, &f, level, &opts, profile,
-    );
+    let mut summary = summarise_with(method, &fit_name, "all", &specs, &problem, &f, level, &opts);
     if law == KLaw::FreePerSeries {
-        for (j, row) in summary.params.iter_mut().enumerate() {
+        for (j, row) in summary.params.iter_mut().take(problem.n).enumerate() {
             row.series = data.labels[j].clone();
         }
     }

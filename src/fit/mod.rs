@@ -6,4 +6,5 @@ pub mod jaeger;
 pub mod jan;
 pub mod k;
 pub mod klaw;
+pub mod posterior;
 pub mod summary;

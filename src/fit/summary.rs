@@ -10,6 +10,8 @@
 //! (`ci_method = covariance`), with the profile's state in the extra columns and the note; with
 //! neither, the cells are empty and `ci_method = none`.
 
+pub use super::posterior::Draws;
+use crate::inverse::mcmc::ParameterDiagnostics;
 use crate::inverse::{
     confidence_intervals, Fit, LsqOptions, ProfileEnd, Residuals, SigmaKind, Termination,
 };
@@ -44,8 +46,24 @@ pub const PARAM_EXTRA_COLUMNS: [&str; 11] = [
     "note",
 ];
 
+/// Posterior columns of the parameter report, after [`PARAM_EXTRA_COLUMNS`]: filled by MCMC
+/// (`ci_method = posterior`), empty for least squares but `lsq_value` (the least-squares
+/// optimum, the start of the chains).
+pub const PARAM_POSTERIOR_COLUMNS: [&str; 10] = [
+    "mean",
+    "sd",
+    "q2.5",
+    "q50",
+    "q97.5",
+    "ess_bulk",
+    "ess_tail",
+    "rhat",
+    "tau",
+    "lsq_value",
+];
+
 /// Columns of the statistics report.
-pub const STATS_COLUMNS: [&str; 16] = [
+pub const STATS_COLUMNS: [&str; 25] = [
     "fit",
     "series",
     "n_points",
@@ -62,6 +80,15 @@ pub const STATS_COLUMNS: [&str; 16] = [
     "sigma",
     "condition",
     "note",
+    "method",
+    "mcmc_status",
+    "walkers",
+    "steps",
+    "burn_in",
+    "draws",
+    "acceptance",
+    "ess_min",
+    "rhat_max",
 ];
 
 /// One fitted parameter.
@@ -95,12 +122,19 @@ pub struct ParamRow {
     pub note: String,
     /// The parameter's box (lower, upper); a covariance interval is cut to it.
     pub bounds: (f64, f64),
+    /// The least-squares optimum (equal to `value` for a least-squares fit).
+    pub lsq_value: Option<f64>,
+    /// Posterior summary (MCMC only): `value` is then its median, `stderr` its sd.
+    pub posterior: Option<ParameterDiagnostics>,
 }
 
 impl ParamRow {
     /// The reported interval and its method: profile when both ends were determined, else
     /// covariance, else none (module docs).
     pub fn interval(&self) -> (Option<(f64, f64)>, &'static str) {
+        if let Some(d) = &self.posterior {
+            return (Some(d.interval), "posterior");
+        }
         if let Some((lo, hi)) = self.profile {
             if let (Some(a), Some(b)) = (closed_end(lo), closed_end(hi)) {
                 return (Some((a, b)), "profile");
@@ -151,6 +185,29 @@ pub struct StatsRow {
     pub condition: Option<f64>,
     /// Anything the user should know about this fit.
     pub note: String,
+    /// The sampler's account, for a posterior run.
+    pub mcmc: Option<McmcStats>,
+}
+
+/// What a posterior run did (the `method = mcmc` columns of the statistics report).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct McmcStats {
+    /// `converged`, `max_steps`, `interrupted` or `failed` (the sampler could not start).
+    pub status: String,
+    /// Walkers of the ensemble.
+    pub walkers: usize,
+    /// Steps run (each moves every walker once).
+    pub steps: usize,
+    /// Steps discarded as burn-in.
+    pub burn_in: usize,
+    /// Draws kept (all walkers, after burn-in and thinning).
+    pub draws: usize,
+    /// Fraction of proposals accepted.
+    pub acceptance: f64,
+    /// Smallest bulk or tail ESS over the parameters.
+    pub ess_min: f64,
+    /// Largest rank-normalised split-R̂ over the parameters.
+    pub rhat_max: f64,
 }
 
 /// The rows of one fit.
@@ -160,6 +217,8 @@ pub struct FitSummary {
     pub params: Vec<ParamRow>,
     /// The statistics.
     pub stats: StatsRow,
+    /// The kept draws of a posterior run (rows of `params` give the parameter order).
+    pub draws: Option<Draws>,
 }
 
 /// A parameter's name, unit and the paper's value (with its source) if there is one.
@@ -296,6 +355,8 @@ pub fn summarise<R: Residuals + ?Sized>(
                 paper_source: s.paper_source,
                 note: pnote.trim_end().to_string(),
                 bounds,
+                lsq_value: Some(f.params[j]),
+                posterior: None,
             }
         })
         .collect();
@@ -318,7 +379,9 @@ pub fn summarise<R: Residuals + ?Sized>(
             sigma: f.sigma,
             condition: f.covariance.as_ref().map(|c| c.condition),
             note,
+            mcmc: None,
         },
+        draws: None,
     }
 }
 
@@ -366,7 +429,12 @@ fn opt(x: Option<f64>) -> String {
 /// The parameter report as CSV: the contract columns, then [`PARAM_EXTRA_COLUMNS`].
 pub fn params_csv(rows: &[ParamRow]) -> csv::Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
-    w.write_record(PARAM_COLUMNS.iter().chain(PARAM_EXTRA_COLUMNS.iter()))?;
+    w.write_record(
+        PARAM_COLUMNS
+            .iter()
+            .chain(PARAM_EXTRA_COLUMNS.iter())
+            .chain(PARAM_POSTERIOR_COLUMNS.iter()),
+    )?;
     for r in rows {
         let (ci, method) = r.interval();
         let (pl, ph) = match r.profile {
@@ -397,6 +465,16 @@ pub fn params_csv(rows: &[ParamRow]) -> csv::Result<Vec<u8>> {
             opt(r.paper_value),
             r.paper_source.to_string(),
             r.note.clone(),
+            opt(r.posterior.as_ref().map(|d| d.mean)),
+            opt(r.posterior.as_ref().map(|d| d.sd)),
+            opt(r.posterior.as_ref().map(|d| d.q025)),
+            opt(r.posterior.as_ref().map(|d| d.median)),
+            opt(r.posterior.as_ref().map(|d| d.q975)),
+            opt(r.posterior.as_ref().map(|d| d.ess_bulk)),
+            opt(r.posterior.as_ref().map(|d| d.ess_tail)),
+            opt(r.posterior.as_ref().map(|d| d.rhat)),
+            opt(r.posterior.as_ref().map(|d| d.tau)),
+            opt(r.lsq_value),
         ])?;
     }
     w.into_inner().map_err(|e| e.into_error().into())
@@ -428,6 +506,34 @@ pub fn stats_csv(rows: &[StatsRow]) -> csv::Result<Vec<u8>> {
             .to_string(),
             opt(r.condition),
             r.note.clone(),
+            if r.mcmc.is_some() { "mcmc" } else { "lsq" }.to_string(),
+            r.mcmc
+                .as_ref()
+                .map(|m| m.status.clone())
+                .unwrap_or_default(),
+            r.mcmc
+                .as_ref()
+                .map(|m| m.walkers.to_string())
+                .unwrap_or_default(),
+            r.mcmc
+                .as_ref()
+                .map(|m| m.steps.to_string())
+                .unwrap_or_default(),
+            r.mcmc
+                .as_ref()
+                .map(|m| m.burn_in.to_string())
+                .unwrap_or_default(),
+            r.mcmc
+                .as_ref()
+                .map(|m| m.draws.to_string())
+                .unwrap_or_default(),
+            opt(r.mcmc.as_ref().map(|m| m.acceptance)),
+            opt(r.mcmc.as_ref().map(|m| m.ess_min).filter(|v| v.is_finite())),
+            opt(r
+                .mcmc
+                .as_ref()
+                .map(|m| m.rhat_max)
+                .filter(|v| v.is_finite())),
         ])?;
     }
     w.into_inner().map_err(|e| e.into_error().into())

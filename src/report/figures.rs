@@ -112,3 +112,137 @@ pub fn scatter_svg(fig: &Scatter) -> Result<String, String> {
     }
     Ok(out)
 }
+
+/// The pooled draws of one posterior, for [`corner_svg`].
+#[derive(Debug, Clone, Default)]
+pub struct CornerBlock {
+    /// Heading (fit and series).
+    pub title: String,
+    /// Parameter names.
+    pub names: Vec<String>,
+    /// Draws per parameter (same length for every parameter).
+    pub draws: Vec<Vec<f64>>,
+}
+
+/// Side of one corner-plot panel, px.
+const PANEL: u32 = 190;
+/// Height of a block's heading, px.
+const HEADING: u32 = 30;
+/// Histogram bins of the marginals.
+const BINS: usize = 30;
+/// Points drawn per scatter panel at most (an even stride through the draws).
+const MAX_SCATTER: usize = 2000;
+
+/// Renders corner plots (marginal histograms on the diagonal, pairwise scatter below it), one
+/// block per posterior, stacked vertically in one SVG document.
+pub fn corner_svg(blocks: &[CornerBlock]) -> Result<String, String> {
+    let n_max = blocks
+        .iter()
+        .map(|b| b.names.len())
+        .max()
+        .unwrap_or(1)
+        .max(1) as u32;
+    let width = (n_max * PANEL).max(400) + 20;
+    let height: u32 = blocks
+        .iter()
+        .map(|b| HEADING + b.names.len().max(1) as u32 * PANEL)
+        .sum::<u32>()
+        .max(100)
+        + 10;
+    let e = |e: DrawingAreaErrorKind<std::io::Error>| e.to_string();
+    let mut out = String::new();
+    {
+        let root = SVGBackend::with_string(&mut out, (width, height)).into_drawing_area();
+        root.fill(&WHITE).map_err(e)?;
+        let mut top = 5i32;
+        for b in blocks {
+            let n = b.names.len();
+            root.draw(&Text::new(
+                b.title.clone(),
+                (12, top + 8),
+                ("sans-serif", 16).into_font(),
+            ))
+            .map_err(e)?;
+            top += HEADING as i32;
+            let ranges: Vec<(f64, f64)> =
+                b.draws.iter().map(|d| range(d.iter().copied())).collect();
+            let len = b.draws.first().map_or(0, Vec::len);
+            let stride = len.div_ceil(MAX_SCATTER).max(1);
+            for r in 0..n {
+                for c in 0..=r {
+                    let area = root.clone().shrink(
+                        (10 + c as u32 * PANEL, top as u32 + r as u32 * PANEL),
+                        (PANEL, PANEL),
+                    );
+                    let (x0, x1) = ranges[c];
+                    if r == c {
+                        let w = (x1 - x0) / BINS as f64;
+                        let mut counts = vec![0usize; BINS];
+                        for v in b.draws[c].iter().filter(|v| v.is_finite()) {
+                            let k = (((v - x0) / w) as usize).min(BINS - 1);
+                            counts[k] += 1;
+                        }
+                        let peak = counts.iter().copied().max().unwrap_or(1).max(1) as f64;
+                        let mut chart = ChartBuilder::on(&area)
+                            .caption(&b.names[c], ("sans-serif", 14))
+                            .margin(4)
+                            .x_label_area_size(22)
+                            .y_label_area_size(8)
+                            .build_cartesian_2d(x0..x1, 0.0..1.05 * peak)
+                            .map_err(e)?;
+                        chart
+                            .configure_mesh()
+                            .disable_y_axis()
+                            .disable_mesh()
+                            .x_labels(3)
+                            .label_style(("sans-serif", 10))
+                            .draw()
+                            .map_err(e)?;
+                        chart
+                            .draw_series(counts.iter().enumerate().map(|(k, &h)| {
+                                let a = x0 + k as f64 * w;
+                                Rectangle::new(
+                                    [(a, 0.0), (a + w, h as f64)],
+                                    BLUE.mix(0.5).filled(),
+                                )
+                            }))
+                            .map_err(e)?;
+                    } else {
+                        let (y0, y1) = ranges[r];
+                        let mut chart = ChartBuilder::on(&area)
+                            .margin(4)
+                            .x_label_area_size(22)
+                            .y_label_area_size(40)
+                            .build_cartesian_2d(x0..x1, y0..y1)
+                            .map_err(e)?;
+                        chart
+                            .configure_mesh()
+                            .disable_mesh()
+                            .x_labels(3)
+                            .y_labels(3)
+                            .x_desc(b.names[c].as_str())
+                            .y_desc(b.names[r].as_str())
+                            .label_style(("sans-serif", 10))
+                            .draw()
+                            .map_err(e)?;
+                        chart
+                            .draw_series(
+                                b.draws[c]
+                                    .iter()
+                                    .zip(&b.draws[r])
+                                    .step_by(stride)
+                                    .filter(|(x, y)| x.is_finite() && y.is_finite())
+                                    .map(|(&x, &y)| {
+                                        Circle::new((x, y), 1, BLACK.mix(0.3).filled())
+                                    }),
+                            )
+                            .map_err(e)?;
+                    }
+                }
+            }
+            top += (n.max(1) as u32 * PANEL) as i32;
+        }
+        root.present().map_err(e)?;
+    }
+    Ok(out)
+}

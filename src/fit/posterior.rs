@@ -1,0 +1,606 @@
+//! Bayesian posteriors of the bead fits: the least-squares problems of [`super::klaw`],
+//! [`super::jan`] and [`super::jaeger`] turned into log densities and sampled by the ensemble
+//! sampler of [`crate::inverse::mcmc`], started from the least-squares optimum.
+//!
+//! Likelihood: independent Gaussian errors, with the weighted residuals of the least-squares
+//! problem r_i = (v_i − v̄_th,i)/σ_i (same problem, same residuals):
+//! - σ given on every row: ln L = −χ²/2;
+//! - with a scale s (parameter `sigma_scale`) multiplying every σ: ln L = −m ln s − χ²/(2s²).
+//!   It is always sampled when no σ is given (unit weights: s is then the scatter itself, in
+//!   the units of v̄), and on request ([`McmcSettings::fit_scatter`]) when the given σ may be
+//!   underestimated.
+//!
+//! Priors, per parameter by name ([`Prior`]): by default flat on the parameter's box (for the
+//! K(α) laws that box is exact: it is where every point stays in regime B), and Jeffreys'
+//! 1/s for `sigma_scale`. The support is the box intersected with the set where every point
+//! has a steady state under the model: the log density is −∞ wherever the residuals are
+//! [`Infeasible`](crate::inverse::Infeasible), never NaN.
+//!
+//! The report keeps the least-squares row format: `value` is the posterior median, `stderr`
+//! the posterior standard deviation, and `ci_low`/`ci_high` the central posterior interval at
+//! the level asked (`ci_method = posterior`); the covariance interval of the least-squares
+//! optimum stays in `cov_low`/`cov_high` and the optimum in `lsq_value`.
+
+use super::summary::{summarise, FitSummary, McmcStats, ParamRow, ParamSpec};
+use crate::inverse::mcmc::{EnsembleSampler, LogDensity, McmcOptions, StopReason};
+use crate::inverse::{Fit, LsqOptions, Residuals, SigmaKind};
+use crate::io::fmt_f64;
+use statrs::distribution::{Continuous, LogNormal, Normal, Uniform};
+use std::fmt;
+use std::str::FromStr;
+
+/// Name of the error-scale parameter.
+pub const SCALE_NAME: &str = "sigma_scale";
+
+/// A prior density of one parameter, parsed from `flat`, `jeffreys`, `uniform(a,b)`,
+/// `normal(mean,sd)`, `lognormal(mu,sigma)` (of ln x) or `halfnormal(scale)`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Prior {
+    text: String,
+    kind: PriorKind,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+enum PriorKind {
+    Flat,
+    Jeffreys,
+    Uniform(Uniform),
+    Normal(Normal),
+    LogNormal(LogNormal),
+    HalfNormal(Normal),
+}
+
+impl Prior {
+    /// The flat (improper uniform) prior: only the support restricts the parameter.
+    pub fn flat() -> Self {
+        Prior {
+            text: "flat".into(),
+            kind: PriorKind::Flat,
+        }
+    }
+
+    /// Jeffreys' prior of a scale, ∝ 1/s on s > 0.
+    pub fn jeffreys() -> Self {
+        Prior {
+            text: "jeffreys".into(),
+            kind: PriorKind::Jeffreys,
+        }
+    }
+
+    /// ln p(x) up to a constant; −∞ outside the prior's support.
+    pub fn ln_pdf(&self, x: f64) -> f64 {
+        match &self.kind {
+            PriorKind::Flat => 0.0,
+            PriorKind::Jeffreys => {
+                if x > 0.0 {
+                    -x.ln()
+                } else {
+                    f64::NEG_INFINITY
+                }
+            }
+            PriorKind::Uniform(d) => d.ln_pdf(x),
+            PriorKind::Normal(d) => d.ln_pdf(x),
+            PriorKind::LogNormal(d) => {
+                if x > 0.0 {
+                    d.ln_pdf(x)
+                } else {
+                    f64::NEG_INFINITY
+                }
+            }
+            PriorKind::HalfNormal(d) => {
+                if x >= 0.0 {
+                    d.ln_pdf(x) + std::f64::consts::LN_2
+                } else {
+                    f64::NEG_INFINITY
+                }
+            }
+        }
+    }
+}
+
+impl Prior {
+    /// The interval outside which the prior density is zero.
+    pub fn support(&self) -> (f64, f64) {
+        match &self.kind {
+            PriorKind::Uniform(d) => (d.min(), d.max()),
+            PriorKind::Jeffreys | PriorKind::LogNormal(_) | PriorKind::HalfNormal(_) => {
+                (0.0, f64::INFINITY)
+            }
+            PriorKind::Flat | PriorKind::Normal(_) => (f64::NEG_INFINITY, f64::INFINITY),
+        }
+    }
+}
+
+impl fmt::Display for Prior {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.text)
+    }
+}
+
+impl FromStr for Prior {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let t: String = s.chars().filter(|c| !c.is_whitespace()).collect();
+        let lower = t.to_ascii_lowercase();
+        let expected = "expected flat, jeffreys, uniform(a,b), normal(mean,sd), \
+                        lognormal(mu,sigma) or halfnormal(scale)";
+        let (name, args) = match lower.split_once('(') {
+            None => (lower.as_str(), Vec::new()),
+            Some((n, rest)) => {
+                let inner = rest
+                    .strip_suffix(')')
+                    .ok_or_else(|| format!("'{s}': missing ')'; {expected}"))?;
+                let args = inner
+                    .split(',')
+                    .map(|a| {
+                        a.parse::<f64>()
+                            .ok()
+                            .filter(|v| v.is_finite())
+                            .ok_or_else(|| format!("'{s}': '{a}' is not a finite number"))
+                    })
+                    .collect::<Result<Vec<_>, _>>()?;
+                (n, args)
+            }
+        };
+        let want = |k: usize| {
+            if args.len() == k {
+                Ok(())
+            } else {
+                Err(format!(
+                    "'{s}': {name} takes {k} number(s), {} given",
+                    args.len()
+                ))
+            }
+        };
+        let kind = match name {
+            "flat" => {
+                want(0)?;
+                PriorKind::Flat
+            }
+            "jeffreys" => {
+                want(0)?;
+                PriorKind::Jeffreys
+            }
+            "uniform" => {
+                want(2)?;
+                if !(args[0] < args[1]) {
+                    return Err(format!("'{s}': uniform(a,b) needs a < b"));
+                }
+                PriorKind::Uniform(
+                    Uniform::new(args[0], args[1]).map_err(|e| format!("'{s}': {e}"))?,
+                )
+            }
+            "normal" => {
+                want(2)?;
+                PriorKind::Normal(Normal::new(args[0], args[1]).map_err(|e| format!("'{s}': {e}"))?)
+            }
+            "lognormal" => {
+                want(2)?;
+                PriorKind::LogNormal(
+                    LogNormal::new(args[0], args[1]).map_err(|e| format!("'{s}': {e}"))?,
+                )
+            }
+            "halfnormal" => {
+                want(1)?;
+                PriorKind::HalfNormal(Normal::new(0.0, args[0]).map_err(|e| format!("'{s}': {e}"))?)
+            }
+            _ => return Err(format!("'{s}': unknown prior; {expected}")),
+        };
+        Ok(Prior { text: t, kind })
+    }
+}
+
+/// How a fit's parameters are estimated.
+#[derive(Debug, Clone)]
+pub enum Method {
+    /// Least squares with covariance intervals, and profile-likelihood ones when `profile`.
+    Lsq {
+        /// Compute the profile-likelihood intervals.
+        profile: bool,
+    },
+    /// Posterior sampling, started from the least-squares optimum.
+    Mcmc(Box<McmcSettings>),
+}
+
+/// Settings of a posterior run.
+#[derive(Debug, Clone, Default)]
+pub struct McmcSettings {
+    /// Sampler options (its `level` is replaced by the fit's level).
+    pub options: McmcOptions,
+    /// Priors by parameter name; parameters not named get the defaults (module docs).
+    pub priors: Vec<(String, Prior)>,
+    /// Sample the error scale `sigma_scale` even when σ is given.
+    pub fit_scatter: bool,
+    /// Show a progress bar on stderr (the caller decides: only on a terminal).
+    pub progress: bool,
+}
+
+impl McmcSettings {
+    fn prior(&self, name: &str) -> Option<&Prior> {
+        self.priors.iter().rev().find(|p| p.0 == name).map(|p| &p.1)
+    }
+}
+
+/// The kept draws of one posterior run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Draws {
+    /// `[walker][kept step][parameter]`, parameters in the order of the summary's rows.
+    pub chains: Vec<Vec<Vec<f64>>>,
+    /// Log posterior (up to a constant) of every kept draw, `[walker][kept step]`.
+    pub log_posterior: Vec<Vec<f64>>,
+    /// Steps discarded as burn-in.
+    pub burn_in: usize,
+    /// Thinning: one step kept in `thin`.
+    pub thin: usize,
+    /// Whether the run was interrupted (stop flag raised).
+    pub interrupted: bool,
+}
+
+impl Draws {
+    /// The step number (counted from 1, burn-in included) of kept draw `k`.
+    pub fn step(&self, k: usize) -> usize {
+        self.burn_in + (k + 1) * self.thin
+    }
+}
+
+/// The log posterior of a least-squares problem (module docs).
+pub struct Posterior<'a, R: ?Sized> {
+    problem: &'a R,
+    lower: Vec<f64>,
+    upper: Vec<f64>,
+    priors: Vec<Prior>,
+    scale: Option<Prior>,
+}
+
+impl<'a, R: Residuals + Sync + ?Sized> Posterior<'a, R> {
+    /// The posterior of `problem` with parameters in the box [`lower`, `upper`], `priors` per
+    /// parameter, and, with `scale`, the error scale appended as a last parameter with that
+    /// prior.
+    pub fn new(
+        problem: &'a R,
+        lower: Vec<f64>,
+        upper: Vec<f64>,
+        priors: Vec<Prior>,
+        scale: Option<Prior>,
+    ) -> Self {
+        Posterior {
+            problem,
+            lower,
+            upper,
+            priors,
+            scale,
+        }
+    }
+}
+
+impl<R: Residuals + Sync + ?Sized> LogDensity for Posterior<'_, R> {
+    fn dim(&self) -> usize {
+        self.problem.n_params() + usize::from(self.scale.is_some())
+    }
+
+    fn log_density(&self, x: &[f64]) -> f64 {
+        let n = self.problem.n_params();
+        let p = &x[..n];
+        let mut lp = 0.0;
+        for (((&x, &lo), &hi), prior) in
+            p.iter().zip(&self.lower).zip(&self.upper).zip(&self.priors)
+        {
+            if !(x >= lo && x <= hi) {
+                return f64::NEG_INFINITY;
+            }
+            lp += prior.ln_pdf(x);
+        }
+        let s = match &self.scale {
+            Some(prior) => {
+                let s = x[n];
+                if !(s > 0.0 && s.is_finite()) {
+                    return f64::NEG_INFINITY;
+                }
+                lp += prior.ln_pdf(s);
+                Some(s)
+            }
+            None => None,
+        };
+        if lp == f64::NEG_INFINITY || lp.is_nan() {
+            return f64::NEG_INFINITY;
+        }
+        let m = self.problem.n_residuals();
+        let mut r = vec![0.0; m];
+        if self.problem.residuals(p, &mut r).is_err() {
+            return f64::NEG_INFINITY;
+        }
+        let chi2: f64 = r.iter().map(|v| v * v).sum();
+        if !chi2.is_finite() {
+            return f64::NEG_INFINITY;
+        }
+        match s {
+            None => lp - 0.5 * chi2,
+            Some(s) => lp - m as f64 * s.ln() - 0.5 * chi2 / (s * s),
+        }
+    }
+}
+
+/// Summarises a finished least-squares fit by `method`: [`summarise`] for least squares, or
+/// a posterior run started from the optimum (module docs) for MCMC.
+#[allow(clippy::too_many_arguments)]
+pub fn summarise_with<R: Residuals + Sync + ?Sized>(
+    method: &Method,
+    fit_name: &str,
+    series: &str,
+    specs: &[ParamSpec],
+    problem: &R,
+    f: &Fit,
+    level: f64,
+    opts: &LsqOptions,
+) -> FitSummary {
+    match method {
+        Method::Lsq { profile } => {
+            summarise(fit_name, series, specs, problem, f, level, opts, *profile)
+        }
+        Method::Mcmc(s) => sample(s, fit_name, series, specs, problem, f, level, opts),
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn sample<R: Residuals + Sync + ?Sized>(
+    settings: &McmcSettings,
+    fit_name: &str,
+    series: &str,
+    specs: &[ParamSpec],
+    problem: &R,
+    f: &Fit,
+    level: f64,
+    opts: &LsqOptions,
+) -> FitSummary {
+    let mut out = summarise(fit_name, series, specs, problem, f, level, opts, false);
+    let n = specs.len();
+    let lower: Vec<f64> = (0..n)
+        .map(|j| opts.lower.as_ref().map_or(f64::NEG_INFINITY, |l| l[j]))
+        .collect();
+    let upper: Vec<f64> = (0..n)
+        .map(|j| opts.upper.as_ref().map_or(f64::INFINITY, |u| u[j]))
+        .collect();
+    let priors: Vec<Prior> = specs
+        .iter()
+        .map(|s| settings.prior(s.name).cloned().unwrap_or_else(Prior::flat))
+        .collect();
+    let with_scale = f.sigma == SigmaKind::Relative || settings.fit_scatter;
+    let scale_prior = with_scale.then(|| {
+        settings
+            .prior(SCALE_NAME)
+            .cloned()
+            .unwrap_or_else(Prior::jeffreys)
+    });
+    let target = Posterior::new(
+        problem,
+        lower.clone(),
+        upper.clone(),
+        priors.clone(),
+        scale_prior.clone(),
+    );
+    // Start: the optimum; the scale at the scatter it implies, sqrt(χ²/dof).
+    let s0 = {
+        let s = (f.chi2 / f.dof.max(1) as f64).sqrt();
+        if s > 0.0 && s.is_finite() {
+            s
+        } else {
+            1.0
+        }
+    };
+    // The optimum may lie outside a prior's support (a prior narrower than the data): start
+    // then just inside the support, cut to the box.
+    let mut start: Vec<f64> = f
+        .params
+        .iter()
+        .zip(&priors)
+        .zip(lower.iter().zip(&upper))
+        .map(|((&x, p), (&l, &u))| {
+            let (a, b) = p.support();
+            let (a, b) = (a.max(l), b.min(u));
+            if x >= a && x <= b {
+                x
+            } else if a.is_finite() && b.is_finite() {
+                let w = b - a;
+                x.clamp(a + 1e-3 * w, b - 1e-3 * w)
+            } else if x < a {
+                a + 1e-3 * a.abs().max(1.0)
+            } else {
+                b - 1e-3 * b.abs().max(1.0)
+            }
+        })
+        .collect();
+    let se = f.std_errors().map(|s| s.to_vec());
+    let mut ball: Vec<f64> = (0..n)
+        .map(|j| match se.as_ref().map(|s| s[j]) {
+            Some(s) if s > 0.0 && s.is_finite() => 1e-2 * s,
+            _ => 1e-4 * start[j].abs().max(1.0),
+        })
+        .collect();
+    if with_scale {
+        start.push(s0);
+        ball.push(1e-2 * s0);
+    }
+    let mut options = settings.options.clone();
+    options.level = level;
+    options.init_scale = Some(ball);
+    let thin = options.thin.max(1);
+    let scale_unit = if f.sigma == SigmaKind::Relative {
+        "v (scatter of v; no sigma given)"
+    } else {
+        "1 (multiplies sigma_v)"
+    };
+    let run = EnsembleSampler::new(&target, options).and_then(|sampler| {
+        let bar = settings.progress.then(|| {
+            let b = indicatif::ProgressBar::new(sampler.options().max_steps as u64);
+            b.set_style(
+                indicatif::ProgressStyle::with_template(
+                    "{msg} {bar:30} {pos}/{len} steps ({elapsed}, checks every {prefix})",
+                )
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+            );
+            b.set_prefix(sampler.options().check_every.to_string());
+            b.set_message(format!("{fit_name} [{series}]"));
+            b
+        });
+        let r = sampler.run_with_progress(&start, |step, _| {
+            if let Some(b) = &bar {
+                if step % 16 == 0 {
+                    b.set_position(step as u64);
+                }
+            }
+        });
+        if let Some(b) = bar {
+            b.finish_and_clear();
+        }
+        r.map(|r| (r, sampler.walkers()))
+    });
+    let (res, walkers) = match run {
+        Ok(r) => r,
+        Err(e) => {
+            out.stats.note = join(&out.stats.note, &format!("MCMC could not start: {e}"));
+            out.stats.converged = false;
+            out.stats.mcmc = Some(McmcStats {
+                status: "failed".into(),
+                ..Default::default()
+            });
+            return out;
+        }
+    };
+    // Rows: the parameters, then the scale.
+    if with_scale {
+        out.params.push(ParamRow {
+            fit: fit_name.to_string(),
+            series: series.to_string(),
+            parameter: SCALE_NAME.to_string(),
+            value: s0,
+            stderr: None,
+            level,
+            cov: None,
+            profile: None,
+            unit: scale_unit,
+            at_bound: false,
+            paper_value: None,
+            paper_source: "",
+            note: String::new(),
+            bounds: (0.0, f64::INFINITY),
+            lsq_value: Some(s0),
+            posterior: None,
+        });
+    }
+    let all_priors: Vec<&Prior> = priors.iter().chain(scale_prior.iter()).collect();
+    for (j, row) in out.params.iter_mut().enumerate() {
+        row.lsq_value = Some(row.value);
+        row.profile = None;
+        let prior_note = format!("prior {}", all_priors[j]);
+        match res.diagnostics.get(j) {
+            Some(d) => {
+                row.value = d.median;
+                row.stderr = Some(d.sd);
+                row.posterior = Some(d.clone());
+                row.note = join(&prior_note, &row.note);
+            }
+            None => {
+                row.note = join(
+                    &format!("{prior_note}; no draw kept: least-squares values"),
+                    &row.note,
+                );
+            }
+        }
+    }
+    let names: Vec<String> = out.params.iter().map(|r| r.parameter.clone()).collect();
+    let kept = res.chains.iter().map(Vec::len).sum::<usize>();
+    let rhat_max = res
+        .diagnostics
+        .iter()
+        .map(|d| d.rhat)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let ess_min = res
+        .diagnostics
+        .iter()
+        .map(|d| d.ess_bulk.min(d.ess_tail))
+        .fold(f64::INFINITY, f64::min);
+    let status = match res.reason {
+        StopReason::Converged => "converged",
+        StopReason::MaxSteps => "max_steps",
+        StopReason::Interrupted => "interrupted",
+    };
+    let mut note = String::new();
+    if res.reason == StopReason::Interrupted {
+        note = format!(
+            "interrupted after {} steps: the draws so far, not converged",
+            res.steps
+        );
+    } else if !res.converged {
+        note = match res.failing_parameter {
+            Some(k) => match res.diagnostics.get(k) {
+                Some(d) => format!(
+                    "not converged after {} steps: parameter '{}' has R-hat {}, bulk ESS {}, \
+                     tail ESS {}, tau {} steps (needs R-hat <= {}, ESS >= {}, run >= {} tau)",
+                    res.steps,
+                    names[k],
+                    sig4(d.rhat),
+                    sig4(d.ess_bulk),
+                    sig4(d.ess_tail),
+                    sig4(d.tau * thin as f64),
+                    fmt_f64(settings.options.rhat_max),
+                    fmt_f64(settings.options.min_ess),
+                    fmt_f64(settings.options.tau_reliability),
+                ),
+                None => format!(
+                    "not converged after {} steps: parameter '{}' (too few draws to assess)",
+                    res.steps, names[k]
+                ),
+            },
+            None => format!("not converged after {} steps", res.steps),
+        };
+    }
+    if res.nan_evaluations > 0 {
+        note = join(
+            &note,
+            &format!(
+                "{} log-density evaluation(s) returned NaN (rejected)",
+                res.nan_evaluations
+            ),
+        );
+    }
+    out.stats.note = join(&out.stats.note, &note);
+    out.stats.converged = res.converged;
+    out.stats.iterations = res.steps;
+    out.stats.residual_evals += walkers * res.steps;
+    out.stats.mcmc = Some(McmcStats {
+        status: status.into(),
+        walkers,
+        steps: res.steps,
+        burn_in: res.burn_in,
+        draws: kept,
+        acceptance: res.acceptance_overall,
+        ess_min,
+        rhat_max,
+    });
+    out.draws = Some(Draws {
+        chains: res.chains,
+        log_posterior: res.log_densities,
+        burn_in: res.burn_in,
+        thin,
+        interrupted: res.reason == StopReason::Interrupted,
+    });
+    out
+}
+
+fn join(a: &str, b: &str) -> String {
+    match (a.is_empty(), b.is_empty()) {
+        (true, _) => b.to_string(),
+        (_, true) => a.to_string(),
+        _ => format!("{a}; {b}"),
+    }
+}
+
+/// Four significant digits, for messages.
+fn sig4(x: f64) -> String {
+    if x.is_finite() {
+        let s = format!("{x:.3e}");
+        s.parse::<f64>().map(fmt_f64).unwrap_or(s)
+    } else {
+        x.to_string()
+    }
+}

@@ -15,7 +15,7 @@
 //! Levenberg–Marquardt.
 
 use super::data::Dataset;
-use super::posterior::{summarise_with, Method};
+use super::posterior::{summarise_with, Method, Prior};
 use super::summary::{FitSummary, ParamSpec};
 use crate::inverse::{fit, Infeasible, LsqOptions, Model, WeightedData};
 use crate::models::jaeger::Jaeger;
@@ -233,11 +233,12 @@ pub fn fit_jaeger_with(
         };
         let paper = paper_values(pts[0].scene.xi);
         let src = if paper.is_some() { "paper Fig. 9" } else { "" };
-        let specs = ["a1", "a2", "a3"].map(|name| ParamSpec {
+        let specs = [("a1", 10.0), ("a2", 100.0), ("a3", 10.0)].map(|(name, scale)| ParamSpec {
             name,
             unit: "1 (Jaeger units, eq 81)",
             paper_value: None,
             paper_source: src,
+            default_prior: Some(Prior::half_normal(scale)),
         });
         let mut specs = specs;
         if let Some(pv) = paper {

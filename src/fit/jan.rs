@@ -193,12 +193,14 @@ pub fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFits {
                 unit: "1",
                 paper_value: Some(paper.lambda),
                 paper_source: "paper eq 75 at this alpha",
+                default_prior: None,
             },
             ParamSpec {
                 name: "mu",
                 unit: "1",
                 paper_value: Some(paper.mu),
                 paper_source: "paper eq 76 at this alpha",
+                default_prior: None,
             },
         ];
         let sum = summarise_with(
@@ -285,24 +287,28 @@ pub fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFits {
                     unit: "1",
                     paper_value: Some(PAPER_GLOBAL[0]),
                     paper_source: src75,
+                    default_prior: None,
                 },
                 ParamSpec {
                     name: "lambda1",
                     unit: "1",
                     paper_value: Some(PAPER_GLOBAL[1]),
                     paper_source: src75,
+                    default_prior: None,
                 },
                 ParamSpec {
                     name: "mu0",
                     unit: "1",
                     paper_value: Some(PAPER_GLOBAL[2]),
                     paper_source: src76,
+                    default_prior: None,
                 },
                 ParamSpec {
                     name: "mu1",
                     unit: "1",
                     paper_value: Some(PAPER_GLOBAL[3]),
                     paper_source: src76,
+                    default_prior: None,
                 },
             ];
             Some(summarise_with(

@@ -485,6 +485,7 @@ pub fn fit_law_with(
             } else {
                 ""
             },
+            default_prior: None,
         })
         .collect();
     let mut summary = summarise_with(method, &fit_name, "all", &specs, &problem, &f, level, &opts);

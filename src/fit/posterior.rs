@@ -12,7 +12,11 @@
 //!
 //! Priors, per parameter by name ([`Prior`]): by default flat on the parameter's box (for the
 //! K(α) laws that box is exact: it is where every point stays in regime B), and Jeffreys'
-//! 1/s for `sigma_scale`. The support is the box intersected with the set where every point
+//! 1/s for `sigma_scale`. Jaeger's a1, a2, a3 are the exception: as a2 → ∞ the resistance
+//! term a1/(1 + a2 X) vanishes and the likelihood tends to a constant, so a flat prior would
+//! leave the posterior improper; their defaults are half-normal with scales 10, 100 and 10,
+//! over 50 times the paper's Fig. 9 values (a1 ≤ 0.19, a2 ≤ 27.7, a3 ≤ 1.41), weak wherever
+//! the data say anything. The support is the box intersected with the set where every point
 //! has a steady state under the model: the log density is −∞ wherever the residuals are
 //! [`Infeasible`](crate::inverse::Infeasible), never NaN.
 //!
@@ -22,7 +26,9 @@
 //! optimum stays in `cov_low`/`cov_high` and the optimum in `lsq_value`.
 
 use super::summary::{summarise, FitSummary, McmcStats, ParamRow, ParamSpec};
-use crate::inverse::mcmc::{EnsembleSampler, LogDensity, McmcOptions, StopReason};
+use crate::inverse::mcmc::{
+    summarise as mcmc_summarise, EnsembleSampler, LogDensity, McmcOptions, StopReason,
+};
 use crate::inverse::{Fit, LsqOptions, Residuals, SigmaKind};
 use crate::io::fmt_f64;
 use statrs::distribution::{Continuous, LogNormal, Normal, Uniform};
@@ -56,6 +62,19 @@ impl Prior {
         Prior {
             text: "flat".into(),
             kind: PriorKind::Flat,
+        }
+    }
+
+    /// The half-normal prior of scale `scale` > 0 on [0, ∞).
+    ///
+    /// # Panics
+    /// If `scale` is not finite and positive (a programming error: user input goes through
+    /// [`FromStr`]).
+    pub fn half_normal(scale: f64) -> Self {
+        let d = Normal::new(0.0, scale).expect("half-normal scale must be finite and > 0");
+        Prior {
+            text: format!("halfnormal({})", fmt_f64(scale)),
+            kind: PriorKind::HalfNormal(d),
         }
     }
 
@@ -243,13 +262,18 @@ impl Draws {
     }
 }
 
-/// The log posterior of a least-squares problem (module docs).
+/// The log posterior of a least-squares problem (module docs), over sampling coordinates y:
+/// a parameter whose box is [0, ∞), and the scale, is sampled as y = ln x (the log density
+/// then gains the Jacobian term ln x = y), every other parameter as itself. Long right tails
+/// of positive parameters (Jaeger's a2, the scale) become short in ln x, where the ensemble
+/// moves mix far better.
 pub struct Posterior<'a, R: ?Sized> {
     problem: &'a R,
     lower: Vec<f64>,
     upper: Vec<f64>,
     priors: Vec<Prior>,
     scale: Option<Prior>,
+    log: Vec<bool>,
 }
 
 impl<'a, R: Residuals + Sync + ?Sized> Posterior<'a, R> {
@@ -263,13 +287,41 @@ impl<'a, R: Residuals + Sync + ?Sized> Posterior<'a, R> {
         priors: Vec<Prior>,
         scale: Option<Prior>,
     ) -> Self {
+        let log = lower
+            .iter()
+            .zip(&upper)
+            .map(|(&l, &u)| l == 0.0 && u == f64::INFINITY)
+            .chain(scale.iter().map(|_| true))
+            .collect();
         Posterior {
             problem,
             lower,
             upper,
             priors,
             scale,
+            log,
         }
+    }
+
+    /// Whether coordinate `j` is sampled as ln x.
+    pub fn is_log(&self, j: usize) -> bool {
+        self.log[j]
+    }
+
+    /// Parameters x from sampling coordinates y.
+    pub fn to_params(&self, y: &[f64]) -> Vec<f64> {
+        y.iter()
+            .zip(&self.log)
+            .map(|(&v, &l)| if l { v.exp() } else { v })
+            .collect()
+    }
+
+    /// Sampling coordinates y from parameters x (x > 0 where sampled as ln x).
+    pub fn to_coordinates(&self, x: &[f64]) -> Vec<f64> {
+        x.iter()
+            .zip(&self.log)
+            .map(|(&v, &l)| if l { v.ln() } else { v })
+            .collect()
     }
 }
 
@@ -278,10 +330,17 @@ impl<R: Residuals + Sync + ?Sized> LogDensity for Posterior<'_, R> {
         self.problem.n_params() + usize::from(self.scale.is_some())
     }
 
-    fn log_density(&self, x: &[f64]) -> f64 {
+    fn log_density(&self, y: &[f64]) -> f64 {
         let n = self.problem.n_params();
+        // Jacobian of x = e^y: ln |dx/dy| = y.
+        let mut lp: f64 = y
+            .iter()
+            .zip(&self.log)
+            .filter(|(_, &l)| l)
+            .map(|(&v, _)| v)
+            .sum();
+        let x = self.to_params(y);
         let p = &x[..n];
-        let mut lp = 0.0;
         for (((&x, &lo), &hi), prior) in
             p.iter().zip(&self.lower).zip(&self.upper).zip(&self.priors)
         {
@@ -362,7 +421,13 @@ fn sample<R: Residuals + Sync + ?Sized>(
         .collect();
     let priors: Vec<Prior> = specs
         .iter()
-        .map(|s| settings.prior(s.name).cloned().unwrap_or_else(Prior::flat))
+        .map(|s| {
+            settings
+                .prior(s.name)
+                .cloned()
+                .or_else(|| s.default_prior.clone())
+                .unwrap_or_else(Prior::flat)
+        })
         .collect();
     let with_scale = f.sigma == SigmaKind::Relative || settings.fit_scatter;
     let scale_prior = with_scale.then(|| {
@@ -409,17 +474,32 @@ fn sample<R: Residuals + Sync + ?Sized>(
             }
         })
         .collect();
-    let se = f.std_errors().map(|s| s.to_vec());
-    let mut ball: Vec<f64> = (0..n)
-        .map(|j| match se.as_ref().map(|s| s[j]) {
-            Some(s) if s > 0.0 && s.is_finite() => 1e-2 * s,
-            _ => 1e-4 * start[j].abs().max(1.0),
+    let mut se: Vec<Option<f64>> = (0..n)
+        .map(|j| {
+            f.std_errors()
+                .map(|s| s[j])
+                .filter(|s| *s > 0.0 && s.is_finite())
         })
         .collect();
     if with_scale {
         start.push(s0);
-        ball.push(1e-2 * s0);
+        se.push(None);
     }
+    // Coordinates sampled as ln x need x > 0: an optimum on the bound 0 starts just above it.
+    for (j, x) in start.iter_mut().enumerate() {
+        if target.is_log(j) && !(*x > 0.0) {
+            *x = se[j].map_or(1e-6, |s| 1e-2 * s);
+        }
+    }
+    let ball: Vec<f64> = (0..start.len())
+        .map(|j| match (target.is_log(j), se[j]) {
+            (true, Some(s)) => (1e-2 * s / start[j]).clamp(1e-4, 1e-1),
+            (true, None) => 1e-2,
+            (false, Some(s)) => 1e-2 * s,
+            (false, None) => 1e-4 * start[j].abs().max(1.0),
+        })
+        .collect();
+    let start = target.to_coordinates(&start);
     let mut options = settings.options.clone();
     options.level = level;
     options.init_scale = Some(ball);
@@ -454,7 +534,7 @@ fn sample<R: Residuals + Sync + ?Sized>(
         }
         r.map(|r| (r, sampler.walkers()))
     });
-    let (res, walkers) = match run {
+    let (mut res, walkers) = match run {
         Ok(r) => r,
         Err(e) => {
             out.stats.note = join(&out.stats.note, &format!("MCMC could not start: {e}"));
@@ -466,6 +546,16 @@ fn sample<R: Residuals + Sync + ?Sized>(
             return out;
         }
     };
+    // Back from sampling coordinates to parameters; the rank-based R̂ and ESS are unchanged by
+    // the monotone map, the moments, quantiles and τ are recomputed on the parameters.
+    for chain in res.chains.iter_mut() {
+        for y in chain.iter_mut() {
+            *y = target.to_params(y);
+        }
+    }
+    if !res.diagnostics.is_empty() {
+        res.diagnostics = mcmc_summarise(&res.chains, level);
+    }
     // Rows: the parameters, then the scale.
     if with_scale {
         out.params.push(ParamRow {

@@ -221,8 +221,9 @@ pub struct FitSummary {
     pub draws: Option<Draws>,
 }
 
-/// A parameter's name, unit and the paper's value (with its source) if there is one.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// A parameter's name, unit, the paper's value (with its source) if there is one, and its
+/// default prior for a posterior run.
+#[derive(Debug, Clone, PartialEq)]
 pub struct ParamSpec {
     /// Name.
     pub name: &'static str,
@@ -232,6 +233,9 @@ pub struct ParamSpec {
     pub paper_value: Option<f64>,
     /// Where the paper's value comes from.
     pub paper_source: &'static str,
+    /// Default prior of a posterior run; `None` for flat on the parameter's box (see
+    /// [`super::posterior`]).
+    pub default_prior: Option<super::posterior::Prior>,
 }
 
 fn termination_name(t: Termination) -> &'static str {

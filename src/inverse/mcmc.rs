@@ -69,7 +69,9 @@ pub struct McmcOptions {
     pub min_ess: f64,
     /// Maximum rank-normalised split-R̂ of every parameter (default 1.01).
     pub rhat_max: f64,
-    /// Steps between convergence checks (default 500).
+    /// Steps between convergence checks (default 500); once the run is ten times longer, a
+    /// check comes every tenth of the run so far, so that the checks (each over the whole
+    /// stored run) cost a fixed multiple of the run, not its square.
     pub check_every: usize,
     /// Burn-in discarded, as a multiple of the largest integrated autocorrelation time
     /// estimated on the run so far (default 5).
@@ -438,6 +440,7 @@ impl<'a, D: LogDensity + ?Sized> EnsembleSampler<'a, D> {
         let mut steps = 0;
         let mut reason = StopReason::MaxSteps;
         let mut last: Option<Assessment> = None;
+        let mut next_check = o.check_every;
         while steps < o.max_steps {
             if o.stop.as_ref().is_some_and(|s| s.load(Ordering::Relaxed)) {
                 reason = StopReason::Interrupted;
@@ -511,7 +514,8 @@ impl<'a, D: LogDensity + ?Sized> EnsembleSampler<'a, D> {
                 }
             }
             progress(steps, o.max_steps);
-            if steps.is_multiple_of(o.check_every) {
+            if steps >= next_check {
+                next_check = steps + o.check_every.max(steps / 10);
                 let assessment = self.assess(&chains);
                 let done = assessment.converged;
                 last = Some(assessment);

@@ -186,8 +186,8 @@ pub fn corner_svg(blocks: &[CornerBlock]) -> Result<String, String> {
                         let mut chart = ChartBuilder::on(&area)
                             .caption(&b.names[c], ("sans-serif", 14))
                             .margin(4)
-                            .x_label_area_size(22)
-                            .y_label_area_size(8)
+                            .x_label_area_size(34)
+                            .y_label_area_size(40)
                             .build_cartesian_2d(x0..x1, 0.0..1.05 * peak)
                             .map_err(e)?;
                         chart
@@ -211,7 +211,7 @@ pub fn corner_svg(blocks: &[CornerBlock]) -> Result<String, String> {
                         let (y0, y1) = ranges[r];
                         let mut chart = ChartBuilder::on(&area)
                             .margin(4)
-                            .x_label_area_size(22)
+                            .x_label_area_size(34)
                             .y_label_area_size(40)
                             .build_cartesian_2d(x0..x1, y0..y1)
                             .map_err(e)?;

@@ -7,6 +7,7 @@ pub mod jan;
 pub mod k;
 pub mod klaw;
 pub mod regimes;
+pub mod report;
 pub mod simulate;
 
 use crate::io::{write_atomic, InputError};
@@ -45,6 +46,9 @@ pub enum Command {
     Jaeger(jaeger::Args),
     /// Regime limits δ_m (eq 32) and δ_d (eq 31) per ξ, and the critical ξ, for a law.
     Regimes(regimes::Args),
+    /// Every model fitted to one data set and the paper's comparisons (bulk friction vs eq 79,
+    /// energy budgets, regime map, model ranking) as CSV tables, SVG figures and report.md.
+    Report(report::Args),
     /// Synthetic measurements inside regime B, reproducible from a seed.
     Simulate(simulate::Args),
 }
@@ -88,6 +92,7 @@ pub fn run(cli: Cli) -> i32 {
         Command::Jan(a) => jan::run(a),
         Command::Jaeger(a) => jaeger::run(a),
         Command::Regimes(a) => regimes::run(a),
+        Command::Report(a) => report::run(a),
         Command::Simulate(a) => simulate::run(a),
     };
     match r {

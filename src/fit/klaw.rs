@@ -227,6 +227,13 @@ impl<'a> KLawProblem<'a> {
         }
     }
 
+    /// Whether point `i` is in regime B at parameters `p` (its K inside its bracket).
+    pub fn point_is_steady(&self, i: usize, p: &[f64]) -> bool {
+        let br = &self.brackets[i];
+        let k = self.k_of(i, p);
+        k > br.lo && k <= br.hi
+    }
+
     /// The exact feasible box of every parameter (see the module docs).
     pub fn feasible_box(&self) -> Result<(Vec<f64>, Vec<f64>), KLawError> {
         let mut lo = vec![(f64::NEG_INFINITY, 0usize); self.n];

@@ -246,3 +246,116 @@ pub fn corner_svg(blocks: &[CornerBlock]) -> Result<String, String> {
     }
     Ok(out)
 }
+
+/// One panel of a [`panels_svg`] figure: points with error bars and curves (a NaN y breaks a
+/// curve).
+#[derive(Debug, Clone, Default)]
+pub struct Panel {
+    /// Caption of the panel.
+    pub title: String,
+    /// x-axis label.
+    pub x_label: String,
+    /// y-axis label.
+    pub y_label: String,
+    /// Point series.
+    pub points: Vec<PointSeries>,
+    /// Curves: label and (x, y) samples.
+    pub curves: Vec<(String, Vec<(f64, f64)>)>,
+}
+
+/// Renders panels in a grid of `cols` columns (560 × 420 px each) under a common title.
+pub fn panels_svg(title: &str, cols: usize, panels: &[Panel]) -> Result<String, String> {
+    let cols = cols.max(1);
+    let rows = panels.len().div_ceil(cols).max(1);
+    let (pw, ph) = (560u32, 420u32);
+    let e = |e: DrawingAreaErrorKind<std::io::Error>| e.to_string();
+    let mut out = String::new();
+    {
+        let root = SVGBackend::with_string(&mut out, (pw * cols as u32, ph * rows as u32 + 40))
+            .into_drawing_area();
+        root.fill(&WHITE).map_err(e)?;
+        let root = root.titled(title, ("sans-serif", 20)).map_err(e)?;
+        let areas = root.split_evenly((rows, cols));
+        for (panel, area) in panels.iter().zip(areas) {
+            let xs = panel
+                .points
+                .iter()
+                .flat_map(|s| s.points.iter().map(|p| p.0))
+                .chain(panel.curves.iter().flat_map(|c| c.1.iter().map(|p| p.0)));
+            let (x0, x1) = range(xs);
+            let ys: Vec<f64> = panel
+                .points
+                .iter()
+                .flat_map(|s| s.points.iter().flat_map(|p| [p.1, p.2, p.3]))
+                .chain(panel.curves.iter().flat_map(|c| c.1.iter().map(|p| p.1)))
+                .collect();
+            let (y0, y1) = range(ys.into_iter());
+            let mut chart = ChartBuilder::on(&area)
+                .caption(&panel.title, ("sans-serif", 16))
+                .margin(12)
+                .x_label_area_size(40)
+                .y_label_area_size(60)
+                .build_cartesian_2d(x0..x1, y0..y1)
+                .map_err(e)?;
+            chart
+                .configure_mesh()
+                .x_desc(&panel.x_label)
+                .y_desc(&panel.y_label)
+                .label_style(("sans-serif", 12))
+                .draw()
+                .map_err(e)?;
+            let mut colour_index = 0;
+            for (label, pts) in &panel.curves {
+                let colour = Palette99::pick(colour_index).to_rgba();
+                colour_index += 1;
+                let mut first = true;
+                for seg in pts
+                    .split(|p| !(p.0.is_finite() && p.1.is_finite()))
+                    .filter(|s| s.len() > 1)
+                {
+                    let s = chart
+                        .draw_series(LineSeries::new(seg.to_vec(), colour.stroke_width(2)))
+                        .map_err(e)?;
+                    if first {
+                        s.label(label.clone()).legend(move |(x, y)| {
+                            PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(2))
+                        });
+                        first = false;
+                    }
+                }
+            }
+            for s in &panel.points {
+                let colour = Palette99::pick(colour_index).to_rgba();
+                colour_index += 1;
+                chart
+                    .draw_series(
+                        s.points
+                            .iter()
+                            .filter(|p| p.0.is_finite() && p.2.is_finite() && p.3 > p.2)
+                            .map(|p| PathElement::new(vec![(p.0, p.2), (p.0, p.3)], colour)),
+                    )
+                    .map_err(e)?;
+                chart
+                    .draw_series(
+                        s.points
+                            .iter()
+                            .filter(|p| p.0.is_finite() && p.1.is_finite())
+                            .map(|p| Circle::new((p.0, p.1), 4, colour.filled())),
+                    )
+                    .map_err(e)?
+                    .label(s.label.clone())
+                    .legend(move |(x, y)| Circle::new((x, y), 4, colour.filled()));
+            }
+            chart
+                .configure_series_labels()
+                .position(SeriesLabelPosition::UpperLeft)
+                .label_font(("sans-serif", 11))
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .draw()
+                .map_err(e)?;
+        }
+        root.present().map_err(e)?;
+    }
+    Ok(out)
+}

@@ -1,3 +1,5 @@
-//! Reports: figures (SVG) and, in later issues, uncertainty tables and model comparison.
+//! Reports: the comparisons of `fitbead report` ([`analysis`]) and the SVG figures
+//! ([`figures`]).
 
+pub mod analysis;
 pub mod figures;

@@ -1,0 +1,1152 @@
+//! The comparisons of `fitbead report`: every model of the paper fitted to one data set, the
+//! bulk friction of Jan's model against the closed form eq 79, the energy budgets, the regime
+//! map and the model ranking. Tables are CSV bytes; nothing here touches files.
+
+use super::figures::{corner_svg, panels_svg, scatter_svg, CornerBlock, Panel, PointSeries};
+use crate::fit::data::Dataset;
+use crate::fit::jaeger::{fit_jaeger_with, JaegerFits, JaegerModel};
+use crate::fit::jan::{fit_jan_with, velocity as jan_velocity, JanFits};
+use crate::fit::k::{bracket, estimate};
+use crate::fit::klaw::{fit_law_with, KLaw, KLawFit, KLawProblem};
+use crate::fit::posterior::Method;
+use crate::fit::summary::{FitSummary, ParamRow};
+use crate::inverse::{Model as _, Residuals, SigmaKind};
+use crate::io::fmt_f64;
+use crate::models::energy;
+use crate::models::regimes::{bulk_friction, critical_xi, delta_d, delta_m};
+use crate::models::{regime_of, ForwardModel, JaegerBranch, Model, Regime};
+use crate::scene::CollisionLaw;
+use rayon::prelude::*;
+
+/// The contract columns of the bulk-friction table, in order.
+pub const MU_COLUMNS: [&str; 12] = [
+    "series",
+    "xi",
+    "mu_jan",
+    "mu_jan_lo",
+    "mu_jan_hi",
+    "K_source",
+    "K",
+    "mu_eq79",
+    "mu_eq79_lo",
+    "mu_eq79_hi",
+    "rel_diff",
+    "intervals_overlap",
+];
+
+/// The two collision models whose K is fitted: pure rolling (the paper's stick model) and
+/// stick/slip.
+const CONTACT: [(Model, &str); 2] = [(Model::Stick, "rolling"), (Model::StickSlip, "stickslip")];
+
+/// ΔAIC (and ΔBIC) above which extra parameters count as supported by the data (the usual
+/// rule of thumb: a difference below 2 is not worth a parameter).
+pub const SUPPORT_THRESHOLD: f64 = 2.0;
+
+/// The laws fitted under one contact model, on the points that model can make steady.
+pub struct ContactFits {
+    /// Model.
+    pub model: Model,
+    /// Name in the tables (`rolling`, `stickslip`).
+    pub name: &'static str,
+    /// The points used (indices into the full data set) and their data set.
+    pub used: Vec<usize>,
+    /// Their data set.
+    pub data: Dataset,
+    /// Law c.
+    pub law_c: Option<KLawFit>,
+    /// One K per series.
+    pub free: Option<KLawFit>,
+    /// χ² of K = cos 2α (the smooth collision, law c with c = 0) and of the impact law, with
+    /// the number of points that have no steady state under each (χ² = ∞ then).
+    pub cos2a_chi2: (f64, usize),
+    /// χ² and unsteady count of the impact law.
+    pub impact_chi2: (f64, usize),
+    /// Why a fit is missing.
+    pub notes: Vec<String>,
+}
+
+/// Everything the report computes.
+pub struct Analysis {
+    /// The data.
+    pub data: Dataset,
+    /// Interval level.
+    pub level: f64,
+    /// Whether the fits were sampled (MCMC).
+    pub mcmc: bool,
+    /// Rolling and stick/slip fits.
+    pub contact: Vec<ContactFits>,
+    /// Jan's fits.
+    pub jan: JanFits,
+    /// Jaeger's fits (upper branch).
+    pub jaeger: JaegerFits,
+}
+
+fn chi2_at(problem: &KLawProblem<'_>, p: &[f64], m: usize) -> (f64, usize) {
+    let mut r = vec![0.0; m];
+    match problem.residuals(p, &mut r) {
+        Ok(()) => (r.iter().map(|x| x * x).sum(), 0),
+        Err(_) => {
+            let data_points = (0..m).filter(|&i| !problem.point_is_steady(i, p)).count();
+            (f64::INFINITY, data_points)
+        }
+    }
+}
+
+/// Fits every model to `data` by `method` at `level`.
+pub fn analyse(data: &Dataset, level: f64, method: &Method) -> Analysis {
+    let mut contact = Vec::new();
+    for (model, name) in CONTACT {
+        let keep: Vec<bool> = data
+            .points
+            .par_iter()
+            .map(|p| bracket(&model, &p.scene).is_ok())
+            .collect();
+        let (sub, used) = data.filter(|i| keep[i]);
+        let mut notes = Vec::new();
+        let dropped = data.points.len() - used.len();
+        if dropped > 0 {
+            notes.push(format!(
+                "{dropped} point(s) have no steady state for any K under the {name} model and \
+                 are left out of its fits"
+            ));
+        }
+        let mut fit = |law: KLaw| match fit_law_with(model, &sub, law, level, method) {
+            Ok(f) => Some(f),
+            Err(e) => {
+                notes.push(format!("{name} law {}: {e}", law.name()));
+                None
+            }
+        };
+        let law_c = fit(KLaw::C);
+        let free = fit(KLaw::FreePerSeries);
+        let m = sub.points.len();
+        let cos2a_chi2 = KLawProblem::new(model, &sub, KLaw::C)
+            .map(|p| chi2_at(&p, &[0.0], m))
+            .unwrap_or((f64::INFINITY, m));
+        let impact_chi2 = KLawProblem::new(model, &sub, KLaw::Impact)
+            .map(|p| chi2_at(&p, &[], m))
+            .unwrap_or((f64::INFINITY, m));
+        contact.push(ContactFits {
+            model,
+            name,
+            used,
+            data: sub,
+            law_c,
+            free,
+            cos2a_chi2,
+            impact_chi2,
+            notes,
+        });
+    }
+    Analysis {
+        data: data.clone(),
+        level,
+        mcmc: matches!(method, Method::Mcmc(_)),
+        contact,
+        jan: fit_jan_with(data, level, method),
+        jaeger: fit_jaeger_with(data, JaegerBranch::Upper, level, method),
+    }
+}
+
+/// The reported interval of a row, or the value itself when there is none.
+fn interval(r: &ParamRow) -> (f64, f64) {
+    r.interval().0.unwrap_or((r.value, r.value))
+}
+
+/// The least-squares value of a row (the optimum also under MCMC).
+fn lsq(r: &ParamRow) -> f64 {
+    r.lsq_value.unwrap_or(r.value)
+}
+
+fn k_of_c(alpha: f64, c: f64) -> f64 {
+    let (s2a, c2a) = (2.0 * alpha).sin_cos();
+    let sa = alpha.sin();
+    c2a + c * sa * sa * s2a
+}
+
+fn opt(x: Option<f64>) -> String {
+    x.filter(|v| v.is_finite()).map(fmt_f64).unwrap_or_default()
+}
+
+/// One row of the bulk-friction table.
+#[derive(Debug, Clone)]
+pub struct MuRow {
+    /// Series label.
+    pub series: String,
+    /// ξ of the series.
+    pub xi: f64,
+    /// α (radians).
+    pub alpha: f64,
+    /// Jan's μ of the series and its interval.
+    pub mu_jan: (f64, f64, f64),
+    /// Which fitted K (`rolling-free`, `rolling-law-c`, `stickslip-free`, …).
+    pub k_source: String,
+    /// K and its interval.
+    pub k: (f64, f64, f64),
+    /// μ of eq 79 at that K, and its interval (K's interval mapped through eq 79).
+    pub mu_eq79: (f64, f64, f64),
+    /// The paper's eq 76 at this α.
+    pub mu_eq76: f64,
+}
+
+impl MuRow {
+    /// (μ_eq79 − μ_Jan)/μ_Jan.
+    pub fn rel_diff(&self) -> f64 {
+        (self.mu_eq79.0 - self.mu_jan.0) / self.mu_jan.0
+    }
+    /// Whether the two intervals share a point.
+    pub fn overlap(&self) -> bool {
+        self.mu_eq79.1 <= self.mu_jan.2 && self.mu_jan.1 <= self.mu_eq79.2
+    }
+}
+
+impl Analysis {
+    /// The bulk-friction comparison: per series with a Jan fit, per fitted K.
+    pub fn mu_rows(&self) -> Vec<MuRow> {
+        let mut out = Vec::new();
+        for (s, label) in self.data.labels.iter().enumerate() {
+            let Some(jan) = &self.jan.series[s] else {
+                continue;
+            };
+            let Some(mu) = jan.params.iter().find(|r| r.parameter == "mu") else {
+                continue;
+            };
+            let p0 = self.data.series(s).next().expect("a series has points");
+            let (xi, alpha) = (p0.scene.xi, p0.scene.alpha);
+            let (lo, hi) = interval(mu);
+            let mu_jan = (mu.value, lo, hi);
+            for c in &self.contact {
+                let mut ks: Vec<(String, (f64, f64, f64))> = Vec::new();
+                if let Some(f) = &c.free {
+                    if let Some(r) = f.summary.params.iter().find(|r| r.series == *label) {
+                        let (a, b) = interval(r);
+                        ks.push((format!("{}-free-K", c.name), (r.value, a, b)));
+                    }
+                }
+                if let Some(f) = &c.law_c {
+                    if let Some(r) = f.summary.params.first() {
+                        let (a, b) = interval(r);
+                        // K rises with c (sin²α sin 2α > 0).
+                        ks.push((
+                            format!("{}-law-c", c.name),
+                            (k_of_c(alpha, r.value), k_of_c(alpha, a), k_of_c(alpha, b)),
+                        ));
+                    }
+                }
+                for (src, k) in ks {
+                    let m = [k.1, k.2].map(|kk| bulk_friction(alpha, kk));
+                    out.push(MuRow {
+                        series: label.clone(),
+                        xi,
+                        alpha,
+                        mu_jan,
+                        k_source: src,
+                        k,
+                        mu_eq79: (bulk_friction(alpha, k.0), m[0].min(m[1]), m[0].max(m[1])),
+                        mu_eq76: 0.0025 * (7.46 * alpha.sin()).exp(),
+                    });
+                }
+            }
+        }
+        out
+    }
+
+    /// The bulk-friction table as CSV ([`MU_COLUMNS`], then `alpha_deg,K_lo,K_hi,mu_eq76,
+    /// rel_diff_eq76,level`).
+    pub fn mu_csv(&self) -> csv::Result<Vec<u8>> {
+        let mut w = csv::Writer::from_writer(Vec::new());
+        let mut h: Vec<&str> = MU_COLUMNS.to_vec();
+        h.extend([
+            "alpha_deg",
+            "K_lo",
+            "K_hi",
+            "mu_eq76",
+            "rel_diff_eq76",
+            "level",
+        ]);
+        w.write_record(&h)?;
+        for r in self.mu_rows() {
+            w.write_record([
+                r.series.clone(),
+                fmt_f64(r.xi),
+                fmt_f64(r.mu_jan.0),
+                fmt_f64(r.mu_jan.1),
+                fmt_f64(r.mu_jan.2),
+                r.k_source.clone(),
+                fmt_f64(r.k.0),
+                fmt_f64(r.mu_eq79.0),
+                fmt_f64(r.mu_eq79.1),
+                fmt_f64(r.mu_eq79.2),
+                fmt_f64(r.rel_diff()),
+                r.overlap().to_string(),
+                fmt_f64(r.alpha.to_degrees()),
+                fmt_f64(r.k.1),
+                fmt_f64(r.k.2),
+                fmt_f64(r.mu_eq76),
+                fmt_f64((r.mu_eq79.0 - r.mu_eq76) / r.mu_eq76),
+                fmt_f64(self.level),
+            ])?;
+        }
+        w.into_inner().map_err(|e| e.into_error().into())
+    }
+
+    /// Energy budget per point: rolling and stick/slip at the K of their law-c fits, and
+    /// Jan's eq 77 ratio with the series' λ. Fractions of the potential drop 2 sin α sin δ.
+    pub fn energy_csv(&self) -> csv::Result<Vec<u8>> {
+        let mut w = csv::Writer::from_writer(Vec::new());
+        w.write_record([
+            "series",
+            "xi",
+            "delta_deg",
+            "v",
+            "model",
+            "K",
+            "potential_drop",
+            "collision_translation",
+            "collision_spin",
+            "collision",
+            "friction",
+            "closure",
+            "status",
+        ])?;
+        for c in &self.contact {
+            let Some(f) = &c.law_c else { continue };
+            let rows: Vec<Vec<String>> = c
+                .data
+                .points
+                .par_iter()
+                .zip(&f.k)
+                .map(|(p, &k)| {
+                    let base = vec![
+                        c.data.labels[p.series].clone(),
+                        fmt_f64(p.scene.xi),
+                        fmt_f64(p.scene.delta_deg()),
+                        fmt_f64(p.v),
+                        c.name.to_string(),
+                        fmt_f64(k),
+                    ];
+                    let part = p.scene.with_k(k).ok().and_then(|sc| {
+                        let st = c.model.evaluate(&sc).ok()?;
+                        match c.model {
+                            Model::Stick => Some(energy::rolling(&sc, &st)),
+                            _ => energy::stickslip(&sc, &st).ok(),
+                        }
+                    });
+                    let mut row = base;
+                    match part {
+                        Some(e) => {
+                            let d = e.potential_drop;
+                            row.extend([
+                                fmt_f64(d),
+                                fmt_f64(e.collision_translation / d),
+                                fmt_f64(e.collision_spin / d),
+                                fmt_f64(e.collision_fraction()),
+                                fmt_f64(e.friction_work / d),
+                                fmt_f64(e.closure()),
+                                "ok".into(),
+                            ]);
+                        }
+                        None => {
+                            row.extend(vec![String::new(); 6]);
+                            row.push("not-steady".into());
+                        }
+                    }
+                    row
+                })
+                .collect();
+            for r in rows {
+                w.write_record(&r)?;
+            }
+        }
+        // Jan's eq 77: collision loss / potential drop = λ v̄² / (2 sin α sin δ).
+        for (s, fit) in self.jan.series.iter().enumerate() {
+            let Some(fit) = fit else { continue };
+            let Some(l) = fit.params.iter().find(|r| r.parameter == "lambda") else {
+                continue;
+            };
+            for p in self.data.series(s) {
+                let d = 2.0 * p.scene.sin_alpha * p.scene.delta.sin();
+                let ratio = l.value * p.v * p.v / d;
+                w.write_record([
+                    self.data.labels[s].clone(),
+                    fmt_f64(p.scene.xi),
+                    fmt_f64(p.scene.delta_deg()),
+                    fmt_f64(p.v),
+                    "jan-eq77".into(),
+                    String::new(),
+                    fmt_f64(d),
+                    String::new(),
+                    String::new(),
+                    fmt_f64(ratio),
+                    fmt_f64(1.0 - ratio),
+                    String::new(),
+                    "ok".into(),
+                ])?;
+            }
+        }
+        w.into_inner().map_err(|e| e.into_error().into())
+    }
+
+    /// Range (min, max) of a fraction column of the energy table, per model.
+    pub fn energy_ranges(&self) -> Vec<(String, f64, f64, f64, f64)> {
+        let mut out = Vec::new();
+        for c in &self.contact {
+            let Some(f) = &c.law_c else { continue };
+            let parts: Vec<(f64, f64)> = c
+                .data
+                .points
+                .par_iter()
+                .zip(&f.k)
+                .filter_map(|(p, &k)| {
+                    let sc = p.scene.with_k(k).ok()?;
+                    let st = c.model.evaluate(&sc).ok()?;
+                    let e = match c.model {
+                        Model::Stick => energy::rolling(&sc, &st),
+                        _ => energy::stickslip(&sc, &st).ok()?,
+                    };
+                    Some((
+                        e.collision_fraction(),
+                        e.collision_translation / e.potential_drop,
+                    ))
+                })
+                .collect();
+            let mm = |f: &dyn Fn(&(f64, f64)) -> f64| {
+                parts
+                    .iter()
+                    .map(f)
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                        (a.min(v), b.max(v))
+                    })
+            };
+            let (c0, c1) = mm(&|x| x.0);
+            let (t0, t1) = mm(&|x| x.1);
+            out.push((c.name.to_string(), c0, c1, t0, t1));
+        }
+        let mut j = (f64::INFINITY, f64::NEG_INFINITY);
+        for (s, fit) in self.jan.series.iter().enumerate() {
+            let Some(l) = fit
+                .as_ref()
+                .and_then(|f| f.params.iter().find(|r| r.parameter == "lambda"))
+            else {
+                continue;
+            };
+            for p in self.data.series(s) {
+                let r = l.value * p.v * p.v / (2.0 * p.scene.sin_alpha * p.scene.delta.sin());
+                j = (j.0.min(r), j.1.max(r));
+            }
+        }
+        if j.0.is_finite() {
+            out.push(("jan-eq77".into(), j.0, j.1, f64::NAN, f64::NAN));
+        }
+        out
+    }
+
+    /// The laws of the regime map: name and law.
+    fn map_laws(&self) -> Vec<(String, CollisionLaw)> {
+        let mut laws = vec![
+            ("cos2a".to_string(), CollisionLaw::Cos2a),
+            ("paper-adjusted".to_string(), CollisionLaw::Adjusted),
+            ("impact".to_string(), CollisionLaw::Impact),
+        ];
+        for c in &self.contact {
+            if let Some(r) = c.law_c.as_ref().and_then(|f| f.summary.params.first()) {
+                laws.push((
+                    format!("{}-law-c (c = {:.4})", c.name, lsq(r)),
+                    CollisionLaw::C(lsq(r)),
+                ));
+            }
+        }
+        laws
+    }
+
+    fn rho(&self) -> f64 {
+        self.data.points.first().map_or(0.4, |p| p.scene.rho)
+    }
+
+    /// δ_m (eq 32) and δ_d (eq 31) against ξ (and α) for the reference and fitted laws, and
+    /// the critical ξ of each law.
+    pub fn regime_map_csv(&self) -> csv::Result<Vec<u8>> {
+        let rho = self.rho();
+        let mut w = csv::Writer::from_writer(Vec::new());
+        w.write_record([
+            "law",
+            "xi",
+            "alpha_deg",
+            "K",
+            "delta_m_deg",
+            "delta_d_deg",
+            "critical_xi",
+        ])?;
+        for (name, law) in self.map_laws() {
+            let crit = critical_xi(law, rho);
+            for i in 0..=80 {
+                let xi = 0.5 * 40f64.powf(i as f64 / 80.0);
+                let a = crate::models::regimes::alpha_of_xi(xi);
+                let k = law.k(a, rho);
+                w.write_record([
+                    name.clone(),
+                    fmt_f64(xi),
+                    fmt_f64(a.to_degrees()),
+                    fmt_f64(k),
+                    fmt_f64(delta_m(a, k).to_degrees()),
+                    fmt_f64(delta_d(a, k, rho).to_degrees()),
+                    opt(crit),
+                ])?;
+            }
+        }
+        w.into_inner().map_err(|e| e.into_error().into())
+    }
+
+    /// The regime each contact model (at its law-c fit) assigns to every data point.
+    pub fn point_regimes(&self) -> Vec<Vec<String>> {
+        self.contact
+            .iter()
+            .map(|c| {
+                let cval = c
+                    .law_c
+                    .as_ref()
+                    .and_then(|f| f.summary.params.first())
+                    .map(lsq);
+                self.data
+                    .points
+                    .par_iter()
+                    .map(|p| {
+                        let Some(cv) = cval else {
+                            return "no-fit".to_string();
+                        };
+                        let k = k_of_c(p.scene.alpha, cv);
+                        match p.scene.with_k(k) {
+                            Ok(sc) => match regime_of(&c.model.evaluate(&sc)) {
+                                Some(Regime::A) => "A".into(),
+                                Some(Regime::B) => "B".into(),
+                                Some(Regime::C) => "C".into(),
+                                None => "invalid".into(),
+                            },
+                            Err(_) => "invalid".into(),
+                        }
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// Points with the regime each model assigns them.
+    pub fn points_csv(&self) -> csv::Result<Vec<u8>> {
+        let reg = self.point_regimes();
+        let mut w = csv::Writer::from_writer(Vec::new());
+        let mut h = vec![
+            "series".to_string(),
+            "xi".into(),
+            "alpha_deg".into(),
+            "delta_deg".into(),
+            "v".into(),
+            "sigma_v".into(),
+        ];
+        for c in &self.contact {
+            h.push(format!("regime_{}", c.name));
+        }
+        w.write_record(&h)?;
+        for (i, p) in self.data.points.iter().enumerate() {
+            let mut r = vec![
+                self.data.labels[p.series].clone(),
+                fmt_f64(p.scene.xi),
+                fmt_f64(p.scene.alpha.to_degrees()),
+                fmt_f64(p.scene.delta_deg()),
+                fmt_f64(p.v),
+                if self.data.sigma == SigmaKind::Absolute {
+                    fmt_f64(p.sigma)
+                } else {
+                    String::new()
+                },
+            ];
+            for rg in &reg {
+                r.push(rg[i].clone());
+            }
+            w.write_record(&r)?;
+        }
+        w.into_inner().map_err(|e| e.into_error().into())
+    }
+
+    /// The model-choice table: every candidate with χ², parameters, AIC, BIC, Δ to the best,
+    /// and rank by AIC.
+    pub fn candidates(&self) -> Vec<Candidate> {
+        let n_all = self.data.points.len();
+        let mut out = Vec::new();
+        for c in &self.contact {
+            let n = c.data.points.len();
+            let note = if n < n_all {
+                format!("{} of {n_all} points (the others cannot be steady)", n)
+            } else {
+                String::new()
+            };
+            let mut push = |name: String, k: usize, chi2: f64, extra: String| {
+                out.push(Candidate::new(name, k, n, chi2, self.data.sigma, {
+                    [note.clone(), extra]
+                        .into_iter()
+                        .filter(|s| !s.is_empty())
+                        .collect::<Vec<_>>()
+                        .join("; ")
+                }))
+            };
+            let unsteady = |u: usize| {
+                if u > 0 {
+                    format!("{u} point(s) not steady under this law")
+                } else {
+                    String::new()
+                }
+            };
+            push(
+                format!("{} K=cos2a", c.name),
+                0,
+                c.cos2a_chi2.0,
+                unsteady(c.cos2a_chi2.1),
+            );
+            push(
+                format!("{} K=impact", c.name),
+                0,
+                c.impact_chi2.0,
+                unsteady(c.impact_chi2.1),
+            );
+            if let Some(f) = &c.law_c {
+                push(
+                    format!("{} law c", c.name),
+                    1,
+                    f.summary.stats.chi2,
+                    String::new(),
+                );
+            }
+            if let Some(f) = &c.free {
+                push(
+                    format!("{} free K per series", c.name),
+                    f.summary.stats.n_params,
+                    f.summary.stats.chi2,
+                    String::new(),
+                );
+            }
+        }
+        let sum_fits = |fits: Vec<&FitSummary>, k_each: usize| {
+            let chi2: f64 = fits.iter().map(|f| f.stats.chi2).sum();
+            let n: usize = fits.iter().map(|f| f.stats.n_points).sum();
+            (chi2, k_each * fits.len(), n)
+        };
+        let jan_series: Vec<&FitSummary> = self.jan.series.iter().flatten().collect();
+        if !jan_series.is_empty() {
+            let (chi2, k, n) = sum_fits(jan_series, 2);
+            let note = if n < n_all {
+                format!("{n} of {n_all} points (series with < 3 points not fitted)")
+            } else {
+                String::new()
+            };
+            out.push(Candidate::new(
+                "jan lambda, mu per series".into(),
+                k,
+                n,
+                chi2,
+                self.data.sigma,
+                note,
+            ));
+        }
+        if let Some(g) = &self.jan.global {
+            out.push(Candidate::new(
+                "jan global laws (eqs 75-76 form)".into(),
+                4,
+                g.stats.n_points,
+                g.stats.chi2,
+                self.data.sigma,
+                String::new(),
+            ));
+        }
+        let jaeger: Vec<&FitSummary> = self
+            .jaeger
+            .series
+            .iter()
+            .flatten()
+            .map(|f| &f.summary)
+            .collect();
+        if !jaeger.is_empty() {
+            let (chi2, k, n) = sum_fits(jaeger, 3);
+            let note = if n < n_all {
+                format!("{n} of {n_all} points (series with < 4 points not fitted)")
+            } else {
+                String::new()
+            };
+            out.push(Candidate::new(
+                "jaeger a1, a2, a3 per series".into(),
+                k,
+                n,
+                chi2,
+                self.data.sigma,
+                note,
+            ));
+        }
+        let best_aic = out
+            .iter()
+            .filter(|c| c.n == n_all)
+            .map(|c| c.aic)
+            .fold(f64::INFINITY, f64::min);
+        let best_bic = out
+            .iter()
+            .filter(|c| c.n == n_all)
+            .map(|c| c.bic)
+            .fold(f64::INFINITY, f64::min);
+        for c in out.iter_mut() {
+            c.delta_aic = c.aic - best_aic;
+            c.delta_bic = c.bic - best_bic;
+        }
+        out.sort_by(|a, b| {
+            (a.n != n_all)
+                .cmp(&(b.n != n_all))
+                .then(a.aic.total_cmp(&b.aic))
+        });
+        out
+    }
+
+    /// The model-choice table as CSV.
+    pub fn models_csv(&self) -> csv::Result<Vec<u8>> {
+        let mut w = csv::Writer::from_writer(Vec::new());
+        w.write_record([
+            "rank",
+            "model",
+            "n_params",
+            "n_points",
+            "chi2",
+            "aic",
+            "bic",
+            "delta_aic",
+            "delta_bic",
+            "note",
+        ])?;
+        for (i, c) in self.candidates().iter().enumerate() {
+            w.write_record([
+                (i + 1).to_string(),
+                c.name.clone(),
+                c.k.to_string(),
+                c.n.to_string(),
+                fmt_f64(c.chi2),
+                fmt_f64(c.aic),
+                fmt_f64(c.bic),
+                fmt_f64(c.delta_aic),
+                fmt_f64(c.delta_bic),
+                c.note.clone(),
+            ])?;
+        }
+        w.into_inner().map_err(|e| e.into_error().into())
+    }
+
+    /// Sentences on which extra parameters the data support (ΔAIC and ΔBIC both beyond
+    /// [`SUPPORT_THRESHOLD`]).
+    pub fn support_statements(&self) -> Vec<String> {
+        let cands = self.candidates();
+        let get = |name: &str| cands.iter().find(|c| c.name == name);
+        let mut out = Vec::new();
+        let mut compare = |simple: &str, rich: &str, what: &str| {
+            if let (Some(a), Some(b)) = (get(simple), get(rich)) {
+                if a.n != b.n || !(a.aic.is_finite() && b.aic.is_finite()) {
+                    return;
+                }
+                let (da, db) = (a.aic - b.aic, a.bic - b.bic);
+                let verdict = if da > SUPPORT_THRESHOLD && db > SUPPORT_THRESHOLD {
+                    "supported"
+                } else if da < -SUPPORT_THRESHOLD && db < -SUPPORT_THRESHOLD {
+                    "not supported (the simpler model is better)"
+                } else {
+                    "not clearly supported"
+                };
+                out.push(format!(
+                    "{what}: {verdict} — `{rich}` ({} parameters) against `{simple}` ({}): \
+                     AIC lower by {}, BIC lower by {}.",
+                    b.k,
+                    a.k,
+                    sig3(da),
+                    sig3(db)
+                ));
+            }
+        };
+        for c in CONTACT.map(|c| c.1) {
+            compare(
+                &format!("{c} K=cos2a"),
+                &format!("{c} law c"),
+                &format!("{c}: the coefficient c of the K(α) law"),
+            );
+            compare(
+                &format!("{c} law c"),
+                &format!("{c} free K per series"),
+                &format!("{c}: one K per series instead of the law"),
+            );
+        }
+        compare(
+            "jan global laws (eqs 75-76 form)",
+            "jan lambda, mu per series",
+            "Jan: λ and μ per series instead of the global laws",
+        );
+        compare(
+            "rolling law c",
+            "stickslip law c",
+            "stick/slip instead of rolling (same single parameter c; f given)",
+        );
+        out
+    }
+
+    /// Posterior blocks for the corner plot (MCMC only).
+    pub fn posteriors(&self) -> Vec<&FitSummary> {
+        let mut v: Vec<&FitSummary> = Vec::new();
+        for c in &self.contact {
+            v.extend(c.law_c.iter().map(|f| &f.summary));
+            v.extend(c.free.iter().map(|f| &f.summary));
+        }
+        v.extend(self.jan.series.iter().flatten());
+        v.extend(self.jan.global.iter());
+        v.extend(self.jaeger.series.iter().flatten().map(|f| &f.summary));
+        v.into_iter().filter(|s| s.draws.is_some()).collect()
+    }
+
+    /// The parameter rows of every fit (the `--output` format of the fit commands).
+    pub fn params(&self) -> Vec<ParamRow> {
+        let mut v = Vec::new();
+        for c in &self.contact {
+            for f in c.law_c.iter().chain(c.free.iter()) {
+                for r in &f.summary.params {
+                    let mut r = r.clone();
+                    r.fit = format!("{}-{}", c.name, r.fit);
+                    v.push(r);
+                }
+            }
+        }
+        for s in self
+            .jan
+            .series
+            .iter()
+            .flatten()
+            .chain(self.jan.global.iter())
+        {
+            v.extend(s.params.iter().cloned());
+        }
+        for f in self.jaeger.series.iter().flatten() {
+            v.extend(f.summary.params.iter().cloned());
+        }
+        v
+    }
+
+    /// Figure: v̄ against δ per series with every fitted model (Figs. 2–3, 8, 9 style).
+    pub fn velocity_figure(&self) -> Result<String, String> {
+        let mut panels = Vec::new();
+        for (s, label) in self.data.labels.iter().enumerate() {
+            let pts: Vec<_> = self.data.series(s).collect();
+            let d0 = pts
+                .iter()
+                .map(|p| p.scene.delta)
+                .fold(f64::INFINITY, f64::min);
+            let d1 = pts
+                .iter()
+                .map(|p| p.scene.delta)
+                .fold(f64::NEG_INFINITY, f64::max);
+            let pad = 0.1 * (d1 - d0).max(1f64.to_radians());
+            let grid: Vec<f64> = (0..=120)
+                .map(|i| (d0 - pad).max(1e-4) + (d1 - d0 + 2.0 * pad) * i as f64 / 120.0)
+                .collect();
+            let s0 = pts[0].scene;
+            let mut curves = Vec::new();
+            for c in &self.contact {
+                if let Some(r) = c.law_c.as_ref().and_then(|f| f.summary.params.first()) {
+                    let k = k_of_c(s0.alpha, lsq(r));
+                    let ys: Vec<(f64, f64)> = grid
+                        .par_iter()
+                        .map(|&d| {
+                            let v = crate::Scene::from_radians(
+                                s0.xi,
+                                d,
+                                s0.rho,
+                                s0.f,
+                                CollisionLaw::Value(k),
+                            )
+                            .ok()
+                            .and_then(|sc| c.model.evaluate(&sc).ok())
+                            .map_or(f64::NAN, |st| st.mean_velocity);
+                            (d.to_degrees(), v)
+                        })
+                        .collect();
+                    curves.push((format!("{} law c", c.name), ys));
+                }
+            }
+            if let Some(j) = &self.jan.series[s] {
+                let (l, m) = (lsq(&j.params[0]), lsq(&j.params[1]));
+                let ys = grid
+                    .iter()
+                    .map(|&d| {
+                        let v = jan_velocity(&(s0.sin_alpha, d.sin(), d.cos()), l, m)
+                            .map_or(f64::NAN, |r| r.0);
+                        (d.to_degrees(), v)
+                    })
+                    .collect();
+                curves.push(("jan".to_string(), ys));
+            }
+            if let Some(j) = &self.jaeger.series[s] {
+                let p: Vec<f64> = j.summary.params.iter().take(3).map(lsq).collect();
+                let model = JaegerModel(JaegerBranch::Upper);
+                let ys = grid
+                    .iter()
+                    .map(|&d| {
+                        let v = model
+                            .value(&(d.tan(), d.cos(), s0.eps), &p)
+                            .unwrap_or(f64::NAN);
+                        (d.to_degrees(), v)
+                    })
+                    .collect();
+                curves.push(("jaeger".to_string(), ys));
+            }
+            panels.push(Panel {
+                title: format!("series {label} (xi = {})", fmt_f64(s0.xi)),
+                x_label: "slope delta (deg)".into(),
+                y_label: "mean velocity v (units sqrt(g(R+r)))".into(),
+                points: vec![PointSeries {
+                    label: "data".into(),
+                    points: pts
+                        .iter()
+                        .map(|p| {
+                            let e = if self.data.sigma == SigmaKind::Absolute {
+                                p.sigma
+                            } else {
+                                0.0
+                            };
+                            (p.scene.delta_deg(), p.v, p.v - e, p.v + e)
+                        })
+                        .collect(),
+                    reference: None,
+                }],
+                curves,
+            });
+        }
+        panels_svg(
+            "Mean velocity against slope: data and fitted models",
+            2,
+            &panels,
+        )
+    }
+
+    /// Figure: v̄²/cos δ against tan δ with Jan's straight lines (Fig. 8).
+    pub fn jan_figure(&self) -> Result<String, String> {
+        let mut points = Vec::new();
+        let mut curves = Vec::new();
+        for (s, label) in self.data.labels.iter().enumerate() {
+            let pts: Vec<_> = self.data.series(s).collect();
+            points.push(PointSeries {
+                label: format!("series {label}"),
+                points: pts
+                    .iter()
+                    .map(|p| {
+                        let c = p.scene.delta.cos();
+                        let y = p.v * p.v / c;
+                        let e = if self.data.sigma == SigmaKind::Absolute {
+                            2.0 * p.v * p.sigma / c
+                        } else {
+                            0.0
+                        };
+                        (p.scene.delta.tan(), y, y - e, y + e)
+                    })
+                    .collect(),
+                reference: None,
+            });
+            if let Some(j) = &self.jan.series[s] {
+                let (l, m) = (lsq(&j.params[0]), lsq(&j.params[1]));
+                let sa = pts[0].scene.sin_alpha;
+                let t1 = pts
+                    .iter()
+                    .map(|p| p.scene.delta.tan())
+                    .fold(f64::NEG_INFINITY, f64::max);
+                // v̄²/cos δ = (2 sin α/λ)(tan δ − μ): a straight line from tan δ = μ.
+                curves.push((
+                    format!("jan, series {label}"),
+                    vec![(m, 0.0), (t1 * 1.05, 2.0 * sa / l * (t1 * 1.05 - m))],
+                ));
+            }
+        }
+        panels_svg(
+            "Jan's linearised plot (paper Fig. 8)",
+            1,
+            &[Panel {
+                title: String::new(),
+                x_label: "tan delta".into(),
+                y_label: "v^2 / cos delta (units g(R+r))".into(),
+                points,
+                curves,
+            }],
+        )
+    }
+
+    /// Figure: K per point (eq 69, stick/slip) against the steady final velocity (Figs. 5–6).
+    pub fn k_figure(&self) -> Result<String, String> {
+        let mut series: Vec<PointSeries> = Vec::new();
+        for (s, label) in self.data.labels.iter().enumerate() {
+            let pts: Vec<_> = self.data.series(s).collect();
+            let est: Vec<_> = pts
+                .par_iter()
+                .map(|p| {
+                    let sg = (self.data.sigma == SigmaKind::Absolute).then_some(p.sigma);
+                    estimate(&Model::StickSlip, &p.scene, p.v, sg)
+                })
+                .collect();
+            let c2 = CollisionLaw::Cos2a.k(pts[0].scene.alpha, pts[0].scene.rho);
+            series.push(PointSeries {
+                label: format!("series {label}"),
+                points: est
+                    .iter()
+                    .filter_map(|e| {
+                        let r = e.root.as_ref().ok()?;
+                        Some((
+                            r.steady.final_velocity,
+                            r.k,
+                            e.k_lo.unwrap_or(r.k),
+                            e.k_hi.unwrap_or(r.k),
+                        ))
+                    })
+                    .collect(),
+                reference: Some((c2, format!("cos 2alpha = {c2:.4}"))),
+            });
+        }
+        scatter_svg(&super::figures::Scatter {
+            title: "K per measurement (eq 69), stick/slip model (paper Figs. 5-6)".into(),
+            x_label: "steady final velocity (units sqrt(g(R+r)))".into(),
+            y_label: "K".into(),
+            series,
+        })
+    }
+
+    /// Figure: the regime map δ_m, δ_d against α with the points by regime (Fig. 4).
+    pub fn regime_figure(&self) -> Result<String, String> {
+        let rho = self.rho();
+        let mut curves = Vec::new();
+        for (name, law) in self.map_laws() {
+            let (mut lm, mut ld) = (Vec::new(), Vec::new());
+            for i in 0..=100 {
+                let xi = 0.5 * 40f64.powf(i as f64 / 100.0);
+                let a = crate::models::regimes::alpha_of_xi(xi);
+                let k = law.k(a, rho);
+                lm.push((a.to_degrees(), delta_m(a, k).to_degrees()));
+                ld.push((a.to_degrees(), delta_d(a, k, rho).to_degrees()));
+            }
+            curves.push((format!("delta_m, {name}"), lm));
+            curves.push((format!("delta_d, {name}"), ld));
+        }
+        let reg = self.point_regimes();
+        let mut points = Vec::new();
+        if let Some(r) = reg.first() {
+            for g in ["A", "B", "C", "invalid", "no-fit"] {
+                let pts: Vec<_> = self
+                    .data
+                    .points
+                    .iter()
+                    .zip(r)
+                    .filter(|(_, x)| x.as_str() == g)
+                    .map(|(p, _)| {
+                        let (a, d) = (p.scene.alpha.to_degrees(), p.scene.delta_deg());
+                        (a, d, d, d)
+                    })
+                    .collect();
+                if !pts.is_empty() {
+                    points.push(PointSeries {
+                        label: format!("data, regime {g} (rolling law c)"),
+                        points: pts,
+                        reference: None,
+                    });
+                }
+            }
+        }
+        panels_svg(
+            "Regime map: steady motion between delta_m (eq 32) and delta_d (eq 31) (paper Fig. 4)",
+            1,
+            &[Panel {
+                title: String::new(),
+                x_label: "contact angle alpha (deg)".into(),
+                y_label: "slope delta (deg)".into(),
+                points,
+                curves,
+            }],
+        )
+    }
+
+    /// Corner plots of every posterior.
+    pub fn corner_figure(&self) -> Result<String, String> {
+        let blocks: Vec<CornerBlock> = self
+            .posteriors()
+            .iter()
+            .filter_map(|p| {
+                let d = p.draws.as_ref()?;
+                let n = p.params.len();
+                let draws: Vec<Vec<f64>> = (0..n)
+                    .map(|j| d.chains.iter().flatten().map(|x| x[j]).collect())
+                    .collect();
+                Some(CornerBlock {
+                    title: format!("{} [{}]", p.stats.fit, p.stats.series),
+                    names: p.params.iter().map(|r| r.parameter.clone()).collect(),
+                    draws,
+                })
+            })
+            .collect();
+        corner_svg(&blocks)
+    }
+}
+
+/// One candidate model of the ranking.
+#[derive(Debug, Clone)]
+pub struct Candidate {
+    /// Name.
+    pub name: String,
+    /// Fitted parameters.
+    pub k: usize,
+    /// Points.
+    pub n: usize,
+    /// χ² at the least-squares optimum.
+    pub chi2: f64,
+    /// AIC.
+    pub aic: f64,
+    /// BIC.
+    pub bic: f64,
+    /// AIC minus the best AIC among candidates on all points.
+    pub delta_aic: f64,
+    /// BIC minus the best BIC.
+    pub delta_bic: f64,
+    /// Remarks.
+    pub note: String,
+}
+
+impl Candidate {
+    /// AIC and BIC with the conventions of the fits ([`crate::inverse::Fit::aic`]): with σ
+    /// given, −2 ln L = χ² up to a constant, AIC = χ² + 2k, BIC = χ² + k ln n; with unit
+    /// weights the scale is one more parameter, −2 ln L = n (ln(2π χ²/n) + 1).
+    fn new(name: String, k: usize, n: usize, chi2: f64, sigma: SigmaKind, note: String) -> Self {
+        let nf = n as f64;
+        let (m2ll, keff) = match sigma {
+            SigmaKind::Absolute => (chi2, k as f64),
+            SigmaKind::Relative => (
+                nf * ((2.0 * std::f64::consts::PI * chi2 / nf).ln() + 1.0),
+                k as f64 + 1.0,
+            ),
+        };
+        let (aic, bic) = if chi2.is_finite() {
+            (m2ll + 2.0 * keff, m2ll + keff * nf.ln())
+        } else {
+            (f64::INFINITY, f64::INFINITY)
+        };
+        Candidate {
+            name,
+            k,
+            n,
+            chi2,
+            aic,
+            bic,
+            delta_aic: f64::NAN,
+            delta_bic: f64::NAN,
+            note,
+        }
+    }
+}
+
+/// Three significant digits.
+pub fn sig3(x: f64) -> String {
+    if x.is_finite() {
+        let s = format!("{x:.2e}");
+        s.parse::<f64>().map(fmt_f64).unwrap_or(s)
+    } else {
+        x.to_string()
+    }
+}

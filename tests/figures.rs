@@ -89,3 +89,28 @@ fn corner_plot_renders() {
 fn k_plot_renders() {
     check("k_stick", &["k", "--model", "stick"]);
 }
+
+#[test]
+fn report_figures_render() {
+    let dir = out_dir().join("report");
+    let out = bin()
+        .args(["report", "--out-dir"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for name in ["velocity", "jan_linear", "k_final_velocity", "regime_map"] {
+        let (w, h, ink, colours) = render(
+            &dir.join(format!("{name}.svg")),
+            &dir.join(format!("{name}.png")),
+        );
+        println!("report {name}: {w}x{h} px, ink {ink:.3}, {colours} colours");
+        assert!(w >= 400 && h >= 300, "{name}: {w}x{h}");
+        assert!(ink > 0.02, "{name}: only {ink} of the canvas inked");
+        assert!(colours > 8, "{name}: {colours} colours");
+    }
+}

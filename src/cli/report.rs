@@ -76,6 +76,10 @@ pub struct Recipe {
     pub min_ess: Option<f64>,
     /// MCMC maximum steps.
     pub max_steps: Option<usize>,
+    /// The input path as written in the recipe (shown in report.md, so that the report does
+    /// not depend on where the recipe was run from).
+    #[serde(skip)]
+    pub shown_input: Option<String>,
 }
 
 fn read_recipe(path: &Path) -> Result<Recipe, CliError> {
@@ -93,6 +97,7 @@ fn read_recipe(path: &Path) -> Result<Recipe, CliError> {
         ))
     })?;
     let dir = path.parent().unwrap_or(Path::new(""));
+    r.shown_input = r.input.as_ref().map(|p| p.display().to_string());
     r.input = r.input.map(|p| dir.join(p));
     r.out_dir = r.out_dir.map(|p| dir.join(p));
     Ok(r)
@@ -104,7 +109,12 @@ pub fn run(a: Args) -> Result<(), CliError> {
         Some(p) => read_recipe(p)?,
         None => Recipe::default(),
     };
-    let input = a.input.clone().or(a.data.clone()).or(r.input);
+    let from_flags = a.input.clone().or(a.data.clone());
+    let shown = match (&from_flags, &r.shown_input) {
+        (None, Some(s)) => Some(s.clone()),
+        _ => None,
+    };
+    let input = from_flags.or(r.input);
     let out_dir = a
         .out_dir
         .clone()
@@ -148,6 +158,10 @@ pub fn run(a: Args) -> Result<(), CliError> {
     ));
     files.push(("points.csv".into(), an.points_csv().map_err(csv_err)?));
     files.push(("models.csv".into(), an.models_csv().map_err(csv_err)?));
+    files.push((
+        "models_by_series.csv".into(),
+        an.models_by_series_csv().map_err(csv_err)?,
+    ));
     let params = an.params();
     let mut stats = Vec::new();
     for c in &an.contact {
@@ -191,7 +205,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
     if an.mcmc {
         files.push(fig("corner.svg", an.corner_figure())?);
     }
-    let md = markdown(&an, &t.source, &io.method);
+    let md = markdown(&an, shown.as_deref().unwrap_or(&t.source), &io.method);
     files.push(("report.md".into(), md.into_bytes()));
     std::fs::create_dir_all(&out_dir)
         .map_err(|e| CliError::Other(format!("{}: cannot create: {e}", out_dir.display())))?;
@@ -390,7 +404,8 @@ fn markdown(an: &Analysis, source: &str, method: &str) -> String {
     m.push_str(
         "χ² at the least-squares optimum, AIC and BIC (with σ given: AIC = χ² + 2k, BIC = χ² + \
          k ln n), ranked by AIC among the models fitted to every point. Table: \
-         [models.csv](models.csv).\n\n| rank | model | k | n | χ² | ΔAIC | ΔBIC | note |\n\
+         [models.csv](models.csv); χ² of every model per series: \
+         [models_by_series.csv](models_by_series.csv).\n\n| rank | model | k | n | χ² | ΔAIC | ΔBIC | note |\n\
          |---|---|---|---|---|---|---|---|\n",
     );
     for (i, c) in an.candidates().iter().enumerate() {

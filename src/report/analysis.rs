@@ -164,6 +164,15 @@ fn k_of_c(alpha: f64, c: f64) -> f64 {
     c2a + c * sa * sa * s2a
 }
 
+/// A number for the model tables: `inf` where a model cannot make a point steady.
+fn num(x: f64) -> String {
+    if x == f64::INFINITY {
+        "inf".into()
+    } else {
+        fmt_f64(x)
+    }
+}
+
 fn opt(x: Option<f64>) -> String {
     x.filter(|v| v.is_finite()).map(fmt_f64).unwrap_or_default()
 }
@@ -701,6 +710,112 @@ impl Analysis {
         out
     }
 
+    /// χ² per series of every candidate (at the least-squares optimum; ∞ where a point of the
+    /// series has no steady state under the candidate), as CSV: series, model, n_points, chi2.
+    pub fn models_by_series_csv(&self) -> csv::Result<Vec<u8>> {
+        let ns = self.data.labels.len();
+        let mut rows: Vec<(String, Vec<(usize, f64)>)> = Vec::new();
+        let per_point = |c: &ContactFits, k: &(dyn Fn(usize) -> f64 + Sync)| -> Vec<(usize, f64)> {
+            let r: Vec<(usize, f64)> = c
+                .data
+                .points
+                .par_iter()
+                .enumerate()
+                .map(|(i, p)| {
+                    let v = p
+                        .scene
+                        .with_k(k(i))
+                        .ok()
+                        .and_then(|sc| c.model.evaluate(&sc).ok())
+                        .map_or(f64::INFINITY, |st| {
+                            ((p.v - st.mean_velocity) / p.sigma).powi(2)
+                        });
+                    (p.series, v)
+                })
+                .collect();
+            let mut acc = vec![(0usize, 0.0); c.data.labels.len()];
+            for (s, v) in r {
+                acc[s].0 += 1;
+                acc[s].1 += v;
+            }
+            acc
+        };
+        for c in &self.contact {
+            let pts = &c.data.points;
+            let rho = |i: usize| pts[i].scene.rho;
+            let alpha = |i: usize| pts[i].scene.alpha;
+            rows.push((
+                format!("{} K=cos2a", c.name),
+                per_point(c, &|i| k_of_c(alpha(i), 0.0)),
+            ));
+            rows.push((
+                format!("{} K=impact", c.name),
+                per_point(c, &|i| CollisionLaw::Impact.k(alpha(i), rho(i))),
+            ));
+            if let Some(f) = &c.law_c {
+                rows.push((format!("{} law c", c.name), per_point(c, &|i| f.k[i])));
+            }
+            if let Some(f) = &c.free {
+                rows.push((
+                    format!("{} free K per series", c.name),
+                    per_point(c, &|i| f.k[i]),
+                ));
+            }
+        }
+        // Series labels of a contact model's subset map back to the full data by name.
+        let mut w = csv::Writer::from_writer(Vec::new());
+        w.write_record(["series", "model", "n_points", "chi2"])?;
+        for c in &self.contact {
+            for (name, acc) in rows.iter().filter(|r| r.0.starts_with(c.name)) {
+                for (j, (n, chi2)) in acc.iter().enumerate() {
+                    w.write_record([
+                        c.data.labels[j].clone(),
+                        name.clone(),
+                        n.to_string(),
+                        num(*chi2),
+                    ])?;
+                }
+            }
+        }
+        for s in 0..ns {
+            let label = &self.data.labels[s];
+            if let Some(f) = &self.jan.series[s] {
+                w.write_record([
+                    label.clone(),
+                    "jan lambda, mu per series".into(),
+                    f.stats.n_points.to_string(),
+                    num(f.stats.chi2),
+                ])?;
+            }
+            if let Some(g) = &self.jan.global {
+                let p: Vec<f64> = g.params.iter().take(4).map(lsq).collect();
+                let (mut n, mut chi2) = (0usize, 0.0);
+                for q in self.data.series(s) {
+                    let x = (q.scene.sin_alpha, q.scene.delta.sin(), q.scene.delta.cos());
+                    n += 1;
+                    chi2 += crate::fit::jan::JanGlobal
+                        .value(&x, &p)
+                        .map_or(f64::INFINITY, |v| ((q.v - v) / q.sigma).powi(2));
+                }
+                w.write_record([
+                    label.clone(),
+                    "jan global laws (eqs 75-76 form)".into(),
+                    n.to_string(),
+                    num(chi2),
+                ])?;
+            }
+            if let Some(f) = &self.jaeger.series[s] {
+                w.write_record([
+                    label.clone(),
+                    "jaeger a1, a2, a3 per series".into(),
+                    f.summary.stats.n_points.to_string(),
+                    num(f.summary.stats.chi2),
+                ])?;
+            }
+        }
+        w.into_inner().map_err(|e| e.into_error().into())
+    }
+
     /// The model-choice table as CSV.
     pub fn models_csv(&self) -> csv::Result<Vec<u8>> {
         let mut w = csv::Writer::from_writer(Vec::new());
@@ -722,11 +837,11 @@ impl Analysis {
                 c.name.clone(),
                 c.k.to_string(),
                 c.n.to_string(),
-                fmt_f64(c.chi2),
-                fmt_f64(c.aic),
-                fmt_f64(c.bic),
-                fmt_f64(c.delta_aic),
-                fmt_f64(c.delta_bic),
+                num(c.chi2),
+                num(c.aic),
+                num(c.bic),
+                num(c.delta_aic),
+                num(c.delta_bic),
                 c.note.clone(),
             ])?;
         }
@@ -741,7 +856,14 @@ impl Analysis {
         let mut out = Vec::new();
         let mut compare = |simple: &str, rich: &str, what: &str| {
             if let (Some(a), Some(b)) = (get(simple), get(rich)) {
-                if a.n != b.n || !(a.aic.is_finite() && b.aic.is_finite()) {
+                if a.n != b.n || !b.aic.is_finite() {
+                    return;
+                }
+                if !a.aic.is_finite() {
+                    out.push(format!(
+                        "{what}: required — `{simple}` cannot make every point steady ({}), `{rich}` can.",
+                        a.note
+                    ));
                     return;
                 }
                 let (da, db) = (a.aic - b.aic, a.bic - b.bic);
@@ -914,6 +1036,7 @@ impl Analysis {
                     reference: None,
                 }],
                 curves,
+                curve_colours: Vec::new(),
             });
         }
         panels_svg(
@@ -969,6 +1092,7 @@ impl Analysis {
                 y_label: "v^2 / cos delta (units g(R+r))".into(),
                 points,
                 curves,
+                curve_colours: Vec::new(),
             }],
         )
     }
@@ -1015,7 +1139,8 @@ impl Analysis {
     pub fn regime_figure(&self) -> Result<String, String> {
         let rho = self.rho();
         let mut curves = Vec::new();
-        for (name, law) in self.map_laws() {
+        let mut colours = Vec::new();
+        for (li, (name, law)) in self.map_laws().into_iter().enumerate() {
             let (mut lm, mut ld) = (Vec::new(), Vec::new());
             for i in 0..=100 {
                 let xi = 0.5 * 40f64.powf(i as f64 / 100.0);
@@ -1024,8 +1149,9 @@ impl Analysis {
                 lm.push((a.to_degrees(), delta_m(a, k).to_degrees()));
                 ld.push((a.to_degrees(), delta_d(a, k, rho).to_degrees()));
             }
-            curves.push((format!("delta_m, {name}"), lm));
-            curves.push((format!("delta_d, {name}"), ld));
+            curves.push((format!("delta_m (thick), delta_d (thin): {name}"), lm));
+            curves.push((String::new(), ld));
+            colours.extend([li, li]);
         }
         let reg = self.point_regimes();
         let mut points = Vec::new();
@@ -1052,7 +1178,7 @@ impl Analysis {
             }
         }
         panels_svg(
-            "Regime map: steady motion between delta_m (eq 32) and delta_d (eq 31) (paper Fig. 4)",
+            "Regime map (paper Fig. 4): steady between delta_m (eq 32) and delta_d (eq 31)",
             1,
             &[Panel {
                 title: String::new(),
@@ -1060,6 +1186,7 @@ impl Analysis {
                 y_label: "slope delta (deg)".into(),
                 points,
                 curves,
+                curve_colours: colours,
             }],
         )
     }

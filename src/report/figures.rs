@@ -261,13 +261,21 @@ pub struct Panel {
     pub points: Vec<PointSeries>,
     /// Curves: label and (x, y) samples.
     pub curves: Vec<(String, Vec<(f64, f64)>)>,
+    /// Palette index of each curve (empty: one colour per curve); a curve whose colour
+    /// repeats the previous curve's is drawn thin (e.g. δ_d beside δ_m of the same law).
+    pub curve_colours: Vec<usize>,
 }
 
-/// Renders panels in a grid of `cols` columns (560 × 420 px each) under a common title.
+/// Renders panels in a grid of `cols` columns (560 × 420 px each; a single panel 900 × 620)
+/// under a common title.
 pub fn panels_svg(title: &str, cols: usize, panels: &[Panel]) -> Result<String, String> {
     let cols = cols.max(1);
     let rows = panels.len().div_ceil(cols).max(1);
-    let (pw, ph) = (560u32, 420u32);
+    let (pw, ph) = if panels.len() == 1 {
+        (900u32, 620u32)
+    } else {
+        (560u32, 420u32)
+    };
     let e = |e: DrawingAreaErrorKind<std::io::Error>| e.to_string();
     let mut out = String::new();
     {
@@ -305,20 +313,30 @@ pub fn panels_svg(title: &str, cols: usize, panels: &[Panel]) -> Result<String, 
                 .draw()
                 .map_err(e)?;
             let mut colour_index = 0;
-            for (label, pts) in &panel.curves {
-                let colour = Palette99::pick(colour_index).to_rgba();
-                colour_index += 1;
+            for (ci, (label, pts)) in panel.curves.iter().enumerate() {
+                let (pick, width) = match panel.curve_colours.get(ci) {
+                    Some(&k) => {
+                        let thin = ci > 0 && panel.curve_colours.get(ci - 1) == Some(&k);
+                        colour_index = colour_index.max(k + 1);
+                        (k, if thin { 1 } else { 2 })
+                    }
+                    None => {
+                        colour_index += 1;
+                        (colour_index - 1, 2)
+                    }
+                };
+                let colour = Palette99::pick(pick).to_rgba();
                 let mut first = true;
                 for seg in pts
                     .split(|p| !(p.0.is_finite() && p.1.is_finite()))
                     .filter(|s| s.len() > 1)
                 {
                     let s = chart
-                        .draw_series(LineSeries::new(seg.to_vec(), colour.stroke_width(2)))
+                        .draw_series(LineSeries::new(seg.to_vec(), colour.stroke_width(width)))
                         .map_err(e)?;
-                    if first {
+                    if first && !label.is_empty() {
                         s.label(label.clone()).legend(move |(x, y)| {
-                            PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(2))
+                            PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(width))
                         });
                         first = false;
                     }

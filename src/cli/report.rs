@@ -205,7 +205,26 @@ pub fn run(a: Args) -> Result<(), CliError> {
     if an.mcmc {
         files.push(fig("corner.svg", an.corner_figure())?);
     }
-    let md = markdown(&an, shown.as_deref().unwrap_or(&t.source), &io.method);
+    let warnings: Vec<String> = stats
+        .iter()
+        .filter(|s| s.mcmc.is_some() && !s.converged)
+        .map(|s| format!("{} [{}]: {}", s.fit, s.series, s.note))
+        .collect();
+    for w in &warnings {
+        eprintln!("fitbead: warning: {w}");
+    }
+    let mut md = markdown(&an, shown.as_deref().unwrap_or(&t.source), &io.method);
+    if !warnings.is_empty() {
+        md.push_str(
+            "
+## Posterior runs that did not converge
+
+",
+        );
+        for w in &warnings {
+            md.push_str(&format!("- {w}\n"));
+        }
+    }
     files.push(("report.md".into(), md.into_bytes()));
     std::fs::create_dir_all(&out_dir)
         .map_err(|e| CliError::Other(format!("{}: cannot create: {e}", out_dir.display())))?;

@@ -597,7 +597,26 @@ fn sample<R: Residuals + Sync + ?Sized>(
             }
         }
     }
-    let names: Vec<String> = out.params.iter().map(|r| r.parameter.clone()).collect();
+    // Names for the messages; a name shared by several parameters (one K per series) gets
+    // its row number in the report.
+    let names: Vec<String> = out
+        .params
+        .iter()
+        .enumerate()
+        .map(|(j, r)| {
+            if out
+                .params
+                .iter()
+                .filter(|q| q.parameter == r.parameter)
+                .count()
+                > 1
+            {
+                format!("{} (row {} of this fit)", r.parameter, j + 1)
+            } else {
+                r.parameter.clone()
+            }
+        })
+        .collect();
     let kept = res.chains.iter().map(Vec::len).sum::<usize>();
     let rhat_max = res
         .diagnostics

@@ -424,12 +424,12 @@ fn markdown(an: &Analysis, source: &str, method: &str) -> String {
         "χ² at the least-squares optimum, AIC and BIC (with σ given: AIC = χ² + 2k, BIC = χ² + \
          k ln n), ranked by AIC among the models fitted to every point. Table: \
          [models.csv](models.csv); χ² of every model per series: \
-         [models_by_series.csv](models_by_series.csv).\n\n| rank | model | k | n | χ² | ΔAIC | ΔBIC | note |\n\
-         |---|---|---|---|---|---|---|---|\n",
+         [models_by_series.csv](models_by_series.csv).\n\n| rank | model | k | n | χ² | ΔAIC | ΔBIC | ΔWAIC | note |\n\
+         |---|---|---|---|---|---|---|---|---|\n",
     );
     for (i, c) in an.candidates().iter().enumerate() {
         m.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {} |\n",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
             i + 1,
             c.name,
             c.k,
@@ -437,8 +437,17 @@ fn markdown(an: &Analysis, source: &str, method: &str) -> String {
             sig3(c.chi2),
             sig3(c.delta_aic),
             sig3(c.delta_bic),
+            c.delta_waic.map_or("—".to_string(), sig3),
             c.note
         ));
+    }
+    if an.mcmc {
+        m.push_str(
+            "\nWAIC (Watanabe 2010, deviance scale) from the posterior draws of every fit \
+             (per-series models: summed over the series); for a law with nothing fitted it is \
+             χ². Columns `waic`, `delta_waic` of models.csv; p_waic and its standard error per \
+             fit in stats.csv.\n",
+        );
     }
     m.push_str(&format!(
         "\nWhat the data support (extra parameters count as supported when both AIC and BIC \

@@ -31,6 +31,7 @@ use crate::inverse::mcmc::{
 };
 use crate::inverse::{Fit, LsqOptions, Residuals, SigmaKind};
 use crate::io::fmt_f64;
+use rayon::prelude::*;
 use statrs::distribution::{Continuous, LogNormal, Normal, Uniform};
 use std::fmt;
 use std::str::FromStr;
@@ -685,6 +686,7 @@ fn sample<R: Residuals + Sync + ?Sized>(
         acceptance: res.acceptance_overall,
         ess_min,
         rhat_max,
+        waic: waic(problem, n, &res.chains),
     });
     out.draws = Some(Draws {
         chains: res.chains,
@@ -694,6 +696,68 @@ fn sample<R: Residuals + Sync + ?Sized>(
         interrupted: res.reason == StopReason::Interrupted,
     });
     out
+}
+
+/// Draws used for WAIC at most (evenly spaced through the pooled kept draws).
+const WAIC_DRAWS: usize = 1000;
+
+/// WAIC (S. Watanabe, JMLR 11, 2010; in the deviance scale of A. Gelman, J. Hwang &
+/// A. Vehtari, Stat. Comput. 24, 2014): −2 Σᵢ (lppdᵢ − p_waic,ᵢ), with lppdᵢ the log of the
+/// posterior mean of p(yᵢ | θ) and p_waic,ᵢ the posterior variance of ln p(yᵢ | θ), over at
+/// most [`WAIC_DRAWS`] draws. Pointwise ln p(yᵢ | θ) = −rᵢ²/2 (σ given) or −ln s − rᵢ²/(2s²)
+/// (with the scale), dropping the constant −ln σᵢ − ½ ln 2π, which is the same for every model
+/// of the same data, so WAIC differences between models are exact. Returns (WAIC, p_waic,
+/// standard error of WAIC), or `None` without draws.
+fn waic<R: Residuals + Sync + ?Sized>(
+    problem: &R,
+    n: usize,
+    chains: &[Vec<Vec<f64>>],
+) -> Option<(f64, f64, f64)> {
+    let pooled: Vec<&Vec<f64>> = chains.iter().flatten().collect();
+    if pooled.len() < 2 {
+        return None;
+    }
+    let stride = pooled.len().div_ceil(WAIC_DRAWS).max(1);
+    let m = problem.n_residuals();
+    let ll: Vec<Vec<f64>> = pooled
+        .par_iter()
+        .step_by(stride)
+        .filter_map(|x| {
+            let mut r = vec![0.0; m];
+            problem.residuals(&x[..n], &mut r).ok()?;
+            let s = x.get(n).copied();
+            Some(
+                r.iter()
+                    .map(|ri| match s {
+                        None => -0.5 * ri * ri,
+                        Some(s) => -s.ln() - 0.5 * ri * ri / (s * s),
+                    })
+                    .collect(),
+            )
+        })
+        .collect();
+    let ns = ll.len();
+    if ns < 2 {
+        return None;
+    }
+    let mut elpd_i = Vec::with_capacity(m);
+    let mut p_total = 0.0;
+    for i in 0..m {
+        let col: Vec<f64> = ll.iter().map(|d| d[i]).collect();
+        let mx = col.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let lppd = mx + (col.iter().map(|v| (v - mx).exp()).sum::<f64>() / ns as f64).ln();
+        let mean = col.iter().sum::<f64>() / ns as f64;
+        let var = col.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (ns as f64 - 1.0);
+        p_total += var;
+        elpd_i.push(lppd - var);
+    }
+    let w: Vec<f64> = elpd_i.iter().map(|e| -2.0 * e).collect();
+    let total: f64 = w.iter().sum();
+    let mean = total / m as f64;
+    let se = (m as f64 * w.iter().map(|v| (v - mean).powi(2)).sum::<f64>()
+        / (m as f64 - 1.0).max(1.0))
+    .sqrt();
+    Some((total, p_total, se))
 }
 
 fn join(a: &str, b: &str) -> String {

@@ -63,7 +63,7 @@ pub const PARAM_POSTERIOR_COLUMNS: [&str; 10] = [
 ];
 
 /// Columns of the statistics report.
-pub const STATS_COLUMNS: [&str; 25] = [
+pub const STATS_COLUMNS: [&str; 28] = [
     "fit",
     "series",
     "n_points",
@@ -89,6 +89,9 @@ pub const STATS_COLUMNS: [&str; 25] = [
     "acceptance",
     "ess_min",
     "rhat_max",
+    "waic",
+    "p_waic",
+    "waic_se",
 ];
 
 /// One fitted parameter.
@@ -208,6 +211,9 @@ pub struct McmcStats {
     pub ess_min: f64,
     /// Largest rank-normalised split-R̂ over the parameters.
     pub rhat_max: f64,
+    /// WAIC, its effective number of parameters p_waic and the standard error of WAIC (see
+    /// [`super::posterior`]); `None` without draws.
+    pub waic: Option<(f64, f64, f64)>,
 }
 
 /// The rows of one fit.
@@ -538,6 +544,9 @@ pub fn stats_csv(rows: &[StatsRow]) -> csv::Result<Vec<u8>> {
                 .as_ref()
                 .map(|m| m.rhat_max)
                 .filter(|v| v.is_finite())),
+            opt(r.mcmc.as_ref().and_then(|m| m.waic).map(|w| w.0)),
+            opt(r.mcmc.as_ref().and_then(|m| m.waic).map(|w| w.1)),
+            opt(r.mcmc.as_ref().and_then(|m| m.waic).map(|w| w.2)),
         ])?;
     }
     w.into_inner().map_err(|e| e.into_error().into())

@@ -588,14 +588,23 @@ impl Analysis {
             } else {
                 String::new()
             };
-            let mut push = |name: String, k: usize, chi2: f64, extra: String| {
-                out.push(Candidate::new(name, k, n, chi2, self.data.sigma, {
+            let mcmc = self.mcmc;
+            let sigma = self.data.sigma;
+            let mut push = |name: String, k: usize, chi2: f64, extra: String, waic: Option<f64>| {
+                let mut cand = Candidate::new(name, k, n, chi2, sigma, {
                     [note.clone(), extra]
                         .into_iter()
                         .filter(|s| !s.is_empty())
                         .collect::<Vec<_>>()
                         .join("; ")
-                }))
+                });
+                // A law with nothing fitted has no posterior spread: WAIC = χ² (σ given).
+                cand.waic = if k == 0 {
+                    (mcmc && sigma == SigmaKind::Absolute).then_some(chi2)
+                } else {
+                    waic
+                };
+                out.push(cand)
             };
             let unsteady = |u: usize| {
                 if u > 0 {
@@ -609,12 +618,14 @@ impl Analysis {
                 0,
                 c.cos2a_chi2.0,
                 unsteady(c.cos2a_chi2.1),
+                None,
             );
             push(
                 format!("{} K=impact", c.name),
                 0,
                 c.impact_chi2.0,
                 unsteady(c.impact_chi2.1),
+                None,
             );
             if let Some(f) = &c.law_c {
                 push(
@@ -622,6 +633,7 @@ impl Analysis {
                     1,
                     f.summary.stats.chi2,
                     String::new(),
+                    waic_sum([&f.summary]),
                 );
             }
             if let Some(f) = &c.free {
@@ -630,6 +642,7 @@ impl Analysis {
                     f.summary.stats.n_params,
                     f.summary.stats.chi2,
                     String::new(),
+                    waic_sum([&f.summary]),
                 );
             }
         }
@@ -640,30 +653,35 @@ impl Analysis {
         };
         let jan_series: Vec<&FitSummary> = self.jan.series.iter().flatten().collect();
         if !jan_series.is_empty() {
+            let w = waic_sum(jan_series.iter().copied());
             let (chi2, k, n) = sum_fits(jan_series, 2);
             let note = if n < n_all {
                 format!("{n} of {n_all} points (series with < 3 points not fitted)")
             } else {
                 String::new()
             };
-            out.push(Candidate::new(
+            let mut cand = Candidate::new(
                 "jan lambda, mu per series".into(),
                 k,
                 n,
                 chi2,
                 self.data.sigma,
                 note,
-            ));
+            );
+            cand.waic = w;
+            out.push(cand);
         }
         if let Some(g) = &self.jan.global {
-            out.push(Candidate::new(
+            let mut cand = Candidate::new(
                 "jan global laws (eqs 75-76 form)".into(),
                 4,
                 g.stats.n_points,
                 g.stats.chi2,
                 self.data.sigma,
                 String::new(),
-            ));
+            );
+            cand.waic = waic_sum([g]);
+            out.push(cand);
         }
         let jaeger: Vec<&FitSummary> = self
             .jaeger
@@ -673,20 +691,23 @@ impl Analysis {
             .map(|f| &f.summary)
             .collect();
         if !jaeger.is_empty() {
+            let w = waic_sum(jaeger.iter().copied());
             let (chi2, k, n) = sum_fits(jaeger, 3);
             let note = if n < n_all {
                 format!("{n} of {n_all} points (series with < 4 points not fitted)")
             } else {
                 String::new()
             };
-            out.push(Candidate::new(
+            let mut cand = Candidate::new(
                 "jaeger a1, a2, a3 per series".into(),
                 k,
                 n,
                 chi2,
                 self.data.sigma,
                 note,
-            ));
+            );
+            cand.waic = w;
+            out.push(cand);
         }
         let best_aic = out
             .iter()
@@ -698,9 +719,15 @@ impl Analysis {
             .filter(|c| c.n == n_all)
             .map(|c| c.bic)
             .fold(f64::INFINITY, f64::min);
+        let best_waic = out
+            .iter()
+            .filter(|c| c.n == n_all)
+            .filter_map(|c| c.waic)
+            .fold(f64::INFINITY, f64::min);
         for c in out.iter_mut() {
             c.delta_aic = c.aic - best_aic;
             c.delta_bic = c.bic - best_bic;
+            c.delta_waic = c.waic.map(|w| w - best_waic);
         }
         out.sort_by(|a, b| {
             (a.n != n_all)
@@ -830,6 +857,8 @@ impl Analysis {
             "delta_aic",
             "delta_bic",
             "note",
+            "waic",
+            "delta_waic",
         ])?;
         for (i, c) in self.candidates().iter().enumerate() {
             w.write_record([
@@ -843,6 +872,8 @@ impl Analysis {
                 num(c.delta_aic),
                 num(c.delta_bic),
                 c.note.clone(),
+                c.waic.map(num).unwrap_or_default(),
+                c.delta_waic.map(num).unwrap_or_default(),
             ])?;
         }
         w.into_inner().map_err(|e| e.into_error().into())
@@ -1232,6 +1263,11 @@ pub struct Candidate {
     pub delta_aic: f64,
     /// BIC minus the best BIC.
     pub delta_bic: f64,
+    /// WAIC (posterior runs only; the sum over the fits of a per-series model; χ² for a
+    /// parameter-free law with σ given).
+    pub waic: Option<f64>,
+    /// WAIC minus the best WAIC.
+    pub delta_waic: Option<f64>,
     /// Remarks.
     pub note: String,
 }
@@ -1263,9 +1299,22 @@ impl Candidate {
             bic,
             delta_aic: f64::NAN,
             delta_bic: f64::NAN,
+            waic: None,
+            delta_waic: None,
             note,
         }
     }
+}
+
+/// The summed WAIC of posterior fits, if every one has it.
+fn waic_sum<'a>(fits: impl IntoIterator<Item = &'a FitSummary>) -> Option<f64> {
+    let mut total = 0.0;
+    let mut any = false;
+    for f in fits {
+        total += f.stats.mcmc.as_ref()?.waic?.0;
+        any = true;
+    }
+    any.then_some(total)
 }
 
 /// Three significant digits.

@@ -3,11 +3,11 @@
 use super::k::{read_rows, Row};
 use super::{emit, read_input, CliError};
 use crate::fit::data::{DataError, Dataset};
-use crate::fit::posterior::{McmcSettings, Method, Prior, SCALE_NAME};
+use crate::fit::posterior::{draws_column, McmcSettings, Method, Prior, SCALE_NAME};
 use crate::fit::summary::{params_csv, stats_csv, FitSummary, ParamRow, StatsRow};
 use crate::inverse::mcmc::McmcOptions;
 use crate::io::scenes::Table;
-use crate::io::{fmt_f64, write_atomic_all};
+use crate::io::{fmt_f64, fmt_sig, write_atomic_all};
 use crate::report::figures::{corner_svg, CornerBlock};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -268,7 +268,7 @@ impl FitArgs {
             None => Vec::new(),
         };
         let corner = match &self.plot {
-            Some(_) => corner_svg(&corner_blocks(posteriors))
+            Some(_) => corner_svg(&CornerBlock::from_posteriors(posteriors))
                 .map_err(|e| CliError::Other(format!("corner plot: {e}")))?
                 .into_bytes(),
             None => Vec::new(),
@@ -294,11 +294,11 @@ impl FitArgs {
                     "{} [{}]: chi2 {} dof {} reduced {} AIC {} BIC {} ({}){}",
                     r.fit,
                     r.series,
-                    fmt_sig(r.chi2),
+                    fmt_sig(r.chi2, 7),
                     r.dof,
-                    fmt_sig(r.reduced_chi2),
-                    fmt_sig(r.aic),
-                    fmt_sig(r.bic),
+                    fmt_sig(r.reduced_chi2, 7),
+                    fmt_sig(r.aic, 7),
+                    fmt_sig(r.bic, 7),
                     r.termination,
                     if r.note.is_empty() {
                         String::new()
@@ -324,16 +324,6 @@ impl FitArgs {
             return Err(CliError::Interrupted);
         }
         Ok(())
-    }
-}
-
-/// The column naming a parameter in the draws file: its name, with the series appended where
-/// a fit across series has one parameter per series (`K[series]`).
-fn draws_column(fit: &FitSummary, row: &ParamRow) -> String {
-    if row.series == fit.stats.series {
-        row.parameter.clone()
-    } else {
-        format!("{}[{}]", row.parameter, row.series)
     }
 }
 
@@ -383,32 +373,4 @@ pub fn draws_csv(posteriors: &[&FitSummary]) -> csv::Result<Vec<u8>> {
         }
     }
     w.into_inner().map_err(|e| e.into_error().into())
-}
-
-fn corner_blocks(posteriors: &[&FitSummary]) -> Vec<CornerBlock> {
-    posteriors
-        .iter()
-        .filter_map(|p| {
-            let d = p.draws.as_ref()?;
-            let n = p.params.len();
-            let draws: Vec<Vec<f64>> = (0..n)
-                .map(|j| d.chains.iter().flatten().map(|x| x[j]).collect())
-                .collect();
-            (draws.first().is_some_and(|v| !v.is_empty())).then(|| CornerBlock {
-                title: format!("{} [{}]", p.stats.fit, p.stats.series),
-                names: p.params.iter().map(|r| draws_column(p, r)).collect(),
-                draws,
-            })
-        })
-        .collect()
-}
-
-/// Six significant digits for the terminal (the CSV files keep every digit).
-fn fmt_sig(x: f64) -> String {
-    if x.is_finite() {
-        let s = format!("{x:.6e}");
-        s.parse::<f64>().map(fmt_f64).unwrap_or(s)
-    } else {
-        x.to_string()
-    }
 }

@@ -30,7 +30,7 @@ use crate::inverse::mcmc::{
     summarise as mcmc_summarise, EnsembleSampler, LogDensity, McmcOptions, StopReason,
 };
 use crate::inverse::{Fit, LsqOptions, Residuals, SigmaKind};
-use crate::io::fmt_f64;
+use crate::io::{fmt_f64, fmt_sig};
 use rayon::prelude::*;
 use statrs::distribution::{Continuous, LogNormal, Normal, Uniform};
 use std::fmt;
@@ -263,6 +263,16 @@ impl Draws {
     }
 }
 
+/// The column naming a parameter in the draws file: its name, with the series appended where
+/// a fit across series has one parameter per series (`K[series]`).
+pub fn draws_column(fit: &FitSummary, row: &ParamRow) -> String {
+    if row.series == fit.stats.series {
+        row.parameter.clone()
+    } else {
+        format!("{}[{}]", row.parameter, row.series)
+    }
+}
+
 /// The log posterior of a least-squares problem (module docs), over sampling coordinates y:
 /// a parameter whose box is [0, ∞), and the scale, is sampled as y = ln x (the log density
 /// then gains the Jacobian term ln x = y), every other parameter as itself. Long right tails
@@ -414,12 +424,8 @@ fn sample<R: Residuals + Sync + ?Sized>(
 ) -> FitSummary {
     let mut out = summarise(fit_name, series, specs, problem, f, level, opts, false);
     let n = specs.len();
-    let lower: Vec<f64> = (0..n)
-        .map(|j| opts.lower.as_ref().map_or(f64::NEG_INFINITY, |l| l[j]))
-        .collect();
-    let upper: Vec<f64> = (0..n)
-        .map(|j| opts.upper.as_ref().map_or(f64::INFINITY, |u| u[j]))
-        .collect();
+    // The box of every parameter, as the least-squares summary read it from `opts`.
+    let (lower, upper): (Vec<f64>, Vec<f64>) = out.params.iter().map(|r| r.bounds).unzip();
     let priors: Vec<Prior> = specs
         .iter()
         .map(|s| {
@@ -648,10 +654,10 @@ fn sample<R: Residuals + Sync + ?Sized>(
                      tail ESS {}, tau {} steps (needs R-hat <= {}, ESS >= {}, run >= {} tau)",
                     res.steps,
                     names[k],
-                    sig4(d.rhat),
-                    sig4(d.ess_bulk),
-                    sig4(d.ess_tail),
-                    sig4(d.tau * thin as f64),
+                    fmt_sig(d.rhat, 4),
+                    fmt_sig(d.ess_bulk, 4),
+                    fmt_sig(d.ess_tail, 4),
+                    fmt_sig(d.tau * thin as f64, 4),
                     fmt_f64(settings.options.rhat_max),
                     fmt_f64(settings.options.min_ess),
                     fmt_f64(settings.options.tau_reliability),
@@ -765,15 +771,5 @@ fn join(a: &str, b: &str) -> String {
         (true, _) => b.to_string(),
         (_, true) => a.to_string(),
         _ => format!("{a}; {b}"),
-    }
-}
-
-/// Four significant digits, for messages.
-fn sig4(x: f64) -> String {
-    if x.is_finite() {
-        let s = format!("{x:.3e}");
-        s.parse::<f64>().map(fmt_f64).unwrap_or(s)
-    } else {
-        x.to_string()
     }
 }

@@ -102,6 +102,17 @@ pub fn write_atomic_all(files: &[(&Path, &[u8])]) -> std::io::Result<()> {
     Ok(())
 }
 
+/// `x` rounded to `digits` significant digits, written as the shortest decimal of that
+/// value (for messages and terminal tables; `inf`/`NaN` spelled out).
+pub fn fmt_sig(x: f64, digits: usize) -> String {
+    if x.is_finite() {
+        let s = format!("{:.*e}", digits.max(1) - 1, x);
+        s.parse::<f64>().map(fmt_f64).unwrap_or(s)
+    } else {
+        x.to_string()
+    }
+}
+
 /// Shortest decimal that reads back as the same double (ryu).
 pub fn fmt_f64(x: f64) -> String {
     if x.is_finite() {

@@ -1224,23 +1224,7 @@ impl Analysis {
 
     /// Corner plots of every posterior.
     pub fn corner_figure(&self) -> Result<String, String> {
-        let blocks: Vec<CornerBlock> = self
-            .posteriors()
-            .iter()
-            .filter_map(|p| {
-                let d = p.draws.as_ref()?;
-                let n = p.params.len();
-                let draws: Vec<Vec<f64>> = (0..n)
-                    .map(|j| d.chains.iter().flatten().map(|x| x[j]).collect())
-                    .collect();
-                Some(CornerBlock {
-                    title: format!("{} [{}]", p.stats.fit, p.stats.series),
-                    names: p.params.iter().map(|r| r.parameter.clone()).collect(),
-                    draws,
-                })
-            })
-            .collect();
-        corner_svg(&blocks)
+        corner_svg(&CornerBlock::from_posteriors(&self.posteriors()))
     }
 }
 
@@ -1317,12 +1301,7 @@ fn waic_sum<'a>(fits: impl IntoIterator<Item = &'a FitSummary>) -> Option<f64> {
     any.then_some(total)
 }
 
-/// Three significant digits.
+/// Three significant digits (report tables and messages).
 pub fn sig3(x: f64) -> String {
-    if x.is_finite() {
-        let s = format!("{x:.2e}");
-        s.parse::<f64>().map(fmt_f64).unwrap_or(s)
-    } else {
-        x.to_string()
-    }
+    crate::io::fmt_sig(x, 3)
 }

@@ -1,6 +1,8 @@
 //! SVG figures drawn with plotters' SVG backend (no font files needed: text is emitted as SVG
 //! `<text>` elements and laid out by the viewer).
 
+use crate::fit::posterior::draws_column;
+use crate::fit::summary::FitSummary;
 use plotters::prelude::*;
 
 /// One series of points with optional vertical error bars, and an optional horizontal
@@ -122,6 +124,30 @@ pub struct CornerBlock {
     pub names: Vec<String>,
     /// Draws per parameter (same length for every parameter).
     pub draws: Vec<Vec<f64>>,
+}
+
+impl CornerBlock {
+    /// One block per posterior that kept draws; parameters named as in the draws file
+    /// ([`draws_column`]).
+    pub fn from_posteriors(posteriors: &[&FitSummary]) -> Vec<CornerBlock> {
+        posteriors
+            .iter()
+            .filter_map(|p| {
+                let d = p.draws.as_ref()?;
+                let draws: Vec<Vec<f64>> = (0..p.params.len())
+                    .map(|j| d.chains.iter().flatten().map(|x| x[j]).collect())
+                    .collect();
+                draws
+                    .first()
+                    .is_some_and(|v| !v.is_empty())
+                    .then(|| CornerBlock {
+                        title: format!("{} [{}]", p.stats.fit, p.stats.series),
+                        names: p.params.iter().map(|r| draws_column(p, r)).collect(),
+                        draws,
+                    })
+            })
+            .collect()
+    }
 }
 
 /// Side of one corner-plot panel, px.

@@ -424,13 +424,7 @@ pub fn fit_law_with(
                 "scored",
             ),
             Err(_) => {
-                let out = (0..m)
-                    .filter(|&i| {
-                        let br = &problem.brackets[i];
-                        let k = problem.k_of(i, &[]);
-                        !(k > br.lo && k <= br.hi)
-                    })
-                    .count();
+                let out = (0..m).filter(|&i| !problem.point_is_steady(i, &[])).count();
                 (
                     f64::INFINITY,
                     format!("{out} of {m} points have no steady state under the impact law"),

@@ -61,6 +61,9 @@ pub struct ContactFits {
     pub cos2a_chi2: (f64, usize),
     /// χ² and unsteady count of the impact law.
     pub impact_chi2: (f64, usize),
+    /// Energy partition of every used point at the K of the law-c fit (`None` where there is
+    /// no fit or no steady state); computed once, read by the energy table and its ranges.
+    pub energy: Vec<Option<energy::EnergyPartition>>,
     /// Why a fit is missing.
     pub notes: Vec<String>,
 }
@@ -126,6 +129,22 @@ pub fn analyse(data: &Dataset, level: f64, method: &Method) -> Analysis {
         let impact_chi2 = KLawProblem::new(model, &sub, KLaw::Impact)
             .map(|p| chi2_at(&p, &[], m))
             .unwrap_or((f64::INFINITY, m));
+        let energy = match &law_c {
+            Some(f) => sub
+                .points
+                .par_iter()
+                .zip(&f.k)
+                .map(|(p, &k)| {
+                    let sc = p.scene.with_k(k).ok()?;
+                    let st = model.evaluate(&sc).ok()?;
+                    match model {
+                        Model::Stick => Some(energy::rolling(&sc, &st)),
+                        _ => energy::stickslip(&sc, &st).ok(),
+                    }
+                })
+                .collect(),
+            None => vec![None; sub.points.len()],
+        };
         contact.push(ContactFits {
             model,
             name,
@@ -135,6 +154,7 @@ pub fn analyse(data: &Dataset, level: f64, method: &Method) -> Analysis {
             free,
             cos2a_chi2,
             impact_chi2,
+            energy,
             notes,
         });
     }
@@ -320,118 +340,60 @@ impl Analysis {
         ])?;
         for c in &self.contact {
             let Some(f) = &c.law_c else { continue };
-            let rows: Vec<Vec<String>> = c
-                .data
-                .points
-                .par_iter()
-                .zip(&f.k)
-                .map(|(p, &k)| {
-                    let base = vec![
-                        c.data.labels[p.series].clone(),
-                        fmt_f64(p.scene.xi),
-                        fmt_f64(p.scene.delta_deg()),
-                        fmt_f64(p.v),
-                        c.name.to_string(),
-                        fmt_f64(k),
-                    ];
-                    let part = p.scene.with_k(k).ok().and_then(|sc| {
-                        let st = c.model.evaluate(&sc).ok()?;
-                        match c.model {
-                            Model::Stick => Some(energy::rolling(&sc, &st)),
-                            _ => energy::stickslip(&sc, &st).ok(),
-                        }
-                    });
-                    let mut row = base;
-                    match part {
-                        Some(e) => {
-                            let d = e.potential_drop;
-                            row.extend([
-                                fmt_f64(d),
-                                fmt_f64(e.collision_translation / d),
-                                fmt_f64(e.collision_spin / d),
-                                fmt_f64(e.collision_fraction()),
-                                fmt_f64(e.friction_work / d),
-                                fmt_f64(e.closure()),
-                                "ok".into(),
-                            ]);
-                        }
-                        None => {
-                            row.extend(vec![String::new(); 6]);
-                            row.push("not-steady".into());
-                        }
-                    }
-                    row
-                })
-                .collect();
-            for r in rows {
-                w.write_record(&r)?;
-            }
-        }
-        // Jan's eq 77: collision loss / potential drop = λ v̄² / (2 sin α sin δ).
-        for (s, fit) in self.jan.series.iter().enumerate() {
-            let Some(fit) = fit else { continue };
-            let Some(l) = fit.params.iter().find(|r| r.parameter == "lambda") else {
-                continue;
-            };
-            for p in self.data.series(s) {
-                let d = 2.0 * p.scene.sin_alpha * p.scene.delta.sin();
-                let ratio = l.value * p.v * p.v / d;
-                w.write_record([
-                    self.data.labels[s].clone(),
+            for ((p, &k), part) in c.data.points.iter().zip(&f.k).zip(&c.energy) {
+                let mut row = vec![
+                    c.data.labels[p.series].clone(),
                     fmt_f64(p.scene.xi),
                     fmt_f64(p.scene.delta_deg()),
                     fmt_f64(p.v),
-                    "jan-eq77".into(),
-                    String::new(),
-                    fmt_f64(d),
-                    String::new(),
-                    String::new(),
-                    fmt_f64(ratio),
-                    fmt_f64(1.0 - ratio),
-                    String::new(),
-                    "ok".into(),
-                ])?;
+                    c.name.to_string(),
+                    fmt_f64(k),
+                ];
+                match part {
+                    Some(e) => {
+                        let d = e.potential_drop;
+                        row.extend([
+                            fmt_f64(d),
+                            fmt_f64(e.collision_translation / d),
+                            fmt_f64(e.collision_spin / d),
+                            fmt_f64(e.collision_fraction()),
+                            fmt_f64(e.friction_work / d),
+                            fmt_f64(e.closure()),
+                            "ok".into(),
+                        ]);
+                    }
+                    None => {
+                        row.extend(vec![String::new(); 6]);
+                        row.push("not-steady".into());
+                    }
+                }
+                w.write_record(&row)?;
             }
+        }
+        for (s, p, d, ratio) in self.jan_eq77() {
+            w.write_record([
+                self.data.labels[s].clone(),
+                fmt_f64(p.scene.xi),
+                fmt_f64(p.scene.delta_deg()),
+                fmt_f64(p.v),
+                "jan-eq77".into(),
+                String::new(),
+                fmt_f64(d),
+                String::new(),
+                String::new(),
+                fmt_f64(ratio),
+                fmt_f64(1.0 - ratio),
+                String::new(),
+                "ok".into(),
+            ])?;
         }
         w.into_inner().map_err(|e| e.into_error().into())
     }
 
-    /// Range (min, max) of a fraction column of the energy table, per model.
-    pub fn energy_ranges(&self) -> Vec<(String, f64, f64, f64, f64)> {
+    /// Jan's eq 77 per point of every fitted series: (series, point, potential drop
+    /// 2 sin α sin δ, collision loss / potential drop = λ v̄² / (2 sin α sin δ)).
+    fn jan_eq77(&self) -> Vec<(usize, &crate::fit::data::Point, f64, f64)> {
         let mut out = Vec::new();
-        for c in &self.contact {
-            let Some(f) = &c.law_c else { continue };
-            let parts: Vec<(f64, f64)> = c
-                .data
-                .points
-                .par_iter()
-                .zip(&f.k)
-                .filter_map(|(p, &k)| {
-                    let sc = p.scene.with_k(k).ok()?;
-                    let st = c.model.evaluate(&sc).ok()?;
-                    let e = match c.model {
-                        Model::Stick => energy::rolling(&sc, &st),
-                        _ => energy::stickslip(&sc, &st).ok()?,
-                    };
-                    Some((
-                        e.collision_fraction(),
-                        e.collision_translation / e.potential_drop,
-                    ))
-                })
-                .collect();
-            let mm = |f: &dyn Fn(&(f64, f64)) -> f64| {
-                parts
-                    .iter()
-                    .map(f)
-                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-                        (a.min(v), b.max(v))
-                    })
-            };
-            let (c0, c1) = mm(&|x| x.0);
-            let (t0, t1) = mm(&|x| x.1);
-            out.push((c.name.to_string(), c0, c1, t0, t1));
-        }
-        let mut j = (f64::INFINITY, f64::NEG_INFINITY);
         for (s, fit) in self.jan.series.iter().enumerate() {
             let Some(l) = fit
                 .as_ref()
@@ -440,12 +402,35 @@ impl Analysis {
                 continue;
             };
             for p in self.data.series(s) {
-                let r = l.value * p.v * p.v / (2.0 * p.scene.sin_alpha * p.scene.delta.sin());
-                j = (j.0.min(r), j.1.max(r));
+                let d = 2.0 * p.scene.sin_alpha * p.scene.delta.sin();
+                out.push((s, p, d, l.value * p.v * p.v / d));
             }
         }
-        if j.0.is_finite() {
-            out.push(("jan-eq77".into(), j.0, j.1, f64::NAN, f64::NAN));
+        out
+    }
+
+    /// Per model: (name, min and max of collision loss / potential drop, min and max of the
+    /// translational collision loss / potential drop; NaN for Jan).
+    pub fn energy_ranges(&self) -> Vec<(String, f64, f64, f64, f64)> {
+        let span = |v: &mut dyn Iterator<Item = f64>| {
+            v.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+                (a.min(x), b.max(x))
+            })
+        };
+        let mut out = Vec::new();
+        for c in self.contact.iter().filter(|c| c.law_c.is_some()) {
+            let parts: Vec<_> = c.energy.iter().flatten().collect();
+            let (c0, c1) = span(&mut parts.iter().map(|e| e.collision_fraction()));
+            let (t0, t1) = span(
+                &mut parts
+                    .iter()
+                    .map(|e| e.collision_translation / e.potential_drop),
+            );
+            out.push((c.name.to_string(), c0, c1, t0, t1));
+        }
+        let (j0, j1) = span(&mut self.jan_eq77().into_iter().map(|r| r.3));
+        if j0.is_finite() {
+            out.push(("jan-eq77".into(), j0, j1, f64::NAN, f64::NAN));
         }
         out
     }

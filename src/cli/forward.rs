@@ -4,6 +4,7 @@ use super::{emit, read_input, CliError};
 use crate::error::Error;
 use crate::io::scenes::Table;
 use crate::io::{fmt_f64, InputError};
+use crate::models::contact::{Contact, SpinRule, SteadyContact};
 use crate::models::jaeger::Jaeger;
 use crate::models::jan::Jan;
 use crate::models::{regime_of, ForwardModel, JaegerBranch, Model, ModelKind, Outcome};
@@ -58,7 +59,30 @@ pub struct Args {
     /// Jaeger root when there are two: upper (default) or lower.
     #[arg(long, default_value = "upper")]
     pub branch: String,
+    /// Spin rule of the collision for --model contact: roll (rolling restarts, the paper's
+    /// choice), keep (spin unchanged), factor=L (ω0 = L ωf, eq 63) or impact (no-slip impact
+    /// conserving angular momentum about the new contact point; K is then not used). A `spin`
+    /// column overrides it per row.
+    #[arg(long, default_value = "roll")]
+    pub spin: String,
+    /// Relative tolerance of the contact model's quadratures (time and spin during slip).
+    #[arg(long, default_value_t = 1e-14)]
+    pub tol: f64,
 }
+
+/// Columns added after [`OUTPUT_COLUMNS`] by --model contact.
+pub const CONTACT_COLUMNS: [&str; 10] = [
+    "phase_sequence",
+    "phase_change_deg",
+    "initial_spin",
+    "final_spin",
+    "beads",
+    "collision_translation_frac",
+    "collision_spin_frac",
+    "friction_work_frac",
+    "energy_closure",
+    "spin_rule",
+];
 
 /// Output columns added to each row.
 pub const OUTPUT_COLUMNS: [&str; 12] = [
@@ -143,6 +167,18 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let c_lambda = t.col("lambda");
     let c_mu = t.col("mu");
     let c_a = [t.col("a1"), t.col("a2"), t.col("a3")];
+    let c_spin = t.col("spin");
+    let flag_spin: SpinRule = a
+        .spin
+        .parse()
+        .map_err(|e: Error| super::flag_error("--spin", &a.spin, e.to_string()))?;
+    if !(a.tol > 0.0 && a.tol < 1.0) {
+        return Err(super::flag_error(
+            "--tol",
+            &a.tol.to_string(),
+            "expected a relative tolerance in (0, 1)",
+        ));
+    }
     let flag_law: CollisionLaw =
         a.k.parse()
             .map_err(|e: Error| super::flag_error("--K", &a.k, e.to_string()))?;
@@ -178,6 +214,16 @@ pub fn run(a: Args) -> Result<(), CliError> {
         let f = t.opt_number(r, c_f)?.unwrap_or(a.f);
         let scene = Scene::new(xi, d, rho, f, law).map_err(|e| scene_error(&t, r, e, &cols))?;
         let model = match (kind, kind.contact_model()) {
+            (ModelKind::Contact, _) => {
+                let spin = match c_spin {
+                    Some(c) if !t.cell(r, c).is_empty() => t
+                        .cell(r, c)
+                        .parse::<SpinRule>()
+                        .map_err(|e| t.err(r, c, e.to_string()))?,
+                    _ => flag_spin,
+                };
+                Model::Contact(Contact { spin, tol: a.tol })
+            }
             (_, Some(m)) => m,
             (ModelKind::Jan, None) => {
                 let paper = Jan::paper_fit(scene.alpha);
@@ -211,21 +257,71 @@ pub fn run(a: Args) -> Result<(), CliError> {
         };
         jobs.push(Job { scene, model });
     }
-    let outcomes: Vec<Outcome> = jobs
+    let (outcomes, details): (Vec<Outcome>, Vec<Option<ContactDetail>>) = jobs
         .par_iter()
-        .map(|j| j.model.evaluate(&j.scene))
-        .collect();
-    let bytes = render(&t, &jobs, &outcomes, kind).map_err(|e| CliError::Other(e.to_string()))?;
+        .map(|j| match j.model {
+            Model::Contact(c) => {
+                let r = c.steady_state(&j.scene);
+                (
+                    Contact::outcome(&j.scene, &r),
+                    Some(ContactDetail {
+                        rule: c.spin,
+                        steady: r.ok(),
+                    }),
+                )
+            }
+            m => (m.evaluate(&j.scene), None),
+        })
+        .unzip();
+    let bytes =
+        render(&t, &jobs, &outcomes, &details, kind).map_err(|e| CliError::Other(e.to_string()))?;
     emit(a.output.as_deref(), &bytes)
 }
 
-fn render(t: &Table, jobs: &[Job], outcomes: &[Outcome], kind: ModelKind) -> csv::Result<Vec<u8>> {
+/// What the contact model adds to a row.
+struct ContactDetail {
+    rule: SpinRule,
+    steady: Option<SteadyContact>,
+}
+
+fn contact_cells(job: &Job, d: &ContactDetail) -> Vec<String> {
+    let Some(s) = &d.steady else {
+        let mut v = vec![String::new(); CONTACT_COLUMNS.len() - 1];
+        v.push(d.rule.to_string());
+        return v;
+    };
+    let e = s.energy(&job.scene);
+    let p = e.potential_drop;
+    vec![
+        s.run.phases.to_string(),
+        s.run.phases.changes_deg(),
+        fmt_f64(s.launch.spin),
+        fmt_f64(s.final_spin),
+        s.beads.to_string(),
+        fmt_f64(e.collision_translation / p),
+        fmt_f64(e.collision_spin / p),
+        fmt_f64(e.friction_work / p),
+        fmt_f64(e.closure()),
+        d.rule.to_string(),
+    ]
+}
+
+fn render(
+    t: &Table,
+    jobs: &[Job],
+    outcomes: &[Outcome],
+    details: &[Option<ContactDetail>],
+    kind: ModelKind,
+) -> csv::Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::with_capacity(t.rows.len() * 160));
+    let general = kind == ModelKind::Contact;
     let mut header: Vec<String> = t
         .headers
         .iter()
         .map(|h| {
-            if OUTPUT_COLUMNS.contains(&h.as_str()) {
+            if OUTPUT_COLUMNS.contains(&h.as_str())
+                || general && CONTACT_COLUMNS.contains(&h.as_str())
+            {
                 format!("in_{h}")
             } else {
                 h.clone()
@@ -233,10 +329,13 @@ fn render(t: &Table, jobs: &[Job], outcomes: &[Outcome], kind: ModelKind) -> csv
         })
         .collect();
     header.extend(OUTPUT_COLUMNS.iter().map(|s| s.to_string()));
+    if general {
+        header.extend(CONTACT_COLUMNS.iter().map(|s| s.to_string()));
+    }
     w.write_record(&header)?;
     let contact = !matches!(kind, ModelKind::Jan | ModelKind::Jaeger);
     let opt = |x: Option<f64>| x.map(fmt_f64).unwrap_or_default();
-    for ((rec, job), o) in t.rows.iter().zip(jobs).zip(outcomes) {
+    for (((rec, job), o), d) in t.rows.iter().zip(jobs).zip(outcomes).zip(details) {
         let mut out: Vec<String> = rec.iter().map(|s| s.to_string()).collect();
         let regime = regime_of(o).map(|r| r.to_string()).unwrap_or_default();
         match o {
@@ -285,6 +384,9 @@ fn render(t: &Table, jobs: &[Job], outcomes: &[Outcome], kind: ModelKind) -> csv
                 }
                 out.push(e.to_string());
             }
+        }
+        if let (true, Some(d)) = (general, d) {
+            out.extend(contact_cells(job, d));
         }
         w.write_record(&out)?;
     }

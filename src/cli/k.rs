@@ -227,7 +227,7 @@ pub fn parse_model(name: &str) -> Result<Model, CliError> {
         super::flag_error(
             "--model",
             name,
-            "expected one of stick, stick-approx, slip, slip-approx, stickslip",
+            "expected one of stick, stick-approx, slip, slip-approx, stickslip, contact",
         )
     };
     let kind: ModelKind = name.parse().map_err(|_| err())?;

@@ -111,7 +111,12 @@ impl fmt::Display for KFailure {
 pub fn invertible(model: &Model) -> bool {
     matches!(
         model,
-        Model::Stick | Model::StickApprox | Model::Slip | Model::SlipApprox | Model::StickSlip
+        Model::Stick
+            | Model::StickApprox
+            | Model::Slip
+            | Model::SlipApprox
+            | Model::StickSlip
+            | Model::Contact(_)
     )
 }
 
@@ -226,6 +231,9 @@ fn candidate(model: &Model, scene: &Scene) -> Option<(f64, f64, LowerLimit)> {
             let r = brent(q, w_lo, w_hi, q_lo, q_hi, 0.0, 200)?;
             Some((lo, r.x / xd, kind))
         }
+        // The general contact model has no closed-form ends: from K → 0 (the bead stops when
+        // Θ0 < 0) to K = 1, both ends found by bisection on the model's own status.
+        Model::Contact(_) => Some((0.0, 1.0, LowerLimit::Zero)),
         _ => None,
     }
 }

@@ -4,6 +4,7 @@
 //! the bead stops (regime A, with where), lifts off or runs away (regime C), or a
 //! model-specific failure. No evaluation returns NaN or panics on a valid [`Scene`].
 
+pub mod contact;
 pub mod energy;
 pub mod jaeger;
 pub mod jan;
@@ -66,7 +67,7 @@ pub struct Steady {
 }
 
 /// The phase sequence of a steady contact.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Phases {
     /// Pure rolling over the whole contact.
     Roll,
@@ -76,6 +77,9 @@ pub enum Phases {
     RollSlip,
     /// No contact mechanics: a phenomenological law (Jan, Jaeger).
     None,
+    /// Any sequence of rolling and slipping (the general contact model), with the angles of
+    /// the phase changes.
+    Sequence(contact::PhaseSeq),
 }
 
 impl fmt::Display for Phases {
@@ -85,6 +89,7 @@ impl fmt::Display for Phases {
             Phases::Slip => "slip",
             Phases::RollSlip => "roll>slip",
             Phases::None => "",
+            Phases::Sequence(p) => return write!(f, "{p}"),
         })
     }
 }
@@ -228,11 +233,13 @@ pub enum Model {
     Jan(jan::Jan),
     /// Jaeger's heuristic law (eqs 80–89).
     Jaeger(jaeger::Jaeger),
+    /// The general contact model: any sequence of rolling and slipping (MODEL.md §4).
+    Contact(contact::Contact),
 }
 
 impl Model {
     /// Names accepted on the command line.
-    pub const NAMES: [&'static str; 7] = [
+    pub const NAMES: [&'static str; 8] = [
         "stick",
         "stick-approx",
         "slip",
@@ -240,6 +247,7 @@ impl Model {
         "stickslip",
         "jan",
         "jaeger",
+        "contact",
     ];
 }
 
@@ -253,6 +261,7 @@ impl ForwardModel for Model {
             Model::StickSlip => "stickslip",
             Model::Jan(_) => "jan",
             Model::Jaeger(_) => "jaeger",
+            Model::Contact(_) => "contact",
         }
     }
 
@@ -265,6 +274,7 @@ impl ForwardModel for Model {
             Model::StickSlip => stickslip::steady(scene),
             Model::Jan(m) => m.evaluate(scene),
             Model::Jaeger(m) => m.evaluate(scene),
+            Model::Contact(m) => m.evaluate(scene),
         }
     }
 }
@@ -286,6 +296,8 @@ pub enum ModelKind {
     Jan,
     /// See [`Model::Jaeger`].
     Jaeger,
+    /// See [`Model::Contact`] (spin rule `roll` unless set apart).
+    Contact,
 }
 
 impl ModelKind {
@@ -298,6 +310,7 @@ impl ModelKind {
             ModelKind::Slip => Model::Slip,
             ModelKind::SlipApprox => Model::SlipApprox,
             ModelKind::StickSlip => Model::StickSlip,
+            ModelKind::Contact => Model::Contact(contact::Contact::default()),
             ModelKind::Jan | ModelKind::Jaeger => return None,
         })
     }
@@ -314,6 +327,7 @@ impl FromStr for ModelKind {
             "stickslip" => ModelKind::StickSlip,
             "jan" => ModelKind::Jan,
             "jaeger" => ModelKind::Jaeger,
+            "contact" => ModelKind::Contact,
             _ => return Err(Error::UnknownModel(s.to_string())),
         })
     }

@@ -59,6 +59,135 @@ pub struct Args {
     /// Output CSV (written atomically); stdout when absent.
     #[arg(long)]
     pub output: Option<PathBuf>,
+    /// --model contact only: launch speed Θ̇0 on the first bead (dimensionless, rolling
+    /// launch). With it, simulate writes the bead-by-bead transient of one scene per ξ of
+    /// --series at --delta-deg instead of synthetic measurements.
+    #[arg(long)]
+    pub v0: Option<f64>,
+    /// Beads of travel for the --v0 transient.
+    #[arg(long, default_value_t = 50)]
+    pub beads: usize,
+    /// Slope of the --v0 transient, degrees.
+    #[arg(long = "delta-deg")]
+    pub delta_deg: Option<f64>,
+    /// Spin rule of the collision for --model contact: roll, keep, factor=L or impact.
+    #[arg(long, default_value = "roll")]
+    pub spin: String,
+}
+
+/// Columns of the `simulate --model contact --v0` transient.
+pub const TRACE_COLUMNS: [&str; 15] = [
+    "xi",
+    "delta_deg",
+    "bead",
+    "initial_velocity",
+    "initial_spin",
+    "final_velocity",
+    "final_spin",
+    "contact_time",
+    "mean_velocity",
+    "phase_sequence",
+    "phase_change_deg",
+    "friction_work",
+    "status",
+    "steady_mean_velocity",
+    "message",
+];
+
+/// `simulate --model contact --v0 V --beads N`: the bead-by-bead transient from a launch.
+fn trace(a: &Args, law: CollisionLaw, series: &[f64], v0: f64) -> Result<(), CliError> {
+    use crate::models::contact::{Contact, ContactEnd, Launch, SpinRule};
+    if !(v0.is_finite() && v0 >= 0.0) {
+        return Err(super::flag_error(
+            "--v0",
+            &v0.to_string(),
+            "expected a finite launch speed >= 0",
+        ));
+    }
+    if a.beads == 0 || a.beads > 10_000_000 {
+        return Err(super::flag_error(
+            "--beads",
+            &a.beads.to_string(),
+            "expected 1 to 10000000 beads",
+        ));
+    }
+    let Some(d) = a.delta_deg else {
+        return Err(super::flag_error(
+            "--delta-deg",
+            "",
+            "--v0 needs the slope of the scene (--delta-deg)",
+        ));
+    };
+    let spin: SpinRule = a
+        .spin
+        .parse()
+        .map_err(|e: crate::Error| super::flag_error("--spin", &a.spin, e.to_string()))?;
+    let model = Contact {
+        spin,
+        ..Contact::default()
+    };
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let io = |e: csv::Error| CliError::Other(e.to_string());
+    w.write_record(TRACE_COLUMNS).map_err(io)?;
+    for &xi in series {
+        let scene = Scene::new(xi, d, a.rho, a.f, law).map_err(|e| {
+            super::flag_error("--series/--delta-deg", &xi.to_string(), e.to_string())
+        })?;
+        let steady = model
+            .evaluate(&scene)
+            .map(|s| fmt_f64(s.mean_velocity))
+            .unwrap_or_default();
+        let runs = model.transient(
+            &scene,
+            Launch {
+                theta_dot: v0,
+                spin: v0,
+            },
+            a.beads,
+        );
+        for (i, (l, r)) in runs.iter().enumerate() {
+            let (fv, fs, status, msg, v) = match r.end {
+                ContactEnd::Collision { theta_dot, spin } => (
+                    fmt_f64(theta_dot),
+                    fmt_f64(spin),
+                    "ok".to_string(),
+                    String::new(),
+                    fmt_f64(2.0 * scene.sin_alpha / r.time),
+                ),
+                ContactEnd::Failed(e) => (
+                    String::new(),
+                    String::new(),
+                    e.status().to_string(),
+                    format!("{e} on bead {}", i + 1),
+                    String::new(),
+                ),
+            };
+            w.write_record([
+                fmt_f64(xi),
+                fmt_f64(d),
+                (i + 1).to_string(),
+                fmt_f64(l.theta_dot),
+                fmt_f64(l.spin),
+                fv,
+                fs,
+                if status == "ok" {
+                    fmt_f64(r.time)
+                } else {
+                    String::new()
+                },
+                v,
+                r.phases.to_string(),
+                r.phases.changes_deg(),
+                fmt_f64(r.friction_work),
+                status,
+                steady.clone(),
+                msg,
+            ])
+            .map_err(io)?;
+        }
+    }
+    let bytes = w.into_inner().map_err(|e| CliError::Other(e.to_string()))?;
+    emit(a.output.as_deref(), &bytes)
 }
 
 /// The slopes (radians) where `model` has a steady state at this ξ: the longest run of a
@@ -134,6 +263,16 @@ pub fn run(a: Args) -> Result<(), CliError> {
         .parse()
         .map_err(|e: crate::Error| super::flag_error("--law", &a.law, e.to_string()))?;
     let series = parse_list("--series", &a.series)?;
+    if let Some(v0) = a.v0 {
+        if kind != ModelKind::Contact {
+            return Err(super::flag_error(
+                "--v0",
+                &v0.to_string(),
+                "the bead-by-bead transient needs --model contact",
+            ));
+        }
+        return trace(&a, law, &series, v0);
+    }
     if a.points == 0 {
         return Err(super::flag_error(
             "--points",

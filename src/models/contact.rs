@@ -31,7 +31,8 @@ use super::stick;
 use super::{NotSteady, Outcome, Phases, Steady};
 use crate::error::{Error, Result};
 use crate::scene::Scene;
-use crate::special::quad::{integrate, QuadOptions};
+use crate::special::cheb::ChebIntegral;
+use crate::special::quad::integrate_smooth;
 use crate::special::root::brent;
 use std::fmt;
 use std::str::FromStr;
@@ -264,14 +265,6 @@ fn mode_at(scene: &Scene, theta: f64, u: f64, s: f64) -> std::result::Result<Pha
 }
 
 impl Contact {
-    fn quad(&self) -> QuadOptions {
-        QuadOptions {
-            rel_tol: self.tol,
-            abs_tol: 1e-300,
-            max_panels: 256,
-        }
-    }
-
     /// The collision: final state (Θ̇f, ωf/ε) on one bead → launch on the next.
     pub fn collide(&self, scene: &Scene, theta_dot_f: f64, spin_f: f64) -> Launch {
         match self.spin {
@@ -328,7 +321,7 @@ impl Contact {
         };
         // After a rolling phase ends at Θ_G (H = +f) the bead slips forward.
         let mut forced: Option<PhaseKind> = None;
-        loop {
+        for _ in 0..4 * MAX_PHASES {
             let kind = match forced.take() {
                 Some(k) => k,
                 None => match mode_at(scene, theta, u, s) {
@@ -379,6 +372,10 @@ impl Contact {
                 }
             }
         }
+        out.end = ContactEnd::Failed(NotSteady::Invalid {
+            reason: "phases of zero length repeat (chattering at a phase boundary)",
+        });
+        out
     }
 
     /// Rolling from (Θa, Θ̇a²) to Θ_G or Θf.
@@ -490,82 +487,160 @@ impl Contact {
         // 3. Slip → stick (s = 0). ds/dθ has the sign of q(θ) = ρ sin θ/(1+ρ) − σ f N: s moves
         // towards 0 only where σ q < 0.
         let eps_f = sigma * f / rho;
+        let integrand = |t: f64| {
+            let uu = u(t).max(f64::MIN_POSITIVE);
+            (t.cos() - uu) / uu.sqrt()
+        };
         let g_int = |a: f64, b: f64| -> f64 {
             if b == a {
                 return 0.0;
             }
-            integrate(
-                |t| {
-                    let uu = u(t).max(f64::MIN_POSITIVE);
-                    (t.cos() - uu) / uu.sqrt()
-                },
-                a,
-                b,
-                self.quad(),
-            )
-            .value
+            integrate_smooth(integrand, a, b, self.tol)
         };
+        // σ q(θ): the sign of dσs/dθ = ((1+ρ)/ρ) σ q / Θ̇.
         let sq = |t: f64| {
             let n = nrm(t);
             sigma * (rho * t.sin() / (1.0 + rho) - sigma * f * n)
         };
         // s relative to its sign: σ s(θ) = σ (Θ̇ − wa) − (f/ρ) G(θ).
         let sig_s = |t: f64, g: f64| sigma * (u(t).max(0.0).sqrt() - wa) - eps_f * sigma * g;
+        let dsig_s = |t: f64| (1.0 + rho) / rho * sq(t) / u(t).max(f64::MIN_POSITIVE).sqrt();
         let mut stick_at: Option<(f64, f64)> = None; // (angle, G there)
         if end > ta && f > 0.0 {
-            // Find the first point after which σq < 0 (a 32-panel scan refined by Brent), then
-            // the zero of σ s on the stretch where it decreases.
-            let n = 32;
-            let mut a = ta;
-            let mut qa = sq(a);
-            let mut down_from: Option<f64> = if qa < 0.0 { Some(ta) } else { None };
-            let mut i = 1;
-            while down_from.is_none() && i <= n {
-                let b = ta + (end - ta) * i as f64 / n as f64;
-                let qb = sq(b);
-                if qb < 0.0 {
-                    down_from = Some(
-                        brent(sq, a, b, qa, qb, 1e-15, 200)
+            // σs decreases exactly where σq < 0. Scan σq on 16 panels for the stretches
+            // [d0, d1] where it is negative (ends refined by Brent); on each, σs is monotone,
+            // so it has a zero there iff σs(d1) ≤ 0, found by safeguarded Newton with the
+            // closed-form derivative and the spin integral carried incrementally.
+            let n = 16;
+            let grid = |i: usize| ta + (end - ta) * i as f64 / n as f64;
+            let mut i = 0;
+            let mut qa = sq(ta);
+            let mut t_known = ta;
+            let mut g_known = 0.0;
+            while i < n && stick_at.is_none() {
+                // Next stretch start.
+                let d0 = if qa < 0.0 {
+                    grid(i)
+                } else {
+                    let mut found = None;
+                    while i < n {
+                        let (a, b) = (grid(i), grid(i + 1));
+                        let qb = sq(b);
+                        i += 1;
+                        if qb < 0.0 {
+                            found = Some(
+                                brent(sq, a, b, qa, qb, 1e-15, 200)
+                                    .map(|r| r.x)
+                                    .unwrap_or(a),
+                            );
+                            qa = qb;
+                            break;
+                        }
+                        qa = qb;
+                    }
+                    match found {
+                        Some(d) => d,
+                        None => break,
+                    }
+                };
+                // Stretch end.
+                let mut d1 = end;
+                while i < n {
+                    let (a, b) = (grid(i), grid(i + 1));
+                    let qb = sq(b);
+                    i += 1;
+                    if qb >= 0.0 {
+                        d1 = brent(sq, a, b, qa, qb, 1e-15, 200)
                             .map(|r| r.x)
-                            .unwrap_or(a),
-                    );
+                            .unwrap_or(b);
+                        qa = qb;
+                        break;
+                    }
+                    qa = qb;
                 }
-                a = b;
-                qa = qb;
-                i += 1;
-            }
-            if let Some(d0) = down_from {
-                // Walk the decreasing stretches of σ s in panels, looking for a sign change.
-                let mut g_prev = g_int(ta, d0);
-                let mut t_prev = d0;
-                let mut s_prev = sig_s(d0, g_prev);
-                let m = 32;
-                for j in 1..=m {
-                    let t = d0 + (end - d0) * j as f64 / m as f64;
-                    let g = g_prev + g_int(t_prev, t);
-                    let s_t = sig_s(t, g);
-                    if s_t <= 0.0 && (s_prev > 0.0 || t_prev > ta) {
-                        let (t0, g0) = (t_prev, g_prev);
-                        let r = brent(
-                            |x| sig_s(x, g0 + g_int(t0, x)),
-                            t0,
-                            t,
-                            s_prev,
-                            s_t,
-                            1e-15,
-                            200,
-                        );
-                        if let Some(r) = r {
-                            stick_at = Some((r.x, g0 + g_int(t0, r.x)));
-                        } else {
-                            stick_at = Some((t, g));
+                let g0 = g_known + g_int(t_known, d0);
+                let s0 = sig_s(d0, g0);
+                if d0 == ta && s0 <= 0.0 {
+                    // The slip starts at s = 0 exactly where σq = 0 (at Θ_G, or where a slip
+                    // reverses): the rounding of σq there says nothing, the mode decision
+                    // already chose σ. Look from the next stretch on.
+                    t_known = d0;
+                    g_known = g0;
+                    continue;
+                }
+                if s0 <= 0.0 {
+                    stick_at = Some((d0, g0));
+                    break;
+                }
+                // σs decreases on [d0, d1]: walk it in 8 panels (the spin integral carried
+                // from panel to panel) to the first panel where σs reaches 0.
+                let panels = 8;
+                let (mut pa, mut ga_, mut sa_) = (d0, g0, s0);
+                let mut found = None;
+                for k in 1..=panels {
+                    let pb = d0 + (d1 - d0) * k as f64 / panels as f64;
+                    let gb_ = ga_ + g_int(pa, pb);
+                    let sb_ = sig_s(pb, gb_);
+                    if sb_ <= 0.0 {
+                        found = Some((pa, ga_, sa_, pb, gb_, sb_));
+                        break;
+                    }
+                    (pa, ga_, sa_) = (pb, gb_, sb_);
+                }
+                t_known = pa;
+                g_known = ga_;
+                let Some((d0, g0, s0, d1, g1, s1)) = found else {
+                    t_known = d1;
+                    g_known = ga_;
+                    continue;
+                };
+                // G on that panel from one Chebyshev interpolant (every Newton iterate reads
+                // it), or by adaptive quadrature where the interpolant does not resolve it.
+                let cheb = ChebIntegral::new(integrand, d0, d1, self.tol);
+                let g_from = |lo: f64, glo: f64, x: f64| match &cheb {
+                    Some(c) => g0 + c.eval(x),
+                    None => glo + g_int(lo, x),
+                };
+                // Safeguarded Newton on [lo, hi] with σs(lo) > 0 ≥ σs(hi).
+                let (mut lo, mut glo) = (d0, g0);
+                let mut hi = d1;
+                let mut x = lo + (hi - lo) * s0 / (s0 - s1);
+                let mut last = (d1, g1);
+                for _ in 0..100 {
+                    if !(x > lo && x < hi) {
+                        x = 0.5 * (lo + hi);
+                    }
+                    let gx = g_from(lo, glo, x);
+                    let sx = sig_s(x, gx);
+                    last = (x, gx);
+                    if sx == 0.0 {
+                        break;
+                    }
+                    if sx > 0.0 {
+                        (lo, glo) = (x, gx);
+                    } else {
+                        hi = x;
+                    }
+                    let dx = dsig_s(x);
+                    let nx = x - sx / dx;
+                    let step = (nx - x).abs();
+                    // Newton within the bracket; otherwise bisect.
+                    x = if dx < 0.0 && nx > lo && nx < hi {
+                        nx
+                    } else {
+                        0.5 * (lo + hi)
+                    };
+                    if step <= 1e-10 * (1.0 + x.abs()) || hi - lo <= 1e-15 * (1.0 + x.abs()) {
+                        // Quadratic convergence: a Newton step below 1e-10 leaves the new
+                        // iterate within ~1e-20 of the zero, far below the rounding of σs
+                        // itself; take it as the event.
+                        if dx < 0.0 && nx > lo && nx < hi {
+                            last = (nx, g_from(lo, glo, nx));
                         }
                         break;
                     }
-                    t_prev = t;
-                    g_prev = g;
-                    s_prev = s_t;
                 }
+                stick_at = Some(last);
             }
         }
         let (end, g_end, at_collision) = match stick_at {
@@ -583,7 +658,24 @@ impl Contact {
             ua
         };
         let w_end = wa + eps_f * g_end;
-        let time = slip_time(&ph, ta, end, self.tol)?;
+        // Time: where Θ̇² stays well away from 0 the integrand 1/Θ̇ is as smooth as the spin's
+        // and one K15 panel usually resolves it; near a crawl (Θ̇² → 0 inside the phase) the
+        // slip model's substitution takes over.
+        let u_lo = if tm > ta && tm < end {
+            um
+        } else {
+            ua.min(u_end)
+        };
+        let time = if u_lo >= 1e-2 * ua.max(u_end) && u_lo > 0.0 {
+            integrate_smooth(
+                |t| 1.0 / u(t).max(f64::MIN_POSITIVE).sqrt(),
+                ta,
+                end,
+                self.tol,
+            )
+        } else {
+            slip_time(&ph, ta, end, self.tol)?
+        };
         // ∫ N dθ in closed form: ∫ cos − ∫ Θ̇², Θ̇² = Θ̇a² E + b (sin θ − sin Θa E) + c (cos θ −
         // cos Θa E), E = e^{2σf(θ−Θa)}.
         let d = end - ta;
@@ -648,6 +740,15 @@ impl Contact {
         } else {
             Some(*scene)
         };
+        if matches!(self.spin, SpinRule::Roll) {
+            // The paper's stick/slip state is exact where its sequence is the true one and
+            // close elsewhere: the best launch to follow the map from.
+            if let Ok(st) = super::stickslip::steady(scene) {
+                if st.initial_velocity > 0.0 {
+                    return st.initial_velocity;
+                }
+            }
+        }
         match sc.map(|s| (s, stick::steady(&s))) {
             Some((s, Ok(st))) if st.initial_velocity > 0.0 => {
                 if matches!(self.spin, SpinRule::Impact) {
@@ -801,7 +902,7 @@ impl Contact {
             beads += 1;
             let dy = (n.theta_dot - l.theta_dot).abs() + (n.spin - l.spin).abs();
             l = n;
-            if dy <= 1e-10 * (l.theta_dot.abs() + l.spin.abs()) {
+            if dy <= 1e-8 * (l.theta_dot.abs() + l.spin.abs()) {
                 converged = true;
                 break;
             }
@@ -809,7 +910,7 @@ impl Contact {
         if !converged {
             return Err(NotSteady::Runaway);
         }
-        for _ in 0..4 {
+        for _ in 0..8 {
             let f0 = self.next_2d(scene, l)?;
             let r = [f0.theta_dot - l.theta_dot, f0.spin - l.spin];
             if r[0].abs() + r[1].abs() <= 4.0 * f64::EPSILON * (l.theta_dot + l.spin.abs()) {

@@ -1,5 +1,6 @@
 //! Math with no beads in it: elliptic integrals, quadrature, root bracketing, double-double.
 
+pub mod cheb;
 pub mod dd;
 pub mod elliptic;
 pub mod quad;

@@ -120,7 +120,7 @@ mod tests {
     fn antiderivatives_of_smooth_functions() {
         // ∫_0.2^x e^t dt = e^x − e^0.2; ∫ cos = sin x − sin a; degree 16 suffices for both.
         let c = ChebIntegral::new(f64::exp, 0.2, 1.3, 1e-15).unwrap();
-        for x in [0.2, 0.5, 0.77, 1.3] {
+        for x in [0.2f64, 0.5, 0.77, 1.3] {
             let exact = x.exp() - 0.2f64.exp();
             assert!(
                 (c.eval(x) - exact).abs() < 2e-15,
@@ -129,7 +129,7 @@ mod tests {
             );
         }
         let c = ChebIntegral::new(f64::cos, -0.7, 0.4, 1e-15).unwrap();
-        for x in [-0.7, -0.1, 0.0, 0.4] {
+        for x in [-0.7f64, -0.1, 0.0, 0.4] {
             let exact = x.sin() - (-0.7f64).sin();
             assert!((c.eval(x) - exact).abs() < 2e-15);
         }

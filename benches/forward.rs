@@ -81,6 +81,30 @@ fn bench(c: &mut Criterion) {
                 .sum::<f64>()
         })
     });
+    // The general contact model on the scenes where it has a steady state (the rest lift off
+    // under it): the full steady-state solve (fixed point of the contact map).
+    let contact = fitbead::models::contact::Contact::default();
+    let steady: Vec<Scene> = s
+        .iter()
+        .copied()
+        .filter(|x| contact.steady_state(x).is_ok())
+        .collect();
+    let per = steady.len() as u64;
+    g.throughput(criterion::Throughput::Elements(per));
+    g.bench_function("contact", |b| {
+        b.iter(|| {
+            steady
+                .iter()
+                .map(|x| {
+                    contact
+                        .steady_state(black_box(x))
+                        .map(|r| r.run.time)
+                        .unwrap_or(0.0)
+                })
+                .sum::<f64>()
+        })
+    });
+    g.throughput(criterion::Throughput::Elements(n));
     g.bench_function("scene-construction", |b| {
         b.iter(|| {
             (0..32)

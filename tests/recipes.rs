@@ -170,3 +170,48 @@ fn report_bad_input_exits_2_and_writes_nothing() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("bogus"));
 }
+
+/// models_by_series.csv: per series, AIC = χ² + 2k and BIC = χ² + k ln n (σ given in the
+/// default data), recomputed here from the χ² column; the AIC rank 1 has ΔAIC = 0.
+#[test]
+fn per_series_information_criteria() {
+    let (h, rows) = read_csv(&root().join("fits/default/models_by_series.csv"));
+    let c = |n: &str| h.iter().position(|x| x == n).unwrap();
+    let (cs, cn, cchi, ck, caic, cbic, cd, cr) = (
+        c("series"),
+        c("n_points"),
+        c("chi2"),
+        c("n_params"),
+        c("aic"),
+        c("bic"),
+        c("delta_aic"),
+        c("rank"),
+    );
+    let mut series = std::collections::BTreeSet::new();
+    for r in &rows {
+        series.insert(r[cs].clone());
+        let chi2: f64 = r[cchi].parse().unwrap();
+        let k: f64 = r[ck].parse().unwrap();
+        let n: f64 = r[cn].parse().unwrap();
+        let aic: f64 = r[caic].parse().unwrap();
+        let bic: f64 = r[cbic].parse().unwrap();
+        if chi2.is_finite() {
+            assert!((aic - (chi2 + 2.0 * k)).abs() <= 1e-9 * aic.abs(), "{r:?}");
+            assert!(
+                (bic - (chi2 + k * n.ln())).abs() <= 1e-9 * bic.abs(),
+                "{r:?}"
+            );
+        } else {
+            assert!(aic.is_infinite() && bic.is_infinite());
+        }
+        if r[cr] == "1" {
+            assert_eq!(r[cd].parse::<f64>().unwrap(), 0.0, "{r:?}");
+        }
+    }
+    for s in &series {
+        assert!(
+            rows.iter().any(|r| &r[cs] == s && r[cr] == "1"),
+            "series {s} has no best model"
+        );
+    }
+}

@@ -423,7 +423,8 @@ fn markdown(an: &Analysis, source: &str, method: &str) -> String {
     m.push_str(
         "χ² at the least-squares optimum, AIC and BIC (with σ given: AIC = χ² + 2k, BIC = χ² + \
          k ln n), ranked by AIC among the models fitted to every point. Table: \
-         [models.csv](models.csv); χ² of every model per series: \
+         [models.csv](models.csv); χ², AIC, BIC and the AIC rank of every model within each \
+         series (parameters shared across series counted whole): \
          [models_by_series.csv](models_by_series.csv).\n\n| rank | model | k | n | χ² | ΔAIC | ΔBIC | ΔWAIC | note |\n\
          |---|---|---|---|---|---|---|---|---|\n",
     );

@@ -722,8 +722,12 @@ impl Analysis {
         out
     }
 
-    /// χ² per series of every candidate (at the least-squares optimum; ∞ where a point of the
-    /// series has no steady state under the candidate), as CSV: series, model, n_points, chi2.
+    /// χ², AIC and BIC per series of every candidate (at the least-squares optimum; ∞ where a
+    /// point of the series has no steady state under the candidate), as CSV: series, model,
+    /// n_points, chi2, then n_params (the parameters the series' fit uses), shared_params (yes
+    /// when they are fitted across all series, as law c and Jan's global laws: the per-series
+    /// AIC then charges each series the whole shared count, a conservative convention), aic,
+    /// bic, delta_aic, delta_bic and rank (by AIC) within the series.
     pub fn models_by_series_csv(&self) -> csv::Result<Vec<u8>> {
         let ns = self.data.labels.len();
         let mut rows: Vec<(String, Vec<(usize, f64)>)> = Vec::new();
@@ -775,29 +779,33 @@ impl Analysis {
             }
         }
         // Series labels of a contact model's subset map back to the full data by name.
-        let mut w = csv::Writer::from_writer(Vec::new());
-        w.write_record(["series", "model", "n_points", "chi2"])?;
+        // (series, model, n_points, chi2, n_params, shared)
+        let mut recs: Vec<(String, String, usize, f64, usize, bool)> = Vec::new();
         for c in &self.contact {
             for (name, acc) in rows.iter().filter(|r| r.0.starts_with(c.name)) {
+                let (k, shared) = if name.ends_with("law c") {
+                    (1, true)
+                } else if name.ends_with("free K per series") {
+                    (1, false)
+                } else {
+                    (0, false)
+                };
                 for (j, (n, chi2)) in acc.iter().enumerate() {
-                    w.write_record([
-                        c.data.labels[j].clone(),
-                        name.clone(),
-                        n.to_string(),
-                        num(*chi2),
-                    ])?;
+                    recs.push((c.data.labels[j].clone(), name.clone(), *n, *chi2, k, shared));
                 }
             }
         }
         for s in 0..ns {
             let label = &self.data.labels[s];
             if let Some(f) = &self.jan.series[s] {
-                w.write_record([
+                recs.push((
                     label.clone(),
                     "jan lambda, mu per series".into(),
-                    f.stats.n_points.to_string(),
-                    num(f.stats.chi2),
-                ])?;
+                    f.stats.n_points,
+                    f.stats.chi2,
+                    2,
+                    false,
+                ));
             }
             if let Some(g) = &self.jan.global {
                 let p: Vec<f64> = g.params.iter().take(4).map(lsq).collect();
@@ -809,21 +817,74 @@ impl Analysis {
                         .value(&x, &p)
                         .map_or(f64::INFINITY, |v| ((q.v - v) / q.sigma).powi(2));
                 }
-                w.write_record([
+                recs.push((
                     label.clone(),
                     "jan global laws (eqs 75-76 form)".into(),
-                    n.to_string(),
-                    num(chi2),
-                ])?;
+                    n,
+                    chi2,
+                    4,
+                    true,
+                ));
             }
             if let Some(f) = &self.jaeger.series[s] {
-                w.write_record([
+                recs.push((
                     label.clone(),
                     "jaeger a1, a2, a3 per series".into(),
-                    f.summary.stats.n_points.to_string(),
-                    num(f.summary.stats.chi2),
-                ])?;
+                    f.summary.stats.n_points,
+                    f.summary.stats.chi2,
+                    3,
+                    false,
+                ));
             }
+        }
+        let cands: Vec<Candidate> = recs
+            .iter()
+            .map(|r| Candidate::new(r.1.clone(), r.4, r.2, r.3, self.data.sigma, String::new()))
+            .collect();
+        let mut w = csv::Writer::from_writer(Vec::new());
+        w.write_record([
+            "series",
+            "model",
+            "n_points",
+            "chi2",
+            "n_params",
+            "shared_params",
+            "aic",
+            "bic",
+            "delta_aic",
+            "delta_bic",
+            "rank",
+        ])?;
+        for (r, c) in recs.iter().zip(&cands) {
+            let same: Vec<&Candidate> = recs
+                .iter()
+                .zip(&cands)
+                .filter(|(q, _)| q.0 == r.0)
+                .map(|(_, c)| c)
+                .collect();
+            let best_aic = same.iter().map(|c| c.aic).fold(f64::INFINITY, f64::min);
+            let best_bic = same.iter().map(|c| c.bic).fold(f64::INFINITY, f64::min);
+            let rank = 1 + same.iter().filter(|o| o.aic < c.aic).count();
+            let delta = |x: f64, best: f64| {
+                if x.is_finite() && best.is_finite() {
+                    num(x - best)
+                } else {
+                    num(f64::INFINITY)
+                }
+            };
+            w.write_record([
+                r.0.clone(),
+                r.1.clone(),
+                r.2.to_string(),
+                num(r.3),
+                r.4.to_string(),
+                if r.5 { "yes" } else { "no" }.to_string(),
+                num(c.aic),
+                num(c.bic),
+                delta(c.aic, best_aic),
+                delta(c.bic, best_bic),
+                rank.to_string(),
+            ])?;
         }
         w.into_inner().map_err(|e| e.into_error().into())
     }

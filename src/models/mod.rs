@@ -7,6 +7,9 @@
 pub mod energy;
 pub mod jaeger;
 pub mod jan;
+// --- md (molecular dynamics, issue 9) ---
+pub mod md;
+// --- end md ---
 pub mod regimes;
 pub mod slip;
 pub mod stick;
@@ -228,11 +231,15 @@ pub enum Model {
     Jan(jan::Jan),
     /// Jaeger's heuristic law (eqs 80–89).
     Jaeger(jaeger::Jaeger),
+    // --- md (molecular dynamics, issue 9) ---
+    /// Ristow's soft-contact molecular dynamics (§5.3, eqs 91–92).
+    Md(md::Md),
+    // --- end md ---
 }
 
 impl Model {
     /// Names accepted on the command line.
-    pub const NAMES: [&'static str; 7] = [
+    pub const NAMES: [&'static str; 8] = [
         "stick",
         "stick-approx",
         "slip",
@@ -240,6 +247,7 @@ impl Model {
         "stickslip",
         "jan",
         "jaeger",
+        "md",
     ];
 }
 
@@ -253,6 +261,7 @@ impl ForwardModel for Model {
             Model::StickSlip => "stickslip",
             Model::Jan(_) => "jan",
             Model::Jaeger(_) => "jaeger",
+            Model::Md(_) => "md",
         }
     }
 
@@ -265,6 +274,7 @@ impl ForwardModel for Model {
             Model::StickSlip => stickslip::steady(scene),
             Model::Jan(m) => m.evaluate(scene),
             Model::Jaeger(m) => m.evaluate(scene),
+            Model::Md(m) => m.evaluate(scene),
         }
     }
 }
@@ -286,11 +296,15 @@ pub enum ModelKind {
     Jan,
     /// See [`Model::Jaeger`].
     Jaeger,
+    // --- md (molecular dynamics, issue 9) ---
+    /// See [`Model::Md`].
+    Md,
+    // --- end md ---
 }
 
 impl ModelKind {
     /// The model for the five contact models, which need no parameters beyond the scene;
-    /// `None` for jan and jaeger.
+    /// `None` for jan, jaeger and md.
     pub fn contact_model(self) -> Option<Model> {
         Some(match self {
             ModelKind::Stick => Model::Stick,
@@ -299,6 +313,7 @@ impl ModelKind {
             ModelKind::SlipApprox => Model::SlipApprox,
             ModelKind::StickSlip => Model::StickSlip,
             ModelKind::Jan | ModelKind::Jaeger => return None,
+            ModelKind::Md => return None,
         })
     }
 }
@@ -314,6 +329,7 @@ impl FromStr for ModelKind {
             "stickslip" => ModelKind::StickSlip,
             "jan" => ModelKind::Jan,
             "jaeger" => ModelKind::Jaeger,
+            "md" => ModelKind::Md,
             _ => return Err(Error::UnknownModel(s.to_string())),
         })
     }

@@ -571,7 +571,6 @@ struct Window {
     episodes: u64,
     distinct: u64,
     lift_offs: u64,
-    skipped: u64,
     jumps: u64,
     jump_angle_sum: f64,
     lift_angle_sum: f64,
@@ -831,10 +830,7 @@ fn run(
                     if k > max_touched {
                         if in_window {
                             win.distinct += 1;
-                            if k > max_touched + 1 {
-                                win.skipped += (k - max_touched - 1) as u64;
-                                jumped = true;
-                            }
+                            jumped = k > max_touched + 1;
                         }
                         max_touched = k;
                         pending = Some((k, (vx * vx + vy * vy).sqrt()));
@@ -1002,7 +998,7 @@ fn run(
         res.lift_off_angle = Some(win.lift_angle_sum / win.lift_offs as f64);
         res.flight_length_mean = Some(win.lift_len_sum / win.lift_offs as f64);
     }
-    res.skipped_fraction = win.skipped as f64 / nw;
+    res.skipped_fraction = (nw - win.distinct as f64).max(0.0) / nw;
     if win.jumps > 0 {
         res.jump_angle = Some(win.jump_angle_sum / win.jumps as f64);
     }

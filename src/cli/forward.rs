@@ -18,7 +18,7 @@ use std::path::PathBuf;
 /// Arguments of `fitbead forward`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Forward model: stick, stick-approx, slip, slip-approx, stickslip, jan, jaeger.
+    /// Forward model: stick, stick-approx, slip, slip-approx, stickslip, jan, jaeger, md.
     #[arg(long)]
     pub model: String,
     /// Scenes CSV with columns xi,delta_deg[,K,rho,f] (K a number or a law name); extra columns

@@ -16,7 +16,7 @@ use std::path::PathBuf;
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Forward model that makes the data: stick, stick-approx, slip, slip-approx, stickslip,
-    /// jan (see --jan), jaeger (see --jaeger).
+    /// jan (see --jan), jaeger (see --jaeger), md (molecular dynamics, see the md-flags).
     #[arg(long, default_value = "stickslip")]
     pub model: String,
     /// Collision law: a number, cos2a, adjusted, impact or c=VALUE.

@@ -39,7 +39,8 @@
 //! below the top of the next row bead, so it can never pass it), C when the bead jumps: it
 //! flies over at least 5 % of the window's row beads without touching them, or on at least half
 //! of them it lifts off a sustained contact (a flight that is not the rebound of an impact,
-//! eq 30a's N = 0); B otherwise.
+//! eq 30a's N = 0), or it runs away (less than 90 % of the potential energy released over the
+//! window is dissipated: the kinetic energy grows); B otherwise.
 
 use super::{NotSteady, Outcome, Phases, Regime, Steady};
 use crate::error::{Error, Result};
@@ -385,6 +386,9 @@ pub struct MdResult {
     pub lift_offs_per_bead: f64,
     /// Mean angle Θ (radians) on the row bead left at the start of the lift-off flights.
     pub lift_off_angle: Option<f64>,
+    /// The bead gains kinetic energy over the window: less than 90 % of the potential energy
+    /// released is dissipated (regime C, runaway).
+    pub runaway: bool,
     /// Fraction of the window's row beads flown over without a touch.
     pub skipped_fraction: f64,
     /// Mean angle Θ (radians) on the row bead left at the start of the flights that skip a
@@ -617,6 +621,7 @@ impl Md {
             stop: None,
             lift_offs_per_bead: 0.0,
             lift_off_angle: None,
+            runaway: false,
             skipped_fraction: 0.0,
             jump_angle: None,
             flight_height_max: 0.0,
@@ -1011,8 +1016,9 @@ fn run(
         res.initial_velocity = Some(win.vi_sum / n);
         res.k_eff = Some(win.k_sum / n);
     }
+    res.runaway = res.dissipation_normal + res.dissipation_tangential < 0.9;
     res.regime = Some(
-        if res.lift_offs_per_bead >= 0.5 || res.skipped_fraction >= 0.05 {
+        if res.lift_offs_per_bead >= 0.5 || res.skipped_fraction >= 0.05 || res.runaway {
             Regime::C
         } else {
             Regime::B

@@ -297,7 +297,12 @@ impl MdRunConfig {
     /// Checks the run settings.
     pub fn validate(&self) -> Result<()> {
         let b = self.beads as f64;
-        check("beads", b, self.beads >= 2, "must be >= 2")?;
+        check(
+            "beads",
+            b,
+            self.beads >= 2 && self.beads <= 1_000_000,
+            "must be in [2, 1000000]",
+        )?;
         check(
             "transient",
             self.transient as f64,
@@ -319,8 +324,8 @@ impl MdRunConfig {
         check(
             "step_fraction",
             self.step_fraction,
-            self.step_fraction > 0.0 && self.step_fraction <= 0.5,
-            "must be in (0, 0.5]",
+            self.step_fraction >= 1e-4 && self.step_fraction <= 0.5,
+            "must be in [1e-4, 0.5]",
         )?;
         check(
             "max_time_per_bead",

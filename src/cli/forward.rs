@@ -8,6 +8,10 @@ use crate::models::contact::{Contact, SpinRule, SteadyContact};
 use crate::models::jaeger::Jaeger;
 use crate::models::jan::Jan;
 use crate::models::{regime_of, ForwardModel, JaegerBranch, Model, ModelKind, Outcome};
+// --- md (molecular dynamics, issue 9) ---
+use crate::models::md::{Md, MdParams, MdResult, MdRunConfig, ReducedMass};
+use crate::models::Regime;
+// --- end md ---
 use crate::scene::{CollisionLaw, Scene};
 use rayon::prelude::*;
 use std::path::PathBuf;
@@ -15,7 +19,7 @@ use std::path::PathBuf;
 /// Arguments of `fitbead forward`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Forward model: stick, stick-approx, slip, slip-approx, stickslip, jan, jaeger.
+    /// Forward model: stick, stick-approx, slip, slip-approx, stickslip, jan, jaeger, md.
     #[arg(long)]
     pub model: String,
     /// Scenes CSV with columns xi,delta_deg[,K,rho,f] (K a number or a law name); extra columns
@@ -68,6 +72,11 @@ pub struct Args {
     /// Relative tolerance of the contact model's quadratures (time and spin during slip).
     #[arg(long, default_value_t = 1e-14)]
     pub tol: f64,
+    // --- md (molecular dynamics, issue 9) ---
+    /// Molecular-dynamics settings (`--model md`).
+    #[command(flatten)]
+    pub md: MdArgs,
+    // --- end md ---
 }
 
 /// Columns added after [`OUTPUT_COLUMNS`] by --model contact.
@@ -159,6 +168,11 @@ pub fn run(a: Args) -> Result<(), CliError> {
         read_input(a.input.as_deref())?
     };
     let t = Table::parse(&source, &text)?;
+    // --- md (molecular dynamics, issue 9) ---
+    if kind == ModelKind::Md {
+        return run_md(&a, &t);
+    }
+    // --- end md ---
     let c_xi = t.require("xi")?;
     let c_d = t.require("delta_deg")?;
     let c_k = t.col("K");
@@ -392,3 +406,406 @@ fn render(
     }
     w.into_inner().map_err(|e| csv::Error::from(e.into_error()))
 }
+
+// --- md (molecular dynamics, issue 9) ---
+
+/// Settings of the molecular-dynamics model (`--model md`), shared by `forward` and
+/// `simulate`. Every one has a default (Ristow's set, [`MdParams::ristow`]; the run of
+/// [`MdRunConfig::default`]); in `forward` each may also be a column of the scenes CSV, named
+/// as the flag with `_` for `-` (`young_pa`, `gamma_n`, …; `mu_c` for `--coulomb`), which
+/// wins over the flag for its row.
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct MdArgs {
+    /// md parameter set: ristow (default: E = 1e7 Pa, gamma_n = 1000/s, gamma_s = 100/s,
+    /// beta = 1.5, R = 2.5 mm, steel density) or steel (E = 2.1e11 Pa, the rest as ristow).
+    #[arg(long = "md-preset", default_value = "ristow")]
+    pub md_preset: String,
+    /// md: radius R of the row beads, m (2.5e-3).
+    #[arg(long = "row-radius-m")]
+    pub row_radius_m: Option<f64>,
+    /// md: Young's modulus E, Pa (Ristow's k_n read as E, Hertz: 1e7).
+    #[arg(long = "young-pa")]
+    pub young_pa: Option<f64>,
+    /// md: Poisson ratio (0.3).
+    #[arg(long)]
+    pub poisson: Option<f64>,
+    /// md: bead density, kg/m^3 (7850).
+    #[arg(long)]
+    pub density: Option<f64>,
+    /// md: exponent beta of the normal force k_n d^beta (1.5).
+    #[arg(long)]
+    pub beta: Option<f64>,
+    /// md: normal damping gamma_n, 1/s (1000).
+    #[arg(long = "gamma-n")]
+    pub gamma_n: Option<f64>,
+    /// md: tangential damping gamma_s, 1/s (100).
+    #[arg(long = "gamma-s")]
+    pub gamma_s: Option<f64>,
+    /// md: Coulomb cap mu_c on the tangential force (column mu_c); none by default (Ristow).
+    #[arg(long)]
+    pub coulomb: Option<f64>,
+    /// md: gravity, m/s^2 (9.81).
+    #[arg(long = "md-g")]
+    pub md_g: Option<f64>,
+    /// md: reduced mass of eq 92: pair (m M/(m+M), default) or mobile (m).
+    #[arg(long = "reduced-mass")]
+    pub reduced_mass: Option<String>,
+    /// md: row beads travelled (400).
+    #[arg(long)]
+    pub beads: Option<usize>,
+    /// md: row beads discarded as transient (100).
+    #[arg(long)]
+    pub transient: Option<usize>,
+    /// md: blocks for the standard error of v (10).
+    #[arg(long)]
+    pub blocks: Option<usize>,
+    /// md: launch speed on the top of the first row bead, units sqrt(g(R+r)) (0.1).
+    #[arg(long = "launch-velocity")]
+    pub launch_velocity: Option<f64>,
+    /// md: time step as a fraction of the contact time (0.01).
+    #[arg(long = "step-fraction")]
+    pub step_fraction: Option<f64>,
+    /// md: run again at half the step and report the relative change of v (step_check_rel).
+    #[arg(long = "check-step")]
+    pub check_step: bool,
+}
+
+/// Column names of the md settings in a scenes CSV.
+pub const MD_COLUMNS: [&str; 14] = [
+    "row_radius_m",
+    "young_pa",
+    "poisson",
+    "density",
+    "beta",
+    "gamma_n",
+    "gamma_s",
+    "mu_c",
+    "g",
+    "beads",
+    "transient",
+    "blocks",
+    "launch_velocity",
+    "step_fraction",
+];
+
+/// md output columns added to each row.
+pub const MD_OUTPUT_COLUMNS: [&str; 29] = [
+    "v",
+    "regime",
+    "status",
+    "v_stderr",
+    "v_m_s",
+    "drift",
+    "beads_passed",
+    "stop_bead",
+    "stop_theta_deg",
+    "lift_offs_per_bead",
+    "lift_off_theta_deg",
+    "skipped_fraction",
+    "flight_height_max",
+    "flight_length_mean",
+    "flight_length_max",
+    "airborne_fraction",
+    "contacts_per_bead",
+    "bounces_per_contact",
+    "diss_normal",
+    "diss_tangential",
+    "energy_error",
+    "final_velocity",
+    "initial_velocity",
+    "K_eff",
+    "dt",
+    "contact_time",
+    "steps",
+    "step_check_rel",
+    "message",
+];
+
+impl MdArgs {
+    /// The model from the preset and the flags (no table).
+    pub fn model(&self) -> Result<Md, CliError> {
+        let vals: Vec<Option<f64>> = self.flag_values();
+        build_md(self, &vals, &|i, msg| {
+            super::flag_error(
+                &format!("--{}", md_flag_name(i)),
+                &vals[i].map(fmt_f64).unwrap_or_default(),
+                msg,
+            )
+        })
+    }
+
+    fn flag_values(&self) -> Vec<Option<f64>> {
+        vec![
+            self.row_radius_m,
+            self.young_pa,
+            self.poisson,
+            self.density,
+            self.beta,
+            self.gamma_n,
+            self.gamma_s,
+            self.coulomb,
+            self.md_g,
+            self.beads.map(|b| b as f64),
+            self.transient.map(|b| b as f64),
+            self.blocks.map(|b| b as f64),
+            self.launch_velocity,
+            self.step_fraction,
+        ]
+    }
+}
+
+fn md_flag_name(i: usize) -> String {
+    match MD_COLUMNS[i] {
+        "mu_c" => "coulomb".into(),
+        "g" => "md-g".into(),
+        c => c.replace('_', "-"),
+    }
+}
+
+fn md_field_index(field: &str) -> Option<usize> {
+    MD_COLUMNS.iter().position(|c| *c == field)
+}
+
+/// Builds the md model from the preset and the values (flags or cells) in MD_COLUMNS order;
+/// `err(i, message)` locates a bad value i.
+fn build_md(
+    a: &MdArgs,
+    vals: &[Option<f64>],
+    err: &dyn Fn(usize, String) -> CliError,
+) -> Result<Md, CliError> {
+    let mut params = match a.md_preset.as_str() {
+        "ristow" => MdParams::ristow(),
+        "steel" => MdParams::steel(),
+        p => {
+            return Err(super::flag_error(
+                "--md-preset",
+                p,
+                "expected ristow or steel",
+            ))
+        }
+    };
+    match a.reduced_mass.as_deref() {
+        None | Some("pair") => {}
+        Some("mobile") => params.reduced_mass = ReducedMass::Mobile,
+        Some(o) => {
+            return Err(super::flag_error(
+                "--reduced-mass",
+                o,
+                "expected pair or mobile",
+            ))
+        }
+    }
+    let mut config = MdRunConfig::default();
+    let count = |i: usize, x: f64| -> Result<usize, CliError> {
+        if x.is_finite() && x >= 0.0 && x.fract() == 0.0 && x <= 1e9 {
+            Ok(x as usize)
+        } else {
+            Err(err(i, "must be a whole number".into()))
+        }
+    };
+    for (i, v) in vals.iter().enumerate() {
+        let Some(x) = *v else { continue };
+        match i {
+            0 => params.row_radius = x,
+            1 => params.young = x,
+            2 => params.poisson = x,
+            3 => params.density = x,
+            4 => params.beta = x,
+            5 => params.gamma_n = x,
+            6 => params.gamma_s = x,
+            7 => params.coulomb = Some(x),
+            8 => params.g = x,
+            9 => config.beads = count(i, x)?,
+            10 => config.transient = count(i, x)?,
+            11 => config.blocks = count(i, x)?,
+            12 => config.launch_velocity = x,
+            _ => config.step_fraction = x,
+        }
+    }
+    let md = Md { params, config };
+    if let Err(e) = md.validate() {
+        let i = match &e {
+            Error::InvalidParameter { field, .. } => md_field_index(field),
+            _ => None,
+        };
+        return Err(match i {
+            Some(i) => err(i, e.to_string()),
+            None => CliError::Other(e.to_string()),
+        });
+    }
+    Ok(md)
+}
+
+/// A progress bar over `total` units on a terminal's stderr only.
+pub fn md_progress_bar(total: u64, what: &str) -> Option<indicatif::ProgressBar> {
+    use std::io::IsTerminal;
+    if !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let b = indicatif::ProgressBar::new(total);
+    b.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{msg} {bar:30} {pos}/{len} ({elapsed}, eta {eta})",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    b.set_message(what.to_string());
+    Some(b)
+}
+
+fn run_md(a: &Args, t: &Table) -> Result<(), CliError> {
+    let c_xi = t.require("xi")?;
+    let c_d = t.require("delta_deg")?;
+    let c_rho = t.col("rho");
+    let cols: Vec<Option<usize>> = MD_COLUMNS.iter().map(|c| t.col(c)).collect();
+    let flags = a.md.flag_values();
+    let mut jobs: Vec<(Scene, Md)> = Vec::with_capacity(t.rows.len());
+    for r in 0..t.rows.len() {
+        let xi = t.number(r, c_xi)?;
+        let d = t.number(r, c_d)?;
+        let rho = t.opt_number(r, c_rho)?.unwrap_or(a.rho);
+        // K and f do not enter the md model: a placeholder K keeps Scene's validation quiet.
+        let scene = Scene::new(xi, d, rho, a.f, CollisionLaw::Value(0.5)).map_err(|e| {
+            scene_error(
+                t,
+                r,
+                e,
+                &[("xi", Some(c_xi)), ("delta_deg", Some(c_d)), ("rho", c_rho)],
+            )
+        })?;
+        if !(rho > 0.0) {
+            let msg = "md needs rho > 0 (the bead's moment of inertia)";
+            return Err(match c_rho {
+                Some(c) => t.err(r, c, msg).into(),
+                None => super::flag_error("--rho", &fmt_f64(rho), msg),
+            });
+        }
+        let mut vals = flags.clone();
+        for (i, c) in cols.iter().enumerate() {
+            if let Some(x) = t.opt_number(r, *c)? {
+                vals[i] = Some(x);
+            }
+        }
+        let md = build_md(&a.md, &vals, &|i, msg| match cols[i] {
+            Some(c) if !t.cell(r, c).is_empty() => t.err(r, c, msg).into(),
+            _ => super::flag_error(
+                &format!("--{}", md_flag_name(i)),
+                &vals[i].map(fmt_f64).unwrap_or_default(),
+                msg,
+            ),
+        })?;
+        jobs.push((scene, md));
+    }
+    let reps: u64 = if a.md.check_step { 3 } else { 1 };
+    let total: u64 = jobs.iter().map(|(_, m)| m.config.beads as u64 * reps).sum();
+    let bar = if total >= 2000 {
+        md_progress_bar(total, "md")
+    } else {
+        None
+    };
+    let tick = |n: u64| {
+        if let Some(b) = &bar {
+            b.inc(n);
+        }
+    };
+    let results: Vec<(MdResult, Option<f64>)> = jobs
+        .par_iter()
+        .map(|(scene, md)| {
+            let r = md.simulate(scene, 1.0, Some(&tick));
+            let rel = if a.md.check_step {
+                let h = md.simulate(scene, 0.5, Some(&tick));
+                match (r.mean_velocity, h.mean_velocity) {
+                    (Some(x), Some(y)) => Some(((y - x) / x).abs()),
+                    _ => None,
+                }
+            } else {
+                None
+            };
+            (r, rel)
+        })
+        .collect();
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    let bytes = render_md(t, &jobs, &results).map_err(|e| CliError::Other(e.to_string()))?;
+    emit(a.output.as_deref(), &bytes)
+}
+
+fn render_md(
+    t: &Table,
+    jobs: &[(Scene, Md)],
+    results: &[(MdResult, Option<f64>)],
+) -> csv::Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::with_capacity(t.rows.len() * 400));
+    let mut header: Vec<String> = t
+        .headers
+        .iter()
+        .map(|h| {
+            if MD_OUTPUT_COLUMNS.contains(&h.as_str()) {
+                format!("in_{h}")
+            } else {
+                h.clone()
+            }
+        })
+        .collect();
+    header.extend(MD_OUTPUT_COLUMNS.iter().map(|s| s.to_string()));
+    w.write_record(&header)?;
+    let opt = |x: Option<f64>| x.map(fmt_f64).unwrap_or_default();
+    for ((rec, (scene, _)), (r, rel)) in t.rows.iter().zip(jobs).zip(results) {
+        let mut out: Vec<String> = rec.iter().map(|s| s.to_string()).collect();
+        let o = Md::outcome(scene, r);
+        let moving = matches!(r.regime, Some(Regime::B) | Some(Regime::C));
+        let deg = |x: Option<f64>| opt(x.map(f64::to_degrees));
+        out.push(if moving {
+            opt(r.mean_velocity)
+        } else {
+            String::new()
+        });
+        out.push(regime_of(&o).map(|g| g.to_string()).unwrap_or_default());
+        out.push(match &o {
+            Ok(_) => "ok".into(),
+            Err(e) => e.status().into(),
+        });
+        out.push(if moving { opt(r.stderr) } else { String::new() });
+        out.push(if moving {
+            opt(r.mean_velocity_si)
+        } else {
+            String::new()
+        });
+        out.push(opt(r.drift));
+        out.push(r.beads_passed.to_string());
+        out.push(r.stop.map(|s| s.bead.to_string()).unwrap_or_default());
+        out.push(deg(r.stop.map(|s| s.angle)));
+        let measured = r.mean_velocity.is_some();
+        let m = |x: f64| if measured { fmt_f64(x) } else { String::new() };
+        out.push(m(r.lift_offs_per_bead));
+        out.push(deg(r.lift_off_angle));
+        out.push(m(r.skipped_fraction));
+        out.push(m(r.flight_height_max));
+        out.push(opt(r.flight_length_mean));
+        out.push(m(r.flight_length_max));
+        out.push(m(r.airborne_fraction));
+        out.push(m(r.contacts_per_bead));
+        out.push(m(r.bounces_per_contact));
+        out.push(m(r.dissipation_normal));
+        out.push(m(r.dissipation_tangential));
+        out.push(fmt_f64(r.energy_error));
+        out.push(opt(r.final_velocity));
+        out.push(opt(r.initial_velocity));
+        out.push(opt(r.k_eff));
+        out.push(fmt_f64(r.dt));
+        out.push(fmt_f64(r.contact_time));
+        out.push(r.steps.to_string());
+        out.push(opt(*rel));
+        out.push(match &o {
+            Ok(_) => String::new(),
+            Err(e) => match r.stop {
+                Some(s) => format!("{e} (trapped after {} row beads)", s.bead),
+                None => e.to_string(),
+            },
+        });
+        w.write_record(&out)?;
+    }
+    w.into_inner().map_err(|e| csv::Error::from(e.into_error()))
+}
+// --- end md ---

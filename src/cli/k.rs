@@ -231,6 +231,15 @@ pub fn parse_model(name: &str) -> Result<Model, CliError> {
         )
     };
     let kind: ModelKind = name.parse().map_err(|_| err())?;
+    // --- md (molecular dynamics, issue 9) ---
+    if kind == ModelKind::Md {
+        return Err(super::flag_error(
+            "--model",
+            name,
+            "model md has no K inversion (its collisions come from the contact forces)",
+        ));
+    }
+    // --- end md ---
     kind.contact_model().ok_or_else(err)
 }
 

@@ -16,7 +16,7 @@ use std::path::PathBuf;
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Forward model that makes the data: stick, stick-approx, slip, slip-approx, stickslip,
-    /// jan (see --jan), jaeger (see --jaeger).
+    /// jan (see --jan), jaeger (see --jaeger), md (molecular dynamics, see the md-flags).
     #[arg(long, default_value = "stickslip")]
     pub model: String,
     /// Collision law: a number, cos2a, adjusted, impact or c=VALUE.
@@ -64,15 +64,17 @@ pub struct Args {
     /// --series at --delta-deg instead of synthetic measurements.
     #[arg(long)]
     pub v0: Option<f64>,
-    /// Beads of travel for the --v0 transient.
-    #[arg(long, default_value_t = 50)]
-    pub beads: usize,
     /// Slope of the --v0 transient, degrees.
     #[arg(long = "delta-deg")]
     pub delta_deg: Option<f64>,
     /// Spin rule of the collision for --model contact: roll, keep, factor=L or impact.
     #[arg(long, default_value = "roll")]
     pub spin: String,
+    // --- md (molecular dynamics, issue 9) ---
+    /// Molecular-dynamics settings (`--model md`).
+    #[command(flatten)]
+    pub md: super::forward::MdArgs,
+    // --- end md ---
 }
 
 /// Columns of the `simulate --model contact --v0` transient.
@@ -104,10 +106,12 @@ fn trace(a: &Args, law: CollisionLaw, series: &[f64], v0: f64) -> Result<(), Cli
             "expected a finite launch speed >= 0",
         ));
     }
-    if a.beads == 0 || a.beads > 10_000_000 {
+    // --beads (shared with md: row beads travelled) defaults to 50 for the transient.
+    let beads = a.md.beads.unwrap_or(50);
+    if beads == 0 || beads > 10_000_000 {
         return Err(super::flag_error(
             "--beads",
-            &a.beads.to_string(),
+            &beads.to_string(),
             "expected 1 to 10000000 beads",
         ));
     }
@@ -143,7 +147,7 @@ fn trace(a: &Args, law: CollisionLaw, series: &[f64], v0: f64) -> Result<(), Cli
                 theta_dot: v0,
                 spin: v0,
             },
-            a.beads,
+            beads,
         );
         for (i, (l, r)) in runs.iter().enumerate() {
             let (fv, fs, status, msg, v) = match r.end {
@@ -287,6 +291,11 @@ pub fn run(a: Args) -> Result<(), CliError> {
             "must be in [0, 0.5)",
         ));
     }
+    // --- md (molecular dynamics, issue 9) ---
+    if kind == ModelKind::Md {
+        return run_md(&a, &series);
+    }
+    // --- end md ---
     let jan = a
         .jan
         .as_deref()
@@ -427,3 +436,253 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let bytes = w.into_inner().map_err(|e| CliError::Other(e.to_string()))?;
     emit(a.output.as_deref(), &bytes)
 }
+
+// --- md (molecular dynamics, issue 9) ---
+
+/// The md scan of slopes for regime B: every 0.5° from 0.5° to 45°.
+const MD_SCAN_STEP_DEG: f64 = 0.5;
+const MD_SCAN_POINTS: usize = 90;
+/// Bisection steps refining each end of the md regime B range (0.5°/2⁷ ≈ 0.004°).
+const MD_REFINE: usize = 7;
+/// How many times a hole in regime B may narrow the md range before `simulate` gives up.
+const MD_NARROW: usize = 8;
+
+/// The slopes (degrees) where the md model is in regime B at this ξ: the longest run of the
+/// 0.5° scan (slopes in parallel), each end refined by bisection.
+pub fn md_regime_b_interval(
+    md: &crate::models::md::Md,
+    xi: f64,
+    rho: f64,
+    tick: &(dyn Fn() + Sync),
+) -> Result<Option<(f64, f64)>, crate::Error> {
+    use crate::models::Regime;
+    use rayon::prelude::*;
+    let is_b = |d: f64| -> Result<bool, crate::Error> {
+        let sc = Scene::new(xi, d, rho, 0.1, CollisionLaw::Value(0.5))?;
+        let r = md.simulate(&sc, 1.0, None);
+        tick();
+        Ok(r.regime == Some(Regime::B))
+    };
+    let grid: Vec<f64> = (1..=MD_SCAN_POINTS)
+        .map(|i| MD_SCAN_STEP_DEG * i as f64)
+        .collect();
+    let flags: Vec<bool> = grid
+        .par_iter()
+        .map(|&d| is_b(d))
+        .collect::<Result<_, _>>()?;
+    let (mut best, mut cur): ((usize, usize), Option<usize>) = ((0, 0), None);
+    for i in 0..=flags.len() {
+        let f = i < flags.len() && flags[i];
+        match (f, cur) {
+            (true, None) => cur = Some(i),
+            (false, Some(st)) => {
+                if i - st > best.1 - best.0 {
+                    best = (st, i);
+                }
+                cur = None;
+            }
+            _ => {}
+        }
+    }
+    if best.1 == best.0 {
+        return Ok(None);
+    }
+    let bisect = |mut good: f64, mut bad: f64| -> Result<f64, crate::Error> {
+        for _ in 0..MD_REFINE {
+            let m = 0.5 * (good + bad);
+            if is_b(m)? {
+                good = m
+            } else {
+                bad = m
+            }
+        }
+        Ok(good)
+    };
+    let lo_good = grid[best.0];
+    let hi_good = grid[best.1 - 1];
+    let (lo, hi) = rayon::join(
+        || {
+            if best.0 == 0 {
+                Ok(lo_good)
+            } else {
+                bisect(lo_good, grid[best.0 - 1])
+            }
+        },
+        || {
+            if best.1 >= grid.len() {
+                Ok(hi_good)
+            } else {
+                bisect(hi_good, grid[best.1])
+            }
+        },
+    );
+    Ok(Some((lo?, hi?)))
+}
+
+fn run_md(a: &Args, series: &[f64]) -> Result<(), CliError> {
+    use crate::models::md::{Md, MdResult};
+    use crate::models::Regime;
+    use rayon::prelude::*;
+    let md: Md = a.md.model()?;
+    if !(a.rho > 0.0) {
+        return Err(super::flag_error(
+            "--rho",
+            &fmt_f64(a.rho),
+            "md needs rho > 0 (the bead's moment of inertia)",
+        ));
+    }
+    let range = match a.delta_range.as_deref() {
+        None => None,
+        Some(s) => {
+            let r = parse_list("--delta-range", s)?;
+            if r.len() != 2 || !(r[0] < r[1]) {
+                return Err(super::flag_error(
+                    "--delta-range",
+                    s,
+                    "expected LO,HI in degrees with LO < HI",
+                ));
+            }
+            Some((r[0], r[1]))
+        }
+    };
+    let per_series = (MD_SCAN_POINTS + 2 * MD_REFINE + a.points) as u64;
+    let bar = super::forward::md_progress_bar(per_series * series.len() as u64, "md simulate");
+    let tick = || {
+        if let Some(b) = &bar {
+            b.inc(1);
+        }
+    };
+    let mut rng = ChaCha8Rng::seed_from_u64(a.seed);
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let io = |e: csv::Error| CliError::Other(e.to_string());
+    w.write_record([
+        "series",
+        "xi",
+        "delta_deg",
+        "v",
+        "sigma_v",
+        "v_true",
+        "v_md_stderr",
+        "v_m_s",
+    ])
+    .map_err(io)?;
+    for &xi in series {
+        Scene::new(xi, 1.0, a.rho, 0.1, CollisionLaw::Value(0.5))
+            .map_err(|e| super::flag_error("--series", &xi.to_string(), e.to_string()))?;
+        let interval = md_regime_b_interval(&md, xi, a.rho, &tick)
+            .map_err(|e| super::flag_error("--series", &xi.to_string(), e.to_string()))?;
+        let Some((lo, hi)) = interval else {
+            return Err(super::flag_error(
+                "--series",
+                &xi.to_string(),
+                "md finds no steady regime (B) for this xi between 0.5 and 45 degrees",
+            ));
+        };
+        let (lo, hi) = match range {
+            Some((l, h)) => {
+                let (l, h) = (l.max(lo), h.min(hi));
+                if !(l < h) {
+                    return Err(super::flag_error(
+                        "--delta-range",
+                        a.delta_range.as_deref().unwrap_or(""),
+                        format!(
+                            "no steady state in this range at xi = {xi} (md steady from {} to {} deg)",
+                            fmt_f64(lo),
+                            fmt_f64(hi)
+                        ),
+                    ));
+                }
+                (l, h)
+            }
+            None => (lo, hi),
+        };
+        // Near the ends of regime B the md bead's bounces are chaotic and B can have holes: a
+        // point that is not in B narrows the range from its side and the points are redrawn.
+        let (mut lo, mut hi) = (lo, hi);
+        let mut runs: Vec<(f64, f64, f64, MdResult)> = Vec::new();
+        for attempt in 0..=MD_NARROW {
+            let slopes: Vec<f64> = (0..a.points)
+                .map(|j| {
+                    let frac = if a.points == 1 {
+                        0.5
+                    } else {
+                        0.05 + 0.9 * j as f64 / (a.points - 1) as f64
+                    };
+                    // Rounded to 1e-4 degree, as a measured slope would be written.
+                    ((lo + (hi - lo) * frac) * 1e4).round() / 1e4
+                })
+                .collect();
+            let done: Vec<(f64, f64, f64, MdResult)> = slopes
+                .par_iter()
+                .map(|&d| {
+                    let sc = Scene::new(xi, d, a.rho, 0.1, CollisionLaw::Value(0.5))
+                        .map_err(|e| CliError::Other(e.to_string()))?;
+                    let r = md.simulate(&sc, 1.0, None);
+                    tick();
+                    Ok((d, lo, hi, r))
+                })
+                .collect::<Result<_, CliError>>()?;
+            let bad: Vec<f64> = done
+                .iter()
+                .filter(|x| x.3.regime != Some(Regime::B))
+                .map(|x| x.0)
+                .collect();
+            if bad.is_empty() {
+                runs = done;
+                break;
+            }
+            if attempt == MD_NARROW {
+                return Err(CliError::Other(format!(
+                    "md: xi {xi}: slopes {bad:?} deg are not in regime B after narrowing the \
+                     steady range {MD_NARROW} times (now {} to {} deg); give --delta-range",
+                    fmt_f64(lo),
+                    fmt_f64(hi)
+                )));
+            }
+            let mid = 0.5 * (lo + hi);
+            let (old_lo, old_hi) = (lo, hi);
+            for &d in &bad {
+                if d >= mid {
+                    hi = hi.min(d - 0.01 * (old_hi - old_lo));
+                } else {
+                    lo = lo.max(d + 0.01 * (old_hi - old_lo));
+                }
+            }
+            eprintln!(
+                "fitbead: note: md, xi {xi}: slopes {bad:?} deg are not in regime B; steady range \
+                 narrowed from [{}, {}] to [{}, {}] deg",
+                fmt_f64(old_lo),
+                fmt_f64(old_hi),
+                fmt_f64(lo),
+                fmt_f64(hi)
+            );
+        }
+        for (d, _, _, r) in runs {
+            let (Some(v_true), Some(se)) = (r.mean_velocity, r.stderr) else {
+                return Err(CliError::Other(format!(
+                    "md: xi {xi}, delta {d} deg: no mean velocity measured"
+                )));
+            };
+            let z: f64 = StandardNormal.sample(&mut rng);
+            let v = v_true * (1.0 + a.noise * z);
+            let sigma = (a.noise * v_true).hypot(se);
+            w.write_record([
+                fmt_f64(xi),
+                fmt_f64(xi),
+                fmt_f64(d),
+                fmt_f64(v),
+                fmt_f64(sigma),
+                fmt_f64(v_true),
+                fmt_f64(se),
+                r.mean_velocity_si.map(fmt_f64).unwrap_or_default(),
+            ])
+            .map_err(io)?;
+        }
+    }
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    let bytes = w.into_inner().map_err(|e| CliError::Other(e.to_string()))?;
+    emit(a.output.as_deref(), &bytes)
+}
+// --- end md ---

@@ -8,6 +8,9 @@ pub mod contact;
 pub mod energy;
 pub mod jaeger;
 pub mod jan;
+// --- md (molecular dynamics, issue 9) ---
+pub mod md;
+// --- end md ---
 pub mod regimes;
 pub mod slip;
 pub mod stick;
@@ -235,11 +238,15 @@ pub enum Model {
     Jaeger(jaeger::Jaeger),
     /// The general contact model: any sequence of rolling and slipping (MODEL.md §4).
     Contact(contact::Contact),
+    // --- md (molecular dynamics, issue 9) ---
+    /// Ristow's soft-contact molecular dynamics (§5.3, eqs 91–92).
+    Md(md::Md),
+    // --- end md ---
 }
 
 impl Model {
     /// Names accepted on the command line.
-    pub const NAMES: [&'static str; 8] = [
+    pub const NAMES: [&'static str; 9] = [
         "stick",
         "stick-approx",
         "slip",
@@ -248,6 +255,7 @@ impl Model {
         "jan",
         "jaeger",
         "contact",
+        "md",
     ];
 }
 
@@ -262,6 +270,7 @@ impl ForwardModel for Model {
             Model::Jan(_) => "jan",
             Model::Jaeger(_) => "jaeger",
             Model::Contact(_) => "contact",
+            Model::Md(_) => "md",
         }
     }
 
@@ -275,6 +284,7 @@ impl ForwardModel for Model {
             Model::Jan(m) => m.evaluate(scene),
             Model::Jaeger(m) => m.evaluate(scene),
             Model::Contact(m) => m.evaluate(scene),
+            Model::Md(m) => m.evaluate(scene),
         }
     }
 }
@@ -298,11 +308,15 @@ pub enum ModelKind {
     Jaeger,
     /// See [`Model::Contact`] (spin rule `roll` unless set apart).
     Contact,
+    // --- md (molecular dynamics, issue 9) ---
+    /// See [`Model::Md`].
+    Md,
+    // --- end md ---
 }
 
 impl ModelKind {
     /// The model for the five contact models, which need no parameters beyond the scene;
-    /// `None` for jan and jaeger.
+    /// `None` for jan, jaeger and md.
     pub fn contact_model(self) -> Option<Model> {
         Some(match self {
             ModelKind::Stick => Model::Stick,
@@ -312,6 +326,7 @@ impl ModelKind {
             ModelKind::StickSlip => Model::StickSlip,
             ModelKind::Contact => Model::Contact(contact::Contact::default()),
             ModelKind::Jan | ModelKind::Jaeger => return None,
+            ModelKind::Md => return None,
         })
     }
 }
@@ -328,6 +343,7 @@ impl FromStr for ModelKind {
             "jan" => ModelKind::Jan,
             "jaeger" => ModelKind::Jaeger,
             "contact" => ModelKind::Contact,
+            "md" => ModelKind::Md,
             _ => return Err(Error::UnknownModel(s.to_string())),
         })
     }

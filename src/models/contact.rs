@@ -32,7 +32,7 @@ use super::{NotSteady, Outcome, Phases, Steady};
 use crate::error::{Error, Result};
 use crate::scene::Scene;
 use crate::special::cheb::ChebIntegral;
-use crate::special::quad::integrate_smooth;
+use crate::special::quad::{integrate_smooth, integrate_smooth_n};
 use crate::special::root::brent;
 use std::fmt;
 use std::str::FromStr;
@@ -643,13 +643,13 @@ impl Contact {
                 stick_at = Some(last);
             }
         }
-        let (end, g_end, at_collision) = match stick_at {
-            Some((t, g)) if t < end => (t, g, false),
+        let (end, g_stick, at_collision) = match stick_at {
+            Some((t, g)) if t < end => (t, Some(g), false),
             _ => {
                 if let Some(e) = fail {
                     return Err(e);
                 }
-                (end, g_int(ta, end), true)
+                (end, None, true)
             }
         };
         let u_end = if at_collision || end > ta {
@@ -657,25 +657,38 @@ impl Contact {
         } else {
             ua
         };
-        let w_end = wa + eps_f * g_end;
         // Time: where Θ̇² stays well away from 0 the integrand 1/Θ̇ is as smooth as the spin's
-        // and one K15 panel usually resolves it; near a crawl (Θ̇² → 0 inside the phase) the
-        // slip model's substitution takes over.
+        // and one K15 panel usually resolves it (with the spin integral, when it is still
+        // needed, on the same abscissae); near a crawl (Θ̇² → 0 inside the phase) the slip
+        // model's substitution takes over.
         let u_lo = if tm > ta && tm < end {
             um
         } else {
             ua.min(u_end)
         };
-        let time = if u_lo >= 1e-2 * ua.max(u_end) && u_lo > 0.0 {
-            integrate_smooth(
-                |t| 1.0 / u(t).max(f64::MIN_POSITIVE).sqrt(),
-                ta,
-                end,
-                self.tol,
-            )
-        } else {
-            slip_time(&ph, ta, end, self.tol)?
+        let smooth = u_lo >= 1e-2 * ua.max(u_end) && u_lo > 0.0;
+        let inv_speed = |t: f64| 1.0 / u(t).max(f64::MIN_POSITIVE).sqrt();
+        let (g_end, time) = match (g_stick, smooth) {
+            (None, true) => {
+                let [g, t] = integrate_smooth_n(
+                    |t| {
+                        let uu = u(t).max(f64::MIN_POSITIVE);
+                        let r = 1.0 / uu.sqrt();
+                        [(t.cos() - uu) * r, r]
+                    },
+                    ta,
+                    end,
+                    self.tol,
+                );
+                (g, t)
+            }
+            (Some(g), true) => (g, integrate_smooth(inv_speed, ta, end, self.tol)),
+            (g, false) => (
+                g.unwrap_or_else(|| g_int(ta, end)),
+                slip_time(&ph, ta, end, self.tol)?,
+            ),
         };
+        let w_end = wa + eps_f * g_end;
         // ∫ N dθ in closed form: ∫ cos − ∫ Θ̇², Θ̇² = Θ̇a² E + b (sin θ − sin Θa E) + c (cos θ −
         // cos Θa E), E = e^{2σf(θ−Θa)}.
         let d = end - ta;

@@ -159,39 +159,49 @@ pub fn integrate<F: FnMut(f64) -> f64>(mut f: F, a: f64, b: f64, opts: QuadOptio
     }
 }
 
-/// K15 on [a, b] with QUADPACK's error estimate (Piessens et al. 1983, qk15):
-/// resasc·min(1, (200 |K15 − G7| / resasc)^{3/2}), resasc = ∫|f − mean|.
-fn gk15_quadpack<F: FnMut(f64) -> f64>(f: &mut F, a: f64, b: f64) -> (f64, f64) {
+/// K15 on [a, b] of a vector integrand with QUADPACK's error estimate per component
+/// (Piessens et al. 1983, qk15): resasc·min(1, (200 |K15 − G7| / resasc)^{3/2}),
+/// resasc = ∫|f − mean|.
+fn gk15_quadpack<const N: usize, F: FnMut(f64) -> [f64; N]>(
+    f: &mut F,
+    a: f64,
+    b: f64,
+) -> ([f64; N], [f64; N]) {
     let c = 0.5 * (a + b);
     let h = 0.5 * (b - a);
-    let mut fv = [0.0f64; 15];
+    let mut fv = [[0.0f64; N]; 15];
     fv[7] = f(c);
     for i in 0..7 {
         let dx = h * XGK[i];
         fv[i] = f(c - dx);
         fv[14 - i] = f(c + dx);
     }
-    let mut rk = WGK[7] * fv[7];
-    let mut rg = WG[3] * fv[7];
-    for i in 0..7 {
-        let s = fv[i] + fv[14 - i];
-        rk += WGK[i] * s;
-        if i % 2 == 1 {
-            rg += WG[i / 2] * s;
+    let mut val = [0.0; N];
+    let mut err = [0.0; N];
+    for n in 0..N {
+        let mut rk = WGK[7] * fv[7][n];
+        let mut rg = WG[3] * fv[7][n];
+        for i in 0..7 {
+            let s = fv[i][n] + fv[14 - i][n];
+            rk += WGK[i] * s;
+            if i % 2 == 1 {
+                rg += WG[i / 2] * s;
+            }
         }
+        let mean = 0.5 * rk;
+        let mut asc = WGK[7] * (fv[7][n] - mean).abs();
+        for i in 0..7 {
+            asc += WGK[i] * ((fv[i][n] - mean).abs() + (fv[14 - i][n] - mean).abs());
+        }
+        let resasc = asc * h.abs();
+        let mut e = ((rk - rg) * h).abs();
+        if resasc != 0.0 && e != 0.0 {
+            e = resasc * (200.0 * e / resasc).powf(1.5).min(1.0);
+        }
+        val[n] = rk * h;
+        err[n] = e;
     }
-    let mean = 0.5 * rk;
-    let mut asc = WGK[7] * (fv[7] - mean).abs();
-    for i in 0..7 {
-        asc += WGK[i] * ((fv[i] - mean).abs() + (fv[14 - i] - mean).abs());
-    }
-    let hk = h.abs();
-    let resasc = asc * hk;
-    let mut err = ((rk - rg) * h).abs();
-    if resasc != 0.0 && err != 0.0 {
-        err = resasc * (200.0 * err / resasc).powf(1.5).min(1.0);
-    }
-    (rk * h, err)
+    (val, err)
 }
 
 /// ∫_a^b f(x) dx for a smooth (analytic) integrand: adaptive K15 with QUADPACK's error
@@ -201,11 +211,23 @@ fn gk15_quadpack<F: FnMut(f64) -> f64>(f: &mut F, a: f64, b: f64) -> (f64, f64) 
 /// model's spin integral it needs one panel where [`integrate`] needs about ten for 1e-14,
 /// with the same result to round-off (tests/contact.rs holds it against an RK4 reference).
 pub fn integrate_smooth<F: FnMut(f64) -> f64>(mut f: F, a: f64, b: f64, rel_tol: f64) -> f64 {
+    integrate_smooth_n(|x| [f(x)], a, b, rel_tol)[0]
+}
+
+/// [`integrate_smooth`] of N integrands sharing their abscissae (one evaluation of `f` gives
+/// all N values): each component to `rel_tol` of its own magnitude.
+pub fn integrate_smooth_n<const N: usize, F: FnMut(f64) -> [f64; N]>(
+    mut f: F,
+    a: f64,
+    b: f64,
+    rel_tol: f64,
+) -> [f64; N] {
     const CAP: usize = 64;
     let mut lo = [0.0f64; CAP];
     let mut hi = [0.0f64; CAP];
-    let mut val = [0.0f64; CAP];
-    let mut err = [0.0f64; CAP];
+    let mut val = [[0.0f64; N]; CAP];
+    let mut err = [[0.0f64; N]; CAP];
+    // Panel error relative to the tolerance of its component, worst component.
     let (v, e) = gk15_quadpack(&mut f, a, b);
     lo[0] = a;
     hi[0] = b;
@@ -213,14 +235,26 @@ pub fn integrate_smooth<F: FnMut(f64) -> f64>(mut f: F, a: f64, b: f64, rel_tol:
     err[0] = e;
     let mut n = 1;
     loop {
-        let total: f64 = val[..n].iter().sum();
-        let total_err: f64 = err[..n].iter().sum();
-        if total_err <= rel_tol * total.abs() || !total.is_finite() || n == CAP {
+        let mut total = [0.0; N];
+        let mut total_err = [0.0; N];
+        for i in 0..n {
+            for c in 0..N {
+                total[c] += val[i][c];
+                total_err[c] += err[i][c];
+            }
+        }
+        let done = (0..N).all(|c| total_err[c] <= rel_tol * total[c].abs());
+        if done || total.iter().any(|t| !t.is_finite()) || n == CAP {
             return total;
         }
+        let scale = |i: usize| {
+            (0..N)
+                .map(|c| err[i][c] / (rel_tol * total[c].abs()).max(f64::MIN_POSITIVE))
+                .fold(0.0, f64::max)
+        };
         let mut k = 0;
         for i in 1..n {
-            if err[i] > err[k] {
+            if scale(i) > scale(k) {
                 k = i;
             }
         }

@@ -402,3 +402,87 @@ fn k_round_trip() {
         assert!((r.k - sc.k).abs() < 1e-11, "{} vs {}", r.k, sc.k);
     }
 }
+
+fn bin() -> std::process::Command {
+    std::process::Command::new(env!("CARGO_BIN_EXE_fitbead"))
+}
+
+/// `forward --model contact`: the phase columns and the energy closure on every row; a bad
+/// spin rule exits 2 naming the flag; `simulate --model contact --v0` writes one row per bead.
+#[test]
+fn cli_forward_and_transient() {
+    let out = bin()
+        .args([
+            "forward",
+            "--model",
+            "contact",
+            "--xi",
+            "1",
+            "--delta-deg",
+            "12",
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    let mut r = csv::Reader::from_reader(text.as_bytes());
+    let h = r.headers().unwrap().clone();
+    for c in [
+        "v",
+        "regime",
+        "status",
+        "phase_sequence",
+        "phase_change_deg",
+        "friction_work_frac",
+        "energy_closure",
+        "spin_rule",
+    ] {
+        assert!(h.iter().any(|x| x == c), "missing column {c}");
+    }
+    let row = r.records().next().unwrap().unwrap();
+    let get = |n: &str| row[h.iter().position(|x| x == n).unwrap()].to_string();
+    assert_eq!(get("phase_sequence"), "backslip>roll>slip");
+    assert!(get("energy_closure").parse::<f64>().unwrap().abs() < 1e-12);
+
+    let bad = bin()
+        .args([
+            "forward",
+            "--model",
+            "contact",
+            "--xi",
+            "1",
+            "--delta-deg",
+            "12",
+            "--spin",
+            "sideways",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--spin"));
+
+    let tr = bin()
+        .args([
+            "simulate",
+            "--model",
+            "contact",
+            "--v0",
+            "0.4",
+            "--beads",
+            "7",
+            "--delta-deg",
+            "12",
+            "--series",
+            "1,2",
+        ])
+        .output()
+        .unwrap();
+    assert!(tr.status.success());
+    let text = String::from_utf8(tr.stdout).unwrap();
+    assert_eq!(text.lines().count(), 1 + 2 * 7);
+    assert!(text
+        .lines()
+        .next()
+        .unwrap()
+        .starts_with("xi,delta_deg,bead,initial_velocity"));
+}

@@ -194,6 +194,25 @@ fn trace(a: &Args, law: CollisionLaw, series: &[f64], v0: f64) -> Result<(), Cli
     emit(a.output.as_deref(), &bytes)
 }
 
+/// The longest run of `true` in `flags` as [start, end) indices; `None` when there is none.
+fn longest_run(flags: &[bool]) -> Option<(usize, usize)> {
+    let (mut best, mut cur): ((usize, usize), Option<usize>) = ((0, 0), None);
+    for i in 0..=flags.len() {
+        let f = i < flags.len() && flags[i];
+        match (f, cur) {
+            (true, None) => cur = Some(i),
+            (false, Some(s)) => {
+                if i - s > best.1 - best.0 {
+                    best = (s, i);
+                }
+                cur = None;
+            }
+            _ => {}
+        }
+    }
+    (best.1 > best.0).then_some(best)
+}
+
 /// The slopes (radians) where `model` has a steady state at this ξ: the longest run of a
 /// 2000-point scan of (0°, 89°), its ends refined by bisection to 1e-12 rad.
 pub fn regime_b_interval(
@@ -212,23 +231,9 @@ pub fn regime_b_interval(
     let top = 89f64.to_radians();
     let grid: Vec<f64> = (1..n).map(|i| top * i as f64 / n as f64).collect();
     let flags: Vec<bool> = grid.iter().map(|&d| ok(d)).collect();
-    let (mut best, mut cur): ((usize, usize), Option<usize>) = ((0, 0), None);
-    for i in 0..=flags.len() {
-        let f = i < flags.len() && flags[i];
-        match (f, cur) {
-            (true, None) => cur = Some(i),
-            (false, Some(s)) => {
-                if i - s > best.1 - best.0 {
-                    best = (s, i);
-                }
-                cur = None;
-            }
-            _ => {}
-        }
-    }
-    if best.1 == best.0 {
+    let Some(best) = longest_run(&flags) else {
         return None;
-    }
+    };
     let bisect = |mut good: f64, mut bad: f64| {
         for _ in 0..60 {
             let m = 0.5 * (good + bad);
@@ -470,23 +475,9 @@ pub fn md_regime_b_interval(
         .par_iter()
         .map(|&d| is_b(d))
         .collect::<Result<_, _>>()?;
-    let (mut best, mut cur): ((usize, usize), Option<usize>) = ((0, 0), None);
-    for i in 0..=flags.len() {
-        let f = i < flags.len() && flags[i];
-        match (f, cur) {
-            (true, None) => cur = Some(i),
-            (false, Some(st)) => {
-                if i - st > best.1 - best.0 {
-                    best = (st, i);
-                }
-                cur = None;
-            }
-            _ => {}
-        }
-    }
-    if best.1 == best.0 {
+    let Some(best) = longest_run(&flags) else {
         return Ok(None);
-    }
+    };
     let bisect = |mut good: f64, mut bad: f64| -> Result<f64, crate::Error> {
         for _ in 0..MD_REFINE {
             let m = 0.5 * (good + bad);

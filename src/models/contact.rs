@@ -217,22 +217,6 @@ impl Default for Contact {
     }
 }
 
-/// Θ_G of a rolling phase with energy invariant ϑ = 2 cos Θa + (1+ρ) Θ̇a² (eq 36 in its
-/// rationalised form, MODEL.md §3): the angle > 0 where H = T/N reaches f; `None` when N < 0
-/// on the whole bead. For f = 0, Θ_G = 0.
-fn theta_g_of(rho: f64, f: f64, vartheta: f64) -> Option<f64> {
-    let p = 3.0 + rho;
-    let disc = rho * rho + f * f * (p - vartheta) * (p + vartheta);
-    if disc < 0.0 || p - vartheta < 0.0 {
-        return None;
-    }
-    let den = rho + disc.sqrt();
-    if den == 0.0 {
-        return None;
-    }
-    Some(2.0 * (f * (p - vartheta) / den).atan())
-}
-
 /// The mode a bead takes at angle θ with squared speed u and slip velocity s.
 fn mode_at(scene: &Scene, theta: f64, u: f64, s: f64) -> std::result::Result<PhaseKind, NotSteady> {
     let n = theta.cos() - u;
@@ -388,7 +372,7 @@ impl Contact {
         let b = scene.b;
         let rho = scene.rho;
         let vartheta = 2.0 * ta.cos() + (1.0 + rho) * ua;
-        let Some(tg) = theta_g_of(rho, scene.f, vartheta) else {
+        let Some(tg) = super::regimes::theta_g_of(rho, scene.f, vartheta) else {
             return Err(NotSteady::LiftOff { angle: ta });
         };
         let end = tg.max(ta).min(scene.theta_f);

@@ -77,9 +77,13 @@ pub fn friction_demand(scene: &Scene, w0sq: f64, theta: f64) -> f64 {
 /// `None` when no real Θ_G exists ((3+ρ)² < ϑ²: the normal force is negative everywhere), or
 /// when ρ = f = 0 (no friction is ever needed).
 pub fn theta_g(scene: &Scene, w0sq: f64) -> Option<f64> {
-    let rho = scene.rho;
-    let f = scene.f;
-    let th = vartheta(scene, w0sq);
+    theta_g_of(scene.rho, scene.f, vartheta(scene, w0sq))
+}
+
+/// Θ_G of a rolling phase with energy invariant ϑ = 2 cos Θa + (1+ρ) Θ̇a² (eq 36, rationalised
+/// as in [`theta_g`]): the angle > 0 where H = T/N reaches f; `None` when N < 0 on the whole
+/// bead.
+pub fn theta_g_of(rho: f64, f: f64, th: f64) -> Option<f64> {
     let p = 3.0 + rho;
     let disc = rho * rho + f * f * (p - th) * (p + th);
     if disc < 0.0 || p - th < 0.0 {

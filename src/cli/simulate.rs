@@ -231,9 +231,7 @@ pub fn regime_b_interval(
     let top = 89f64.to_radians();
     let grid: Vec<f64> = (1..n).map(|i| top * i as f64 / n as f64).collect();
     let flags: Vec<bool> = grid.iter().map(|&d| ok(d)).collect();
-    let Some(best) = longest_run(&flags) else {
-        return None;
-    };
+    let best = longest_run(&flags)?;
     let bisect = |mut good: f64, mut bad: f64| {
         for _ in 0..60 {
             let m = 0.5 * (good + bad);

@@ -527,20 +527,19 @@ impl Contact {
                         None => break,
                     }
                 };
-                // Stretch end.
+                // Stretch end: the first grid point where σq ≥ 0 again. It need not be
+                // refined: past the true end σs rises, so the first zero of σs after d0 is
+                // the same on [d0, d1].
                 let mut d1 = end;
                 while i < n {
-                    let (a, b) = (grid(i), grid(i + 1));
+                    let b = grid(i + 1);
                     let qb = sq(b);
                     i += 1;
+                    qa = qb;
                     if qb >= 0.0 {
-                        d1 = brent(sq, a, b, qa, qb, 1e-15, 200)
-                            .map(|r| r.x)
-                            .unwrap_or(b);
-                        qa = qb;
+                        d1 = b;
                         break;
                     }
-                    qa = qb;
                 }
                 let g0 = g_known + g_int(t_known, d0);
                 let s0 = sig_s(d0, g0);

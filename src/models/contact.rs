@@ -472,8 +472,9 @@ impl Contact {
         // towards 0 only where σ q < 0.
         let eps_f = sigma * f / rho;
         let integrand = |t: f64| {
-            let uu = u(t).max(f64::MIN_POSITIVE);
-            (t.cos() - uu) / uu.sqrt()
+            let (uu, _, c) = ph.speed_sq_sin_cos(t);
+            let uu = uu.max(f64::MIN_POSITIVE);
+            (c - uu) / uu.sqrt()
         };
         let g_int = |a: f64, b: f64| -> f64 {
             if b == a {
@@ -483,8 +484,8 @@ impl Contact {
         };
         // σ q(θ): the sign of dσs/dθ = ((1+ρ)/ρ) σ q / Θ̇.
         let sq = |t: f64| {
-            let n = nrm(t);
-            sigma * (rho * t.sin() / (1.0 + rho) - sigma * f * n)
+            let (uu, sn, c) = ph.speed_sq_sin_cos(t);
+            sigma * (rho * sn / (1.0 + rho) - sigma * f * (c - uu))
         };
         // s relative to its sign: σ s(θ) = σ (Θ̇ − wa) − (f/ρ) G(θ).
         let sig_s = |t: f64, g: f64| sigma * (u(t).max(0.0).sqrt() - wa) - eps_f * sigma * g;
@@ -655,9 +656,10 @@ impl Contact {
             (None, true) => {
                 let [g, t] = integrate_smooth_n(
                     |t| {
-                        let uu = u(t).max(f64::MIN_POSITIVE);
+                        let (uu, _, c) = ph.speed_sq_sin_cos(t);
+                        let uu = uu.max(f64::MIN_POSITIVE);
                         let r = 1.0 / uu.sqrt();
-                        [(t.cos() - uu) * r, r]
+                        [(c - uu) * r, r]
                     },
                     ta,
                     end,
@@ -782,43 +784,67 @@ impl Contact {
         }
     }
 
-    /// Secant iteration on g(y) = P(y) − y from the start and one plain step of the map: the
-    /// map is smooth near an ordinary fixed point, so this converges superlinearly (about 5
-    /// contacts from the stick/slip state). `None` when it does not settle (a jump of the map,
-    /// a failure of a contact, slow progress): the bracketing search takes over.
-    fn secant_1d(&self, scene: &Scene, y0: f64, g0: f64) -> Option<(f64, usize, f64)> {
+    /// g(y) = P(y) − y with the contact run that gave it (failures mapped as in `excess`).
+    fn excess_run(&self, scene: &Scene, y: f64) -> (f64, ContactRun) {
+        let r = self.run(
+            scene,
+            Launch {
+                theta_dot: y,
+                spin: y,
+            },
+        );
+        let g = match r.end {
+            ContactEnd::Collision { theta_dot, spin } => {
+                self.collide(scene, theta_dot, spin).theta_dot - y
+            }
+            ContactEnd::Failed(NotSteady::Stops { .. }) => -y.max(1e-300),
+            ContactEnd::Failed(_) => f64::INFINITY,
+        };
+        (g, r)
+    }
+
+    /// Secant iteration on g(y) = P(y) − y from the start y0 and a second point y0 +
+    /// g0/(1 − K²) (the rolling map's slope K² as the first estimate of P'): the map is smooth
+    /// near an ordinary fixed point, so this converges superlinearly — 3 to 4 contacts from the
+    /// stick/slip state. Stops once a secant step is below 1e-10 relative (the next iterate is
+    /// then within ~1e-14 of the root, the steps shrinking superlinearly) and returns that
+    /// iterate's run with the slope g' of the last secant. `None` when it does not settle (a
+    /// jump of the map, a failed contact, no progress): the bracketing search takes over.
+    fn secant_1d(&self, scene: &Scene, y0: f64, g0: f64) -> Option<(f64, usize, f64, ContactRun)> {
         let (mut ya, mut ga) = (y0, g0);
-        let mut yb = y0 + g0;
+        let slope = (scene.k * scene.k).min(0.9);
+        let mut yb = y0 + g0 / (1.0 - slope);
         if !(yb > 0.0 && yb.is_finite()) {
             return None;
         }
-        let mut gb = self.excess(scene, yb);
+        let (mut gb, mut rb) = self.excess_run(scene, yb);
         let mut evals = 1;
         for _ in 0..12 {
             if !gb.is_finite() || gb <= -yb {
                 return None;
             }
-            if gb.abs() <= 4.0 * f64::EPSILON * yb {
-                return Some((yb, evals, (gb - ga) / (yb - ya)));
-            }
             let d = gb - ga;
             if d == 0.0 {
-                return None;
+                return (gb.abs() <= 4.0 * f64::EPSILON * yb).then_some((yb, evals, -0.5, rb));
             }
-            let yc = yb - gb * (yb - ya) / d;
+            let dg = d / (yb - ya);
+            if gb.abs() <= 4.0 * f64::EPSILON * yb {
+                return Some((yb, evals, dg, rb));
+            }
+            let yc = yb - gb / dg;
             if !(yc > 0.0 && yc.is_finite()) {
                 return None;
             }
-            if (yc - yb).abs() <= 2.0 * f64::EPSILON * yb {
-                return Some((yc, evals, d / (yb - ya)));
-            }
-            let gc = self.excess(scene, yc);
+            let (gc, rc) = self.excess_run(scene, yc);
             evals += 1;
+            if (yc - yb).abs() <= 1e-10 * yb && gc.abs() <= (yc - yb).abs() {
+                return Some((yc, evals, dg, rc));
+            }
             if !(gc.abs() < gb.abs()) {
                 // No progress: at the map's own rounding level when tiny, otherwise not smooth.
-                return (gb.abs() <= 1e-13 * yb).then_some((yb, evals, d / (yb - ya)));
+                return (gb.abs() <= 1e-13 * yb).then_some((yb, evals, dg, rb));
             }
-            (ya, ga, yb, gb) = (yb, gb, yc, gc);
+            (ya, ga, yb, gb, rb) = (yb, gb, yc, gc, rc);
         }
         None
     }
@@ -829,18 +855,19 @@ impl Contact {
         let mut g = self.excess(scene, y);
         let mut beads = 1;
         if g != 0.0 && g.is_finite() {
-            if let Some((ys, n, dg)) = self.secant_1d(scene, y, g) {
+            if let Some((ys, n, dg, run)) = self.secant_1d(scene, y, g) {
                 // H(y) = y to rounding: a fixed point. It is the one a bead settles on when
                 // stable, |H'| < 1, i.e. −2 < g' < 0 (g' from the last secant); otherwise
                 // follow the map as a bead would.
                 if dg < 0.0 && dg > -2.0 {
-                    return self.finish(
+                    return self.finish_run(
                         scene,
                         Launch {
                             theta_dot: ys,
                             spin: ys,
                         },
                         beads + n,
+                        run,
                     );
                 }
                 beads += n;
@@ -1024,7 +1051,17 @@ impl Contact {
         l: Launch,
         beads: usize,
     ) -> std::result::Result<SteadyContact, NotSteady> {
-        let r = self.run(scene, l);
+        self.finish_run(scene, l, beads, self.run(scene, l))
+    }
+
+    /// The steady contact from the run at its launch `l`.
+    fn finish_run(
+        &self,
+        scene: &Scene,
+        l: Launch,
+        beads: usize,
+        r: ContactRun,
+    ) -> std::result::Result<SteadyContact, NotSteady> {
         let ContactEnd::Collision { theta_dot, spin } = r.end else {
             let ContactEnd::Failed(e) = r.end else {
                 unreachable!()

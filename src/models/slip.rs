@@ -71,6 +71,22 @@ impl SlipPhase {
             + self.c * (dcos - self.cos_s * em1)
     }
 
+    /// [`Self::speed_sq`] with sin θ and cos θ, which come almost free from the half-angle
+    /// sines and cosines it already needs (addition formulas: a few ulp).
+    #[inline]
+    pub fn speed_sq_sin_cos(&self, theta: f64) -> (f64, f64, f64) {
+        let d = theta - self.theta_s;
+        let em1 = (2.0 * self.f * d).exp_m1();
+        let (sh, ch) = (0.5 * d).sin_cos();
+        let (sm, cm) = (self.theta_s + 0.5 * d).sin_cos();
+        let dsin = 2.0 * cm * sh;
+        let dcos = -2.0 * sm * sh;
+        let u = self.ws_sq * (1.0 + em1)
+            + self.b * (dsin - self.sin_s * em1)
+            + self.c * (dcos - self.cos_s * em1);
+        (u, sm * ch + cm * sh, cm * ch - sm * sh)
+    }
+
     /// d(Θ̇²)/dθ = 2 Θ̈ = 2 (sin θ − f (cos θ − Θ̇²)) (eq 37).
     #[inline]
     pub fn speed_sq_slope(&self, theta: f64) -> f64 {

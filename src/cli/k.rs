@@ -240,6 +240,15 @@ pub fn parse_model(name: &str) -> Result<Model, CliError> {
         ));
     }
     // --- end md ---
+    // --- auto (work-precision, issue 7) ---
+    if kind == ModelKind::Auto {
+        return Err(super::flag_error(
+            "--model",
+            name,
+            "model auto is available in forward and bench; for k and klaw choose a model",
+        ));
+    }
+    // --- end auto ---
     kind.contact_model().ok_or_else(err)
 }
 

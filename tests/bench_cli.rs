@@ -187,3 +187,79 @@ fn forward_auto_rejects_a_bad_tolerance() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--tol"));
 }
+
+fn k_rows(args: &[&str]) -> Vec<HashMap<String, String>> {
+    let out = bin().arg("k").args(args).output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    parse_csv(&String::from_utf8(out.stdout).unwrap()).1
+}
+
+#[test]
+fn k_auto_inverts_each_row_with_the_model_it_names() {
+    // The embedded default data set: every row says its model, and its K is that model's K.
+    let auto = k_rows(&["--model", "auto", "--tol", "1e-10"]);
+    let ss = k_rows(&["--model", "stickslip"]);
+    let contact = k_rows(&["--model", "contact"]);
+    let stick = k_rows(&["--model", "stick"]);
+    assert!(!auto.is_empty());
+    let mut used = std::collections::HashSet::new();
+    for (i, a) in auto.iter().enumerate() {
+        assert_eq!(a["model"], "auto");
+        assert!(a["reason"].starts_with("at the stick K"), "{a:?}");
+        used.insert(a["model_used"].clone());
+        let other = match a["model_used"].as_str() {
+            "stick" => &stick[i],
+            "stickslip" => &ss[i],
+            "contact" => &contact[i],
+            m => panic!("model_used {m}"),
+        };
+        assert_eq!(a["status"], other["status"], "{a:?}");
+        if a["K"].is_empty() {
+            continue;
+        }
+        let (ka, ko) = (num(a, "K"), num(other, "K"));
+        // contact inside auto runs at T/10 = 1e-11 (the plain run at 1e-14).
+        assert!(((ka - ko) / ko).abs() <= 1e-9, "{a:?} vs {ko}");
+        // The choice was made at the stick K of the same row.
+        if !stick[i]["K"].is_empty() {
+            let ks = num(&stick[i], "K");
+            assert!(a["reason"].contains(&format!("{ks:.6}")), "{a:?} {ks}");
+        }
+    }
+    assert!(
+        used.contains("contact") && used.contains("stickslip"),
+        "{used:?}"
+    );
+}
+
+#[test]
+fn klaw_auto_fits_with_the_most_general_model_any_point_needs_and_says_so() {
+    let out = bin()
+        .args(["klaw", "--model", "auto", "--tol", "1e-10"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let (_, rows) = parse_csv(&String::from_utf8(out.stdout).unwrap());
+    let c = rows.iter().find(|r| r["fit"] == "klaw-c").unwrap();
+    // The fit summary (stderr) carries the note.
+    assert!(
+        err.contains("klaw-c [all]") && err.contains("model_used contact for all points"),
+        "{err}"
+    );
+    // The same fit as --model contact at the auto's inner tolerance: c agrees closely.
+    let out = bin().args(["klaw", "--model", "contact"]).output().unwrap();
+    let (_, plain) = parse_csv(&String::from_utf8(out.stdout).unwrap());
+    let p = plain.iter().find(|r| r["fit"] == "klaw-c").unwrap();
+    let (ca, cp) = (num(c, "value"), num(p, "value"));
+    assert!(((ca - cp) / cp).abs() < 1e-8, "{ca} {cp}");
+    let bad = bin()
+        .args(["k", "--model", "auto", "--tol", "2"])
+        .output()
+        .unwrap();
+    assert_eq!(bad.status.code(), Some(2));
+}

@@ -206,3 +206,40 @@ impl Auto {
         self.choose(scene).outcome
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::CollisionLaw;
+
+    fn scene(xi: f64, d: f64, f: f64) -> Scene {
+        Scene::new(xi, d, 0.4, f, CollisionLaw::Adjusted).unwrap()
+    }
+
+    #[test]
+    fn auto_picks_each_model_where_its_assumptions_hold_and_meets_the_general_model() {
+        let auto = Auto { tol: 1e-10 };
+        let general = Contact {
+            spin: SpinRule::Roll,
+            tol: 1e-14,
+        };
+        // (scene, expected choice): f = 0.5 never slips; the paper's Fig. 7 scenes slip
+        // after the top (ξ = 2) and before it (ξ = 1, Θ0 ≈ −18.5° < −Θ_G ≈ −15.7°).
+        for (s, want) in [
+            (scene(2.0, 5.73, 0.5), Choice::Stick),
+            (scene(2.0, 5.73, 0.1), Choice::StickSlip),
+            (scene(1.0, 11.53, 0.1), Choice::Contact),
+        ] {
+            let r = auto.choose(&s);
+            assert_eq!(r.choice, want, "{:?}", r.reason);
+            let va = r.outcome.unwrap().mean_velocity;
+            let vg = general.evaluate(&s).unwrap().mean_velocity;
+            assert!(((va - vg) / vg).abs() <= auto.tol, "{want:?}: {va} {vg}");
+        }
+        let s = scene(2.0, 5.73, 0.5);
+        assert_eq!(
+            auto.evaluate(&s).unwrap().mean_velocity,
+            stick::steady(&s).unwrap().mean_velocity
+        );
+    }
+}

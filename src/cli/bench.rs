@@ -701,16 +701,24 @@ pub fn render(rows: &[WpRow]) -> csv::Result<Vec<u8>> {
 }
 
 /// The work-precision diagram: log10 median time per evaluation against log10 maximum
-/// relative error, one curve per model (its tolerances joined), single methods as points.
+/// relative error, one curve per model and method (its tolerances joined), single methods as
+/// points. A method that is invalid on some scenes (infinite maximum error) is drawn at its
+/// median error and says so in its label.
 pub fn plot(rows: &[WpRow], title: &str) -> Result<String, String> {
     use plotters::prelude::*;
     let floor = 1e-17f64;
-    let pts: Vec<(&WpRow, f64, f64)> = rows
+    // (row, x, y, drawn at the median error)
+    let pts: Vec<(&WpRow, f64, f64, bool)> = rows
         .iter()
         .filter(|r| !r.method.starts_with("crosscheck") && !r.model.starts_with("k-"))
         .filter_map(|r| {
             let t = r.ns_median?;
-            (r.err_max.is_finite() && t > 0.0).then(|| (r, r.err_max.max(floor).log10(), t.log10()))
+            let (e, median) = if r.err_max.is_finite() {
+                (r.err_max, false)
+            } else {
+                (r.err_median, true)
+            };
+            (e.is_finite() && t > 0.0).then(|| (r, e.max(floor).log10(), t.log10(), median))
         })
         .collect();
     let (mut x0, mut x1, mut y0, mut y1) = (-17.0f64, 0.0f64, f64::INFINITY, f64::NEG_INFINITY);
@@ -736,27 +744,32 @@ pub fn plot(rows: &[WpRow], title: &str) -> Result<String, String> {
             .map_err(|e| e.to_string())?;
         chart
             .configure_mesh()
-            .x_desc("log10 max relative error of v (errors below 1e-17 drawn at -17)")
+            .x_desc("log10 max relative error of v (below 1e-17 drawn at -17)")
             .y_desc("log10 median time per evaluation (ns)")
             .draw()
             .map_err(|e| e.to_string())?;
-        let mut models: Vec<&str> = Vec::new();
+        let mut groups: Vec<(&str, &str)> = Vec::new();
         for p in &pts {
-            if !models.contains(&p.0.model.as_str()) {
-                models.push(&p.0.model);
+            let g = (p.0.model.as_str(), p.0.method.as_str());
+            if !groups.contains(&g) {
+                groups.push(g);
             }
         }
-        for (i, m) in models.iter().enumerate() {
+        for (i, (m, meth)) in groups.iter().enumerate() {
             let colour = Palette99::pick(i).to_rgba();
-            let line: Vec<(f64, f64)> = pts
+            let sel: Vec<&(&WpRow, f64, f64, bool)> = pts
                 .iter()
-                .filter(|p| p.0.model == *m)
-                .map(|p| (p.1, p.2))
+                .filter(|p| p.0.model == *m && p.0.method == *meth)
                 .collect();
-            let label = match pts.iter().find(|p| p.0.model == *m) {
-                Some(p) if line.len() == 1 => format!("{m} ({})", p.0.method),
-                _ => m.to_string(),
+            let line: Vec<(f64, f64)> = sel.iter().map(|p| (p.1, p.2)).collect();
+            let mut label = if *meth == "auto" || *meth == "quadrature" {
+                format!("{m} (tolerances)")
+            } else {
+                format!("{m} ({meth})")
             };
+            if sel.iter().any(|p| p.3) {
+                label.push_str(": median error, invalid on some scenes");
+            }
             chart
                 .draw_series(LineSeries::new(line.clone(), colour.stroke_width(2)))
                 .map_err(|e| e.to_string())?

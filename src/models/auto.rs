@@ -13,7 +13,9 @@
 //!    Θ0 to Θ_G and slips after (the paper's sequence).
 //! 3. **General contact model** at a tolerance matched to T otherwise: Θ0 < −Θ_G (slip before
 //!    the top, which the paper's stick/slip sequence ignores), or stick/slip has no steady
-//!    state (map jump, runaway, stop) and the general model decides.
+//!    state (map jump, runaway, stop) and the general model decides. Where Θ0 < −Θ_G already
+//!    at the rolling launch and the stick/slip map carries the rolling final velocity upwards,
+//!    this is decided without solving stick/slip ([`Reason::SlipBeforeTopRolling`]).
 //!
 //! The stick approximation (eq 29) is never chosen: its error (about 1 %, growing as k'²
 //! grows) has no cheap a-priori bound that was checked to hold on every scene, and the exact
@@ -84,6 +86,16 @@ pub enum Reason {
         /// Θ0.
         theta_0: f64,
     },
+    /// Θ0 < −Θ_G at the rolling steady launch, and the stick/slip map carries the rolling
+    /// final velocity L upwards (map(L) ≥ L), so the stick/slip fixed point launches at least as
+    /// fast and its Θ_G (decreasing in the launch velocity, eq 36) is smaller still: slip
+    /// before the top, decided without solving stick/slip.
+    SlipBeforeTopRolling {
+        /// Θ_G at the rolling steady launch (an upper bound of the stick/slip one).
+        theta_g: f64,
+        /// Θ0.
+        theta_0: f64,
+    },
     /// The friction demand has no real Θ_G (eq 36) at the stick/slip steady launch.
     NoThetaG,
     /// Stick/slip has no steady state; the general model decides.
@@ -108,6 +120,13 @@ impl fmt::Display for Reason {
             Reason::SlipBeforeTop { theta_g, theta_0 } => write!(
                 f,
                 "slip before the top: Theta_0 = {:.4} deg < -Theta_G = {:.4} deg",
+                theta_0.to_degrees(),
+                -theta_g.to_degrees()
+            ),
+            Reason::SlipBeforeTopRolling { theta_g, theta_0 } => write!(
+                f,
+                "slip before the top: Theta_0 = {:.4} deg < -Theta_G = {:.4} deg at the rolling \
+                 launch, and stick/slip launches faster (smaller Theta_G)",
                 theta_0.to_degrees(),
                 -theta_g.to_degrees()
             ),
@@ -145,6 +164,13 @@ impl Auto {
 
     /// Chooses the model for one scene and evaluates it.
     pub fn choose(&self, scene: &Scene) -> AutoOutcome {
+        self.choose_with(scene, true)
+    }
+
+    /// [`Auto::choose`], with (`shortcut`) or without the test that decides slip before the
+    /// top from the rolling steady state alone ([`Reason::SlipBeforeTopRolling`]); both give
+    /// the same choice.
+    pub fn choose_with(&self, scene: &Scene, shortcut: bool) -> AutoOutcome {
         if let Ok(s) = stick::steady(scene) {
             let w0 = s.initial_velocity;
             if let Some(tg) = theta_g(scene, w0 * w0) {
@@ -159,6 +185,24 @@ impl Auto {
                             theta_f: scene.theta_f,
                         },
                     };
+                }
+                // Θ_G falls as the launch velocity grows (eq 36: tan(Θ_G/2) increases with
+                // ρ̃ = 3 + ρ − ϑ and ϑ grows with Θ̇0²). When map(L) ≥ L, the stick/slip
+                // fixed point is searched upwards from L (stickslip::fixed_point_from), so it
+                // launches at least as fast as rolling and Θ0 < −Θ_G holds there too; if it
+                // has no fixed point, the general model decides as well.
+                if shortcut && scene.theta_0 < -tg {
+                    let l = s.final_velocity;
+                    if matches!(stickslip::map(scene, l), Ok(m) if m.final_velocity >= l) {
+                        return AutoOutcome {
+                            outcome: self.contact().evaluate(scene),
+                            choice: Choice::Contact,
+                            reason: Reason::SlipBeforeTopRolling {
+                                theta_g: tg,
+                                theta_0: scene.theta_0,
+                            },
+                        };
+                    }
                 }
             }
         }
@@ -236,6 +280,21 @@ mod tests {
             let vg = general.evaluate(&s).unwrap().mean_velocity;
             assert!(((va - vg) / vg).abs() <= auto.tol, "{want:?}: {va} {vg}");
         }
+        // The shortcut changes nothing but the reason, on the bench's scenes (hard ones
+        // included).
+        let mut fired = 0;
+        for (s, _) in crate::cli::bench::draw_scenes(400, 3) {
+            for tol in [1e-4, 1e-10] {
+                let a = Auto { tol };
+                let (x, y) = (a.choose_with(&s, true), a.choose_with(&s, false));
+                assert_eq!(x.choice, y.choice, "{:?} {:?}", x.reason, y.reason);
+                assert_eq!(x.outcome, y.outcome);
+                if matches!(x.reason, Reason::SlipBeforeTopRolling { .. }) {
+                    fired += 1;
+                }
+            }
+        }
+        assert!(fired > 50, "{fired}");
         let s = scene(2.0, 5.73, 0.5);
         assert_eq!(
             auto.evaluate(&s).unwrap().mean_velocity,

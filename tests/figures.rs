@@ -114,3 +114,10 @@ fn report_figures_render() {
         assert!(colours > 8, "{name}: {colours} colours");
     }
 }
+
+// --- work-precision (issue 7) ---
+#[test]
+fn bench_plot_renders() {
+    check("bench_wp", &["bench", "--scenes", "40"]);
+}
+// --- end work-precision ---

@@ -5,6 +5,9 @@ use crate::error::Error;
 use crate::io::scenes::Table;
 use crate::io::{fmt_f64, InputError};
 use crate::models::contact::{Contact, SpinRule, SteadyContact};
+// --- auto (work-precision, issue 7) ---
+use crate::models::auto::{Auto, AutoOutcome};
+// --- end auto ---
 use crate::models::jaeger::Jaeger;
 use crate::models::jan::Jan;
 use crate::models::{regime_of, ForwardModel, JaegerBranch, Model, ModelKind, Outcome};
@@ -19,7 +22,8 @@ use std::path::PathBuf;
 /// Arguments of `fitbead forward`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Forward model: stick, stick-approx, slip, slip-approx, stickslip, jan, jaeger, md.
+    /// Forward model: stick, stick-approx, slip, slip-approx, stickslip, contact, jan, jaeger,
+    /// md, or auto (per scene the cheapest model meeting --tol whose assumptions hold).
     #[arg(long)]
     pub model: String,
     /// Scenes CSV with columns xi,delta_deg[,K,rho,f] (K a number or a law name); extra columns
@@ -69,7 +73,8 @@ pub struct Args {
     /// column overrides it per row.
     #[arg(long, default_value = "roll")]
     pub spin: String,
-    /// Relative tolerance of the contact model's quadratures (time and spin during slip).
+    /// Relative tolerance of the contact model's quadratures (time and spin during slip); with
+    /// --model auto, the target relative tolerance T on v.
     #[arg(long, default_value_t = 1e-14)]
     pub tol: f64,
     // --- md (molecular dynamics, issue 9) ---
@@ -92,6 +97,11 @@ pub const CONTACT_COLUMNS: [&str; 10] = [
     "energy_closure",
     "spin_rule",
 ];
+
+// --- auto (work-precision, issue 7) ---
+/// Columns added after [`OUTPUT_COLUMNS`] by --model auto: the model used and why.
+pub const AUTO_COLUMNS: [&str; 2] = ["model_used", "reason"];
+// --- end auto ---
 
 /// Output columns added to each row.
 pub const OUTPUT_COLUMNS: [&str; 12] = [
@@ -228,6 +238,9 @@ pub fn run(a: Args) -> Result<(), CliError> {
         let f = t.opt_number(r, c_f)?.unwrap_or(a.f);
         let scene = Scene::new(xi, d, rho, f, law).map_err(|e| scene_error(&t, r, e, &cols))?;
         let model = match (kind, kind.contact_model()) {
+            // --- auto (work-precision, issue 7) ---
+            (ModelKind::Auto, _) => Model::Auto(Auto { tol: a.tol }),
+            // --- end auto ---
             (ModelKind::Contact, _) => {
                 let spin = match c_spin {
                     Some(c) if !t.cell(r, c).is_empty() => t
@@ -271,7 +284,8 @@ pub fn run(a: Args) -> Result<(), CliError> {
         };
         jobs.push(Job { scene, model });
     }
-    let (outcomes, details): (Vec<Outcome>, Vec<Option<ContactDetail>>) = jobs
+    // --- auto (work-precision, issue 7): the auto choice travels with each outcome ---
+    let evaluated: Vec<(Outcome, Option<ContactDetail>, Option<AutoOutcome>)> = jobs
         .par_iter()
         .map(|j| match j.model {
             Model::Contact(c) => {
@@ -282,13 +296,27 @@ pub fn run(a: Args) -> Result<(), CliError> {
                         rule: c.spin,
                         steady: r.ok(),
                     }),
+                    None,
                 )
             }
-            m => (m.evaluate(&j.scene), None),
+            Model::Auto(au) => {
+                let r = au.choose(&j.scene);
+                (r.outcome, None, Some(r))
+            }
+            m => (m.evaluate(&j.scene), None, None),
         })
-        .unzip();
-    let bytes =
-        render(&t, &jobs, &outcomes, &details, kind).map_err(|e| CliError::Other(e.to_string()))?;
+        .collect();
+    let mut outcomes = Vec::with_capacity(evaluated.len());
+    let mut details = Vec::with_capacity(evaluated.len());
+    let mut autos = Vec::with_capacity(evaluated.len());
+    for (o, d, au) in evaluated {
+        outcomes.push(o);
+        details.push(d);
+        autos.push(au);
+    }
+    let bytes = render(&t, &jobs, &outcomes, &details, &autos, kind)
+        .map_err(|e| CliError::Other(e.to_string()))?;
+    // --- end auto ---
     emit(a.output.as_deref(), &bytes)
 }
 
@@ -325,6 +353,7 @@ fn render(
     jobs: &[Job],
     outcomes: &[Outcome],
     details: &[Option<ContactDetail>],
+    autos: &[Option<AutoOutcome>],
     kind: ModelKind,
 ) -> csv::Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::with_capacity(t.rows.len() * 160));
@@ -346,10 +375,23 @@ fn render(
     if general {
         header.extend(CONTACT_COLUMNS.iter().map(|s| s.to_string()));
     }
+    // --- auto (work-precision, issue 7) ---
+    let auto = kind == ModelKind::Auto;
+    if auto {
+        header.extend(AUTO_COLUMNS.iter().map(|s| s.to_string()));
+    }
+    // --- end auto ---
     w.write_record(&header)?;
     let contact = !matches!(kind, ModelKind::Jan | ModelKind::Jaeger);
     let opt = |x: Option<f64>| x.map(fmt_f64).unwrap_or_default();
-    for (((rec, job), o), d) in t.rows.iter().zip(jobs).zip(outcomes).zip(details) {
+    for ((((rec, job), o), d), au) in t
+        .rows
+        .iter()
+        .zip(jobs)
+        .zip(outcomes)
+        .zip(details)
+        .zip(autos)
+    {
         let mut out: Vec<String> = rec.iter().map(|s| s.to_string()).collect();
         let regime = regime_of(o).map(|r| r.to_string()).unwrap_or_default();
         match o {
@@ -402,6 +444,17 @@ fn render(
         if let (true, Some(d)) = (general, d) {
             out.extend(contact_cells(job, d));
         }
+        // --- auto (work-precision, issue 7) ---
+        if auto {
+            match au {
+                Some(r) => {
+                    out.push(r.choice.name().to_string());
+                    out.push(r.reason.to_string());
+                }
+                None => out.extend([String::new(), String::new()]),
+            }
+        }
+        // --- end auto ---
         w.write_record(&out)?;
     }
     w.into_inner().map_err(|e| csv::Error::from(e.into_error()))

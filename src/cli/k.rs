@@ -3,6 +3,10 @@
 
 use super::{emit, read_input, CliError};
 use crate::fit::k::{estimate, KEstimate, KFailure, LowerLimit, UpperLimit};
+// --- auto (work-precision, issue 7) ---
+use crate::fit::kauto::{self, KChoice};
+use crate::models::auto::Auto;
+// --- end auto ---
 use crate::io::scenes::Table;
 use crate::io::{fmt_f64, write_atomic, InputError};
 use crate::models::{Model, ModelKind};
@@ -14,7 +18,8 @@ use std::path::PathBuf;
 /// Arguments of `fitbead k`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Contact model: stick, stick-approx, slip, slip-approx, stickslip.
+    /// Contact model: stick, stick-approx, slip, slip-approx, stickslip, contact, or auto (per
+    /// row the model chosen at the stick K; see --tol).
     #[arg(long)]
     pub model: String,
     /// Measurements CSV: series,xi,delta_deg,v[,sigma_v] (v dimensionless), or dimensional
@@ -40,6 +45,11 @@ pub struct Args {
     /// lines (as the paper's Fig. 5).
     #[arg(long)]
     pub plot: Option<PathBuf>,
+    // --- auto (work-precision, issue 7) ---
+    /// With --model auto: the target relative tolerance T on v of the model chosen per row.
+    #[arg(long, default_value_t = 1e-10)]
+    pub tol: f64,
+    // --- end auto ---
 }
 
 /// The contract columns, in order.
@@ -63,6 +73,12 @@ pub const COLUMNS: [&str; 18] = [
     "status",
     "iterations",
 ];
+
+// --- auto (work-precision, issue 7) ---
+/// Columns added after [`EXTRA_COLUMNS`] by --model auto: the model each row was inverted
+/// with, and why.
+pub const AUTO_COLUMNS: [&str; 2] = ["model_used", "reason"];
+// --- end auto ---
 
 /// Columns added after the contract ones.
 pub const EXTRA_COLUMNS: [&str; 5] = ["K_min", "K_max", "lower_limit", "upper_limit", "message"];
@@ -240,22 +256,60 @@ pub fn parse_model(name: &str) -> Result<Model, CliError> {
         ));
     }
     // --- end md ---
+    // --- auto (work-precision, issue 7) ---
+    if kind == ModelKind::Auto {
+        return Err(super::flag_error(
+            "--model",
+            name,
+            "model auto is chosen per row by k and klaw themselves (see --tol), not here",
+        ));
+    }
+    // --- end auto ---
     kind.contact_model().ok_or_else(err)
 }
 
+// --- auto (work-precision, issue 7) ---
+/// The auto model of `--model auto --tol T` (k and klaw), or `None` for any other model.
+pub fn parse_auto(name: &str, tol: f64) -> Result<Option<Auto>, CliError> {
+    if name != "auto" {
+        return Ok(None);
+    }
+    if !(tol > 0.0 && tol < 1.0) {
+        return Err(super::flag_error(
+            "--tol",
+            &tol.to_string(),
+            "expected a relative tolerance in (0, 1)",
+        ));
+    }
+    Ok(Some(Auto { tol }))
+}
+// --- end auto ---
+
 /// Runs `fitbead k`.
 pub fn run(a: Args) -> Result<(), CliError> {
-    let model = parse_model(&a.model)?;
+    // --- auto (work-precision, issue 7): per row, the model chosen at the stick K ---
+    let auto = parse_auto(&a.model, a.tol)?;
+    let model = match auto {
+        Some(_) => Model::Stick,
+        None => parse_model(&a.model)?,
+    };
     let input = a.input.as_deref().or(a.data.as_deref());
     let (source, text) = read_input(input)?;
     let t = Table::parse(&source, &text)?;
     let rows = read_rows(&t, a.rho, a.f, a.g)?;
-    let results: Vec<KEstimate> = rows
+    let (results, autos): (Vec<KEstimate>, Vec<Option<KChoice>>) = rows
         .par_iter()
-        .map(|r| estimate(&model, &r.scene, r.v, r.sigma_v))
-        .collect();
-    let bytes =
-        render(&t, &rows, &results, &a.model).map_err(|e| CliError::Other(e.to_string()))?;
+        .map(|r| match &auto {
+            Some(au) => {
+                let c = kauto::choose(au, &r.scene, r.v);
+                (estimate(&c.model, &r.scene, r.v, r.sigma_v), Some(c))
+            }
+            None => (estimate(&model, &r.scene, r.v, r.sigma_v), None),
+        })
+        .unzip();
+    let bytes = render(&t, &rows, &results, &autos, &a.model)
+        .map_err(|e| CliError::Other(e.to_string()))?;
+    // --- end auto ---
     if let Some(p) = &a.plot {
         let svg = plot(&rows, &results, &a.model).map_err(CliError::Other)?;
         write_atomic(p, svg.as_bytes())
@@ -279,13 +333,24 @@ fn upper_name(u: UpperLimit) -> &'static str {
     }
 }
 
-fn render(t: &Table, rows: &[Row], res: &[KEstimate], model: &str) -> csv::Result<Vec<u8>> {
+fn render(
+    t: &Table,
+    rows: &[Row],
+    res: &[KEstimate],
+    autos: &[Option<KChoice>],
+    model: &str,
+) -> csv::Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::with_capacity(rows.len() * 260));
+    // --- auto (work-precision, issue 7): model_used, reason after the extra columns ---
+    let auto = autos.iter().any(|a| a.is_some());
+    let auto_cols: &[&str] = if auto { &AUTO_COLUMNS } else { &[] };
     let own: Vec<&str> = COLUMNS
         .iter()
         .chain(EXTRA_COLUMNS.iter())
+        .chain(auto_cols.iter())
         .copied()
         .collect();
+    // --- end auto ---
     let input_own = ["series", "xi", "delta_deg", "v", "sigma_v"];
     let pass: Vec<usize> = (0..t.headers.len())
         .filter(|&i| !input_own.contains(&t.headers[i].as_str()))
@@ -301,7 +366,7 @@ fn render(t: &Table, rows: &[Row], res: &[KEstimate], model: &str) -> csv::Resul
     }
     w.write_record(&header)?;
     let opt = |x: Option<f64>| x.map(fmt_f64).unwrap_or_default();
-    for (i, (row, e)) in rows.iter().zip(res).enumerate() {
+    for (i, ((row, e), au)) in rows.iter().zip(res).zip(autos).enumerate() {
         let s = &row.scene;
         let mut out: Vec<String> = Vec::with_capacity(header.len());
         out.push(row.series.clone());
@@ -351,6 +416,17 @@ fn render(t: &Table, rows: &[Row], res: &[KEstimate], model: &str) -> csv::Resul
         }
         msg.extend(e.notes.iter().cloned());
         out.push(msg.join("; "));
+        // --- auto (work-precision, issue 7) ---
+        if auto {
+            match au {
+                Some(c) => {
+                    out.push(c.choice.name().to_string());
+                    out.push(c.reason.clone());
+                }
+                None => out.extend([String::new(), String::new()]),
+            }
+        }
+        // --- end auto ---
         for &c in &pass {
             out.push(t.cell(i, c).to_string());
         }

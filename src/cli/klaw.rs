@@ -3,6 +3,11 @@
 
 use super::fitargs::FitArgs;
 use super::k::parse_model;
+// --- auto (work-precision, issue 7) ---
+use super::k::parse_auto;
+use crate::fit::kauto::{self, KChoice};
+use crate::models::Model;
+// --- end auto ---
 use super::CliError;
 use crate::fit::k::bracket;
 use crate::fit::klaw::{fit_law, fit_law_with, KLaw, KLawError};
@@ -14,7 +19,8 @@ use rayon::prelude::*;
 /// Arguments of `fitbead klaw`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Contact model: stick, slip or stickslip (stick-approx and slip-approx work too).
+    /// Contact model: stick, slip or stickslip (stick-approx and slip-approx work too), or auto
+    /// (the most general model any point needs at its stick K; see --tol).
     #[arg(long)]
     pub model: String,
     /// The law: c (K = cos 2α + c sin²α sin 2α), impact (K = (cos 2α + ρ)/(1 + ρ), scored
@@ -28,11 +34,22 @@ pub struct Args {
     /// Input, output and interval flags.
     #[command(flatten)]
     pub io: FitArgs,
+    // --- auto (work-precision, issue 7) ---
+    /// With --model auto: the target relative tolerance T on v.
+    #[arg(long, default_value_t = 1e-10)]
+    pub tol: f64,
+    // --- end auto ---
 }
 
 /// Runs `fitbead klaw`.
 pub fn run(a: Args) -> Result<(), CliError> {
-    let model = parse_model(&a.model)?;
+    // --- auto (work-precision, issue 7): the model is chosen once the data are read ---
+    let auto = parse_auto(&a.model, a.tol)?;
+    let mut model = match auto {
+        Some(_) => Model::Stick,
+        None => parse_model(&a.model)?,
+    };
+    // --- end auto ---
     let law: KLaw = a
         .law
         .parse()
@@ -44,6 +61,33 @@ pub fn run(a: Args) -> Result<(), CliError> {
         KLaw::Impact => &[],
     };
     let choice = a.io.method(names)?;
+    // --- auto (work-precision, issue 7): per point at its stick K (eq 69), then the most
+    // general model any point needs, for all points ---
+    let mut auto_note = String::new();
+    if let Some(au) = &auto {
+        let choices: Vec<KChoice> = ds
+            .points
+            .par_iter()
+            .map(|p| kauto::choose(au, &p.scene, p.v))
+            .collect();
+        let (c, n) = kauto::most_general(&choices);
+        model = choices
+            .iter()
+            .find(|k| k.choice == c)
+            .map(|k| k.model)
+            .unwrap_or(Model::Stick);
+        auto_note = format!(
+            "auto (T = {}): model_used {} for all points, the most general any point needs \
+             (per point at its stick K: stick {}, stickslip {}, contact {})",
+            fmt_f64(au.tol),
+            c.name(),
+            n[0],
+            n[1],
+            n[2]
+        );
+        eprintln!("fitbead klaw: {auto_note}");
+    }
+    // --- end auto ---
     if law == KLaw::Impact && matches!(choice.method, Method::Mcmc(_)) {
         return Err(super::flag_error(
             "--method",
@@ -120,6 +164,15 @@ pub fn run(a: Args) -> Result<(), CliError> {
         let imp = fit_law(model, &ds, KLaw::Impact, a.io.level, false).map_err(fail)?;
         stats.push(imp.summary.stats);
     }
+    // --- auto (work-precision, issue 7) ---
+    if !auto_note.is_empty() {
+        skipped_note = if skipped_note.is_empty() {
+            auto_note
+        } else {
+            format!("{auto_note}; {skipped_note}")
+        };
+    }
+    // --- end auto ---
     if !skipped_note.is_empty() {
         for s in stats.iter_mut() {
             s.note = if s.note.is_empty() {

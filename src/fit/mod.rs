@@ -5,6 +5,9 @@ pub mod data;
 pub mod jaeger;
 pub mod jan;
 pub mod k;
+// --- auto (work-precision, issue 7) ---
+pub mod kauto;
+// --- end auto ---
 pub mod klaw;
 pub mod posterior;
 pub mod summary;

@@ -4,6 +4,10 @@
 //! the bead stops (regime A, with where), lifts off or runs away (regime C), or a
 //! model-specific failure. No evaluation returns NaN or panics on a valid [`Scene`].
 
+// --- auto and stick by quadrature (work-precision, issue 7) ---
+pub mod auto;
+pub mod stickquad;
+// --- end auto ---
 pub mod contact;
 pub mod energy;
 pub mod jaeger;
@@ -242,11 +246,16 @@ pub enum Model {
     /// Ristow's soft-contact molecular dynamics (§5.3, eqs 91–92).
     Md(md::Md),
     // --- end md ---
+    // --- auto (work-precision, issue 7) ---
+    /// Per scene the cheapest model whose assumptions hold and whose error is within a target
+    /// tolerance (stick, stickslip or contact; [`auto::Auto`]).
+    Auto(auto::Auto),
+    // --- end auto ---
 }
 
 impl Model {
     /// Names accepted on the command line.
-    pub const NAMES: [&'static str; 9] = [
+    pub const NAMES: [&'static str; 10] = [
         "stick",
         "stick-approx",
         "slip",
@@ -256,6 +265,7 @@ impl Model {
         "jaeger",
         "contact",
         "md",
+        "auto",
     ];
 }
 
@@ -271,6 +281,7 @@ impl ForwardModel for Model {
             Model::Jaeger(_) => "jaeger",
             Model::Contact(_) => "contact",
             Model::Md(_) => "md",
+            Model::Auto(_) => "auto",
         }
     }
 
@@ -285,6 +296,7 @@ impl ForwardModel for Model {
             Model::Jaeger(m) => m.evaluate(scene),
             Model::Contact(m) => m.evaluate(scene),
             Model::Md(m) => m.evaluate(scene),
+            Model::Auto(m) => m.evaluate(scene),
         }
     }
 }
@@ -312,11 +324,15 @@ pub enum ModelKind {
     /// See [`Model::Md`].
     Md,
     // --- end md ---
+    // --- auto (work-precision, issue 7) ---
+    /// See [`Model::Auto`] (target tolerance 1e-10 unless set apart).
+    Auto,
+    // --- end auto ---
 }
 
 impl ModelKind {
-    /// The model for the five contact models, which need no parameters beyond the scene;
-    /// `None` for jan, jaeger and md.
+    /// The model for the five contact models and auto, which need no parameters beyond the
+    /// scene; `None` for jan, jaeger and md.
     pub fn contact_model(self) -> Option<Model> {
         Some(match self {
             ModelKind::Stick => Model::Stick,
@@ -327,6 +343,7 @@ impl ModelKind {
             ModelKind::Contact => Model::Contact(contact::Contact::default()),
             ModelKind::Jan | ModelKind::Jaeger => return None,
             ModelKind::Md => return None,
+            ModelKind::Auto => Model::Auto(auto::Auto::default()),
         })
     }
 }
@@ -344,6 +361,7 @@ impl FromStr for ModelKind {
             "jaeger" => ModelKind::Jaeger,
             "contact" => ModelKind::Contact,
             "md" => ModelKind::Md,
+            "auto" => ModelKind::Auto,
             _ => return Err(Error::UnknownModel(s.to_string())),
         })
     }

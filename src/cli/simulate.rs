@@ -194,6 +194,22 @@ fn trace(a: &Args, law: CollisionLaw, series: &[f64], v0: f64) -> Result<(), Cli
     emit(a.output.as_deref(), &bytes)
 }
 
+/// `--delta-range LO,HI` (degrees, LO < HI), when given.
+fn delta_range(flag: Option<&str>) -> Result<Option<(f64, f64)>, CliError> {
+    let Some(s) = flag else {
+        return Ok(None);
+    };
+    let r = parse_list("--delta-range", s)?;
+    if r.len() != 2 || !(r[0] < r[1]) {
+        return Err(super::flag_error(
+            "--delta-range",
+            s,
+            "expected LO,HI in degrees with LO < HI",
+        ));
+    }
+    Ok(Some((r[0], r[1])))
+}
+
 /// The longest run of `true` in `flags` as [start, end) indices; `None` when there is none.
 fn longest_run(flags: &[bool]) -> Option<(usize, usize)> {
     let (mut best, mut cur): ((usize, usize), Option<usize>) = ((0, 0), None);
@@ -328,20 +344,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         "lower" => JaegerBranch::Lower,
         b => return Err(super::flag_error("--branch", b, "expected upper or lower")),
     };
-    let range = match a.delta_range.as_deref() {
-        None => None,
-        Some(s) => {
-            let r = parse_list("--delta-range", s)?;
-            if r.len() != 2 || !(r[0] < r[1]) {
-                return Err(super::flag_error(
-                    "--delta-range",
-                    s,
-                    "expected LO,HI in degrees with LO < HI",
-                ));
-            }
-            Some((r[0], r[1]))
-        }
-    };
+    let range = delta_range(a.delta_range.as_deref())?;
     let mut rng = ChaCha8Rng::seed_from_u64(a.seed);
     let mut w = csv::Writer::from_writer(Vec::new());
     let io = |e: csv::Error| CliError::Other(e.to_string());
@@ -520,20 +523,7 @@ fn run_md(a: &Args, series: &[f64]) -> Result<(), CliError> {
             "md needs rho > 0 (the bead's moment of inertia)",
         ));
     }
-    let range = match a.delta_range.as_deref() {
-        None => None,
-        Some(s) => {
-            let r = parse_list("--delta-range", s)?;
-            if r.len() != 2 || !(r[0] < r[1]) {
-                return Err(super::flag_error(
-                    "--delta-range",
-                    s,
-                    "expected LO,HI in degrees with LO < HI",
-                ));
-            }
-            Some((r[0], r[1]))
-        }
-    };
+    let range = delta_range(a.delta_range.as_deref())?;
     let per_series = (MD_SCAN_POINTS + 2 * MD_REFINE + a.points) as u64;
     let bar = super::forward::md_progress_bar(per_series * series.len() as u64, "md simulate");
     let tick = || {

@@ -75,6 +75,13 @@ fn rolling_state(scene: &Scene) -> Result<RollingState, NotSteady> {
     Ok(RollingState { l2, w0sq, wtsq })
 }
 
+/// The steady rolling velocities (L = Θ̇f, K L = Θ̇0; eq 19) when the rolling steady state
+/// exists (the same checks as [`steady`], without its contact time).
+pub fn rolling_velocities(scene: &Scene) -> Result<(f64, f64), NotSteady> {
+    let st = rolling_state(scene)?;
+    Ok((st.l2.sqrt(), st.w0sq.sqrt()))
+}
+
 /// Steady pure rolling, exact: τ = ∫_{Θ0}^{Θf} dθ / sqrt(A − B cos θ) (eq 11) in Carlson's
 /// form (see [`cos_integral`]; equal to eqs 21–27 with MODEL.md's corrections), v̄ = 2 sin α / τ
 /// (eq 27).

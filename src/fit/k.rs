@@ -123,6 +123,9 @@ pub fn invertible(model: &Model) -> bool {
 fn eval(model: &Model, scene: &Scene, k: f64, evals: &mut usize) -> Result<Steady, NotSteady> {
     *evals += 1;
     match scene.with_k(k) {
+        // The search needs v̄ and the final velocity only: stick/slip skips its map-slope
+        // and second-fixed-point diagnostics (they cost more than the steady state).
+        Ok(s) if k.is_finite() && matches!(model, Model::StickSlip) => stickslip::steady_lean(&s),
         Ok(s) if k.is_finite() => model.evaluate(&s),
         _ => Err(NotSteady::Invalid {
             reason: "K out of range",
@@ -403,7 +406,8 @@ pub fn bracket(model: &Model, scene: &Scene) -> Result<KBracket, KFailure> {
 pub struct KRoot {
     /// The collisional parameter.
     pub k: f64,
-    /// The steady state at that K.
+    /// The steady state at that K (for stick/slip without the forward model's map-slope and
+    /// second-fixed-point diagnostics, which the search does not compute).
     pub steady: Steady,
     /// Forward evaluations used by the root search.
     pub evals: usize,
@@ -604,6 +608,15 @@ fn clamp_end(
 
 /// K, its interval at v ± σ, dv̄/dK and diagnostics for one measurement (eq 69).
 pub fn estimate(model: &Model, scene: &Scene, v: f64, sigma_v: Option<f64>) -> KEstimate {
+    // Stick and stick/slip with Θ0 < 0: solve in the launch speed (no fixed point inside).
+    if let Some(e) = super::klaunch::estimate(model, scene, v, sigma_v) {
+        return e;
+    }
+    estimate_in_k(model, scene, v, sigma_v)
+}
+
+/// [`estimate`] by the general search in K: [`bracket`], then [`solve`] at v and v ± σ.
+pub fn estimate_in_k(model: &Model, scene: &Scene, v: f64, sigma_v: Option<f64>) -> KEstimate {
     let br = match bracket(model, scene) {
         Ok(b) => b,
         Err(e) => {

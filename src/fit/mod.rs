@@ -5,6 +5,7 @@ pub mod data;
 pub mod jaeger;
 pub mod jan;
 pub mod k;
+pub mod klaunch;
 // --- auto (work-precision, issue 7) ---
 pub mod kauto;
 // --- end auto ---

@@ -147,13 +147,19 @@ pub fn rolling_speed_sq(b: f64, theta_a: f64, wa_sq: f64, theta: f64) -> f64 {
 /// Time to roll from Θa to Θb (Θa ≤ Θb, both on the row bead) starting with squared speed
 /// `wa_sq` at Θa; `None` if the bead stops before Θb. Used by the stick/slip model.
 pub fn rolling_time(b: f64, theta_a: f64, theta_b: f64, wa_sq: f64) -> Option<f64> {
+    let sa = (0.5 * theta_a).sin();
+    rolling_time_top(b, theta_a, theta_b, wa_sq, wa_sq - 2.0 * b * sa * sa)
+}
+
+/// [`rolling_time`] with the squared speed at the top, `wt_sq` = Θ̇a² − 2B sin²(Θa/2), given by
+/// the caller (who may know it without the cancellation of that difference).
+pub fn rolling_time_top(b: f64, theta_a: f64, theta_b: f64, wa_sq: f64, wt_sq: f64) -> Option<f64> {
     use crate::special::SinCos;
     let ha = SinCos::of(0.5 * theta_a);
     let hb = SinCos::of(0.5 * theta_b);
     // Θ̇² = Θ̇a² + B (cos Θa − cos θ) = Θ̇a² + 2B (sin²(θ/2) − sin²(Θa/2)).
     let den = (0.5 * (theta_b + theta_a)).sin() * (0.5 * (theta_b - theta_a)).sin();
     let wb_sq = wa_sq + 2.0 * b * den;
-    let wt_sq = wa_sq - 2.0 * b * ha.s * ha.s;
     if wb_sq < 0.0 || (theta_a < 0.0 && theta_b > 0.0 && wt_sq <= 0.0) {
         return None;
     }

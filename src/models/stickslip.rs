@@ -38,14 +38,22 @@ pub struct MapStep {
 /// one (collision Θ̇0 = K x, rolling restarts, eqs 64–67).
 pub fn map(scene: &Scene, x: f64) -> Result<MapStep, NotSteady> {
     let w0sq = scene.k * scene.k * x * x;
-    let b = scene.b;
     let s0 = scene.sc_half_0.s;
+    launch(scene, w0sq, w0sq - 2.0 * scene.b * s0 * s0)
+}
+
+/// One contact launched at Θ0 with squared speed `w0sq` (the map without the collision: it
+/// does not involve K). `top_sq` = w0sq − 2B sin²(Θ0/2) is the squared speed the rolling law
+/// gives at the top Θ = 0, passed by the caller so that a launch just above the crawl speed
+/// keeps its digits (it decides whether the bead passes the top when Θ0 < 0).
+pub fn launch(scene: &Scene, w0sq: f64, top_sq: f64) -> Result<MapStep, NotSteady> {
+    let b = scene.b;
     let Some(tg) = theta_g(scene, w0sq) else {
         return Err(NotSteady::LiftOff {
             angle: scene.theta_0,
         });
     };
-    if scene.theta_0 < 0.0 && tg > 0.0 && w0sq - 2.0 * b * s0 * s0 <= 0.0 {
+    if scene.theta_0 < 0.0 && tg > 0.0 && top_sq <= 0.0 {
         return Err(NotSteady::Stops {
             angle: stick::stop_angle(scene, w0sq),
         });
@@ -85,6 +93,36 @@ pub fn map(scene: &Scene, x: f64) -> Result<MapStep, NotSteady> {
         branch,
         theta_g: tg,
     })
+}
+
+/// Contact time of a launch (eqs 64–65): rolling to Θ_G by Carlson's form, slip to Θf by
+/// quadrature to `tol`; `w0sq`, `top_sq` and `step` as given to and returned by [`launch`].
+pub fn launch_time(
+    scene: &Scene,
+    w0sq: f64,
+    top_sq: f64,
+    step: &MapStep,
+    tol: f64,
+) -> Result<f64, NotSteady> {
+    let b = scene.b;
+    let tau = match step.branch {
+        Branch::NoSlip => stick::rolling_time_top(b, scene.theta_0, scene.theta_f, w0sq, top_sq),
+        Branch::SlipFromStart => SlipPhase::new(scene.theta_0, w0sq, scene.f)
+            .time_to(scene.theta_f, tol)
+            .ok(),
+        Branch::RollSlip => {
+            let tg = step.theta_g;
+            let t1 = stick::rolling_time_top(b, scene.theta_0, tg, w0sq, top_sq);
+            let wg_sq = stick::rolling_speed_sq(b, scene.theta_0, w0sq, tg);
+            let ph = SlipPhase::new(tg, wg_sq, scene.f);
+            let t2 = slip_time(&ph, tg, scene.theta_f, tol).ok();
+            t1.zip(t2).map(|(a, b)| a + b)
+        }
+    };
+    tau.filter(|t| t.is_finite() && *t > 0.0)
+        .ok_or(NotSteady::Invalid {
+            reason: "stick/slip contact time not finite",
+        })
 }
 
 fn check_slip_positive(ph: &SlipPhase, end: f64) -> Result<(), NotSteady> {
@@ -154,12 +192,16 @@ pub fn fixed_point_from(scene: &Scene, x0: f64) -> Result<f64, NotSteady> {
     // Where the map's asymptotic slope K e^{2fα} is well below 1 the fixed point is unique (the
     // same premise as [`steady_tol`]'s search for a second one), so any convergent iteration
     // finds the one the bead settles on: try the secant method first.
-    if scene.k * (2.0 * scene.f * scene.alpha).exp() < 0.95 {
+    let unique = scene.k * (2.0 * scene.f * scene.alpha).exp() < 0.95;
+    if unique {
         if let Some(x) = secant_fixed_point(scene, x0) {
             return Ok(x);
         }
     }
     match follow(scene, x0) {
+        // Following the map ended in a definite lift-off or stop of an iterate (not in an
+        // iteration cap): with a single fixed point there is none to find beyond it.
+        Err(e @ (NotSteady::LiftOff { .. } | NotSteady::Stops { .. })) if unique => Err(e),
         Err(e @ (NotSteady::Runaway | NotSteady::LiftOff { .. } | NotSteady::Stops { .. })) => {
             scan(scene, x0).unwrap_or(Err(e))
         }
@@ -366,6 +408,17 @@ pub fn steady(scene: &Scene) -> Outcome {
 
 /// [`steady`] with a chosen quadrature tolerance for the slip phase.
 pub fn steady_tol(scene: &Scene, tol: f64) -> Outcome {
+    steady_with(scene, tol, true)
+}
+
+/// [`steady`] without the diagnostics that cost more map evaluations than the steady state
+/// itself: the map's slope at the fixed point and the search for a second fixed point (64
+/// maps where K e^{2fα} ≥ 0.95). For root finders that need only v̄ and the final velocity.
+pub fn steady_lean(scene: &Scene) -> Outcome {
+    steady_with(scene, 1e-14, false)
+}
+
+fn steady_with(scene: &Scene, tol: f64, diagnostics: bool) -> Outcome {
     let x_hi = scene.sc_f.c.max(0.0).sqrt();
     // Start from the rolling steady state when it exists (its contact time, an elliptic
     // integral, only when it is the answer).
@@ -389,33 +442,20 @@ pub fn steady_tol(scene: &Scene, tol: f64) -> Outcome {
     };
     let xs = fixed_point_from(scene, x0.min(x_hi))?;
     let step = map(scene, xs)?;
-    let slope = slope_at(scene, xs);
+    let slope = if diagnostics {
+        slope_at(scene, xs)
+    } else {
+        None
+    };
     let asym = scene.k * (2.0 * scene.f * scene.alpha).exp();
-    let other = if asym >= 0.95 {
+    let other = if diagnostics && asym >= 0.95 {
         other_fixed_point(scene, xs)
     } else {
         None
     };
     let w0sq = scene.k * scene.k * xs * xs;
-    let tau = match step.branch {
-        Branch::NoSlip => stick::rolling_time(scene.b, scene.theta_0, scene.theta_f, w0sq),
-        Branch::SlipFromStart => SlipPhase::new(scene.theta_0, w0sq, scene.f)
-            .time_to(scene.theta_f, tol)
-            .ok(),
-        Branch::RollSlip => {
-            let tg = step.theta_g;
-            let t1 = stick::rolling_time(scene.b, scene.theta_0, tg, w0sq);
-            let wg_sq = stick::rolling_speed_sq(scene.b, scene.theta_0, w0sq, tg);
-            let ph = SlipPhase::new(tg, wg_sq, scene.f);
-            let t2 = slip_time(&ph, tg, scene.theta_f, tol).ok();
-            t1.zip(t2).map(|(a, b)| a + b)
-        }
-    };
-    let Some(tau) = tau.filter(|t| t.is_finite() && *t > 0.0) else {
-        return Err(NotSteady::Invalid {
-            reason: "stick/slip contact time not finite",
-        });
-    };
+    let s0 = scene.sc_half_0.s;
+    let tau = launch_time(scene, w0sq, w0sq - 2.0 * scene.b * s0 * s0, &step, tol)?;
     let mut s = Steady::basic(2.0 * scene.sin_alpha / tau, xs, scene.k * xs, tau);
     s.theta_g = Some(step.theta_g);
     s.map_slope = slope;

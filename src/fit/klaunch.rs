@@ -1,0 +1,546 @@
+//! K inversion (eq 69) through the launch speed: the fast path of [`super::k::estimate`] for
+//! the stick and stick/slip models.
+//!
+//! A contact launched at Θ0 with speed Θ̇0 = w0 ends at Θf with a speed Φ(w0) after a time
+//! τ(w0), and neither involves K: K enters only through the collision, Θ̇0 = K Θ̇f. A steady
+//! state is a launch that reproduces itself, so each launch speed *is* a steady state, of
+//! K = w0 / Φ(w0). Eq 69 is then one equation in one unknown with no fixed point inside:
+//! τ(w0) = τ* = 2 sin α / v (eq 10), one contact per evaluation instead of one fixed point
+//! of the final-velocity map (stick/slip) or one closed form in K (stick).
+//!
+//! The unknown is u = ln y, y = w0² − 2B sin²(Θ0/2) the squared speed the rolling law gives at
+//! the top (Θ0 < 0). As the bead crawls over the top (y → 0, K → K_min) the contact time grows
+//! like −u/sqrt(2B): in u the equation is nearly linear at the slow end, smooth at the fast end
+//! (lift-off, y_d), and y keeps its digits where K itself no longer resolves the motion. The
+//! root is found by the secant method from the asinh approximation of eq 29 (its error in τ is
+//! 0.1–3 %), kept inside the bracket; K_lo and K_hi start from a second-order Taylor step off
+//! the root, with τ' and τ'' from the central difference that also gives dv̄/dK.
+//!
+//! The path applies when Θ0 < 0 (δ < α) and, for stick/slip, when the slip starts after the top
+//! at the crawl and the map's asymptotic slope K e^{2fα} stays below 0.95 up to lift-off (a
+//! single fixed point, the premise of the forward model's own search); its stick/slip root is
+//! checked against the forward model. Elsewhere [`super::k::estimate`] uses its general
+//! bracketing search in K.
+
+use super::k::{KBracket, KEstimate, KFailure, KRoot, LowerLimit, UpperLimit};
+use crate::models::regimes::theta_g;
+use crate::models::stickslip::{self, Branch};
+use crate::models::{Model, NotSteady, Phases, Steady};
+use crate::scene::Scene;
+use crate::special::elliptic::cos_integral;
+use crate::special::root::brent;
+
+/// Which contact mechanics the launch follows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Mechanics {
+    Roll,
+    RollSlip,
+}
+
+/// One contact from a launch: time, launch and final speeds.
+#[derive(Debug, Clone, Copy)]
+struct Pass {
+    tau: f64,
+    w0: f64,
+    wf: f64,
+    /// Θ_G (stick/slip).
+    theta_g: Option<f64>,
+    /// Phases (stick/slip).
+    branch: Option<Branch>,
+}
+
+impl Pass {
+    fn k(&self) -> f64 {
+        self.w0 / self.wf
+    }
+}
+
+struct Launch<'a> {
+    scene: &'a Scene,
+    mech: Mechanics,
+    /// Squared crawl launch speed 2B sin²(Θ0/2).
+    wc2: f64,
+    /// Potential drop of a rolling contact, 2B sin δ sin α (eq 9).
+    drop: f64,
+    /// Largest y with a steady state (lift-off at Θf).
+    y_d: f64,
+    /// K at the crawl.
+    k_min: f64,
+}
+
+/// Squared-speed gain of the contact time's asinh approximation (eq 29), as a function of y:
+/// τ̃(y) = 2/r [asinh(r a_f / q) + asinh(r a_0 / q)], r = sqrt(y + 2B), q = sqrt(y),
+/// a = |tan(Θ/2)|; returns τ̃ and dτ̃/du (u = ln y).
+fn approx_tau(b: f64, a0: f64, af: f64, y: f64) -> (f64, f64) {
+    let r = (y + 2.0 * b).sqrt();
+    let q = y.sqrt();
+    let mut sum = 0.0;
+    let mut dsum = 0.0;
+    for a in [a0, af] {
+        let x = r * a / q;
+        sum += x.asinh();
+        // dX/dy = −a B / (r q³)
+        dsum += -a * b / (r * q * q * q) / (1.0 + x * x).sqrt();
+    }
+    let tau = 2.0 / r * sum;
+    let dtau_dy = -sum / (r * r * r) + 2.0 / r * dsum;
+    (tau, y * dtau_dy)
+}
+
+impl<'a> Launch<'a> {
+    fn new(model: &Model, scene: &'a Scene) -> Option<Self> {
+        let mech = match model {
+            Model::Stick => Mechanics::Roll,
+            Model::StickSlip => Mechanics::RollSlip,
+            _ => return None,
+        };
+        let s0 = scene.sc_half_0.s;
+        if !(s0 < 0.0) {
+            return None;
+        }
+        let b = scene.b;
+        let wc2 = 2.0 * b * s0 * s0;
+        let drop = 2.0 * b * scene.sin_delta_sin_alpha();
+        let cf = scene.sc_f.c;
+        let mut l = Launch {
+            scene,
+            mech,
+            wc2,
+            drop,
+            y_d: 0.0,
+            k_min: -s0 / scene.sc_half_f.s,
+        };
+        match mech {
+            Mechanics::Roll => {
+                // Lift-off at Θf: w0² + drop = cos Θf.
+                l.y_d = cf - drop - wc2;
+            }
+            Mechanics::RollSlip => {
+                // Slip must start after the top at the crawl (else the crawl speed is another).
+                if !theta_g(scene, wc2).is_some_and(|t| t > 0.0) {
+                    return None;
+                }
+                let crawl = l.launch(f64::MIN_POSITIVE)?;
+                l.k_min = crawl.w0 / crawl.wf;
+                // Lift-off: the launch whose final speed is sqrt(cos Θf).
+                let xd = cf.max(0.0).sqrt();
+                // A launch that stops is slower than lift-off, one that lifts off faster.
+                let q = |y: f64| match stickslip::launch(scene, y + wc2, y) {
+                    Ok(st) => st.final_velocity - xd,
+                    Err(NotSteady::Stops { .. }) => -xd,
+                    Err(_) => xd,
+                };
+                let mut y_hi = (cf - wc2).max(1e-3);
+                let mut q_hi = q(y_hi);
+                let mut n = 0;
+                while !(q_hi > 0.0) && n < 60 {
+                    y_hi *= 2.0;
+                    q_hi = q(y_hi);
+                    n += 1;
+                }
+                let y_lo = f64::MIN_POSITIVE;
+                let r = brent(q, y_lo, y_hi, crawl.wf - xd, q_hi, 0.0, 200)?;
+                // The largest launch at or below lift-off.
+                let mut y = r.x;
+                while y > 0.0 && !l.launch(y).is_some_and(|p| p.wf <= xd) {
+                    y *= 1.0 - 4.0 * f64::EPSILON;
+                }
+                l.y_d = y;
+                // One fixed point per K: K(w0) = w0/Φ(w0) increasing from the crawl to
+                // lift-off (dK/dw0 > 0 is H'(x) = K Φ'(K x) < 1 at every fixed point: no
+                // saddle-node, no second branch). Where the map's asymptotic slope K e^{2fα}
+                // stays below 0.95 that is the forward model's own premise; above, K(w0) is
+                // checked on 41 launches — 32 log-spaced from 1e-8 y_d to y_d, 8 at
+                // y_d (1 − 2^-j) and one at y_d (1 − 1e-7) — since a saddle-node below
+                // lift-off shows as K falling towards y_d. Then the bracket, the statuses and
+                // each root are those of the forward model, whose search starts from the
+                // rolling state.
+                let k_d = l.k_of_launch(y)?;
+                if k_d * (2.0 * scene.f * scene.alpha).exp() >= 0.95 {
+                    let mut ys: Vec<f64> = (0..32)
+                        .map(|i| y * 10f64.powf(-8.0 * (31 - i) as f64 / 31.0))
+                        .collect();
+                    ys.extend((1..=8).map(|j| y * (1.0 - 0.5f64.powi(j))));
+                    ys.push(y * (1.0 - 1e-7));
+                    ys.push(y);
+                    ys.sort_by(f64::total_cmp);
+                    let mut k_prev = l.k_min;
+                    for yi in ys {
+                        let k = l.k_of_launch(yi)?;
+                        if !(k > k_prev) {
+                            return None;
+                        }
+                        k_prev = k;
+                    }
+                }
+            }
+        }
+        (l.y_d > 0.0 && l.k_min < l.k_of_launch(l.y_d)?).then_some(l)
+    }
+
+    /// Launch and final speeds without the contact time.
+    fn launch(&self, y: f64) -> Option<Pass> {
+        let w0sq = y + self.wc2;
+        match self.mech {
+            Mechanics::Roll => Some(Pass {
+                tau: f64::NAN,
+                w0: w0sq.sqrt(),
+                wf: (w0sq + self.drop).sqrt(),
+                theta_g: None,
+                branch: None,
+            }),
+            Mechanics::RollSlip => {
+                let st = stickslip::launch(self.scene, w0sq, y).ok()?;
+                Some(Pass {
+                    tau: f64::NAN,
+                    w0: w0sq.sqrt(),
+                    wf: st.final_velocity,
+                    theta_g: Some(st.theta_g),
+                    branch: Some(st.branch),
+                })
+            }
+        }
+    }
+
+    fn k_of_launch(&self, y: f64) -> Option<f64> {
+        self.launch(y).map(|p| p.k())
+    }
+
+    /// dK/du at y (u = ln y). K changes by a relative O(y) over a step in u, so near the crawl a
+    /// difference of K in u would cancel: rolling has the closed form, K² = w0²/(w0² + drop)
+    /// gives dK/dy = drop / (2 K wf⁴); stick/slip differences Φ in w0², which is smooth
+    /// through the crawl (only the contact time has a logarithm there), with step 1e-5 w0².
+    /// Also returns the slope of the final-velocity map at this fixed point, H'(x) = K Φ'(w0).
+    fn dk_du(&self, y: f64, p: &Pass) -> Option<(f64, f64)> {
+        let k = p.k();
+        match self.mech {
+            Mechanics::Roll => {
+                let wf2 = p.wf * p.wf;
+                // Φ² = w0² + drop: H' = K w0/Φ = K².
+                Some((y * self.drop / (2.0 * k * wf2 * wf2), k * k))
+            }
+            Mechanics::RollSlip => {
+                let w0sq = y + self.wc2;
+                let h = 1e-5 * w0sq;
+                // The final speed depends on w0² alone; the top speed only gates the crawl.
+                let phi = |dw: f64| {
+                    stickslip::launch(self.scene, w0sq + dw, (y + dw).max(f64::MIN_POSITIVE))
+                        .ok()
+                        .map(|st| st.final_velocity)
+                };
+                // Central where the launch below exists, else one-sided (second order).
+                let (lo, mid) = match phi(-h) {
+                    Some(pm) => (-h, pm),
+                    None => (0.0, p.wf),
+                };
+                let (hi, top) = (lo + 2.0 * h, phi(lo + 2.0 * h)?);
+                let kq = |dw: f64, f: f64| (w0sq + dw).sqrt() / f;
+                let (dk_dy, dphi_dy) = if lo < 0.0 {
+                    (
+                        (kq(hi, top) - kq(lo, mid)) / (2.0 * h),
+                        (top - mid) / (2.0 * h),
+                    )
+                } else {
+                    let (q1, f1) = (h, phi(h)?);
+                    (
+                        (-3.0 * kq(0.0, p.wf) + 4.0 * kq(q1, f1) - kq(hi, top)) / (2.0 * h),
+                        (-3.0 * p.wf + 4.0 * f1 - top) / (2.0 * h),
+                    )
+                };
+                // dΦ/dw0 = 2 w0 dΦ/d(w0²).
+                let dphi = 2.0 * p.w0 * dphi_dy;
+                Some((y * dk_dy, k * dphi))
+            }
+        }
+    }
+
+    /// One whole contact: speeds and time.
+    fn pass(&self, y: f64, evals: &mut usize) -> Option<Pass> {
+        *evals += 1;
+        let sc = self.scene;
+        let w0sq = y + self.wc2;
+        match self.mech {
+            Mechanics::Roll => {
+                let wf2 = w0sq + self.drop;
+                let tau = cos_integral(
+                    sc.sc_half_0,
+                    sc.sc_half_f,
+                    w0sq,
+                    wf2,
+                    y,
+                    sc.sin_delta_sin_alpha(),
+                );
+                (tau.is_finite() && tau > 0.0).then(|| Pass {
+                    tau,
+                    w0: w0sq.sqrt(),
+                    wf: wf2.sqrt(),
+                    theta_g: None,
+                    branch: None,
+                })
+            }
+            Mechanics::RollSlip => {
+                let st = stickslip::launch(sc, w0sq, y).ok()?;
+                let tau = stickslip::launch_time(sc, w0sq, y, &st, 1e-14).ok()?;
+                Some(Pass {
+                    tau,
+                    w0: w0sq.sqrt(),
+                    wf: st.final_velocity,
+                    theta_g: Some(st.theta_g),
+                    branch: Some(st.branch),
+                })
+            }
+        }
+    }
+
+    /// The start of the root search: the asinh approximation (eq 29) solved for τ̃ = τ* by
+    /// Newton's method in u from its crawl asymptote, and its slope there.
+    fn guess(&self, tau_star: f64) -> (f64, f64) {
+        let sc = self.scene;
+        let b = sc.b;
+        let a0 = (sc.sc_half_0.s / sc.sc_half_0.c).abs();
+        let af = (sc.sc_half_f.s / sc.sc_half_f.c).abs();
+        let u_d = self.y_d.ln();
+        // y → 0: τ̃ ≈ 2/sqrt(2B) [ln(8B a0 af) − ln y].
+        let mut u = ((8.0 * b * a0 * af).ln() - tau_star * (0.5 * b).sqrt()).min(u_d);
+        let mut slope = -(2.0 / b).sqrt();
+        for _ in 0..6 {
+            let (t, d) = approx_tau(b, a0, af, u.exp());
+            if !(t.is_finite() && d < 0.0) {
+                break;
+            }
+            slope = d;
+            let step = (t - tau_star) / d;
+            u = (u - step).min(u_d);
+            // The approximation itself is off by ~1 %: no point in more digits.
+            if step.abs() < 1e-3 * u.abs().max(1.0) {
+                break;
+            }
+        }
+        (u, slope)
+    }
+
+    /// Solves τ(e^u) = τ* by the secant method from `u0` (first step with `slope0` ≈ dτ/du),
+    /// kept inside (−∞, u_d] with bisection once both sides are known. Returns u and, when
+    /// the last iterate was evaluated there, its pass.
+    ///
+    /// With `curv` = τ''/(2τ') known (K_lo, K_hi: from the root's differences), a secant
+    /// iterate whose predicted error |curv| |Δ_n| |Δ_{n−1}| (the secant method's error
+    /// recursion) is below one ulp of u is returned without its own evaluation.
+    fn solve(
+        &self,
+        tau_star: f64,
+        u0: f64,
+        slope0: f64,
+        (u_d, tau_d): (f64, f64),
+        curv: Option<f64>,
+        evals: &mut usize,
+    ) -> Option<(f64, Option<Pass>)> {
+        // Bracket: g = τ − τ* > 0 below the root (slower), < 0 above.
+        let mut lo = f64::NEG_INFINITY;
+        let mut hi = u_d;
+        let g_hi = tau_d - tau_star;
+        if g_hi >= 0.0 {
+            return None;
+        }
+        let mut x = u0.min(u_d);
+        if x == u_d {
+            x -= 1e-3;
+        }
+        let mut p = self.pass(x.exp(), evals)?;
+        let mut gx = p.tau - tau_star;
+        let mut prev: Option<(f64, f64)> = None;
+        for it in 0..80 {
+            // |τ − τ*| at the rounding level of τ itself: no iterate can do better.
+            if gx.abs() <= 4.0 * f64::EPSILON * tau_star {
+                return Some((x, Some(p)));
+            }
+            if gx > 0.0 {
+                lo = x;
+            } else {
+                hi = x;
+            }
+            let tol = 4.0 * f64::EPSILON * x.abs().max(1.0);
+            let mut next = match prev {
+                Some((xp, gp)) if gp != gx && it < 30 => x - gx * (x - xp) / (gx - gp),
+                None => x - gx / slope0,
+                _ => f64::NAN,
+            };
+            if !(next > lo && next < hi) {
+                next = if lo.is_finite() {
+                    0.5 * (lo + hi)
+                } else {
+                    // The slow side is not bracketed yet: step down in u.
+                    x - 2.0 * (1.0 + (x - prev.map_or(x, |q| q.0)).abs())
+                };
+            } else if let (Some(c), Some((xp, _))) = (curv, prev) {
+                if (c * (next - x) * (x - xp)).abs() <= 0.5 * tol {
+                    return Some((next, None));
+                }
+            }
+            // The last step is the error of x: x is the root to within `tol`.
+            if (next - x).abs() <= tol || hi - lo <= tol {
+                return Some((x, Some(p)));
+            }
+            prev = Some((x, gx));
+            x = next;
+            p = self.pass(x.exp(), evals)?;
+            gx = p.tau - tau_star;
+        }
+        None
+    }
+}
+
+/// The steady state of a launch, as the forward model reports it.
+fn steady_of(scene: &Scene, p: &Pass, y: f64, map_slope: f64) -> Steady {
+    let mut s = Steady::basic(2.0 * scene.sin_alpha / p.tau, p.wf, p.w0, p.tau);
+    s.top_velocity_sq = Some(y);
+    s.map_slope = Some(map_slope);
+    s.theta_g = p.theta_g;
+    s.phases = match p.branch {
+        None | Some(Branch::NoSlip) => Phases::Roll,
+        Some(Branch::RollSlip) => Phases::RollSlip,
+        Some(Branch::SlipFromStart) => Phases::Slip,
+    };
+    s
+}
+
+/// [`super::k::estimate`] by the launch speed, when this path applies (`None`: use the
+/// general search). Same outputs and statuses as the general path.
+pub fn estimate(model: &Model, scene: &Scene, v: f64, sigma_v: Option<f64>) -> Option<KEstimate> {
+    if !(v > 0.0 && v.is_finite()) {
+        return None;
+    }
+    let l = Launch::new(model, scene)?;
+    let mut evals = 0;
+    let top = l.pass(l.y_d, &mut evals)?;
+    let u_d = l.y_d.ln();
+    let sin_alpha = scene.sin_alpha;
+    let br = KBracket {
+        lo: l.k_min,
+        hi: top.k(),
+        v_lo: 0.0,
+        v_hi: 2.0 * sin_alpha / top.tau,
+        tau_hi: top.tau,
+        lower: LowerLimit::Crawl,
+        upper: UpperLimit::LiftOff,
+        evals,
+    };
+    let end = (u_d, top.tau);
+    let mut notes = Vec::new();
+    let tau_star = 2.0 * sin_alpha / v;
+    if v > br.v_hi {
+        return Some(KEstimate {
+            bracket: Some(br),
+            root: Err(KFailure::AboveRange),
+            k_lo: None,
+            k_hi: None,
+            dv_dk: None,
+            theta_g: None,
+            notes,
+        });
+    }
+    // The root.
+    let mut n_root = 0;
+    let (u0, s0) = l.guess(tau_star);
+    let (u, p) = l.solve(tau_star, u0, s0, end, None, &mut n_root)?;
+    let y = u.exp();
+    // Keep the crawl end to the general search: there K rounds to K_min.
+    if y < 1e-12 * l.wc2 {
+        return None;
+    }
+    let p = match p {
+        Some(p) => p,
+        None => l.pass(y, &mut n_root)?,
+    };
+    let k = p.k();
+    // dτ/du and d²τ/du² by central differences, h = 1e-5 in u (one-sided at lift-off).
+    let h = 1e-5;
+    let mut n_side = 0;
+    let (pm, pp) = if u + h <= u_d {
+        (
+            l.pass((u - h).exp(), &mut n_side)?,
+            l.pass((u + h).exp(), &mut n_side)?,
+        )
+    } else {
+        (
+            l.pass((u - 2.0 * h).exp(), &mut n_side)?,
+            l.pass((u - h).exp(), &mut n_side)?,
+        )
+    };
+    let (d1, d2) = if u + h <= u_d {
+        (
+            (pp.tau - pm.tau) / (2.0 * h),
+            (pp.tau - 2.0 * p.tau + pm.tau) / (h * h),
+        )
+    } else {
+        (
+            (3.0 * p.tau - 4.0 * pp.tau + pm.tau) / (2.0 * h),
+            (p.tau - 2.0 * pp.tau + pm.tau) / (h * h),
+        )
+    };
+    let (dk, map_slope) = l.dk_du(y, &p)?;
+    // v̄ = 2 sin α / τ: dv̄/du = −v̄ τ'/τ.
+    let dv_dk = -(2.0 * sin_alpha / p.tau) * d1 / p.tau / dk;
+    // K at v ± σ: a second-order Taylor step in τ off the root, then the secant method.
+    let mut end_k = |vs: f64, name: &'static str, notes: &mut Vec<String>| -> Option<f64> {
+        let side = if name == "K_lo" {
+            "v - sigma_v"
+        } else {
+            "v + sigma_v"
+        };
+        if vs <= 0.0 {
+            notes.push(format!("{name} is the bracket's lower end: {side} <= 0"));
+            return Some(br.lo);
+        }
+        if vs > br.v_hi {
+            notes.push(format!(
+                "{name} is the bracket's upper end: {side} is above the steady range"
+            ));
+            return Some(br.hi);
+        }
+        let t = 2.0 * sin_alpha / vs;
+        let dt = t - p.tau;
+        let du = dt / d1;
+        let du = du - 0.5 * d2 * du * du / d1;
+        let (ue, pe) = l.solve(
+            t,
+            u + du,
+            d1 + d2 * du,
+            end,
+            Some(0.5 * d2 / d1),
+            &mut n_side,
+        )?;
+        match pe {
+            Some(pe) => Some(pe.k()),
+            None => l.k_of_launch(ue.exp()),
+        }
+    };
+    let (k_lo, k_hi) = match sigma_v {
+        Some(sg) => (
+            end_k(v - sg, "K_lo", &mut notes)?,
+            end_k(v + sg, "K_hi", &mut notes)?,
+        ),
+        None => (f64::NAN, f64::NAN),
+    };
+    let steady = steady_of(scene, &p, y, map_slope);
+    let theta_g = match l.mech {
+        Mechanics::Roll => scene.with_k(k).ok().and_then(|s| theta_g(&s, p.w0 * p.w0)),
+        Mechanics::RollSlip => steady.theta_g,
+    };
+    Some(KEstimate {
+        bracket: Some(KBracket {
+            evals: br.evals,
+            ..br
+        }),
+        root: Ok(KRoot {
+            k,
+            steady,
+            evals: n_root,
+        }),
+        k_lo: sigma_v.map(|_| k_lo),
+        k_hi: sigma_v.map(|_| k_hi),
+        dv_dk: Some(dv_dk),
+        theta_g,
+        notes,
+    })
+}

@@ -1134,3 +1134,257 @@ fn render_md(
     w.into_inner().map_err(|e| csv::Error::from(e.into_error()))
 }
 // --- end md ---
+
+#[cfg(test)]
+mod tests {
+    //! The streaming path against the old whole-table path ([`reference`]): the same bytes on
+    //! the shipped data and on a generated table with every kind of cell, for every model but
+    //! md, at several chunk sizes; the same message for every kind of bad input.
+
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cmd {
+        #[command(flatten)]
+        a: Args,
+    }
+
+    fn args(flags: &[&str]) -> Args {
+        Cmd::parse_from(std::iter::once("forward").chain(flags.iter().copied())).a
+    }
+
+    fn kind_branch(a: &Args) -> (ModelKind, JaegerBranch) {
+        let kind = a.model.parse().unwrap();
+        let branch = match a.branch.as_str() {
+            "lower" => JaegerBranch::Lower,
+            _ => JaegerBranch::Upper,
+        };
+        (kind, branch)
+    }
+
+    fn old(a: &Args, text: &[u8]) -> Result<Vec<u8>, String> {
+        let (kind, branch) = kind_branch(a);
+        let t = Table::parse("in.csv", text).map_err(|e| e.to_string())?;
+        reference::forward_table(a, kind, branch, &t).map_err(|e| e.to_string())
+    }
+
+    fn new(a: &Args, text: &[u8], chunk: usize, task: usize) -> Result<Vec<u8>, String> {
+        let (kind, branch) = kind_branch(a);
+        let reader = TableReader::new("in.csv", text).map_err(|e| e.to_string())?;
+        let mut out = Vec::new();
+        match stream(a, kind, branch, reader, &mut out, chunk, task) {
+            Ok(()) => Ok(out),
+            Err(Failure::Input(e)) => Err(e.to_string()),
+            Err(Failure::Write(e)) => panic!("write to a Vec failed: {e}"),
+        }
+    }
+
+    const SIZES: [(usize, usize); 4] = [(1, 1), (7, 3), (64, 5), (CHUNK_ROWS, TASK_ROWS)];
+
+    fn same(flags: &[&str], text: &[u8]) {
+        let a = args(flags);
+        let want = old(&a, text);
+        for (chunk, task) in SIZES {
+            let got = new(&a, text, chunk, task);
+            match (&want, &got) {
+                (Ok(w), Ok(g)) => assert!(
+                    w == g,
+                    "{flags:?}, chunks of {chunk}: output differs\nold:\n{}\nnew:\n{}",
+                    String::from_utf8_lossy(w),
+                    String::from_utf8_lossy(g)
+                ),
+                _ => assert_eq!(want, got, "{flags:?}, chunks of {chunk}"),
+            }
+        }
+    }
+
+    const MODELS: [&[&str]; 11] = [
+        &["--model", "stick"],
+        &["--model", "stick", "--K", "cos2a", "--rho", "0.5"],
+        &["--model", "stick-approx"],
+        &["--model", "slip"],
+        &["--model", "slip-approx"],
+        &["--model", "stickslip", "--f", "0.3"],
+        &["--model", "contact", "--spin", "keep"],
+        &["--model", "jan"],
+        &[
+            "--model", "jaeger", "--a1", "0.05", "--a2", "0.4", "--a3", "1.5",
+        ],
+        &[
+            "--model", "jaeger", "--a1", "0.1", "--a2", "2", "--a3", "0.3", "--branch", "lower",
+        ],
+        &["--model", "auto", "--tol", "1e-8"],
+    ];
+
+    /// A table with every kind of cell the readers and writers meet: quoted cells (commas,
+    /// quotes, a newline), non-ASCII text, columns whose names clash with the output (`v`,
+    /// `regime`, `phase_sequence`), laws by name, empty cells falling back on the flags,
+    /// padded cells, blank lines, and scenes in regimes A, B and C.
+    fn generated(rows: usize) -> String {
+        let mut s = String::from(
+            "id, xi ,delta_deg,K,rho,f,v,regime,spin,lambda,mu,a1,a2,a3,phase_sequence,note\n",
+        );
+        let laws = [
+            "", "0.6", "cos2a", "adjusted", "impact", "c=0.3", "0.95", " 0.3 ", "1e-1",
+        ];
+        let spins = ["", "roll", "keep", "factor=0.5", "impact"];
+        let notes = [
+            "",
+            "plain",
+            "\"quoted, comma\"",
+            "\"say \"\"hi\"\"\"",
+            "\"two\nlines\"",
+            "é→ü",
+        ];
+        let mut x: u64 = 0x9e37_79b9_7f4a_7c15;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for i in 0..rows {
+            let xi = 0.65 + 9.35 * next();
+            let d = 40.0 * next();
+            let pick = |u: f64, n: usize| ((u * n as f64) as usize).min(n - 1);
+            let law = laws[pick(next(), laws.len())];
+            let rho = if i % 5 == 0 {
+                String::new()
+            } else {
+                format!("{}", 0.5 * next())
+            };
+            let f = if i % 3 == 0 {
+                String::new()
+            } else {
+                format!("{}", 0.4 * next())
+            };
+            let spin = spins[pick(next(), spins.len())];
+            let lambda = if i % 4 == 0 {
+                String::new()
+            } else {
+                format!("{}", 0.5 + next())
+            };
+            let mu = if i % 6 == 0 {
+                String::new()
+            } else {
+                format!("{}", next())
+            };
+            let note = notes[i % notes.len()];
+            s.push_str(&format!(
+                "r{i},{xi},{d},{law},{rho},{f},{},B,{spin},{lambda},{mu},0.05,0.4,1.5,x,{note}\n",
+                0.3 * next()
+            ));
+            if i % 17 == 0 {
+                s.push('\n');
+            }
+        }
+        s
+    }
+
+    #[test]
+    fn same_bytes_as_the_whole_table_path_on_the_shipped_data() {
+        for data in [
+            &include_bytes!("../../data/default.csv")[..],
+            &include_bytes!("../../data/virtual/md_ristow.csv")[..],
+        ] {
+            for m in MODELS {
+                same(m, data);
+            }
+        }
+    }
+
+    #[test]
+    fn same_bytes_as_the_whole_table_path_on_a_generated_table() {
+        let text = generated(300);
+        for m in MODELS {
+            same(m, text.as_bytes());
+        }
+        // Many rows, one cheap model: several full-size chunks.
+        let text = generated(3 * CHUNK_ROWS + 123);
+        same(&["--model", "stick"], text.as_bytes());
+        // A single scene on the command line goes through the same path.
+        let a = args(&["--model", "stick"]);
+        assert_eq!(
+            old(&a, b"xi,delta_deg\n1,12\n"),
+            new(&a, b"xi,delta_deg\n1,12\n", 1, 1)
+        );
+    }
+
+    #[test]
+    fn same_error_as_the_whole_table_path() {
+        let good = "1,12\n".repeat(40);
+        let late = |bad: &str| format!("xi,delta_deg\n{good}{bad}{good}");
+        let stick: &[&str] = &["--model", "stick"];
+        let cases: Vec<(&[&str], String)> = vec![
+            (stick, String::new()),
+            (stick, " \n\t\n".into()),
+            (stick, "xi,delta_deg\n".into()),
+            (stick, "xi,delta_deg\n\n\n".into()),
+            (stick, "xi,,delta_deg\n1,2,3\n".into()),
+            (stick, "xi,xi,delta_deg\n1,2,3\n".into()),
+            (stick, "xi,K\n1,0.6\n".into()),
+            (stick, "xi,delta_deg\n1,abc\n".into()),
+            (stick, "xi,delta_deg\n1,10\n1,NaN\n".into()),
+            (stick, "xi,delta_deg\n1,inf\n".into()),
+            (stick, "xi,delta_deg\n-1,10\n".into()),
+            (stick, "xi,delta_deg\n1,95\n".into()),
+            (stick, "xi,delta_deg\n ,10\n".into()),
+            (stick, "xi,delta_deg,K\n1,10,smooth\n".into()),
+            (stick, "xi,delta_deg,K\n1,10,-0.5\n".into()),
+            (stick, "xi,delta_deg,K\n1,10,inf\n".into()),
+            (stick, "xi,delta_deg,K\n1,10,c=abc\n".into()),
+            (stick, "xi,delta_deg,rho\n1,10,-2\n".into()),
+            (stick, "xi,delta_deg,f\n1,10,x\n".into()),
+            // Bad rows after the first chunks; the first one is reported.
+            (stick, late("1,abc\n")),
+            (stick, late("1,10\n0,10\n1,abc\n")),
+            // A malformed row anywhere wins over a bad value before it.
+            (stick, late("1,10,3\n")),
+            (stick, format!("{}1,abc\n{good}1,10,3\n", late(""))),
+            (stick, format!("xi,delta_deg\n1,abc\n{good}\"1,10\n")),
+            (
+                stick,
+                b"xi,delta_deg\n1,10\n1,\xff\n"
+                    .iter()
+                    .map(|&b| b as char)
+                    .collect(),
+            ),
+            // Flag errors come after the table's own errors.
+            (&["--model", "stick", "--tol", "2"], "xi,delta_deg\n".into()),
+            (&["--model", "stick", "--tol", "2"], late("1,10,3\n")),
+            (&["--model", "stick", "--tol", "2"], late("")),
+            (&["--model", "stick", "--K", "bogus"], late("")),
+            (&["--model", "stick", "--spin", "bogus"], late("")),
+            (&["--model", "stick", "--rho=-1"], late("")),
+            (&["--model", "jaeger"], late("")),
+            (
+                &["--model", "jaeger", "--a1", "1", "--a2", "1"],
+                "xi,delta_deg,a3\n1,10,1\n1,10,\n".into(),
+            ),
+            (
+                &["--model", "jaeger", "--a1", "1", "--a2", "1", "--a3=-1"],
+                late(""),
+            ),
+            (
+                &["--model", "jan"],
+                "xi,delta_deg,lambda\n1,10,0.8\n1,10,-1\n".into(),
+            ),
+            (&["--model", "jan", "--mu=-1"], late("")),
+            (
+                &["--model", "contact"],
+                "xi,delta_deg,spin\n1,10,roll\n1,10,twirl\n".into(),
+            ),
+            (&["--model", "auto"], late("1,-3\n")),
+        ];
+        for (flags, text) in cases {
+            let a = args(flags);
+            let want = old(&a, text.as_bytes());
+            assert!(want.is_err(), "{flags:?} {text:?} should fail");
+            for (chunk, task) in SIZES {
+                let got = new(&a, text.as_bytes(), chunk, task);
+                assert_eq!(want, got, "{flags:?} {text:?}, chunks of {chunk}");
+            }
+        }
+    }
+}

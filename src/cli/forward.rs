@@ -545,7 +545,7 @@ impl<'a> Plan<'a> {
         let contact = !matches!(kind, ModelKind::Jan | ModelKind::Jaeger);
         let mut w = Cells::new(out);
         for cell in rec.iter() {
-            w.text(cell);
+            w.text(cell.trim());
         }
         let regime = regime_of(&o);
         match &o {
@@ -1165,7 +1165,7 @@ mod tests {
 
     fn old(a: &Args, text: &[u8]) -> Result<Vec<u8>, String> {
         let (kind, branch) = kind_branch(a);
-        let t = Table::parse("in.csv", text).map_err(|e| e.to_string())?;
+        let t = reference::Table::parse("in.csv", text).map_err(|e| e.to_string())?;
         reference::forward_table(a, kind, branch, &t).map_err(|e| e.to_string())
     }
 
@@ -1220,7 +1220,7 @@ mod tests {
     /// A table with every kind of cell the readers and writers meet: quoted cells (commas,
     /// quotes, a newline), non-ASCII text, columns whose names clash with the output (`v`,
     /// `regime`, `phase_sequence`), laws by name, empty cells falling back on the flags,
-    /// padded cells, blank lines, and scenes in regimes A, B and C.
+    /// padded cells (ASCII and Unicode spaces), blank lines, and scenes in regimes A, B and C.
     fn generated(rows: usize) -> String {
         let mut s = String::from(
             "id, xi ,delta_deg,K,rho,f,v,regime,spin,lambda,mu,a1,a2,a3,phase_sequence,note\n",
@@ -1231,7 +1231,8 @@ mod tests {
         let spins = ["", "roll", "keep", "factor=0.5", "impact"];
         let notes = [
             "",
-            "plain",
+            " plain\t",
+            "\u{2003}em space\u{a0}",
             "\"quoted, comma\"",
             "\"say \"\"hi\"\"\"",
             "\"two\nlines\"",
@@ -1314,10 +1315,11 @@ mod tests {
     #[test]
     fn same_error_as_the_whole_table_path() {
         let good = "1,12\n".repeat(40);
-        let late = |bad: &str| format!("xi,delta_deg\n{good}{bad}{good}");
+        let late_s = |bad: &str| format!("xi,delta_deg\n{good}{bad}{good}");
+        let late = |bad: &str| late_s(bad).into_bytes();
         let stick: &[&str] = &["--model", "stick"];
-        let cases: Vec<(&[&str], String)> = vec![
-            (stick, String::new()),
+        let cases: Vec<(&[&str], Vec<u8>)> = vec![
+            (stick, Vec::new()),
             (stick, " \n\t\n".into()),
             (stick, "xi,delta_deg\n".into()),
             (stick, "xi,delta_deg\n\n\n".into()),
@@ -1341,15 +1343,15 @@ mod tests {
             (stick, late("1,10\n0,10\n1,abc\n")),
             // A malformed row anywhere wins over a bad value before it.
             (stick, late("1,10,3\n")),
-            (stick, format!("{}1,abc\n{good}1,10,3\n", late(""))),
-            (stick, format!("xi,delta_deg\n1,abc\n{good}\"1,10\n")),
-            (
-                stick,
-                b"xi,delta_deg\n1,10\n1,\xff\n"
-                    .iter()
-                    .map(|&b| b as char)
-                    .collect(),
-            ),
+            (stick, format!("{}1,abc\n{good}1,10,3\n", late_s("")).into()),
+            (stick, format!("xi,delta_deg\n1,abc\n{good}\"1,10\n").into()),
+            // Invalid UTF-8, the byte index counted in the trimmed cell.
+            (stick, b"xi,delta_deg\n1,10\n1,\xff\n".to_vec()),
+            (stick, b"xi,delta_deg\n1,10\n1, \t \xc3\xa9\xff \n".to_vec()),
+            (stick, b"xi,delta_deg\n\n\n1,10\n\n1,\xc3\n".to_vec()),
+            (stick, late("1,\u{e9}\n")),
+            (stick, [late(""), b"  \xfe,1\n".to_vec()].concat()),
+            (stick, [late("1,abc\n"), b"  \xfe,1\n".to_vec()].concat()),
             // Flag errors come after the table's own errors.
             (&["--model", "stick", "--tol", "2"], "xi,delta_deg\n".into()),
             (&["--model", "stick", "--tol", "2"], late("1,10,3\n")),
@@ -1377,12 +1379,13 @@ mod tests {
             ),
             (&["--model", "auto"], late("1,-3\n")),
         ];
-        for (flags, text) in cases {
+        for (flags, bytes) in cases {
             let a = args(flags);
-            let want = old(&a, text.as_bytes());
+            let want = old(&a, &bytes);
+            let text = String::from_utf8_lossy(&bytes);
             assert!(want.is_err(), "{flags:?} {text:?} should fail");
             for (chunk, task) in SIZES {
-                let got = new(&a, text.as_bytes(), chunk, task);
+                let got = new(&a, &bytes, chunk, task);
                 assert_eq!(want, got, "{flags:?} {text:?}, chunks of {chunk}");
             }
         }

@@ -65,7 +65,7 @@ impl<R: Read> TableReader<R> {
         }
         let mut rdr = csv::ReaderBuilder::new()
             .has_headers(true)
-            .trim(csv::Trim::All)
+            .trim(csv::Trim::Headers)
             .buffer_capacity(1 << 16)
             .from_reader(Cursor::new(prefix).chain(input));
         let headers: Vec<String> = rdr
@@ -121,7 +121,9 @@ impl<R: Read> TableReader<R> {
 
     /// Reads up to `max` rows into `recs[..n]` (reusing the records already there, growing
     /// `recs` as needed) and returns `n`; fewer than `max` only at the end of the input.
-    /// Line numbers: [`line_of`]. A malformed row is an error naming its line.
+    /// Cells are as in the file, not trimmed: read them through [`Row`], which trims them
+    /// (as [`Table`] does). Line numbers: [`line_of`]. A malformed row is an error naming
+    /// its line.
     pub fn read_chunk(
         &mut self,
         recs: &mut Vec<csv::StringRecord>,
@@ -132,20 +134,8 @@ impl<R: Read> TableReader<R> {
             if n == recs.len() {
                 recs.push(csv::StringRecord::new());
             }
-            match self.rdr.read_record(&mut recs[n]) {
-                Ok(true) => {
-                    let r = &recs[n];
-                    if r.len() == 1 && r.get(0) == Some("") {
-                        continue; // blank line
-                    }
-                    self.rows_seen += 1;
-                    n += 1;
-                }
-                Ok(false) => self.done = true,
-                Err(e) => {
-                    self.done = true;
-                    return Err(self.csv_error(e));
-                }
+            if self.read_one(&mut recs[n])? {
+                n += 1;
             }
         }
         Ok(n)
@@ -156,20 +146,62 @@ impl<R: Read> TableReader<R> {
     pub fn drain(&mut self) -> Option<InputError> {
         let mut rec = csv::StringRecord::new();
         while !self.done {
-            match self.rdr.read_record(&mut rec) {
-                Ok(true) => {
-                    if !(rec.len() == 1 && rec.get(0) == Some("")) {
-                        self.rows_seen += 1;
-                    }
-                }
-                Ok(false) => self.done = true,
-                Err(e) => {
-                    self.done = true;
-                    return Some(self.csv_error(e));
-                }
+            if let Err(e) = self.read_one(&mut rec) {
+                return Some(e);
             }
         }
         (self.rows_seen == 0).then(|| self.no_rows())
+    }
+
+    /// Reads one record into `rec`, reusing its buffers; true for a row, false for a blank
+    /// line or the end of the input. The cells are not trimmed, but a record with invalid
+    /// UTF-8 is reported as when they were (the byte index counted from the trimmed cell).
+    fn read_one(&mut self, rec: &mut csv::StringRecord) -> Result<bool, InputError> {
+        let pos = self.rdr.position().clone();
+        let mut b = std::mem::take(rec).into_byte_record();
+        let read = self.rdr.read_byte_record(&mut b);
+        let utf8 = csv::StringRecord::from_byte_record(b);
+        let more = match read {
+            Ok(more) => more,
+            Err(e) => {
+                self.done = true;
+                return Err(self.csv_error(e));
+            }
+        };
+        *rec = match utf8 {
+            Ok(r) => r,
+            Err(e) => {
+                self.done = true;
+                let (field, up_to) = (e.utf8_error().field(), e.utf8_error().valid_up_to());
+                let b = e.into_byte_record();
+                let cell = b.get(field).unwrap_or(b"");
+                let lead = cell.iter().take_while(|c| c.is_ascii_whitespace()).count();
+                return Err(InputError {
+                    file: self.source.clone(),
+                    line: Some(pos.line()),
+                    column: None,
+                    value: None,
+                    message: format!(
+                        "malformed CSV: CSV parse error: record {} (line {}, field: {field}, \
+                         byte: {}): invalid utf-8: invalid UTF-8 in field {field} near byte \
+                         index {}",
+                        pos.record(),
+                        pos.line(),
+                        pos.byte(),
+                        up_to.saturating_sub(lead)
+                    ),
+                });
+            }
+        };
+        if !more {
+            self.done = true;
+            return Ok(false);
+        }
+        if rec.len() == 1 && rec.get(0).map(str::trim) == Some("") {
+            return Ok(false); // blank line
+        }
+        self.rows_seen += 1;
+        Ok(true)
     }
 
     /// The error for an input with a header and no data rows.
@@ -224,9 +256,9 @@ pub struct Row<'a> {
 }
 
 impl<'a> Row<'a> {
-    /// Raw text of a cell.
+    /// Text of a cell, without leading and trailing whitespace.
     pub fn cell(&self, col: usize) -> &'a str {
-        self.rec.get(col).unwrap_or("")
+        self.rec.get(col).unwrap_or("").trim()
     }
 
     /// A finite number from a cell, or an error naming file, line, column and value.
@@ -265,6 +297,9 @@ impl Table {
         let mut rows = Vec::new();
         let n = r.read_chunk(&mut rows, usize::MAX)?;
         rows.truncate(n);
+        for row in &mut rows {
+            row.trim();
+        }
         if rows.is_empty() {
             return Err(r.no_rows());
         }

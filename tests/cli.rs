@@ -152,6 +152,90 @@ fn bad_inputs_exit_2_with_file_line_column_value() {
     );
 }
 
+/// The streaming `forward` (chunks of 32,768 rows): a bad row far past the first chunk is
+/// still reported with its line, and nothing is left at --output.
+#[test]
+fn bad_row_past_the_first_chunks_exits_2_and_leaves_no_output() {
+    let f = ["forward", "--model", "stick"];
+    let mut text = String::from("id,xi,delta_deg\n");
+    for i in 0..100_000 {
+        if i == 70_000 {
+            text.push_str("bad,1,abc\n");
+        } else {
+            text.push_str(&format!("{i},1,{}\n", 5 + i % 20));
+        }
+    }
+    expect_error(&f, &text, &["line 70002", "delta_deg", "'abc'"]);
+    // A malformed row later still wins, as when the whole table was read first.
+    text.push_str("1,2\n");
+    expect_error(&f, &text, &["line 100002", "malformed CSV"]);
+}
+
+/// Many chunks: the file written atomically and the stream on stdout are the same bytes, one
+/// row per scene in input order.
+#[test]
+fn forward_file_and_stdout_agree_on_many_chunks() {
+    let d = tmpdir();
+    let mut text = String::from("id,xi,delta_deg,K\n");
+    for i in 0..80_000 {
+        let k = ["adjusted", "0.6", "", "cos2a"][i % 4];
+        text.push_str(&format!(
+            "s{i},{},{},{k}\n",
+            0.7 + (i % 97) as f64 * 0.1,
+            (i % 31) as f64
+        ));
+    }
+    let inp = write(&d, "many.csv", &text);
+    let outp = d.path().join("many.out.csv");
+    let run = |to_file: bool| {
+        let mut c = bin();
+        c.args(["forward", "--model", "stick", "--input"]).arg(&inp);
+        if to_file {
+            c.arg("--output").arg(&outp);
+        }
+        let o = c.output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        o.stdout
+    };
+    assert!(run(true).is_empty());
+    let stdout = run(false);
+    let file = std::fs::read(&outp).unwrap();
+    assert!(stdout == file, "stdout and --output differ");
+    let s = String::from_utf8(file).unwrap();
+    assert_eq!(s.lines().count(), 80_001);
+    for (i, l) in s.lines().skip(1).enumerate() {
+        assert!(l.starts_with(&format!("s{i},")), "row {i}: {l}");
+    }
+    assert_eq!(
+        std::fs::read_dir(d.path()).unwrap().count(),
+        2,
+        "temporary files left"
+    );
+}
+
+/// An output that cannot be created (missing directory) is exit 2 "cannot write", reported
+/// only when the input is good: a bad input is reported first.
+#[test]
+fn unwritable_output_is_reported_after_the_input() {
+    let d = tmpdir();
+    let good = write(&d, "good.csv", "xi,delta_deg\n1,12\n");
+    let bad = write(&d, "bad.csv", "xi,delta_deg\n1,12\n1,abc\n");
+    let outp = d.path().join("missing").join("o.csv");
+    for (inp, want) in [(&good, "cannot write"), (&bad, "'abc'")] {
+        let o = bin()
+            .args(["forward", "--model", "stick", "--input"])
+            .arg(inp)
+            .arg("--output")
+            .arg(&outp)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2));
+        let err = String::from_utf8(o.stderr).unwrap();
+        assert!(err.contains(want), "{err}");
+    }
+    assert!(!outp.exists());
+}
+
 #[test]
 fn regimes_reports_the_critical_xi() {
     let out = bin()

@@ -2,8 +2,8 @@
 
 use super::{emit, read_input, CliError};
 use crate::error::Error;
-use crate::io::scenes::Table;
-use crate::io::{fmt_f64, InputError};
+use crate::io::scenes::{line_of, Row, Table, TableReader};
+use crate::io::{fmt_f64, push_csv_field, push_f64, AtomicFile, InputError};
 use crate::models::contact::{Contact, SpinRule, SteadyContact};
 // --- auto (work-precision, issue 7) ---
 use crate::models::auto::{Auto, AutoOutcome};
@@ -17,7 +17,13 @@ use crate::models::Regime;
 // --- end md ---
 use crate::scene::{CollisionLaw, Scene};
 use rayon::prelude::*;
+use std::fs::File;
+use std::io::{Cursor, Read, Write};
 use std::path::PathBuf;
+
+#[cfg(test)]
+#[path = "forward_reference.rs"]
+mod reference;
 
 /// Arguments of `fitbead forward`.
 #[derive(Debug, clap::Args)]
@@ -119,6 +125,12 @@ pub const OUTPUT_COLUMNS: [&str; 12] = [
     "message",
 ];
 
+/// Rows read, checked, evaluated and formatted per step of the streaming path: memory stays
+/// bounded by two chunks of input records and one of output bytes.
+const CHUNK_ROWS: usize = 32 * 1024;
+/// Rows per parallel task within a chunk.
+const TASK_ROWS: usize = 512;
+
 struct Job {
     scene: Scene,
     model: Model,
@@ -131,20 +143,20 @@ fn field_column(field: &str) -> &str {
     }
 }
 
-fn scene_error(t: &Table, row: usize, e: Error, cols: &[(&str, Option<usize>)]) -> InputError {
+fn scene_error(r: &Row, e: Error, cols: &[(&str, Option<usize>)]) -> InputError {
     let field = match &e {
         Error::InvalidParameter { field, .. } => field_column(field).to_string(),
         Error::UnknownLaw(_) => "K".into(),
         Error::UnknownModel(_) => "model".into(),
     };
     match cols.iter().find(|(n, _)| *n == field).and_then(|(_, c)| *c) {
-        Some(c) => t.err(row, c, e.to_string()),
+        Some(c) => r.err(c, e.to_string()),
         None => InputError {
             file: "<command line>".into(),
             line: None,
             column: Some(format!("--{field}")),
             value: None,
-            message: format!("{e} (line {} of {})", t.lines[row], t.source),
+            message: format!("{e} (line {} of {})", r.line, r.source),
         },
     }
 }
@@ -163,11 +175,8 @@ pub fn run(a: Args) -> Result<(), CliError> {
         "lower" => JaegerBranch::Lower,
         b => return Err(super::flag_error("--branch", b, "expected upper or lower")),
     };
-    let (source, text) = if let (Some(xi), Some(d)) = (a.xi, a.delta_deg) {
-        (
-            "<command line>".to_string(),
-            format!("xi,delta_deg\n{},{}\n", fmt_f64(xi), fmt_f64(d)).into_bytes(),
-        )
+    let single = if let (Some(xi), Some(d)) = (a.xi, a.delta_deg) {
+        Some(format!("xi,delta_deg\n{},{}\n", fmt_f64(xi), fmt_f64(d)).into_bytes())
     } else if a.xi.is_some() || a.delta_deg.is_some() {
         return Err(super::flag_error(
             "--xi/--delta-deg",
@@ -175,97 +184,280 @@ pub fn run(a: Args) -> Result<(), CliError> {
             "a single scene needs both --xi and --delta-deg",
         ));
     } else {
-        read_input(a.input.as_deref())?
+        None
     };
-    let t = Table::parse(&source, &text)?;
     // --- md (molecular dynamics, issue 9) ---
     if kind == ModelKind::Md {
+        let (source, text) = match single {
+            Some(text) => ("<command line>".to_string(), text),
+            None => read_input(a.input.as_deref())?,
+        };
+        let t = Table::parse(&source, &text)?;
         return run_md(&a, &t);
     }
     // --- end md ---
-    let c_xi = t.require("xi")?;
-    let c_d = t.require("delta_deg")?;
-    let c_k = t.col("K");
-    let c_rho = t.col("rho");
-    let c_f = t.col("f");
-    let c_lambda = t.col("lambda");
-    let c_mu = t.col("mu");
-    let c_a = [t.col("a1"), t.col("a2"), t.col("a3")];
-    let c_spin = t.col("spin");
-    let flag_spin: SpinRule = a
-        .spin
-        .parse()
-        .map_err(|e: Error| super::flag_error("--spin", &a.spin, e.to_string()))?;
-    if !(a.tol > 0.0 && a.tol < 1.0) {
-        return Err(super::flag_error(
-            "--tol",
-            &a.tol.to_string(),
-            "expected a relative tolerance in (0, 1)",
-        ));
-    }
-    let flag_law: CollisionLaw =
-        a.k.parse()
-            .map_err(|e: Error| super::flag_error("--K", &a.k, e.to_string()))?;
-    let cols = [
-        ("xi", Some(c_xi)),
-        ("delta_deg", Some(c_d)),
-        ("K", c_k),
-        ("rho", c_rho),
-        ("f", c_f),
-        ("lambda", c_lambda),
-        ("mu", c_mu),
-        ("a1", c_a[0]),
-        ("a2", c_a[1]),
-        ("a3", c_a[2]),
-    ];
-    let mut jobs = Vec::with_capacity(t.rows.len());
-    for r in 0..t.rows.len() {
-        let xi = t.number(r, c_xi)?;
-        let d = t.number(r, c_d)?;
-        let law = match c_k {
-            Some(c) if !t.cell(r, c).is_empty() => t
-                .cell(r, c)
-                .parse::<CollisionLaw>()
-                .map_err(|e| t.err(r, c, e.to_string()))?,
-            _ => flag_law,
-        };
-        if let (CollisionLaw::Value(k), Some(c)) = (law, c_k) {
-            if !k.is_finite() {
-                return Err(t.err(r, c, "value must be a finite number").into());
+    let (source, input): (String, Box<dyn Read + Send>) = match (single, a.input.as_deref()) {
+        (Some(text), _) => ("<command line>".to_string(), Box::new(Cursor::new(text))),
+        (None, None) => (
+            super::DEFAULT_DATA_NAME.to_string(),
+            Box::new(super::DEFAULT_DATA.as_bytes()),
+        ),
+        (None, Some(p)) => {
+            let name = p.display().to_string();
+            let f =
+                File::open(p).map_err(|e| InputError::file(&name, format!("cannot read: {e}")))?;
+            (name, Box::new(f))
+        }
+    };
+    let reader = TableReader::new(&source, input)?;
+    match a.output.as_deref() {
+        Some(p) => {
+            let cannot =
+                |e: std::io::Error| CliError::Other(format!("{}: cannot write: {e}", p.display()));
+            // A file that cannot be created is reported only after the input proved good,
+            // as when the whole output was written at the end.
+            let mut file = AtomicFile::create(p);
+            let r = match &mut file {
+                Ok(f) => stream(&a, kind, branch, reader, f, CHUNK_ROWS, TASK_ROWS),
+                Err(_) => stream(
+                    &a,
+                    kind,
+                    branch,
+                    reader,
+                    &mut std::io::sink(),
+                    CHUNK_ROWS,
+                    TASK_ROWS,
+                ),
+            };
+            match r {
+                Err(Failure::Input(e)) => Err(e),
+                Err(Failure::Write(e)) => Err(cannot(e)),
+                Ok(()) => file.and_then(AtomicFile::commit).map_err(cannot),
             }
         }
-        let rho = t.opt_number(r, c_rho)?.unwrap_or(a.rho);
-        let f = t.opt_number(r, c_f)?.unwrap_or(a.f);
-        let scene = Scene::new(xi, d, rho, f, law).map_err(|e| scene_error(&t, r, e, &cols))?;
-        let model = match (kind, kind.contact_model()) {
+        None => {
+            let mut out = std::io::stdout();
+            let r = stream(&a, kind, branch, reader, &mut out, CHUNK_ROWS, TASK_ROWS)
+                .and_then(|()| out.flush().map_err(Failure::Write));
+            match r {
+                Ok(()) => Ok(()),
+                Err(Failure::Input(e)) => Err(e),
+                Err(Failure::Write(e)) => Err(CliError::Other(format!("<stdout>: {e}"))),
+            }
+        }
+    }
+}
+
+/// Why the streaming path stopped: bad input (which wins), or a failed write.
+enum Failure {
+    Input(CliError),
+    Write(std::io::Error),
+}
+
+impl From<InputError> for Failure {
+    fn from(e: InputError) -> Self {
+        Failure::Input(e.into())
+    }
+}
+
+/// The error to report when a check failed at `e`: a malformed row anywhere in the input, or
+/// an input without rows, is reported first (as when the whole table was read before any
+/// check).
+fn first_error<R: Read>(reader: &mut TableReader<R>, e: CliError) -> Failure {
+    Failure::Input(reader.drain().map(CliError::from).unwrap_or(e))
+}
+
+fn write_parts(out: &mut dyn Write, parts: &[Vec<u8>], failed: &mut Option<std::io::Error>) {
+    for p in parts {
+        if failed.is_some() {
+            return;
+        }
+        if let Err(e) = out.write_all(p) {
+            *failed = Some(e);
+        }
+    }
+}
+
+/// `forward` on a stream of rows: reads `chunk_rows` rows at a time; checks, evaluates and
+/// formats each chunk in parallel (tasks of `task_rows` rows) while the previous chunk's
+/// bytes are written and the next chunk is read. Output bytes are those of the csv crate's
+/// writer (header with `in_` for clashing input names, input cells as read, then the model's
+/// columns). The first bad row in the file is reported; a failed write is reported only
+/// once the whole input proved good, writing stopping at the failure.
+fn stream<R: Read + Send>(
+    a: &Args,
+    kind: ModelKind,
+    branch: JaegerBranch,
+    mut reader: TableReader<R>,
+    out: &mut (dyn Write + Send),
+    chunk_rows: usize,
+    task_rows: usize,
+) -> Result<(), Failure> {
+    let plan = match Plan::new(a, kind, branch, &reader) {
+        Ok(p) => p,
+        Err(e) => return Err(first_error(&mut reader, e)),
+    };
+    let mut cur = Vec::new();
+    let mut next = Vec::new();
+    let mut n_cur = reader.read_chunk(&mut cur, chunk_rows)?;
+    if n_cur == 0 {
+        return Err(reader.no_rows().into());
+    }
+    let mut pending = vec![plan.header()];
+    let mut failed = None;
+    loop {
+        let (read, done) = rayon::join(
+            || {
+                write_parts(out, &pending, &mut failed);
+                reader.read_chunk(&mut next, chunk_rows)
+            },
+            || plan.chunk(&cur[..n_cur], task_rows),
+        );
+        let n_next = read?;
+        pending = match done {
+            Ok(parts) => parts,
+            Err(e) => return Err(first_error(&mut reader, e)),
+        };
+        if n_next == 0 {
+            break;
+        }
+        std::mem::swap(&mut cur, &mut next);
+        n_cur = n_next;
+    }
+    write_parts(out, &pending, &mut failed);
+    match failed {
+        Some(e) => Err(Failure::Write(e)),
+        None => Ok(()),
+    }
+}
+
+/// Everything a row needs besides its cells: flags, columns, the model.
+struct Plan<'a> {
+    a: &'a Args,
+    kind: ModelKind,
+    branch: JaegerBranch,
+    source: String,
+    headers: Vec<String>,
+    c_xi: usize,
+    c_d: usize,
+    c_k: Option<usize>,
+    c_rho: Option<usize>,
+    c_f: Option<usize>,
+    c_lambda: Option<usize>,
+    c_mu: Option<usize>,
+    c_a: [Option<usize>; 3],
+    c_spin: Option<usize>,
+    flag_spin: SpinRule,
+    flag_law: CollisionLaw,
+}
+
+impl<'a> Plan<'a> {
+    fn new<R: Read>(
+        a: &'a Args,
+        kind: ModelKind,
+        branch: JaegerBranch,
+        t: &TableReader<R>,
+    ) -> Result<Self, CliError> {
+        let c_xi = t.require("xi")?;
+        let c_d = t.require("delta_deg")?;
+        let flag_spin: SpinRule = a
+            .spin
+            .parse()
+            .map_err(|e: Error| super::flag_error("--spin", &a.spin, e.to_string()))?;
+        if !(a.tol > 0.0 && a.tol < 1.0) {
+            return Err(super::flag_error(
+                "--tol",
+                &a.tol.to_string(),
+                "expected a relative tolerance in (0, 1)",
+            ));
+        }
+        let flag_law: CollisionLaw =
+            a.k.parse()
+                .map_err(|e: Error| super::flag_error("--K", &a.k, e.to_string()))?;
+        Ok(Plan {
+            a,
+            kind,
+            branch,
+            source: t.source().to_string(),
+            headers: t.headers().to_vec(),
+            c_xi,
+            c_d,
+            c_k: t.col("K"),
+            c_rho: t.col("rho"),
+            c_f: t.col("f"),
+            c_lambda: t.col("lambda"),
+            c_mu: t.col("mu"),
+            c_a: [t.col("a1"), t.col("a2"), t.col("a3")],
+            c_spin: t.col("spin"),
+            flag_spin,
+            flag_law,
+        })
+    }
+
+    fn cols(&self) -> [(&'static str, Option<usize>); 10] {
+        [
+            ("xi", Some(self.c_xi)),
+            ("delta_deg", Some(self.c_d)),
+            ("K", self.c_k),
+            ("rho", self.c_rho),
+            ("f", self.c_f),
+            ("lambda", self.c_lambda),
+            ("mu", self.c_mu),
+            ("a1", self.c_a[0]),
+            ("a2", self.c_a[1]),
+            ("a3", self.c_a[2]),
+        ]
+    }
+
+    /// The scene and model of one row, or the row's first bad value.
+    fn job(&self, r: &Row) -> Result<Job, CliError> {
+        let a = self.a;
+        let xi = r.number(self.c_xi)?;
+        let d = r.number(self.c_d)?;
+        let law = match self.c_k {
+            Some(c) if !r.cell(c).is_empty() => r
+                .cell(c)
+                .parse::<CollisionLaw>()
+                .map_err(|e| r.err(c, e.to_string()))?,
+            _ => self.flag_law,
+        };
+        if let (CollisionLaw::Value(k), Some(c)) = (law, self.c_k) {
+            if !k.is_finite() {
+                return Err(r.err(c, "value must be a finite number").into());
+            }
+        }
+        let rho = r.opt_number(self.c_rho)?.unwrap_or(a.rho);
+        let f = r.opt_number(self.c_f)?.unwrap_or(a.f);
+        let scene = Scene::new(xi, d, rho, f, law).map_err(|e| scene_error(r, e, &self.cols()))?;
+        let model = match (self.kind, self.kind.contact_model()) {
             // --- auto (work-precision, issue 7) ---
             (ModelKind::Auto, _) => Model::Auto(Auto { tol: a.tol }),
             // --- end auto ---
             (ModelKind::Contact, _) => {
-                let spin = match c_spin {
-                    Some(c) if !t.cell(r, c).is_empty() => t
-                        .cell(r, c)
+                let spin = match self.c_spin {
+                    Some(c) if !r.cell(c).is_empty() => r
+                        .cell(c)
                         .parse::<SpinRule>()
-                        .map_err(|e| t.err(r, c, e.to_string()))?,
-                    _ => flag_spin,
+                        .map_err(|e| r.err(c, e.to_string()))?,
+                    _ => self.flag_spin,
                 };
                 Model::Contact(Contact { spin, tol: a.tol })
             }
             (_, Some(m)) => m,
             (ModelKind::Jan, None) => {
                 let paper = Jan::paper_fit(scene.alpha);
-                let lambda = t
-                    .opt_number(r, c_lambda)?
+                let lambda = r
+                    .opt_number(self.c_lambda)?
                     .or(a.lambda)
                     .unwrap_or(paper.lambda);
-                let mu = t.opt_number(r, c_mu)?.or(a.mu).unwrap_or(paper.mu);
-                Model::Jan(Jan::new(lambda, mu).map_err(|e| scene_error(&t, r, e, &cols))?)
+                let mu = r.opt_number(self.c_mu)?.or(a.mu).unwrap_or(paper.mu);
+                Model::Jan(Jan::new(lambda, mu).map_err(|e| scene_error(r, e, &self.cols()))?)
             }
             _ => {
                 let mut v = [0.0; 3];
                 let flags = [a.a1, a.a2, a.a3];
                 for i in 0..3 {
-                    v[i] = match t.opt_number(r, c_a[i])?.or(flags[i]) {
+                    v[i] = match r.opt_number(self.c_a[i])?.or(flags[i]) {
                         Some(x) => x,
                         None => {
                             return Err(super::flag_error(
@@ -277,47 +469,173 @@ pub fn run(a: Args) -> Result<(), CliError> {
                     };
                 }
                 Model::Jaeger(
-                    Jaeger::new(v[0], v[1], v[2], branch)
-                        .map_err(|e| scene_error(&t, r, e, &cols))?,
+                    Jaeger::new(v[0], v[1], v[2], self.branch)
+                        .map_err(|e| scene_error(r, e, &self.cols()))?,
                 )
             }
         };
-        jobs.push(Job { scene, model });
+        Ok(Job { scene, model })
     }
-    // --- auto (work-precision, issue 7): the auto choice travels with each outcome ---
-    let evaluated: Vec<(Outcome, Option<ContactDetail>, Option<AutoOutcome>)> = jobs
-        .par_iter()
-        .map(|j| match j.model {
-            Model::Contact(c) => {
-                let r = c.steady_state(&j.scene);
-                (
-                    Contact::outcome(&j.scene, &r),
-                    Some(ContactDetail {
-                        rule: c.spin,
-                        steady: r.ok(),
-                    }),
-                    None,
-                )
+
+    /// The output header line.
+    fn header(&self) -> Vec<u8> {
+        let general = self.kind == ModelKind::Contact;
+        let mut out = Vec::new();
+        let mut w = Cells::new(&mut out);
+        for h in &self.headers {
+            if OUTPUT_COLUMNS.contains(&h.as_str())
+                || general && CONTACT_COLUMNS.contains(&h.as_str())
+            {
+                w.text(&format!("in_{h}"));
+            } else {
+                w.text(h);
             }
-            Model::Auto(au) => {
-                let r = au.choose(&j.scene);
-                (r.outcome, None, Some(r))
+        }
+        for c in OUTPUT_COLUMNS {
+            w.text(c);
+        }
+        if general {
+            for c in CONTACT_COLUMNS {
+                w.text(c);
             }
-            m => (m.evaluate(&j.scene), None, None),
-        })
-        .collect();
-    let mut outcomes = Vec::with_capacity(evaluated.len());
-    let mut details = Vec::with_capacity(evaluated.len());
-    let mut autos = Vec::with_capacity(evaluated.len());
-    for (o, d, au) in evaluated {
-        outcomes.push(o);
-        details.push(d);
-        autos.push(au);
+        }
+        // --- auto (work-precision, issue 7) ---
+        if self.kind == ModelKind::Auto {
+            for c in AUTO_COLUMNS {
+                w.text(c);
+            }
+        }
+        // --- end auto ---
+        w.end();
+        out
     }
-    let bytes = render(&t, &jobs, &outcomes, &details, &autos, kind)
-        .map_err(|e| CliError::Other(e.to_string()))?;
-    // --- end auto ---
-    emit(a.output.as_deref(), &bytes)
+
+    /// One chunk of rows: their output bytes in order (one buffer per task), or the first
+    /// bad row's error.
+    fn chunk(
+        &self,
+        recs: &[csv::StringRecord],
+        task_rows: usize,
+    ) -> Result<Vec<Vec<u8>>, CliError> {
+        let parts: Vec<Result<Vec<u8>, CliError>> = recs
+            .par_chunks(task_rows.max(1))
+            .map(|rs| {
+                let mut buf = Vec::with_capacity(rs.len() * 192);
+                for rec in rs {
+                    self.row(rec, &mut buf)?;
+                }
+                Ok(buf)
+            })
+            .collect();
+        parts.into_iter().collect()
+    }
+
+    /// Checks, evaluates and formats one row onto `out`.
+    fn row(&self, rec: &csv::StringRecord, out: &mut Vec<u8>) -> Result<(), CliError> {
+        let r = Row {
+            source: &self.source,
+            headers: &self.headers,
+            rec,
+            line: line_of(rec),
+        };
+        let job = self.job(&r)?;
+        let (o, d, au) = evaluate(&job);
+        let kind = self.kind;
+        let general = kind == ModelKind::Contact;
+        let contact = !matches!(kind, ModelKind::Jan | ModelKind::Jaeger);
+        let mut w = Cells::new(out);
+        for cell in rec.iter() {
+            w.text(cell.trim());
+        }
+        let regime = regime_of(&o);
+        match &o {
+            Ok(s) => {
+                w.num(s.mean_velocity);
+                w.opt_show(regime);
+                w.text("ok");
+                if contact {
+                    w.num(job.scene.k);
+                    w.num(s.final_velocity);
+                    w.num(s.initial_velocity);
+                } else {
+                    w.empty();
+                    w.empty();
+                    w.empty();
+                }
+                w.num(s.contact_time);
+                w.opt(s.theta_g.map(f64::to_degrees));
+                w.opt(s.map_slope);
+                w.opt(s.other_fixed_point);
+                w.show(s.phases);
+                w.text(if s.other_fixed_point.is_some() {
+                    if contact {
+                        "bistable: another fixed point of the final-velocity map"
+                    } else {
+                        "two positive roots (eq 84): bistable band"
+                    }
+                } else {
+                    ""
+                });
+            }
+            Err(e) => {
+                w.empty();
+                w.opt_show(regime);
+                w.text(e.status());
+                if contact {
+                    w.num(job.scene.k);
+                } else {
+                    w.empty();
+                }
+                for _ in 0..7 {
+                    w.empty();
+                }
+                w.show(e);
+            }
+        }
+        if let (true, Some(d)) = (general, &d) {
+            contact_cells(&mut w, &job, d);
+        }
+        // --- auto (work-precision, issue 7) ---
+        if kind == ModelKind::Auto {
+            match au {
+                Some(r) => {
+                    w.text(r.choice.name());
+                    w.show(r.reason);
+                }
+                None => {
+                    w.empty();
+                    w.empty();
+                }
+            }
+        }
+        // --- end auto ---
+        w.end();
+        Ok(())
+    }
+}
+
+/// One row's outcome, with what the contact model and `auto` add.
+fn evaluate(j: &Job) -> (Outcome, Option<ContactDetail>, Option<AutoOutcome>) {
+    match j.model {
+        Model::Contact(c) => {
+            let r = c.steady_state(&j.scene);
+            (
+                Contact::outcome(&j.scene, &r),
+                Some(ContactDetail {
+                    rule: c.spin,
+                    steady: r.ok(),
+                }),
+                None,
+            )
+        }
+        // --- auto (work-precision, issue 7): the auto choice travels with each outcome ---
+        Model::Auto(au) => {
+            let r = au.choose(&j.scene);
+            (r.outcome, None, Some(r))
+        }
+        // --- end auto ---
+        m => (m.evaluate(&j.scene), None, None),
+    }
 }
 
 /// What the contact model adds to a row.
@@ -326,138 +644,93 @@ struct ContactDetail {
     steady: Option<SteadyContact>,
 }
 
-fn contact_cells(job: &Job, d: &ContactDetail) -> Vec<String> {
+fn contact_cells(w: &mut Cells, job: &Job, d: &ContactDetail) {
     let Some(s) = &d.steady else {
-        let mut v = vec![String::new(); CONTACT_COLUMNS.len() - 1];
-        v.push(d.rule.to_string());
-        return v;
+        for _ in 0..CONTACT_COLUMNS.len() - 1 {
+            w.empty();
+        }
+        w.show(d.rule);
+        return;
     };
     let e = s.energy(&job.scene);
     let p = e.potential_drop;
-    vec![
-        s.run.phases.to_string(),
-        s.run.phases.changes_deg(),
-        fmt_f64(s.launch.spin),
-        fmt_f64(s.final_spin),
-        s.beads.to_string(),
-        fmt_f64(e.collision_translation / p),
-        fmt_f64(e.collision_spin / p),
-        fmt_f64(e.friction_work / p),
-        fmt_f64(e.closure()),
-        d.rule.to_string(),
-    ]
+    w.show(s.run.phases);
+    w.text(&s.run.phases.changes_deg());
+    w.num(s.launch.spin);
+    w.num(s.final_spin);
+    w.show(s.beads);
+    w.num(e.collision_translation / p);
+    w.num(e.collision_spin / p);
+    w.num(e.friction_work / p);
+    w.num(e.closure());
+    w.show(d.rule);
 }
 
-fn render(
-    t: &Table,
-    jobs: &[Job],
-    outcomes: &[Outcome],
-    details: &[Option<ContactDetail>],
-    autos: &[Option<AutoOutcome>],
-    kind: ModelKind,
-) -> csv::Result<Vec<u8>> {
-    let mut w = csv::Writer::from_writer(Vec::with_capacity(t.rows.len() * 160));
-    let general = kind == ModelKind::Contact;
-    let mut header: Vec<String> = t
-        .headers
-        .iter()
-        .map(|h| {
-            if OUTPUT_COLUMNS.contains(&h.as_str())
-                || general && CONTACT_COLUMNS.contains(&h.as_str())
-            {
-                format!("in_{h}")
-            } else {
-                h.clone()
-            }
-        })
-        .collect();
-    header.extend(OUTPUT_COLUMNS.iter().map(|s| s.to_string()));
-    if general {
-        header.extend(CONTACT_COLUMNS.iter().map(|s| s.to_string()));
+/// Writes the cells of one CSV record onto a byte buffer, as the csv crate's default writer
+/// does (comma separators, quotes only where needed, `\n` after the record).
+struct Cells<'b> {
+    out: &'b mut Vec<u8>,
+    first: bool,
+}
+
+impl<'b> Cells<'b> {
+    fn new(out: &'b mut Vec<u8>) -> Self {
+        Cells { out, first: true }
     }
-    // --- auto (work-precision, issue 7) ---
-    let auto = kind == ModelKind::Auto;
-    if auto {
-        header.extend(AUTO_COLUMNS.iter().map(|s| s.to_string()));
+
+    fn sep(&mut self) {
+        if !self.first {
+            self.out.push(b',');
+        }
+        self.first = false;
     }
-    // --- end auto ---
-    w.write_record(&header)?;
-    let contact = !matches!(kind, ModelKind::Jan | ModelKind::Jaeger);
-    let opt = |x: Option<f64>| x.map(fmt_f64).unwrap_or_default();
-    for ((((rec, job), o), d), au) in t
-        .rows
-        .iter()
-        .zip(jobs)
-        .zip(outcomes)
-        .zip(details)
-        .zip(autos)
-    {
-        let mut out: Vec<String> = rec.iter().map(|s| s.to_string()).collect();
-        let regime = regime_of(o).map(|r| r.to_string()).unwrap_or_default();
-        match o {
-            Ok(s) => {
-                out.push(fmt_f64(s.mean_velocity));
-                out.push(regime);
-                out.push("ok".into());
-                out.push(if contact {
-                    fmt_f64(job.scene.k)
-                } else {
-                    String::new()
-                });
-                if contact {
-                    out.push(fmt_f64(s.final_velocity));
-                    out.push(fmt_f64(s.initial_velocity));
-                } else {
-                    out.push(String::new());
-                    out.push(String::new());
-                }
-                out.push(fmt_f64(s.contact_time));
-                out.push(opt(s.theta_g.map(f64::to_degrees)));
-                out.push(opt(s.map_slope));
-                out.push(opt(s.other_fixed_point));
-                out.push(s.phases.to_string());
-                out.push(if s.other_fixed_point.is_some() {
-                    if contact {
-                        "bistable: another fixed point of the final-velocity map".into()
-                    } else {
-                        "two positive roots (eq 84): bistable band".into()
-                    }
-                } else {
-                    String::new()
-                });
-            }
-            Err(e) => {
-                out.push(String::new());
-                out.push(regime);
-                out.push(e.status().into());
-                out.push(if contact {
-                    fmt_f64(job.scene.k)
-                } else {
-                    String::new()
-                });
-                for _ in 0..7 {
-                    out.push(String::new());
-                }
-                out.push(e.to_string());
-            }
-        }
-        if let (true, Some(d)) = (general, d) {
-            out.extend(contact_cells(job, d));
-        }
-        // --- auto (work-precision, issue 7) ---
-        if auto {
-            match au {
-                Some(r) => {
-                    out.push(r.choice.name().to_string());
-                    out.push(r.reason.to_string());
-                }
-                None => out.extend([String::new(), String::new()]),
-            }
-        }
-        // --- end auto ---
-        w.write_record(&out)?;
+
+    fn empty(&mut self) {
+        self.sep();
     }
-    w.into_inner().map_err(|e| csv::Error::from(e.into_error()))
+
+    fn text(&mut self, s: &str) {
+        self.sep();
+        push_csv_field(self.out, s.as_bytes());
+    }
+
+    /// A number as [`fmt_f64`] writes it (never needs quotes).
+    fn num(&mut self, x: f64) {
+        self.sep();
+        push_f64(self.out, x);
+    }
+
+    fn opt(&mut self, x: Option<f64>) {
+        self.sep();
+        if let Some(x) = x {
+            push_f64(self.out, x);
+        }
+    }
+
+    fn show(&mut self, x: impl std::fmt::Display) {
+        self.sep();
+        let start = self.out.len();
+        // Writing into a Vec cannot fail.
+        let _ = write!(self.out, "{x}");
+        if self.out[start..]
+            .iter()
+            .any(|&b| matches!(b, b',' | b'"' | b'\r' | b'\n'))
+        {
+            let s = self.out.split_off(start);
+            push_csv_field(self.out, &s);
+        }
+    }
+
+    fn opt_show(&mut self, x: Option<impl std::fmt::Display>) {
+        match x {
+            Some(x) => self.show(x),
+            None => self.empty(),
+        }
+    }
+
+    fn end(self) {
+        self.out.push(b'\n');
+    }
 }
 
 // --- md (molecular dynamics, issue 9) ---
@@ -720,8 +993,7 @@ fn run_md(a: &Args, t: &Table) -> Result<(), CliError> {
         // K and f do not enter the md model: a placeholder K keeps Scene's validation quiet.
         let scene = Scene::new(xi, d, rho, a.f, CollisionLaw::Value(0.5)).map_err(|e| {
             scene_error(
-                t,
-                r,
+                &t.row(r),
                 e,
                 &[("xi", Some(c_xi)), ("delta_deg", Some(c_d)), ("rho", c_rho)],
             )
@@ -862,3 +1134,260 @@ fn render_md(
     w.into_inner().map_err(|e| csv::Error::from(e.into_error()))
 }
 // --- end md ---
+
+#[cfg(test)]
+mod tests {
+    //! The streaming path against the old whole-table path ([`reference`]): the same bytes on
+    //! the shipped data and on a generated table with every kind of cell, for every model but
+    //! md, at several chunk sizes; the same message for every kind of bad input.
+
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cmd {
+        #[command(flatten)]
+        a: Args,
+    }
+
+    fn args(flags: &[&str]) -> Args {
+        Cmd::parse_from(std::iter::once("forward").chain(flags.iter().copied())).a
+    }
+
+    fn kind_branch(a: &Args) -> (ModelKind, JaegerBranch) {
+        let kind = a.model.parse().unwrap();
+        let branch = match a.branch.as_str() {
+            "lower" => JaegerBranch::Lower,
+            _ => JaegerBranch::Upper,
+        };
+        (kind, branch)
+    }
+
+    fn old(a: &Args, text: &[u8]) -> Result<Vec<u8>, String> {
+        let (kind, branch) = kind_branch(a);
+        let t = reference::Table::parse("in.csv", text).map_err(|e| e.to_string())?;
+        reference::forward_table(a, kind, branch, &t).map_err(|e| e.to_string())
+    }
+
+    fn new(a: &Args, text: &[u8], chunk: usize, task: usize) -> Result<Vec<u8>, String> {
+        let (kind, branch) = kind_branch(a);
+        let reader = TableReader::new("in.csv", text).map_err(|e| e.to_string())?;
+        let mut out = Vec::new();
+        match stream(a, kind, branch, reader, &mut out, chunk, task) {
+            Ok(()) => Ok(out),
+            Err(Failure::Input(e)) => Err(e.to_string()),
+            Err(Failure::Write(e)) => panic!("write to a Vec failed: {e}"),
+        }
+    }
+
+    const SIZES: [(usize, usize); 4] = [(1, 1), (7, 3), (64, 5), (CHUNK_ROWS, TASK_ROWS)];
+
+    fn same(flags: &[&str], text: &[u8]) {
+        let a = args(flags);
+        let want = old(&a, text);
+        for (chunk, task) in SIZES {
+            let got = new(&a, text, chunk, task);
+            match (&want, &got) {
+                (Ok(w), Ok(g)) => assert!(
+                    w == g,
+                    "{flags:?}, chunks of {chunk}: output differs\nold:\n{}\nnew:\n{}",
+                    String::from_utf8_lossy(w),
+                    String::from_utf8_lossy(g)
+                ),
+                _ => assert_eq!(want, got, "{flags:?}, chunks of {chunk}"),
+            }
+        }
+    }
+
+    const MODELS: [&[&str]; 11] = [
+        &["--model", "stick"],
+        &["--model", "stick", "--K", "cos2a", "--rho", "0.5"],
+        &["--model", "stick-approx"],
+        &["--model", "slip"],
+        &["--model", "slip-approx"],
+        &["--model", "stickslip", "--f", "0.3"],
+        &["--model", "contact", "--spin", "keep"],
+        &["--model", "jan"],
+        &[
+            "--model", "jaeger", "--a1", "0.05", "--a2", "0.4", "--a3", "1.5",
+        ],
+        &[
+            "--model", "jaeger", "--a1", "0.1", "--a2", "2", "--a3", "0.3", "--branch", "lower",
+        ],
+        &["--model", "auto", "--tol", "1e-8"],
+    ];
+
+    /// A table with every kind of cell the readers and writers meet: quoted cells (commas,
+    /// quotes, a newline), non-ASCII text, columns whose names clash with the output (`v`,
+    /// `regime`, `phase_sequence`), laws by name, empty cells falling back on the flags,
+    /// padded cells (ASCII and Unicode spaces), blank lines, and scenes in regimes A, B and C.
+    fn generated(rows: usize) -> String {
+        let mut s = String::from(
+            "id, xi ,delta_deg,K,rho,f,v,regime,spin,lambda,mu,a1,a2,a3,phase_sequence,note\n",
+        );
+        let laws = [
+            "", "0.6", "cos2a", "adjusted", "impact", "c=0.3", "0.95", " 0.3 ", "1e-1",
+        ];
+        let spins = ["", "roll", "keep", "factor=0.5", "impact"];
+        let notes = [
+            "",
+            " plain\t",
+            "\u{2003}em space\u{a0}",
+            "\"quoted, comma\"",
+            "\"say \"\"hi\"\"\"",
+            "\"two\nlines\"",
+            "é→ü",
+        ];
+        let mut x: u64 = 0x9e37_79b9_7f4a_7c15;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for i in 0..rows {
+            let xi = 0.65 + 9.35 * next();
+            let d = 40.0 * next();
+            let pick = |u: f64, n: usize| ((u * n as f64) as usize).min(n - 1);
+            let law = laws[pick(next(), laws.len())];
+            let rho = if i % 5 == 0 {
+                String::new()
+            } else {
+                format!("{}", 0.5 * next())
+            };
+            let f = if i % 3 == 0 {
+                String::new()
+            } else {
+                format!("{}", 0.4 * next())
+            };
+            let spin = spins[pick(next(), spins.len())];
+            let lambda = if i % 4 == 0 {
+                String::new()
+            } else {
+                format!("{}", 0.5 + next())
+            };
+            let mu = if i % 6 == 0 {
+                String::new()
+            } else {
+                format!("{}", next())
+            };
+            let note = notes[i % notes.len()];
+            s.push_str(&format!(
+                "r{i},{xi},{d},{law},{rho},{f},{},B,{spin},{lambda},{mu},0.05,0.4,1.5,x,{note}\n",
+                0.3 * next()
+            ));
+            if i % 17 == 0 {
+                s.push('\n');
+            }
+        }
+        s
+    }
+
+    #[test]
+    fn same_bytes_as_the_whole_table_path_on_the_shipped_data() {
+        for data in [
+            &include_bytes!("../../data/default.csv")[..],
+            &include_bytes!("../../data/virtual/md_ristow.csv")[..],
+        ] {
+            for m in MODELS {
+                same(m, data);
+            }
+        }
+    }
+
+    #[test]
+    fn same_bytes_as_the_whole_table_path_on_a_generated_table() {
+        let text = generated(300);
+        for m in MODELS {
+            same(m, text.as_bytes());
+        }
+        // Many rows, one cheap model: several full-size chunks.
+        let text = generated(3 * CHUNK_ROWS + 123);
+        same(&["--model", "stick"], text.as_bytes());
+        // A single scene on the command line goes through the same path.
+        let a = args(&["--model", "stick"]);
+        assert_eq!(
+            old(&a, b"xi,delta_deg\n1,12\n"),
+            new(&a, b"xi,delta_deg\n1,12\n", 1, 1)
+        );
+    }
+
+    #[test]
+    fn same_error_as_the_whole_table_path() {
+        let good = "1,12\n".repeat(40);
+        let late_s = |bad: &str| format!("xi,delta_deg\n{good}{bad}{good}");
+        let late = |bad: &str| late_s(bad).into_bytes();
+        let stick: &[&str] = &["--model", "stick"];
+        let cases: Vec<(&[&str], Vec<u8>)> = vec![
+            (stick, Vec::new()),
+            (stick, " \n\t\n".into()),
+            (stick, "xi,delta_deg\n".into()),
+            (stick, "xi,delta_deg\n\n\n".into()),
+            (stick, "xi,,delta_deg\n1,2,3\n".into()),
+            (stick, "xi,xi,delta_deg\n1,2,3\n".into()),
+            (stick, "xi,K\n1,0.6\n".into()),
+            (stick, "xi,delta_deg\n1,abc\n".into()),
+            (stick, "xi,delta_deg\n1,10\n1,NaN\n".into()),
+            (stick, "xi,delta_deg\n1,inf\n".into()),
+            (stick, "xi,delta_deg\n-1,10\n".into()),
+            (stick, "xi,delta_deg\n1,95\n".into()),
+            (stick, "xi,delta_deg\n ,10\n".into()),
+            (stick, "xi,delta_deg,K\n1,10,smooth\n".into()),
+            (stick, "xi,delta_deg,K\n1,10,-0.5\n".into()),
+            (stick, "xi,delta_deg,K\n1,10,inf\n".into()),
+            (stick, "xi,delta_deg,K\n1,10,c=abc\n".into()),
+            (stick, "xi,delta_deg,rho\n1,10,-2\n".into()),
+            (stick, "xi,delta_deg,f\n1,10,x\n".into()),
+            // Bad rows after the first chunks; the first one is reported.
+            (stick, late("1,abc\n")),
+            (stick, late("1,10\n0,10\n1,abc\n")),
+            // A malformed row anywhere wins over a bad value before it.
+            (stick, late("1,10,3\n")),
+            (stick, format!("{}1,abc\n{good}1,10,3\n", late_s("")).into()),
+            (stick, format!("xi,delta_deg\n1,abc\n{good}\"1,10\n").into()),
+            // Invalid UTF-8, the byte index counted in the trimmed cell.
+            (stick, b"xi,delta_deg\n1,10\n1,\xff\n".to_vec()),
+            (stick, b"xi,delta_deg\n1,10\n1, \t \xc3\xa9\xff \n".to_vec()),
+            (stick, b"xi,delta_deg\n\n\n1,10\n\n1,\xc3\n".to_vec()),
+            (stick, late("1,\u{e9}\n")),
+            (stick, [late(""), b"  \xfe,1\n".to_vec()].concat()),
+            (stick, [late("1,abc\n"), b"  \xfe,1\n".to_vec()].concat()),
+            // Flag errors come after the table's own errors.
+            (&["--model", "stick", "--tol", "2"], "xi,delta_deg\n".into()),
+            (&["--model", "stick", "--tol", "2"], late("1,10,3\n")),
+            (&["--model", "stick", "--tol", "2"], late("")),
+            (&["--model", "stick", "--K", "bogus"], late("")),
+            (&["--model", "stick", "--spin", "bogus"], late("")),
+            (&["--model", "stick", "--rho=-1"], late("")),
+            (&["--model", "jaeger"], late("")),
+            (
+                &["--model", "jaeger", "--a1", "1", "--a2", "1"],
+                "xi,delta_deg,a3\n1,10,1\n1,10,\n".into(),
+            ),
+            (
+                &["--model", "jaeger", "--a1", "1", "--a2", "1", "--a3=-1"],
+                late(""),
+            ),
+            (
+                &["--model", "jan"],
+                "xi,delta_deg,lambda\n1,10,0.8\n1,10,-1\n".into(),
+            ),
+            (&["--model", "jan", "--mu=-1"], late("")),
+            (
+                &["--model", "contact"],
+                "xi,delta_deg,spin\n1,10,roll\n1,10,twirl\n".into(),
+            ),
+            (&["--model", "auto"], late("1,-3\n")),
+        ];
+        for (flags, bytes) in cases {
+            let a = args(flags);
+            let want = old(&a, &bytes);
+            let text = String::from_utf8_lossy(&bytes);
+            assert!(want.is_err(), "{flags:?} {text:?} should fail");
+            for (chunk, task) in SIZES {
+                let got = new(&a, &bytes, chunk, task);
+                assert_eq!(want, got, "{flags:?} {text:?}, chunks of {chunk}");
+            }
+        }
+    }
+}

@@ -81,25 +81,73 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
 pub fn write_atomic_all(files: &[(&Path, &[u8])]) -> std::io::Result<()> {
     let mut staged = Vec::with_capacity(files.len());
     for (path, bytes) in files {
+        let mut tmp = AtomicFile::create(path)?;
+        tmp.write_all(bytes)?;
+        tmp.sync()?;
+        staged.push(tmp);
+    }
+    for tmp in staged {
+        tmp.persist()?;
+    }
+    Ok(())
+}
+
+/// A file written under a temporary name in the target's directory and renamed over the
+/// target only by [`AtomicFile::commit`]; dropped uncommitted, the temporary file is removed
+/// and the target is untouched.
+pub struct AtomicFile {
+    tmp: tempfile::NamedTempFile,
+    path: PathBuf,
+}
+
+impl AtomicFile {
+    /// Creates the temporary file next to `path`.
+    pub fn create(path: &Path) -> std::io::Result<AtomicFile> {
         let dir: PathBuf = match path.parent() {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
         };
-        let mut tmp = tempfile::Builder::new()
+        let tmp = tempfile::Builder::new()
             .prefix(".fitbead-")
             .suffix(".tmp")
             .tempfile_in(&dir)
             .map_err(|e| std::io::Error::new(e.kind(), format!("{}: {e}", path.display())))?;
-        tmp.write_all(bytes)?;
-        tmp.as_file().sync_all()?;
-        staged.push((tmp, *path));
+        Ok(AtomicFile {
+            tmp,
+            path: path.to_path_buf(),
+        })
     }
-    for (tmp, path) in staged {
-        tmp.persist(path).map_err(|e| {
+
+    /// Flushes the data to disk and renames the file over its target.
+    pub fn commit(self) -> std::io::Result<()> {
+        self.sync()?;
+        self.persist()
+    }
+
+    fn sync(&self) -> std::io::Result<()> {
+        self.tmp.as_file().sync_all()
+    }
+
+    fn persist(self) -> std::io::Result<()> {
+        let path = self.path;
+        self.tmp.persist(&path).map(|_| ()).map_err(|e| {
             std::io::Error::new(e.error.kind(), format!("{}: {}", path.display(), e.error))
-        })?;
+        })
     }
-    Ok(())
+}
+
+impl Write for AtomicFile {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.tmp.write(buf)
+    }
+
+    fn write_all(&mut self, buf: &[u8]) -> std::io::Result<()> {
+        self.tmp.write_all(buf)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.tmp.flush()
+    }
 }
 
 /// `x` rounded to `digits` significant digits, written as the shortest decimal of that
@@ -113,13 +161,43 @@ pub fn fmt_sig(x: f64, digits: usize) -> String {
     }
 }
 
-/// Shortest decimal that reads back as the same double (ryu).
+/// Shortest decimal that reads back as the same double (ryu); empty for inf and NaN.
 pub fn fmt_f64(x: f64) -> String {
+    let mut b = ryu::Buffer::new();
+    f64_str(&mut b, x).to_string()
+}
+
+/// [`fmt_f64`] appended to `out`, without allocating.
+pub fn push_f64(out: &mut Vec<u8>, x: f64) {
+    let mut b = ryu::Buffer::new();
+    out.extend_from_slice(f64_str(&mut b, x).as_bytes());
+}
+
+fn f64_str(b: &mut ryu::Buffer, x: f64) -> &str {
     if x.is_finite() {
-        let mut b = ryu::Buffer::new();
         let s = b.format_finite(x);
-        s.strip_suffix(".0").unwrap_or(s).to_string()
+        s.strip_suffix(".0").unwrap_or(s)
     } else {
-        String::new()
+        ""
+    }
+}
+
+/// Appends one CSV field to `out` as the `csv` crate's default writer does: quoted (with
+/// quotes doubled) when it holds a comma, a quote, a carriage return or a newline.
+pub fn push_csv_field(out: &mut Vec<u8>, field: &[u8]) {
+    if field
+        .iter()
+        .any(|&b| matches!(b, b',' | b'"' | b'\r' | b'\n'))
+    {
+        out.push(b'"');
+        for &b in field {
+            if b == b'"' {
+                out.push(b'"');
+            }
+            out.push(b);
+        }
+        out.push(b'"');
+    } else {
+        out.extend_from_slice(field);
     }
 }

@@ -1,8 +1,10 @@
 //! Reading tables of scenes or measurements: typed, validated rows that keep their extra
-//! columns and their line numbers.
+//! columns and their line numbers — whole ([`Table`]) or a chunk at a time
+//! ([`TableReader`]), with the same checks and messages either way.
 
 use super::InputError;
 use std::collections::HashMap;
+use std::io::{Chain, Cursor, Read};
 
 /// A CSV table read into memory: header, rows, line numbers.
 #[derive(Debug, Clone)]
@@ -18,19 +20,54 @@ pub struct Table {
     index: HashMap<String, usize>,
 }
 
-impl Table {
-    /// Parses CSV text. Fails on an empty input, a ragged row or a header without rows.
-    pub fn parse(source: &str, text: &[u8]) -> Result<Table, InputError> {
-        if text.iter().all(|b| b.is_ascii_whitespace()) {
-            return Err(InputError::file(
-                source,
-                "file is empty: expected a header line",
-            ));
+/// Streams the rows of a CSV table: the header is read and checked on creation, the rows a
+/// chunk at a time. Empty input, an empty or duplicate column name, a malformed or ragged
+/// row and an input without rows are reported as [`Table::parse`] reports them (it is built
+/// on this reader); blank lines are skipped.
+pub struct TableReader<R: Read> {
+    source: String,
+    headers: Vec<String>,
+    index: HashMap<String, usize>,
+    rdr: csv::Reader<Chain<Cursor<Vec<u8>>, R>>,
+    rows_seen: u64,
+    done: bool,
+}
+
+/// 1-based line number where a record read by [`TableReader`] starts (0 when unknown).
+pub fn line_of(rec: &csv::StringRecord) -> u64 {
+    rec.position().map(|p| p.line()).unwrap_or(0)
+}
+
+impl<R: Read> TableReader<R> {
+    /// Reads and checks the header of `input`; `source` names it in messages. Fails on an
+    /// input that is empty or only whitespace, an unreadable header, an empty or duplicate
+    /// column name, or a read error ("cannot read").
+    pub fn new(source: &str, mut input: R) -> Result<Self, InputError> {
+        // The leading whitespace (if any) up to the first other byte decides "file is empty".
+        let mut prefix = Vec::new();
+        let mut buf = [0u8; 8192];
+        loop {
+            let n = match input.read(&mut buf) {
+                Ok(n) => n,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+                Err(e) => return Err(InputError::file(source, format!("cannot read: {e}"))),
+            };
+            if n == 0 {
+                return Err(InputError::file(
+                    source,
+                    "file is empty: expected a header line",
+                ));
+            }
+            prefix.extend_from_slice(&buf[..n]);
+            if buf[..n].iter().any(|b| !b.is_ascii_whitespace()) {
+                break;
+            }
         }
         let mut rdr = csv::ReaderBuilder::new()
             .has_headers(true)
-            .trim(csv::Trim::All)
-            .from_reader(text);
+            .trim(csv::Trim::Headers)
+            .buffer_capacity(1 << 16)
+            .from_reader(Cursor::new(prefix).chain(input));
         let headers: Vec<String> = rdr
             .headers()
             .map_err(|e| InputError::file(source, format!("cannot read header: {e}")))?
@@ -52,41 +89,227 @@ impl Table {
                 return Err(InputError::cell(source, 1, h, h, "duplicate column name"));
             }
         }
-        let mut rows = Vec::new();
-        let mut lines = Vec::new();
-        let mut rec = csv::StringRecord::new();
-        loop {
-            match rdr.read_record(&mut rec) {
-                Ok(true) => {
-                    let line = rec.position().map(|p| p.line()).unwrap_or(0);
-                    if rec.len() == 1 && rec.get(0) == Some("") {
-                        continue; // blank line
-                    }
-                    rows.push(rec.clone());
-                    lines.push(line);
-                }
-                Ok(false) => break,
-                Err(e) => {
-                    let line = e.position().map(|p| p.line());
-                    return Err(InputError {
-                        file: source.to_string(),
-                        line,
-                        column: None,
-                        value: None,
-                        message: format!("malformed CSV: {e}"),
-                    });
-                }
-            }
-        }
-        if rows.is_empty() {
-            return Err(InputError::file(source, "no data rows after the header"));
-        }
-        Ok(Table {
+        Ok(TableReader {
             source: source.to_string(),
             headers,
+            index,
+            rdr,
+            rows_seen: 0,
+            done: false,
+        })
+    }
+
+    /// Where the input came from (for messages).
+    pub fn source(&self) -> &str {
+        &self.source
+    }
+
+    /// Column names.
+    pub fn headers(&self) -> &[String] {
+        &self.headers
+    }
+
+    /// Index of a column, if present.
+    pub fn col(&self, name: &str) -> Option<usize> {
+        self.index.get(name).copied()
+    }
+
+    /// Index of a required column.
+    pub fn require(&self, name: &str) -> Result<usize, InputError> {
+        require(&self.source, &self.headers, &self.index, name)
+    }
+
+    /// Reads up to `max` rows into `recs[..n]` (reusing the records already there, growing
+    /// `recs` as needed) and returns `n`; fewer than `max` only at the end of the input.
+    /// Cells are as in the file, not trimmed: read them through [`Row`], which trims them
+    /// (as [`Table`] does). Line numbers: [`line_of`]. A malformed row is an error naming
+    /// its line.
+    pub fn read_chunk(
+        &mut self,
+        recs: &mut Vec<csv::StringRecord>,
+        max: usize,
+    ) -> Result<usize, InputError> {
+        let mut n = 0;
+        while n < max && !self.done {
+            if n == recs.len() {
+                recs.push(csv::StringRecord::new());
+            }
+            if self.read_one(&mut recs[n])? {
+                n += 1;
+            }
+        }
+        Ok(n)
+    }
+
+    /// Reads the rest of the input only to find what [`Table::parse`] would have reported
+    /// before any check of the values: a malformed row, or no data rows at all.
+    pub fn drain(&mut self) -> Option<InputError> {
+        let mut rec = csv::StringRecord::new();
+        while !self.done {
+            if let Err(e) = self.read_one(&mut rec) {
+                return Some(e);
+            }
+        }
+        (self.rows_seen == 0).then(|| self.no_rows())
+    }
+
+    /// Reads one record into `rec`, reusing its buffers; true for a row, false for a blank
+    /// line or the end of the input. The cells are not trimmed, but a record with invalid
+    /// UTF-8 is reported as when they were (the byte index counted from the trimmed cell).
+    fn read_one(&mut self, rec: &mut csv::StringRecord) -> Result<bool, InputError> {
+        let pos = self.rdr.position().clone();
+        let mut b = std::mem::take(rec).into_byte_record();
+        let read = self.rdr.read_byte_record(&mut b);
+        let utf8 = csv::StringRecord::from_byte_record(b);
+        let more = match read {
+            Ok(more) => more,
+            Err(e) => {
+                self.done = true;
+                return Err(self.csv_error(e));
+            }
+        };
+        *rec = match utf8 {
+            Ok(r) => r,
+            Err(e) => {
+                self.done = true;
+                let (field, up_to) = (e.utf8_error().field(), e.utf8_error().valid_up_to());
+                let b = e.into_byte_record();
+                let cell = b.get(field).unwrap_or(b"");
+                let lead = cell.iter().take_while(|c| c.is_ascii_whitespace()).count();
+                return Err(InputError {
+                    file: self.source.clone(),
+                    line: Some(pos.line()),
+                    column: None,
+                    value: None,
+                    message: format!(
+                        "malformed CSV: CSV parse error: record {} (line {}, field: {field}, \
+                         byte: {}): invalid utf-8: invalid UTF-8 in field {field} near byte \
+                         index {}",
+                        pos.record(),
+                        pos.line(),
+                        pos.byte(),
+                        up_to.saturating_sub(lead)
+                    ),
+                });
+            }
+        };
+        if !more {
+            self.done = true;
+            return Ok(false);
+        }
+        if rec.len() == 1 && rec.get(0).map(str::trim) == Some("") {
+            return Ok(false); // blank line
+        }
+        self.rows_seen += 1;
+        Ok(true)
+    }
+
+    /// The error for an input with a header and no data rows.
+    pub fn no_rows(&self) -> InputError {
+        InputError::file(&self.source, "no data rows after the header")
+    }
+
+    fn csv_error(&self, e: csv::Error) -> InputError {
+        if let csv::ErrorKind::Io(io) = e.kind() {
+            return InputError::file(&self.source, format!("cannot read: {io}"));
+        }
+        InputError {
+            file: self.source.clone(),
+            line: e.position().map(|p| p.line()),
+            column: None,
+            value: None,
+            message: format!("malformed CSV: {e}"),
+        }
+    }
+}
+
+fn require(
+    source: &str,
+    headers: &[String],
+    index: &HashMap<String, usize>,
+    name: &str,
+) -> Result<usize, InputError> {
+    index.get(name).copied().ok_or_else(|| InputError {
+        file: source.to_string(),
+        line: Some(1),
+        column: Some(name.to_string()),
+        value: None,
+        message: format!(
+            "missing required column (header has: {})",
+            headers.join(",")
+        ),
+    })
+}
+
+/// One row of a table with what its messages need: the source, the column names and the
+/// line number.
+#[derive(Debug, Clone, Copy)]
+pub struct Row<'a> {
+    /// Where it came from (for messages).
+    pub source: &'a str,
+    /// Column names.
+    pub headers: &'a [String],
+    /// The cells.
+    pub rec: &'a csv::StringRecord,
+    /// 1-based line number.
+    pub line: u64,
+}
+
+impl<'a> Row<'a> {
+    /// Text of a cell, without leading and trailing whitespace.
+    pub fn cell(&self, col: usize) -> &'a str {
+        self.rec.get(col).unwrap_or("").trim()
+    }
+
+    /// A finite number from a cell, or an error naming file, line, column and value.
+    pub fn number(&self, col: usize) -> Result<f64, InputError> {
+        match self.cell(col).parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(v),
+            Ok(_) => Err(self.err(col, "value must be a finite number")),
+            Err(_) => Err(self.err(col, "not a number")),
+        }
+    }
+
+    /// An optional number: empty cell or absent column gives `None`.
+    pub fn opt_number(&self, col: Option<usize>) -> Result<Option<f64>, InputError> {
+        match col {
+            Some(c) if !self.cell(c).is_empty() => self.number(c).map(Some),
+            _ => Ok(None),
+        }
+    }
+
+    /// An error at one cell.
+    pub fn err(&self, col: usize, message: impl Into<String>) -> InputError {
+        InputError::cell(
+            self.source,
+            self.line,
+            &self.headers[col],
+            self.cell(col),
+            message,
+        )
+    }
+}
+
+impl Table {
+    /// Parses CSV text. Fails on an empty input, a ragged row or a header without rows.
+    pub fn parse(source: &str, text: &[u8]) -> Result<Table, InputError> {
+        let mut r = TableReader::new(source, text)?;
+        let mut rows = Vec::new();
+        let n = r.read_chunk(&mut rows, usize::MAX)?;
+        rows.truncate(n);
+        for row in &mut rows {
+            row.trim();
+        }
+        if rows.is_empty() {
+            return Err(r.no_rows());
+        }
+        let lines = rows.iter().map(line_of).collect();
+        Ok(Table {
+            source: r.source,
+            headers: r.headers,
             rows,
             lines,
-            index,
+            index: r.index,
         })
     }
 
@@ -97,16 +320,17 @@ impl Table {
 
     /// Index of a required column.
     pub fn require(&self, name: &str) -> Result<usize, InputError> {
-        self.col(name).ok_or_else(|| InputError {
-            file: self.source.clone(),
-            line: Some(1),
-            column: Some(name.to_string()),
-            value: None,
-            message: format!(
-                "missing required column (header has: {})",
-                self.headers.join(",")
-            ),
-        })
+        require(&self.source, &self.headers, &self.index, name)
+    }
+
+    /// Row `row` with its line number, for typed cells and located errors.
+    pub fn row(&self, row: usize) -> Row<'_> {
+        Row {
+            source: &self.source,
+            headers: &self.headers,
+            rec: &self.rows[row],
+            line: self.lines[row],
+        }
     }
 
     /// Raw text of a cell.
@@ -116,30 +340,16 @@ impl Table {
 
     /// A finite number from a cell, or an error naming file, line, column and value.
     pub fn number(&self, row: usize, col: usize) -> Result<f64, InputError> {
-        let s = self.cell(row, col);
-        match s.parse::<f64>() {
-            Ok(v) if v.is_finite() => Ok(v),
-            Ok(_) => Err(self.err(row, col, "value must be a finite number")),
-            Err(_) => Err(self.err(row, col, "not a number")),
-        }
+        self.row(row).number(col)
     }
 
     /// An optional number: empty cell or absent column gives `None`.
     pub fn opt_number(&self, row: usize, col: Option<usize>) -> Result<Option<f64>, InputError> {
-        match col {
-            Some(c) if !self.cell(row, c).is_empty() => self.number(row, c).map(Some),
-            _ => Ok(None),
-        }
+        self.row(row).opt_number(col)
     }
 
     /// An error at one cell.
     pub fn err(&self, row: usize, col: usize, message: impl Into<String>) -> InputError {
-        InputError::cell(
-            &self.source,
-            self.lines[row],
-            &self.headers[col],
-            self.cell(row, col),
-            message,
-        )
+        self.row(row).err(col, message)
     }
 }

@@ -268,7 +268,8 @@ fn launch_speed_path_agrees_with_the_search_in_k() {
                     continue;
                 };
                 let v = st.mean_velocity;
-                let sg = Some(rng.random_range(0.005..0.1) * v);
+                let sigma = rng.random_range(0.005..0.1) * v;
+                let sg = Some(sigma);
                 tried += 1;
                 let Some(fast) = klaunch::estimate(&m, &s, v, sg) else {
                     continue;
@@ -284,8 +285,8 @@ fn launch_speed_path_agrees_with_the_search_in_k() {
                             let back = m.evaluate(&with_k(&s, kk)).unwrap().mean_velocity;
                             let target = match what {
                                 "K" => v,
-                                "K_lo" => v - sg.unwrap(),
-                                _ => v + sg.unwrap(),
+                                "K_lo" => v - sigma,
+                                _ => v + sigma,
                             };
                             assert!(
                                 (back - target).abs() <= 8.0 * f64::EPSILON * target,

@@ -17,10 +17,13 @@
 //! the root, with τ' and τ'' from the central difference that also gives dv̄/dK.
 //!
 //! The path applies when Θ0 < 0 (δ < α) and, for stick/slip, when the slip starts after the top
-//! at the crawl and the map's asymptotic slope K e^{2fα} stays below 0.95 up to lift-off (a
-//! single fixed point, the premise of the forward model's own search); its stick/slip root is
-//! checked against the forward model. Elsewhere [`super::k::estimate`] uses its general
-//! bracketing search in K.
+//! at the crawl and K(w0) rises from the crawl: either all the way to lift-off (one fixed point
+//! per K) or to a maximum, the saddle-node of the final-velocity map, beyond which the launches
+//! belong to the unstable branch. In that second case the range ends at the saddle-node
+//! (`UpperLimit::Model`), each root is checked against the forward model (it must settle on the
+//! stable fixed point found here), and measurements within 1e-6 of the fastest stable motion
+//! are left to the general search, where the forward model's own fixed-point search gives out.
+//! Elsewhere [`super::k::estimate`] uses its general bracketing search in K.
 
 use super::k::{KBracket, KEstimate, KFailure, KRoot, LowerLimit, UpperLimit};
 use crate::models::regimes::theta_g;
@@ -66,6 +69,9 @@ struct Launch<'a> {
     y_d: f64,
     /// K at the crawl.
     k_min: f64,
+    /// K(w0) rises to a maximum below lift-off (a saddle-node of the final-velocity map):
+    /// `y_d` is that maximum, the end of the stable branch.
+    saddle: bool,
 }
 
 /// Squared-speed gain of the contact time's asinh approximation (eq 29), as a function of y:
@@ -109,6 +115,7 @@ impl<'a> Launch<'a> {
             drop,
             y_d: 0.0,
             k_min: -s0 / scene.sc_half_f.s,
+            saddle: false,
         };
         match mech {
             Mechanics::Roll => {
@@ -140,10 +147,18 @@ impl<'a> Launch<'a> {
                 }
                 let y_lo = f64::MIN_POSITIVE;
                 let r = brent(q, y_lo, y_hi, crawl.wf - xd, q_hi, 0.0, 200)?;
-                // The largest launch at or below lift-off.
+                // The largest launch at or below lift-off: within a few ulp of Brent's answer
+                // when Φ crosses sqrt(cos Θf) continuously; otherwise the range ends at a
+                // jump of the map (the launch stops or lifts off elsewhere): leave that to
+                // the general search.
                 let mut y = r.x;
-                while y > 0.0 && !l.launch(y).is_some_and(|p| p.wf <= xd) {
+                let mut steps = 0;
+                while !l.launch(y).is_some_and(|p| p.wf <= xd) {
                     y *= 1.0 - 4.0 * f64::EPSILON;
+                    steps += 1;
+                    if steps > 64 {
+                        return None;
+                    }
                 }
                 l.y_d = y;
                 // One fixed point per K: K(w0) = w0/Φ(w0) increasing from the crawl to
@@ -165,10 +180,42 @@ impl<'a> Launch<'a> {
                     ys.push(y);
                     ys.sort_by(f64::total_cmp);
                     let mut k_prev = l.k_min;
-                    for yi in ys {
+                    for (i, &yi) in ys.iter().enumerate() {
                         let k = l.k_of_launch(yi)?;
                         if !(k > k_prev) {
-                            return None;
+                            // K falls: the stable branch ends at the maximum of K between
+                            // ys[i-2] and ys[i], found by golden section in u to 1e-9 of
+                            // that span.
+                            if i < 2 {
+                                return None;
+                            }
+                            let f = |u: f64| l.k_of_launch(u.exp()).unwrap_or(f64::NEG_INFINITY);
+                            let (mut a, mut b) = (ys[i - 2].ln(), ys[i].ln());
+                            let r = 0.5 * (5f64.sqrt() - 1.0);
+                            let (mut c, mut d) = (b - r * (b - a), a + r * (b - a));
+                            let (mut fc, mut fd) = (f(c), f(d));
+                            let tol = 1e-9 * (b - a);
+                            for _ in 0..100 {
+                                if b - a <= tol {
+                                    break;
+                                }
+                                if fc >= fd {
+                                    b = d;
+                                    d = c;
+                                    fd = fc;
+                                    c = b - r * (b - a);
+                                    fc = f(c);
+                                } else {
+                                    a = c;
+                                    c = d;
+                                    fc = fd;
+                                    d = a + r * (b - a);
+                                    fd = f(d);
+                                }
+                            }
+                            l.y_d = a.exp();
+                            l.saddle = true;
+                            break;
                         }
                         k_prev = k;
                     }
@@ -303,7 +350,7 @@ impl<'a> Launch<'a> {
         // y → 0: τ̃ ≈ 2/sqrt(2B) [ln(8B a0 af) − ln y].
         let mut u = ((8.0 * b * a0 * af).ln() - tau_star * (0.5 * b).sqrt()).min(u_d);
         let mut slope = -(2.0 / b).sqrt();
-        for _ in 0..6 {
+        for _ in 0..3 {
             let (t, d) = approx_tau(b, a0, af, u.exp());
             if !(t.is_finite() && d < 0.0) {
                 break;
@@ -312,7 +359,7 @@ impl<'a> Launch<'a> {
             let step = (t - tau_star) / d;
             u = (u - step).min(u_d);
             // The approximation itself is off by ~1 %: no point in more digits.
-            if step.abs() < 1e-3 * u.abs().max(1.0) {
+            if step.abs() < 1e-2 * u.abs().max(1.0) {
                 break;
             }
         }
@@ -323,9 +370,10 @@ impl<'a> Launch<'a> {
     /// kept inside (−∞, u_d] with bisection once both sides are known. Returns u and, when
     /// the last iterate was evaluated there, its pass.
     ///
-    /// With `curv` = τ''/(2τ') known (K_lo, K_hi: from the root's differences), a secant
-    /// iterate whose predicted error |curv| |Δ_n| |Δ_{n−1}| (the secant method's error
-    /// recursion) is below one ulp of u is returned without its own evaluation.
+    /// With C = τ''/(2τ') — given as `curv` (K_lo, K_hi: from the root's differences) or
+    /// estimated from the divided differences of the last three iterates — a secant iterate
+    /// whose predicted error |C| |Δ_n| |Δ_{n−1}| (the secant method's error recursion) is
+    /// below one ulp of u is returned without its own evaluation.
     fn solve(
         &self,
         tau_star: f64,
@@ -349,6 +397,7 @@ impl<'a> Launch<'a> {
         let mut p = self.pass(x.exp(), evals)?;
         let mut gx = p.tau - tau_star;
         let mut prev: Option<(f64, f64)> = None;
+        let mut before: Option<(f64, f64)> = None;
         for it in 0..80 {
             // |τ − τ*| at the rounding level of τ itself: no iterate can do better.
             if gx.abs() <= 4.0 * f64::EPSILON * tau_star {
@@ -372,15 +421,24 @@ impl<'a> Launch<'a> {
                     // The slow side is not bracketed yet: step down in u.
                     x - 2.0 * (1.0 + (x - prev.map_or(x, |q| q.0)).abs())
                 };
-            } else if let (Some(c), Some((xp, _))) = (curv, prev) {
-                if (c * (next - x) * (x - xp)).abs() <= 0.5 * tol {
-                    return Some((next, None));
+            } else if let Some((xp, gp)) = prev {
+                let c = curv.or_else(|| {
+                    let (xb, gb) = before?;
+                    let d1 = (gx - gp) / (x - xp);
+                    let d2 = (d1 - (gp - gb) / (xp - xb)) / (x - xb);
+                    Some(d2 / d1)
+                });
+                if let Some(c) = c.filter(|c| c.is_finite()) {
+                    if (c * (next - x) * (x - xp)).abs() <= 0.5 * tol {
+                        return Some((next, None));
+                    }
                 }
             }
             // The last step is the error of x: x is the root to within `tol`.
             if (next - x).abs() <= tol || hi - lo <= tol {
                 return Some((x, Some(p)));
             }
+            before = prev;
             prev = Some((x, gx));
             x = next;
             p = self.pass(x.exp(), evals)?;
@@ -422,12 +480,22 @@ pub fn estimate(model: &Model, scene: &Scene, v: f64, sigma_v: Option<f64>) -> O
         v_hi: 2.0 * sin_alpha / top.tau,
         tau_hi: top.tau,
         lower: LowerLimit::Crawl,
-        upper: UpperLimit::LiftOff,
+        upper: if l.saddle {
+            UpperLimit::Model
+        } else {
+            UpperLimit::LiftOff
+        },
         evals,
     };
     let end = (u_d, top.tau);
     let mut notes = Vec::new();
     let tau_star = 2.0 * sin_alpha / v;
+    // Near a saddle-node the forward model's own fixed-point search gives out first (within
+    // ~1e-9 of it): measurements within 1e-6 of the fastest stable motion, or whose v + σ
+    // passes it, are left to the general search, whose bracket is the forward model's.
+    if l.saddle && v + sigma_v.unwrap_or(0.0) > br.v_hi * (1.0 - 1e-6) {
+        return None;
+    }
     if v > br.v_hi {
         return Some(KEstimate {
             bracket: Some(br),
@@ -448,9 +516,14 @@ pub fn estimate(model: &Model, scene: &Scene, v: f64, sigma_v: Option<f64>) -> O
     if y < 1e-12 * l.wc2 {
         return None;
     }
+    // An unevaluated root is the secant step from evaluated neighbours with a predicted error
+    // below one ulp of u: its contact time is τ* and its speeds need no quadrature.
     let p = match p {
         Some(p) => p,
-        None => l.pass(y, &mut n_root)?,
+        None => Pass {
+            tau: tau_star,
+            ..l.launch(y)?
+        },
     };
     let k = p.k();
     // dτ/du and d²τ/du² by central differences, h = 1e-5 in u (one-sided at lift-off).
@@ -522,6 +595,15 @@ pub fn estimate(model: &Model, scene: &Scene, v: f64, sigma_v: Option<f64>) -> O
         ),
         None => (f64::NAN, f64::NAN),
     };
+    if l.saddle {
+        // Two fixed points per K here: the forward model must settle on this one, the stable
+        // one below the saddle-node.
+        let st = stickslip::steady_lean(&scene.with_k(k).ok()?).ok()?;
+        n_root += 1;
+        if (st.contact_time - p.tau).abs() > 1e-9 * p.tau {
+            return None;
+        }
+    }
     let steady = steady_of(scene, &p, y, map_slope);
     let theta_g = match l.mech {
         Mechanics::Roll => scene.with_k(k).ok().and_then(|s| theta_g(&s, p.w0 * p.w0)),

@@ -1,5 +1,7 @@
 //! K inversion (eq 69) benchmarks: one measurement row — bracket, K, K_lo, K_hi (v ± σ, exact
-//! inverses), dv/dK — single-threaded, on the shipped default data (36 rows, 4 series).
+//! inverses), dv/dK — single-threaded, on the shipped default data (36 rows, 4 series); K
+//! alone; and K alone by the general search in K (src/fit/k.rs) for comparison with the
+//! launch-speed path that `estimate` takes for stick and stick/slip (src/fit/klaunch.rs).
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use fitbead::fit::k::{bracket, estimate, solve};
@@ -43,6 +45,18 @@ fn bench(c: &mut Criterion) {
             })
         });
         g.bench_function(format!("{name} K only"), |b| {
+            b.iter(|| {
+                rows.iter()
+                    .map(|(s, v, _)| {
+                        let e = estimate(&m, black_box(s), *v, None);
+                        e.root.map(|r| r.k).unwrap_or(0.0)
+                    })
+                    .sum::<f64>()
+            })
+        });
+        // The general search in K alone (bracket, then Brent in ln(K − K_min)): what every
+        // model used before the launch-speed path, and what slip still uses.
+        g.bench_function(format!("{name} K only, search in K"), |b| {
             b.iter(|| {
                 rows.iter()
                     .map(|(s, v, _)| {

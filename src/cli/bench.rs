@@ -637,9 +637,19 @@ pub fn run_bench(scenes: &[(Scene, Draw)]) -> BenchResult {
             }),
         ));
     }
+    // The same inversions through `k::estimate`, which takes the launch-speed path
+    // (src/fit/klaunch.rs) for stick and stick/slip where it applies.
+    kmodels.push(("k-stick", "estimate-eq69".into(), None, Model::Stick));
+    kmodels.push((
+        "k-stickslip",
+        "estimate-eq69".into(),
+        Some(1e-14),
+        Model::StickSlip,
+    ));
     for (name, method, tol, model) in &kmodels {
         let mut errs = Vec::new();
         let mut ns = Vec::new();
+        let by_estimate = method.starts_with("estimate");
         for ((s, _), r) in scenes.iter().take(nk).zip(&refs) {
             let which = match model {
                 Model::Stick | Model::StickApprox => Ref::Stick,
@@ -651,7 +661,11 @@ pub fn run_bench(scenes: &[(Scene, Draw)]) -> BenchResult {
                 continue;
             };
             let t0 = Instant::now();
-            let k = bracket(model, s).and_then(|br| solve(model, s, &br, vref));
+            let k = if by_estimate {
+                crate::fit::k::estimate(model, s, vref, None).root
+            } else {
+                bracket(model, s).and_then(|br| solve(model, s, &br, vref))
+            };
             ns.push(t0.elapsed().as_nanos() as f64);
             errs.push(match k {
                 Ok(root) => rel(root.k, s.k),

@@ -193,13 +193,8 @@ fn gk15_quadpack<const N: usize, F: FnMut(f64) -> [f64; N]>(
         for i in 0..7 {
             asc += WGK[i] * ((fv[i][n] - mean).abs() + (fv[14 - i][n] - mean).abs());
         }
-        let resasc = asc * h.abs();
-        let mut e = ((rk - rg) * h).abs();
-        if resasc != 0.0 && e != 0.0 {
-            e = resasc * (200.0 * e / resasc).powf(1.5).min(1.0);
-        }
         val[n] = rk * h;
-        err[n] = e;
+        err[n] = quadpack_error((rk - rg) * h, asc * h);
     }
     (val, err)
 }
@@ -268,12 +263,18 @@ pub fn gk21_pairs<F: FnMut(f64) -> (f64, f64)>(mut pair: F, fc: f64, h: f64) -> 
     for i in 0..10 {
         asc += WK21[i] * ((fv[i].0 - mean).abs() + (fv[i].1 - mean).abs());
     }
-    let resasc = asc * h.abs();
-    let mut e = ((rk - rg) * h).abs();
+    (rk * h, quadpack_error((rk - rg) * h, asc * h))
+}
+
+/// QUADPACK's error estimate of a Kronrod panel (Piessens et al. 1983, qk15/qk21) from the
+/// Kronrod − Gauss difference and resasc = ∫|f − mean|: resasc·min(1, (200 |K − G| / resasc)^{3/2}).
+fn quadpack_error(k_minus_g: f64, resasc: f64) -> f64 {
+    let (e, resasc) = (k_minus_g.abs(), resasc.abs());
     if resasc != 0.0 && e != 0.0 {
-        e = resasc * (200.0 * e / resasc).powf(1.5).min(1.0);
+        resasc * (200.0 * e / resasc).powf(1.5).min(1.0)
+    } else {
+        e
     }
-    (rk * h, e)
 }
 
 /// ∫_a^b f(x) dx for a smooth (analytic) integrand: adaptive K15 with QUADPACK's error

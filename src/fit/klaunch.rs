@@ -74,7 +74,7 @@ struct Launch<'a> {
     saddle: bool,
 }
 
-/// Squared-speed gain of the contact time's asinh approximation (eq 29), as a function of y:
+/// The contact time in the asinh approximation (eq 29) as a function of y:
 /// τ̃(y) = 2/r [asinh(r a_f / q) + asinh(r a_0 / q)], r = sqrt(y + 2B), q = sqrt(y),
 /// a = |tan(Θ/2)|; returns τ̃ and dτ̃/du (u = ln y).
 fn approx_tau(b: f64, a0: f64, af: f64, y: f64) -> (f64, f64) {

@@ -203,10 +203,100 @@ pub fn fixed_point_from(scene: &Scene, x0: f64) -> Result<f64, NotSteady> {
         // iteration cap): with a single fixed point there is none to find beyond it.
         Err(e @ (NotSteady::LiftOff { .. } | NotSteady::Stops { .. })) if unique => Err(e),
         Err(e @ (NotSteady::Runaway | NotSteady::LiftOff { .. } | NotSteady::Stops { .. })) => {
-            scan(scene, x0).unwrap_or(Err(e))
+            match stable_branch_fixed_point(scene, x0) {
+                Some(x) => Ok(x),
+                None => scan(scene, x0).unwrap_or(Err(e)),
+            }
         }
         r => r,
     }
+}
+
+/// The stable fixed point below a saddle-node of the map, found in launch space (the view of
+/// src/fit/klaunch.rs): a launch at Θ0 with squared top speed y is the fixed point of
+/// K(y) = Θ̇0/Φ(Θ̇0), and K(y) rises from the crawl to a maximum K_sn at the saddle-node; the
+/// stable fixed point for K ≤ K_sn solves K(y) = K below that maximum, where K(y) is monotone
+/// (Brent). Within ~1e-9 of the saddle-node the map's slope is so close to 1 that following it
+/// does not settle and the grid of [`scan`] misses the pair of fixed points (3e-5 apart); this
+/// finds them. `None` unless (for Θ0 < 0) the slip starts after the top at the crawl, the maximum of
+/// K(y) is bracketed on a 56-point grid (40 log-spaced, 16 crowding towards lift-off) and refined (golden section), K ≤ K_sn, and the
+/// launch speed x0 the bead starts from is below the saddle-node's (so that the bead, following
+/// the map, settles on this fixed point).
+fn stable_branch_fixed_point(scene: &Scene, x0: f64) -> Option<f64> {
+    // With Θ0 < 0, y is the squared top speed (y = Θ̇0² − 2B sin²(Θ0/2)); else y = Θ̇0².
+    let s0 = scene.sc_half_0.s;
+    let wc2 = if s0 < 0.0 {
+        2.0 * scene.b * s0 * s0
+    } else {
+        0.0
+    };
+    if s0 < 0.0 && !theta_g(scene, wc2).is_some_and(|t| t > 0.0) {
+        return None;
+    }
+    let k_of = |y: f64| {
+        launch(scene, y + wc2, y)
+            .ok()
+            .map(|m| ((y + wc2).sqrt() / m.final_velocity, m.final_velocity))
+    };
+    // Launches up to lift-off at Θf: Θ̇0² ≤ cos Θf.
+    let y_top = scene.sc_f.c - wc2;
+    if !(y_top > 0.0) {
+        return None;
+    }
+    let mut grid: Vec<f64> = (0..40)
+        .map(|i| y_top * 10f64.powf(-8.0 * (39 - i) as f64 / 39.0))
+        .collect();
+    grid.extend((1..=16).map(|j| y_top * (1.0 - 0.6 * 0.75f64.powi(j))));
+    grid.sort_by(f64::total_cmp);
+    let mut prev = (f64::NEG_INFINITY, 0usize);
+    let mut peak = None;
+    for (i, &y) in grid.iter().enumerate() {
+        let Some((k, _)) = k_of(y) else { break };
+        if k <= prev.0 {
+            peak = Some(i);
+            break;
+        }
+        prev = (k, i);
+    }
+    let i = peak?;
+    if i < 2 {
+        return None;
+    }
+    let f = |u: f64| k_of(u.exp()).map_or(f64::NEG_INFINITY, |p| p.0);
+    let (mut a, mut b) = (grid[i - 2].ln(), grid[i].ln());
+    let r = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut c, mut d) = (b - r * (b - a), a + r * (b - a));
+    let (mut fc, mut fd) = (f(c), f(d));
+    for _ in 0..100 {
+        if b - a <= 1e-12 * (grid[i].ln() - grid[i - 2].ln()) {
+            break;
+        }
+        if fc >= fd {
+            b = d;
+            d = c;
+            fd = fc;
+            c = b - r * (b - a);
+            fc = f(c);
+        } else {
+            a = c;
+            c = d;
+            fc = fd;
+            d = a + r * (b - a);
+            fd = f(d);
+        }
+    }
+    let y_sn = a.exp();
+    let (k_sn, x_sn) = k_of(y_sn)?;
+    let (k_lo, _) = k_of(grid[0])?;
+    if !(scene.k <= k_sn && scene.k > k_lo && x0 <= x_sn) {
+        return None;
+    }
+    let g = |y: f64| k_of(y).map_or(f64::NAN, |p| p.0 - scene.k);
+    let root = brent(g, grid[0], y_sn, k_lo - scene.k, k_sn - scene.k, 0.0, 200)?;
+    let (_, x) = k_of(root.x)?;
+    // A true fixed point of the map at this K.
+    let back = map(scene, x).ok()?.final_velocity;
+    ((back - x).abs() <= 1e-10 * x).then_some(x)
 }
 
 /// The secant method on g(x) = H(x) − x from x0 and x0 + g(x0) (one step of the map): about

@@ -56,8 +56,8 @@ pub struct KBracket {
     /// Lowest K (exclusive).
     pub lo: f64,
     /// Highest K (inclusive: the forward model is steady there; for a stick/slip range ending
-    /// at the map's saddle-node, the forward search may miss the fixed point within ~1e-9 of
-    /// it — open work, see the ignored test in tests/k_inversion.rs).
+    /// at the map's saddle-node, the last K below it where the forward model finds the stable
+    /// fixed point — tested to within 1e-9 of the range in tests/k_inversion.rs).
     pub hi: f64,
     /// v̄ at the lower end (0 when the bead crawls over the top).
     pub v_lo: f64,

@@ -490,9 +490,9 @@ pub fn estimate(model: &Model, scene: &Scene, v: f64, sigma_v: Option<f64>) -> O
     let end = (u_d, top.tau);
     let mut notes = Vec::new();
     let tau_star = 2.0 * sin_alpha / v;
-    // Near a saddle-node the forward model's own fixed-point search gives out first (within
-    // ~1e-9 of it): measurements within 1e-6 of the fastest stable motion, or whose v + σ
-    // passes it, are left to the general search, whose bracket is the forward model's.
+    // Near a saddle-node the range's end is where the forward model's status search puts it:
+    // measurements within 1e-6 of the fastest stable motion, or whose v + σ passes it, are
+    // left to the general search, whose bracket (and so whose statuses there) is that one.
     if l.saddle && v + sigma_v.unwrap_or(0.0) > br.v_hi * (1.0 - 1e-6) {
         return None;
     }

@@ -31,7 +31,7 @@ use crate::models::stickslip::{self, Branch};
 use crate::models::{Model, NotSteady, Phases, Steady};
 use crate::scene::Scene;
 use crate::special::elliptic::cos_integral;
-use crate::special::root::brent;
+use crate::special::root::{brent, golden_max};
 
 /// Which contact mechanics the launch follows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -190,29 +190,8 @@ impl<'a> Launch<'a> {
                                 return None;
                             }
                             let f = |u: f64| l.k_of_launch(u.exp()).unwrap_or(f64::NEG_INFINITY);
-                            let (mut a, mut b) = (ys[i - 2].ln(), ys[i].ln());
-                            let r = 0.5 * (5f64.sqrt() - 1.0);
-                            let (mut c, mut d) = (b - r * (b - a), a + r * (b - a));
-                            let (mut fc, mut fd) = (f(c), f(d));
-                            let tol = 1e-9 * (b - a);
-                            for _ in 0..100 {
-                                if b - a <= tol {
-                                    break;
-                                }
-                                if fc >= fd {
-                                    b = d;
-                                    d = c;
-                                    fd = fc;
-                                    c = b - r * (b - a);
-                                    fc = f(c);
-                                } else {
-                                    a = c;
-                                    c = d;
-                                    fc = fd;
-                                    d = a + r * (b - a);
-                                    fd = f(d);
-                                }
-                            }
+                            let (a, b) = (ys[i - 2].ln(), ys[i].ln());
+                            let a = golden_max(f, a, b, 1e-9 * (b - a), 100);
                             l.y_d = a.exp();
                             l.saddle = true;
                             break;

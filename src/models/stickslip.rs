@@ -10,7 +10,7 @@ use super::slip::{slip_time, SlipPhase};
 use super::stick;
 use super::{NotSteady, Outcome, Phases, Steady};
 use crate::scene::Scene;
-use crate::special::root::brent;
+use crate::special::root::{brent, golden_max};
 
 /// Which phases one contact goes through under the stick/slip model.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -263,28 +263,8 @@ fn stable_branch_fixed_point(scene: &Scene, x0: f64) -> Option<f64> {
         return None;
     }
     let f = |u: f64| k_of(u.exp()).map_or(f64::NEG_INFINITY, |p| p.0);
-    let (mut a, mut b) = (grid[i - 2].ln(), grid[i].ln());
-    let r = 0.5 * (5f64.sqrt() - 1.0);
-    let (mut c, mut d) = (b - r * (b - a), a + r * (b - a));
-    let (mut fc, mut fd) = (f(c), f(d));
-    for _ in 0..100 {
-        if b - a <= 1e-12 * (grid[i].ln() - grid[i - 2].ln()) {
-            break;
-        }
-        if fc >= fd {
-            b = d;
-            d = c;
-            fd = fc;
-            c = b - r * (b - a);
-            fc = f(c);
-        } else {
-            a = c;
-            c = d;
-            fc = fd;
-            d = a + r * (b - a);
-            fd = f(d);
-        }
-    }
+    let (a, b) = (grid[i - 2].ln(), grid[i].ln());
+    let a = golden_max(f, a, b, 1e-12 * (b - a), 100);
     let y_sn = a.exp();
     let (k_sn, x_sn) = k_of(y_sn)?;
     let (k_lo, _) = k_of(grid[0])?;

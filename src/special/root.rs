@@ -113,6 +113,40 @@ pub fn brent<F: FnMut(f64) -> f64>(
     }
 }
 
+/// The maximum of a unimodal f on [a, b] by golden-section search, to a bracket of width
+/// ≤ `xtol` (at most `max_iter` steps); returns the lower end of the final bracket. Used on
+/// K(launch speed) of the stick/slip model, whose maximum is the saddle-node of its map.
+pub fn golden_max<F: FnMut(f64) -> f64>(
+    mut f: F,
+    mut a: f64,
+    mut b: f64,
+    xtol: f64,
+    max_iter: usize,
+) -> f64 {
+    let r = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut c, mut d) = (b - r * (b - a), a + r * (b - a));
+    let (mut fc, mut fd) = (f(c), f(d));
+    for _ in 0..max_iter {
+        if b - a <= xtol {
+            break;
+        }
+        if fc >= fd {
+            b = d;
+            d = c;
+            fd = fc;
+            c = b - r * (b - a);
+            fc = f(c);
+        } else {
+            a = c;
+            c = d;
+            fc = fd;
+            d = a + r * (b - a);
+            fd = f(d);
+        }
+    }
+    a
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -123,6 +157,12 @@ mod tests {
         let r = brent(f, 0.0, 2.0, f(0.0), f(2.0), 0.0, 200).unwrap();
         assert!((r.x - 2f64.cbrt()).abs() <= 4.0 * f64::EPSILON, "{r:?}");
         assert!(r.evals < 20);
+    }
+
+    #[test]
+    fn golden_section_finds_a_parabola_peak() {
+        let x = golden_max(|x| -(x - 0.3) * (x - 0.3), 0.0, 1.0, 1e-12, 200);
+        assert!((x - 0.3).abs() < 1e-6, "{x}");
     }
 
     #[test]

@@ -3,6 +3,7 @@
 
 use super::{NotSteady, Outcome, Phases, Steady};
 use crate::scene::Scene;
+use crate::special::dd::Dd;
 use crate::special::elliptic::cos_integral;
 use crate::special::quad::{gk21_pairs, integrate, QuadOptions};
 use crate::special::root::brent;
@@ -158,9 +159,11 @@ fn slip_time_panel(ph: &SlipPhase, a: f64, b: f64, ga: f64, tol: f64) -> Option<
 /// q = ½ d²Θ̇²/dθ² at θm, which turns the near-singular peak (a bead crawling over the top)
 /// into an almost constant integrand.
 pub fn slip_time(ph: &SlipPhase, a: f64, b: f64, tol: f64) -> Result<f64, NotSteady> {
-    if b <= a {
-        return Ok(0.0);
-    }
+    slip_time_in(ph, a, b, tol, None)
+}
+
+/// Where Θ̇² is least on [a, b] (an end, or the zero of its slope), with the slopes at a and b.
+fn minimum_angle(ph: &SlipPhase, a: f64, b: f64) -> Result<(f64, f64, f64), NotSteady> {
     let ga = ph.speed_sq_slope(a);
     let gb = ph.speed_sq_slope(b);
     let tm = if ga >= 0.0 {
@@ -177,6 +180,44 @@ pub fn slip_time(ph: &SlipPhase, a: f64, b: f64, tol: f64) -> Result<f64, NotSte
             }
         }
     };
+    Ok((tm, ga, gb))
+}
+
+/// The least squared speed of the slip model's steady contact (§4.3) and where it lies:
+/// (θm, Θ̇²(θm)), in double-double ([`SlipDd`]) when θm is interior. It vanishes at the slip
+/// model's stop limit, like the squared top speed of rolling at δ_m.
+pub fn speed_minimum(scene: &Scene) -> Result<(f64, f64), NotSteady> {
+    let l2 = final_velocity_sq(scene)?;
+    let ph = SlipPhase::new(scene.theta_0, scene.k * scene.k * l2, scene.f);
+    let (tm, _, _) = minimum_angle(&ph, scene.theta_0, scene.theta_f)?;
+    if tm == scene.theta_0 || tm == scene.theta_f {
+        return Ok((tm, ph.speed_sq(tm)));
+    }
+    Ok((tm, SlipDd::new(scene)?.speed_sq_slope(tm).0.to_f64()))
+}
+
+/// Interior minima of Θ̇² below this value are recomputed in double-double when the phase is
+/// the slip model's whole contact: the double minimum carries an absolute error of a few ulp
+/// of its O(1) terms, i.e. a relative error ~1e-16/m, and v̄ inherits about 0.02 of it
+/// (measured on the stop-limit rows of tests/reference/forward_refs.csv), so below 1e-2 the
+/// double form could cost more than 1e-13.
+const DD_MINIMUM_BELOW: f64 = 1e-2;
+
+/// [`slip_time`]; with `scene` given, the phase is the slip model's whole contact of that
+/// scene (from Θ0 with Θ̇0² = K² L'²), and an interior speed minimum below
+/// [`DD_MINIMUM_BELOW`] is taken from [`SlipDd`] with the integrand expanded about it
+/// ([`slip_time_about_minimum`]).
+fn slip_time_in(
+    ph: &SlipPhase,
+    a: f64,
+    b: f64,
+    tol: f64,
+    scene: Option<&Scene>,
+) -> Result<f64, NotSteady> {
+    if b <= a {
+        return Ok(0.0);
+    }
+    let (tm, ga, gb) = minimum_angle(ph, a, b)?;
     if ga >= 0.0 {
         // The slowest point is the start: one 21-point panel usually settles it.
         if let Some(t) = slip_time_panel(ph, a, b, ga, tol) {
@@ -184,6 +225,12 @@ pub fn slip_time(ph: &SlipPhase, a: f64, b: f64, tol: f64) -> Result<f64, NotSte
         }
     }
     let m = ph.speed_sq(tm);
+    if let Some(scene) = scene {
+        if tm != a && tm != b && m < DD_MINIMUM_BELOW {
+            let exact = SlipDd::new(scene)?;
+            return slip_time_about_minimum(ph, &exact, a, b, tm, tol);
+        }
+    }
     if !(m > 0.0) {
         // Stops where Θ̇² first reaches 0 before the minimum.
         let ya = ph.speed_sq(a);
@@ -275,16 +322,197 @@ pub fn slip_time(ph: &SlipPhase, a: f64, b: f64, tol: f64) -> Result<f64, NotSte
     }
 }
 
+/// The slip model's steady contact in double-double (about 30 digits), from the exact double
+/// inputs ξ, δ, K, f: α = asin(1/(1+ξ)) by [`Dd::asin`], Θ0 and Θf = δ ∓ α, L'² (eq 50
+/// corrected) and the coefficient a of eq 38 at Θ0. Two places need it: L'² where
+/// 1 − K² e^{4fα} is small (its double form loses digits in proportion, 4.6e-11 at 1e-6), and
+/// the speed minimum of a bead crawling over the top, a difference of O(1) terms.
+#[derive(Debug, Clone, Copy)]
+pub struct SlipDd {
+    f: f64,
+    th0: Dd,
+    a: Dd,
+    b: Dd,
+    c: Dd,
+    /// L'² = Θ̇f² (eq 50 corrected).
+    pub l2: Dd,
+}
+
+impl SlipDd {
+    /// The steady slip state of `scene`; `Err(Runaway)` when K² e^{4fα} ≥ 1.
+    pub fn new(scene: &Scene) -> Result<Self, NotSteady> {
+        let f = scene.f;
+        let alpha = Dd::asin(Dd::from(1.0) / Dd::sum(1.0, scene.xi)); // eq 2
+        let delta = Dd::from(scene.delta);
+        let th0 = delta - alpha;
+        let (s0, c0) = Dd::sin_cos_dd(th0);
+        let (sf, cf) = Dd::sin_cos_dd(delta + alpha);
+        // b = −6f/(1+4f²), c = (4f² − 2)/(1+4f²) (eq 39).
+        let f2x4 = Dd::prod(f, f).scale(4.0);
+        let d = Dd::from(1.0) + f2x4;
+        let b = -(Dd::prod(f, 6.0) / d);
+        let c = (f2x4 - Dd::from(2.0)) / d;
+        let em1 = Dd::exp_m1(alpha.mul_f64(f).scale(4.0));
+        let k2 = Dd::prod(scene.k, scene.k);
+        let den = Dd::from(1.0) - k2 - k2 * em1;
+        if !(den.hi > 0.0) {
+            return Err(NotSteady::Runaway);
+        }
+        let u0 = b * s0 + c * c0;
+        let l2 = (b * (sf - s0) + c * (cf - c0) - u0 * em1) / den;
+        Ok(SlipDd {
+            f,
+            th0,
+            a: k2 * l2 - u0,
+            b,
+            c,
+            l2,
+        })
+    }
+
+    /// Θ̇²(θ) = a e^{2f(θ−Θ0)} + b sin θ + c cos θ (eq 38) and its slope
+    /// 2f a e^{2f(θ−Θ0)} + b cos θ − c sin θ at a double θ.
+    pub fn speed_sq_slope(&self, theta: f64) -> (Dd, Dd) {
+        let x = (Dd::from(theta) - self.th0).mul_f64(self.f).scale(2.0);
+        let ae = self.a * (Dd::exp_m1(x) + Dd::from(1.0));
+        let (s, c) = Dd::sin_cos_dd(Dd::from(theta));
+        (
+            ae + self.b * s + self.c * c,
+            ae.mul_f64(self.f).scale(2.0) + self.b * c - self.c * s,
+        )
+    }
+}
+
+/// 1/n! for n = 0..=19 (each one division from the previous: the first terms, which dominate,
+/// are correctly rounded).
+fn inv_factorials() -> [f64; 20] {
+    let mut t = [1.0; 20];
+    for n in 1..20 {
+        t[n] = t[n - 1] / n as f64;
+    }
+    t
+}
+
+/// e^x − 1 − x to a few ulp relative for every x (Taylor series to x¹⁹ for |x| < 1, whose
+/// truncation is below 2e-17 relative; the direct form beyond, where it cannot cancel).
+fn exp_m1_minus_x(x: f64, inv: &[f64; 20]) -> f64 {
+    if x.abs() >= 1.0 {
+        return x.exp_m1() - x;
+    }
+    let mut p = 0.0;
+    for n in (2..20).rev() {
+        p = p * x + inv[n];
+    }
+    p * x * x
+}
+
+/// sin x − x to a few ulp relative for |x| < 1 (odd Taylor terms to x¹⁹, truncation below
+/// 1e-16 relative), and the direct form beyond (absolute error ~1e-16, where the excess it
+/// feeds is O(1)).
+fn sin_minus_x(x: f64, inv: &[f64; 20]) -> f64 {
+    if x.abs() >= 1.0 {
+        return x.sin() - x;
+    }
+    let x2 = x * x;
+    let mut p = 0.0;
+    for n in (3..20).rev().step_by(2) {
+        p = p * x2 + if n % 4 == 3 { -inv[n] } else { inv[n] };
+    }
+    p * x2 * x
+}
+
+/// The slip time of the slip model's whole contact about an interior speed minimum at `tm`
+/// (see [`slip_time`]), with the minimum m = Θ̇²(θm) and the slope s1 there (≈ 0, θm being
+/// rounded) in double-double from `exact`, and the integrand as m + [Θ̇²(θm + d) − m] where the
+/// bracket is written in terms that are each O(d²) (eq 38 expanded about θm), plus s1 d:
+///
+/// `A (e^{2fd} − 1 − 2fd) + b [sin θm (cos d − 1) + cos θm (sin d − d)]`
+/// `+ c [cos θm (cos d − 1) − sin θm (sin d − d)] + s1 d`, with A = m − b sin θm − c cos θm.
+///
+/// Its relative error is a few ulp at every d, so the integrand keeps double precision even
+/// where Θ̇² is 1e-10 of its terms (a bead crawling over the top within 1e-9 of the stop
+/// limit), and no tolerance floor is needed.
+fn slip_time_about_minimum(
+    ph: &SlipPhase,
+    exact: &SlipDd,
+    a: f64,
+    b: f64,
+    tm: f64,
+    tol: f64,
+) -> Result<f64, NotSteady> {
+    let (m_dd, s1_dd) = exact.speed_sq_slope(tm);
+    let m = m_dd.to_f64();
+    if !(m > 0.0) {
+        let ya = ph.speed_sq(a);
+        let angle = brent(|t| ph.speed_sq(t), a, tm, ya, ph.speed_sq(tm), 1e-15, 200)
+            .map(|r| r.x)
+            .unwrap_or(tm);
+        return Err(NotSteady::Stops { angle });
+    }
+    let s1 = s1_dd.to_f64();
+    let (sm, cm) = tm.sin_cos();
+    let big_a = m - ph.b * sm - ph.c * cm;
+    let f2 = 2.0 * ph.f;
+    let inv = inv_factorials();
+    let excess = |d: f64| {
+        let cm1 = -2.0 * (0.5 * d).sin().powi(2);
+        let smx = sin_minus_x(d, &inv);
+        big_a * exp_m1_minus_x(f2 * d, &inv)
+            + ph.b * (sm * cm1 + cm * smx)
+            + ph.c * (cm * cm1 - sm * smx)
+            + s1 * d
+    };
+    let q = (tm.cos() + ph.f * tm.sin()).max(1e-3);
+    let h = (m / q).sqrt();
+    let opts = QuadOptions {
+        rel_tol: tol,
+        abs_tol: 0.0,
+        max_panels: 128,
+    };
+    let mut total = 0.0;
+    for (end, dir) in [(a, -1.0), (b, 1.0)] {
+        let span = (end - tm).abs();
+        let tmax = (span / h).asinh();
+        let r = integrate(
+            |t: f64| {
+                let g = m + excess(dir * h * t.sinh());
+                if g > 0.0 {
+                    h * t.cosh() / g.sqrt()
+                } else {
+                    f64::INFINITY
+                }
+            },
+            0.0,
+            tmax,
+            opts,
+        );
+        total += r.value;
+    }
+    if total.is_finite() && total > 0.0 {
+        Ok(total)
+    } else {
+        Err(NotSteady::Invalid {
+            reason: "slip integrand not positive",
+        })
+    }
+}
+
+/// Below this value of 1 − K² e^{4fα}, [`final_velocity_sq`] takes L'² from [`SlipDd`].
+const DD_DENOMINATOR_BELOW: f64 = 0.05;
+
 /// Steady final velocity squared of the slip model (eq 50 corrected):
 /// L'² = (b sin Θf + c cos Θf − (b sin Θ0 + c cos Θ0) e^{4fα}) / (1 − K² e^{4fα}), with the
-/// differences in product form (e^{4fα} − 1 by expm1). `Err(Runaway)` when K² e^{4fα} ≥ 1.
+/// differences in product form (e^{4fα} − 1 by expm1), and from [`SlipDd`] where the
+/// denominator is below [`DD_DENOMINATOR_BELOW`]. `Err(Runaway)` when K² e^{4fα} ≥ 1.
 pub fn final_velocity_sq(scene: &Scene) -> Result<f64, NotSteady> {
     let (b, c) = slip_coefficients(scene.f);
     let em1 = (4.0 * scene.f * scene.alpha).exp_m1();
     let k2 = scene.k * scene.k;
     let den = scene.one_minus_k2() - k2 * em1;
-    if !(den > 0.0) {
-        return Err(NotSteady::Runaway);
+    if den < DD_DENOMINATOR_BELOW {
+        // 1 − K² e^{4fα} cancels: its double form has an absolute error of a few ulp of
+        // K² e^{4fα} (and of α), a relative error ~1e-16/den.
+        return SlipDd::new(scene).map(|s| s.l2.to_f64());
     }
     let sa = scene.sin_alpha;
     let dsin = 2.0 * scene.sc_delta.c * sa - scene.sc_0.s * em1;
@@ -324,7 +552,7 @@ pub fn steady_tol(scene: &Scene, tol: f64) -> Outcome {
     let l2 = slip_state(scene)?;
     let w0sq = scene.k * scene.k * l2;
     let ph = SlipPhase::new(scene.theta_0, w0sq, scene.f);
-    let tau = slip_time(&ph, scene.theta_0, scene.theta_f, tol)?;
+    let tau = slip_time_in(&ph, scene.theta_0, scene.theta_f, tol, Some(scene))?;
     check_lift_off(scene, l2)?;
     let l = l2.sqrt();
     let mut s = Steady::basic(2.0 * scene.sin_alpha / tau, l, scene.k * l, tau);

@@ -199,9 +199,14 @@ pub fn speed_minimum(scene: &Scene) -> Result<(f64, f64), NotSteady> {
 /// Interior minima of Θ̇² below this value are recomputed in double-double when the phase is
 /// the slip model's whole contact: the double minimum carries an absolute error of a few ulp
 /// of its O(1) terms, i.e. a relative error ~1e-16/m, and v̄ inherits about 0.02 of it
-/// (measured on the stop-limit rows of tests/reference/forward_refs.csv), so below 1e-2 the
-/// double form could cost more than 1e-13.
-const DD_MINIMUM_BELOW: f64 = 1e-2;
+/// (6.9e-12 at m = 5.4e-7 on the stop-limit rows of tests/reference/forward_refs.csv), so
+/// above 1e-4 the double form costs at most ~4e-14. The double-double path costs 3–5× the
+/// double one (about 17 µs against 3.5 µs per scene), hence the threshold.
+const DD_MINIMUM_BELOW: f64 = 1e-4;
+
+/// A double minimum below this is a stop whatever its rounding (its absolute error is a few
+/// ulp of O(1) terms): no double-double needed to say so.
+const DD_MINIMUM_ABOVE: f64 = -1e-12;
 
 /// [`slip_time`]; with `scene` given, the phase is the slip model's whole contact of that
 /// scene (from Θ0 with Θ̇0² = K² L'²), and an interior speed minimum below
@@ -226,7 +231,7 @@ fn slip_time_in(
     }
     let m = ph.speed_sq(tm);
     if let Some(scene) = scene {
-        if tm != a && tm != b && m < DD_MINIMUM_BELOW {
+        if tm != a && tm != b && m < DD_MINIMUM_BELOW && m > DD_MINIMUM_ABOVE {
             let exact = SlipDd::new(scene)?;
             return slip_time_about_minimum(ph, &exact, a, b, tm, tol);
         }

@@ -6,8 +6,9 @@ Same method and conventions as make_refs.py, whose functions it imports (direct 
 eq 51 by tanh-sinh at 40 digits, checked by Gauss-Legendre at 50 digits; every input an exact
 double; alpha = asin(1/(1+xi)) at working precision):
 
-* the slip model within 1e-6, 1e-9 and 1e-12 (relative, in delta) above its stop limit, where
-  the least squared speed of the contact vanishes, for xi in {0.65, 1, 2, 10}, f in
+* the slip model within 1e-3, 2e-4, 1e-6, 1e-9 and 1e-12 (relative, in delta) above its stop
+  limit, where the least squared speed of the contact vanishes (the first two on either side of
+  the point where fitbead switches to double-double, a least squared speed of 1e-4), for xi in {0.65, 1, 2, 10}, f in
   {0.01, 0.1, 0.5, 2} and the fitted and cos 2 alpha laws of K;
 * slip and slip-approx with K = e^{-2 f alpha} (1 - eta) rounded to a double, eta in
   {1e-6, 1e-9, 1e-12} (1 - K^2 e^{4 f alpha} ~ 2 eta), at the slope where L'^2 = cos(Thetaf)/2,
@@ -40,7 +41,7 @@ def tasks():
                     ds = M.slip_stop_delta(xi, K, f)
                     if ds is None:
                         continue
-                    for eta in ('1e-6', '1e-9', '1e-12'):
+                    for eta in ('1e-3', '2e-4', '1e-6', '1e-9', '1e-12'):
                         d = float(ds * (1 + mpf(eta)))
                         T.append(('slip stop limit*(1+%s) %s' % (eta, law), 'slip', xi, d, K, None, f))
         for xi in (0.65, 1.0, 2.0, 10.0):

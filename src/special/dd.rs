@@ -82,6 +82,17 @@ impl Dd {
         Dd { hi, lo }
     }
 
+    /// Division by a double (one correction step: about 1e-32 relative, three times cheaper
+    /// than the double-double division).
+    #[inline]
+    pub fn div_f64(self, b: f64) -> Dd {
+        let q1 = self.hi / b;
+        let (p, e) = two_prod(q1, b);
+        let r = ((self.hi - p) - e) + self.lo;
+        let (hi, lo) = quick_two_sum(q1, r / b);
+        Dd { hi, lo }
+    }
+
     /// Multiplication by a power of two (exact).
     #[inline]
     pub fn scale(self, p: f64) -> Dd {
@@ -104,7 +115,7 @@ impl Dd {
         let mut term = r;
         let mut s = r;
         for n in 2..=14 {
-            term = (term * r) / Dd::from(n as f64);
+            term = (term * r).div_f64(n as f64);
             s = s + term;
         }
         for _ in 0..k {
@@ -153,7 +164,7 @@ impl Dd {
         let mut s = xd;
         let mut n = 1.0;
         for _ in 0..14 {
-            term = -(term * x2) / Dd::from((n + 1.0) * (n + 2.0));
+            term = -(term * x2).div_f64((n + 1.0) * (n + 2.0));
             s = s + term;
             n += 2.0;
         }
@@ -161,7 +172,7 @@ impl Dd {
         let mut c = Dd::from(1.0);
         let mut n = 0.0;
         for _ in 0..14 {
-            term = -(term * x2) / Dd::from((n + 1.0) * (n + 2.0));
+            term = -(term * x2).div_f64((n + 1.0) * (n + 2.0));
             c = c + term;
             n += 2.0;
         }

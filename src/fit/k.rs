@@ -559,7 +559,7 @@ pub struct KEstimate {
     pub k_lo: Option<f64>,
     /// K at v + σ (exact inverse); the bracket's upper end when v + σ is above its range.
     pub k_hi: Option<f64>,
-    /// dv̄/dK at the root (central difference in ln(K − K_min)).
+    /// dv̄/dK at the root (a second-order difference on steps uniform in ln(K − K_min)).
     pub dv_dk: Option<f64>,
     /// Θ_G at the root (radians): where rolling gives way to slip (eq 36); for the rolling
     /// models, where the steady rolling motion would need more friction than f.
@@ -665,26 +665,42 @@ pub fn estimate_in_k(model: &Model, scene: &Scene, v: f64, sigma_v: Option<f64>)
     }
 }
 
-/// dv̄/dK by a central difference in s = ln(K − K_min) with step 1e-5 (one-sided at the
-/// bracket's top), divided by dK/ds = K − K_min: keeps its accuracy where the slope in K is
-/// nearly infinite.
+/// dv̄/dK at the root from v̄ at K_min + d e^{±h}, d = K − K_min, h = 1e-5 (steps uniform in
+/// s = ln(K − K_min), which keeps their size right where the slope in K is nearly infinite),
+/// differenced over the K values actually evaluated (a three-point Lagrange derivative at the
+/// root, second-order accurate on any spacing). Near the bracket's top, where K_min + d e^h
+/// is out of range, the step is shrunk to fit and, failing that, the points are taken at
+/// s − h and s − 2h (one-sided, still second order). With a first-order one-sided difference
+/// here the error below lift-off was 5e-4 (tests/k_inversion.rs, mpmath references).
 fn slope(model: &Model, scene: &Scene, br: &KBracket, r: &KRoot) -> Option<f64> {
     let mut n = 0;
     let d = r.k - br.lo;
     if !(d > 0.0) {
         return None;
     }
-    let h: f64 = 1e-5;
-    let kp = br.lo + d * h.exp();
-    let km = br.lo + d * (-h).exp();
-    let vm = eval(model, scene, km, &mut n).ok()?.mean_velocity;
-    let (dv, ds) = if kp <= br.hi {
-        let vp = eval(model, scene, kp, &mut n).ok()?.mean_velocity;
-        (vp - vm, 2.0 * h)
+    let k0 = r.k;
+    let v0 = r.steady.mean_velocity;
+    let mut v_at = |k: f64| eval(model, scene, k, &mut n).ok().map(|s| s.mean_velocity);
+    let h_max = if br.hi > k0 {
+        ((br.hi - br.lo) / d).ln()
     } else {
-        (r.steady.mean_velocity - vm, h)
+        0.0
     };
-    Some(dv / ds / d)
+    let h = 1e-5f64.min(0.5 * h_max);
+    let (k1, k2) = if h >= 1e-7 {
+        (br.lo + d * (-h).exp(), br.lo + d * h.exp())
+    } else {
+        let h = 1e-5f64;
+        (br.lo + d * (-h).exp(), br.lo + d * (-2.0 * h).exp())
+    };
+    if !(k1 != k0 && k2 != k0 && k1 != k2) {
+        return None;
+    }
+    let (v1, v2) = (v_at(k1)?, v_at(k2)?);
+    // f'(x0) of the quadratic through (x0, f0), (x1, f1), (x2, f2).
+    let (a1, a2) = (k1 - k0, k2 - k0);
+    let dv = -v0 * (a1 + a2) / (a1 * a2) + v1 * a2 / (a1 * (a2 - a1)) - v2 * a1 / (a2 * (a2 - a1));
+    dv.is_finite().then_some(dv)
 }
 
 #[cfg(test)]

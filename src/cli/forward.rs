@@ -170,11 +170,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
             format!("unknown model; expected one of {}", Model::NAMES.join(", ")),
         )
     })?;
-    let branch = match a.branch.as_str() {
-        "upper" => JaegerBranch::Upper,
-        "lower" => JaegerBranch::Lower,
-        b => return Err(super::flag_error("--branch", b, "expected upper or lower")),
-    };
+    let branch = super::jaeger_branch(&a.branch)?;
     let single = if let (Some(xi), Some(d)) = (a.xi, a.delta_deg) {
         Some(format!("xi,delta_deg\n{},{}\n", fmt_f64(xi), fmt_f64(d)).into_bytes())
     } else if a.xi.is_some() || a.delta_deg.is_some() {

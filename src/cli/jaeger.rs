@@ -5,7 +5,6 @@ use super::fitargs::FitArgs;
 use super::CliError;
 use crate::fit::jaeger::fit_jaeger_with;
 use crate::fit::summary::FitSummary;
-use crate::models::JaegerBranch;
 
 /// Arguments of `fitbead jaeger`.
 #[derive(Debug, clap::Args)]
@@ -20,17 +19,7 @@ pub struct Args {
 
 /// Runs `fitbead jaeger`.
 pub fn run(a: Args) -> Result<(), CliError> {
-    let branch = match a.branch.as_str() {
-        "upper" => JaegerBranch::Upper,
-        "lower" => JaegerBranch::Lower,
-        _ => {
-            return Err(super::flag_error(
-                "--branch",
-                &a.branch,
-                "expected upper or lower",
-            ))
-        }
-    };
+    let branch = super::jaeger_branch(&a.branch)?;
     let (_t, _rows, ds) = a.io.read()?;
     let choice = a.io.method(&["a1", "a2", "a3"])?;
     let fits = fit_jaeger_with(&ds, branch, a.io.level, &choice.method);

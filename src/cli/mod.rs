@@ -169,6 +169,16 @@ pub fn parse_list(flag: &str, s: &str) -> Result<Vec<f64>, CliError> {
         .collect()
 }
 
+/// The Jaeger root of `--branch` (`upper`, the default, or `lower`; eqs 80–89).
+pub fn jaeger_branch(value: &str) -> Result<crate::models::JaegerBranch, CliError> {
+    use crate::models::JaegerBranch;
+    match value {
+        "upper" => Ok(JaegerBranch::Upper),
+        "lower" => Ok(JaegerBranch::Lower),
+        b => Err(flag_error("--branch", b, "expected upper or lower")),
+    }
+}
+
 /// An error about a command-line flag value.
 pub fn flag_error(flag: &str, value: &str, message: impl Into<String>) -> CliError {
     CliError::Input(InputError {

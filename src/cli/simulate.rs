@@ -5,7 +5,7 @@ use super::{emit, parse_list, CliError};
 use crate::io::fmt_f64;
 use crate::models::jaeger::Jaeger;
 use crate::models::jan::Jan;
-use crate::models::{ForwardModel, JaegerBranch, Model, ModelKind};
+use crate::models::{ForwardModel, Model, ModelKind};
 use crate::scene::{CollisionLaw, Scene};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -339,11 +339,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
             "expected three numbers a1,a2,a3",
         ));
     }
-    let branch = match a.branch.as_str() {
-        "upper" => JaegerBranch::Upper,
-        "lower" => JaegerBranch::Lower,
-        b => return Err(super::flag_error("--branch", b, "expected upper or lower")),
-    };
+    let branch = super::jaeger_branch(&a.branch)?;
     let range = delta_range(a.delta_range.as_deref())?;
     let mut rng = ChaCha8Rng::seed_from_u64(a.seed);
     let mut w = csv::Writer::from_writer(Vec::new());

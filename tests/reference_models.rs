@@ -246,8 +246,9 @@ fn slip_near_its_limits_at_1e_12() {
 /// inputs): within 1e-3, 2e-4, 1e-6, 1e-9 and 1e-12 of the slip model's stop limit (least Θ̇²
 /// from ~5e-4, either side of the switch to double-double at 1e-4, down to ~5e-13 of its O(1)
 /// terms) for ξ from 0.65 to 10, f = 0.01 and 0.1 and two K laws, and
-/// 1 − K e^{2fα} = 1e-6, 1e-9, 1e-12 for slip and slip-approx at f up to 1. v̄ and Θ̇f to
-/// 1e-12 in regime B; the regime where the reference has none.
+/// 1 − K e^{2fα} = 1e-2 and 3e-3 (either side of the double-double switch at
+/// 1 − K² e^{4fα} = 1e-2), 1e-3, 5.5e-4, 1e-6, 1e-9, 1e-12 for slip and slip-approx at f up to 1.
+/// v̄ and Θ̇f to 1e-12 in regime B; the regime where the reference has none.
 #[test]
 fn slip_deep_in_its_limits_at_1e_12() {
     let rows = rows_from(concat!(
@@ -291,7 +292,7 @@ fn slip_deep_in_its_limits_at_1e_12() {
         "{n_b} steady rows, largest relative error {:.2e} ({}); {n_other} rows in regime A or C agree",
         worst.0, worst.1
     );
-    assert!(n_b >= 90 && n_other >= 40, "{n_b} {n_other}");
+    assert!(n_b >= 140 && n_other >= 70, "{n_b} {n_other}");
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 

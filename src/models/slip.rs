@@ -516,8 +516,8 @@ fn slip_time_about_minimum(
 
 /// Below this value of 1 − K² e^{4fα}, [`final_velocity_sq`] takes L'² from [`SlipDd`]. The
 /// double form's error in v̄ is up to about 3e-16/den (measured on
-/// tests/reference/slip_limits_refs.csv: 4.6e-11 at den = 2e-6, 1.4e-13 at 2e-3, 1.6e-13 at
-/// 1.1e-3), so above 1e-2 it stays near 3e-14.
+/// tests/reference/slip_limits_refs.csv: 4.6e-11 at den = 2e-6, 1.6e-13 at 1.1e-3, 1.4e-13 at
+/// 2e-3), so above 1e-2 it stays near 3e-14 (measured: at most 1.2e-14 at den = 2e-2).
 const DD_DENOMINATOR_BELOW: f64 = 1e-2;
 
 /// A double denominator below this is a runaway (K² e^{4fα} > 1) whatever its rounding.

@@ -11,8 +11,8 @@ double; alpha = asin(1/(1+xi)) at working precision):
   the point where fitbead switches to double-double, a least squared speed of 1e-4), for xi in {0.65, 1, 2, 10}, f in
   {0.01, 0.1, 0.5, 2} and the fitted and cos 2 alpha laws of K;
 * slip and slip-approx with K = e^{-2 f alpha} (1 - eta) rounded to a double, eta in
-  {1e-3, 5.5e-4, 1e-6, 1e-9, 1e-12} (1 - K^2 e^{4 f alpha} ~ 2 eta: the first two either side
-  of 1e-3, where fitbead switches to double-double), at the slope where L'^2 = cos(Thetaf)/2,
+  {1e-2, 3e-3, 1e-3, 5.5e-4, 1e-6, 1e-9, 1e-12} (1 - K^2 e^{4 f alpha} ~ 2 eta: the first two
+  either side of 1e-2, where fitbead switches to double-double), at the slope where L'^2 = cos(Thetaf)/2,
   for xi in {0.65, 1, 2, 10} and f in {0.01, 0.1, 1}.
 
 Run: python3 tests/reference/slip_limits_refs.py [--jobs N]  (mpmath; about ten minutes on
@@ -48,7 +48,7 @@ def tasks():
         for xi in (0.65, 1.0, 2.0, 10.0):
             for f in (0.01, 0.1, 1.0):
                 a = M.alpha_of(xi)
-                for eta in ('1e-3', '5.5e-4', '1e-6', '1e-9', '1e-12'):
+                for eta in ('1e-2', '3e-3', '1e-3', '5.5e-4', '1e-6', '1e-9', '1e-12'):
                     K = float(mpmath.exp(-2 * mpf(f) * a) * (1 - mpf(eta)))
                     d = M.slip_delta_for_Lp2(xi, K, f, mpf('0.5'))
                     if d is None:

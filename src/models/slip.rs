@@ -200,8 +200,10 @@ pub fn speed_minimum(scene: &Scene) -> Result<(f64, f64), NotSteady> {
 /// the slip model's whole contact: the double minimum carries an absolute error of a few ulp
 /// of its O(1) terms, i.e. a relative error ~1e-16/m, and v̄ inherits about 0.02 of it
 /// (6.9e-12 at m = 5.4e-7 on the stop-limit rows of tests/reference/forward_refs.csv), so
-/// above 1e-4 the double form costs at most ~4e-14. The double-double path costs 3–5× the
-/// double one (about 17 µs against 3.5 µs per scene), hence the threshold.
+/// above 1e-4 the double form costs at most ~4e-14 (5.4e-14 measured at m ≈ 1.1e-4). The
+/// double-double path cost 2.4–2.7× the double one (17–19 µs against 7.1–7.3 µs on two
+/// crawling scenes of `cargo bench --bench forward`, measured before `SlipDd::new` went from
+/// 2.8 to 2.0 µs), hence the threshold.
 const DD_MINIMUM_BELOW: f64 = 1e-4;
 
 /// A double minimum below this is a stop whatever its rounding (its absolute error is a few

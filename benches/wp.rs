@@ -1,4 +1,4 @@
-//! Work-precision hot paths (issue 7): one evaluation of each variant the `bench` command
+//! Work-precision hot paths: one evaluation of each variant the `bench` command
 //! times, on a fixed set of scenes drawn by `fitbead bench`'s own generator.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};

@@ -1,4 +1,4 @@
-//! `fitbead bench` and `--model auto` (issue 7): columns, the references' cross-checks, and
+//! `fitbead bench` and `--model auto`: columns, the references' cross-checks, and
 //! auto meeting its tolerance on every scene.
 
 use std::collections::HashMap;

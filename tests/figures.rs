@@ -115,9 +115,7 @@ fn report_figures_render() {
     }
 }
 
-// --- work-precision (issue 7) ---
 #[test]
 fn bench_plot_renders() {
     check("bench_wp", &["bench", "--scenes", "40"]);
 }
-// --- end work-precision ---

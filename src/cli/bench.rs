@@ -1,4 +1,4 @@
-//! `fitbead bench`: work-precision report (issue 7). Draws scenes across regime B, computes
+//! `fitbead bench`: work-precision report. Draws scenes across regime B, computes
 //! cross-checked high-precision references once, then for every model and method variant
 //! records the relative error of v̄ (median, 99th percentile, maximum over scenes) and the
 //! time per evaluation (median, 99th percentile over scenes; single thread, each scene timed

@@ -4,17 +4,13 @@ use super::{emit, read_input, CliError};
 use crate::error::Error;
 use crate::io::scenes::{line_of, Row, Table, TableReader};
 use crate::io::{fmt_f64, push_csv_field, push_f64, AtomicFile, InputError};
-use crate::models::contact::{Contact, SpinRule, SteadyContact};
-// --- auto (work-precision, issue 7) ---
 use crate::models::auto::{Auto, AutoOutcome};
-// --- end auto ---
+use crate::models::contact::{Contact, SpinRule, SteadyContact};
 use crate::models::jaeger::Jaeger;
 use crate::models::jan::Jan;
-use crate::models::{regime_of, ForwardModel, JaegerBranch, Model, ModelKind, Outcome};
-// --- md (molecular dynamics, issue 9) ---
 use crate::models::md::{Md, MdParams, MdResult, MdRunConfig, ReducedMass};
 use crate::models::Regime;
-// --- end md ---
+use crate::models::{regime_of, ForwardModel, JaegerBranch, Model, ModelKind, Outcome};
 use crate::scene::{CollisionLaw, Scene};
 use rayon::prelude::*;
 use std::fs::File;
@@ -83,11 +79,9 @@ pub struct Args {
     /// --model auto, the target relative tolerance T on v.
     #[arg(long, default_value_t = 1e-14)]
     pub tol: f64,
-    // --- md (molecular dynamics, issue 9) ---
     /// Molecular-dynamics settings (`--model md`).
     #[command(flatten)]
     pub md: MdArgs,
-    // --- end md ---
 }
 
 /// Columns added after [`OUTPUT_COLUMNS`] by --model contact.
@@ -104,10 +98,8 @@ pub const CONTACT_COLUMNS: [&str; 10] = [
     "spin_rule",
 ];
 
-// --- auto (work-precision, issue 7) ---
 /// Columns added after [`OUTPUT_COLUMNS`] by --model auto: the model used and why.
 pub const AUTO_COLUMNS: [&str; 2] = ["model_used", "reason"];
-// --- end auto ---
 
 /// Output columns added to each row.
 pub const OUTPUT_COLUMNS: [&str; 12] = [
@@ -182,7 +174,6 @@ pub fn run(a: Args) -> Result<(), CliError> {
     } else {
         None
     };
-    // --- md (molecular dynamics, issue 9) ---
     if kind == ModelKind::Md {
         let (source, text) = match single {
             Some(text) => ("<command line>".to_string(), text),
@@ -191,7 +182,6 @@ pub fn run(a: Args) -> Result<(), CliError> {
         let t = Table::parse(&source, &text)?;
         return run_md(&a, &t);
     }
-    // --- end md ---
     let (source, input): (String, Box<dyn Read + Send>) = match (single, a.input.as_deref()) {
         (Some(text), _) => ("<command line>".to_string(), Box::new(Cursor::new(text))),
         (None, None) => (
@@ -426,9 +416,7 @@ impl<'a> Plan<'a> {
         let f = r.opt_number(self.c_f)?.unwrap_or(a.f);
         let scene = Scene::new(xi, d, rho, f, law).map_err(|e| scene_error(r, e, &self.cols()))?;
         let model = match (self.kind, self.kind.contact_model()) {
-            // --- auto (work-precision, issue 7) ---
             (ModelKind::Auto, _) => Model::Auto(Auto { tol: a.tol }),
-            // --- end auto ---
             (ModelKind::Contact, _) => {
                 let spin = match self.c_spin {
                     Some(c) if !r.cell(c).is_empty() => r
@@ -495,13 +483,11 @@ impl<'a> Plan<'a> {
                 w.text(c);
             }
         }
-        // --- auto (work-precision, issue 7) ---
         if self.kind == ModelKind::Auto {
             for c in AUTO_COLUMNS {
                 w.text(c);
             }
         }
-        // --- end auto ---
         w.end();
         out
     }
@@ -591,7 +577,6 @@ impl<'a> Plan<'a> {
         if let (true, Some(d)) = (general, &d) {
             contact_cells(&mut w, &job, d);
         }
-        // --- auto (work-precision, issue 7) ---
         if kind == ModelKind::Auto {
             match au {
                 Some(r) => {
@@ -604,7 +589,6 @@ impl<'a> Plan<'a> {
                 }
             }
         }
-        // --- end auto ---
         w.end();
         Ok(())
     }
@@ -624,12 +608,11 @@ fn evaluate(j: &Job) -> (Outcome, Option<ContactDetail>, Option<AutoOutcome>) {
                 None,
             )
         }
-        // --- auto (work-precision, issue 7): the auto choice travels with each outcome ---
+        // The auto choice travels with each outcome
         Model::Auto(au) => {
             let r = au.choose(&j.scene);
             (r.outcome, None, Some(r))
         }
-        // --- end auto ---
         m => (m.evaluate(&j.scene), None, None),
     }
 }
@@ -728,8 +711,6 @@ impl<'b> Cells<'b> {
         self.out.push(b'\n');
     }
 }
-
-// --- md (molecular dynamics, issue 9) ---
 
 /// Settings of the molecular-dynamics model (`--model md`), shared by `forward` and
 /// `simulate`. Every one has a default (Ristow's set, [`MdParams::ristow`]; the run of
@@ -1129,7 +1110,6 @@ fn render_md(
     }
     w.into_inner().map_err(|e| csv::Error::from(e.into_error()))
 }
-// --- end md ---
 
 #[cfg(test)]
 mod tests {

@@ -254,9 +254,7 @@ pub(super) fn forward_table(
         let f = t.opt_number(r, c_f)?.unwrap_or(a.f);
         let scene = Scene::new(xi, d, rho, f, law).map_err(|e| scene_error(t, r, e, &cols))?;
         let model = match (kind, kind.contact_model()) {
-            // --- auto (work-precision, issue 7) ---
             (ModelKind::Auto, _) => Model::Auto(Auto { tol: a.tol }),
-            // --- end auto ---
             (ModelKind::Contact, _) => {
                 let spin = match c_spin {
                     Some(c) if !t.cell(r, c).is_empty() => t
@@ -300,7 +298,7 @@ pub(super) fn forward_table(
         };
         jobs.push(Job { scene, model });
     }
-    // --- auto (work-precision, issue 7): the auto choice travels with each outcome ---
+    // The auto choice travels with each outcome
     let evaluated: Vec<(Outcome, Option<ContactDetail>, Option<AutoOutcome>)> = jobs
         .par_iter()
         .map(|j| match j.model {
@@ -388,12 +386,10 @@ fn render(
     if general {
         header.extend(CONTACT_COLUMNS.iter().map(|s| s.to_string()));
     }
-    // --- auto (work-precision, issue 7) ---
     let auto = kind == ModelKind::Auto;
     if auto {
         header.extend(AUTO_COLUMNS.iter().map(|s| s.to_string()));
     }
-    // --- end auto ---
     w.write_record(&header)?;
     let contact = !matches!(kind, ModelKind::Jan | ModelKind::Jaeger);
     let opt = |x: Option<f64>| x.map(fmt_f64).unwrap_or_default();
@@ -457,7 +453,6 @@ fn render(
         if let (true, Some(d)) = (general, d) {
             out.extend(contact_cells(job, d));
         }
-        // --- auto (work-precision, issue 7) ---
         if auto {
             match au {
                 Some(r) => {
@@ -467,7 +462,6 @@ fn render(
                 None => out.extend([String::new(), String::new()]),
             }
         }
-        // --- end auto ---
         w.write_record(&out)?;
     }
     w.into_inner().map_err(|e| csv::Error::from(e.into_error()))

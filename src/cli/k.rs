@@ -3,12 +3,10 @@
 
 use super::{emit, read_input, CliError};
 use crate::fit::k::{estimate, KEstimate, KFailure, LowerLimit, UpperLimit};
-// --- auto (work-precision, issue 7) ---
 use crate::fit::kauto::{self, KChoice};
-use crate::models::auto::Auto;
-// --- end auto ---
 use crate::io::scenes::Table;
 use crate::io::{fmt_f64, write_atomic, InputError};
+use crate::models::auto::Auto;
 use crate::models::{Model, ModelKind};
 use crate::report::figures::{scatter_svg, PointSeries, Scatter};
 use crate::scene::{CollisionLaw, Scene};
@@ -45,11 +43,9 @@ pub struct Args {
     /// lines (as the paper's Fig. 5).
     #[arg(long)]
     pub plot: Option<PathBuf>,
-    // --- auto (work-precision, issue 7) ---
     /// With --model auto: the target relative tolerance T on v of the model chosen per row.
     #[arg(long, default_value_t = 1e-10)]
     pub tol: f64,
-    // --- end auto ---
 }
 
 /// The contract columns, in order.
@@ -74,11 +70,9 @@ pub const COLUMNS: [&str; 18] = [
     "iterations",
 ];
 
-// --- auto (work-precision, issue 7) ---
 /// Columns added after [`EXTRA_COLUMNS`] by --model auto: the model each row was inverted
 /// with, and why.
 pub const AUTO_COLUMNS: [&str; 2] = ["model_used", "reason"];
-// --- end auto ---
 
 /// Columns added after the contract ones.
 pub const EXTRA_COLUMNS: [&str; 5] = ["K_min", "K_max", "lower_limit", "upper_limit", "message"];
@@ -247,7 +241,6 @@ pub fn parse_model(name: &str) -> Result<Model, CliError> {
         )
     };
     let kind: ModelKind = name.parse().map_err(|_| err())?;
-    // --- md (molecular dynamics, issue 9) ---
     if kind == ModelKind::Md {
         return Err(super::flag_error(
             "--model",
@@ -255,8 +248,6 @@ pub fn parse_model(name: &str) -> Result<Model, CliError> {
             "model md has no K inversion (its collisions come from the contact forces)",
         ));
     }
-    // --- end md ---
-    // --- auto (work-precision, issue 7) ---
     if kind == ModelKind::Auto {
         return Err(super::flag_error(
             "--model",
@@ -264,11 +255,9 @@ pub fn parse_model(name: &str) -> Result<Model, CliError> {
             "model auto is chosen per row by k and klaw themselves (see --tol), not here",
         ));
     }
-    // --- end auto ---
     kind.contact_model().ok_or_else(err)
 }
 
-// --- auto (work-precision, issue 7) ---
 /// The auto model of `--model auto --tol T` (k and klaw), or `None` for any other model.
 pub fn parse_auto(name: &str, tol: f64) -> Result<Option<Auto>, CliError> {
     if name != "auto" {
@@ -283,11 +272,10 @@ pub fn parse_auto(name: &str, tol: f64) -> Result<Option<Auto>, CliError> {
     }
     Ok(Some(Auto { tol }))
 }
-// --- end auto ---
 
 /// Runs `fitbead k`.
 pub fn run(a: Args) -> Result<(), CliError> {
-    // --- auto (work-precision, issue 7): per row, the model chosen at the stick K ---
+    // Per row, the model chosen at the stick K
     let auto = parse_auto(&a.model, a.tol)?;
     let model = match auto {
         Some(_) => Model::Stick,
@@ -309,7 +297,6 @@ pub fn run(a: Args) -> Result<(), CliError> {
         .unzip();
     let bytes = render(&t, &rows, &results, &autos, &a.model)
         .map_err(|e| CliError::Other(e.to_string()))?;
-    // --- end auto ---
     if let Some(p) = &a.plot {
         let svg = plot(&rows, &results, &a.model).map_err(CliError::Other)?;
         write_atomic(p, svg.as_bytes())
@@ -341,7 +328,7 @@ fn render(
     model: &str,
 ) -> csv::Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::with_capacity(rows.len() * 260));
-    // --- auto (work-precision, issue 7): model_used, reason after the extra columns ---
+    // Model_used, reason after the extra columns
     let auto = autos.iter().any(|a| a.is_some());
     let auto_cols: &[&str] = if auto { &AUTO_COLUMNS } else { &[] };
     let own: Vec<&str> = COLUMNS
@@ -350,7 +337,6 @@ fn render(
         .chain(auto_cols.iter())
         .copied()
         .collect();
-    // --- end auto ---
     let input_own = ["series", "xi", "delta_deg", "v", "sigma_v"];
     let pass: Vec<usize> = (0..t.headers.len())
         .filter(|&i| !input_own.contains(&t.headers[i].as_str()))
@@ -416,7 +402,6 @@ fn render(
         }
         msg.extend(e.notes.iter().cloned());
         out.push(msg.join("; "));
-        // --- auto (work-precision, issue 7) ---
         if auto {
             match au {
                 Some(c) => {
@@ -426,7 +411,6 @@ fn render(
                 None => out.extend([String::new(), String::new()]),
             }
         }
-        // --- end auto ---
         for &c in &pass {
             out.push(t.cell(i, c).to_string());
         }

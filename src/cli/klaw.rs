@@ -2,18 +2,16 @@
 //! parameter-free impact law scored beside it.
 
 use super::fitargs::FitArgs;
-use super::k::parse_model;
-// --- auto (work-precision, issue 7) ---
 use super::k::parse_auto;
-use crate::fit::kauto::{self, KChoice};
-use crate::models::Model;
-// --- end auto ---
+use super::k::parse_model;
 use super::CliError;
 use crate::fit::k::bracket;
+use crate::fit::kauto::{self, KChoice};
 use crate::fit::klaw::{fit_law, fit_law_with, KLaw, KLawError};
 use crate::fit::posterior::Method;
 use crate::fit::summary::FitSummary;
 use crate::io::fmt_f64;
+use crate::models::Model;
 use rayon::prelude::*;
 
 /// Arguments of `fitbead klaw`.
@@ -34,22 +32,19 @@ pub struct Args {
     /// Input, output and interval flags.
     #[command(flatten)]
     pub io: FitArgs,
-    // --- auto (work-precision, issue 7) ---
     /// With --model auto: the target relative tolerance T on v.
     #[arg(long, default_value_t = 1e-10)]
     pub tol: f64,
-    // --- end auto ---
 }
 
 /// Runs `fitbead klaw`.
 pub fn run(a: Args) -> Result<(), CliError> {
-    // --- auto (work-precision, issue 7): the model is chosen once the data are read ---
+    // The model is chosen once the data are read
     let auto = parse_auto(&a.model, a.tol)?;
     let mut model = match auto {
         Some(_) => Model::Stick,
         None => parse_model(&a.model)?,
     };
-    // --- end auto ---
     let law: KLaw = a
         .law
         .parse()
@@ -61,8 +56,8 @@ pub fn run(a: Args) -> Result<(), CliError> {
         KLaw::Impact => &[],
     };
     let choice = a.io.method(names)?;
-    // --- auto (work-precision, issue 7): per point at its stick K (eq 69), then the most
-    // general model any point needs, for all points ---
+    // Per point at its stick K (eq 69), then the most
+    // general model any point needs, for all points.
     let mut auto_note = String::new();
     if let Some(au) = &auto {
         let choices: Vec<KChoice> = ds
@@ -87,7 +82,6 @@ pub fn run(a: Args) -> Result<(), CliError> {
         );
         eprintln!("fitbead klaw: {auto_note}");
     }
-    // --- end auto ---
     if law == KLaw::Impact && matches!(choice.method, Method::Mcmc(_)) {
         return Err(super::flag_error(
             "--method",
@@ -164,7 +158,6 @@ pub fn run(a: Args) -> Result<(), CliError> {
         let imp = fit_law(model, &ds, KLaw::Impact, a.io.level, false).map_err(fail)?;
         stats.push(imp.summary.stats);
     }
-    // --- auto (work-precision, issue 7) ---
     if !auto_note.is_empty() {
         skipped_note = if skipped_note.is_empty() {
             auto_note
@@ -172,7 +165,6 @@ pub fn run(a: Args) -> Result<(), CliError> {
             format!("{auto_note}; {skipped_note}")
         };
     }
-    // --- end auto ---
     if !skipped_note.is_empty() {
         for s in stats.iter_mut() {
             s.note = if s.note.is_empty() {

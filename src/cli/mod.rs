@@ -1,8 +1,6 @@
 //! The command line: one module per subcommand. Errors are rendered here, once.
 
-// --- bench (work-precision, issue 7) ---
 pub mod bench;
-// --- end bench ---
 pub mod fitargs;
 pub mod forward;
 pub mod jaeger;
@@ -54,11 +52,9 @@ pub enum Command {
     Report(report::Args),
     /// Synthetic measurements inside regime B, reproducible from a seed.
     Simulate(simulate::Args),
-    // --- bench (work-precision, issue 7) ---
     /// Work-precision report: error against time of every model and method variant, and of
     /// `--model auto`, against cross-checked references (CSV and SVG).
     Bench(bench::Args),
-    // --- end bench ---
 }
 
 /// Why a command failed: bad input (exit 2), an I/O failure (exit 2 as well: nothing was

@@ -70,11 +70,9 @@ pub struct Args {
     /// Spin rule of the collision for --model contact: roll, keep, factor=L or impact.
     #[arg(long, default_value = "roll")]
     pub spin: String,
-    // --- md (molecular dynamics, issue 9) ---
     /// Molecular-dynamics settings (`--model md`).
     #[command(flatten)]
     pub md: super::forward::MdArgs,
-    // --- end md ---
 }
 
 /// Columns of the `simulate --model contact --v0` transient.
@@ -310,11 +308,9 @@ pub fn run(a: Args) -> Result<(), CliError> {
             "must be in [0, 0.5)",
         ));
     }
-    // --- md (molecular dynamics, issue 9) ---
     if kind == ModelKind::Md {
         return run_md(&a, &series);
     }
-    // --- end md ---
     let jan = a
         .jan
         .as_deref()
@@ -438,8 +434,6 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let bytes = w.into_inner().map_err(|e| CliError::Other(e.to_string()))?;
     emit(a.output.as_deref(), &bytes)
 }
-
-// --- md (molecular dynamics, issue 9) ---
 
 /// The md scan of slopes for regime B: every 0.5° from 0.5° to 45°.
 const MD_SCAN_STEP_DEG: f64 = 0.5;
@@ -660,4 +654,3 @@ fn run_md(a: &Args, series: &[f64]) -> Result<(), CliError> {
     let bytes = w.into_inner().map_err(|e| CliError::Other(e.to_string()))?;
     emit(a.output.as_deref(), &bytes)
 }
-// --- end md ---

@@ -1,4 +1,4 @@
-//! `--model auto` for the inverse problems (issue 7): which model to invert eq 69 with, per
+//! `--model auto` for the inverse problems: which model to invert eq 69 with, per
 //! measured point.
 //!
 //! The choice needs a K, which is what is being sought: the point's K is first found under

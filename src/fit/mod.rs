@@ -5,10 +5,8 @@ pub mod data;
 pub mod jaeger;
 pub mod jan;
 pub mod k;
-pub mod klaunch;
-// --- auto (work-precision, issue 7) ---
 pub mod kauto;
-// --- end auto ---
+pub mod klaunch;
 pub mod klaw;
 pub mod posterior;
 pub mod summary;

@@ -1,5 +1,5 @@
 //! `auto`: per scene, the cheapest model whose assumptions hold there and whose error bound
-//! is within a target tolerance T (issue 7).
+//! is within a target tolerance T.
 //!
 //! The physics being approximated is the general contact model (MODEL.md §4, spin rule
 //! `roll` as the paper). The paper's cheaper models equal it where their assumptions hold:

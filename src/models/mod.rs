@@ -4,20 +4,16 @@
 //! the bead stops (regime A, with where), lifts off or runs away (regime C), or a
 //! model-specific failure. No evaluation returns NaN or panics on a valid [`Scene`].
 
-// --- auto and stick by quadrature (work-precision, issue 7) ---
 pub mod auto;
-pub mod stickquad;
-// --- end auto ---
 pub mod contact;
 pub mod energy;
 pub mod jaeger;
 pub mod jan;
-// --- md (molecular dynamics, issue 9) ---
 pub mod md;
-// --- end md ---
 pub mod regimes;
 pub mod slip;
 pub mod stick;
+pub mod stickquad;
 pub mod stickslip;
 
 use crate::error::{Error, Result};
@@ -242,15 +238,11 @@ pub enum Model {
     Jaeger(jaeger::Jaeger),
     /// The general contact model: any sequence of rolling and slipping (MODEL.md §4).
     Contact(contact::Contact),
-    // --- md (molecular dynamics, issue 9) ---
     /// Ristow's soft-contact molecular dynamics (§5.3, eqs 91–92).
     Md(md::Md),
-    // --- end md ---
-    // --- auto (work-precision, issue 7) ---
     /// Per scene the cheapest model whose assumptions hold and whose error is within a target
     /// tolerance (stick, stickslip or contact; [`auto::Auto`]).
     Auto(auto::Auto),
-    // --- end auto ---
 }
 
 impl Model {
@@ -320,14 +312,10 @@ pub enum ModelKind {
     Jaeger,
     /// See [`Model::Contact`] (spin rule `roll` unless set apart).
     Contact,
-    // --- md (molecular dynamics, issue 9) ---
     /// See [`Model::Md`].
     Md,
-    // --- end md ---
-    // --- auto (work-precision, issue 7) ---
     /// See [`Model::Auto`] (target tolerance 1e-10 unless set apart).
     Auto,
-    // --- end auto ---
 }
 
 impl ModelKind {

@@ -1,27 +1,59 @@
-//! Typed errors of the library. They are rendered once, at the command line, with file, line,
-//! column and value where the error came from a file.
+//! The one error type of the public API. Each module keeps its own precise error (a scene
+//! parameter out of its domain, a bad cell in a file, a point that no K makes steady, …);
+//! [`Error`] wraps any of them, so `?` works across modules and into
+//! `Box<dyn std::error::Error>`.
 
+use crate::fit::data::DataError;
+use crate::fit::k::KFailure;
+use crate::fit::klaw::KLawError;
+use crate::inverse::{LsqError, McmcError};
+use crate::io::InputError;
+use crate::models::NotSteady;
+use crate::scene::ParameterError;
 use thiserror::Error;
 
-/// Every way a library call can refuse its input.
-#[derive(Debug, Error, Clone, PartialEq)]
+/// Every way a library call can fail.
+#[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum Error {
-    /// A scene or model parameter is outside its domain (or not finite).
-    #[error("invalid {field} = {value}: {reason}")]
-    InvalidParameter {
-        /// Name of the field, as the user wrote it (`xi`, `delta_deg`, `K`, …).
-        field: &'static str,
-        /// The offending value, as text.
-        value: String,
-        /// What the domain is.
-        reason: &'static str,
+    /// A scene or model parameter outside its domain, or an unknown law or model name.
+    #[error(transparent)]
+    Parameter(#[from] ParameterError),
+    /// A bad file, row or cell (file, line, column and value are in the error).
+    #[error(transparent)]
+    Input(#[from] InputError),
+    /// Measurements that cannot form a data set.
+    #[error(transparent)]
+    Data(#[from] DataError),
+    /// A forward model found no steady state (regime A or C, or the model's own validity).
+    #[error(transparent)]
+    NotSteady(#[from] NotSteady),
+    /// A measured point with no collisional parameter K (eq 69).
+    #[error(transparent)]
+    K(#[from] KFailure),
+    /// A K(α) law that cannot be fitted to the data.
+    #[error(transparent)]
+    KLaw(#[from] KLawError),
+    /// The least-squares solver refused its problem.
+    #[error(transparent)]
+    Lsq(#[from] LsqError),
+    /// The posterior sampler refused its problem.
+    #[error(transparent)]
+    Mcmc(#[from] McmcError),
+    /// A fit that cannot be made (too few points, no starting point, …), with why.
+    #[error("{0}")]
+    Fit(String),
+    /// A parameter name that the fit does not have.
+    #[error("no parameter '{name}' in this fit (it has: {have})")]
+    NoSuchParameter {
+        /// The name asked for.
+        name: String,
+        /// The names the fit has, comma-separated.
+        have: String,
     },
-    /// A collision law name that fitbead does not know.
-    #[error("unknown collision law '{0}' (expected a number, cos2a, adjusted, impact or c=VALUE)")]
-    UnknownLaw(String),
-    /// A model name that fitbead does not know.
-    #[error("unknown model '{0}'")]
-    UnknownModel(String),
+    /// Reading or writing a file failed.
+    #[error(transparent)]
+    Io(#[from] std::io::Error),
 }
 
 /// Result alias for library calls.

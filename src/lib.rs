@@ -23,6 +23,8 @@ pub mod error;
 pub mod fit;
 pub mod inverse;
 pub mod models;
+pub mod numfmt;
+pub mod progress;
 pub mod report;
 pub mod scene;
 pub mod special;
@@ -30,5 +32,5 @@ pub mod special;
 pub use error::{Error, Result};
 pub use models::{ForwardModel, Model, ModelKind, NotSteady, Outcome, Regime, Steady};
 pub use scene::{CollisionLaw, Scene};
-pub mod cli;
+
 pub mod io;

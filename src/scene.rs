@@ -1,11 +1,38 @@
 //! A scene: the mobile bead on the row (ξ, δ, ρ, f) and the collision law K; derived geometry.
 
-use crate::error::{Error, Result};
 use crate::special::dd::Dd;
 pub use crate::special::SinCos;
 use std::f64::consts::FRAC_PI_2;
 use std::fmt;
 use std::str::FromStr;
+use thiserror::Error;
+
+/// Why a scene or a model's parameters are refused: a value outside its domain, or a name
+/// fitbead does not know.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum ParameterError {
+    /// A scene or model parameter is outside its domain (or not finite).
+    #[error("invalid {field} = {value}: {reason}")]
+    InvalidParameter {
+        /// Name of the field, as the user wrote it (`xi`, `delta_deg`, `K`, …).
+        field: &'static str,
+        /// The offending value, as text.
+        value: String,
+        /// What the domain is.
+        reason: &'static str,
+    },
+    /// A collision law name that fitbead does not know.
+    #[error("unknown collision law '{0}' (expected a number, cos2a, adjusted, impact or c=VALUE)")]
+    UnknownLaw(String),
+    /// A model name that fitbead does not know.
+    #[error("unknown model '{0}'")]
+    UnknownModel(String),
+}
+
+/// Result of the constructors and parsers that validate parameters.
+pub type ParameterResult<T> = std::result::Result<T, ParameterError>;
+
+type Result<T> = ParameterResult<T>;
 
 /// The collisional parameter K (eq 1): a number, or a law K(α).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -45,7 +72,7 @@ impl CollisionLaw {
 }
 
 impl FromStr for CollisionLaw {
-    type Err = Error;
+    type Err = ParameterError;
     fn from_str(s: &str) -> Result<Self> {
         let t = s.trim();
         match t.to_ascii_lowercase().as_str() {
@@ -57,12 +84,12 @@ impl FromStr for CollisionLaw {
         if let Some(rest) = t.strip_prefix("c=") {
             return match rest.trim().parse::<f64>() {
                 Ok(c) if c.is_finite() => Ok(CollisionLaw::C(c)),
-                _ => Err(Error::UnknownLaw(t.to_string())),
+                _ => Err(ParameterError::UnknownLaw(t.to_string())),
             };
         }
         match t.parse::<f64>() {
             Ok(k) => Ok(CollisionLaw::Value(k)),
-            Err(_) => Err(Error::UnknownLaw(t.to_string())),
+            Err(_) => Err(ParameterError::UnknownLaw(t.to_string())),
         }
     }
 }
@@ -131,7 +158,7 @@ fn check(field: &'static str, value: f64, ok: bool, reason: &'static str) -> Res
     if value.is_finite() && ok {
         Ok(())
     } else {
-        Err(Error::InvalidParameter {
+        Err(ParameterError::InvalidParameter {
             field,
             value: value.to_string(),
             reason,

@@ -1,14 +1,14 @@
 //! Flags and I/O shared by the fit commands (`klaw`, `jan`, `jaeger`).
 
-use super::k::{read_rows, Row};
 use super::{emit, read_input, CliError};
-use crate::fit::data::{DataError, Dataset};
-use crate::fit::posterior::{draws_column, McmcSettings, Method, Prior, SCALE_NAME};
-use crate::fit::summary::{params_csv, stats_csv, FitSummary, ParamRow, StatsRow};
-use crate::inverse::mcmc::McmcOptions;
-use crate::io::scenes::Table;
-use crate::io::{fmt_f64, fmt_sig, write_atomic_all};
-use crate::report::figures::{corner_svg, CornerBlock};
+use fitbead::fit::data::Dataset;
+use fitbead::fit::posterior::{draws_column, McmcSettings, Method, Prior, SCALE_NAME};
+use fitbead::fit::summary::{params_csv, stats_csv, FitSummary, ParamRow, StatsRow};
+use fitbead::inverse::mcmc::McmcOptions;
+use fitbead::io::measurements::{dataset_of, read_measurements, Measurement};
+use fitbead::io::scenes::Table;
+use fitbead::io::{fmt_f64, fmt_sig, write_atomic_all};
+use fitbead::report::figures::{corner_svg, CornerBlock};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -91,13 +91,11 @@ pub struct FitArgs {
     pub plot: Option<PathBuf>,
 }
 
-/// The estimation method asked for on the command line, with the stop flag raised by Ctrl-C
-/// during a posterior run.
+/// The estimation method asked for on the command line (a posterior run carries the stop
+/// flag raised by Ctrl-C in its sampler options).
 pub struct MethodChoice {
     /// The method.
     pub method: Method,
-    /// Raised when the user presses Ctrl-C (MCMC only).
-    pub stop: Option<Arc<AtomicBool>>,
 }
 
 impl FitArgs {
@@ -125,7 +123,6 @@ impl FitArgs {
                     method: Method::Lsq {
                         profile: !self.no_profile,
                     },
-                    stop: None,
                 });
             }
             "mcmc" => {}
@@ -199,20 +196,21 @@ impl FitArgs {
         // A second handler cannot be installed in the same process; the first one (set by an
         // earlier command run in-process) keeps working, so the error is ignored.
         let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
-        options.stop = Some(stop.clone());
+        options.stop = Some(stop);
         Ok(MethodChoice {
             method: Method::Mcmc(Box::new(McmcSettings {
                 options,
                 priors,
                 fit_scatter: self.fit_scatter,
-                progress: std::io::stderr().is_terminal(),
+                progress: std::io::stderr()
+                    .is_terminal()
+                    .then(super::sampler_progress_bar),
             })),
-            stop: Some(stop),
         })
     }
 
     /// Validates the flags and reads the measurements.
-    pub fn read(&self) -> Result<(Table, Vec<Row>, Dataset), CliError> {
+    pub fn read(&self) -> Result<(Table, Vec<Measurement>, Dataset), CliError> {
         if !(self.level > 0.0 && self.level < 1.0) {
             return Err(super::flag_error(
                 "--level",
@@ -223,28 +221,9 @@ impl FitArgs {
         let input = self.input.as_deref().or(self.data.as_deref());
         let (source, text) = read_input(input)?;
         let t = Table::parse(&source, &text)?;
-        let rows = read_rows(&t, self.rho, self.f, self.g)?;
-        let ds = Dataset::new(
-            rows.iter()
-                .map(|r| (r.series.clone(), r.scene, r.v, r.sigma_v)),
-        )
-        .map_err(|e| match e {
-            DataError::Empty => {
-                CliError::Input(crate::io::InputError::file(&t.source, "no data rows"))
-            }
-            DataError::MixedSigma(i) => {
-                let c = t
-                    .col("sigma_v")
-                    .or_else(|| t.col("sigma_v_m_s"))
-                    .unwrap_or(0);
-                CliError::Input(t.err(
-                    i,
-                    c,
-                    "sigma missing on this row while other rows have it: give sigma on every \
-                     row or on none",
-                ))
-            }
-        })?;
+        let defaults = super::measurement_defaults(self.rho, self.f, self.g)?;
+        let rows = read_measurements(&t, &defaults)?;
+        let ds = dataset_of(&t, &rows)?;
         Ok((t, rows, ds))
     }
 

@@ -1,17 +1,17 @@
 //! `fitbead forward`: mean velocity, regime and diagnostics of each scene under one model.
 
 use super::{emit, read_input, CliError};
-use crate::error::Error;
-use crate::io::scenes::{line_of, Row, Table, TableReader};
-use crate::io::{fmt_f64, push_csv_field, push_f64, AtomicFile, InputError};
-use crate::models::auto::{Auto, AutoOutcome};
-use crate::models::contact::{Contact, SpinRule, SteadyContact};
-use crate::models::jaeger::Jaeger;
-use crate::models::jan::Jan;
-use crate::models::md::{Md, MdParams, MdResult, MdRunConfig, ReducedMass};
-use crate::models::Regime;
-use crate::models::{regime_of, ForwardModel, JaegerBranch, Model, ModelKind, Outcome};
-use crate::scene::{CollisionLaw, Scene};
+use fitbead::io::scenes::{line_of, Row, Table, TableReader};
+use fitbead::io::{fmt_f64, push_csv_field, push_f64, AtomicFile, InputError};
+use fitbead::models::auto::{Auto, AutoOutcome};
+use fitbead::models::contact::{Contact, SpinRule, SteadyContact};
+use fitbead::models::jaeger::Jaeger;
+use fitbead::models::jan::Jan;
+use fitbead::models::md::{Md, MdParams, MdResult, MdRunConfig, ReducedMass};
+use fitbead::models::Regime;
+use fitbead::models::{regime_of, ForwardModel, JaegerBranch, Model, ModelKind, Outcome};
+use fitbead::scene::ParameterError as Error;
+use fitbead::scene::{CollisionLaw, Scene};
 use rayon::prelude::*;
 use std::fs::File;
 use std::io::{Cursor, Read, Write};

@@ -4,14 +4,14 @@
 
 use super::{field_column, Args};
 use crate::cli::{flag_error, CliError};
-use crate::error::Error;
-use crate::io::{fmt_f64, InputError};
-use crate::models::auto::{Auto, AutoOutcome};
-use crate::models::contact::{Contact, SpinRule, SteadyContact};
-use crate::models::jaeger::Jaeger;
-use crate::models::jan::Jan;
-use crate::models::{regime_of, ForwardModel, JaegerBranch, Model, ModelKind, Outcome};
-use crate::scene::{CollisionLaw, Scene};
+use fitbead::io::{fmt_f64, InputError};
+use fitbead::models::auto::{Auto, AutoOutcome};
+use fitbead::models::contact::{Contact, SpinRule, SteadyContact};
+use fitbead::models::jaeger::Jaeger;
+use fitbead::models::jan::Jan;
+use fitbead::models::{regime_of, ForwardModel, JaegerBranch, Model, ModelKind, Outcome};
+use fitbead::scene::ParameterError as Error;
+use fitbead::scene::{CollisionLaw, Scene};
 use rayon::prelude::*;
 
 use super::{AUTO_COLUMNS, CONTACT_COLUMNS, OUTPUT_COLUMNS};
@@ -20,7 +20,7 @@ pub(super) use table::Table;
 /// The table reader as it was (src/io/scenes.rs before streaming).
 pub(super) mod table {
 
-    use crate::io::InputError;
+    use fitbead::io::InputError;
     use std::collections::HashMap;
 
     /// A CSV table read into memory: header, rows, line numbers.

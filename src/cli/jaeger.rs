@@ -3,8 +3,8 @@
 
 use super::fitargs::FitArgs;
 use super::CliError;
-use crate::fit::jaeger::fit_jaeger_with;
-use crate::fit::summary::FitSummary;
+use fitbead::fit::jaeger::fit_jaeger_with;
+use fitbead::fit::summary::FitSummary;
 
 /// Arguments of `fitbead jaeger`.
 #[derive(Debug, clap::Args)]

@@ -3,8 +3,8 @@
 
 use super::fitargs::FitArgs;
 use super::CliError;
-use crate::fit::jan::fit_jan_with;
-use crate::fit::summary::FitSummary;
+use fitbead::fit::jan::fit_jan_with;
+use fitbead::fit::summary::FitSummary;
 
 /// Arguments of `fitbead jan`.
 #[derive(Debug, clap::Args)]

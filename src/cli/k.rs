@@ -2,14 +2,15 @@
 //! v ± σ, and why where there is none.
 
 use super::{emit, read_input, CliError};
-use crate::fit::k::{estimate, KEstimate, KFailure, LowerLimit, UpperLimit};
-use crate::fit::kauto::{self, KChoice};
-use crate::io::scenes::Table;
-use crate::io::{fmt_f64, write_atomic, InputError};
-use crate::models::auto::Auto;
-use crate::models::{Model, ModelKind};
-use crate::report::figures::{scatter_svg, PointSeries, Scatter};
-use crate::scene::{CollisionLaw, Scene};
+use fitbead::fit::k::{estimate, KEstimate, KFailure, LowerLimit, UpperLimit};
+use fitbead::fit::kauto::{self, KChoice};
+use fitbead::io::measurements::{read_measurements, Measurement};
+use fitbead::io::scenes::Table;
+use fitbead::io::{fmt_f64, write_atomic};
+use fitbead::models::auto::Auto;
+use fitbead::models::{Model, ModelKind};
+use fitbead::report::figures::{scatter_svg, PointSeries, Scatter};
+use fitbead::scene::CollisionLaw;
 use rayon::prelude::*;
 use std::path::PathBuf;
 
@@ -77,160 +78,6 @@ pub const AUTO_COLUMNS: [&str; 2] = ["model_used", "reason"];
 /// Columns added after the contract ones.
 pub const EXTRA_COLUMNS: [&str; 5] = ["K_min", "K_max", "lower_limit", "upper_limit", "message"];
 
-/// One measurement, validated.
-#[derive(Debug, Clone)]
-pub struct Row {
-    /// Series label (empty when the file has none).
-    pub series: String,
-    /// The scene (its K is a placeholder).
-    pub scene: Scene,
-    /// Dimensionless mean velocity.
-    pub v: f64,
-    /// Its standard deviation, when given.
-    pub sigma_v: Option<f64>,
-}
-
-fn positive(t: &Table, r: usize, c: usize, what: &str) -> Result<f64, InputError> {
-    let x = t.number(r, c)?;
-    if x > 0.0 {
-        Ok(x)
-    } else {
-        Err(t.err(r, c, format!("{what} must be > 0")))
-    }
-}
-
-/// Reads and validates the measurements (dimensional input converted with
-/// v = v_m_s / sqrt(g R (1 + ξ))).
-pub fn read_rows(t: &Table, rho: f64, f: f64, g: f64) -> Result<Vec<Row>, CliError> {
-    let c_xi = t.require("xi")?;
-    let c_d = t.require("delta_deg")?;
-    let c_series = t.col("series");
-    let c_v = t.col("v");
-    let c_vms = t.col("v_m_s");
-    let c_sigma = t.col("sigma_v");
-    let c_sigma_ms = t.col("sigma_v_m_s");
-    let c_r = t.col("R_m");
-    let c_g = t.col("g");
-    let c_rho = t.col("rho");
-    let c_f = t.col("f");
-    if c_v.is_none() && c_vms.is_none() {
-        return Err(t.require("v").unwrap_err().into());
-    }
-    if let (Some(_), Some(cs)) = (c_v, c_sigma_ms) {
-        return Err(InputError {
-            file: t.source.clone(),
-            line: Some(1),
-            column: Some(t.headers[cs].clone()),
-            value: None,
-            message: "sigma_v_m_s is in m/s but v is dimensionless: give v_m_s and R_m with \
-                      sigma_v_m_s, or sigma_v with v"
-                .into(),
-        }
-        .into());
-    }
-    if c_v.is_none() && c_r.is_none() {
-        return Err(t.require("R_m").unwrap_err().into());
-    }
-    for (flag, x) in [("--rho", rho), ("--f", f)] {
-        if !(x >= 0.0 && x.is_finite()) {
-            return Err(super::flag_error(
-                flag,
-                &x.to_string(),
-                "must be a finite number >= 0",
-            ));
-        }
-    }
-    if !(g > 0.0 && g.is_finite()) {
-        return Err(super::flag_error("--g", &g.to_string(), "g must be > 0"));
-    }
-    let mut first_xi: std::collections::HashMap<String, (f64, u64)> = Default::default();
-    let mut rows = Vec::with_capacity(t.rows.len());
-    for r in 0..t.rows.len() {
-        let xi = t.number(r, c_xi)?;
-        let d = t.number(r, c_d)?;
-        let rho = t.opt_number(r, c_rho)?.unwrap_or(rho);
-        let f = t.opt_number(r, c_f)?.unwrap_or(f);
-        let scene = Scene::new(xi, d, rho, f, CollisionLaw::Value(0.5)).map_err(|e| {
-            let col = match &e {
-                crate::Error::InvalidParameter { field, .. } => match *field {
-                    "xi" => Some(c_xi),
-                    "delta" | "delta_deg" => Some(c_d),
-                    "rho" => c_rho,
-                    "f" => c_f,
-                    _ => None,
-                },
-                _ => None,
-            };
-            match col {
-                Some(c) => CliError::Input(t.err(r, c, e.to_string())),
-                None => CliError::Other(format!("{}, line {}: {e}", t.source, t.lines[r])),
-            }
-        })?;
-        let (v, sigma_v) = match c_v {
-            Some(c) => {
-                let v = positive(t, r, c, "v")?;
-                let s = match c_sigma {
-                    Some(cs) if !t.cell(r, cs).is_empty() => Some(positive(t, r, cs, "sigma_v")?),
-                    _ => None,
-                };
-                (v, s)
-            }
-            None => {
-                let (c, cr) = (c_vms.unwrap_or(0), c_r.unwrap_or(0));
-                let vms = positive(t, r, c, "v_m_s")?;
-                let radius = positive(t, r, cr, "R_m")?;
-                let gg = match c_g {
-                    Some(cg) if !t.cell(r, cg).is_empty() => positive(t, r, cg, "g")?,
-                    _ => g,
-                };
-                let scale = (gg * radius * (1.0 + xi)).sqrt();
-                let s = match (c_sigma_ms, c_sigma) {
-                    (Some(cs), _) if !t.cell(r, cs).is_empty() => {
-                        Some(positive(t, r, cs, "sigma_v_m_s")? / scale)
-                    }
-                    (_, Some(cs)) if !t.cell(r, cs).is_empty() => {
-                        Some(positive(t, r, cs, "sigma_v")?)
-                    }
-                    _ => None,
-                };
-                (vms / scale, s)
-            }
-        };
-        let series = c_series
-            .map(|c| t.cell(r, c).to_string())
-            .unwrap_or_default();
-        if let (Some(c), false) = (c_series, series.is_empty()) {
-            match first_xi.get(&series) {
-                Some(&(x0, line)) if x0 != xi => {
-                    return Err(t
-                        .err(
-                            r,
-                            c_xi,
-                            format!(
-                                "series '{series}' mixes xi values: {} on line {line}, {} here",
-                                fmt_f64(x0),
-                                fmt_f64(xi)
-                            ),
-                        )
-                        .into());
-                }
-                Some(_) => {}
-                None => {
-                    first_xi.insert(series.clone(), (xi, t.lines[r]));
-                }
-            }
-            let _ = c;
-        }
-        rows.push(Row {
-            series,
-            scene,
-            v,
-            sigma_v,
-        });
-    }
-    Ok(rows)
-}
-
 /// Parses the model flag of `k` (the five contact models).
 pub fn parse_model(name: &str) -> Result<Model, CliError> {
     let err = || {
@@ -284,7 +131,8 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let input = a.input.as_deref().or(a.data.as_deref());
     let (source, text) = read_input(input)?;
     let t = Table::parse(&source, &text)?;
-    let rows = read_rows(&t, a.rho, a.f, a.g)?;
+    let defaults = super::measurement_defaults(a.rho, a.f, a.g)?;
+    let rows = read_measurements(&t, &defaults)?;
     let (results, autos): (Vec<KEstimate>, Vec<Option<KChoice>>) = rows
         .par_iter()
         .map(|r| match &auto {
@@ -322,7 +170,7 @@ fn upper_name(u: UpperLimit) -> &'static str {
 
 fn render(
     t: &Table,
-    rows: &[Row],
+    rows: &[Measurement],
     res: &[KEstimate],
     autos: &[Option<KChoice>],
     model: &str,
@@ -419,7 +267,7 @@ fn render(
     w.into_inner().map_err(|e| csv::Error::from(e.into_error()))
 }
 
-fn plot(rows: &[Row], res: &[KEstimate], model: &str) -> Result<String, String> {
+fn plot(rows: &[Measurement], res: &[KEstimate], model: &str) -> Result<String, String> {
     let mut series: Vec<PointSeries> = Vec::new();
     for (row, e) in rows.iter().zip(res) {
         let Ok(r) = &e.root else { continue };

@@ -5,13 +5,13 @@ use super::fitargs::FitArgs;
 use super::k::parse_auto;
 use super::k::parse_model;
 use super::CliError;
-use crate::fit::k::bracket;
-use crate::fit::kauto::{self, KChoice};
-use crate::fit::klaw::{fit_law, fit_law_with, KLaw, KLawError};
-use crate::fit::posterior::Method;
-use crate::fit::summary::FitSummary;
-use crate::io::fmt_f64;
-use crate::models::Model;
+use fitbead::fit::k::bracket;
+use fitbead::fit::kauto::{self, KChoice};
+use fitbead::fit::klaw::{fit_law, fit_law_with, KLaw, KLawError};
+use fitbead::fit::posterior::Method;
+use fitbead::fit::summary::FitSummary;
+use fitbead::io::fmt_f64;
+use fitbead::models::Model;
 use rayon::prelude::*;
 
 /// Arguments of `fitbead klaw`.
@@ -96,7 +96,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         .enumerate()
         .filter_map(|(i, p)| bracket(&model, &p.scene).err().map(|e| (i, e.to_string())))
         .collect();
-    let locate = |d: &crate::fit::data::Dataset, i: usize| {
+    let locate = |d: &fitbead::fit::data::Dataset, i: usize| {
         let p = &d.points[i];
         format!(
             "{}, line {} (series '{}', xi {}, delta_deg {})",

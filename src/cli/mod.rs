@@ -11,14 +11,13 @@ pub mod regimes;
 pub mod report;
 pub mod simulate;
 
-use crate::io::{write_atomic, InputError};
 use clap::{Parser, Subcommand};
+use fitbead::io::{write_atomic, InputError};
+use fitbead::progress::{Progress, ProgressEvent};
 use std::path::Path;
+use std::sync::Mutex;
 
-/// The shipped default data set (synthetic; provenance in data/README.md).
-pub const DEFAULT_DATA: &str = include_str!("../../data/default.csv");
-/// Name used for the default data set in messages.
-pub const DEFAULT_DATA_NAME: &str = "<embedded default data: data/default.csv>";
+use fitbead::io::measurements::{MeasurementDefaults, DEFAULT_DATA, DEFAULT_DATA_NAME};
 
 /// fitbead: a bead rolling down a row of beads (Ancey, Evesque & Coussot 1996) — forward
 /// models, regime limits and synthetic data. Velocities are dimensionless (units
@@ -144,6 +143,60 @@ pub fn emit(output: Option<&Path>, bytes: &[u8]) -> Result<(), CliError> {
     }
 }
 
+/// Checks the `--rho`, `--f` and `--g` flags and makes them the measurement defaults.
+pub fn measurement_defaults(rho: f64, f: f64, g: f64) -> Result<MeasurementDefaults, CliError> {
+    for (flag, x) in [("--rho", rho), ("--f", f)] {
+        if !(x >= 0.0 && x.is_finite()) {
+            return Err(flag_error(
+                flag,
+                &x.to_string(),
+                "must be a finite number >= 0",
+            ));
+        }
+    }
+    if !(g > 0.0 && g.is_finite()) {
+        return Err(flag_error("--g", &g.to_string(), "g must be > 0"));
+    }
+    Ok(MeasurementDefaults { rho, f, g })
+}
+
+/// A progress bar on stderr for posterior runs: one bar per run, drawn from the library's
+/// progress events.
+pub fn sampler_progress_bar() -> Progress {
+    let bar: Mutex<Option<indicatif::ProgressBar>> = Mutex::new(None);
+    Progress::new(move |e| {
+        let Ok(mut slot) = bar.lock() else { return };
+        match e {
+            ProgressEvent::Start {
+                label,
+                total,
+                check_every,
+            } => {
+                let b = indicatif::ProgressBar::new(total);
+                b.set_style(
+                    indicatif::ProgressStyle::with_template(
+                        "{msg} {bar:30} {pos}/{len} steps ({elapsed}, checks every {prefix})",
+                    )
+                    .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+                );
+                b.set_prefix(check_every.to_string());
+                b.set_message(label.to_string());
+                *slot = Some(b);
+            }
+            ProgressEvent::Position(p) => {
+                if let Some(b) = slot.as_ref() {
+                    b.set_position(p);
+                }
+            }
+            ProgressEvent::Finish => {
+                if let Some(b) = slot.take() {
+                    b.finish_and_clear();
+                }
+            }
+        }
+    })
+}
+
 /// Parses a comma-separated list of numbers given on the command line.
 pub fn parse_list(flag: &str, s: &str) -> Result<Vec<f64>, CliError> {
     s.split(',')
@@ -166,8 +219,8 @@ pub fn parse_list(flag: &str, s: &str) -> Result<Vec<f64>, CliError> {
 }
 
 /// The Jaeger root of `--branch` (`upper`, the default, or `lower`; eqs 80–89).
-pub fn jaeger_branch(value: &str) -> Result<crate::models::JaegerBranch, CliError> {
-    use crate::models::JaegerBranch;
+pub fn jaeger_branch(value: &str) -> Result<fitbead::models::JaegerBranch, CliError> {
+    use fitbead::models::JaegerBranch;
     match value {
         "upper" => Ok(JaegerBranch::Upper),
         "lower" => Ok(JaegerBranch::Lower),

@@ -2,9 +2,9 @@
 //! critical ξ below which no steady regime exists.
 
 use super::{emit, CliError};
-use crate::io::fmt_f64;
-use crate::models::regimes::{alpha_of_xi, bulk_friction, critical_xi, delta_d, delta_m};
-use crate::scene::CollisionLaw;
+use fitbead::io::fmt_f64;
+use fitbead::models::regimes::{alpha_of_xi, bulk_friction, critical_xi, delta_d, delta_m};
+use fitbead::scene::CollisionLaw;
 use std::path::PathBuf;
 
 /// Arguments of `fitbead regimes`.
@@ -26,10 +26,9 @@ pub struct Args {
 
 /// Runs `fitbead regimes`.
 pub fn run(a: Args) -> Result<(), CliError> {
-    let law: CollisionLaw = a
-        .law
-        .parse()
-        .map_err(|e: crate::Error| super::flag_error("--law", &a.law, e.to_string()))?;
+    let law: CollisionLaw = a.law.parse().map_err(|e: fitbead::scene::ParameterError| {
+        super::flag_error("--law", &a.law, e.to_string())
+    })?;
     if !(a.rho.is_finite() && a.rho >= 0.0) {
         return Err(super::flag_error(
             "--rho",

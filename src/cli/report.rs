@@ -4,8 +4,8 @@
 
 use super::fitargs::FitArgs;
 use super::CliError;
-use crate::io::{fmt_f64, write_atomic_all};
-use crate::report::analysis::{analyse, sig3, Analysis};
+use fitbead::io::{fmt_f64, write_atomic_all};
+use fitbead::report::analysis::{analyse, sig3, Analysis};
 use std::path::{Path, PathBuf};
 
 /// Arguments of `fitbead report`.
@@ -85,13 +85,13 @@ pub struct Recipe {
 fn read_recipe(path: &Path) -> Result<Recipe, CliError> {
     let name = path.display().to_string();
     let text = std::fs::read_to_string(path).map_err(|e| {
-        CliError::Input(crate::io::InputError::file(
+        CliError::Input(fitbead::io::InputError::file(
             &name,
             format!("cannot read: {e}"),
         ))
     })?;
     let mut r: Recipe = toml::from_str(&text).map_err(|e| {
-        CliError::Input(crate::io::InputError::file(
+        CliError::Input(fitbead::io::InputError::file(
             &name,
             format!("not a valid recipe: {e}"),
         ))
@@ -188,11 +188,11 @@ pub fn run(a: Args) -> Result<(), CliError> {
     );
     files.push((
         "params.csv".into(),
-        crate::fit::summary::params_csv(&params).map_err(csv_err)?,
+        fitbead::fit::summary::params_csv(&params).map_err(csv_err)?,
     ));
     files.push((
         "stats.csv".into(),
-        crate::fit::summary::stats_csv(&stats).map_err(csv_err)?,
+        fitbead::fit::summary::stats_csv(&stats).map_err(csv_err)?,
     ));
     let fig = |name: &str, r: Result<String, String>| {
         r.map(|s| (name.to_string(), s.into_bytes()))
@@ -315,7 +315,7 @@ fn markdown(an: &Analysis, source: &str, method: &str) -> String {
         fmt_f64(p0.rho),
         fmt_f64(p0.f),
         fmt_f64(an.level),
-        if d.sigma == crate::inverse::SigmaKind::Absolute {
+        if d.sigma == fitbead::inverse::SigmaKind::Absolute {
             "given on every row"
         } else {
             "not given (unit weights, scale estimated)"
@@ -453,7 +453,7 @@ fn markdown(an: &Analysis, source: &str, method: &str) -> String {
     m.push_str(&format!(
         "\nWhat the data support (extra parameters count as supported when both AIC and BIC \
          drop by more than {}):\n\n",
-        fmt_f64(crate::report::analysis::SUPPORT_THRESHOLD)
+        fmt_f64(fitbead::report::analysis::SUPPORT_THRESHOLD)
     ));
     for s in an.support_statements() {
         m.push_str(&format!("- {s}\n"));

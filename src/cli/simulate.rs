@@ -2,11 +2,15 @@
 //! multiplicative Gaussian noise, reproducible from the seed (ChaCha8 stream).
 
 use super::{emit, parse_list, CliError};
-use crate::io::fmt_f64;
-use crate::models::jaeger::Jaeger;
-use crate::models::jan::Jan;
-use crate::models::{ForwardModel, Model, ModelKind};
-use crate::scene::{CollisionLaw, Scene};
+use fitbead::io::fmt_f64;
+use fitbead::models::jaeger::Jaeger;
+use fitbead::models::jan::Jan;
+use fitbead::models::md::{
+    regime_b_interval as md_regime_b_interval, MD_NARROW, MD_REFINE, MD_SCAN_POINTS,
+};
+use fitbead::models::regimes::regime_b_interval;
+use fitbead::models::{ForwardModel, Model, ModelKind};
+use fitbead::scene::{CollisionLaw, Scene};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
@@ -96,7 +100,7 @@ pub const TRACE_COLUMNS: [&str; 15] = [
 
 /// `simulate --model contact --v0 V --beads N`: the bead-by-bead transient from a launch.
 fn trace(a: &Args, law: CollisionLaw, series: &[f64], v0: f64) -> Result<(), CliError> {
-    use crate::models::contact::{Contact, ContactEnd, Launch, SpinRule};
+    use fitbead::models::contact::{Contact, ContactEnd, Launch, SpinRule};
     if !(v0.is_finite() && v0 >= 0.0) {
         return Err(super::flag_error(
             "--v0",
@@ -123,7 +127,9 @@ fn trace(a: &Args, law: CollisionLaw, series: &[f64], v0: f64) -> Result<(), Cli
     let spin: SpinRule = a
         .spin
         .parse()
-        .map_err(|e: crate::Error| super::flag_error("--spin", &a.spin, e.to_string()))?;
+        .map_err(|e: fitbead::scene::ParameterError| {
+            super::flag_error("--spin", &a.spin, e.to_string())
+        })?;
     let model = Contact {
         spin,
         ..Contact::default()
@@ -208,81 +214,15 @@ fn delta_range(flag: Option<&str>) -> Result<Option<(f64, f64)>, CliError> {
     Ok(Some((r[0], r[1])))
 }
 
-/// The longest run of `true` in `flags` as [start, end) indices; `None` when there is none.
-fn longest_run(flags: &[bool]) -> Option<(usize, usize)> {
-    let (mut best, mut cur): ((usize, usize), Option<usize>) = ((0, 0), None);
-    for i in 0..=flags.len() {
-        let f = i < flags.len() && flags[i];
-        match (f, cur) {
-            (true, None) => cur = Some(i),
-            (false, Some(s)) => {
-                if i - s > best.1 - best.0 {
-                    best = (s, i);
-                }
-                cur = None;
-            }
-            _ => {}
-        }
-    }
-    (best.1 > best.0).then_some(best)
-}
-
-/// The slopes (radians) where `model` has a steady state at this ξ: the longest run of a
-/// 2000-point scan of (0°, 89°), its ends refined by bisection to 1e-12 rad.
-pub fn regime_b_interval(
-    model: &Model,
-    xi: f64,
-    rho: f64,
-    f: f64,
-    law: CollisionLaw,
-) -> Option<(f64, f64)> {
-    let ok = |d: f64| {
-        Scene::from_radians(xi, d, rho, f, law)
-            .map(|s| model.evaluate(&s).is_ok())
-            .unwrap_or(false)
-    };
-    let n = 2000;
-    let top = 89f64.to_radians();
-    let grid: Vec<f64> = (1..n).map(|i| top * i as f64 / n as f64).collect();
-    let flags: Vec<bool> = grid.iter().map(|&d| ok(d)).collect();
-    let best = longest_run(&flags)?;
-    let bisect = |mut good: f64, mut bad: f64| {
-        for _ in 0..60 {
-            let m = 0.5 * (good + bad);
-            if ok(m) {
-                good = m
-            } else {
-                bad = m
-            }
-            if (good - bad).abs() < 1e-12 {
-                break;
-            }
-        }
-        good
-    };
-    let lo = if best.0 == 0 {
-        grid[0]
-    } else {
-        bisect(grid[best.0], grid[best.0 - 1])
-    };
-    let hi = if best.1 >= grid.len() {
-        grid[grid.len() - 1]
-    } else {
-        bisect(grid[best.1 - 1], grid[best.1])
-    };
-    Some((lo, hi))
-}
-
 /// Runs `fitbead simulate`.
 pub fn run(a: Args) -> Result<(), CliError> {
     let kind: ModelKind = a
         .model
         .parse()
         .map_err(|_| super::flag_error("--model", &a.model, "unknown model"))?;
-    let law: CollisionLaw = a
-        .law
-        .parse()
-        .map_err(|e: crate::Error| super::flag_error("--law", &a.law, e.to_string()))?;
+    let law: CollisionLaw = a.law.parse().map_err(|e: fitbead::scene::ParameterError| {
+        super::flag_error("--law", &a.law, e.to_string())
+    })?;
     let series = parse_list("--series", &a.series)?;
     if let Some(v0) = a.v0 {
         if kind != ModelKind::Contact {
@@ -361,7 +301,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
             _ => {
                 let p = match &jaeger {
                     Some(p) => [p[0], p[1], p[2]],
-                    None => crate::fit::jaeger::paper_values(xi).ok_or_else(|| {
+                    None => fitbead::fit::jaeger::paper_values(xi).ok_or_else(|| {
                         super::flag_error(
                             "--series",
                             &xi.to_string(),
@@ -435,75 +375,9 @@ pub fn run(a: Args) -> Result<(), CliError> {
     emit(a.output.as_deref(), &bytes)
 }
 
-/// The md scan of slopes for regime B: every 0.5° from 0.5° to 45°.
-const MD_SCAN_STEP_DEG: f64 = 0.5;
-const MD_SCAN_POINTS: usize = 90;
-/// Bisection steps refining each end of the md regime B range (0.5°/2⁷ ≈ 0.004°).
-const MD_REFINE: usize = 7;
-/// How many times a hole in regime B may narrow the md range before `simulate` gives up.
-const MD_NARROW: usize = 8;
-
-/// The slopes (degrees) where the md model is in regime B at this ξ: the longest run of the
-/// 0.5° scan (slopes in parallel), each end refined by bisection.
-pub fn md_regime_b_interval(
-    md: &crate::models::md::Md,
-    xi: f64,
-    rho: f64,
-    tick: &(dyn Fn() + Sync),
-) -> Result<Option<(f64, f64)>, crate::Error> {
-    use crate::models::Regime;
-    use rayon::prelude::*;
-    let is_b = |d: f64| -> Result<bool, crate::Error> {
-        let sc = Scene::new(xi, d, rho, 0.1, CollisionLaw::Value(0.5))?;
-        let r = md.simulate(&sc, 1.0, None);
-        tick();
-        Ok(r.regime == Some(Regime::B))
-    };
-    let grid: Vec<f64> = (1..=MD_SCAN_POINTS)
-        .map(|i| MD_SCAN_STEP_DEG * i as f64)
-        .collect();
-    let flags: Vec<bool> = grid
-        .par_iter()
-        .map(|&d| is_b(d))
-        .collect::<Result<_, _>>()?;
-    let Some(best) = longest_run(&flags) else {
-        return Ok(None);
-    };
-    let bisect = |mut good: f64, mut bad: f64| -> Result<f64, crate::Error> {
-        for _ in 0..MD_REFINE {
-            let m = 0.5 * (good + bad);
-            if is_b(m)? {
-                good = m
-            } else {
-                bad = m
-            }
-        }
-        Ok(good)
-    };
-    let lo_good = grid[best.0];
-    let hi_good = grid[best.1 - 1];
-    let (lo, hi) = rayon::join(
-        || {
-            if best.0 == 0 {
-                Ok(lo_good)
-            } else {
-                bisect(lo_good, grid[best.0 - 1])
-            }
-        },
-        || {
-            if best.1 >= grid.len() {
-                Ok(hi_good)
-            } else {
-                bisect(hi_good, grid[best.1])
-            }
-        },
-    );
-    Ok(Some((lo?, hi?)))
-}
-
 fn run_md(a: &Args, series: &[f64]) -> Result<(), CliError> {
-    use crate::models::md::{Md, MdResult};
-    use crate::models::Regime;
+    use fitbead::models::md::{Md, MdResult};
+    use fitbead::models::Regime;
     use rayon::prelude::*;
     let md: Md = a.md.model()?;
     if !(a.rho > 0.0) {

@@ -37,6 +37,22 @@ pub enum DataError {
     MixedSigma(usize),
 }
 
+impl std::fmt::Display for DataError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            DataError::Empty => f.write_str("no data rows"),
+            DataError::MixedSigma(i) => write!(
+                f,
+                "point {}: sigma missing while other points have it: give sigma on every \
+                 point or on none",
+                i + 1
+            ),
+        }
+    }
+}
+
+impl std::error::Error for DataError {}
+
 impl Dataset {
     /// Groups `(series label, scene, v, σ)` rows; rows without a label are grouped by ξ.
     pub fn new(
@@ -60,7 +76,7 @@ impl Dataset {
         let mut points = Vec::with_capacity(rows.len());
         for (label, scene, v, s) in rows {
             let label = if label.is_empty() {
-                format!("xi={}", crate::io::fmt_f64(scene.xi))
+                format!("xi={}", crate::numfmt::fmt_f64(scene.xi))
             } else {
                 label
             };

@@ -95,6 +95,8 @@ impl KFailure {
     }
 }
 
+impl std::error::Error for KFailure {}
+
 impl fmt::Display for KFailure {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {

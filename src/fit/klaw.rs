@@ -90,6 +90,8 @@ pub enum KLawError {
     Solver(String),
 }
 
+impl std::error::Error for KLawError {}
+
 impl fmt::Display for KLawError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
@@ -121,9 +123,9 @@ impl fmt::Display for KLawError {
                  (below, the bead stops) but point {} needs {param} <= {} (above, it lifts off \
                  or runs away)",
                 lower.1 + 1,
-                crate::io::fmt_f64(lower.0),
+                crate::numfmt::fmt_f64(lower.0),
                 upper.1 + 1,
-                crate::io::fmt_f64(upper.0)
+                crate::numfmt::fmt_f64(upper.0)
             ),
             KLawError::Solver(s) => write!(f, "least-squares solver: {s}"),
         }

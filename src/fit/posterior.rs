@@ -30,7 +30,8 @@ use crate::inverse::mcmc::{
     summarise as mcmc_summarise, EnsembleSampler, LogDensity, McmcOptions, StopReason,
 };
 use crate::inverse::{Fit, LsqOptions, Residuals, SigmaKind};
-use crate::io::{fmt_f64, fmt_sig};
+use crate::numfmt::{fmt_f64, fmt_sig};
+use crate::progress::{Progress, ProgressEvent};
 use rayon::prelude::*;
 use statrs::distribution::{Continuous, LogNormal, Normal, Uniform};
 use std::fmt;
@@ -231,8 +232,8 @@ pub struct McmcSettings {
     pub priors: Vec<(String, Prior)>,
     /// Sample the error scale `sigma_scale` even when σ is given.
     pub fit_scatter: bool,
-    /// Show a progress bar on stderr (the caller decides: only on a terminal).
-    pub progress: bool,
+    /// Where to report the sampler's progress (steps run), if anywhere.
+    pub progress: Option<Progress>,
 }
 
 impl McmcSettings {
@@ -517,27 +518,23 @@ fn sample<R: Residuals + Sync + ?Sized>(
         "1 (multiplies sigma_v)"
     };
     let run = EnsembleSampler::new(&target, options).and_then(|sampler| {
-        let bar = settings.progress.then(|| {
-            let b = indicatif::ProgressBar::new(sampler.options().max_steps as u64);
-            b.set_style(
-                indicatif::ProgressStyle::with_template(
-                    "{msg} {bar:30} {pos}/{len} steps ({elapsed}, checks every {prefix})",
-                )
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-            );
-            b.set_prefix(sampler.options().check_every.to_string());
-            b.set_message(format!("{fit_name} [{series}]"));
-            b
-        });
+        let bar = settings.progress.as_ref();
+        if let Some(p) = bar {
+            p.report(ProgressEvent::Start {
+                label: &format!("{fit_name} [{series}]"),
+                total: sampler.options().max_steps as u64,
+                check_every: sampler.options().check_every as u64,
+            });
+        }
         let r = sampler.run_with_progress(&start, |step, _| {
-            if let Some(b) = &bar {
+            if let Some(p) = bar {
                 if step % 16 == 0 {
-                    b.set_position(step as u64);
+                    p.report(ProgressEvent::Position(step as u64));
                 }
             }
         });
-        if let Some(b) = bar {
-            b.finish_and_clear();
+        if let Some(p) = bar {
+            p.report(ProgressEvent::Finish);
         }
         r.map(|r| (r, sampler.walkers()))
     });

@@ -15,7 +15,7 @@ use crate::inverse::mcmc::ParameterDiagnostics;
 use crate::inverse::{
     confidence_intervals, Fit, LsqOptions, ProfileEnd, Residuals, SigmaKind, Termination,
 };
-use crate::io::fmt_f64;
+use crate::numfmt::fmt_f64;
 
 /// The contract columns of the parameter report, in order.
 pub const PARAM_COLUMNS: [&str; 9] = [

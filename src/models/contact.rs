@@ -29,8 +29,8 @@
 use super::slip::{slip_time, SlipPhase};
 use super::stick;
 use super::{NotSteady, Outcome, Phases, Steady};
-use crate::error::{Error, Result};
 use crate::scene::Scene;
+use crate::scene::{ParameterError as Error, ParameterResult as Result};
 use crate::special::cheb::ChebIntegral;
 use crate::special::quad::{integrate_smooth, integrate_smooth_n};
 use crate::special::root::brent;
@@ -144,7 +144,7 @@ impl PhaseSeq {
     pub fn changes_deg(&self) -> String {
         self.changes()
             .iter()
-            .map(|a| crate::io::fmt_f64(a.to_degrees()))
+            .map(|a| crate::numfmt::fmt_f64(a.to_degrees()))
             .collect::<Vec<_>>()
             .join(";")
     }

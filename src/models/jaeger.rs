@@ -2,8 +2,8 @@
 //! velocity u = v_SI / sqrt(2 g r cos δ) (eq 81); in the paper's units u² = v̄² ε / (2 cos δ).
 
 use super::{JaegerBranch, NotSteady, Outcome, Steady};
-use crate::error::{Error, Result};
 use crate::scene::Scene;
+use crate::scene::{ParameterError as Error, ParameterResult as Result};
 
 /// Jaeger's model with its three coefficients (Jaeger units).
 #[derive(Debug, Clone, Copy, PartialEq)]

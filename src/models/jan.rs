@@ -1,8 +1,8 @@
 //! Jan's energy balance (§5.1, eqs 73–76): m g 2R sin δ = m λ v̄² + μ m g 2R cos δ.
 
 use super::{NotSteady, Outcome, Steady};
-use crate::error::{Error, Result};
 use crate::scene::Scene;
+use crate::scene::{ParameterError as Error, ParameterResult as Result};
 
 /// Jan's model with collisional coefficient λ and bulk friction μ.
 #[derive(Debug, Clone, Copy, PartialEq)]

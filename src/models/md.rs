@@ -43,8 +43,8 @@
 //! window is dissipated: the kinetic energy grows); B otherwise.
 
 use super::{NotSteady, Outcome, Phases, Regime, Steady};
-use crate::error::{Error, Result};
-use crate::scene::Scene;
+use crate::scene::{CollisionLaw, Scene};
+use crate::scene::{ParameterError as Error, ParameterResult as Result};
 use std::f64::consts::PI;
 
 /// How the reduced mass m_eff of eq 92 is formed for a contact with a (fixed) row bead.
@@ -1042,4 +1042,70 @@ mod tests {
         // Linear spring: ∫₀¹ du/√(1−u²) = π/2.
         assert!((impact_integral(1.0) - PI / 2.0).abs() < 1e-12);
     }
+}
+
+/// The md scan of slopes for regime B: every 0.5° from 0.5° to 45°.
+pub const MD_SCAN_STEP_DEG: f64 = 0.5;
+pub const MD_SCAN_POINTS: usize = 90;
+/// Bisection steps refining each end of the md regime B range (0.5°/2⁷ ≈ 0.004°).
+pub const MD_REFINE: usize = 7;
+/// How many times a hole in regime B may narrow the md range before `simulate` gives up.
+pub const MD_NARROW: usize = 8;
+
+/// The slopes (degrees) where the md model is in regime B at this ξ: the longest run of the
+/// 0.5° scan (slopes in parallel), each end refined by bisection.
+pub fn regime_b_interval(
+    md: &Md,
+    xi: f64,
+    rho: f64,
+    tick: &(dyn Fn() + Sync),
+) -> std::result::Result<Option<(f64, f64)>, Error> {
+    use crate::models::Regime;
+    use rayon::prelude::*;
+    let is_b = |d: f64| -> std::result::Result<bool, Error> {
+        let sc = Scene::new(xi, d, rho, 0.1, CollisionLaw::Value(0.5))?;
+        let r = md.simulate(&sc, 1.0, None);
+        tick();
+        Ok(r.regime == Some(Regime::B))
+    };
+    let grid: Vec<f64> = (1..=MD_SCAN_POINTS)
+        .map(|i| MD_SCAN_STEP_DEG * i as f64)
+        .collect();
+    let flags: Vec<bool> = grid
+        .par_iter()
+        .map(|&d| is_b(d))
+        .collect::<std::result::Result<_, _>>()?;
+    let Some(best) = crate::models::regimes::longest_run(&flags) else {
+        return Ok(None);
+    };
+    let bisect = |mut good: f64, mut bad: f64| -> std::result::Result<f64, Error> {
+        for _ in 0..MD_REFINE {
+            let m = 0.5 * (good + bad);
+            if is_b(m)? {
+                good = m
+            } else {
+                bad = m
+            }
+        }
+        Ok(good)
+    };
+    let lo_good = grid[best.0];
+    let hi_good = grid[best.1 - 1];
+    let (lo, hi) = rayon::join(
+        || {
+            if best.0 == 0 {
+                Ok(lo_good)
+            } else {
+                bisect(lo_good, grid[best.0 - 1])
+            }
+        },
+        || {
+            if best.1 >= grid.len() {
+                Ok(hi_good)
+            } else {
+                bisect(hi_good, grid[best.1])
+            }
+        },
+    );
+    Ok(Some((lo?, hi?)))
 }

@@ -16,8 +16,8 @@ pub mod stick;
 pub mod stickquad;
 pub mod stickslip;
 
-use crate::error::{Error, Result};
 use crate::scene::Scene;
+use crate::scene::{ParameterError as Error, ParameterResult as Result};
 use std::fmt;
 use std::str::FromStr;
 
@@ -167,6 +167,8 @@ impl NotSteady {
         }
     }
 }
+
+impl std::error::Error for NotSteady {}
 
 impl fmt::Display for NotSteady {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {

@@ -1,6 +1,7 @@
 //! Regime limits and derived quantities of the rolling model: δ_m (eq 32), δ_d (eq 31), the
 //! smallest ξ with a steady regime, Θ_G (eq 36), H (eq 35) and the bulk friction μ (eq 79).
 
+use super::{ForwardModel, Model};
 use crate::scene::{CollisionLaw, Scene};
 use crate::special::root::brent;
 
@@ -20,6 +21,27 @@ pub fn delta_d(alpha: f64, k: f64, rho: f64) -> f64 {
 /// = (1 − K²) sin α / ((1 + K²) cos α + 2K) (eqs 78–79). Equals tan δ_m exactly.
 pub fn bulk_friction(alpha: f64, k: f64) -> f64 {
     (1.0 - k) * (1.0 + k) * alpha.sin() / ((1.0 + k * k) * alpha.cos() + 2.0 * k)
+}
+
+/// The K whose stop limit δ_m is `delta` at contact angle `alpha` (eq 32 solved for K):
+/// K = (1 − t)/(1 + t) with t = tan(δ/2)/tan(α/2). Negative when δ > α (no K > 0 stops the
+/// bead there). Radians.
+pub fn k_at_delta_m(alpha: f64, delta: f64) -> f64 {
+    let t = (0.5 * delta).tan() / (0.5 * alpha).tan();
+    (1.0 - t) / (1.0 + t)
+}
+
+/// The K whose lift-off limit δ_d is `delta` (eq 31 solved for K):
+/// K² = 1 − 4u/((1 − u)(1 + ρ)) with u = tan δ tan α; `None` when no K > 0 has δ_d = δ
+/// (the bead lifts off at this slope whatever K). Radians.
+pub fn k_at_delta_d(alpha: f64, delta: f64, rho: f64) -> Option<f64> {
+    let u = delta.tan() * alpha.tan();
+    if u >= 1.0 {
+        return None;
+    }
+    let c = 4.0 * u / (1.0 - u);
+    let k2 = 1.0 - c / (1.0 + rho);
+    (k2 > 0.0).then(|| k2.sqrt())
 }
 
 /// α = asin(1/(1+ξ)) (eq 2).
@@ -94,4 +116,69 @@ pub fn theta_g_of(rho: f64, f: f64, th: f64) -> Option<f64> {
         return None;
     }
     Some(2.0 * (f * (p - th) / den).atan())
+}
+
+/// The longest run of `true` in `flags` as [start, end) indices; `None` when there is none.
+pub(crate) fn longest_run(flags: &[bool]) -> Option<(usize, usize)> {
+    let (mut best, mut cur): ((usize, usize), Option<usize>) = ((0, 0), None);
+    for i in 0..=flags.len() {
+        let f = i < flags.len() && flags[i];
+        match (f, cur) {
+            (true, None) => cur = Some(i),
+            (false, Some(s)) => {
+                if i - s > best.1 - best.0 {
+                    best = (s, i);
+                }
+                cur = None;
+            }
+            _ => {}
+        }
+    }
+    (best.1 > best.0).then_some(best)
+}
+
+/// The slopes (radians) where `model` has a steady state at this ξ: the longest run of a
+/// 2000-point scan of (0°, 89°), its ends refined by bisection to 1e-12 rad.
+pub fn regime_b_interval(
+    model: &Model,
+    xi: f64,
+    rho: f64,
+    f: f64,
+    law: CollisionLaw,
+) -> Option<(f64, f64)> {
+    let ok = |d: f64| {
+        Scene::from_radians(xi, d, rho, f, law)
+            .map(|s| model.evaluate(&s).is_ok())
+            .unwrap_or(false)
+    };
+    let n = 2000;
+    let top = 89f64.to_radians();
+    let grid: Vec<f64> = (1..n).map(|i| top * i as f64 / n as f64).collect();
+    let flags: Vec<bool> = grid.iter().map(|&d| ok(d)).collect();
+    let best = longest_run(&flags)?;
+    let bisect = |mut good: f64, mut bad: f64| {
+        for _ in 0..60 {
+            let m = 0.5 * (good + bad);
+            if ok(m) {
+                good = m
+            } else {
+                bad = m
+            }
+            if (good - bad).abs() < 1e-12 {
+                break;
+            }
+        }
+        good
+    };
+    let lo = if best.0 == 0 {
+        grid[0]
+    } else {
+        bisect(grid[best.0], grid[best.0 - 1])
+    };
+    let hi = if best.1 >= grid.len() {
+        grid[grid.len() - 1]
+    } else {
+        bisect(grid[best.1 - 1], grid[best.1])
+    };
+    Some((lo, hi))
 }

@@ -1,5 +1,6 @@
-//! Reports: the comparisons of `fitbead report` ([`analysis`]) and the SVG figures
-//! ([`figures`]).
+//! Reports: the comparisons of `fitbead report` ([`analysis`]), its SVG figures ([`figures`])
+//! and the work-precision engine of `fitbead bench` ([`workprecision`]).
 
 pub mod analysis;
 pub mod figures;
+pub mod workprecision;

@@ -1,0 +1,779 @@
+//! The work-precision engine behind `fitbead bench`: draws scenes across regime B, computes
+//! cross-checked high-precision references once, then for every model and method variant
+//! records the relative error of v̄ (median, 99th percentile, maximum over scenes) and the
+//! time per evaluation (median, 99th percentile over scenes; single thread, each scene timed
+//! over a batch of repeats). Writes a CSV and an SVG of log time against log error.
+
+use crate::fit::k::{bracket, solve};
+use crate::io::fmt_f64;
+use crate::models::auto::Auto;
+use crate::models::contact::{Contact, PhaseKind, SpinRule};
+use crate::models::regimes::{alpha_of_xi, delta_d, k_at_delta_d, k_at_delta_m};
+use crate::models::slip::SlipPhase;
+use crate::models::{slip, stick, stickquad, stickslip, Model, Outcome, Phases};
+use crate::scene::{CollisionLaw, Scene};
+use crate::special::quad::{integrate, QuadOptions};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+
+/// The contract columns of the CSV.
+pub const COLUMNS: [&str; 9] = [
+    "model",
+    "method",
+    "tolerance",
+    "scenes",
+    "err_median",
+    "err_p99",
+    "err_max",
+    "ns_median",
+    "ns_p99",
+];
+
+/// Tolerances of the quadrature variants.
+pub const TOLS: [f64; 6] = [1e-4, 1e-6, 1e-8, 1e-10, 1e-12, 1e-14];
+/// Tolerances tried for auto.
+pub const AUTO_TOLS: [f64; 5] = [1e-4, 1e-6, 1e-8, 1e-10, 1e-12];
+/// Tolerances of the contact model in the K inversion rows.
+const K_CONTACT_TOLS: [f64; 3] = [1e-6, 1e-10, 1e-14];
+/// Scenes used for the K inversion rows (each inversion costs tens of forward evaluations).
+pub const K_SCENES: usize = 100;
+
+/// Bounds the references' cross-checks must meet (maximum relative disagreement of v̄).
+pub const XCHECK_BOUNDS: [(&str, f64); 4] = [
+    ("stick", 1e-13),
+    ("slip", 1e-11),
+    ("stickslip", 1e-11),
+    ("contact", 1e-12),
+];
+
+/// How a scene was drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Draw {
+    /// K uniform inside its feasible range.
+    Ordinary,
+    /// K within 1e-9…1e-3 (relative to the range) of the stop limit δ = δ_m (eq 32).
+    NearDeltaM,
+    /// δ within a relative 1e-8…1e-2 of α: Θ0 ≈ 0.
+    NearTheta0,
+    /// K within 1e-9…1e-3 of the lift-off limit δ = δ_d (eq 31).
+    NearKLimit,
+}
+
+/// Draws `n` scenes of regime B for rolling (ξ ∈ [0.65, 10] log-uniform, ρ ∈ {0.4, 0.5},
+/// f ∈ [0.01, 0.5] log-uniform, K inside (K at δ_m, K at δ_d)), reproducible from `seed`.
+pub fn draw_scenes(n: usize, seed: u64) -> Vec<(Scene, Draw)> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut out = Vec::with_capacity(n);
+    let logu = |rng: &mut ChaCha8Rng, a: f64, b: f64| (rng.random_range(a.ln()..b.ln())).exp();
+    for i in 0..n {
+        let draw = match i % 10 {
+            7 => Draw::NearDeltaM,
+            8 => Draw::NearTheta0,
+            9 => Draw::NearKLimit,
+            _ => Draw::Ordinary,
+        };
+        for _ in 0..100_000 {
+            let xi = logu(&mut rng, 0.65, 10.0);
+            let rho = if rng.random_bool(0.5) { 0.4 } else { 0.5 };
+            let f = logu(&mut rng, 0.01, 0.5);
+            let alpha = alpha_of_xi(xi);
+            let delta = match draw {
+                Draw::NearTheta0 => {
+                    let s = if rng.random_bool(0.5) { 1.0 } else { -1.0 };
+                    alpha * (1.0 + s * logu(&mut rng, 1e-8, 1e-2))
+                }
+                _ => rng.random_range(0.1f64..45.0).to_radians(),
+            };
+            let k_m = k_at_delta_m(alpha, delta).max(0.0);
+            let Some(k_d) = k_at_delta_d(alpha, delta, rho) else {
+                continue;
+            };
+            if k_d <= k_m || (draw == Draw::NearDeltaM && k_m <= 0.0) {
+                continue;
+            }
+            let frac = match draw {
+                Draw::NearDeltaM => logu(&mut rng, 1e-9, 1e-3),
+                Draw::NearKLimit => 1.0 - logu(&mut rng, 1e-9, 1e-3),
+                _ => rng.random_range(0.01..0.99),
+            };
+            let k = k_m + frac * (k_d - k_m);
+            let Ok(scene) = Scene::from_radians(xi, delta, rho, f, CollisionLaw::Value(k)) else {
+                continue;
+            };
+            debug_assert!(delta < delta_d(alpha, k, rho) * (1.0 + 1e-9));
+            if stick::steady(&scene).is_ok() {
+                out.push((scene, draw));
+                break;
+            }
+        }
+    }
+    out
+}
+
+fn v(o: &Outcome) -> Option<f64> {
+    o.as_ref().ok().map(|s| s.mean_velocity)
+}
+
+fn rel(a: f64, b: f64) -> f64 {
+    ((a - b) / b).abs()
+}
+
+/// Slip time by plain adaptive quadrature of the raw integrand 1/sqrt(Θ̇²) of eq 38 (no
+/// substitution): the slip reference's independent cross-check.
+fn slip_raw(scene: &Scene) -> Option<f64> {
+    let l2 = slip::final_velocity_sq(scene).ok()?;
+    if !(l2 > 0.0) || scene.sc_f.c - l2 < 0.0 {
+        return None; // stops or lifts off at Θf (eq 30a): no steady slip contact
+    }
+    let w0sq = scene.k * scene.k * l2;
+    let ph = SlipPhase::new(scene.theta_0, w0sq, scene.f);
+    let r = integrate(
+        |t: f64| {
+            let g = ph.speed_sq(t);
+            if g > 0.0 {
+                1.0 / g.sqrt()
+            } else {
+                f64::INFINITY
+            }
+        },
+        scene.theta_0,
+        scene.theta_f,
+        QuadOptions {
+            rel_tol: 1e-15,
+            abs_tol: 0.0,
+            max_panels: 256,
+        },
+    );
+    (r.value.is_finite() && r.value > 0.0).then(|| 2.0 * scene.sin_alpha / r.value)
+}
+
+/// The references of one scene.
+#[derive(Debug, Clone, Copy)]
+pub struct References {
+    /// Stick, elliptic closed form.
+    pub stick: Outcome,
+    /// Stick by quadrature at 1e-15 (cross-check).
+    pub stick_x: Outcome,
+    /// Slip at 1e-14.
+    pub slip: Outcome,
+    /// Slip by raw quadrature (cross-check).
+    pub slip_x: Option<f64>,
+    /// Stick/slip at 1e-14.
+    pub stickslip: Outcome,
+    /// Contact model at 1e-14.
+    pub contact: Outcome,
+    /// Contact model at 1e-15 (cross-check).
+    pub contact_x: Outcome,
+    /// Where the physics reference (the best value of the general contact model's v̄) comes
+    /// from.
+    pub physics_source: PhysicsSource,
+}
+
+/// The physics reference of a scene: the general contact model's v̄ computed by the most
+/// accurate path that describes its phase sequence.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PhysicsSource {
+    /// The contact model rolls throughout: the exact rolling closed form (cross-checked by
+    /// quadrature). Near δ_m the contact model itself loses digits to cancellation in the
+    /// squared top velocity, which the closed form computes without cancellation.
+    Stick,
+    /// The contact model rolls then slips (the paper's sequence): stick/slip at 1e-14
+    /// (cross-checked against the contact model).
+    StickSlip,
+    /// Any other sequence, or no steady state: the contact model at 1e-14 (cross-checked at
+    /// 1e-15).
+    Contact,
+}
+
+impl References {
+    /// Computes every reference of one scene.
+    pub fn of(scene: &Scene) -> Self {
+        let c = |tol| {
+            Contact {
+                spin: SpinRule::Roll,
+                tol,
+            }
+            .evaluate(scene)
+        };
+        let mut r = References {
+            stick: stick::steady(scene),
+            stick_x: stickquad::steady_quad(scene, 1e-15),
+            slip: slip::steady(scene),
+            slip_x: slip_raw(scene),
+            stickslip: stickslip::steady(scene),
+            contact: c(1e-14),
+            contact_x: c(1e-15),
+            physics_source: PhysicsSource::Contact,
+        };
+        r.physics_source = match r.contact_sequence() {
+            Some(Seq::Roll) if r.stick.is_ok() => PhysicsSource::Stick,
+            Some(Seq::RollSlip) if r.stickslip.is_ok() => PhysicsSource::StickSlip,
+            _ => PhysicsSource::Contact,
+        };
+        r
+    }
+
+    /// The physics reference: v̄ of the general contact model by the most accurate path.
+    pub fn physics(&self) -> Outcome {
+        match self.physics_source {
+            PhysicsSource::Stick => self.stick,
+            PhysicsSource::StickSlip => self.stickslip,
+            PhysicsSource::Contact => self.contact,
+        }
+    }
+
+    fn contact_sequence(&self) -> Option<Seq> {
+        match &self.contact {
+            Ok(s) => match s.phases {
+                Phases::Sequence(p) => {
+                    let k = p.kinds();
+                    if k == [PhaseKind::Roll] {
+                        Some(Seq::Roll)
+                    } else if k == [PhaseKind::Roll, PhaseKind::Slip] {
+                        Some(Seq::RollSlip)
+                    } else {
+                        Some(Seq::Other)
+                    }
+                }
+                _ => Some(Seq::Other),
+            },
+            Err(_) => None,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Seq {
+    Roll,
+    RollSlip,
+    Other,
+}
+
+/// Which reference a variant is measured against.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Ref {
+    Stick,
+    Slip,
+    StickSlip,
+    /// The physics reference ([`References::physics`]).
+    Physics,
+}
+
+fn reference(r: &References, which: Ref) -> Outcome {
+    match which {
+        Ref::Stick => r.stick,
+        Ref::Slip => r.slip,
+        Ref::StickSlip => r.stickslip,
+        Ref::Physics => r.physics(),
+    }
+}
+
+/// The value the reference variant itself is compared with (its cross-check).
+fn cross(r: &References, which: Ref) -> Option<f64> {
+    match which {
+        Ref::Stick => v(&r.stick_x),
+        Ref::Slip => r.slip_x,
+        Ref::StickSlip => match r.contact_sequence() {
+            Some(Seq::RollSlip) => v(&r.contact),
+            Some(Seq::Roll) => v(&r.stick),
+            _ => None,
+        },
+        Ref::Physics => match r.physics_source {
+            PhysicsSource::Contact => v(&r.contact_x),
+            _ => v(&r.physics()),
+        },
+    }
+}
+
+/// One model and method variant.
+struct Variant {
+    model: &'static str,
+    method: &'static str,
+    tol: Option<f64>,
+    reference: Ref,
+    is_ref: bool,
+    eval: Box<dyn Fn(&Scene) -> Outcome>,
+}
+
+fn variants() -> Vec<Variant> {
+    let mut v: Vec<Variant> = Vec::new();
+    v.push(Variant {
+        model: "stick",
+        method: "elliptic",
+        tol: None,
+        reference: Ref::Stick,
+        is_ref: true,
+        eval: Box::new(stick::steady),
+    });
+    for &t in &TOLS {
+        v.push(Variant {
+            model: "stick",
+            method: "quadrature",
+            tol: Some(t),
+            reference: Ref::Stick,
+            is_ref: false,
+            eval: Box::new(move |s| stickquad::steady_quad(s, t)),
+        });
+    }
+    v.push(Variant {
+        model: "stick-approx",
+        method: "asinh-eq29",
+        tol: None,
+        reference: Ref::Stick,
+        is_ref: false,
+        eval: Box::new(stick::steady_approx),
+    });
+    for &t in &TOLS {
+        v.push(Variant {
+            model: "slip",
+            method: "quadrature",
+            tol: Some(t),
+            reference: Ref::Slip,
+            is_ref: t == 1e-14,
+            eval: Box::new(move |s| slip::steady_tol(s, t)),
+        });
+    }
+    v.push(Variant {
+        model: "slip-approx",
+        method: "elliptic-eq57",
+        tol: None,
+        reference: Ref::Slip,
+        is_ref: false,
+        eval: Box::new(slip::steady_approx),
+    });
+    for &t in &TOLS {
+        v.push(Variant {
+            model: "stickslip",
+            method: "quadrature",
+            tol: Some(t),
+            reference: Ref::StickSlip,
+            is_ref: t == 1e-14,
+            eval: Box::new(move |s| stickslip::steady_tol(s, t)),
+        });
+    }
+    for &t in &TOLS {
+        v.push(Variant {
+            model: "contact",
+            method: "quadrature",
+            tol: Some(t),
+            reference: Ref::Physics,
+            is_ref: t == 1e-14,
+            eval: Box::new(move |s| {
+                Contact {
+                    spin: SpinRule::Roll,
+                    tol: t,
+                }
+                .evaluate(s)
+            }),
+        });
+    }
+    for &t in &AUTO_TOLS {
+        v.push(Variant {
+            model: "auto",
+            method: "auto",
+            tol: Some(t),
+            reference: Ref::Physics,
+            is_ref: false,
+            eval: Box::new(move |s| Auto { tol: t }.evaluate(s)),
+        });
+    }
+    v
+}
+
+/// Time of one evaluation: a batch of repeats long enough to time (≥ 20 µs or 64 repeats).
+fn time_one(f: &dyn Fn(&Scene) -> Outcome, s: &Scene, first: Duration) -> f64 {
+    let target = 20_000.0;
+    let one = first.as_nanos().max(1) as f64;
+    let reps = ((target / one).ceil() as usize).clamp(1, 64);
+    let t0 = Instant::now();
+    for _ in 0..reps {
+        black_box(f(black_box(s)).ok());
+    }
+    t0.elapsed().as_nanos() as f64 / reps as f64
+}
+
+/// One row of the work-precision table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WpRow {
+    /// Model name.
+    pub model: String,
+    /// Method name.
+    pub method: String,
+    /// Tolerance (when the method has one).
+    pub tol: Option<f64>,
+    /// Scenes counted (the reference steady, or the variant steady).
+    pub scenes: usize,
+    /// Median relative error.
+    pub err_median: f64,
+    /// 99th percentile of the relative error.
+    pub err_p99: f64,
+    /// Maximum relative error.
+    pub err_max: f64,
+    /// Median time per evaluation, ns.
+    pub ns_median: Option<f64>,
+    /// 99th percentile of the time per evaluation, ns.
+    pub ns_p99: Option<f64>,
+}
+
+fn quantile(sorted: &[f64], q: f64) -> f64 {
+    if sorted.is_empty() {
+        return f64::NAN;
+    }
+    let i = ((q * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len()) - 1;
+    sorted[i]
+}
+
+fn sorted(mut x: Vec<f64>) -> Vec<f64> {
+    x.sort_by(|a, b| a.total_cmp(b));
+    x
+}
+
+fn row(model: &str, method: &str, tol: Option<f64>, errs: Vec<f64>, ns: Option<Vec<f64>>) -> WpRow {
+    let e = sorted(errs);
+    let t = ns.map(sorted);
+    WpRow {
+        model: model.into(),
+        method: method.into(),
+        tol,
+        scenes: e.len(),
+        err_median: quantile(&e, 0.5),
+        err_p99: quantile(&e, 0.99),
+        err_max: e.last().copied().unwrap_or(f64::NAN),
+        ns_median: t.as_ref().map(|t| quantile(t, 0.5)),
+        ns_p99: t.as_ref().map(|t| quantile(t, 0.99)),
+    }
+}
+
+/// Error of a variant against a reference value: relative error when both are steady,
+/// infinite when exactly one is, `None` when neither is (not counted).
+fn error_of(o: &Outcome, r: Option<f64>, ref_ok: bool) -> Option<f64> {
+    match (v(o), r) {
+        (Some(a), Some(b)) => Some(rel(a, b)),
+        (None, None) => None,
+        (Some(_), None) if !ref_ok => Some(f64::INFINITY),
+        (None, Some(_)) => Some(f64::INFINITY),
+        _ => None,
+    }
+}
+
+/// Everything the bench measures.
+#[derive(Debug, Clone)]
+pub struct BenchResult {
+    /// The rows, in order.
+    pub rows: Vec<WpRow>,
+    /// Per auto tolerance: the cheapest single variant (by median time) that meets it on all
+    /// scenes against the physics reference, with its median time.
+    pub cheapest: Vec<(f64, Option<(String, f64)>)>,
+    /// Which model auto used, counted over scenes at T = 1e-10: (stick, stickslip, contact).
+    pub auto_mix: (usize, usize, usize),
+}
+
+/// Runs the whole bench on `scenes` (single thread).
+pub fn run_bench(scenes: &[(Scene, Draw)]) -> BenchResult {
+    let refs: Vec<References> = scenes.iter().map(|(s, _)| References::of(s)).collect();
+    let mut rows = Vec::new();
+    // Cross-checks of the references.
+    let mut xs: Vec<(&str, &str, Vec<f64>)> = vec![
+        ("stick", "crosscheck:elliptic-vs-quadrature-1e-15", vec![]),
+        ("slip", "crosscheck:1e-14-vs-raw-quadrature-1e-15", vec![]),
+        (
+            "stickslip",
+            "crosscheck:1e-14-vs-contact-1e-14-on-roll>slip",
+            vec![],
+        ),
+        (
+            "contact",
+            "crosscheck:1e-14-vs-1e-15-on-other-sequences",
+            vec![],
+        ),
+    ];
+    for r in &refs {
+        if let Some(e) = error_of(&r.stick, v(&r.stick_x), r.stick_x.is_ok()) {
+            xs[0].2.push(e);
+        }
+        if let Some(e) = error_of(&r.slip, r.slip_x, r.slip_x.is_some()) {
+            xs[1].2.push(e);
+        }
+        if r.contact_sequence() == Some(Seq::RollSlip) {
+            if let Some(e) = error_of(&r.stickslip, v(&r.contact), true) {
+                xs[2].2.push(e);
+            }
+        }
+        if r.physics_source == PhysicsSource::Contact {
+            if let Some(e) = error_of(&r.contact, v(&r.contact_x), r.contact_x.is_ok()) {
+                xs[3].2.push(e);
+            }
+        }
+    }
+    for (m, meth, e) in xs {
+        rows.push(row(m, meth, None, e, None));
+    }
+    // Every variant.
+    let mut vs_contact: Vec<(String, f64, Option<f64>, f64)> = Vec::new();
+    for var in variants() {
+        let mut errs = Vec::new();
+        let mut errs_c = Vec::new();
+        let mut ns = Vec::new();
+        for ((s, _), r) in scenes.iter().zip(&refs) {
+            let t0 = Instant::now();
+            let o = (var.eval)(s);
+            let first = t0.elapsed();
+            ns.push(time_one(&*var.eval, s, first));
+            let refo = reference(r, var.reference);
+            let target = if var.is_ref {
+                cross(r, var.reference).filter(|_| refo.is_ok())
+            } else {
+                v(&refo)
+            };
+            if var.is_ref && target.is_none() {
+                // No independent value here: not counted.
+            } else if let Some(e) = error_of(&o, target, refo.is_ok()) {
+                errs.push(e);
+            }
+            let phys = r.physics();
+            if let Some(e) = error_of(&o, v(&phys), phys.is_ok()) {
+                errs_c.push(e);
+            }
+        }
+        let rw = row(var.model, var.method, var.tol, errs, Some(ns));
+        let max_c = errs_c.iter().fold(0.0f64, |a, &b| a.max(b));
+        vs_contact.push((
+            format!(
+                "{}/{}{}",
+                var.model,
+                var.method,
+                var.tol.map(|t| format!("@{t:e}")).unwrap_or_default()
+            ),
+            max_c,
+            var.tol.filter(|_| var.model == "auto"),
+            rw.ns_median.unwrap_or(f64::NAN),
+        ));
+        rows.push(rw);
+    }
+    // Auto against the cheapest single method meeting T on all scenes.
+    let mut cheapest = Vec::new();
+    for &t in &AUTO_TOLS {
+        let best = vs_contact
+            .iter()
+            .filter(|(name, max_c, auto_t, _)| {
+                auto_t.is_none() && !name.starts_with("auto") && *max_c <= t
+            })
+            .min_by(|a, b| a.3.total_cmp(&b.3))
+            .map(|(name, _, _, ns)| (name.clone(), *ns));
+        cheapest.push((t, best));
+    }
+    let mut mix = (0, 0, 0);
+    for (s, _) in scenes {
+        match (Auto { tol: 1e-10 }).choose(s).choice {
+            crate::models::auto::Choice::Stick => mix.0 += 1,
+            crate::models::auto::Choice::StickSlip => mix.1 += 1,
+            crate::models::auto::Choice::Contact => mix.2 += 1,
+        }
+    }
+    // K inversion (eq 69) with each model: v from the model's own reference at the scene's
+    // K; error |K̂ − K| / K.
+    let nk = scenes.len().min(K_SCENES);
+    let mut kmodels: Vec<(&str, String, Option<f64>, Model)> = vec![
+        ("k-stick", "brent-eq69".into(), None, Model::Stick),
+        (
+            "k-stick-approx",
+            "brent-eq69".into(),
+            None,
+            Model::StickApprox,
+        ),
+        ("k-slip", "brent-eq69".into(), Some(1e-14), Model::Slip),
+        (
+            "k-slip-approx",
+            "brent-eq69".into(),
+            None,
+            Model::SlipApprox,
+        ),
+        (
+            "k-stickslip",
+            "brent-eq69".into(),
+            Some(1e-14),
+            Model::StickSlip,
+        ),
+    ];
+    for &t in &K_CONTACT_TOLS {
+        kmodels.push((
+            "k-contact",
+            "brent-eq69".into(),
+            Some(t),
+            Model::Contact(Contact {
+                spin: SpinRule::Roll,
+                tol: t,
+            }),
+        ));
+    }
+    // The same inversions through `k::estimate`, which takes the launch-speed path
+    // (src/fit/klaunch.rs) for stick and stick/slip where it applies.
+    kmodels.push(("k-stick", "estimate-eq69".into(), None, Model::Stick));
+    kmodels.push((
+        "k-stickslip",
+        "estimate-eq69".into(),
+        Some(1e-14),
+        Model::StickSlip,
+    ));
+    for (name, method, tol, model) in &kmodels {
+        let mut errs = Vec::new();
+        let mut ns = Vec::new();
+        let by_estimate = method.starts_with("estimate");
+        for ((s, _), r) in scenes.iter().take(nk).zip(&refs) {
+            let which = match model {
+                Model::Stick | Model::StickApprox => Ref::Stick,
+                Model::Slip | Model::SlipApprox => Ref::Slip,
+                Model::StickSlip => Ref::StickSlip,
+                _ => Ref::Physics,
+            };
+            let Some(vref) = v(&reference(r, which)) else {
+                continue;
+            };
+            let t0 = Instant::now();
+            let k = if by_estimate {
+                crate::fit::k::estimate(model, s, vref, None).root
+            } else {
+                bracket(model, s).and_then(|br| solve(model, s, &br, vref))
+            };
+            ns.push(t0.elapsed().as_nanos() as f64);
+            errs.push(match k {
+                Ok(root) => rel(root.k, s.k),
+                Err(_) => f64::INFINITY,
+            });
+        }
+        rows.push(row(name, method, *tol, errs, Some(ns)));
+    }
+    BenchResult {
+        rows,
+        cheapest,
+        auto_mix: mix,
+    }
+}
+
+/// The CSV of the rows.
+pub fn render(rows: &[WpRow]) -> csv::Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(COLUMNS)?;
+    let opt = |x: Option<f64>| x.map(fmt_f64).unwrap_or_default();
+    let e = |x: f64| {
+        if x.is_nan() {
+            String::new()
+        } else if x.is_infinite() {
+            "inf".to_string()
+        } else if x == 0.0 {
+            "0".to_string()
+        } else {
+            format!("{x:.3e}")
+        }
+    };
+    let ns = |x: Option<f64>| x.map(|t| format!("{t:.0}")).unwrap_or_default();
+    for r in rows {
+        w.write_record([
+            r.model.clone(),
+            r.method.clone(),
+            opt(r.tol),
+            r.scenes.to_string(),
+            e(r.err_median),
+            e(r.err_p99),
+            e(r.err_max),
+            ns(r.ns_median),
+            ns(r.ns_p99),
+        ])?;
+    }
+    w.into_inner().map_err(|e| csv::Error::from(e.into_error()))
+}
+
+/// The work-precision diagram: log10 median time per evaluation against log10 maximum
+/// relative error, one curve per model and method (its tolerances joined), single methods as
+/// points. A method that is invalid on some scenes (infinite maximum error) is drawn at its
+/// median error and says so in its label.
+pub fn plot(rows: &[WpRow], title: &str) -> Result<String, String> {
+    use plotters::prelude::*;
+    let floor = 1e-17f64;
+    // (row, x, y, drawn at the median error)
+    let pts: Vec<(&WpRow, f64, f64, bool)> = rows
+        .iter()
+        .filter(|r| !r.method.starts_with("crosscheck") && !r.model.starts_with("k-"))
+        .filter_map(|r| {
+            let t = r.ns_median?;
+            let (e, median) = if r.err_max.is_finite() {
+                (r.err_max, false)
+            } else {
+                (r.err_median, true)
+            };
+            (e.is_finite() && t > 0.0).then(|| (r, e.max(floor).log10(), t.log10(), median))
+        })
+        .collect();
+    let (mut x0, mut x1, mut y0, mut y1) = (-17.0f64, 0.0f64, f64::INFINITY, f64::NEG_INFINITY);
+    for p in &pts {
+        x0 = x0.min(p.1);
+        x1 = x1.max(p.1);
+        y0 = y0.min(p.2);
+        y1 = y1.max(p.2);
+    }
+    if !y0.is_finite() {
+        (y0, y1) = (1.0, 6.0);
+    }
+    let mut out = String::new();
+    {
+        let root = SVGBackend::with_string(&mut out, (900, 620)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 18))
+            .margin(16)
+            .x_label_area_size(44)
+            .y_label_area_size(60)
+            .build_cartesian_2d((x0 - 0.5)..(x1 + 0.5), (y0 - 0.2)..(y1 + 0.2))
+            .map_err(|e| e.to_string())?;
+        chart
+            .configure_mesh()
+            .x_desc("log10 max relative error of v (below 1e-17 drawn at -17)")
+            .y_desc("log10 median time per evaluation (ns)")
+            .draw()
+            .map_err(|e| e.to_string())?;
+        let mut groups: Vec<(&str, &str)> = Vec::new();
+        for p in &pts {
+            let g = (p.0.model.as_str(), p.0.method.as_str());
+            if !groups.contains(&g) {
+                groups.push(g);
+            }
+        }
+        for (i, (m, meth)) in groups.iter().enumerate() {
+            let colour = Palette99::pick(i).to_rgba();
+            let sel: Vec<&(&WpRow, f64, f64, bool)> = pts
+                .iter()
+                .filter(|p| p.0.model == *m && p.0.method == *meth)
+                .collect();
+            let line: Vec<(f64, f64)> = sel.iter().map(|p| (p.1, p.2)).collect();
+            let mut label = if *meth == "auto" || *meth == "quadrature" {
+                format!("{m} (tolerances)")
+            } else {
+                format!("{m} ({meth})")
+            };
+            if sel.iter().any(|p| p.3) {
+                label.push_str(": median error, invalid on some scenes");
+            }
+            chart
+                .draw_series(LineSeries::new(line.clone(), colour.stroke_width(2)))
+                .map_err(|e| e.to_string())?
+                .label(label)
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(2))
+                });
+            chart
+                .draw_series(line.iter().map(|&p| Circle::new(p, 4, colour.filled())))
+                .map_err(|e| e.to_string())?;
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(|e| e.to_string())?;
+        root.present().map_err(|e| e.to_string())?;
+    }
+    Ok(out)
+}

@@ -2,8 +2,8 @@
 //! v ± σ, and why where there is none.
 
 use super::{emit, read_input, CliError};
+use fitbead::fit::k::auto::{self as kauto, KChoice};
 use fitbead::fit::k::{estimate, KEstimate, KFailure, LowerLimit, UpperLimit};
-use fitbead::fit::kauto::{self, KChoice};
 use fitbead::io::measurements::{read_measurements, Measurement};
 use fitbead::io::scenes::Table;
 use fitbead::io::{fmt_f64, write_atomic};

@@ -16,7 +16,7 @@
 
 use super::data::Dataset;
 use super::posterior::{summarise_with, Method, Prior};
-use super::summary::{FitSummary, ParamSpec};
+use super::summary::{FitSummary, ParamSpec, Solved};
 use crate::inverse::{fit, Infeasible, LsqOptions, Model, WeightedData};
 use crate::models::jaeger::Jaeger;
 use crate::models::JaegerBranch;
@@ -246,8 +246,18 @@ pub fn fit_jaeger_with(
                 specs[k].paper_value = Some(pv[k]);
             }
         }
-        let mut summary =
-            summarise_with(method, "jaeger", label, &specs, &problem, &f, level, &opts);
+        let mut summary = summarise_with(
+            method,
+            Solved {
+                name: "jaeger",
+                series: label,
+                specs: &specs,
+                problem: &problem,
+                fit: &f,
+                level,
+                options: &opts,
+            },
+        );
         let m = Jaeger {
             a1: f.params[0],
             a2: f.params[1],

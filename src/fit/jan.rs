@@ -13,7 +13,7 @@
 
 use super::data::Dataset;
 use super::posterior::{summarise_with, Method};
-use super::summary::{FitSummary, ParamSpec};
+use super::summary::{FitSummary, ParamSpec, Solved};
 use crate::inverse::{fit, Infeasible, LsqOptions, Model, WeightedData};
 
 /// The paper's global values (λ0, λ1, μ0, μ1), eqs 75–76.
@@ -205,13 +205,15 @@ pub fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFits {
         ];
         let sum = summarise_with(
             method,
-            "jan-series",
-            label,
-            &specs,
-            &problem,
-            &f,
-            level,
-            &opts,
+            Solved {
+                name: "jan-series",
+                series: label,
+                specs: &specs,
+                problem: &problem,
+                fit: &f,
+                level,
+                options: &opts,
+            },
         );
         if f.converged() {
             let se = f.std_errors().map(|s| s.to_vec()).unwrap_or(vec![1.0; 2]);
@@ -313,13 +315,15 @@ pub fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFits {
             ];
             Some(summarise_with(
                 method,
-                "jan-global",
-                "all",
-                &specs,
-                &problem,
-                &f,
-                level,
-                &opts,
+                Solved {
+                    name: "jan-global",
+                    series: "all",
+                    specs: &specs,
+                    problem: &problem,
+                    fit: &f,
+                    level,
+                    options: &opts,
+                },
             ))
         })
     };

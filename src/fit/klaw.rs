@@ -23,7 +23,7 @@
 use super::data::Dataset;
 use super::k::{bracket, estimate, KBracket};
 use super::posterior::{summarise_with, Method};
-use super::summary::{information_criteria, FitSummary, ParamSpec, StatsRow};
+use super::summary::{information_criteria, FitSummary, ParamSpec, Solved, StatsRow};
 use crate::inverse::{fit, Infeasible, LsqOptions, Residuals};
 use crate::models::{ForwardModel, Model};
 use faer::MatMut;
@@ -491,7 +491,18 @@ pub fn fit_law_with(
             default_prior: None,
         })
         .collect();
-    let mut summary = summarise_with(method, &fit_name, "all", &specs, &problem, &f, level, &opts);
+    let mut summary = summarise_with(
+        method,
+        Solved {
+            name: &fit_name,
+            series: "all",
+            specs: &specs,
+            problem: &problem,
+            fit: &f,
+            level,
+            options: &opts,
+        },
+    );
     if law == KLaw::FreePerSeries {
         for (j, row) in summary.params.iter_mut().take(problem.n).enumerate() {
             row.series = data.labels[j].clone();

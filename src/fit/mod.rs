@@ -5,8 +5,6 @@ pub mod data;
 pub mod jaeger;
 pub mod jan;
 pub mod k;
-pub mod kauto;
-pub mod klaunch;
 pub mod klaw;
 pub mod posterior;
 pub mod summary;

@@ -10,8 +10,8 @@
 //! (`ci_method = covariance`), with the profile's state in the extra columns and the note; with
 //! neither, the cells are empty and `ci_method = none`.
 
-pub use super::posterior::Draws;
 use crate::inverse::mcmc::ParameterDiagnostics;
+pub use crate::inverse::posterior::Draws;
 use crate::inverse::{
     confidence_intervals, Fit, LsqOptions, ProfileEnd, Residuals, SigmaKind, Termination,
 };
@@ -241,7 +241,7 @@ pub struct ParamSpec {
     pub paper_source: &'static str,
     /// Default prior of a posterior run; `None` for flat on the parameter's box (see
     /// [`super::posterior`]).
-    pub default_prior: Option<super::posterior::Prior>,
+    pub default_prior: Option<crate::inverse::posterior::Prior>,
 }
 
 fn termination_name(t: Termination) -> &'static str {
@@ -258,19 +258,46 @@ fn termination_name(t: Termination) -> &'static str {
     }
 }
 
+/// A finished least-squares fit with what its summary needs: the fit's name and series, the
+/// parameters' specifications, the problem, the solver's result and options, and the
+/// confidence level of the intervals.
+pub struct Solved<'a, R: ?Sized> {
+    /// Name of the fit (e.g. `klaw-c`).
+    pub name: &'a str,
+    /// Series label, or `all`.
+    pub series: &'a str,
+    /// One specification per parameter.
+    pub specs: &'a [ParamSpec],
+    /// The problem that was solved.
+    pub problem: &'a R,
+    /// The solver's result.
+    pub fit: &'a Fit,
+    /// Confidence level of the intervals, in (0, 1).
+    pub level: f64,
+    /// The solver's options (bounds, σ convention).
+    pub options: &'a LsqOptions,
+}
+
+impl<R: ?Sized> Clone for Solved<'_, R> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<R: ?Sized> Copy for Solved<'_, R> {}
+
 /// Builds the summary of a finished fit: covariance intervals, and profile intervals when
 /// `profile` is set and the fit converged.
-#[allow(clippy::too_many_arguments)]
-pub fn summarise<R: Residuals + ?Sized>(
-    fit_name: &str,
-    series: &str,
-    specs: &[ParamSpec],
-    problem: &R,
-    f: &Fit,
-    level: f64,
-    opts: &LsqOptions,
-    profile: bool,
-) -> FitSummary {
+pub fn summarise<R: Residuals + ?Sized>(s: Solved<'_, R>, profile: bool) -> FitSummary {
+    let Solved {
+        name: fit_name,
+        series,
+        specs,
+        problem,
+        fit: f,
+        level,
+        options: opts,
+    } = s;
     let mut note = String::new();
     let ci = if f.converged() && f.chi2.is_finite() {
         if profile {

@@ -21,6 +21,7 @@
 mod lmpar;
 pub mod lsq;
 pub mod mcmc;
+pub mod posterior;
 pub mod profile;
 
 pub use lsq::{

@@ -1,4 +1,4 @@
-//! K inversion (eq 69) through the launch speed: the fast path of [`super::k::estimate`] for
+//! K inversion (eq 69) through the launch speed: the fast path of [`super::estimate()`](super::estimate::estimate) for
 //! the stick and stick/slip models.
 //!
 //! A contact launched at Θ0 with speed Θ̇0 = w0 ends at Θf with a speed Φ(w0) after a time
@@ -23,9 +23,9 @@
 //! (`UpperLimit::Model`), each root is checked against the forward model (it must settle on the
 //! stable fixed point found here), and measurements within 1e-6 of the fastest stable motion
 //! are left to the general search, where the forward model's own fixed-point search gives out.
-//! Elsewhere [`super::k::estimate`] uses its general bracketing search in K.
+//! Elsewhere [`super::estimate()`](super::estimate::estimate) uses its general bracketing search in K.
 
-use super::k::{KBracket, KEstimate, KFailure, KRoot, LowerLimit, UpperLimit};
+use super::types::{KBracket, KEstimate, KFailure, KRoot, LowerLimit, UpperLimit};
 use crate::models::regimes::theta_g;
 use crate::models::stickslip::{self, Branch};
 use crate::models::{Model, NotSteady, Phases, Steady};
@@ -441,7 +441,7 @@ fn steady_of(scene: &Scene, p: &Pass, y: f64, map_slope: f64) -> Steady {
     s
 }
 
-/// [`super::k::estimate`] by the launch speed, when this path applies (`None`: use the
+/// [`super::estimate()`](super::estimate::estimate) by the launch speed, when this path applies (`None`: use the
 /// general search). Same outputs and statuses as the general path.
 pub fn estimate(model: &Model, scene: &Scene, v: f64, sigma_v: Option<f64>) -> Option<KEstimate> {
     if !(v > 0.0 && v.is_finite()) {

@@ -8,7 +8,7 @@
 //! point is then inverted with the chosen model. Where no K makes the point steady under
 //! stick, the general model is used.
 
-use super::k::estimate;
+use super::estimate::estimate;
 use crate::models::auto::{Auto, Choice};
 use crate::models::contact::{Contact, SpinRule};
 use crate::models::Model;

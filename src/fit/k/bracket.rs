@@ -1,0 +1,308 @@
+//! The bracket of K (module docs of [`super`]): derived ends, checked against the forward
+//! model, moved to the model's true boundary where it fails inside.
+
+use super::types::{KBracket, KFailure, LowerLimit, UpperLimit};
+use crate::models::regimes::theta_g;
+use crate::models::slip::SlipPhase;
+use crate::models::{stickslip, ForwardModel, Model, NotSteady, Steady};
+use crate::scene::Scene;
+use crate::special::root::brent;
+
+/// The models whose K can be inverted.
+pub fn invertible(model: &Model) -> bool {
+    matches!(
+        model,
+        Model::Stick
+            | Model::StickApprox
+            | Model::Slip
+            | Model::SlipApprox
+            | Model::StickSlip
+            | Model::Contact(_)
+    )
+}
+
+pub(super) fn eval(
+    model: &Model,
+    scene: &Scene,
+    k: f64,
+    evals: &mut usize,
+) -> Result<Steady, NotSteady> {
+    *evals += 1;
+    match scene.with_k(k) {
+        // The search needs v̄ and the final velocity only: stick/slip skips its map-slope
+        // and second-fixed-point diagnostics (they cost more than the steady state).
+        Ok(s) if k.is_finite() && matches!(model, Model::StickSlip) => stickslip::steady_lean(&s),
+        Ok(s) if k.is_finite() => model.evaluate(&s),
+        _ => Err(NotSteady::Invalid {
+            reason: "K out of range",
+        }),
+    }
+}
+
+/// Squared speed at Θf of one slip contact launched at Θ0 with squared speed `w0sq` (eq 38
+/// from Θ0; no stop check: the caller's bracket logic handles stopping).
+fn slip_contact_sq(scene: &Scene, w0sq: f64) -> f64 {
+    slip_contact_sq_at(scene, w0sq, scene.theta_f)
+}
+
+/// Analytic candidate bracket (lo, hi, lower kind); `None` when it is empty.
+fn candidate(model: &Model, scene: &Scene) -> Option<(f64, f64, LowerLimit)> {
+    let s0 = scene.sc_half_0.s;
+    let sf = scene.sc_half_f.s;
+    let cf = scene.sc_f.c;
+    let drop = 2.0 * scene.b * scene.sin_delta_sin_alpha(); // B (cos Θ0 − cos Θf), eq 9
+    match model {
+        Model::Stick | Model::StickApprox => {
+            // Lift-off at the steady state: L² = K²L² + drop = cos Θf (eqs 19, 30a).
+            if !(cf > drop) {
+                return None;
+            }
+            let hi = (1.0 - drop / cf).sqrt();
+            let (lo, kind) = if matches!(model, Model::StickApprox) {
+                // eq 28 needs A > B: both factors of the top speed² positive (|Θ0| either way).
+                (
+                    s0.abs() / sf,
+                    if s0 < 0.0 {
+                        LowerLimit::Crawl
+                    } else {
+                        LowerLimit::Model
+                    },
+                )
+            } else if s0 < 0.0 {
+                (-s0 / sf, LowerLimit::Crawl) // P = 0: eq 32 inverted
+            } else {
+                (0.0, LowerLimit::Zero)
+            };
+            Some((lo, hi, kind))
+        }
+        Model::Slip | Model::SlipApprox => {
+            // Θ̇² = w0² E(θ) + g(θ), E = e^{2f(θ−Θ0)}: the bead passes iff w0² > −g/E at its
+            // minimum, where d(g/E)/dθ ∝ sin θ − f cos θ vanishes: θ* = atan f.
+            let ts = scene.f.atan().clamp(scene.theta_0, scene.theta_f);
+            let e_s = (2.0 * scene.f * (ts - scene.theta_0)).exp();
+            let wc2 = (-slip_contact_sq_at(scene, 0.0, ts) / e_s).max(0.0);
+            let e_f = (4.0 * scene.f * scene.alpha).exp();
+            let g_f = slip_contact_sq(scene, 0.0);
+            // Lift-off: x² = K² x² E_f + g_f = cos Θf.
+            if !(cf > g_f) {
+                return None;
+            }
+            let hi = ((cf - g_f) / (cf * e_f)).sqrt();
+            let (lo, kind) = if matches!(model, Model::SlipApprox) {
+                // eqs 56–59 have their own stop and validity limits: start from K → 0 and let
+                // the status bisection find them.
+                (0.0, LowerLimit::Zero)
+            } else if wc2 > 0.0 {
+                ((wc2 / (wc2 * e_f + g_f)).sqrt(), LowerLimit::Crawl)
+            } else {
+                (0.0, LowerLimit::Zero)
+            };
+            Some((lo, hi, kind))
+        }
+        Model::StickSlip => {
+            let unit = scene.with_k(1.0).ok()?;
+            let phi = |w0: f64| stickslip::map(&unit, w0).map(|m| m.final_velocity);
+            // Lower end: rolling over the top needs w0² > 2B sin²(Θ0/2) (when slip starts
+            // after the top); the contact from there is K-independent.
+            let (lo, kind) = if s0 < 0.0 {
+                let wc = (2.0 * scene.b).sqrt() * s0.abs();
+                let tg_ok = theta_g(&unit, wc * wc).is_some_and(|t| t > 0.0);
+                // Φ at the crawl itself is a limit (the top speed 0 is not launched): take it by
+                // linear extrapolation from just above, h and 2h, leaving an O(h²) error.
+                let h = 1e-13;
+                match (phi(wc * (1.0 + h)), phi(wc * (1.0 + 2.0 * h))) {
+                    (Ok(x1), Ok(x2)) if tg_ok => (wc / (2.0 * x1 - x2), LowerLimit::Crawl),
+                    _ => (0.0, LowerLimit::Model),
+                }
+            } else {
+                (0.0, LowerLimit::Zero)
+            };
+            // Upper end: the launch speed whose final speed is the lift-off speed.
+            let xd = cf.max(0.0).sqrt();
+            let q = |w0: f64| match phi(w0) {
+                Ok(x) => x - xd,
+                Err(NotSteady::Stops { .. }) => -xd,
+                Err(_) => xd,
+            };
+            let w_lo = f64::MIN_POSITIVE;
+            let q_lo = q(w_lo);
+            if !(q_lo < 0.0) {
+                return None;
+            }
+            let mut w_hi = xd;
+            let mut q_hi = q(w_hi);
+            let mut n = 0;
+            while q_hi < 0.0 && n < 60 {
+                w_hi *= 2.0;
+                q_hi = q(w_hi);
+                n += 1;
+            }
+            let r = brent(q, w_lo, w_hi, q_lo, q_hi, 0.0, 200)?;
+            Some((lo, r.x / xd, kind))
+        }
+        // The general contact model has no closed-form ends: from K → 0 (the bead stops when
+        // Θ0 < 0) to K = 1, both ends found by bisection on the model's own status.
+        Model::Contact(_) => Some((0.0, 1.0, LowerLimit::Zero)),
+        _ => None,
+    }
+}
+
+fn slip_contact_sq_at(scene: &Scene, w0sq: f64, theta: f64) -> f64 {
+    SlipPhase::new(scene.theta_0, w0sq, scene.f).speed_sq(theta)
+}
+
+/// The steady K closest to `bad` between `good` (steady) and `bad` (not steady): the largest
+/// steady K at an upper end, the smallest at a lower end; bisection on the model's status to
+/// |ΔK| ≤ 1e-15 + 2 ulp.
+fn status_boundary(
+    model: &Model,
+    scene: &Scene,
+    mut good: f64,
+    mut bad: f64,
+    evals: &mut usize,
+) -> (f64, Steady) {
+    let mut best = None;
+    for _ in 0..80 {
+        let mid = 0.5 * (good + bad);
+        if (good - bad).abs() <= 1e-15 + 2.0 * f64::EPSILON * good.abs()
+            || mid == good
+            || mid == bad
+        {
+            break;
+        }
+        match eval(model, scene, mid, evals) {
+            Ok(s) => {
+                good = mid;
+                best = Some(s);
+            }
+            Err(_) => bad = mid,
+        }
+    }
+    let s = match best {
+        Some(s) => s,
+        None => match eval(model, scene, good, evals) {
+            Ok(s) => s,
+            Err(_) => unreachable_steady(),
+        },
+    };
+    (good, s)
+}
+
+// `good` was verified steady before the bisection started; re-evaluating it cannot fail, but a
+// failure must not panic either: an empty steady state makes the caller's checks reject it.
+fn unreachable_steady() -> Steady {
+    Steady::basic(0.0, 0.0, 0.0, f64::INFINITY)
+}
+
+/// The bracket of K with a steady state for `model` at the scene's ξ, δ, ρ, f (the scene's own
+/// K is ignored).
+pub fn bracket(model: &Model, scene: &Scene) -> Result<KBracket, KFailure> {
+    if !invertible(model) {
+        return Err(KFailure::Invalid(format!(
+            "K is not a parameter of the {} model",
+            model.name()
+        )));
+    }
+    let mut evals = 0;
+    let none = || {
+        KFailure::Invalid(
+            "no K gives a steady state at this xi and slope (the bead stops or lifts off)".into(),
+        )
+    };
+    let (lo, hi, mut lower) = candidate(model, scene).ok_or_else(|| {
+        KFailure::Invalid(
+            "no K gives a steady state: the bead lifts off at this xi and slope even as K -> 0"
+                .into(),
+        )
+    })?;
+    if !(lo < hi) {
+        return Err(KFailure::Invalid(format!(
+            "no K gives a steady state: the lowest K that carries the bead over the top \
+             ({lo:.6}) already makes it lift off (K_d = {hi:.6})"
+        )));
+    }
+    let tiny = (hi - lo) * 1e-9;
+    let hi_in = hi * (1.0 - 4.0 * f64::EPSILON);
+    let lo_test = if lo == 0.0 {
+        f64::MIN_POSITIVE
+    } else {
+        lo + tiny
+    };
+    let r_lo = eval(model, scene, lo_test, &mut evals);
+    let r_hi = eval(model, scene, hi_in, &mut evals);
+    let mut upper = UpperLimit::LiftOff;
+    // A steady point inside the bracket, to bisect from where an end fails.
+    let good = match (&r_lo, &r_hi) {
+        (Ok(_), _) => Some(lo_test),
+        (_, Ok(_)) => Some(hi_in),
+        _ => (1..32)
+            .map(|i| lo + (hi - lo) * i as f64 / 32.0)
+            .find(|&k| eval(model, scene, k, &mut evals).is_ok()),
+    }
+    .ok_or_else(none)?;
+    let (hi, top) = match r_hi {
+        Ok(s) => {
+            // Stick/slip: lift-off of the final-velocity map's fixed point can happen on its
+            // unstable branch, while the stable one (the one a bead settles on) lives on up to
+            // the saddle-node where the two merge. Probe above; if steady, walk up to the end.
+            let mut d = 1e-9 * (hi - lo);
+            let mut last_ok = (hi_in, s);
+            let mut found_bad = None;
+            if matches!(model, Model::StickSlip) {
+                while hi_in + d < 1.0 {
+                    match eval(model, scene, hi_in + d, &mut evals) {
+                        Ok(t) => last_ok = (hi_in + d, t),
+                        Err(_) => {
+                            found_bad = Some(hi_in + d);
+                            break;
+                        }
+                    }
+                    d *= 4.0;
+                }
+                if last_ok.0 > hi_in && found_bad.is_none() {
+                    found_bad = Some(1.0);
+                }
+            }
+            match found_bad {
+                Some(bad) if last_ok.0 > hi_in => {
+                    upper = UpperLimit::Model;
+                    status_boundary(model, scene, last_ok.0, bad, &mut evals)
+                }
+                _ => (hi_in, s),
+            }
+        }
+        Err(_) => {
+            upper = UpperLimit::Model;
+            status_boundary(model, scene, good, hi, &mut evals)
+        }
+    };
+    let (lo, v_lo) = match (&r_lo, lower) {
+        (Ok(_), LowerLimit::Crawl) => (lo, 0.0),
+        (Ok(s), LowerLimit::Zero) => (0.0, s.mean_velocity),
+        (Ok(_), LowerLimit::Model) => {
+            // An approximate model's own limit (the analytic candidate is its exact boundary):
+            // the slowest motion is its limit at lo.
+            let s = eval(model, scene, lo + (hi - lo) * 1e-13, &mut evals);
+            (lo, s.map(|s| s.mean_velocity).unwrap_or(0.0))
+        }
+        (Err(_), _) => {
+            lower = LowerLimit::Model;
+            let (k, s) = status_boundary(model, scene, good, lo_test.min(good), &mut evals);
+            // The model is steady from k up: the bracket starts just below.
+            (k * (1.0 - 2.0 * f64::EPSILON), s.mean_velocity)
+        }
+    };
+    if !(top.contact_time.is_finite() && top.contact_time > 0.0) {
+        return Err(none());
+    }
+    Ok(KBracket {
+        lo,
+        hi,
+        v_lo,
+        v_hi: top.mean_velocity,
+        tau_hi: top.contact_time,
+        lower,
+        upper,
+        evals,
+    })
+}

@@ -8,14 +8,33 @@
 //! Units are dimensionless: length R + r, time 1/ω0 with ω0² = g/(R+r); a velocity v converts
 //! to SI as v · sqrt(g (R + r)).
 //!
+//! ## Layers
+//!
+//! ```text
+//!   io ─────────── CSV schemas, measurements with units (Dataset::from_csv), atomic files
+//!   report ─────── the paper's comparisons, figures, the work-precision engine
+//!   fit ────────── the bead problems: K per point (eq 69), K(α) laws, Jan, Jaeger;
+//!                  typed results (FitResult) with a printable fit report, builders
+//!   inverse ────── solvers that know nothing of beads: Levenberg–Marquardt, profiles,
+//!                  ensemble MCMC, priors and posteriors over any residual problem
+//!   models ─────── one forward model per file (stick, slip, stick/slip, contact, Jan,
+//!                  Jaeger, md, auto); regimes (δ_m, δ_d, the regime-B interval)
+//!   scene ──────── ξ, δ, ρ, f and the collision law, validated
+//!   special ────── math with no beads in it: elliptic integrals, quadrature, roots, dd
 //! ```
-//! use fitbead::{CollisionLaw, ForwardModel, Model, Scene};
-//! // ξ = 1, δ = 12°, ρ = 0.4, f = 0.1, the paper's fitted collision law (§3.6.1).
-//! let scene = Scene::new(1.0, 12.0, 0.4, 0.1, CollisionLaw::Adjusted).unwrap();
-//! let v = Model::Stick.evaluate(&scene).unwrap().mean_velocity;
-//! assert!((v - 0.39120827).abs() < 1e-8); // MODEL.md §2
-//! ```
-
+//!
+//! Each layer uses only the layers below it (`numfmt`, `progress` and `error` are leaves or
+//! the crate's top). The command line is the binary's (`src/main.rs`, `src/cli/`), built with
+//! the default feature `cli`; without it (`default-features = false`) the library has no
+//! command-line dependencies.
+//!
+//! ## Quickstart
+//!
+//! The program `examples/quickstart.rs` (`cargo run --release --example quickstart`):
+//!
+#![doc = "```"]
+#![doc = include_str!("../examples/quickstart.rs")]
+#![doc = "```"]
 // `!(x > 0.0)` is deliberate throughout: a NaN must land in the failure branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
@@ -29,8 +48,11 @@ pub mod report;
 pub mod scene;
 pub mod special;
 
+pub mod io;
+pub mod prelude;
+
 pub use error::{Error, Result};
+pub use fit::data::Dataset;
+pub use fit::summary::FitResult;
 pub use models::{ForwardModel, Model, ModelKind, NotSteady, Outcome, Regime, Steady};
 pub use scene::{CollisionLaw, Scene};
-
-pub mod io;

@@ -3,7 +3,7 @@
 use super::{emit, read_input, CliError};
 use fitbead::fit::data::Dataset;
 use fitbead::fit::posterior::{draws_column, McmcSettings, Method, Prior, SCALE_NAME};
-use fitbead::fit::summary::{params_csv, stats_csv, FitSummary, ParamRow, StatsRow};
+use fitbead::fit::summary::{params_csv, stats_csv, FitResult, ParamRow, StatsRow};
 use fitbead::inverse::mcmc::McmcOptions;
 use fitbead::io::measurements::{dataset_of, read_measurements, Measurement};
 use fitbead::io::scenes::Table;
@@ -238,7 +238,7 @@ impl FitArgs {
         &self,
         params: &[ParamRow],
         stats: &[StatsRow],
-        posteriors: &[&FitSummary],
+        posteriors: &[&FitResult],
     ) -> Result<(), CliError> {
         let p_csv = params_csv(params).map_err(|e| CliError::Other(e.to_string()))?;
         let s = stats_csv(stats).map_err(|e| CliError::Other(e.to_string()))?;
@@ -308,7 +308,7 @@ impl FitArgs {
 
 /// The draws of every posterior as one CSV: fit, series, walker, step, the union of the
 /// parameter columns (empty where a fit has no such parameter), log_posterior.
-pub fn draws_csv(posteriors: &[&FitSummary]) -> csv::Result<Vec<u8>> {
+pub fn draws_csv(posteriors: &[&FitResult]) -> csv::Result<Vec<u8>> {
     let mut columns: Vec<String> = Vec::new();
     for p in posteriors {
         for r in &p.params {

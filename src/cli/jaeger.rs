@@ -4,7 +4,7 @@
 use super::fitargs::FitArgs;
 use super::CliError;
 use fitbead::fit::jaeger::fit_jaeger_with;
-use fitbead::fit::summary::FitSummary;
+use fitbead::fit::summary::FitResult;
 
 /// Arguments of `fitbead jaeger`.
 #[derive(Debug, clap::Args)]
@@ -36,7 +36,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
             "jaeger: no fit could be made (see the notes above)".into(),
         ));
     }
-    let posteriors: Vec<&FitSummary> = fits
+    let posteriors: Vec<&FitResult> = fits
         .series
         .iter()
         .flatten()

@@ -4,7 +4,7 @@
 use super::fitargs::FitArgs;
 use super::CliError;
 use fitbead::fit::jan::fit_jan_with;
-use fitbead::fit::summary::FitSummary;
+use fitbead::fit::summary::FitResult;
 
 /// Arguments of `fitbead jan`.
 #[derive(Debug, clap::Args)]
@@ -23,7 +23,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
     for n in &fits.notes {
         eprintln!("fitbead jan: {n}");
     }
-    let all: Vec<&FitSummary> = fits
+    let all: Vec<&FitResult> = fits
         .series
         .iter()
         .flatten()
@@ -34,7 +34,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         params.extend(s.params.iter().cloned());
         stats.push(s.stats.clone());
     }
-    let posteriors: Vec<&FitSummary> = all.into_iter().filter(|s| s.draws.is_some()).collect();
+    let posteriors: Vec<&FitResult> = all.into_iter().filter(|s| s.draws.is_some()).collect();
     if params.is_empty() {
         return Err(CliError::Other(
             "jan: no fit could be made (see the notes above)".into(),

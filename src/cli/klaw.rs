@@ -9,7 +9,7 @@ use fitbead::fit::k::auto::{self as kauto, KChoice};
 use fitbead::fit::k::bracket;
 use fitbead::fit::klaw::{fit_law, fit_law_with, KLaw, KLawError};
 use fitbead::fit::posterior::Method;
-use fitbead::fit::summary::FitSummary;
+use fitbead::fit::summary::FitResult;
 use fitbead::io::fmt_f64;
 use fitbead::models::Model;
 use rayon::prelude::*;
@@ -174,7 +174,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
             };
         }
     }
-    let posteriors: Vec<&FitSummary> = [&main.summary]
+    let posteriors: Vec<&FitResult> = [&main.summary]
         .into_iter()
         .filter(|s| s.draws.is_some())
         .collect();

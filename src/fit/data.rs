@@ -106,6 +106,13 @@ impl Dataset {
         self.points.iter().filter(move |p| p.series == s)
     }
 
+    /// Indices (in [`Dataset::points`]) of the points of series `s`, in order.
+    pub fn series_index(&self, s: usize) -> Vec<usize> {
+        (0..self.points.len())
+            .filter(|&i| self.points[i].series == s)
+            .collect()
+    }
+
     /// The sub-dataset of series `s` alone (its label kept, index 0).
     pub fn only(&self, s: usize) -> Dataset {
         Dataset {

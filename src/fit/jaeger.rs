@@ -16,7 +16,7 @@
 
 use super::data::Dataset;
 use super::posterior::{summarise_with, Method, Prior};
-use super::summary::{FitSummary, ParamSpec, Solved};
+use super::summary::{FitResult, ParamSpec, Solved};
 use crate::inverse::{fit, Infeasible, LsqOptions, Model, WeightedData};
 use crate::models::jaeger::Jaeger;
 use crate::models::JaegerBranch;
@@ -98,7 +98,7 @@ impl Model<JaegerX> for JaegerModel {
 #[derive(Debug, Clone, PartialEq)]
 pub struct JaegerFit {
     /// Reports (parameter rows carry the paper's Fig. 9 values where ξ matches).
-    pub summary: FitSummary,
+    pub summary: FitResult,
     /// Branch used.
     pub branch: JaegerBranch,
     /// Points of the series inside the bistable band (eq 90) at the fitted values.
@@ -258,6 +258,7 @@ pub fn fit_jaeger_with(
                 options: &opts,
             },
         );
+        summary.attach_points(data, &data.series_index(s));
         let m = Jaeger {
             a1: f.params[0],
             a2: f.params[1],

@@ -13,7 +13,7 @@
 
 use super::data::Dataset;
 use super::posterior::{summarise_with, Method};
-use super::summary::{FitSummary, ParamSpec, Solved};
+use super::summary::{FitResult, ParamSpec, Solved};
 use crate::inverse::{fit, Infeasible, LsqOptions, Model, WeightedData};
 
 /// The paper's global values (λ0, λ1, μ0, μ1), eqs 75–76.
@@ -81,9 +81,9 @@ impl Model<JanX> for JanGlobal {
 pub struct JanFits {
     /// Per series (λ, μ), in the dataset's series order; `None` where the series has fewer
     /// than 3 points (no degree of freedom left for the scatter).
-    pub series: Vec<Option<FitSummary>>,
+    pub series: Vec<Option<FitResult>>,
     /// The global laws; `None` with fewer than two distinct α.
-    pub global: Option<FitSummary>,
+    pub global: Option<FitResult>,
     /// Why a fit was not made.
     pub notes: Vec<String>,
 }
@@ -203,7 +203,7 @@ pub fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFits {
                 default_prior: None,
             },
         ];
-        let sum = summarise_with(
+        let mut sum = summarise_with(
             method,
             Solved {
                 name: "jan-series",
@@ -215,6 +215,7 @@ pub fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFits {
                 options: &opts,
             },
         );
+        sum.attach_points(data, &data.series_index(s));
         if f.converged() {
             let se = f.std_errors().map(|s| s.to_vec()).unwrap_or(vec![1.0; 2]);
             if f.params[0] > 0.0 {
@@ -313,7 +314,7 @@ pub fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFits {
                     default_prior: None,
                 },
             ];
-            Some(summarise_with(
+            let mut sum = summarise_with(
                 method,
                 Solved {
                     name: "jan-global",
@@ -324,7 +325,9 @@ pub fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFits {
                     level,
                     options: &opts,
                 },
-            ))
+            );
+            sum.attach_points(data, &(0..data.points.len()).collect::<Vec<_>>());
+            Some(sum)
         })
     };
     JanFits {

@@ -23,7 +23,7 @@
 use super::data::Dataset;
 use super::k::{bracket, estimate, KBracket};
 use super::posterior::{summarise_with, Method};
-use super::summary::{information_criteria, FitSummary, ParamSpec, Solved, StatsRow};
+use super::summary::{information_criteria, FitResult, ParamSpec, Solved, StatsRow};
 use crate::inverse::{fit, Infeasible, LsqOptions, Residuals};
 use crate::models::{ForwardModel, Model};
 use faer::MatMut;
@@ -387,7 +387,7 @@ pub struct KLawFit {
     pub law: KLaw,
     /// Parameter rows and statistics (for the impact law: no parameter rows, the statistics
     /// of the score).
-    pub summary: FitSummary,
+    pub summary: FitResult,
     /// K of every point at the estimate (NaN where the point is outside its bracket).
     pub k: Vec<f64>,
 }
@@ -441,33 +441,34 @@ pub fn fit_law_with(
         };
         let reduced = if m > 0 { chi2 / m as f64 } else { f64::NAN };
         let k = (0..m).map(|i| problem.k_of(i, &[])).collect();
-        return Ok(KLawFit {
-            law,
-            summary: FitSummary {
-                params: Vec::new(),
-                stats: StatsRow {
-                    fit: fit_name,
-                    series: "all".into(),
-                    n_points: m,
-                    n_params: 0,
-                    chi2,
-                    dof: m,
-                    reduced_chi2: reduced,
-                    aic,
-                    bic,
-                    termination: termination.into(),
-                    converged: chi2.is_finite(),
-                    iterations: 0,
-                    residual_evals: 1,
-                    sigma: data.sigma,
-                    condition: None,
-                    note,
-                    mcmc: None,
-                },
-                draws: None,
+        let mut summary = FitResult {
+            params: Vec::new(),
+            stats: StatsRow {
+                fit: fit_name,
+                series: "all".into(),
+                n_points: m,
+                n_params: 0,
+                chi2,
+                dof: m,
+                reduced_chi2: reduced,
+                aic,
+                bic,
+                termination: termination.into(),
+                converged: chi2.is_finite(),
+                iterations: 0,
+                residual_evals: 1,
+                sigma: data.sigma,
+                condition: None,
+                note,
+                mcmc: None,
             },
-            k,
-        });
+            draws: None,
+            correlation: None,
+            residuals: r,
+            points: Vec::new(),
+        };
+        summary.attach_points(data, &(0..m).collect::<Vec<_>>());
+        return Ok(KLawFit { law, summary, k });
     }
     let (lower, upper) = problem.feasible_box()?;
     let start = problem.start()?;
@@ -517,5 +518,6 @@ pub fn fit_law_with(
         }
     }
     let k = (0..m).map(|i| problem.k_of(i, &f.params)).collect();
+    summary.attach_points(data, &(0..m).collect::<Vec<_>>());
     Ok(KLawFit { law, summary, k })
 }

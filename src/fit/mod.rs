@@ -1,10 +1,14 @@
-//! The bead problems posed to the solvers: K per measurement (eq 69), the K(α) laws across
-//! series, Jan's λ/μ and Jaeger's a1–a3. Nothing here reads CSV or knows the CLI.
+//! The bead problems posed to the solvers: K per measurement (eq 69, [`k`]), the K(α) laws
+//! across series ([`klaw`]), Jan's λ/μ ([`jan`]) and Jaeger's a1–a3 ([`jaeger`]); their
+//! results ([`summary`]), fit reports ([`report`]) and builders ([`builder`]). Nothing here
+//! reads files, prints or knows the command line.
 
+pub mod builder;
 pub mod data;
 pub mod jaeger;
 pub mod jan;
 pub mod k;
 pub mod klaw;
 pub mod posterior;
+pub mod report;
 pub mod summary;

@@ -25,7 +25,7 @@
 //! the level asked (`ci_method = posterior`); the covariance interval of the least-squares
 //! optimum stays in `cov_low`/`cov_high` and the optimum in `lsq_value`.
 
-use super::summary::{summarise, FitSummary, McmcStats, ParamRow, Solved};
+use super::summary::{summarise, FitResult, McmcStats, ParamRow, Solved};
 use crate::inverse::mcmc::{summarise as mcmc_summarise, EnsembleSampler, StopReason};
 use crate::inverse::posterior::Posterior;
 pub use crate::inverse::posterior::{Draws, McmcSettings, Method, Prior, SCALE_NAME};
@@ -36,7 +36,7 @@ use rayon::prelude::*;
 
 /// The column naming a parameter in the draws file: its name, with the series appended where
 /// a fit across series has one parameter per series (`K[series]`).
-pub fn draws_column(fit: &FitSummary, row: &ParamRow) -> String {
+pub fn draws_column(fit: &FitResult, row: &ParamRow) -> String {
     if row.series == fit.stats.series {
         row.parameter.clone()
     } else {
@@ -49,7 +49,7 @@ pub fn draws_column(fit: &FitSummary, row: &ParamRow) -> String {
 pub fn summarise_with<R: Residuals + Sync + ?Sized>(
     method: &Method,
     solved: Solved<'_, R>,
-) -> FitSummary {
+) -> FitResult {
     match method {
         Method::Lsq { profile } => summarise(solved, *profile),
         Method::Mcmc(s) => sample(s, solved),
@@ -59,7 +59,7 @@ pub fn summarise_with<R: Residuals + Sync + ?Sized>(
 fn sample<R: Residuals + Sync + ?Sized>(
     settings: &McmcSettings,
     solved: Solved<'_, R>,
-) -> FitSummary {
+) -> FitResult {
     let Solved {
         name: fit_name,
         series,
@@ -247,6 +247,15 @@ fn sample<R: Residuals + Sync + ?Sized>(
             }
         }
     }
+    // Residuals at the posterior medians, and the correlations of the draws.
+    if res.diagnostics.len() >= n {
+        let median: Vec<f64> = res.diagnostics[..n].iter().map(|d| d.median).collect();
+        let mut r = vec![0.0; problem.n_residuals()];
+        if problem.residuals(&median, &mut r).is_ok() {
+            out.residuals = r;
+        }
+        out.correlation = draws_correlation(&res.chains);
+    }
     // Names for the messages; a name shared by several parameters (one K per series) gets
     // its row number in the report.
     let names: Vec<String> = out
@@ -407,6 +416,33 @@ fn waic<R: Residuals + Sync + ?Sized>(
         / (m as f64 - 1.0).max(1.0))
     .sqrt();
     Some((total, p_total, se))
+}
+
+/// Pearson correlation matrix of the draws, all walkers pooled; `None` without draws.
+fn draws_correlation(chains: &[Vec<Vec<f64>>]) -> Option<Vec<Vec<f64>>> {
+    let n = chains.first()?.first()?.len();
+    let draws: Vec<&Vec<f64>> = chains.iter().flatten().collect();
+    let m = draws.len() as f64;
+    let mean: Vec<f64> = (0..n)
+        .map(|j| draws.iter().map(|x| x[j]).sum::<f64>() / m)
+        .collect();
+    let mut cov = vec![vec![0.0; n]; n];
+    for x in &draws {
+        for i in 0..n {
+            for j in 0..n {
+                cov[i][j] += (x[i] - mean[i]) * (x[j] - mean[j]);
+            }
+        }
+    }
+    Some(
+        (0..n)
+            .map(|i| {
+                (0..n)
+                    .map(|j| cov[i][j] / (cov[i][i] * cov[j][j]).sqrt())
+                    .collect()
+            })
+            .collect(),
+    )
 }
 
 fn join(a: &str, b: &str) -> String {

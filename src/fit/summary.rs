@@ -216,15 +216,173 @@ pub struct McmcStats {
     pub waic: Option<(f64, f64, f64)>,
 }
 
-/// The rows of one fit.
+/// One fit: its parameters with their uncertainties, its statistics, the correlations, every
+/// point against the fitted curve and, for a posterior run, the draws. `Display` prints a
+/// one-screen fit report (see [`super::report`]).
 #[derive(Debug, Clone, PartialEq)]
-pub struct FitSummary {
+pub struct FitResult {
     /// One row per parameter.
     pub params: Vec<ParamRow>,
     /// The statistics.
     pub stats: StatsRow,
     /// The kept draws of a posterior run (rows of `params` give the parameter order).
     pub draws: Option<Draws>,
+    /// Correlation matrix of the parameters, in the order of `params` (least squares: from
+    /// the covariance at the optimum; posterior: of the draws); `None` when it does not exist.
+    pub correlation: Option<Vec<Vec<f64>>>,
+    /// Weighted residuals (v_i − v̄_i)/σ_i at the reported estimate, in the problem's point
+    /// order (unit σ when the data carry none).
+    pub residuals: Vec<f64>,
+    /// Every point of the fit against the fitted v̄ (empty for a fit not made on a
+    /// [`Dataset`](super::data::Dataset)).
+    pub points: Vec<PointFit>,
+}
+
+/// One measured point against its fit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointFit {
+    /// Series label.
+    pub series: String,
+    /// Radius ratio ξ.
+    pub xi: f64,
+    /// Slope δ in degrees.
+    pub delta_deg: f64,
+    /// Measured dimensionless mean velocity v̄.
+    pub v: f64,
+    /// Its standard deviation, when the data carry one.
+    pub sigma_v: Option<f64>,
+    /// The fitted v̄ at this point (NaN where the point has no steady state at the estimate).
+    pub v_fit: f64,
+    /// v − v_fit.
+    pub residual: f64,
+    /// (v − v_fit)/σ; without σ, divided by the scatter estimated from the fit,
+    /// sqrt(χ²/dof).
+    pub normalised_residual: f64,
+}
+
+impl FitResult {
+    /// The parameter called `name`; a fit with one parameter per series (`K` of
+    /// `free-per-series`) names them `K[series]`, and `K` alone is the first.
+    pub fn param(&self, name: &str) -> crate::Result<&ParamRow> {
+        self.params
+            .iter()
+            .find(|r| r.parameter == name || self.qualified_name(r) == name)
+            .ok_or_else(|| crate::Error::NoSuchParameter {
+                name: name.to_string(),
+                have: self.param_names().join(", "),
+            })
+    }
+
+    /// The parameters' names, qualified by series where a fit has one per series.
+    pub fn param_names(&self) -> Vec<String> {
+        self.params.iter().map(|r| self.qualified_name(r)).collect()
+    }
+
+    fn qualified_name(&self, r: &ParamRow) -> String {
+        if r.series == self.stats.series {
+            r.parameter.clone()
+        } else {
+            format!("{}[{}]", r.parameter, r.series)
+        }
+    }
+
+    /// The correlation of parameters `a` and `b`, when the matrix exists.
+    pub fn correlation_of(&self, a: &str, b: &str) -> Option<f64> {
+        let names = self.param_names();
+        let i = names.iter().position(|n| n == a)?;
+        let j = names.iter().position(|n| n == b)?;
+        self.correlation.as_ref().map(|c| c[i][j])
+    }
+
+    /// χ² at the estimate.
+    pub fn chi2(&self) -> f64 {
+        self.stats.chi2
+    }
+
+    /// χ²/dof.
+    pub fn reduced_chi2(&self) -> f64 {
+        self.stats.reduced_chi2
+    }
+
+    /// Akaike's information criterion.
+    pub fn aic(&self) -> f64 {
+        self.stats.aic
+    }
+
+    /// The Bayesian information criterion.
+    pub fn bic(&self) -> f64 {
+        self.stats.bic
+    }
+
+    /// Whether the solver converged (and, for a posterior run, the sampler met its R̂ and
+    /// ESS thresholds).
+    pub fn converged(&self) -> bool {
+        self.stats.converged
+    }
+
+    /// Every kept posterior draw of parameter `name`, all walkers pooled (`None` for a
+    /// least-squares fit or an unknown name).
+    pub fn draws_of(&self, name: &str) -> Option<Vec<f64>> {
+        let d = self.draws.as_ref()?;
+        let j = self.param_names().iter().position(|n| n == name)?;
+        Some(
+            d.chains
+                .iter()
+                .flat_map(|c| c.iter().map(move |x| x[j]))
+                .collect(),
+        )
+    }
+
+    /// Fills [`FitResult::points`] from the data the fit was made on: `data.points[i]` for
+    /// each `i` of `index`, in the problem's order (the order of [`FitResult::residuals`]).
+    pub fn attach_points(&mut self, data: &super::data::Dataset, index: &[usize]) {
+        let scatter = if data.sigma == SigmaKind::Relative {
+            let s = self.stats.reduced_chi2.sqrt();
+            if s > 0.0 && s.is_finite() {
+                s
+            } else {
+                f64::NAN
+            }
+        } else {
+            1.0
+        };
+        self.points = index
+            .iter()
+            .enumerate()
+            .map(|(k, &i)| {
+                let p = &data.points[i];
+                let r = self.residuals.get(k).copied().unwrap_or(f64::NAN);
+                let residual = r * p.sigma;
+                PointFit {
+                    series: data.labels[p.series].clone(),
+                    xi: p.scene.xi,
+                    delta_deg: p.scene.delta_deg(),
+                    v: p.v,
+                    sigma_v: (data.sigma == SigmaKind::Absolute).then_some(p.sigma),
+                    v_fit: p.v - residual,
+                    residual,
+                    normalised_residual: r / scatter,
+                }
+            })
+            .collect();
+    }
+}
+
+impl ParamRow {
+    /// Lower end of the reported interval (`None` when there is none).
+    pub fn interval_low(&self) -> Option<f64> {
+        self.interval().0.map(|i| i.0)
+    }
+
+    /// Upper end of the reported interval.
+    pub fn interval_high(&self) -> Option<f64> {
+        self.interval().0.map(|i| i.1)
+    }
+
+    /// How the reported interval was obtained: `profile`, `covariance`, `posterior` or `none`.
+    pub fn interval_method(&self) -> &'static str {
+        self.interval().1
+    }
 }
 
 /// A parameter's name, unit, the paper's value (with its source) if there is one, and its
@@ -288,7 +446,7 @@ impl<R: ?Sized> Copy for Solved<'_, R> {}
 
 /// Builds the summary of a finished fit: covariance intervals, and profile intervals when
 /// `profile` is set and the fit converged.
-pub fn summarise<R: Residuals + ?Sized>(s: Solved<'_, R>, profile: bool) -> FitSummary {
+pub fn summarise<R: Residuals + ?Sized>(s: Solved<'_, R>, profile: bool) -> FitResult {
     let Solved {
         name: fit_name,
         series,
@@ -397,7 +555,7 @@ pub fn summarise<R: Residuals + ?Sized>(s: Solved<'_, R>, profile: bool) -> FitS
             }
         })
         .collect();
-    FitSummary {
+    FitResult {
         params,
         stats: StatsRow {
             fit: fit_name.to_string(),
@@ -419,6 +577,17 @@ pub fn summarise<R: Residuals + ?Sized>(s: Solved<'_, R>, profile: bool) -> FitS
             mcmc: None,
         },
         draws: None,
+        correlation: f.covariance.as_ref().map(|c| {
+            (0..c.correlation.nrows())
+                .map(|i| {
+                    (0..c.correlation.ncols())
+                        .map(|j| c.correlation[(i, j)])
+                        .collect()
+                })
+                .collect()
+        }),
+        residuals: f.residuals.clone(),
+        points: Vec::new(),
     }
 }
 

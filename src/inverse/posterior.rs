@@ -219,6 +219,15 @@ pub struct McmcSettings {
 }
 
 impl McmcSettings {
+    /// The default settings (flat priors on the parameter boxes, R̂ ≤ 1.01 and ESS ≥ 1000 or
+    /// 100 000 steps) with the sampler seeded by `seed`: the same seed gives the same draws
+    /// whatever the number of threads.
+    pub fn seeded(seed: u64) -> Self {
+        let mut s = Self::default();
+        s.options.seed = seed;
+        s
+    }
+
     /// The prior given for parameter `name` (the last one given wins), if any.
     pub fn prior(&self, name: &str) -> Option<&Prior> {
         self.priors.iter().rev().find(|p| p.0 == name).map(|p| &p.1)

@@ -9,7 +9,7 @@ use crate::fit::jan::{fit_jan_with, velocity as jan_velocity, JanFits};
 use crate::fit::k::{bracket, estimate};
 use crate::fit::klaw::{fit_law_with, KLaw, KLawFit, KLawProblem};
 use crate::fit::posterior::Method;
-use crate::fit::summary::{FitSummary, ParamRow};
+use crate::fit::summary::{FitResult, ParamRow};
 use crate::inverse::{Model as _, Residuals, SigmaKind};
 use crate::io::fmt_f64;
 use crate::models::energy;
@@ -631,12 +631,12 @@ impl Analysis {
                 );
             }
         }
-        let sum_fits = |fits: Vec<&FitSummary>, k_each: usize| {
+        let sum_fits = |fits: Vec<&FitResult>, k_each: usize| {
             let chi2: f64 = fits.iter().map(|f| f.stats.chi2).sum();
             let n: usize = fits.iter().map(|f| f.stats.n_points).sum();
             (chi2, k_each * fits.len(), n)
         };
-        let jan_series: Vec<&FitSummary> = self.jan.series.iter().flatten().collect();
+        let jan_series: Vec<&FitResult> = self.jan.series.iter().flatten().collect();
         if !jan_series.is_empty() {
             let w = waic_sum(jan_series.iter().copied());
             let (chi2, k, n) = sum_fits(jan_series, 2);
@@ -668,7 +668,7 @@ impl Analysis {
             cand.waic = waic_sum([g]);
             out.push(cand);
         }
-        let jaeger: Vec<&FitSummary> = self
+        let jaeger: Vec<&FitResult> = self
             .jaeger
             .series
             .iter()
@@ -987,8 +987,8 @@ impl Analysis {
     }
 
     /// Posterior blocks for the corner plot (MCMC only).
-    pub fn posteriors(&self) -> Vec<&FitSummary> {
-        let mut v: Vec<&FitSummary> = Vec::new();
+    pub fn posteriors(&self) -> Vec<&FitResult> {
+        let mut v: Vec<&FitResult> = Vec::new();
         for c in &self.contact {
             v.extend(c.law_c.iter().map(|f| &f.summary));
             v.extend(c.free.iter().map(|f| &f.summary));
@@ -1337,7 +1337,7 @@ impl Candidate {
 }
 
 /// The summed WAIC of posterior fits, if every one has it.
-fn waic_sum<'a>(fits: impl IntoIterator<Item = &'a FitSummary>) -> Option<f64> {
+fn waic_sum<'a>(fits: impl IntoIterator<Item = &'a FitResult>) -> Option<f64> {
     let mut total = 0.0;
     let mut any = false;
     for f in fits {

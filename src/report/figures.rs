@@ -2,7 +2,7 @@
 //! `<text>` elements and laid out by the viewer).
 
 use crate::fit::posterior::draws_column;
-use crate::fit::summary::FitSummary;
+use crate::fit::summary::FitResult;
 use plotters::prelude::*;
 
 /// One series of points with optional vertical error bars, and an optional horizontal
@@ -129,7 +129,7 @@ pub struct CornerBlock {
 impl CornerBlock {
     /// One block per posterior that kept draws; parameters named as in the draws file
     /// ([`draws_column`]).
-    pub fn from_posteriors(posteriors: &[&FitSummary]) -> Vec<CornerBlock> {
+    pub fn from_posteriors(posteriors: &[&FitResult]) -> Vec<CornerBlock> {
         posteriors
             .iter()
             .filter_map(|p| {

@@ -70,6 +70,13 @@ impl KFailure {
     }
 }
 
+impl KEstimate {
+    /// K at the measured v̄, or why there is none.
+    pub fn k(&self) -> Result<f64, KFailure> {
+        self.root.as_ref().map(|r| r.k).map_err(Clone::clone)
+    }
+}
+
 impl std::error::Error for KFailure {}
 
 impl fmt::Display for KFailure {

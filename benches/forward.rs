@@ -117,7 +117,7 @@ fn bench(c: &mut Criterion) {
                         CollisionLaw::Adjusted,
                     )
                     .unwrap()
-                    .k
+                    .k()
                 })
                 .sum::<f64>()
         })

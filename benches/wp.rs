@@ -2,10 +2,10 @@
 //! times, on a fixed set of scenes drawn by `fitbead bench`'s own generator.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use fitbead::cli::bench::draw_scenes;
 use fitbead::models::auto::Auto;
 use fitbead::models::contact::{Contact, SpinRule};
 use fitbead::models::{slip, stick, stickquad, stickslip, Outcome};
+use fitbead::report::workprecision::draw_scenes;
 use fitbead::Scene;
 
 fn sum(s: &[Scene], f: impl Fn(&Scene) -> Outcome) -> f64 {

@@ -21,7 +21,7 @@ fn main() {
         let r = Model::Stick.evaluate(&sc).unwrap().mean_velocity;
         let s = Model::StickSlip.evaluate(&sc).unwrap().mean_velocity;
         let c = Contact::default().steady_state(&sc).unwrap();
-        let cv = 2.0 * sc.sin_alpha / c.run.time;
+        let cv = 2.0 * sc.sin_alpha() / c.run.time;
         println!(
             "| {xi} | {d} | {r:.6} | {s:.6} | {cv:.6} | {:.4} | {:.4} | {:+.2e} | {} ({}) |",
             s / r,

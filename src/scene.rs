@@ -111,47 +111,47 @@ impl fmt::Display for CollisionLaw {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Scene {
     /// Radius ratio ξ = r/R of the mobile bead to the row beads.
-    pub xi: f64,
+    pub(crate) xi: f64,
     /// Slope δ of the row (radians).
-    pub delta: f64,
+    pub(crate) delta: f64,
     /// Gyration parameter ρ (moment of inertia m ρ r²): 2/5 sphere, 1/2 cylinder.
-    pub rho: f64,
+    pub(crate) rho: f64,
     /// Coulomb friction coefficient f at the contact.
-    pub f: f64,
+    pub(crate) f: f64,
     /// The collision law as given.
-    pub law: CollisionLaw,
+    pub(crate) law: CollisionLaw,
     /// The collisional parameter K evaluated from the law (eq 1).
-    pub k: f64,
+    pub(crate) k: f64,
     /// α = asin(1/(1+ξ)) (eq 2).
-    pub alpha: f64,
+    pub(crate) alpha: f64,
     /// sin α.
-    pub sin_alpha: f64,
+    pub(crate) sin_alpha: f64,
     /// cos α.
-    pub cos_alpha: f64,
+    pub(crate) cos_alpha: f64,
     /// ε = (1+ξ)/ξ (eq 4).
-    pub eps: f64,
+    pub(crate) eps: f64,
     /// Θ0 = δ − α: angle just after the collision.
-    pub theta_0: f64,
+    pub(crate) theta_0: f64,
     /// Θf = δ + α: angle at the next collision.
-    pub theta_f: f64,
+    pub(crate) theta_f: f64,
     /// sin, cos of δ.
-    pub sc_delta: SinCos,
+    pub(crate) sc_delta: SinCos,
     /// sin, cos of δ/2.
-    pub sc_half_delta: SinCos,
+    pub(crate) sc_half_delta: SinCos,
     /// sin, cos of α/2.
-    pub sc_half_alpha: SinCos,
+    pub(crate) sc_half_alpha: SinCos,
     /// sin, cos of Θ0/2.
-    pub sc_half_0: SinCos,
+    pub(crate) sc_half_0: SinCos,
     /// sin, cos of Θf/2.
-    pub sc_half_f: SinCos,
+    pub(crate) sc_half_f: SinCos,
     /// sin, cos of Θ0.
-    pub sc_0: SinCos,
+    pub(crate) sc_0: SinCos,
     /// sin, cos of Θf.
-    pub sc_f: SinCos,
+    pub(crate) sc_f: SinCos,
     /// tan(α/2) = 1/(1 + ξ + sqrt(ξ(2+ξ))) in double-double precision (for the δ_m cancellation).
-    pub tan_half_alpha: Dd,
+    pub(crate) tan_half_alpha: Dd,
     /// B = 2/(1+ρ) (eq 9).
-    pub b: f64,
+    pub(crate) b: f64,
 }
 
 fn check(field: &'static str, value: f64, ok: bool, reason: &'static str) -> Result<()> {
@@ -265,9 +265,92 @@ impl Scene {
         Self::from_radians(self.xi, delta, self.rho, self.f, self.law)
     }
 
-    /// Slope in degrees.
+    /// Radius ratio ξ = r/R of the mobile bead to the row beads.
+    #[inline]
+    pub fn xi(&self) -> f64 {
+        self.xi
+    }
+
+    /// Slope δ of the row in degrees.
     pub fn delta_deg(&self) -> f64 {
         self.delta.to_degrees()
+    }
+
+    /// Slope δ of the row in radians.
+    #[inline]
+    pub fn delta_rad(&self) -> f64 {
+        self.delta
+    }
+
+    /// Gyration parameter ρ (moment of inertia m ρ r²): 2/5 sphere, 1/2 cylinder.
+    #[inline]
+    pub fn rho(&self) -> f64 {
+        self.rho
+    }
+
+    /// Coulomb friction coefficient f at the contact.
+    #[inline]
+    pub fn f(&self) -> f64 {
+        self.f
+    }
+
+    /// The collision law as given.
+    #[inline]
+    pub fn law(&self) -> CollisionLaw {
+        self.law
+    }
+
+    /// The collisional parameter K evaluated from the law (eq 1), dimensionless.
+    #[inline]
+    pub fn k(&self) -> f64 {
+        self.k
+    }
+
+    /// Contact angle α = asin(1/(1+ξ)) (eq 2) in radians.
+    #[inline]
+    pub fn alpha_rad(&self) -> f64 {
+        self.alpha
+    }
+
+    /// Contact angle α in degrees.
+    pub fn alpha_deg(&self) -> f64 {
+        self.alpha.to_degrees()
+    }
+
+    /// sin α = 1/(1+ξ).
+    #[inline]
+    pub fn sin_alpha(&self) -> f64 {
+        self.sin_alpha
+    }
+
+    /// cos α.
+    #[inline]
+    pub fn cos_alpha(&self) -> f64 {
+        self.cos_alpha
+    }
+
+    /// ε = (1+ξ)/ξ (eq 4).
+    #[inline]
+    pub fn eps(&self) -> f64 {
+        self.eps
+    }
+
+    /// Θ0 = δ − α, the angle just after a collision, in radians.
+    #[inline]
+    pub fn theta_0_rad(&self) -> f64 {
+        self.theta_0
+    }
+
+    /// Θf = δ + α, the angle at the next collision, in radians.
+    #[inline]
+    pub fn theta_f_rad(&self) -> f64 {
+        self.theta_f
+    }
+
+    /// B = 2/(1+ρ) (eq 9).
+    #[inline]
+    pub fn b(&self) -> f64 {
+        self.b
     }
 
     /// 1 − K² computed as (1 − K)(1 + K), without cancellation near K = 1.

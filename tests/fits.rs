@@ -8,7 +8,6 @@
 //!   [0.90, 0.99] (±3.2 binomial standard deviations of 200 draws). The figures are printed
 //!   (`cargo test --release --test fits -- --nocapture`).
 
-use fitbead::cli::simulate::regime_b_interval;
 use fitbead::fit::data::Dataset;
 use fitbead::fit::jaeger::{fit_jaeger, paper_values};
 use fitbead::fit::jan::fit_jan;
@@ -16,6 +15,7 @@ use fitbead::fit::klaw::{fit_law, KLaw};
 use fitbead::fit::summary::ParamRow;
 use fitbead::models::jaeger::Jaeger;
 use fitbead::models::jan::Jan;
+use fitbead::models::regimes::regime_b_interval;
 use fitbead::{CollisionLaw, ForwardModel, Model, Scene};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -36,7 +36,7 @@ pub fn simulate(
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut rows = Vec::new();
     for &xi in &XIS {
-        let alpha = Scene::new(xi, 1.0, 0.4, 0.1, law).unwrap().alpha;
+        let alpha = Scene::new(xi, 1.0, 0.4, 0.1, law).unwrap().alpha_rad();
         let model = model_of(xi, alpha);
         let (lo, hi) = range_of(&model, xi);
         for j in 0..points {

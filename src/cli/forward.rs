@@ -429,7 +429,7 @@ impl<'a> Plan<'a> {
             }
             (_, Some(m)) => m,
             (ModelKind::Jan, None) => {
-                let paper = Jan::paper_fit(scene.alpha);
+                let paper = Jan::paper_fit(scene.alpha_rad());
                 let lambda = r
                     .opt_number(self.c_lambda)?
                     .or(a.lambda)
@@ -536,7 +536,7 @@ impl<'a> Plan<'a> {
                 w.opt_show(regime);
                 w.text("ok");
                 if contact {
-                    w.num(job.scene.k);
+                    w.num(job.scene.k());
                     w.num(s.final_velocity);
                     w.num(s.initial_velocity);
                 } else {
@@ -564,7 +564,7 @@ impl<'a> Plan<'a> {
                 w.opt_show(regime);
                 w.text(e.status());
                 if contact {
-                    w.num(job.scene.k);
+                    w.num(job.scene.k());
                 } else {
                     w.empty();
                 }

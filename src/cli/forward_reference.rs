@@ -267,7 +267,7 @@ pub(super) fn forward_table(
             }
             (_, Some(m)) => m,
             (ModelKind::Jan, None) => {
-                let paper = Jan::paper_fit(scene.alpha);
+                let paper = Jan::paper_fit(scene.alpha_rad());
                 let lambda = t
                     .opt_number(r, c_lambda)?
                     .or(a.lambda)
@@ -409,7 +409,7 @@ fn render(
                 out.push(regime);
                 out.push("ok".into());
                 out.push(if contact {
-                    fmt_f64(job.scene.k)
+                    fmt_f64(job.scene.k())
                 } else {
                     String::new()
                 });
@@ -440,7 +440,7 @@ fn render(
                 out.push(regime);
                 out.push(e.status().into());
                 out.push(if contact {
-                    fmt_f64(job.scene.k)
+                    fmt_f64(job.scene.k())
                 } else {
                     String::new()
                 });

@@ -204,7 +204,7 @@ fn render(
         let s = &row.scene;
         let mut out: Vec<String> = Vec::with_capacity(header.len());
         out.push(row.series.clone());
-        out.push(fmt_f64(s.xi));
+        out.push(fmt_f64(s.xi()));
         out.push(t.cell(i, t.col("delta_deg").unwrap_or(0)).to_string());
         out.push(fmt_f64(row.v));
         out.push(opt(row.sigma_v));
@@ -223,9 +223,9 @@ fn render(
         out.push(opt(e.dv_dk));
         out.push(opt(fv));
         out.push(opt(e.theta_g.map(f64::to_degrees)));
-        out.push(fmt_f64(CollisionLaw::Cos2a.k(s.alpha, s.rho)));
-        out.push(fmt_f64(CollisionLaw::Adjusted.k(s.alpha, s.rho)));
-        out.push(fmt_f64(CollisionLaw::Impact.k(s.alpha, s.rho)));
+        out.push(fmt_f64(CollisionLaw::Cos2a.k(s.alpha_rad(), s.rho())));
+        out.push(fmt_f64(CollisionLaw::Adjusted.k(s.alpha_rad(), s.rho())));
+        out.push(fmt_f64(CollisionLaw::Impact.k(s.alpha_rad(), s.rho())));
         let (regime, status) = match &e.root {
             Ok(_) => ("B", "ok"),
             Err(KFailure::BelowRange) => ("A", "below-range"),
@@ -272,14 +272,14 @@ fn plot(rows: &[Measurement], res: &[KEstimate], model: &str) -> Result<String, 
     for (row, e) in rows.iter().zip(res) {
         let Ok(r) = &e.root else { continue };
         let label = if row.series.is_empty() {
-            format!("xi = {}", fmt_f64(row.scene.xi))
+            format!("xi = {}", fmt_f64(row.scene.xi()))
         } else {
             format!("series {}", row.series)
         };
         let idx = match series.iter().position(|s| s.label == label) {
             Some(i) => i,
             None => {
-                let c2 = CollisionLaw::Cos2a.k(row.scene.alpha, row.scene.rho);
+                let c2 = CollisionLaw::Cos2a.k(row.scene.alpha_rad(), row.scene.rho());
                 series.push(PointSeries {
                     label: label.clone(),
                     points: Vec::new(),

@@ -103,7 +103,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
             t.source,
             t.lines[i],
             d.labels[p.series],
-            fmt_f64(p.scene.xi),
+            fmt_f64(p.scene.xi()),
             fmt_f64(p.scene.delta_deg()),
         )
     };

@@ -312,8 +312,8 @@ fn markdown(an: &Analysis, source: &str, method: &str) -> String {
          method `{method}`; intervals at level {}; sigma {}.\n\n",
         d.points.len(),
         d.labels.len(),
-        fmt_f64(p0.rho),
-        fmt_f64(p0.f),
+        fmt_f64(p0.rho()),
+        fmt_f64(p0.f()),
         fmt_f64(an.level),
         if d.sigma == fitbead::inverse::SigmaKind::Absolute {
             "given on every row"

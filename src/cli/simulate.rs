@@ -160,7 +160,7 @@ fn trace(a: &Args, law: CollisionLaw, series: &[f64], v0: f64) -> Result<(), Cli
                     fmt_f64(spin),
                     "ok".to_string(),
                     String::new(),
-                    fmt_f64(2.0 * scene.sin_alpha / r.time),
+                    fmt_f64(2.0 * scene.sin_alpha() / r.time),
                 ),
                 ContactEnd::Failed(e) => (
                     String::new(),
@@ -285,7 +285,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
     for &xi in &series {
         let alpha = Scene::from_radians(xi, 0.1, a.rho, a.f, law)
             .map_err(|e| super::flag_error("--series", &xi.to_string(), e.to_string()))?
-            .alpha;
+            .alpha_rad();
         let model = match (kind, kind.contact_model()) {
             (_, Some(m)) => m,
             (ModelKind::Jan, None) => match &jan {

@@ -272,6 +272,8 @@ fn slope(model: &Model, scene: &Scene, br: &KBracket, r: &KRoot) -> Option<f64> 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fit::k::types::UpperLimit;
+    use crate::models::ForwardModel;
     use crate::scene::CollisionLaw;
 
     fn scene(xi: f64, delta_deg: f64) -> Scene {

@@ -9,6 +9,8 @@ use fitbead::{CollisionLaw, ForwardModel, Model, Scene};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
+use crate::common::reference_table;
+
 const MODELS: [Model; 5] = [
     Model::Stick,
     Model::StickApprox,
@@ -372,11 +374,9 @@ fn launch_speed_path_agrees_with_the_search_in_k() {
 #[test]
 fn dv_dk_matches_mpmath_at_hard_points() {
     const SEARCH_DV_DK_TOL: f64 = 1e-9;
-    let text = include_str!("reference/dvdk_refs.csv");
-    let mut rdr = csv::Reader::from_reader(text.as_bytes());
+    let (_, records) = reference_table("dvdk_refs.csv");
     let mut n = 0;
-    for rec in rdr.records() {
-        let rec = rec.unwrap();
+    for rec in records {
         let x = |i: usize| rec[i].parse::<f64>().unwrap();
         let (xi, delta, rho, k, reference) = (x(0), x(1), x(2), x(3), x(4));
         let s = Scene::from_radians(xi, delta, rho, 0.1, CollisionLaw::Value(k)).unwrap();

@@ -7,6 +7,8 @@
 use fitbead::models::{stick, NotSteady, Regime};
 use fitbead::{CollisionLaw, ForwardModel, Model, Scene};
 
+use crate::common::{col, reference_table};
+
 struct Row {
     case: String,
     model: String,
@@ -21,41 +23,35 @@ struct Row {
 }
 
 fn rows() -> Vec<Row> {
-    rows_from(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/tests/reference/forward_refs.csv"
-    ))
+    rows_from("forward_refs.csv")
 }
 
-fn rows_from(path: &str) -> Vec<Row> {
-    let mut rdr = csv::Reader::from_path(path).expect("reference table present");
-    let h = rdr.headers().unwrap().clone();
-    let col = |n: &str| {
-        h.iter()
-            .position(|x| x == n)
-            .unwrap_or_else(|| panic!("column {n}"))
-    };
+/// The rows of a forward-model table of tests/reference/.
+fn rows_from(name: &str) -> Vec<Row> {
+    let (h, records) = reference_table(name);
+    let c = |n: &str| col(&h, n);
     let (c_case, c_model, c_xi, c_d, c_k, c_rho, c_f) = (
-        col("case"),
-        col("model"),
-        col("xi"),
-        col("delta_rad"),
-        col("K"),
-        col("rho"),
-        col("f"),
+        c("case"),
+        c("model"),
+        c("xi"),
+        c("delta_rad"),
+        c("K"),
+        c("rho"),
+        c("f"),
     );
-    let (c_v, c_fv, c_reg, c_extra, c_en, c_fpi) = (
-        col("v"),
-        col("final_velocity"),
-        col("regime"),
-        col("extra"),
-        col("extra_name"),
-        col("fixed_point_index"),
+    let (c_v, c_fv, c_reg, c_extra, c_en, c_fpi, c_note) = (
+        c("v"),
+        c("final_velocity"),
+        c("regime"),
+        c("extra"),
+        c("extra_name"),
+        c("fixed_point_index"),
+        c("note"),
     );
     let num = |s: &str| s.trim().parse::<f64>().ok();
-    rdr.records()
+    records
+        .into_iter()
         .map(|r| {
-            let r = r.unwrap();
             let f = num(&r[c_f]).unwrap_or(0.1);
             let scene = Scene::from_radians(
                 num(&r[c_xi]).unwrap(),
@@ -75,7 +71,7 @@ fn rows_from(path: &str) -> Vec<Row> {
                 extra: num(&r[c_extra]),
                 extra_name: r[c_en].to_string(),
                 fixed_point_index: r[c_fpi].trim().parse().ok(),
-                note: r[col("note")].to_string(),
+                note: r[c_note].to_string(),
             }
         })
         .collect()
@@ -251,10 +247,7 @@ fn slip_near_its_limits_at_1e_12() {
 /// v̄ and Θ̇f to 1e-12 in regime B; the regime where the reference has none.
 #[test]
 fn slip_deep_in_its_limits_at_1e_12() {
-    let rows = rows_from(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/tests/reference/slip_limits_refs.csv"
-    ));
+    let rows = rows_from("slip_limits_refs.csv");
     let (mut n_b, mut n_other, mut worst) = (0, 0, (0.0f64, String::new()));
     let mut failures = Vec::new();
     for r in &rows {
@@ -302,12 +295,10 @@ fn slip_deep_in_its_limits_at_1e_12() {
 #[test]
 fn carlson_rf_matches_mpmath_at_hard_points() {
     use fitbead::special::elliptic::rf;
-    let text = include_str!("reference/elliptic_refs.csv");
-    let mut rdr = csv::Reader::from_reader(text.as_bytes());
+    let (_, records) = reference_table("elliptic_refs.csv");
     let (mut n, mut worst) = (0, 0.0f64);
-    for rec in rdr.records() {
-        let rec = rec.unwrap();
-        if &rec[0] != "rf" {
+    for rec in records {
+        if rec[0] != "rf" {
             continue;
         }
         let x = |i: usize| rec[i].parse::<f64>().unwrap();

@@ -1,6 +1,6 @@
 //! Speed of the bead fits: `klaw` (stick/slip model, 40 points), `jan` and `jaeger` (four
 //! series), each with covariance and profile-likelihood intervals as the commands compute them.
-//! The data are made as in `tests/fits.rs` (whose simulation helpers this bench shares).
+//! The data are made as in `tests/it/fits.rs` (whose simulation helpers this bench shares).
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use fitbead::fit::jaeger::fit_jaeger;
@@ -10,7 +10,7 @@ use fitbead::models::JaegerBranch;
 use fitbead::{CollisionLaw, Model};
 
 #[allow(dead_code, unused_imports)]
-#[path = "../tests/fits.rs"]
+#[path = "../tests/it/fits.rs"]
 mod fits;
 
 fn bench(c: &mut Criterion) {

@@ -1,5 +1,5 @@
 //! Effective samples per second of the K(α) posterior (law c, stick/slip model, 40 points made
-//! as in `tests/fits.rs`), on one core: a rayon pool of one thread runs the whole command's
+//! as in `tests/it/fits.rs`), on one core: a rayon pool of one thread runs the whole command's
 //! work — the least-squares start, the sampler to its stopping rule (bulk and tail ESS ≥ 1000,
 //! R̂ ≤ 1.01, run ≥ 50 τ) and the diagnostics.
 //!
@@ -14,7 +14,7 @@ use fitbead::inverse::mcmc::McmcOptions;
 use fitbead::{CollisionLaw, Model};
 
 #[allow(dead_code, unused_imports)]
-#[path = "../tests/fits.rs"]
+#[path = "../tests/it/fits.rs"]
 mod fits;
 
 fn bench(c: &mut Criterion) {

@@ -1,12 +1,12 @@
 //! Speed of the least-squares solver: all 54 NIST StRD nonlinear cases (27 problems × 2
-//! starts), each fitted with covariance, as in `tests/nist.rs` (whose parser and models this
+//! starts), each fitted with covariance, as in `tests/it/nist.rs` (whose parser and models this
 //! bench shares).
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use fitbead::inverse::fit;
 
 #[allow(dead_code)]
-#[path = "../tests/nist.rs"]
+#[path = "../tests/it/nist.rs"]
 mod nist;
 
 fn bench(c: &mut Criterion) {

@@ -17,10 +17,6 @@ use std::fs::File;
 use std::io::{Cursor, Read, Write};
 use std::path::PathBuf;
 
-#[cfg(test)]
-#[path = "forward_reference.rs"]
-mod reference;
-
 /// Arguments of `fitbead forward`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -1113,9 +1109,11 @@ fn render_md(
 
 #[cfg(test)]
 mod tests {
-    //! The streaming path against the old whole-table path ([`reference`]): the same bytes on
-    //! the shipped data and on a generated table with every kind of cell, for every model but
-    //! md, at several chunk sizes; the same message for every kind of bad input.
+    //! The streaming path against golden outputs (tests/golden/forward/, written by a separate
+    //! implementation of `forward` that read the whole table, evaluated it, then wrote it): the
+    //! same bytes on the shipped data and on a table with every kind of cell, for every model
+    //! but md, at chunk sizes from 1 row to [`CHUNK_ROWS`]; the same message for every kind of
+    //! bad input.
 
     use super::*;
     use clap::Parser;
@@ -1139,12 +1137,6 @@ mod tests {
         (kind, branch)
     }
 
-    fn old(a: &Args, text: &[u8]) -> Result<Vec<u8>, String> {
-        let (kind, branch) = kind_branch(a);
-        let t = reference::Table::parse("in.csv", text).map_err(|e| e.to_string())?;
-        reference::forward_table(a, kind, branch, &t).map_err(|e| e.to_string())
-    }
-
     fn new(a: &Args, text: &[u8], chunk: usize, task: usize) -> Result<Vec<u8>, String> {
         let (kind, branch) = kind_branch(a);
         let reader = TableReader::new("in.csv", text).map_err(|e| e.to_string())?;
@@ -1158,143 +1150,136 @@ mod tests {
 
     const SIZES: [(usize, usize); 4] = [(1, 1), (7, 3), (64, 5), (CHUNK_ROWS, TASK_ROWS)];
 
-    fn same(flags: &[&str], text: &[u8]) {
+    /// The streaming output of `text` under `flags` equals `want` at every chunk size.
+    fn same(flags: &[&str], text: &[u8], want: &[u8]) {
         let a = args(flags);
-        let want = old(&a, text);
         for (chunk, task) in SIZES {
-            let got = new(&a, text, chunk, task);
-            match (&want, &got) {
-                (Ok(w), Ok(g)) => assert!(
-                    w == g,
-                    "{flags:?}, chunks of {chunk}: output differs\nold:\n{}\nnew:\n{}",
-                    String::from_utf8_lossy(w),
-                    String::from_utf8_lossy(g)
-                ),
-                _ => assert_eq!(want, got, "{flags:?}, chunks of {chunk}"),
-            }
+            let got = new(&a, text, chunk, task)
+                .unwrap_or_else(|e| panic!("{flags:?}, chunks of {chunk}: {e}"));
+            assert!(
+                want == got,
+                "{flags:?}, chunks of {chunk}: output differs\nwant:\n{}\ngot:\n{}",
+                String::from_utf8_lossy(want),
+                String::from_utf8_lossy(&got)
+            );
         }
     }
 
-    const MODELS: [&[&str]; 11] = [
-        &["--model", "stick"],
-        &["--model", "stick", "--K", "cos2a", "--rho", "0.5"],
-        &["--model", "stick-approx"],
-        &["--model", "slip"],
-        &["--model", "slip-approx"],
-        &["--model", "stickslip", "--f", "0.3"],
-        &["--model", "contact", "--spin", "keep"],
-        &["--model", "jan"],
-        &[
-            "--model", "jaeger", "--a1", "0.05", "--a2", "0.4", "--a3", "1.5",
-        ],
-        &[
-            "--model", "jaeger", "--a1", "0.1", "--a2", "2", "--a3", "0.3", "--branch", "lower",
-        ],
-        &["--model", "auto", "--tol", "1e-8"],
+    /// A golden file under tests/golden/forward/.
+    macro_rules! golden {
+        ($($part:literal),+) => {
+            include_bytes!(concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/tests/golden/forward/",
+                $($part),+
+            ))
+        };
+    }
+
+    /// Each model's flags and its golden outputs on data/default.csv,
+    /// data/virtual/md_ristow.csv and tests/golden/forward/generated/input.csv.
+    macro_rules! models {
+        ($(($name:literal, $flags:expr)),* $(,)?) => {
+            [$(Golden {
+                flags: $flags,
+                default: golden!("default/", $name, ".csv"),
+                md_ristow: golden!("md_ristow/", $name, ".csv"),
+                generated: golden!("generated/", $name, ".csv"),
+            }),*]
+        };
+    }
+
+    struct Golden {
+        flags: &'static [&'static str],
+        default: &'static [u8],
+        md_ristow: &'static [u8],
+        generated: &'static [u8],
+    }
+
+    const MODELS: [Golden; 11] = models![
+        ("stick", &["--model", "stick"]),
+        (
+            "stick_cos2a_rho0.5",
+            &["--model", "stick", "--K", "cos2a", "--rho", "0.5"]
+        ),
+        ("stick-approx", &["--model", "stick-approx"]),
+        ("slip", &["--model", "slip"]),
+        ("slip-approx", &["--model", "slip-approx"]),
+        ("stickslip_f0.3", &["--model", "stickslip", "--f", "0.3"]),
+        ("contact_keep", &["--model", "contact", "--spin", "keep"]),
+        ("jan", &["--model", "jan"]),
+        (
+            "jaeger_upper",
+            &["--model", "jaeger", "--a1", "0.05", "--a2", "0.4", "--a3", "1.5"]
+        ),
+        (
+            "jaeger_lower",
+            &["--model", "jaeger", "--a1", "0.1", "--a2", "2", "--a3", "0.3", "--branch", "lower"]
+        ),
+        ("auto_tol1e-8", &["--model", "auto", "--tol", "1e-8"]),
     ];
 
     /// A table with every kind of cell the readers and writers meet: quoted cells (commas,
     /// quotes, a newline), non-ASCII text, columns whose names clash with the output (`v`,
     /// `regime`, `phase_sequence`), laws by name, empty cells falling back on the flags,
-    /// padded cells (ASCII and Unicode spaces), blank lines, and scenes in regimes A, B and C.
-    fn generated(rows: usize) -> String {
-        let mut s = String::from(
-            "id, xi ,delta_deg,K,rho,f,v,regime,spin,lambda,mu,a1,a2,a3,phase_sequence,note\n",
-        );
-        let laws = [
-            "", "0.6", "cos2a", "adjusted", "impact", "c=0.3", "0.95", " 0.3 ", "1e-1",
-        ];
-        let spins = ["", "roll", "keep", "factor=0.5", "impact"];
-        let notes = [
-            "",
-            " plain\t",
-            "\u{2003}em space\u{a0}",
-            "\"quoted, comma\"",
-            "\"say \"\"hi\"\"\"",
-            "\"two\nlines\"",
-            "é→ü",
-        ];
-        let mut x: u64 = 0x9e37_79b9_7f4a_7c15;
-        let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            (x >> 11) as f64 / (1u64 << 53) as f64
-        };
-        for i in 0..rows {
-            let xi = 0.65 + 9.35 * next();
-            let d = 40.0 * next();
-            let pick = |u: f64, n: usize| ((u * n as f64) as usize).min(n - 1);
-            let law = laws[pick(next(), laws.len())];
-            let rho = if i % 5 == 0 {
-                String::new()
-            } else {
-                format!("{}", 0.5 * next())
-            };
-            let f = if i % 3 == 0 {
-                String::new()
-            } else {
-                format!("{}", 0.4 * next())
-            };
-            let spin = spins[pick(next(), spins.len())];
-            let lambda = if i % 4 == 0 {
-                String::new()
-            } else {
-                format!("{}", 0.5 + next())
-            };
-            let mu = if i % 6 == 0 {
-                String::new()
-            } else {
-                format!("{}", next())
-            };
-            let note = notes[i % notes.len()];
-            s.push_str(&format!(
-                "r{i},{xi},{d},{law},{rho},{f},{},B,{spin},{lambda},{mu},0.05,0.4,1.5,x,{note}\n",
-                0.3 * next()
-            ));
-            if i % 17 == 0 {
-                s.push('\n');
-            }
-        }
-        s
-    }
+    /// padded cells (ASCII and Unicode spaces), blank lines, and scenes in regimes A, B and C
+    /// with every outcome and phase sequence each model gives on them.
+    const GENERATED: &[u8] = golden!("generated/input.csv");
+    /// Rows of [`GENERATED`].
+    const GENERATED_ROWS: usize = 44;
 
     #[test]
-    fn same_bytes_as_the_whole_table_path_on_the_shipped_data() {
-        for data in [
-            &include_bytes!("../../data/default.csv")[..],
-            &include_bytes!("../../data/virtual/md_ristow.csv")[..],
-        ] {
-            for m in MODELS {
-                same(m, data);
-            }
+    fn same_bytes_as_the_golden_outputs_on_the_shipped_data() {
+        for m in &MODELS {
+            same(m.flags, include_bytes!("../../data/default.csv"), m.default);
+            same(
+                m.flags,
+                include_bytes!("../../data/virtual/md_ristow.csv"),
+                m.md_ristow,
+            );
         }
     }
 
     #[test]
-    fn same_bytes_as_the_whole_table_path_on_a_generated_table() {
-        let text = generated(300);
-        for m in MODELS {
-            same(m, text.as_bytes());
+    fn same_bytes_as_the_golden_outputs_on_the_generated_table() {
+        for m in &MODELS {
+            same(m.flags, GENERATED, m.generated);
         }
-        // Many rows, one cheap model: several full-size chunks.
-        let text = generated(3 * CHUNK_ROWS + 123);
-        same(&["--model", "stick"], text.as_bytes());
         // A single scene on the command line goes through the same path.
-        let a = args(&["--model", "stick"]);
-        assert_eq!(
-            old(&a, b"xi,delta_deg\n1,12\n"),
-            new(&a, b"xi,delta_deg\n1,12\n", 1, 1)
+        same(
+            &["--model", "stick"],
+            b"xi,delta_deg\n1,12\n",
+            golden!("single_scene.csv"),
         );
     }
 
+    /// Several full-size chunks and a partial one: the generated table's body repeated, whose
+    /// output is the golden header and the golden body repeated (every row's output depends on
+    /// that row alone).
     #[test]
-    fn same_error_as_the_whole_table_path() {
+    fn same_bytes_over_several_full_chunks() {
+        let split = |b: &'static [u8]| {
+            let i = b.iter().position(|&c| c == b'\n').unwrap() + 1;
+            (&b[..i], &b[i..])
+        };
+        let reps = 3 * CHUNK_ROWS / GENERATED_ROWS + 1;
+        let (head, body) = split(GENERATED);
+        let text = [head, &body.repeat(reps)].concat();
+        let (head, body) = split(MODELS[0].generated);
+        let want = [head, &body.repeat(reps)].concat();
+        let rows = csv::Reader::from_reader(MODELS[0].generated)
+            .records()
+            .count();
+        assert_eq!(rows, GENERATED_ROWS);
+        same(MODELS[0].flags, &text, &want);
+    }
+
+    fn error_cases() -> Vec<(&'static [&'static str], Vec<u8>)> {
         let good = "1,12\n".repeat(40);
         let late_s = |bad: &str| format!("xi,delta_deg\n{good}{bad}{good}");
         let late = |bad: &str| late_s(bad).into_bytes();
         let stick: &[&str] = &["--model", "stick"];
-        let cases: Vec<(&[&str], Vec<u8>)> = vec![
+        vec![
             (stick, Vec::new()),
             (stick, " \n\t\n".into()),
             (stick, "xi,delta_deg\n".into()),
@@ -1354,15 +1339,31 @@ mod tests {
                 "xi,delta_deg,spin\n1,10,roll\n1,10,twirl\n".into(),
             ),
             (&["--model", "auto"], late("1,-3\n")),
-        ];
-        for (flags, bytes) in cases {
+        ]
+    }
+
+    /// tests/golden/forward/errors.txt: one line per case of [`error_cases`], the message as a
+    /// Rust string literal (`{:?}`).
+    #[test]
+    fn same_error_as_the_golden_messages() {
+        let want: Vec<&str> = std::str::from_utf8(golden!("errors.txt"))
+            .unwrap()
+            .lines()
+            .collect();
+        let cases = error_cases();
+        assert_eq!(want.len(), cases.len());
+        for ((flags, bytes), want) in cases.into_iter().zip(want) {
             let a = args(flags);
-            let want = old(&a, &bytes);
             let text = String::from_utf8_lossy(&bytes);
-            assert!(want.is_err(), "{flags:?} {text:?} should fail");
             for (chunk, task) in SIZES {
-                let got = new(&a, &bytes, chunk, task);
-                assert_eq!(want, got, "{flags:?} {text:?}, chunks of {chunk}");
+                match new(&a, &bytes, chunk, task) {
+                    Ok(_) => panic!("{flags:?} {text:?}, chunks of {chunk}: should fail"),
+                    Err(e) => assert_eq!(
+                        format!("{e:?}"),
+                        want,
+                        "{flags:?} {text:?}, chunks of {chunk}"
+                    ),
+                }
             }
         }
     }

@@ -2,27 +2,8 @@
 //! auto meeting its tolerance on every scene.
 
 use std::collections::HashMap;
-use std::process::Command;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_fitbead"))
-}
-
-fn parse_csv(text: &str) -> (Vec<String>, Vec<HashMap<String, String>>) {
-    let mut r = csv::Reader::from_reader(text.as_bytes());
-    let h: Vec<String> = r.headers().unwrap().iter().map(String::from).collect();
-    let rows = r
-        .records()
-        .map(|x| {
-            let x = x.unwrap();
-            h.iter()
-                .cloned()
-                .zip(x.iter().map(String::from))
-                .collect::<HashMap<_, _>>()
-        })
-        .collect();
-    (h, rows)
-}
+use crate::common::{bin, records, stdout_ok, tmpdir, write};
 
 fn num(r: &HashMap<String, String>, c: &str) -> f64 {
     r[c].parse::<f64>()
@@ -31,7 +12,7 @@ fn num(r: &HashMap<String, String>, c: &str) -> f64 {
 
 #[test]
 fn bench_small_run_has_the_contract_columns_checked_references_and_auto_within_tolerance() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = tmpdir();
     let csv_path = dir.path().join("wp.csv");
     let svg_path = dir.path().join("wp.svg");
     let out = bin()
@@ -45,7 +26,7 @@ fn bench_small_run_has_the_contract_columns_checked_references_and_auto_within_t
     assert!(out.status.success(), "{err}");
     assert!(!err.contains("FAILED"), "{err}");
     let text = std::fs::read_to_string(&csv_path).unwrap();
-    let (h, rows) = parse_csv(&text);
+    let (h, rows) = records(&text);
     assert_eq!(
         h,
         [
@@ -123,20 +104,14 @@ fn bench_rejects_zero_scenes() {
 }
 
 fn forward(model: &str, tol: &str, input: &str) -> Vec<HashMap<String, String>> {
-    let dir = tempfile::tempdir().unwrap();
-    let p = dir.path().join("s.csv");
-    std::fs::write(&p, input).unwrap();
+    let dir = tmpdir();
+    let p = write(&dir, "s.csv", input);
     let out = bin()
         .args(["forward", "--model", model, "--tol", tol, "--input"])
         .arg(&p)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    parse_csv(&String::from_utf8(out.stdout).unwrap()).1
+    records(&stdout_ok(&out)).1
 }
 
 #[test]
@@ -190,12 +165,7 @@ fn forward_auto_rejects_a_bad_tolerance() {
 
 fn k_rows(args: &[&str]) -> Vec<HashMap<String, String>> {
     let out = bin().arg("k").args(args).output().unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    parse_csv(&String::from_utf8(out.stdout).unwrap()).1
+    records(&stdout_ok(&out)).1
 }
 
 #[test]
@@ -244,7 +214,7 @@ fn klaw_auto_fits_with_the_most_general_model_any_point_needs_and_says_so() {
         .unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{err}");
-    let (_, rows) = parse_csv(&String::from_utf8(out.stdout).unwrap());
+    let (_, rows) = records(&String::from_utf8(out.stdout).unwrap());
     let c = rows.iter().find(|r| r["fit"] == "klaw-c").unwrap();
     // The fit summary (stderr) carries the note.
     assert!(
@@ -253,7 +223,7 @@ fn klaw_auto_fits_with_the_most_general_model_any_point_needs_and_says_so() {
     );
     // The same fit as --model contact at the auto's inner tolerance: c agrees closely.
     let out = bin().args(["klaw", "--model", "contact"]).output().unwrap();
-    let (_, plain) = parse_csv(&String::from_utf8(out.stdout).unwrap());
+    let (_, plain) = records(&String::from_utf8(out.stdout).unwrap());
     let p = plain.iter().find(|r| r["fit"] == "klaw-c").unwrap();
     let (ca, cp) = (num(c, "value"), num(p, "value"));
     assert!(((ca - cp) / cp).abs() < 1e-8, "{ca} {cp}");

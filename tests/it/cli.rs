@@ -1,21 +1,6 @@
 //! Command-line contracts: column names, exit codes, located errors, atomic output.
 
-use std::path::PathBuf;
-use std::process::Command;
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_fitbead"))
-}
-
-fn tmpdir() -> tempfile::TempDir {
-    tempfile::tempdir().unwrap()
-}
-
-fn write(dir: &tempfile::TempDir, name: &str, text: &str) -> PathBuf {
-    let p = dir.path().join(name);
-    std::fs::write(&p, text).unwrap();
-    p
-}
+use crate::common::{bin, col, read_table, table, tmpdir, write};
 
 #[test]
 fn forward_single_scene_reports_v_regime_status() {
@@ -95,8 +80,7 @@ fn forward_file_passes_extra_columns_and_keeps_order() {
 fn expect_error(args: &[&str], input: &str, must_contain: &[&str]) {
     let d = tmpdir();
     let inp = write(&d, "bad.csv", input);
-    let outp = d.path().join("out.csv");
-    std::fs::write(&outp, "precious").unwrap();
+    let outp = write(&d, "out.csv", "precious");
     let out = bin()
         .args(args)
         .arg("--input")
@@ -311,15 +295,9 @@ fn forward_without_input_runs_on_the_embedded_default_data() {
     assert_eq!(s.lines().count(), 37);
 }
 
+/// The CSV on stdout of a run, whatever its exit status.
 fn k_table(out: &std::process::Output) -> (Vec<String>, Vec<Vec<String>>) {
-    let s = String::from_utf8(out.stdout.clone()).unwrap();
-    let mut rdr = csv::Reader::from_reader(s.as_bytes());
-    let header = rdr.headers().unwrap().iter().map(String::from).collect();
-    let rows = rdr
-        .records()
-        .map(|r| r.unwrap().iter().map(String::from).collect())
-        .collect();
-    (header, rows)
+    table(&String::from_utf8(out.stdout.clone()).unwrap())
 }
 
 #[test]
@@ -570,13 +548,10 @@ fn fit_commands_write_the_contract_reports() {
             "{cmd}: {}",
             String::from_utf8_lossy(&out.stderr)
         );
-        let text = std::fs::read_to_string(&rep).unwrap();
-        let mut r = csv::Reader::from_reader(text.as_bytes());
-        let h: Vec<String> = r.headers().unwrap().iter().map(String::from).collect();
+        let (h, recs) = read_table(&rep);
         assert_eq!(&h[..9], &FIT_COLUMNS[..], "{cmd}");
-        let recs: Vec<csv::StringRecord> = r.records().map(|x| x.unwrap()).collect();
         assert_eq!(recs.len(), rows, "{cmd} {extra:?}");
-        let level = h.iter().position(|c| c == "level").unwrap();
+        let level = col(&h, "level");
         for rec in &recs {
             assert!(rec[3].parse::<f64>().unwrap().is_finite());
             assert_eq!(&rec[level], "0.9");
@@ -585,13 +560,11 @@ fn fit_commands_write_the_contract_reports() {
                 assert!(lo <= v && v <= hi, "{cmd}: {rec:?}");
             }
         }
-        let stats = std::fs::read_to_string(&st).unwrap();
-        let mut r = csv::Reader::from_reader(stats.as_bytes());
-        let h: Vec<String> = r.headers().unwrap().iter().map(String::from).collect();
+        let (h, stat_rows) = read_table(&st);
         for c in ["chi2", "dof", "aic", "bic", "termination"] {
             assert!(h.iter().any(|x| x == c), "{cmd}: stats lacks {c}");
         }
-        let names: Vec<String> = r.records().map(|x| x.unwrap()[0].to_string()).collect();
+        let names: Vec<String> = stat_rows.into_iter().map(|r| r[0].clone()).collect();
         for f in &fits {
             assert!(names.iter().any(|n| n == f), "{cmd}: {names:?} lacks {f}");
         }
@@ -689,9 +662,7 @@ fn simulate_jan_and_jaeger_with_their_flags() {
             "{args:?}: {}",
             String::from_utf8_lossy(&out.stderr)
         );
-        let text = String::from_utf8(out.stdout).unwrap();
-        let mut r = csv::Reader::from_reader(text.as_bytes());
-        let n = r.records().count();
+        let n = table(&String::from_utf8(out.stdout).unwrap()).1.len();
         assert!(n >= 9, "{args:?}: {n} rows");
     }
     for (args, flag) in [

@@ -5,7 +5,7 @@
 //! The data files are unmodified copies in `tests/nist-strd/` (see its README). Each model below
 //! is written by hand from its file's `Model:` section, with its analytic gradient.
 //!
-//! Run with `cargo test --release --test nist -- --nocapture` to see the table.
+//! Run with `cargo test --release --test it nist:: -- --nocapture` to see the table.
 
 // `!(x > 0.0)` is deliberate: a NaN must land in the failure branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -764,6 +764,16 @@ pub fn min_lres(p: &Problem, f: &Fit) -> (f64, f64) {
 /// reported as not converged rather than wrong.
 const UNREACHABLE: &[(&str, usize)] = &[];
 
+/// Smallest log relative errors over the 54 fits against NIST's certified values: README.md's
+/// figures (parameters 7.83, standard errors 6.99), the first floored to its last digit
+/// (measured 7.827).
+const MIN_LRE_PARAMS: f64 = 7.82;
+const MIN_LRE_STDERR: f64 = 6.99;
+
+/// The 54 fits against NIST's certified parameters and standard deviations (the StRD files in
+/// tests/nist-strd/): each converges with LRE ≥ 6 (parameters) and ≥ 4 (standard errors), NIST's
+/// usual pass mark, and the smallest LREs over all fits are at least [`MIN_LRE_PARAMS`] and
+/// [`MIN_LRE_STDERR`].
 #[test]
 fn nist_strd_all_54() {
     let opts = options();
@@ -815,23 +825,36 @@ fn nist_strd_all_54() {
             }
         }
     }
-    println!("{passed} of 54 pass; min LRE params {worst_p:.2}, stderr {worst_s:.2}");
+    println!("{passed} of 54 pass; min LRE params {worst_p:.4}, stderr {worst_s:.4}");
     assert!(failures.is_empty(), "failures:\n{}", failures.join("\n"));
+    assert!(worst_p >= MIN_LRE_PARAMS, "min LRE params {worst_p}");
+    assert!(worst_s >= MIN_LRE_STDERR, "min LRE stderr {worst_s}");
 }
 
+/// Checks the hand-written models: at the certified parameters the residual sum of squares
+/// matches NIST's certified value (tests/nist-strd/) to 3e-10 relative (measured 1.0e-10,
+/// Lanczos2) plus 6e-21 absolute, and the analytic gradients match central differences.
 #[test]
 fn certified_point_is_a_minimum_of_the_models() {
-    // Checks the hand-written models: at the certified parameters the residual sum of squares
-    // matches NIST's certified value, and the analytic gradients match central differences.
+    let mut worst: f64 = 0.0;
     for p in problems() {
         let d = data(&p);
         let mut r = vec![0.0; p.y.len()];
         d.residuals(&p.certified, &mut r).unwrap();
         let rss: f64 = r.iter().map(|v| v * v).sum();
+        let diff = (rss - p.certified_rss).abs();
+        println!(
+            "{:<9} RSS difference {diff:.3e}, relative {:.3e}",
+            p.name,
+            diff / p.certified_rss
+        );
         // Lanczos1's RSS (1.4e-25) is below what its 11-digit certified parameters reproduce
-        // (~4e-21), hence the absolute slack.
+        // (~4e-21, measured difference 3.9e-21), hence the absolute slack.
+        if p.name != "Lanczos1" {
+            worst = worst.max(diff / p.certified_rss);
+        }
         assert!(
-            (rss - p.certified_rss).abs() <= 1e-6 * p.certified_rss + 1e-20,
+            diff <= 3e-10 * p.certified_rss + 6e-21,
             "{}: RSS {rss:e} vs certified {:e}",
             p.name,
             p.certified_rss
@@ -861,6 +884,7 @@ fn certified_point_is_a_minimum_of_the_models() {
             }
         }
     }
+    println!("largest relative RSS difference but Lanczos1's: {worst:.3e}");
 }
 
 #[test]
@@ -954,5 +978,7 @@ fn nist_profile_intervals() {
     println!(
         "{found} of {total} profile ends found; {agree} confirmed by an independent cold-started fit"
     );
-    assert!(found * 10 >= total * 9 && agree * 10 >= found * 9);
+    // README.md: 240 of 240 found, 239 confirmed.
+    assert_eq!(found, total);
+    assert!(agree + 1 >= found, "{agree} of {found} confirmed");
 }

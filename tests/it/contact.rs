@@ -6,6 +6,8 @@ use fitbead::models::contact::{Contact, ContactEnd, Launch, PhaseKind, SpinRule}
 use fitbead::models::{ForwardModel, Model, Phases};
 use fitbead::scene::{CollisionLaw, Scene};
 
+use crate::common::bin;
+
 fn scene(xi: f64, delta_deg: f64, rho: f64, f: f64, law: CollisionLaw) -> Scene {
     Scene::new(xi, delta_deg, rho, f, law).unwrap()
 }
@@ -401,10 +403,6 @@ fn k_round_trip() {
         println!("xi {xi} d {d}: K {} vs {} ({} evals)", r.k, sc.k, r.evals);
         assert!((r.k - sc.k).abs() < 1e-11, "{} vs {}", r.k, sc.k);
     }
-}
-
-fn bin() -> std::process::Command {
-    std::process::Command::new(env!("CARGO_BIN_EXE_fitbead"))
 }
 
 /// `forward --model contact`: the phase columns and the energy closure on every row; a bad

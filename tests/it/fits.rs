@@ -6,7 +6,7 @@
 //! * Recovery and coverage: on 200 replicates with 2 % Gaussian noise (fixed seeds) the 95 %
 //!   intervals must cover the truth in a fraction of replicates compatible with 95 %: inside
 //!   [0.90, 0.99] (±3.2 binomial standard deviations of 200 draws). The figures are printed
-//!   (`cargo test --release --test fits -- --nocapture`).
+//!   (`cargo test --release --test it fits:: -- --nocapture`).
 
 use fitbead::fit::data::Dataset;
 use fitbead::fit::jaeger::{fit_jaeger, paper_values};

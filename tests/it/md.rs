@@ -5,7 +5,8 @@
 use fitbead::models::md::{Md, MdParams, MdRunConfig, ReducedMass};
 use fitbead::models::{stick, ForwardModel, NotSteady, Regime};
 use fitbead::{CollisionLaw, Scene};
-use std::process::Command;
+
+use crate::common::{bin, tmpdir, write};
 
 fn scene(xi: f64, d: f64) -> Scene {
     // K and f do not enter md; the scene's K is a placeholder.
@@ -162,15 +163,14 @@ fn no_inertia_is_invalid_not_a_panic() {
     ));
 }
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_fitbead"))
-}
-
 #[test]
 fn forward_md_needs_only_xi_and_delta() {
-    let dir = tempfile::tempdir().unwrap();
-    let input = dir.path().join("s.csv");
-    std::fs::write(&input, "xi,delta_deg,gamma_s\n1,12,\n1,8,\n1,20,50\n").unwrap();
+    let dir = tmpdir();
+    let input = write(
+        &dir,
+        "s.csv",
+        "xi,delta_deg,gamma_s\n1,12,\n1,8,\n1,20,50\n",
+    );
     let out = dir.path().join("o.csv");
     let st = bin()
         .args(["forward", "--model", "md", "--input"])
@@ -220,9 +220,8 @@ fn forward_md_bad_values_exit_2_with_location() {
         "{err}"
     );
 
-    let dir = tempfile::tempdir().unwrap();
-    let input = dir.path().join("s.csv");
-    std::fs::write(&input, "xi,delta_deg,beads\n1,12,2.5\n").unwrap();
+    let dir = tmpdir();
+    let input = write(&dir, "s.csv", "xi,delta_deg,beads\n1,12,2.5\n");
     let out = bin()
         .args(["forward", "--model", "md", "--input"])
         .arg(&input)

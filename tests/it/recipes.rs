@@ -1,26 +1,7 @@
 //! `fitbead report`: the committed outputs of the recipes in fits/ match a fresh run, the
 //! bulk-friction table has its contract columns and honest numbers, and bad input exits 2.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_fitbead"))
-}
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn read_csv(p: &Path) -> (Vec<String>, Vec<Vec<String>>) {
-    let mut r = csv::Reader::from_path(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
-    let h = r.headers().unwrap().iter().map(String::from).collect();
-    let rows = r
-        .records()
-        .map(|x| x.unwrap().iter().map(String::from).collect())
-        .collect();
-    (h, rows)
-}
+use crate::common::{bin, read_table, root, tmpdir, write};
 
 /// Numbers equal to 1e-9 relative (1e-12 absolute near zero); anything else exactly.
 fn same_cell(a: &str, b: &str) -> bool {
@@ -43,7 +24,7 @@ fn committed_recipe_outputs_match_a_fresh_run() {
         }
         recipes += 1;
         let committed = fits.join(recipe.file_stem().unwrap());
-        let tmp = tempfile::tempdir().unwrap();
+        let tmp = tmpdir();
         let out = bin()
             .args(["report", "--recipe"])
             .arg(&recipe)
@@ -64,8 +45,8 @@ fn committed_recipe_outputs_match_a_fresh_run() {
                 continue;
             }
             let name = f.file_name().unwrap();
-            let (h0, r0) = read_csv(&f);
-            let (h1, r1) = read_csv(&tmp.path().join(name));
+            let (h0, r0) = read_table(&f);
+            let (h1, r1) = read_table(&tmp.path().join(name));
             assert_eq!(h0, h1, "{}: columns", f.display());
             assert_eq!(r0.len(), r1.len(), "{}: rows", f.display());
             for (i, (a, b)) in r0.iter().zip(&r1).enumerate() {
@@ -93,14 +74,14 @@ fn committed_recipe_outputs_match_a_fresh_run() {
 
 #[test]
 fn bulk_friction_table_contract_and_values() {
-    let tmp = tempfile::tempdir().unwrap();
+    let tmp = tmpdir();
     let out = bin()
         .args(["report", "--out-dir"])
         .arg(tmp.path())
         .output()
         .unwrap();
     assert!(out.status.success());
-    let (h, rows) = read_csv(&tmp.path().join("bulk_friction.csv"));
+    let (h, rows) = read_table(&tmp.path().join("bulk_friction.csv"));
     let contract = [
         "series",
         "xi",
@@ -145,9 +126,12 @@ fn bulk_friction_table_contract_and_values() {
 
 #[test]
 fn report_bad_input_exits_2_and_writes_nothing() {
-    let tmp = tempfile::tempdir().unwrap();
-    let data = tmp.path().join("bad.csv");
-    std::fs::write(&data, "series,xi,delta_deg,v\na,1,12,0.4\na,1,13,abc\n").unwrap();
+    let tmp = tmpdir();
+    let data = write(
+        &tmp,
+        "bad.csv",
+        "series,xi,delta_deg,v\na,1,12,0.4\na,1,13,abc\n",
+    );
     let outdir = tmp.path().join("out");
     let out = bin()
         .args(["report", "--input"])
@@ -160,8 +144,7 @@ fn report_bad_input_exits_2_and_writes_nothing() {
     let e = String::from_utf8_lossy(&out.stderr);
     assert!(e.contains("line 3") && e.contains("abc"), "{e}");
     assert!(!outdir.exists());
-    let recipe = tmp.path().join("r.toml");
-    std::fs::write(&recipe, "input = 'x.csv'\nbogus = 1\n").unwrap();
+    let recipe = write(&tmp, "r.toml", "input = 'x.csv'\nbogus = 1\n");
     let out = bin()
         .args(["report", "--recipe"])
         .arg(&recipe)
@@ -175,7 +158,7 @@ fn report_bad_input_exits_2_and_writes_nothing() {
 /// default data), recomputed here from the χ² column; the AIC rank 1 has ΔAIC = 0.
 #[test]
 fn per_series_information_criteria() {
-    let (h, rows) = read_csv(&root().join("fits/default/models_by_series.csv"));
+    let (h, rows) = read_table(&root().join("fits/default/models_by_series.csv"));
     let c = |n: &str| h.iter().position(|x| x == n).unwrap();
     let (cs, cn, cchi, ck, caic, cbic, cd, cr) = (
         c("series"),

@@ -4,11 +4,8 @@
 //! (`target/tmp/figures/`) for a look.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_fitbead"))
-}
+use crate::common::bin;
 
 fn out_dir() -> PathBuf {
     let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join("figures");

@@ -13,7 +13,7 @@
 //! The draws used for the ranks are 3 per walker, a third of the kept chain apart (the chain
 //! is at least 50 autocorrelation times long by the stopping rule, so they are nearly
 //! independent): L = 95 of them (3 × 32 − 1, so that the L + 1 = 96 rank values fill 8 bins
-//! evenly). Figures: `cargo test --release --test sbc -- --nocapture`.
+//! evenly). Figures: `cargo test --release --test it sbc:: -- --nocapture`.
 
 use fitbead::fit::data::Dataset;
 use fitbead::fit::klaw::{fit_law_with, KLaw, KLawProblem};

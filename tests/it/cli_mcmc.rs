@@ -2,27 +2,9 @@
 //! seed, flag errors (exit 2), and a clean stop on Ctrl-C (exit 130, draws written).
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_fitbead"))
-}
-
-fn table(text: &str) -> (Vec<String>, Vec<Vec<String>>) {
-    let mut r = csv::Reader::from_reader(text.as_bytes());
-    let h = r.headers().unwrap().iter().map(String::from).collect();
-    let rows = r
-        .records()
-        .map(|x| x.unwrap().iter().map(String::from).collect())
-        .collect();
-    (h, rows)
-}
-
-fn col(h: &[String], name: &str) -> usize {
-    h.iter()
-        .position(|c| c == name)
-        .unwrap_or_else(|| panic!("missing column {name}: {h:?}"))
-}
+use crate::common::{bin, col, table, tmpdir, write};
 
 struct Run {
     out: Output,
@@ -54,7 +36,7 @@ fn run(dir: &Path, tag: &str, args: &[&str]) -> Run {
 
 #[test]
 fn klaw_mcmc_report_draws_and_seed() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = tmpdir();
     let args = [
         "klaw",
         "--model",
@@ -135,7 +117,7 @@ fn klaw_mcmc_report_draws_and_seed() {
 
 #[test]
 fn scale_is_sampled_without_sigma_and_with_fit_scatter() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = tmpdir();
     // The default data without its sigma_v column: the scatter is a parameter.
     let text: String = fitbead::cli::DEFAULT_DATA
         .lines()
@@ -144,8 +126,7 @@ fn scale_is_sampled_without_sigma_and_with_fit_scatter() {
             format!("{},{},{},{}\n", f[0], f[1], f[2], f[3])
         })
         .collect();
-    let data = dir.path().join("nosigma.csv");
-    std::fs::write(&data, text).unwrap();
+    let data = write(&dir, "nosigma.csv", &text);
     let common = ["--method", "mcmc", "--min-ess", "300"];
     let mut args = vec![
         "klaw",
@@ -191,7 +172,7 @@ fn scale_is_sampled_without_sigma_and_with_fit_scatter() {
 
 #[test]
 fn jaeger_mcmc_reports_priors_and_names_what_did_not_converge() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = tmpdir();
     let args = [
         "jaeger",
         "--method",
@@ -294,7 +275,7 @@ fn mcmc_flag_errors_exit_2() {
 #[cfg(unix)]
 #[test]
 fn ctrl_c_stops_cleanly_and_writes_the_draws() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = tmpdir();
     let p = |s: &str| dir.path().join(s);
     let mut child = bin()
         .args([
@@ -317,7 +298,7 @@ fn ctrl_c_stops_cleanly_and_writes_the_draws() {
         .spawn()
         .unwrap();
     std::thread::sleep(std::time::Duration::from_millis(1500));
-    let kill = Command::new("kill")
+    let kill = std::process::Command::new("kill")
         .args(["-INT", &child.id().to_string()])
         .status()
         .unwrap();

@@ -1,0 +1,81 @@
+//! Helpers shared by the test modules: the fitbead binary and its output, temporary files, CSV
+//! tables, and the reference tables under tests/reference/.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// A command that runs the fitbead binary cargo built for these tests.
+pub fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_fitbead"))
+}
+
+/// The stdout of a run that must have succeeded; panics with its stderr otherwise.
+pub fn stdout_ok(out: &Output) -> String {
+    assert!(out.status.success(), "{}", stderr(out));
+    String::from_utf8(out.stdout.clone()).unwrap()
+}
+
+/// The stderr of a run, lossily decoded.
+pub fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// The crate root.
+pub fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// A fresh temporary directory, removed when dropped.
+pub fn tmpdir() -> tempfile::TempDir {
+    tempfile::tempdir().unwrap()
+}
+
+/// Writes `text` to the file `name` in `dir` and returns its path.
+pub fn write(dir: impl AsRef<Path>, name: &str, text: &str) -> PathBuf {
+    let p = dir.as_ref().join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// A CSV text as its header and its rows of cells.
+pub fn table(text: &str) -> (Vec<String>, Vec<Vec<String>>) {
+    rows_of(csv::Reader::from_reader(text.as_bytes()))
+}
+
+/// A CSV file as its header and its rows of cells.
+pub fn read_table(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
+    let r = csv::Reader::from_path(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    rows_of(r)
+}
+
+fn rows_of<R: std::io::Read>(mut r: csv::Reader<R>) -> (Vec<String>, Vec<Vec<String>>) {
+    let h = r.headers().unwrap().iter().map(String::from).collect();
+    let rows = r
+        .records()
+        .map(|x| x.unwrap().iter().map(String::from).collect())
+        .collect();
+    (h, rows)
+}
+
+/// A CSV text as its header and its rows, each keyed by column name.
+pub fn records(text: &str) -> (Vec<String>, Vec<HashMap<String, String>>) {
+    let (h, rows) = table(text);
+    let rows = rows
+        .into_iter()
+        .map(|r| h.iter().cloned().zip(r).collect())
+        .collect();
+    (h, rows)
+}
+
+/// The index of column `name` in the header `h`.
+pub fn col(h: &[String], name: &str) -> usize {
+    h.iter()
+        .position(|c| c == name)
+        .unwrap_or_else(|| panic!("missing column {name}: {h:?}"))
+}
+
+/// A table of tests/reference/ (see its README.md for how each was made).
+pub fn reference_table(name: &str) -> (Vec<String>, Vec<Vec<String>>) {
+    read_table(&root().join("tests").join("reference").join(name))
+}

@@ -1,0 +1,21 @@
+//! The integration tests, in one binary. Each module covers one area; run one with
+//! `cargo test --release --test it <module>::` and add `-- --nocapture` to see the figures
+//! the tests print (measured errors, coverage tables).
+
+mod common;
+
+mod bench_cli;
+mod cli;
+mod cli_mcmc;
+mod contact;
+mod figures;
+mod fits;
+mod k_inversion;
+mod mcmc;
+mod md;
+mod nist;
+mod paper_figures;
+mod properties;
+mod recipes;
+mod reference_models;
+mod sbc;

@@ -136,10 +136,11 @@ impl fmt::Display for FitResult {
         if let Some(c) = &self.correlation {
             let names = self.param_names();
             let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
-            for i in 0..c.len().min(names.len()) {
-                for j in i + 1..c.len().min(names.len()) {
-                    if c[i][j].abs() > CORRELATION_SHOWN {
-                        pairs.push((c[i][j], i, j));
+            let n = c.len().min(names.len());
+            for (i, row) in c.iter().enumerate().take(n) {
+                for (j, &r) in row.iter().enumerate().take(n).skip(i + 1) {
+                    if r.abs() > CORRELATION_SHOWN {
+                        pairs.push((r, i, j));
                     }
                 }
             }

@@ -1031,19 +1031,6 @@ fn run(
     );
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn hertz_integral_matches_known_constant() {
-        // Hertz: t_c = 2.9432 d_max / v, i.e. ∫₀¹ du/√(1−u^{5/2}) = 1.4716.
-        assert!((2.0 * impact_integral(1.5) - 2.9432).abs() < 1e-4);
-        // Linear spring: ∫₀¹ du/√(1−u²) = π/2.
-        assert!((impact_integral(1.0) - PI / 2.0).abs() < 1e-12);
-    }
-}
-
 /// The md scan of slopes for regime B: every 0.5° from 0.5° to 45°.
 pub const MD_SCAN_STEP_DEG: f64 = 0.5;
 pub const MD_SCAN_POINTS: usize = 90;
@@ -1108,4 +1095,17 @@ pub fn regime_b_interval(
         },
     );
     Ok(Some((lo?, hi?)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hertz_integral_matches_known_constant() {
+        // Hertz: t_c = 2.9432 d_max / v, i.e. ∫₀¹ du/√(1−u^{5/2}) = 1.4716.
+        assert!((2.0 * impact_integral(1.5) - 2.9432).abs() < 1e-4);
+        // Linear spring: ∫₀¹ du/√(1−u²) = π/2.
+        assert!((impact_integral(1.0) - PI / 2.0).abs() < 1e-12);
+    }
 }

@@ -119,7 +119,7 @@ fn klaw_mcmc_report_draws_and_seed() {
 fn scale_is_sampled_without_sigma_and_with_fit_scatter() {
     let dir = tmpdir();
     // The default data without its sigma_v column: the scatter is a parameter.
-    let text: String = fitbead::cli::DEFAULT_DATA
+    let text: String = fitbead::io::measurements::DEFAULT_DATA
         .lines()
         .map(|l| {
             let f: Vec<&str> = l.split(',').collect();

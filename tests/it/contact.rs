@@ -109,13 +109,13 @@ fn ordinary_scenes_start_with_a_backward_slip() {
     );
     let ch = c.run.phases.changes();
     // Backward slip ends before the top, forward slip starts after it near Θ_G ≈ 15°.
-    assert!(ch[0] < 0.0 && ch[0] > sc.theta_0, "{ch:?}");
+    assert!(ch[0] < 0.0 && ch[0] > sc.theta_0_rad(), "{ch:?}");
     assert!(
         ch[1].to_degrees() > 14.0 && ch[1].to_degrees() < 17.0,
         "{ch:?}"
     );
     let ss = Model::StickSlip.evaluate(&sc).unwrap();
-    assert!(rel(2.0 * sc.sin_alpha / c.run.time, ss.mean_velocity) > 1e-6);
+    assert!(rel(2.0 * sc.sin_alpha() / c.run.time, ss.mean_velocity) > 1e-6);
 }
 
 /// Potential drop per bead = collision loss (translation + spin) + friction work, to 1e-12
@@ -301,10 +301,10 @@ fn one_contact_matches_a_time_stepping_reference() {
         let reference = Reference {
             rho: 0.4,
             f,
-            theta_f: sc.theta_f,
+            theta_f: sc.theta_f_rad(),
         };
-        let (rv, rw, rt, rwork, modes) = reference.run(sc.theta_0, v0, 2e-4);
-        let (rv2, _, rt2, _, _) = reference.run(sc.theta_0, v0, 4e-4);
+        let (rv, rw, rt, rwork, modes) = reference.run(sc.theta_0_rad(), v0, 2e-4);
+        let (rv2, _, rt2, _, _) = reference.run(sc.theta_0_rad(), v0, 4e-4);
         // The reference's own error, from halving its step (RK4: error ∝ h⁴).
         let own = (rv - rv2).abs().max((rt - rt2).abs());
         println!(
@@ -400,8 +400,8 @@ fn k_round_trip() {
         let v = m.evaluate(&sc).unwrap().mean_velocity;
         let br = bracket(&m, &sc).unwrap();
         let r = solve(&m, &sc, &br, v).unwrap();
-        println!("xi {xi} d {d}: K {} vs {} ({} evals)", r.k, sc.k, r.evals);
-        assert!((r.k - sc.k).abs() < 1e-11, "{} vs {}", r.k, sc.k);
+        println!("xi {xi} d {d}: K {} vs {} ({} evals)", r.k, sc.k(), r.evals);
+        assert!((r.k - sc.k()).abs() < 1e-11, "{} vs {}", r.k, sc.k());
     }
 }
 

@@ -108,10 +108,10 @@ fn klaw_free_recovers_each_series_k_from_exact_data() {
     for (row, &xi) in f.summary.params.iter().zip(&XIS) {
         let s = Scene::new(xi, 1.0, 0.4, 0.1, law).unwrap();
         assert!(
-            (row.value - s.k).abs() < 1e-10,
+            (row.value - s.k()).abs() < 1e-10,
             "ξ {xi}: {} vs {}",
             row.value,
-            s.k
+            s.k()
         );
         assert_eq!(row.series, format!("{xi}"));
     }
@@ -146,7 +146,7 @@ fn jan_recovers_the_paper_laws_from_exact_data() {
     }
     for (s, &xi) in fits.series.iter().zip(&XIS) {
         let s = s.as_ref().unwrap();
-        let alpha = Scene::new(xi, 1.0, 0.4, 0.1, law).unwrap().alpha;
+        let alpha = Scene::new(xi, 1.0, 0.4, 0.1, law).unwrap().alpha_rad();
         let p = Jan::paper_fit(alpha);
         assert!((s.params[0].value - p.lambda).abs() < 1e-9 * p.lambda);
         assert!((s.params[1].value - p.mu).abs() < 1e-9);
@@ -250,7 +250,7 @@ fn klaw_and_jan_intervals_cover_the_truth_95_percent_of_200_replicates() {
         for (j, &xi) in XIS.iter().enumerate() {
             free[j].add(
                 &f.summary.params[j],
-                Scene::new(xi, 1.0, 0.4, 0.1, law).unwrap().k,
+                Scene::new(xi, 1.0, 0.4, 0.1, law).unwrap().k(),
             );
         }
         let ds = simulate(

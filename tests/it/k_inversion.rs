@@ -249,7 +249,7 @@ fn stickslip_within_1e_9_of_the_saddle_node() {
 #[test]
 fn launch_speed_path_agrees_with_the_search_in_k() {
     use fitbead::fit::k::estimate_in_k;
-    use fitbead::fit::klaunch;
+    use fitbead::fit::k::launch as klaunch;
     let mut rng = ChaCha8Rng::seed_from_u64(70);
     for m in [Model::Stick, Model::StickSlip] {
         let (mut taken, mut tried, mut worst, mut worst_slope) = (0, 0, 0.0f64, 0.0f64);

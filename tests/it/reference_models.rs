@@ -188,7 +188,7 @@ fn squared_top_velocity_keeps_its_digits_near_delta_m() {
         if r.model != "stick"
             || r.extra_name != "min_velocity2"
             || r.regime != "B"
-            || r.scene.theta_0 >= 0.0
+            || r.scene.theta_0_rad() >= 0.0
         {
             continue;
         }
@@ -304,7 +304,7 @@ fn slip_deep_in_its_limits() {
                 if e.max(ef) > worst.0 {
                     worst = (
                         e.max(ef),
-                        format!("{} {} xi={}", r.case, r.model, r.scene.xi),
+                        format!("{} {} xi={}", r.case, r.model, r.scene.xi()),
                     );
                 }
                 let (tv, tf) = tol(&r.model);
@@ -321,7 +321,10 @@ fn slip_deep_in_its_limits() {
             }
             (reg, out) => failures.push(format!(
                 "{} {} xi={} f={}: reference regime {reg}, fitbead {out:?}",
-                r.case, r.model, r.scene.xi, r.scene.f
+                r.case,
+                r.model,
+                r.scene.xi(),
+                r.scene.f()
             )),
         }
     }

@@ -38,7 +38,7 @@ fn design() -> Vec<(String, Scene)> {
     let mut out = Vec::new();
     for xi in [0.8, 1.2, 1.6] {
         let (lo, hi) =
-            fitbead::cli::simulate::regime_b_interval(&Model::Stick, xi, 0.4, 0.1, law).unwrap();
+            fitbead::models::regimes::regime_b_interval(&Model::Stick, xi, 0.4, 0.1, law).unwrap();
         for j in 0..4 {
             let d = lo + (hi - lo) * (0.3 + 0.4 * j as f64 / 3.0);
             out.push((
@@ -52,8 +52,8 @@ fn design() -> Vec<(String, Scene)> {
 
 fn dataset(design: &[(String, Scene)], c: f64, rng: &mut ChaCha8Rng) -> Dataset {
     Dataset::new(design.iter().map(|(label, s)| {
-        let (s2a, c2a) = (2.0 * s.alpha).sin_cos();
-        let k = c2a + c * s.sin_alpha * s.sin_alpha * s2a;
+        let (s2a, c2a) = (2.0 * s.alpha_rad()).sin_cos();
+        let k = c2a + c * s.sin_alpha() * s.sin_alpha() * s2a;
         let v = Model::Stick
             .evaluate(&s.with_k(k).unwrap())
             .unwrap()
@@ -92,7 +92,7 @@ fn sbc_klaw_c_stick() {
             },
             priors: vec![("c".into(), prior.clone())],
             fit_scatter: false,
-            progress: false,
+            progress: None,
         }));
         let fit = fit_law_with(Model::Stick, &ds, KLaw::C, 0.9, &method).unwrap();
         let s = &fit.summary;

@@ -349,6 +349,66 @@ fn table(name: &str) -> Vec<std::collections::HashMap<String, String>> {
         .collect()
 }
 
+/// The slip approximation (eqs 54–59) near its own stop limit, against
+/// tests/reference/slip_approx_limit_refs.csv (made by tests/reference/slip_approx_limit_refs.py:
+/// mpmath quadrature of the approximate integrand at 40 digits, checked at 50, at exactly the
+/// double inputs). For nine scenes whose least approximate squared speed a′ − p lies inside the
+/// contact (the first: ξ = 4, δ = 22.551947104571017°, f = 0.2) and three where it lies at Θ0,
+/// K = K_lim (1 + η) with η = 1e-1 … 1e-12, where K_lim is the K at which that least value
+/// vanishes. v̄ is held to 8 cond·u, cond being the table's relative condition number of v̄ with
+/// respect to the inputs ξ, δ, K, f; the rows at η = −1e-3 and −1e-9 must stop (regime A),
+/// and the few rows at η = 1e-1 that lift off must do so (regime C).
+/// Print with `cargo test --release --test reference_models -- --nocapture`.
+#[test]
+fn slip_approx_near_its_stop_limit_within_8_cond_u() {
+    let (mut n_b, mut n_a, mut worst) = (0, 0, (0.0f64, String::new()));
+    let mut failures = Vec::new();
+    for r in table("slip_approx_limit_refs.csv") {
+        let x = |c: &str| r[c].parse::<f64>().unwrap();
+        let scene = Scene::from_radians(
+            x("xi"),
+            x("delta_rad"),
+            0.4, // the slip models do not depend on ρ
+            x("f"),
+            CollisionLaw::Value(x("K")),
+        )
+        .unwrap();
+        let out = Model::SlipApprox.evaluate(&scene);
+        let label = format!(
+            "xi={} delta_rad={} f={} eta={} ({})",
+            r["xi"], r["delta_rad"], r["f"], r["eta"], r["kind"]
+        );
+        match (r["regime"].as_str(), &out) {
+            ("B", Ok(s)) => {
+                let (v, cond) = (x("v"), x("cond"));
+                let e = (s.mean_velocity - v).abs() / v;
+                let ratio = e / (cond * U);
+                eprintln!("  {label}: rel {e:.2e}, cond {cond:.3e}, {ratio:.2} cond·u");
+                if ratio > worst.0 {
+                    worst = (ratio, label.clone());
+                }
+                if e > 8.0 * cond * U {
+                    failures.push(format!(
+                        "{label}: v {} vs {v}: rel {e:.2e} = {ratio:.1} cond·u",
+                        s.mean_velocity
+                    ));
+                }
+                n_b += 1;
+            }
+            (reg, Err(e)) if e.regime().map(|g| g.to_string()).as_deref() == Some(reg) => n_a += 1,
+            (reg, out) => {
+                failures.push(format!("{label}: reference regime {reg}, fitbead {out:?}"))
+            }
+        }
+    }
+    eprintln!(
+        "{n_b} steady rows, largest error {:.2} cond·u ({}); {n_a} rows in regime A or C agree",
+        worst.0, worst.1
+    );
+    assert!(n_b >= 70 && n_a >= 24, "{n_b} {n_a}");
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
 /// The collision laws given by name at large ξ, against tests/reference/named_law_refs.csv
 /// (made by tests/reference/named_law_refs.py with mpmath at 40 digits, K evaluated from the
 /// exact α of the double ξ and never rounded; each value checked by a second route at 50

@@ -473,3 +473,30 @@ fn named_laws_at_large_xi_within_1e_14() {
         failures.join("\n")
     );
 }
+
+/// At ρ = 0 rolling needs no friction (H = 0, eq 35), so the stick/slip model is the stick
+/// model, lift-off included. At ξ = 4, δ = 9.35014338756306°, K = 0.9278383671769062 the steady
+/// rolling state has N(Θf) = cos Θf − L² < 0 (eqs 19, 30a), so the normal force vanishes at
+/// Θf = δ + α = 20.887102°, not at Θ0 = −2.186816°.
+#[test]
+fn stickslip_at_rho_0_lifts_off_where_the_normal_force_vanishes() {
+    let (xi, deg, k): (f64, f64, f64) = (4.0, 9.35014338756306, 0.9278383671769062);
+    let alpha = (1.0f64 / (1.0 + xi)).asin();
+    let (delta, theta_f) = (deg.to_radians(), deg.to_radians() + alpha);
+    // Eq 19 at ρ = 0 and eq 30a: the rolling steady state lifts off at Θf.
+    let l2 = 4.0 * delta.sin() * alpha.sin() / (1.0 - k * k);
+    assert!(theta_f.cos() - l2 < 0.0);
+    for f in [0.01, 0.3] {
+        let scene = Scene::new(xi, deg, 0.0, f, CollisionLaw::Value(k)).unwrap();
+        let out = Model::StickSlip.evaluate(&scene);
+        let Err(e @ NotSteady::LiftOff { angle }) = out else {
+            panic!("f = {f}: expected lift-off, got {out:?}");
+        };
+        assert!(
+            (angle - theta_f).abs() <= 1e-12,
+            "f = {f}: {e} (Θf = {} deg)",
+            theta_f.to_degrees()
+        );
+        assert!(e.to_string().contains("20.887102"), "f = {f}: {e}");
+    }
+}

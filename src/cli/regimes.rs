@@ -3,7 +3,9 @@
 
 use super::{emit, CliError};
 use fitbead::io::fmt_f64;
-use fitbead::models::regimes::{alpha_of_xi, bulk_friction, critical_xi, delta_d, delta_m};
+use fitbead::models::regimes::{
+    alpha_of_xi, bulk_friction_law, critical_xi, delta_d_law, delta_m_law,
+};
 use fitbead::scene::CollisionLaw;
 use std::path::PathBuf;
 
@@ -67,14 +69,14 @@ pub fn run(a: Args) -> Result<(), CliError> {
                 format!("K = {k} at xi = {xi}: must be > 0"),
             ));
         }
-        let (dm, dd) = (delta_m(al, k), delta_d(al, k, a.rho));
+        let (dm, dd) = (delta_m_law(al, law, a.rho), delta_d_law(al, law, a.rho));
         w.write_record([
             fmt_f64(xi),
             fmt_f64(al.to_degrees()),
             fmt_f64(k),
             fmt_f64(dm.to_degrees()),
             fmt_f64(dd.to_degrees()),
-            fmt_f64(bulk_friction(al, k)),
+            fmt_f64(bulk_friction_law(al, law, a.rho)),
             (if dm < dd { "yes" } else { "no" }).to_string(),
             xc.map(fmt_f64).unwrap_or_default(),
         ])

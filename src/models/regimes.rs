@@ -7,20 +7,52 @@ use crate::special::root::brent;
 
 /// Lower limit of the steady regime, δ_m = 2 atan(tan(α/2) (1−K)/(1+K)) (eq 32), radians.
 pub fn delta_m(alpha: f64, k: f64) -> f64 {
-    2.0 * ((0.5 * alpha).tan() * (1.0 - k) / (1.0 + k)).atan()
+    delta_m_of(alpha, k, 1.0 - k)
 }
 
 /// Upper limit (lift-off at Θf), δ_d = atan((1+ρ)(1−K²) / (tan α (4 + (1+ρ)(1−K²)))) (eq 31),
 /// radians.
 pub fn delta_d(alpha: f64, k: f64, rho: f64) -> f64 {
-    let c = (1.0 + rho) * (1.0 - k) * (1.0 + k);
-    (c / (alpha.tan() * (4.0 + c))).atan()
+    delta_d_of(alpha, k, 1.0 - k, rho)
 }
 
 /// Bulk friction of the rolling model, μ = lim_{v→0} tan δ
 /// = (1 − K²) sin α / ((1 + K²) cos α + 2K) (eqs 78–79). Equals tan δ_m exactly.
 pub fn bulk_friction(alpha: f64, k: f64) -> f64 {
-    (1.0 - k) * (1.0 + k) * alpha.sin() / ((1.0 + k * k) * alpha.cos() + 2.0 * k)
+    bulk_friction_of(alpha, k, 1.0 - k)
+}
+
+/// [`delta_m`] for a collision law at α and ρ, with 1 − K from
+/// [`CollisionLaw::one_minus_k`]: for a named law it keeps its relative accuracy as ξ → ∞,
+/// where 1 − K ≈ 2 sin²α and the 1 − K of a double K would cost about u/(2 sin²α).
+pub fn delta_m_law(alpha: f64, law: CollisionLaw, rho: f64) -> f64 {
+    delta_m_of(alpha, law.k(alpha, rho), law.one_minus_k(alpha, rho))
+}
+
+/// [`delta_d`] for a collision law at α and ρ (1 − K as in [`delta_m_law`]).
+pub fn delta_d_law(alpha: f64, law: CollisionLaw, rho: f64) -> f64 {
+    delta_d_of(alpha, law.k(alpha, rho), law.one_minus_k(alpha, rho), rho)
+}
+
+/// [`bulk_friction`] (eq 79) for a collision law at α and ρ (1 − K as in [`delta_m_law`]).
+pub fn bulk_friction_law(alpha: f64, law: CollisionLaw, rho: f64) -> f64 {
+    bulk_friction_of(alpha, law.k(alpha, rho), law.one_minus_k(alpha, rho))
+}
+
+/// Eq 32 with K and 1 − K given separately.
+fn delta_m_of(alpha: f64, k: f64, omk: f64) -> f64 {
+    2.0 * ((0.5 * alpha).tan() * omk / (1.0 + k)).atan()
+}
+
+/// Eq 31 with K and 1 − K given separately.
+fn delta_d_of(alpha: f64, k: f64, omk: f64, rho: f64) -> f64 {
+    let c = (1.0 + rho) * omk * (1.0 + k);
+    (c / (alpha.tan() * (4.0 + c))).atan()
+}
+
+/// Eq 79 with K and 1 − K given separately.
+fn bulk_friction_of(alpha: f64, k: f64, omk: f64) -> f64 {
+    omk * (1.0 + k) * alpha.sin() / ((1.0 + k * k) * alpha.cos() + 2.0 * k)
 }
 
 /// The K whose stop limit δ_m is `delta` at contact angle `alpha` (eq 32 solved for K):
@@ -49,11 +81,11 @@ pub fn alpha_of_xi(xi: f64) -> f64 {
     (1.0 / (1.0 + xi)).asin()
 }
 
-/// δ_m and δ_d (radians) at radius ratio ξ for a collision law.
+/// δ_m and δ_d (radians) at radius ratio ξ for a collision law ([`delta_m_law`],
+/// [`delta_d_law`]).
 pub fn limits(xi: f64, law: CollisionLaw, rho: f64) -> (f64, f64) {
     let a = alpha_of_xi(xi);
-    let k = law.k(a, rho);
-    (delta_m(a, k), delta_d(a, k, rho))
+    (delta_m_law(a, law, rho), delta_d_law(a, law, rho))
 }
 
 /// Smallest ξ with a steady regime (δ_m < δ_d) for a law, where δ_m(ξ) = δ_d(ξ); `None` if the

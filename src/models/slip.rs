@@ -331,13 +331,16 @@ fn slip_time_in(
 
 /// The slip model's steady contact in double-double (about 30 digits), from the exact double
 /// inputs ξ, δ, K, f: α = asin(1/(1+ξ)) by [`Dd::asin`], Θ0 and Θf = δ ∓ α, L'² (eq 50
-/// corrected) and the coefficient a of eq 38 at Θ0. Two places need it: L'² where
-/// 1 − K² e^{4fα} is small (its double form loses digits in proportion, 4.6e-11 at 1e-6), and
-/// the speed minimum of a bead crawling over the top, a difference of O(1) terms.
+/// corrected) and the coefficient a of eq 38 at Θ0. Three places need it: L'² where
+/// 1 − K² e^{4fα} is small (its double form loses digits in proportion, 4.6e-11 at 1e-6),
+/// the speed minimum of a bead crawling over the top, a difference of O(1) terms, and the
+/// same minimum under the slip approximation ([`SlipDd::approx_speeds_sq`]).
 #[derive(Debug, Clone, Copy)]
 pub struct SlipDd {
     f: f64,
     th0: Dd,
+    sc0: (Dd, Dd),
+    scf: (Dd, Dd),
     a: Dd,
     b: Dd,
     c: Dd,
@@ -377,6 +380,8 @@ impl SlipDd {
         Ok(SlipDd {
             f,
             th0,
+            sc0: (s0, c0),
+            scf: (sf, cf),
             a: k2 * l2 - u0,
             b,
             c,
@@ -395,6 +400,39 @@ impl SlipDd {
             ae.mul_f64(self.f).scale(2.0) + self.b * c - self.c * s,
         )
     }
+
+    /// The squared speed of the slip approximation, a′ + b′ sin θ + c′ cos θ (eqs 56a–c), in
+    /// double-double: its least value a′ − p (eq 58c), formed as (a′² − b′² − c′²)/(a′ + p)
+    /// so that nothing cancels but the double-double numerator, and its values at Θ0 and Θf.
+    /// The coefficients come from e = a e^{−2fΘ0} (eq 53 with a at Θ0): a′ = e (1 + 4f²),
+    /// b′ = b + 2f e, c′ = c − 4f² e.
+    pub fn approx_speeds_sq(&self) -> ApproxSpeedsSq {
+        let f = self.f;
+        let e = self.a * (Dd::exp_m1(-self.th0.mul_f64(f).scale(2.0)) + Dd::from(1.0));
+        let f2x4 = Dd::prod(f, f).scale(4.0);
+        let a1 = e * (Dd::from(1.0) + f2x4);
+        let b1 = self.b + e.mul_f64(f).scale(2.0);
+        let c1 = self.c - e * f2x4;
+        let bc2 = b1 * b1 + c1 * c1;
+        let least = (a1 * a1 - bc2) / (a1 + bc2.sqrt());
+        let at = |(s, c): (Dd, Dd)| (a1 + b1 * s + c1 * c).to_f64();
+        ApproxSpeedsSq {
+            least: least.to_f64(),
+            at_0: at(self.sc0),
+            at_f: at(self.scf),
+        }
+    }
+}
+
+/// Squared speeds of the slip approximation from [`SlipDd::approx_speeds_sq`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ApproxSpeedsSq {
+    /// a′ − p: the least value over all θ (eq 58c).
+    pub least: f64,
+    /// At Θ0.
+    pub at_0: f64,
+    /// At Θf.
+    pub at_f: f64,
 }
 
 /// 1/n! for n = 0..=19 (each one division from the previous: the first terms, which dominate,
@@ -589,9 +627,32 @@ pub fn steady_tol(scene: &Scene, tol: f64) -> Outcome {
     Ok(s)
 }
 
+/// Below this fraction of a′, the least squared speed of the slip approximation on the contact
+/// (a′ − p inside it, or the value at an end) is taken from [`SlipDd::approx_speeds_sq`]. In
+/// double it is a difference of O(a′) terms that each carry a rounding error of order u a′, so
+/// its relative error is about u a′/least, while v̄ depends on it only through the
+/// problem's conditioning (at ξ = 4, δ = 22.551947104571017°, f = 0.2 the double path was
+/// 118 cond·u off at 1e-3 above the stop limit in K, 242 cond·u at 1e-9). Measured on
+/// tests/reference/slip_approx_limit_refs.csv in double: 9.9 cond·u at least/a′ = 6.8e-3, at
+/// most 1.2 cond·u from 1.4e-2 up, hence the threshold.
+const APPROX_DD_BELOW: f64 = 1e-2;
+
+/// A double least squared speed below this fraction of a′ is a stop whatever its rounding.
+const APPROX_DD_ABOVE: f64 = -1e-12;
+
+/// [`SlipDd::approx_speeds_sq`] of the slip model's steady contact of `scene`, kept out of
+/// line: the common double path of [`steady_approx`] does not need it.
+#[cold]
+#[inline(never)]
+fn approx_speeds_sq_dd(scene: &Scene) -> Result<ApproxSpeedsSq, NotSteady> {
+    Ok(SlipDd::new(scene)?.approx_speeds_sq())
+}
+
 /// Steady slip with the paper's approximation e^{2fθ} ≈ 1 + 4f² + 2f sin θ − 4f² cos θ
 /// (eqs 54–56 as used): Θ̇² ≈ a' + b' sin θ + c' cos θ = a' + p cos(θ − θ*), whose time is an
-/// elliptic integral (eqs 57–59), evaluated by [`cos_integral`].
+/// elliptic integral (eqs 57–59), evaluated by [`cos_integral`]. Near the approximation's own
+/// stop limit, where its least squared speed is below 1e-2 a′, that least value and the
+/// squared speeds at Θ0 and Θf come from double-double ([`SlipDd::approx_speeds_sq`]).
 pub fn steady_approx(scene: &Scene) -> Outcome {
     let l2 = slip_state(scene)?;
     let (b, c) = slip_coefficients(scene.f);
@@ -623,10 +684,16 @@ pub fn steady_approx(scene: &Scene) -> Outcome {
         });
     }
     let vsq = |th: f64| a1 + b1 * th.sin() + c1 * th.cos();
-    let w0 = vsq(scene.theta_0);
-    let wf = vsq(scene.theta_f);
-    let wt = a1 - p;
-    if !(w0 > 0.0 && wf > 0.0) || (psi0 < 0.0 && psif > 0.0 && !(wt > 0.0)) {
+    let mut w0 = vsq(scene.theta_0);
+    let mut wf = vsq(scene.theta_f);
+    let mut wt = a1 - p;
+    let interior = psi0 < 0.0 && psif > 0.0;
+    let least = if interior { wt } else { w0.min(wf) };
+    if least < APPROX_DD_BELOW * a1 && least > APPROX_DD_ABOVE * a1 {
+        let dd = approx_speeds_sq_dd(scene)?;
+        (wt, w0, wf) = (dd.least, dd.at_0, dd.at_f);
+    }
+    if !(w0 > 0.0 && wf > 0.0) || (interior && !(wt > 0.0)) {
         // The approximate speed² vanishes on the way: under this model the bead stops where
         // a' − p cos ψ = 0 before the top (ψ < 0).
         let psi_stop = -(a1 / p).clamp(-1.0, 1.0).acos();

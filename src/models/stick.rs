@@ -14,22 +14,36 @@ pub fn final_velocity_sq(scene: &Scene) -> f64 {
 /// P = sin(Θ0/2) + K sin(Θf/2) = cos(δ/2) cos(α/2) [(1+K) tan(δ/2) − (1−K) tan(α/2)]:
 /// the factor of the squared top velocity that vanishes at δ = δ_m (eq 32). The bracket is
 /// recomputed in double-double when it cancels, so P keeps its relative accuracy for δ as close
-/// to δ_m as the double inputs allow.
+/// to δ_m as the double inputs allow; 1 − K comes from [`Scene::one_minus_k`] (exact for a
+/// number K, from sin²α for a named law).
 pub fn lower_limit_factor(scene: &Scene) -> f64 {
     let k = scene.k;
+    let omk = scene.one_minus_k();
     let (sd, cd) = (scene.sc_half_delta.s, scene.sc_half_delta.c);
     let ta = scene.tan_half_alpha.to_f64();
     let td = sd / cd;
     let up = (1.0 + k) * td;
-    let mut bracket = up - (1.0 - k) * ta;
+    let mut bracket = up - omk * ta;
     if bracket.abs() < 1e-3 * up.abs() {
-        let (s, c) = Dd::sin_cos(0.5 * scene.delta);
-        let one = Dd::from(1.0);
-        let kd = Dd::from(k);
-        let b = (one + kd) * (s / c) - (one - kd) * scene.tan_half_alpha;
-        bracket = b.to_f64();
+        bracket = lower_limit_bracket_dd(scene, omk);
     }
     cd * scene.sc_half_alpha.c * bracket
+}
+
+/// The bracket (1+K) tan(δ/2) − (1−K) tan(α/2) of [`lower_limit_factor`] in double-double,
+/// with 1 − K exact for a number K and `omk` (relative error ~u) for a named law.
+#[cold]
+#[inline(never)]
+fn lower_limit_bracket_dd(scene: &Scene, omk: f64) -> f64 {
+    let (s, c) = Dd::sin_cos(0.5 * scene.delta);
+    let one = Dd::from(1.0);
+    let kd = Dd::from(scene.k);
+    let omk = if scene.law.is_value() {
+        one - kd
+    } else {
+        Dd::from(omk)
+    };
+    ((one + kd) * (s / c) - omk * scene.tan_half_alpha).to_f64()
 }
 
 /// Squared velocity at the top Θ = 0 in the steady rolling state:

@@ -470,6 +470,16 @@ fn other_fixed_point(scene: &Scene, x: f64) -> Option<f64> {
     None
 }
 
+/// ρ = 0: rolling needs no friction (H = 0, eq 35), so the bead never slips and the model is
+/// the stick model, its regimes and the angles it reports included. (Eq 36 then gives the
+/// angle where the normal force of the rolling motion vanishes, not a friction limit; it is
+/// reported as Θ_G, as on the no-slip branch.)
+fn rolling_without_friction(scene: &Scene) -> Outcome {
+    let mut out = stick::steady(scene)?;
+    out.theta_g = theta_g(scene, out.initial_velocity * out.initial_velocity);
+    Ok(out)
+}
+
 /// Steady stick/slip state: mean velocity v̄'' = 2 sin α / τ'' (eq 68), τ'' = rolling time to
 /// Θ_G (eq 64, Carlson form) + slip time to Θf (eq 65, quadrature to 1e-14).
 pub fn steady(scene: &Scene) -> Outcome {
@@ -489,6 +499,9 @@ pub fn steady_lean(scene: &Scene) -> Outcome {
 }
 
 fn steady_with(scene: &Scene, tol: f64, diagnostics: bool) -> Outcome {
+    if scene.rho == 0.0 {
+        return rolling_without_friction(scene);
+    }
     let x_hi = scene.sc_f.c.max(0.0).sqrt();
     // Start from the rolling steady state when it exists (its contact time, an elliptic
     // integral, only when it is the answer).

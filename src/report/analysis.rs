@@ -13,7 +13,7 @@ use crate::fit::summary::{FitResult, ParamRow};
 use crate::inverse::{Model as _, Residuals, SigmaKind};
 use crate::io::fmt_f64;
 use crate::models::energy;
-use crate::models::regimes::{bulk_friction, critical_xi, delta_d, delta_m};
+use crate::models::regimes::{bulk_friction, critical_xi, delta_d_law, delta_m_law};
 use crate::models::{regime_of, ForwardModel, JaegerBranch, Model, Regime};
 use crate::scene::CollisionLaw;
 use rayon::prelude::*;
@@ -482,8 +482,8 @@ impl Analysis {
                     fmt_f64(xi),
                     fmt_f64(a.to_degrees()),
                     fmt_f64(k),
-                    fmt_f64(delta_m(a, k).to_degrees()),
-                    fmt_f64(delta_d(a, k, rho).to_degrees()),
+                    fmt_f64(delta_m_law(a, law, rho).to_degrees()),
+                    fmt_f64(delta_d_law(a, law, rho).to_degrees()),
                     opt(crit),
                 ])?;
             }
@@ -1222,9 +1222,8 @@ impl Analysis {
             for i in 0..=100 {
                 let xi = 0.5 * 40f64.powf(i as f64 / 100.0);
                 let a = crate::models::regimes::alpha_of_xi(xi);
-                let k = law.k(a, rho);
-                lm.push((a.to_degrees(), delta_m(a, k).to_degrees()));
-                ld.push((a.to_degrees(), delta_d(a, k, rho).to_degrees()));
+                lm.push((a.to_degrees(), delta_m_law(a, law, rho).to_degrees()));
+                ld.push((a.to_degrees(), delta_d_law(a, law, rho).to_degrees()));
             }
             curves.push((format!("delta_m (thick), delta_d (thin): {name}"), lm));
             curves.push((String::new(), ld));

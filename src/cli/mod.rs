@@ -66,7 +66,40 @@ pub enum CliError {
     Other(String),
     /// Stopped by Ctrl-C after writing what there was (exit 130).
     Interrupted,
+    /// Reading or writing failed (a closed pipe on stdout is not an error: exit 0).
+    Io(std::io::Error),
 }
+
+impl From<std::io::Error> for CliError {
+    fn from(e: std::io::Error) -> Self {
+        CliError::Io(e)
+    }
+}
+
+impl From<csv::Error> for CliError {
+    fn from(e: csv::Error) -> Self {
+        if e.is_io_error() {
+            match e.into_kind() {
+                csv::ErrorKind::Io(io) => CliError::Io(io),
+                k => CliError::Other(format!("{k:?}")),
+            }
+        } else {
+            CliError::Other(e.to_string())
+        }
+    }
+}
+
+impl From<fitbead::Error> for CliError {
+    fn from(e: fitbead::Error) -> Self {
+        match e {
+            fitbead::Error::Input(i) => CliError::Input(i),
+            fitbead::Error::Io(io) => CliError::Io(io),
+            e => CliError::Other(e.to_string()),
+        }
+    }
+}
+
+impl std::error::Error for CliError {}
 
 impl From<InputError> for CliError {
     fn from(e: InputError) -> Self {
@@ -82,6 +115,7 @@ impl std::fmt::Display for CliError {
             CliError::Interrupted => f.write_str(
                 "interrupted (Ctrl-C): the outputs hold the draws so far, marked interrupted",
             ),
+            CliError::Io(e) => write!(f, "{e}"),
         }
     }
 }
@@ -101,6 +135,7 @@ pub fn run(cli: Cli) -> i32 {
     };
     match r {
         Ok(()) => 0,
+        Err(CliError::Io(e)) if e.kind() == std::io::ErrorKind::BrokenPipe => 0,
         Err(CliError::Interrupted) => {
             eprintln!("fitbead: {}", CliError::Interrupted);
             130
@@ -133,13 +168,19 @@ pub fn emit(output: Option<&Path>, bytes: &[u8]) -> Result<(), CliError> {
     match output {
         Some(p) => write_atomic(p, bytes)
             .map_err(|e| CliError::Other(format!("{}: cannot write: {e}", p.display()))),
-        None => {
-            use std::io::Write;
-            let mut out = std::io::stdout().lock();
-            out.write_all(bytes)
-                .and_then(|_| out.flush())
-                .map_err(|e| CliError::Other(format!("<stdout>: {e}")))
-        }
+        None => print_stdout(bytes),
+    }
+}
+
+/// Writes `bytes` to stdout. A reader that closed the pipe early (`fitbead … | head -1`) is
+/// [`CliError::Io`] with kind `BrokenPipe`, which [`run`] turns into a quiet exit 0.
+pub fn print_stdout(bytes: &[u8]) -> Result<(), CliError> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(bytes).and_then(|_| out.flush()) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Err(CliError::Io(e)),
+        Err(e) => Err(CliError::Other(format!("<stdout>: {e}"))),
     }
 }
 

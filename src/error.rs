@@ -4,6 +4,7 @@
 //! `Box<dyn std::error::Error>`.
 
 use crate::fit::data::DataError;
+use crate::fit::error::FitError;
 use crate::fit::k::KFailure;
 use crate::fit::klaw::KLawError;
 use crate::inverse::{LsqError, McmcError};
@@ -40,20 +41,18 @@ pub enum Error {
     /// The posterior sampler refused its problem.
     #[error(transparent)]
     Mcmc(#[from] McmcError),
-    /// A fit that cannot be made (too few points, no starting point, …), with why.
-    #[error("{0}")]
-    Fit(String),
-    /// A parameter name that the fit does not have.
-    #[error("no parameter '{name}' in this fit (it has: {have})")]
-    NoSuchParameter {
-        /// The name asked for.
-        name: String,
-        /// The names the fit has, comma-separated.
-        have: String,
-    },
+    /// A fit that cannot be made, or a parameter the fit does not have.
+    #[error(transparent)]
+    Fit(#[from] FitError),
     /// Reading or writing a file failed.
     #[error(transparent)]
     Io(#[from] std::io::Error),
+}
+
+impl From<crate::fit::summary::NoSuchParameter> for Error {
+    fn from(e: crate::fit::summary::NoSuchParameter) -> Self {
+        Error::Fit(e.into())
+    }
 }
 
 /// Result alias for library calls.

@@ -3,6 +3,7 @@
 pub use crate::error::{Error, Result};
 pub use crate::fit::builder::{JaegerFitter, JanFitter, KLawFitter};
 pub use crate::fit::data::Dataset;
+pub use crate::fit::error::FitError;
 pub use crate::fit::k::{estimate as estimate_k, KEstimate, KFailure};
 pub use crate::fit::klaw::KLaw;
 pub use crate::fit::report::FitSet;

@@ -11,6 +11,7 @@
 //! ```
 
 use super::data::Dataset;
+use super::error::FitError;
 use super::jaeger::fit_jaeger_with;
 use super::jan::fit_jan_with;
 use super::klaw::{fit_law_with, KLaw};
@@ -37,14 +38,11 @@ impl Default for Common {
 }
 
 impl Common {
-    fn check(&self) -> crate::Result<()> {
+    fn check(&self) -> Result<(), FitError> {
         if self.level > 0.0 && self.level < 1.0 {
             Ok(())
         } else {
-            Err(crate::Error::Fit(format!(
-                "confidence level {} is not in (0, 1)",
-                self.level
-            )))
+            Err(FitError::Level(self.level))
         }
     }
 }
@@ -94,7 +92,7 @@ impl KLawFitter {
     common_setters!();
 
     /// Fits the law to `data` (the impact law, with nothing to fit, is scored).
-    pub fn fit(&self, data: &Dataset) -> crate::Result<FitResult> {
+    pub fn fit(&self, data: &Dataset) -> Result<FitResult, FitError> {
         self.common.check()?;
         let f = fit_law_with(
             self.model,
@@ -122,7 +120,7 @@ impl JanFitter {
     common_setters!();
 
     /// Fits every series with at least 3 points, then the global laws.
-    pub fn fit(&self, data: &Dataset) -> crate::Result<FitSet> {
+    pub fn fit(&self, data: &Dataset) -> Result<FitSet, FitError> {
         self.common.check()?;
         let j = fit_jan_with(data, self.common.level, &self.common.method);
         Ok(FitSet {
@@ -157,7 +155,7 @@ impl JaegerFitter {
     common_setters!();
 
     /// Fits every series with at least 4 points.
-    pub fn fit(&self, data: &Dataset) -> crate::Result<FitSet> {
+    pub fn fit(&self, data: &Dataset) -> Result<FitSet, FitError> {
         self.common.check()?;
         let j = fit_jaeger_with(data, self.branch, self.common.level, &self.common.method);
         Ok(FitSet {

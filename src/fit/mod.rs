@@ -5,6 +5,7 @@
 
 pub mod builder;
 pub mod data;
+pub mod error;
 pub mod jaeger;
 pub mod jan;
 pub mod k;

@@ -260,14 +260,24 @@ pub struct PointFit {
     pub normalised_residual: f64,
 }
 
+/// A parameter name that a fit does not have.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("no parameter '{name}' in this fit (it has: {have})")]
+pub struct NoSuchParameter {
+    /// The name asked for.
+    pub name: String,
+    /// The names the fit has, comma-separated.
+    pub have: String,
+}
+
 impl FitResult {
     /// The parameter called `name`; a fit with one parameter per series (`K` of
     /// `free-per-series`) names them `K[series]`, and `K` alone is the first.
-    pub fn param(&self, name: &str) -> crate::Result<&ParamRow> {
+    pub fn param(&self, name: &str) -> Result<&ParamRow, NoSuchParameter> {
         self.params
             .iter()
             .find(|r| r.parameter == name || self.qualified_name(r) == name)
-            .ok_or_else(|| crate::Error::NoSuchParameter {
+            .ok_or_else(|| NoSuchParameter {
                 name: name.to_string(),
                 have: self.param_names().join(", "),
             })

@@ -277,7 +277,7 @@ impl MeasurementFile {
 impl Dataset {
     /// Reads a measurement CSV (module docs for its columns and units) with the default ρ,
     /// f and g of [`MeasurementDefaults::default`].
-    pub fn from_csv(path: impl AsRef<Path>) -> crate::Result<Dataset> {
+    pub fn from_csv(path: impl AsRef<Path>) -> Result<Dataset, InputError> {
         Self::from_csv_with(path, &MeasurementDefaults::default())
     }
 
@@ -285,7 +285,7 @@ impl Dataset {
     pub fn from_csv_with(
         path: impl AsRef<Path>,
         defaults: &MeasurementDefaults,
-    ) -> crate::Result<Dataset> {
+    ) -> Result<Dataset, InputError> {
         Ok(MeasurementFile::read(path.as_ref(), defaults)?.dataset)
     }
 

@@ -1,0 +1,20 @@
+//! Why a fit across series cannot be made or queried.
+
+use super::klaw::KLawError;
+use super::summary::NoSuchParameter;
+use thiserror::Error;
+
+/// Why a fit cannot be made, or a result has no such parameter.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum FitError {
+    /// The K(α) law cannot be fitted to the data.
+    #[error(transparent)]
+    KLaw(#[from] KLawError),
+    /// A confidence level outside (0, 1).
+    #[error("confidence level {0} is not in (0, 1)")]
+    Level(f64),
+    /// A parameter name that the fit does not have.
+    #[error(transparent)]
+    NoSuchParameter(#[from] NoSuchParameter),
+}

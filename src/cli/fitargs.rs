@@ -2,12 +2,13 @@
 
 use super::{emit, read_input, CliError};
 use fitbead::fit::data::Dataset;
-use fitbead::fit::posterior::{draws_column, McmcSettings, Method, Prior, SCALE_NAME};
-use fitbead::fit::summary::{params_csv, stats_csv, FitResult, ParamRow, StatsRow};
+use fitbead::fit::posterior::{McmcSettings, Method, Prior, SCALE_NAME};
+use fitbead::fit::summary::{FitResult, ParamRow, StatsRow};
 use fitbead::inverse::mcmc::McmcOptions;
 use fitbead::io::measurements::{dataset_of, read_measurements, Measurement};
+use fitbead::io::reports::{draws_csv, params_csv, stats_csv};
 use fitbead::io::scenes::Table;
-use fitbead::io::{fmt_f64, fmt_sig, write_atomic_all};
+use fitbead::io::{fmt_sig, write_atomic_all};
 use fitbead::report::figures::{corner_svg, CornerBlock};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -304,52 +305,4 @@ impl FitArgs {
         }
         Ok(())
     }
-}
-
-/// The draws of every posterior as one CSV: fit, series, walker, step, the union of the
-/// parameter columns (empty where a fit has no such parameter), log_posterior.
-pub fn draws_csv(posteriors: &[&FitResult]) -> csv::Result<Vec<u8>> {
-    let mut columns: Vec<String> = Vec::new();
-    for p in posteriors {
-        for r in &p.params {
-            let c = draws_column(p, r);
-            if !columns.contains(&c) {
-                columns.push(c);
-            }
-        }
-    }
-    let mut w = csv::Writer::from_writer(Vec::new());
-    let mut header: Vec<String> = ["fit", "series", "walker", "step"]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-    header.extend(columns.iter().cloned());
-    header.push("log_posterior".into());
-    w.write_record(&header)?;
-    for p in posteriors {
-        let Some(d) = &p.draws else { continue };
-        let idx: Vec<usize> = p
-            .params
-            .iter()
-            .map(|r| {
-                let c = draws_column(p, r);
-                columns.iter().position(|x| *x == c).unwrap_or(0)
-            })
-            .collect();
-        for (wk, chain) in d.chains.iter().enumerate() {
-            for (k, x) in chain.iter().enumerate() {
-                let mut rec = vec![String::new(); header.len()];
-                rec[0] = p.stats.fit.clone();
-                rec[1] = p.stats.series.clone();
-                rec[2] = wk.to_string();
-                rec[3] = d.step(k).to_string();
-                for (j, v) in x.iter().enumerate() {
-                    rec[4 + idx[j]] = fmt_f64(*v);
-                }
-                rec[header.len() - 1] = fmt_f64(d.log_posterior[wk][k]);
-                w.write_record(&rec)?;
-            }
-        }
-    }
-    w.into_inner().map_err(|e| e.into_error().into())
 }

@@ -189,11 +189,11 @@ pub fn run(a: Args) -> Result<(), CliError> {
     );
     files.push((
         "params.csv".into(),
-        fitbead::fit::summary::params_csv(&params).map_err(csv_err)?,
+        fitbead::io::reports::params_csv(&params).map_err(csv_err)?,
     ));
     files.push((
         "stats.csv".into(),
-        fitbead::fit::summary::stats_csv(&stats).map_err(csv_err)?,
+        fitbead::io::reports::stats_csv(&stats).map_err(csv_err)?,
     ));
     let fig = |name: &str, r: Result<String, String>| {
         r.map(|s| (name.to_string(), s.into_bytes()))

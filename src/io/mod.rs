@@ -1,6 +1,7 @@
 //! Files: CSV reading with errors that name file, line, column and value; atomic writing.
 
 pub mod measurements;
+pub mod reports;
 pub mod scenes;
 
 pub use crate::numfmt::{fmt_f64, fmt_sig, push_f64};

@@ -1,0 +1,268 @@
+//! The CSV schemas of the fit reports: one row per parameter (`--output`, params.csv), one row
+//! of statistics per fit (`--output-stats`, stats.csv), and the posterior draws (`--draws`).
+
+use crate::fit::posterior::draws_column;
+use crate::fit::summary::{FitResult, ParamRow, StatsRow};
+use crate::inverse::{ProfileEnd, SigmaKind};
+use crate::numfmt::fmt_f64;
+
+/// The contract columns of the parameter report, in order.
+pub const PARAM_COLUMNS: [&str; 9] = [
+    "fit",
+    "series",
+    "parameter",
+    "value",
+    "stderr",
+    "ci_low",
+    "ci_high",
+    "ci_method",
+    "unit",
+];
+
+/// Columns of the parameter report after the contract ones (`cov_low`/`cov_high` are the
+/// uncut covariance interval).
+pub const PARAM_EXTRA_COLUMNS: [&str; 11] = [
+    "level",
+    "cov_low",
+    "cov_high",
+    "profile_low",
+    "profile_high",
+    "profile_low_status",
+    "profile_high_status",
+    "at_bound",
+    "paper_value",
+    "paper_source",
+    "note",
+];
+
+/// Posterior columns of the parameter report, after [`PARAM_EXTRA_COLUMNS`]: filled by MCMC
+/// (`ci_method = posterior`), empty for least squares but `lsq_value` (the least-squares
+/// optimum, the start of the chains).
+pub const PARAM_POSTERIOR_COLUMNS: [&str; 10] = [
+    "mean",
+    "sd",
+    "q2.5",
+    "q50",
+    "q97.5",
+    "ess_bulk",
+    "ess_tail",
+    "rhat",
+    "tau",
+    "lsq_value",
+];
+
+/// Columns of the statistics report.
+pub const STATS_COLUMNS: [&str; 28] = [
+    "fit",
+    "series",
+    "n_points",
+    "n_params",
+    "chi2",
+    "dof",
+    "reduced_chi2",
+    "aic",
+    "bic",
+    "termination",
+    "converged",
+    "iterations",
+    "residual_evals",
+    "sigma",
+    "condition",
+    "note",
+    "method",
+    "mcmc_status",
+    "walkers",
+    "steps",
+    "burn_in",
+    "draws",
+    "acceptance",
+    "ess_min",
+    "rhat_max",
+    "waic",
+    "p_waic",
+    "waic_se",
+];
+
+fn end_value(e: ProfileEnd) -> Option<f64> {
+    match e {
+        ProfileEnd::Found(v) | ProfileEnd::Bound(v) | ProfileEnd::Edge(v) => Some(v),
+        ProfileEnd::NotFound => None,
+    }
+}
+
+fn end_status(e: ProfileEnd) -> &'static str {
+    match e {
+        ProfileEnd::Found(_) => "found",
+        ProfileEnd::Bound(_) => "bound",
+        ProfileEnd::Edge(_) => "edge",
+        ProfileEnd::NotFound => "not_found",
+    }
+}
+
+fn opt(x: Option<f64>) -> String {
+    x.map(fmt_f64).unwrap_or_default()
+}
+
+/// The parameter report as CSV: the contract columns, then [`PARAM_EXTRA_COLUMNS`].
+pub fn params_csv(rows: &[ParamRow]) -> csv::Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(
+        PARAM_COLUMNS
+            .iter()
+            .chain(PARAM_EXTRA_COLUMNS.iter())
+            .chain(PARAM_POSTERIOR_COLUMNS.iter()),
+    )?;
+    for r in rows {
+        let (ci, method) = r.interval();
+        let (pl, ph) = match r.profile {
+            Some((a, b)) => (
+                (opt(end_value(a)), end_status(a)),
+                (opt(end_value(b)), end_status(b)),
+            ),
+            None => ((String::new(), "none"), (String::new(), "none")),
+        };
+        w.write_record([
+            r.fit.clone(),
+            r.series.clone(),
+            r.parameter.clone(),
+            fmt_f64(r.value),
+            opt(r.stderr),
+            opt(ci.map(|c| c.0)),
+            opt(ci.map(|c| c.1)),
+            method.to_string(),
+            r.unit.to_string(),
+            fmt_f64(r.level),
+            opt(r.cov.map(|c| c.0)),
+            opt(r.cov.map(|c| c.1)),
+            pl.0,
+            ph.0,
+            pl.1.to_string(),
+            ph.1.to_string(),
+            r.at_bound.to_string(),
+            opt(r.paper_value),
+            r.paper_source.to_string(),
+            r.note.clone(),
+            opt(r.posterior.as_ref().map(|d| d.mean)),
+            opt(r.posterior.as_ref().map(|d| d.sd)),
+            opt(r.posterior.as_ref().map(|d| d.q025)),
+            opt(r.posterior.as_ref().map(|d| d.median)),
+            opt(r.posterior.as_ref().map(|d| d.q975)),
+            opt(r.posterior.as_ref().map(|d| d.ess_bulk)),
+            opt(r.posterior.as_ref().map(|d| d.ess_tail)),
+            opt(r.posterior.as_ref().map(|d| d.rhat)),
+            opt(r.posterior.as_ref().map(|d| d.tau)),
+            opt(r.lsq_value),
+        ])?;
+    }
+    w.into_inner().map_err(|e| e.into_error().into())
+}
+
+/// The statistics report as CSV ([`STATS_COLUMNS`]).
+pub fn stats_csv(rows: &[StatsRow]) -> csv::Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(STATS_COLUMNS)?;
+    for r in rows {
+        w.write_record([
+            r.fit.clone(),
+            r.series.clone(),
+            r.n_points.to_string(),
+            r.n_params.to_string(),
+            fmt_f64(r.chi2),
+            r.dof.to_string(),
+            fmt_f64(r.reduced_chi2),
+            fmt_f64(r.aic),
+            fmt_f64(r.bic),
+            r.termination.clone(),
+            r.converged.to_string(),
+            r.iterations.to_string(),
+            r.residual_evals.to_string(),
+            match r.sigma {
+                SigmaKind::Absolute => "given",
+                SigmaKind::Relative => "estimated",
+            }
+            .to_string(),
+            opt(r.condition),
+            r.note.clone(),
+            if r.mcmc.is_some() { "mcmc" } else { "lsq" }.to_string(),
+            r.mcmc
+                .as_ref()
+                .map(|m| m.status.clone())
+                .unwrap_or_default(),
+            r.mcmc
+                .as_ref()
+                .map(|m| m.walkers.to_string())
+                .unwrap_or_default(),
+            r.mcmc
+                .as_ref()
+                .map(|m| m.steps.to_string())
+                .unwrap_or_default(),
+            r.mcmc
+                .as_ref()
+                .map(|m| m.burn_in.to_string())
+                .unwrap_or_default(),
+            r.mcmc
+                .as_ref()
+                .map(|m| m.draws.to_string())
+                .unwrap_or_default(),
+            opt(r.mcmc.as_ref().map(|m| m.acceptance)),
+            opt(r.mcmc.as_ref().map(|m| m.ess_min).filter(|v| v.is_finite())),
+            opt(r
+                .mcmc
+                .as_ref()
+                .map(|m| m.rhat_max)
+                .filter(|v| v.is_finite())),
+            opt(r.mcmc.as_ref().and_then(|m| m.waic).map(|w| w.0)),
+            opt(r.mcmc.as_ref().and_then(|m| m.waic).map(|w| w.1)),
+            opt(r.mcmc.as_ref().and_then(|m| m.waic).map(|w| w.2)),
+        ])?;
+    }
+    w.into_inner().map_err(|e| e.into_error().into())
+}
+
+/// The draws of every posterior as one CSV: fit, series, walker, step, the union of the
+/// parameter columns (empty where a fit has no such parameter), log_posterior.
+pub fn draws_csv(posteriors: &[&FitResult]) -> csv::Result<Vec<u8>> {
+    let mut columns: Vec<String> = Vec::new();
+    for p in posteriors {
+        for r in &p.params {
+            let c = draws_column(p, r);
+            if !columns.contains(&c) {
+                columns.push(c);
+            }
+        }
+    }
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let mut header: Vec<String> = ["fit", "series", "walker", "step"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    header.extend(columns.iter().cloned());
+    header.push("log_posterior".into());
+    w.write_record(&header)?;
+    for p in posteriors {
+        let Some(d) = &p.draws else { continue };
+        let idx: Vec<usize> = p
+            .params
+            .iter()
+            .map(|r| {
+                let c = draws_column(p, r);
+                columns.iter().position(|x| *x == c).unwrap_or(0)
+            })
+            .collect();
+        for (wk, chain) in d.chains.iter().enumerate() {
+            for (k, x) in chain.iter().enumerate() {
+                let mut rec = vec![String::new(); header.len()];
+                rec[0] = p.stats.fit.clone();
+                rec[1] = p.stats.series.clone();
+                rec[2] = wk.to_string();
+                rec[3] = d.step(k).to_string();
+                for (j, v) in x.iter().enumerate() {
+                    rec[4 + idx[j]] = fmt_f64(*v);
+                }
+                rec[header.len() - 1] = fmt_f64(d.log_posterior[wk][k]);
+                w.write_record(&rec)?;
+            }
+        }
+    }
+    w.into_inner().map_err(|e| e.into_error().into())
+}

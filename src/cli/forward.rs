@@ -1,21 +1,23 @@
 //! `fitbead forward`: mean velocity, regime and diagnostics of each scene under one model.
+//! The rows stream through the library's engine (`fitbead::io::stream`) with the scene plan
+//! of `fitbead::io::forward`; md, whose runs are long and few, reads the whole table.
 
 use super::{emit, read_input, CliError};
-use fitbead::io::scenes::{line_of, Row, Table, TableReader};
-use fitbead::io::{fmt_f64, push_csv_field, push_f64, AtomicFile, InputError};
-use fitbead::models::auto::{Auto, AutoOutcome};
-use fitbead::models::contact::{Contact, SpinRule, SteadyContact};
-use fitbead::models::jaeger::Jaeger;
-use fitbead::models::jan::Jan;
+use fitbead::io::forward::{scene_error, ForwardPlan, ForwardSettings, SceneColumns};
+use fitbead::io::scenes::{Table, TableReader};
+use fitbead::io::stream::{stream, RowPlan, StreamError, StreamOptions, Streamed};
+use fitbead::io::{fmt_f64, AtomicFile, InputError};
 use fitbead::models::md::{Md, MdParams, MdResult, MdRunConfig, ReducedMass};
 use fitbead::models::Regime;
-use fitbead::models::{regime_of, ForwardModel, JaegerBranch, Model, ModelKind, Outcome};
+use fitbead::models::{regime_of, JaegerBranch, Model, ModelKind};
 use fitbead::scene::ParameterError as Error;
 use fitbead::scene::{CollisionLaw, Scene};
 use rayon::prelude::*;
 use std::fs::File;
 use std::io::{Cursor, Read, Write};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 /// Arguments of `fitbead forward`.
 #[derive(Debug, clap::Args)]
@@ -80,75 +82,6 @@ pub struct Args {
     pub md: MdArgs,
 }
 
-/// Columns added after [`OUTPUT_COLUMNS`] by --model contact.
-pub const CONTACT_COLUMNS: [&str; 10] = [
-    "phase_sequence",
-    "phase_change_deg",
-    "initial_spin",
-    "final_spin",
-    "beads",
-    "collision_translation_frac",
-    "collision_spin_frac",
-    "friction_work_frac",
-    "energy_closure",
-    "spin_rule",
-];
-
-/// Columns added after [`OUTPUT_COLUMNS`] by --model auto: the model used and why.
-pub const AUTO_COLUMNS: [&str; 2] = ["model_used", "reason"];
-
-/// Output columns added to each row.
-pub const OUTPUT_COLUMNS: [&str; 12] = [
-    "v",
-    "regime",
-    "status",
-    "K_used",
-    "final_velocity",
-    "initial_velocity",
-    "contact_time",
-    "theta_G_deg",
-    "map_slope",
-    "other_fixed_point",
-    "phases",
-    "message",
-];
-
-/// Rows read, checked, evaluated and formatted per step of the streaming path: memory stays
-/// bounded by two chunks of input records and one of output bytes.
-const CHUNK_ROWS: usize = 32 * 1024;
-/// Rows per parallel task within a chunk.
-const TASK_ROWS: usize = 512;
-
-struct Job {
-    scene: Scene,
-    model: Model,
-}
-
-fn field_column(field: &str) -> &str {
-    match field {
-        "delta" => "delta_deg",
-        other => other,
-    }
-}
-
-fn scene_error(r: &Row, e: Error, cols: &[(&str, Option<usize>)]) -> InputError {
-    let field = match &e {
-        Error::InvalidParameter { field, .. } => field_column(field).to_string(),
-        Error::UnknownLaw(_) => "K".into(),
-        Error::UnknownModel(_) => "model".into(),
-    };
-    match cols.iter().find(|(n, _)| *n == field).and_then(|(_, c)| *c) {
-        Some(c) => r.err(c, e.to_string()),
-        None => InputError {
-            file: "<command line>".into(),
-            line: None,
-            column: Some(format!("--{field}")),
-            value: None,
-            message: format!("{e} (line {} of {})", r.line, r.source),
-        },
-    }
-}
-
 /// Runs `fitbead forward`.
 pub fn run(a: Args) -> Result<(), CliError> {
     let kind: ModelKind = a.model.parse().map_err(|_| {
@@ -178,533 +111,190 @@ pub fn run(a: Args) -> Result<(), CliError> {
         let t = Table::parse(&source, &text)?;
         return run_md(&a, &t);
     }
-    let (source, input): (String, Box<dyn Read + Send>) = match (single, a.input.as_deref()) {
-        (Some(text), _) => ("<command line>".to_string(), Box::new(Cursor::new(text))),
-        (None, None) => (
+    let (source, input, size) = match single {
+        Some(text) => {
+            let n = text.len() as u64;
+            (
+                "<command line>".to_string(),
+                Input::Text(Cursor::new(text)),
+                n,
+            )
+        }
+        None => open_input(a.input.as_deref())?,
+    };
+    let reader = TableReader::new(&source, input)?;
+    let opts = stream_options("forward", size);
+    let make = |r: &TableReader<Input>| plan(&a, kind, branch, r);
+    stream_to(reader, make, (), a.output.as_deref(), &opts, |_| Ok(())).map(|_| ())
+}
+
+/// The scene plan of `a` for a table with `r`'s header: the columns first, then the flags
+/// (`--spin`, `--tol`, `--K`), so that their errors come in that order.
+fn plan<R: Read>(
+    a: &Args,
+    kind: ModelKind,
+    branch: JaegerBranch,
+    r: &TableReader<R>,
+) -> Result<ForwardPlan, InputError> {
+    let cols = SceneColumns::new(r)?;
+    let spin = a
+        .spin
+        .parse()
+        .map_err(|e: Error| flag_input_error("--spin", &a.spin, e.to_string()))?;
+    if !(a.tol > 0.0 && a.tol < 1.0) {
+        return Err(flag_input_error(
+            "--tol",
+            &a.tol.to_string(),
+            "expected a relative tolerance in (0, 1)",
+        ));
+    }
+    let law =
+        a.k.parse()
+            .map_err(|e: Error| flag_input_error("--K", &a.k, e.to_string()))?;
+    let settings = ForwardSettings {
+        kind,
+        law,
+        rho: a.rho,
+        f: a.f,
+        lambda: a.lambda,
+        mu: a.mu,
+        a: [a.a1, a.a2, a.a3],
+        branch,
+        spin,
+        tol: a.tol,
+    };
+    Ok(ForwardPlan::new(r, cols, settings))
+}
+
+/// A flag error as the input error it is reported as.
+pub(super) fn flag_input_error(flag: &str, value: &str, message: impl Into<String>) -> InputError {
+    InputError {
+        file: "<command line>".into(),
+        line: None,
+        column: Some(flag.to_string()),
+        value: Some(value.to_string()),
+        message: message.into(),
+    }
+}
+
+/// A streamed input: a file, the embedded default data, or text from the command line.
+pub(super) enum Input {
+    /// A file.
+    File(File),
+    /// Text held in memory.
+    Text(Cursor<Vec<u8>>),
+    /// The embedded default data.
+    Static(&'static [u8]),
+}
+
+impl Read for Input {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        match self {
+            Input::File(f) => f.read(buf),
+            Input::Text(c) => c.read(buf),
+            Input::Static(s) => s.read(buf),
+        }
+    }
+}
+
+/// Opens `path` for streaming (the embedded default data when `None`): its name in messages,
+/// the reader and its size in bytes.
+pub(super) fn open_input(path: Option<&Path>) -> Result<(String, Input, u64), CliError> {
+    match path {
+        None => Ok((
             super::DEFAULT_DATA_NAME.to_string(),
-            Box::new(super::DEFAULT_DATA.as_bytes()),
-        ),
-        (None, Some(p)) => {
+            Input::Static(super::DEFAULT_DATA.as_bytes()),
+            super::DEFAULT_DATA.len() as u64,
+        )),
+        Some(p) => {
             let name = p.display().to_string();
             let f =
                 File::open(p).map_err(|e| InputError::file(&name, format!("cannot read: {e}")))?;
-            (name, Box::new(f))
+            let size = f.metadata().map(|m| m.len()).unwrap_or(0);
+            Ok((name, Input::File(f), size))
         }
-    };
-    let reader = TableReader::new(&source, input)?;
-    match a.output.as_deref() {
+    }
+}
+
+/// Stream options with a stop flag raised by Ctrl-C or SIGTERM (the stream then ends between
+/// tasks, `--output` untouched, exit 130) and a progress bar on a terminal's stderr for runs
+/// longer than a couple of seconds.
+pub(super) fn stream_options(label: &str, input_bytes: u64) -> StreamOptions {
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = stop.clone();
+    // One handler per process; a command runs once per process, so a failure here means one
+    // is already installed (and keeps its own flag): the stream then simply runs to its end.
+    let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
+    StreamOptions {
+        stop: Some(stop),
+        progress: super::delayed_progress_bar("bytes"),
+        label: label.to_string(),
+        input_bytes: Some(input_bytes),
+        ..StreamOptions::default()
+    }
+}
+
+/// Streams `reader` through the plan `make` builds into `output` (written atomically: a
+/// temporary file renamed over the target only when the whole input proved good and `finish`
+/// succeeded; a target that cannot be created is reported only after the input proved good)
+/// or stdout. `finish` runs on the plan's ledger before the output is committed.
+pub(super) fn stream_to<R, P, F>(
+    reader: TableReader<R>,
+    make: F,
+    ledger: P::Ledger,
+    output: Option<&Path>,
+    opts: &StreamOptions,
+    finish: impl FnOnce(&P::Ledger) -> Result<(), CliError>,
+) -> Result<Streamed<P::Ledger>, CliError>
+where
+    R: Read + Send,
+    P: RowPlan,
+    F: FnOnce(&TableReader<R>) -> Result<P, InputError>,
+{
+    match output {
         Some(p) => {
             let cannot =
                 |e: std::io::Error| CliError::Other(format!("{}: cannot write: {e}", p.display()));
-            // A file that cannot be created is reported only after the input proved good,
-            // as when the whole output was written at the end.
             let mut file = AtomicFile::create(p);
             let r = match &mut file {
-                Ok(f) => stream(&a, kind, branch, reader, f, CHUNK_ROWS, TASK_ROWS),
-                Err(_) => stream(
-                    &a,
-                    kind,
-                    branch,
-                    reader,
-                    &mut std::io::sink(),
-                    CHUNK_ROWS,
-                    TASK_ROWS,
-                ),
+                Ok(f) => stream(reader, make, ledger, f, opts),
+                Err(_) => stream(reader, make, ledger, &mut std::io::sink(), opts),
             };
             match r {
-                Err(Failure::Input(e)) => Err(e),
-                Err(Failure::Write(e)) => Err(cannot(e)),
-                Ok(()) => file.and_then(AtomicFile::commit).map_err(cannot),
+                Ok(done) => {
+                    finish(&done.ledger)?;
+                    file.and_then(AtomicFile::commit).map_err(cannot)?;
+                    Ok(done)
+                }
+                Err(e) => Err(stream_error(e, &p.display().to_string(), true)),
             }
         }
         None => {
             let mut out = std::io::stdout();
-            let r = stream(&a, kind, branch, reader, &mut out, CHUNK_ROWS, TASK_ROWS)
-                .and_then(|()| out.flush().map_err(Failure::Write));
+            let r = stream(reader, make, ledger, &mut out, opts)
+                .and_then(|d| out.flush().map(|()| d).map_err(StreamError::Write));
             match r {
-                Ok(()) => Ok(()),
-                Err(Failure::Input(e)) => Err(e),
-                Err(Failure::Write(e)) => Err(CliError::Other(format!("<stdout>: {e}"))),
-            }
-        }
-    }
-}
-
-/// Why the streaming path stopped: bad input (which wins), or a failed write.
-enum Failure {
-    Input(CliError),
-    Write(std::io::Error),
-}
-
-impl From<InputError> for Failure {
-    fn from(e: InputError) -> Self {
-        Failure::Input(e.into())
-    }
-}
-
-/// The error to report when a check failed at `e`: a malformed row anywhere in the input, or
-/// an input without rows, is reported first (as when the whole table was read before any
-/// check).
-fn first_error<R: Read>(reader: &mut TableReader<R>, e: CliError) -> Failure {
-    Failure::Input(reader.drain().map(CliError::from).unwrap_or(e))
-}
-
-fn write_parts(out: &mut dyn Write, parts: &[Vec<u8>], failed: &mut Option<std::io::Error>) {
-    for p in parts {
-        if failed.is_some() {
-            return;
-        }
-        if let Err(e) = out.write_all(p) {
-            *failed = Some(e);
-        }
-    }
-}
-
-/// `forward` on a stream of rows: reads `chunk_rows` rows at a time; checks, evaluates and
-/// formats each chunk in parallel (tasks of `task_rows` rows) while the previous chunk's
-/// bytes are written and the next chunk is read. Output bytes are those of the csv crate's
-/// writer (header with `in_` for clashing input names, input cells as read, then the model's
-/// columns). The first bad row in the file is reported; a failed write is reported only
-/// once the whole input proved good, writing stopping at the failure.
-fn stream<R: Read + Send>(
-    a: &Args,
-    kind: ModelKind,
-    branch: JaegerBranch,
-    mut reader: TableReader<R>,
-    out: &mut (dyn Write + Send),
-    chunk_rows: usize,
-    task_rows: usize,
-) -> Result<(), Failure> {
-    let plan = match Plan::new(a, kind, branch, &reader) {
-        Ok(p) => p,
-        Err(e) => return Err(first_error(&mut reader, e)),
-    };
-    let mut cur = Vec::new();
-    let mut next = Vec::new();
-    let mut n_cur = reader.read_chunk(&mut cur, chunk_rows)?;
-    if n_cur == 0 {
-        return Err(reader.no_rows().into());
-    }
-    let mut pending = vec![plan.header()];
-    let mut failed = None;
-    loop {
-        let (read, done) = rayon::join(
-            || {
-                write_parts(out, &pending, &mut failed);
-                reader.read_chunk(&mut next, chunk_rows)
-            },
-            || plan.chunk(&cur[..n_cur], task_rows),
-        );
-        let n_next = read?;
-        pending = match done {
-            Ok(parts) => parts,
-            Err(e) => return Err(first_error(&mut reader, e)),
-        };
-        if n_next == 0 {
-            break;
-        }
-        std::mem::swap(&mut cur, &mut next);
-        n_cur = n_next;
-    }
-    write_parts(out, &pending, &mut failed);
-    match failed {
-        Some(e) => Err(Failure::Write(e)),
-        None => Ok(()),
-    }
-}
-
-/// Everything a row needs besides its cells: flags, columns, the model.
-struct Plan<'a> {
-    a: &'a Args,
-    kind: ModelKind,
-    branch: JaegerBranch,
-    source: String,
-    headers: Vec<String>,
-    c_xi: usize,
-    c_d: usize,
-    c_k: Option<usize>,
-    c_rho: Option<usize>,
-    c_f: Option<usize>,
-    c_lambda: Option<usize>,
-    c_mu: Option<usize>,
-    c_a: [Option<usize>; 3],
-    c_spin: Option<usize>,
-    flag_spin: SpinRule,
-    flag_law: CollisionLaw,
-}
-
-impl<'a> Plan<'a> {
-    fn new<R: Read>(
-        a: &'a Args,
-        kind: ModelKind,
-        branch: JaegerBranch,
-        t: &TableReader<R>,
-    ) -> Result<Self, CliError> {
-        let c_xi = t.require("xi")?;
-        let c_d = t.require("delta_deg")?;
-        let flag_spin: SpinRule = a
-            .spin
-            .parse()
-            .map_err(|e: Error| super::flag_error("--spin", &a.spin, e.to_string()))?;
-        if !(a.tol > 0.0 && a.tol < 1.0) {
-            return Err(super::flag_error(
-                "--tol",
-                &a.tol.to_string(),
-                "expected a relative tolerance in (0, 1)",
-            ));
-        }
-        let flag_law: CollisionLaw =
-            a.k.parse()
-                .map_err(|e: Error| super::flag_error("--K", &a.k, e.to_string()))?;
-        Ok(Plan {
-            a,
-            kind,
-            branch,
-            source: t.source().to_string(),
-            headers: t.headers().to_vec(),
-            c_xi,
-            c_d,
-            c_k: t.col("K"),
-            c_rho: t.col("rho"),
-            c_f: t.col("f"),
-            c_lambda: t.col("lambda"),
-            c_mu: t.col("mu"),
-            c_a: [t.col("a1"), t.col("a2"), t.col("a3")],
-            c_spin: t.col("spin"),
-            flag_spin,
-            flag_law,
-        })
-    }
-
-    fn cols(&self) -> [(&'static str, Option<usize>); 10] {
-        [
-            ("xi", Some(self.c_xi)),
-            ("delta_deg", Some(self.c_d)),
-            ("K", self.c_k),
-            ("rho", self.c_rho),
-            ("f", self.c_f),
-            ("lambda", self.c_lambda),
-            ("mu", self.c_mu),
-            ("a1", self.c_a[0]),
-            ("a2", self.c_a[1]),
-            ("a3", self.c_a[2]),
-        ]
-    }
-
-    /// The scene and model of one row, or the row's first bad value.
-    fn job(&self, r: &Row) -> Result<Job, CliError> {
-        let a = self.a;
-        let xi = r.number(self.c_xi)?;
-        let d = r.number(self.c_d)?;
-        let law = match self.c_k {
-            Some(c) if !r.cell(c).is_empty() => r
-                .cell(c)
-                .parse::<CollisionLaw>()
-                .map_err(|e| r.err(c, e.to_string()))?,
-            _ => self.flag_law,
-        };
-        if let (CollisionLaw::Value(k), Some(c)) = (law, self.c_k) {
-            if !k.is_finite() {
-                return Err(r.err(c, "value must be a finite number").into());
-            }
-        }
-        let rho = r.opt_number(self.c_rho)?.unwrap_or(a.rho);
-        let f = r.opt_number(self.c_f)?.unwrap_or(a.f);
-        let scene = Scene::new(xi, d, rho, f, law).map_err(|e| scene_error(r, e, &self.cols()))?;
-        let model = match (self.kind, self.kind.contact_model()) {
-            (ModelKind::Auto, _) => Model::Auto(Auto { tol: a.tol }),
-            (ModelKind::Contact, _) => {
-                let spin = match self.c_spin {
-                    Some(c) if !r.cell(c).is_empty() => r
-                        .cell(c)
-                        .parse::<SpinRule>()
-                        .map_err(|e| r.err(c, e.to_string()))?,
-                    _ => self.flag_spin,
-                };
-                Model::Contact(Contact { spin, tol: a.tol })
-            }
-            (_, Some(m)) => m,
-            (ModelKind::Jan, None) => {
-                let paper = Jan::paper_fit(scene.alpha_rad());
-                let lambda = r
-                    .opt_number(self.c_lambda)?
-                    .or(a.lambda)
-                    .unwrap_or(paper.lambda);
-                let mu = r.opt_number(self.c_mu)?.or(a.mu).unwrap_or(paper.mu);
-                Model::Jan(Jan::new(lambda, mu).map_err(|e| scene_error(r, e, &self.cols()))?)
-            }
-            _ => {
-                let mut v = [0.0; 3];
-                let flags = [a.a1, a.a2, a.a3];
-                for i in 0..3 {
-                    v[i] = match r.opt_number(self.c_a[i])?.or(flags[i]) {
-                        Some(x) => x,
-                        None => {
-                            return Err(super::flag_error(
-                                &format!("--a{}", i + 1),
-                                "",
-                                "jaeger needs a1, a2, a3 (flags or columns)",
-                            ))
-                        }
-                    };
+                Ok(done) => {
+                    finish(&done.ledger)?;
+                    Ok(done)
                 }
-                Model::Jaeger(
-                    Jaeger::new(v[0], v[1], v[2], self.branch)
-                        .map_err(|e| scene_error(r, e, &self.cols()))?,
-                )
-            }
-        };
-        Ok(Job { scene, model })
-    }
-
-    /// The output header line.
-    fn header(&self) -> Vec<u8> {
-        let general = self.kind == ModelKind::Contact;
-        let mut out = Vec::new();
-        let mut w = Cells::new(&mut out);
-        for h in &self.headers {
-            if OUTPUT_COLUMNS.contains(&h.as_str())
-                || general && CONTACT_COLUMNS.contains(&h.as_str())
-            {
-                w.text(&format!("in_{h}"));
-            } else {
-                w.text(h);
+                Err(e) => Err(stream_error(e, "<stdout>", false)),
             }
         }
-        for c in OUTPUT_COLUMNS {
-            w.text(c);
-        }
-        if general {
-            for c in CONTACT_COLUMNS {
-                w.text(c);
-            }
-        }
-        if self.kind == ModelKind::Auto {
-            for c in AUTO_COLUMNS {
-                w.text(c);
-            }
-        }
-        w.end();
-        out
-    }
-
-    /// One chunk of rows: their output bytes in order (one buffer per task), or the first
-    /// bad row's error.
-    fn chunk(
-        &self,
-        recs: &[csv::StringRecord],
-        task_rows: usize,
-    ) -> Result<Vec<Vec<u8>>, CliError> {
-        let parts: Vec<Result<Vec<u8>, CliError>> = recs
-            .par_chunks(task_rows.max(1))
-            .map(|rs| {
-                let mut buf = Vec::with_capacity(rs.len() * 192);
-                for rec in rs {
-                    self.row(rec, &mut buf)?;
-                }
-                Ok(buf)
-            })
-            .collect();
-        parts.into_iter().collect()
-    }
-
-    /// Checks, evaluates and formats one row onto `out`.
-    fn row(&self, rec: &csv::StringRecord, out: &mut Vec<u8>) -> Result<(), CliError> {
-        let r = Row {
-            source: &self.source,
-            headers: &self.headers,
-            rec,
-            line: line_of(rec),
-        };
-        let job = self.job(&r)?;
-        let (o, d, au) = evaluate(&job);
-        let kind = self.kind;
-        let general = kind == ModelKind::Contact;
-        let contact = !matches!(kind, ModelKind::Jan | ModelKind::Jaeger);
-        let mut w = Cells::new(out);
-        for cell in rec.iter() {
-            w.text(cell.trim());
-        }
-        let regime = regime_of(&o);
-        match &o {
-            Ok(s) => {
-                w.num(s.mean_velocity);
-                w.opt_show(regime);
-                w.text("ok");
-                if contact {
-                    w.num(job.scene.k());
-                    w.num(s.final_velocity);
-                    w.num(s.initial_velocity);
-                } else {
-                    w.empty();
-                    w.empty();
-                    w.empty();
-                }
-                w.num(s.contact_time);
-                w.opt(s.theta_g.map(f64::to_degrees));
-                w.opt(s.map_slope);
-                w.opt(s.other_fixed_point);
-                w.show(s.phases);
-                w.text(if s.other_fixed_point.is_some() {
-                    if contact {
-                        "bistable: another fixed point of the final-velocity map"
-                    } else {
-                        "two positive roots (eq 84): bistable band"
-                    }
-                } else {
-                    ""
-                });
-            }
-            Err(e) => {
-                w.empty();
-                w.opt_show(regime);
-                w.text(e.status());
-                if contact {
-                    w.num(job.scene.k());
-                } else {
-                    w.empty();
-                }
-                for _ in 0..7 {
-                    w.empty();
-                }
-                w.show(e);
-            }
-        }
-        if let (true, Some(d)) = (general, &d) {
-            contact_cells(&mut w, &job, d);
-        }
-        if kind == ModelKind::Auto {
-            match au {
-                Some(r) => {
-                    w.text(r.choice.name());
-                    w.show(r.reason);
-                }
-                None => {
-                    w.empty();
-                    w.empty();
-                }
-            }
-        }
-        w.end();
-        Ok(())
     }
 }
 
-/// One row's outcome, with what the contact model and `auto` add.
-fn evaluate(j: &Job) -> (Outcome, Option<ContactDetail>, Option<AutoOutcome>) {
-    match j.model {
-        Model::Contact(c) => {
-            let r = c.steady_state(&j.scene);
-            (
-                Contact::outcome(&j.scene, &r),
-                Some(ContactDetail {
-                    rule: c.spin,
-                    steady: r.ok(),
-                }),
-                None,
-            )
-        }
-        // The auto choice travels with each outcome
-        Model::Auto(au) => {
-            let r = au.choose(&j.scene);
-            (r.outcome, None, Some(r))
-        }
-        m => (m.evaluate(&j.scene), None, None),
-    }
-}
-
-/// What the contact model adds to a row.
-struct ContactDetail {
-    rule: SpinRule,
-    steady: Option<SteadyContact>,
-}
-
-fn contact_cells(w: &mut Cells, job: &Job, d: &ContactDetail) {
-    let Some(s) = &d.steady else {
-        for _ in 0..CONTACT_COLUMNS.len() - 1 {
-            w.empty();
-        }
-        w.show(d.rule);
-        return;
-    };
-    let e = s.energy(&job.scene);
-    let p = e.potential_drop;
-    w.show(s.run.phases);
-    w.text(&s.run.phases.changes_deg());
-    w.num(s.launch.spin);
-    w.num(s.final_spin);
-    w.show(s.beads);
-    w.num(e.collision_translation / p);
-    w.num(e.collision_spin / p);
-    w.num(e.friction_work / p);
-    w.num(e.closure());
-    w.show(d.rule);
-}
-
-/// Writes the cells of one CSV record onto a byte buffer, as the csv crate's default writer
-/// does (comma separators, quotes only where needed, `\n` after the record).
-struct Cells<'b> {
-    out: &'b mut Vec<u8>,
-    first: bool,
-}
-
-impl<'b> Cells<'b> {
-    fn new(out: &'b mut Vec<u8>) -> Self {
-        Cells { out, first: true }
-    }
-
-    fn sep(&mut self) {
-        if !self.first {
-            self.out.push(b',');
-        }
-        self.first = false;
-    }
-
-    fn empty(&mut self) {
-        self.sep();
-    }
-
-    fn text(&mut self, s: &str) {
-        self.sep();
-        push_csv_field(self.out, s.as_bytes());
-    }
-
-    /// A number as [`fmt_f64`] writes it (never needs quotes).
-    fn num(&mut self, x: f64) {
-        self.sep();
-        push_f64(self.out, x);
-    }
-
-    fn opt(&mut self, x: Option<f64>) {
-        self.sep();
-        if let Some(x) = x {
-            push_f64(self.out, x);
-        }
-    }
-
-    fn show(&mut self, x: impl std::fmt::Display) {
-        self.sep();
-        let start = self.out.len();
-        // Writing into a Vec cannot fail.
-        let _ = write!(self.out, "{x}");
-        if self.out[start..]
-            .iter()
-            .any(|&b| matches!(b, b',' | b'"' | b'\r' | b'\n'))
-        {
-            let s = self.out.split_off(start);
-            push_csv_field(self.out, &s);
-        }
-    }
-
-    fn opt_show(&mut self, x: Option<impl std::fmt::Display>) {
-        match x {
-            Some(x) => self.show(x),
-            None => self.empty(),
-        }
-    }
-
-    fn end(self) {
-        self.out.push(b'\n');
+fn stream_error(e: StreamError, target: &str, file: bool) -> CliError {
+    match e {
+        StreamError::Input(e) => CliError::Input(e),
+        StreamError::Write(e) if file => CliError::Other(format!("{target}: cannot write: {e}")),
+        StreamError::Write(e) if e.kind() == std::io::ErrorKind::BrokenPipe => CliError::Io(e),
+        StreamError::Write(e) => CliError::Other(format!("{target}: {e}")),
+        StreamError::Stopped => CliError::Stopped(if file {
+            format!("interrupted: {target} was not written")
+        } else {
+            "interrupted: the output on stdout is incomplete".into()
+        }),
     }
 }
 
@@ -1117,6 +707,7 @@ mod tests {
 
     use super::*;
     use clap::Parser;
+    use fitbead::io::stream::{CHUNK_ROWS, TASK_ROWS};
 
     #[derive(Parser)]
     struct Cmd {
@@ -1141,10 +732,15 @@ mod tests {
         let (kind, branch) = kind_branch(a);
         let reader = TableReader::new("in.csv", text).map_err(|e| e.to_string())?;
         let mut out = Vec::new();
-        match stream(a, kind, branch, reader, &mut out, chunk, task) {
-            Ok(()) => Ok(out),
-            Err(Failure::Input(e)) => Err(e.to_string()),
-            Err(Failure::Write(e)) => panic!("write to a Vec failed: {e}"),
+        let opts = StreamOptions {
+            chunk_rows: chunk,
+            task_rows: task,
+            ..StreamOptions::default()
+        };
+        match stream(reader, |r| plan(a, kind, branch, r), (), &mut out, &opts) {
+            Ok(_) => Ok(out),
+            Err(StreamError::Input(e)) => Err(e.to_string()),
+            Err(e) => panic!("writing to a Vec failed: {e:?}"),
         }
     }
 

@@ -1,17 +1,14 @@
 //! `fitbead k`: the collisional parameter K of every measured point (eq 69), its interval at
 //! v ± σ, and why where there is none.
 
-use super::{emit, read_input, CliError};
-use fitbead::fit::k::auto::{self as kauto, KChoice};
-use fitbead::fit::k::{estimate, KEstimate, KFailure, LowerLimit, UpperLimit};
-use fitbead::io::measurements::{read_measurements, Measurement};
-use fitbead::io::scenes::Table;
-use fitbead::io::{fmt_f64, write_atomic};
+use super::forward::{open_input, stream_options, stream_to, Input};
+use super::CliError;
+use fitbead::io::kstream::{KLedger, KPlan, KSettings};
+use fitbead::io::scenes::TableReader;
+use fitbead::io::{AtomicFile, InputError};
 use fitbead::models::auto::Auto;
 use fitbead::models::{Model, ModelKind};
-use fitbead::report::figures::{scatter_svg, PointSeries, Scatter};
-use fitbead::scene::CollisionLaw;
-use rayon::prelude::*;
+use std::io::Write;
 use std::path::PathBuf;
 
 /// Arguments of `fitbead k`.
@@ -48,35 +45,6 @@ pub struct Args {
     #[arg(long, default_value_t = 1e-10)]
     pub tol: f64,
 }
-
-/// The contract columns, in order.
-pub const COLUMNS: [&str; 18] = [
-    "series",
-    "xi",
-    "delta_deg",
-    "v",
-    "sigma_v",
-    "model",
-    "K",
-    "K_lo",
-    "K_hi",
-    "dv_dK",
-    "final_velocity",
-    "theta_G_deg",
-    "K_cos2a",
-    "K_adjusted",
-    "K_impact",
-    "regime",
-    "status",
-    "iterations",
-];
-
-/// Columns added after [`EXTRA_COLUMNS`] by --model auto: the model each row was inverted
-/// with, and why.
-pub const AUTO_COLUMNS: [&str; 2] = ["model_used", "reason"];
-
-/// Columns added after the contract ones.
-pub const EXTRA_COLUMNS: [&str; 5] = ["K_min", "K_max", "lower_limit", "upper_limit", "message"];
 
 /// Parses the model flag of `k` (the five contact models).
 pub fn parse_model(name: &str) -> Result<Model, CliError> {
@@ -120,7 +88,8 @@ pub fn parse_auto(name: &str, tol: f64) -> Result<Option<Auto>, CliError> {
     Ok(Some(Auto { tol }))
 }
 
-/// Runs `fitbead k`.
+/// Runs `fitbead k`: the rows stream through the library's engine with the K plan of
+/// `fitbead::io::kstream`; `--plot` keeps the inverted points for the figure.
 pub fn run(a: Args) -> Result<(), CliError> {
     // Per row, the model chosen at the stick K
     let auto = parse_auto(&a.model, a.tol)?;
@@ -129,176 +98,45 @@ pub fn run(a: Args) -> Result<(), CliError> {
         None => parse_model(&a.model)?,
     };
     let input = a.input.as_deref().or(a.data.as_deref());
-    let (source, text) = read_input(input)?;
-    let t = Table::parse(&source, &text)?;
-    let defaults = super::measurement_defaults(a.rho, a.f, a.g)?;
-    let rows = read_measurements(&t, &defaults)?;
-    let (results, autos): (Vec<KEstimate>, Vec<Option<KChoice>>) = rows
-        .par_iter()
-        .map(|r| match &auto {
-            Some(au) => {
-                let c = kauto::choose(au, &r.scene, r.v);
-                (estimate(&c.model, &r.scene, r.v, r.sigma_v), Some(c))
-            }
-            None => (estimate(&model, &r.scene, r.v, r.sigma_v), None),
-        })
-        .unzip();
-    let bytes = render(&t, &rows, &results, &autos, &a.model)
-        .map_err(|e| CliError::Other(e.to_string()))?;
-    if let Some(p) = &a.plot {
-        let svg = plot(&rows, &results, &a.model).map_err(CliError::Other)?;
-        write_atomic(p, svg.as_bytes())
-            .map_err(|e| CliError::Other(format!("{}: cannot write: {e}", p.display())))?;
-    }
-    emit(a.output.as_deref(), &bytes)
-}
-
-fn lower_name(l: LowerLimit) -> &'static str {
-    match l {
-        LowerLimit::Crawl => "crawl-over-top",
-        LowerLimit::Zero => "K=0",
-        LowerLimit::Model => "model-limit",
-    }
-}
-
-fn upper_name(u: UpperLimit) -> &'static str {
-    match u {
-        UpperLimit::LiftOff => "lift-off",
-        UpperLimit::Model => "model-limit",
-    }
-}
-
-fn render(
-    t: &Table,
-    rows: &[Measurement],
-    res: &[KEstimate],
-    autos: &[Option<KChoice>],
-    model: &str,
-) -> csv::Result<Vec<u8>> {
-    let mut w = csv::Writer::from_writer(Vec::with_capacity(rows.len() * 260));
-    // Model_used, reason after the extra columns
-    let auto = autos.iter().any(|a| a.is_some());
-    let auto_cols: &[&str] = if auto { &AUTO_COLUMNS } else { &[] };
-    let own: Vec<&str> = COLUMNS
-        .iter()
-        .chain(EXTRA_COLUMNS.iter())
-        .chain(auto_cols.iter())
-        .copied()
-        .collect();
-    let input_own = ["series", "xi", "delta_deg", "v", "sigma_v"];
-    let pass: Vec<usize> = (0..t.headers.len())
-        .filter(|&i| !input_own.contains(&t.headers[i].as_str()))
-        .collect();
-    let mut header: Vec<String> = own.iter().map(|s| s.to_string()).collect();
-    for &i in &pass {
-        let h = &t.headers[i];
-        header.push(if own.contains(&h.as_str()) {
-            format!("in_{h}")
-        } else {
-            h.clone()
-        });
-    }
-    w.write_record(&header)?;
-    let opt = |x: Option<f64>| x.map(fmt_f64).unwrap_or_default();
-    for (i, ((row, e), au)) in rows.iter().zip(res).zip(autos).enumerate() {
-        let s = &row.scene;
-        let mut out: Vec<String> = Vec::with_capacity(header.len());
-        out.push(row.series.clone());
-        out.push(fmt_f64(s.xi()));
-        out.push(t.cell(i, t.col("delta_deg").unwrap_or(0)).to_string());
-        out.push(fmt_f64(row.v));
-        out.push(opt(row.sigma_v));
-        out.push(model.to_string());
-        let (k, fv, iters) = match &e.root {
-            Ok(r) => (
-                Some(r.k),
-                Some(r.steady.final_velocity),
-                Some(r.evals as f64),
-            ),
-            Err(_) => (None, None, None),
+    let (source, input, size) = open_input(input)?;
+    let reader = TableReader::new(&source, input)?;
+    // Checked here, reported after the table's own errors (as when it was read whole).
+    let defaults = super::measurement_defaults(a.rho, a.f, a.g);
+    let settings = KSettings {
+        model,
+        auto,
+        model_name: a.model.clone(),
+        plot: a.plot.is_some(),
+    };
+    let make = |r: &TableReader<Input>| -> Result<KPlan, InputError> {
+        let d = match defaults {
+            Ok(d) => d,
+            Err(CliError::Input(e)) => return Err(e),
+            Err(e) => return Err(InputError::file("<command line>", e.to_string())),
         };
-        out.push(opt(k));
-        out.push(opt(e.k_lo));
-        out.push(opt(e.k_hi));
-        out.push(opt(e.dv_dk));
-        out.push(opt(fv));
-        out.push(opt(e.theta_g.map(f64::to_degrees)));
-        out.push(fmt_f64(CollisionLaw::Cos2a.k(s.alpha_rad(), s.rho())));
-        out.push(fmt_f64(CollisionLaw::Adjusted.k(s.alpha_rad(), s.rho())));
-        out.push(fmt_f64(CollisionLaw::Impact.k(s.alpha_rad(), s.rho())));
-        let (regime, status) = match &e.root {
-            Ok(_) => ("B", "ok"),
-            Err(KFailure::BelowRange) => ("A", "below-range"),
-            Err(KFailure::AboveRange) => ("C", "above-range"),
-            Err(KFailure::Invalid(_)) => ("", "invalid"),
-        };
-        out.push(regime.into());
-        out.push(status.into());
-        out.push(opt(iters));
-        match &e.bracket {
-            Some(b) => {
-                out.push(fmt_f64(b.lo));
-                out.push(fmt_f64(b.hi));
-                out.push(lower_name(b.lower).into());
-                out.push(upper_name(b.upper).into());
-            }
-            None => out.extend(std::iter::repeat_n(String::new(), 4)),
-        }
-        let mut msg: Vec<String> = Vec::new();
-        if let Err(f) = &e.root {
-            msg.push(f.to_string());
-        }
-        msg.extend(e.notes.iter().cloned());
-        out.push(msg.join("; "));
-        if auto {
-            match au {
-                Some(c) => {
-                    out.push(c.choice.name().to_string());
-                    out.push(c.reason.clone());
-                }
-                None => out.extend([String::new(), String::new()]),
-            }
-        }
-        for &c in &pass {
-            out.push(t.cell(i, c).to_string());
-        }
-        w.write_record(&out)?;
-    }
-    w.into_inner().map_err(|e| csv::Error::from(e.into_error()))
-}
-
-fn plot(rows: &[Measurement], res: &[KEstimate], model: &str) -> Result<String, String> {
-    let mut series: Vec<PointSeries> = Vec::new();
-    for (row, e) in rows.iter().zip(res) {
-        let Ok(r) = &e.root else { continue };
-        let label = if row.series.is_empty() {
-            format!("xi = {}", fmt_f64(row.scene.xi()))
-        } else {
-            format!("series {}", row.series)
-        };
-        let idx = match series.iter().position(|s| s.label == label) {
-            Some(i) => i,
-            None => {
-                let c2 = CollisionLaw::Cos2a.k(row.scene.alpha_rad(), row.scene.rho());
-                series.push(PointSeries {
-                    label: label.clone(),
-                    points: Vec::new(),
-                    reference: Some((c2, format!("cos 2alpha = {c2:.4}"))),
-                });
-                series.len() - 1
-            }
-        };
-        series[idx].points.push((
-            r.steady.final_velocity,
-            r.k,
-            e.k_lo.unwrap_or(r.k),
-            e.k_hi.unwrap_or(r.k),
-        ));
-    }
-    scatter_svg(&Scatter {
-        title: format!("K per measurement (eq 69), {model} model"),
-        x_label: "steady final velocity (units sqrt(g(R+r)))".into(),
-        y_label: "K".into(),
-        series,
-    })
+        KPlan::new(r, &d, settings)
+    };
+    // The plot's file is created first so that a target that cannot be written is reported
+    // (after the input proved good) before the output is committed.
+    let plot = a.plot.as_deref().map(|p| (p, AtomicFile::create(p)));
+    let opts = stream_options("k", size);
+    stream_to(
+        reader,
+        make,
+        KLedger::default(),
+        a.output.as_deref(),
+        &opts,
+        |ledger| {
+            let Some((p, file)) = plot else {
+                return Ok(());
+            };
+            let cannot =
+                |e: std::io::Error| CliError::Other(format!("{}: cannot write: {e}", p.display()));
+            let svg = ledger.plot_svg(&a.model).map_err(CliError::Other)?;
+            let mut f = file.map_err(cannot)?;
+            f.write_all(svg.as_bytes()).map_err(cannot)?;
+            f.commit().map_err(cannot)
+        },
+    )
+    .map(|_| ())
 }

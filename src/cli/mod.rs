@@ -68,6 +68,8 @@ pub enum CliError {
     Interrupted,
     /// Reading or writing failed (a closed pipe on stdout is not an error: exit 0).
     Io(std::io::Error),
+    /// Stopped by Ctrl-C or SIGTERM before the end, saying what was (not) written (exit 130).
+    Stopped(String),
 }
 
 impl From<std::io::Error> for CliError {
@@ -116,6 +118,7 @@ impl std::fmt::Display for CliError {
                 "interrupted (Ctrl-C): the outputs hold the draws so far, marked interrupted",
             ),
             CliError::Io(e) => write!(f, "{e}"),
+            CliError::Stopped(s) => f.write_str(s),
         }
     }
 }
@@ -136,8 +139,8 @@ pub fn run(cli: Cli) -> i32 {
     match r {
         Ok(()) => 0,
         Err(CliError::Io(e)) if e.kind() == std::io::ErrorKind::BrokenPipe => 0,
-        Err(CliError::Interrupted) => {
-            eprintln!("fitbead: {}", CliError::Interrupted);
+        Err(e @ (CliError::Interrupted | CliError::Stopped(_))) => {
+            eprintln!("fitbead: {e}");
             130
         }
         Err(e) => {
@@ -236,6 +239,72 @@ pub fn sampler_progress_bar() -> Progress {
             }
         }
     })
+}
+
+/// A progress bar on a terminal's stderr for long runs (none when stderr is not a terminal):
+/// drawn from the library's progress events only once a task has run for two seconds, so
+/// that short runs show nothing. Totals count `unit`s; a task of unknown total (0) shows a
+/// spinner with the count.
+pub fn delayed_progress_bar(unit: &'static str) -> Option<Progress> {
+    use std::io::IsTerminal;
+    use std::time::{Duration, Instant};
+    if !std::io::stderr().is_terminal() {
+        return None;
+    }
+    struct State {
+        label: String,
+        total: u64,
+        started: Instant,
+        bar: Option<indicatif::ProgressBar>,
+    }
+    let state: Mutex<Option<State>> = Mutex::new(None);
+    Some(Progress::new(move |e| {
+        let Ok(mut slot) = state.lock() else { return };
+        match e {
+            ProgressEvent::Start { label, total, .. } => {
+                if let Some(b) = slot.take().and_then(|s| s.bar) {
+                    b.finish_and_clear();
+                }
+                *slot = Some(State {
+                    label: label.to_string(),
+                    total,
+                    started: Instant::now(),
+                    bar: None,
+                });
+            }
+            ProgressEvent::Position(p) => {
+                let Some(s) = slot.as_mut() else { return };
+                if s.bar.is_none() && s.started.elapsed() >= Duration::from_secs(2) {
+                    let (b, template) = if s.total > 0 {
+                        (
+                            indicatif::ProgressBar::new(s.total),
+                            format!("{{msg}} {{bar:30}} {{percent}}% of {{len}} {unit} ({{elapsed}}, eta {{eta}})"),
+                        )
+                    } else {
+                        (
+                            indicatif::ProgressBar::new_spinner(),
+                            format!("{{msg}} {{spinner}} {{pos}} {unit} ({{elapsed}})"),
+                        )
+                    };
+                    b.set_style(
+                        indicatif::ProgressStyle::with_template(&template)
+                            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+                    );
+                    b.set_message(s.label.clone());
+                    b.enable_steady_tick(Duration::from_millis(200));
+                    s.bar = Some(b);
+                }
+                if let Some(b) = &s.bar {
+                    b.set_position(p);
+                }
+            }
+            ProgressEvent::Finish => {
+                if let Some(b) = slot.take().and_then(|s| s.bar) {
+                    b.finish_and_clear();
+                }
+            }
+        }
+    }))
 }
 
 /// Parses a comma-separated list of numbers given on the command line.

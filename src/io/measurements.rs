@@ -7,11 +7,12 @@
 //! v = v_m_s / sqrt(g R (1 + ξ)). Optional `series` (rows without one are grouped by ξ),
 //! `rho` and `f` (per-row values of the defaults). A series may not mix ξ values.
 
-use super::scenes::Table;
+use super::scenes::{Header, Row, Table};
 use super::InputError;
 use crate::fit::data::{DataError, Dataset};
 use crate::numfmt::fmt_f64;
 use crate::scene::{CollisionLaw, Scene};
+use std::collections::HashMap;
 use std::path::Path;
 
 /// The shipped default data set (synthetic; provenance in data/README.md).
@@ -76,12 +77,196 @@ pub struct Measurement {
     pub sigma_v: Option<f64>,
 }
 
-fn positive(t: &Table, r: usize, c: usize, what: &str) -> Result<f64, InputError> {
-    let x = t.number(r, c)?;
+/// Where the measurement columns are in a table (module docs), with the defaults of the
+/// columns a table may leave out: reads one row at a time ([`MeasurementColumns::read`]),
+/// so that a table streamed in chunks is checked exactly as one read whole.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeasurementColumns {
+    xi: usize,
+    delta_deg: usize,
+    series: Option<usize>,
+    v: Option<usize>,
+    v_m_s: Option<usize>,
+    sigma_v: Option<usize>,
+    sigma_v_m_s: Option<usize>,
+    r_m: Option<usize>,
+    g: Option<usize>,
+    rho: Option<usize>,
+    f: Option<usize>,
+    defaults: MeasurementDefaults,
+}
+
+/// One measurement row, validated; its series label is the row's `series` cell.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Measured {
+    /// The scene (its K is a placeholder).
+    pub scene: Scene,
+    /// Dimensionless mean velocity.
+    pub v: f64,
+    /// Its standard deviation, when given.
+    pub sigma_v: Option<f64>,
+}
+
+/// What the checks across rows keep: per series, the first ξ and its line (a series may not
+/// mix ξ values). Its size grows with the number of series, not of rows.
+#[derive(Debug, Clone, Default)]
+pub struct SeriesLedger {
+    first_xi: HashMap<String, (f64, u64)>,
+}
+
+impl MeasurementColumns {
+    /// The columns of a table's header: `xi`, `delta_deg`, and `v` or `v_m_s` with `R_m` are
+    /// required, `sigma_v_m_s` goes with `v_m_s`; then `defaults` are checked.
+    pub fn new(t: &impl Header, defaults: &MeasurementDefaults) -> Result<Self, InputError> {
+        let xi = t.require("xi")?;
+        let delta_deg = t.require("delta_deg")?;
+        let c = MeasurementColumns {
+            xi,
+            delta_deg,
+            series: t.col("series"),
+            v: t.col("v"),
+            v_m_s: t.col("v_m_s"),
+            sigma_v: t.col("sigma_v"),
+            sigma_v_m_s: t.col("sigma_v_m_s"),
+            r_m: t.col("R_m"),
+            g: t.col("g"),
+            rho: t.col("rho"),
+            f: t.col("f"),
+            defaults: *defaults,
+        };
+        if c.v.is_none() && c.v_m_s.is_none() {
+            return Err(t.require("v").unwrap_err());
+        }
+        if let (Some(_), Some(cs)) = (c.v, c.sigma_v_m_s) {
+            return Err(InputError {
+                file: t.source().to_string(),
+                line: Some(1),
+                column: Some(t.headers()[cs].clone()),
+                value: None,
+                message: "sigma_v_m_s is in m/s but v is dimensionless: give v_m_s and R_m \
+                          with sigma_v_m_s, or sigma_v with v"
+                    .into(),
+            });
+        }
+        if c.v.is_none() && c.r_m.is_none() {
+            return Err(t.require("R_m").unwrap_err());
+        }
+        defaults.validate(t.source())?;
+        Ok(c)
+    }
+
+    /// The column of ξ.
+    pub fn xi(&self) -> usize {
+        self.xi
+    }
+
+    /// The column of δ (degrees).
+    pub fn delta_deg(&self) -> usize {
+        self.delta_deg
+    }
+
+    /// The series label of a row: its `series` cell, empty when the table has none.
+    pub fn series<'a>(&self, r: &Row<'a>) -> &'a str {
+        self.series.map_or("", |c| r.cell(c))
+    }
+
+    /// Reads and validates one row (dimensional input converted with
+    /// v = v_m_s / sqrt(g R (1 + ξ))), or reports its first bad value.
+    pub fn read(&self, r: &Row<'_>) -> Result<Measured, InputError> {
+        let MeasurementDefaults { rho, f, g } = self.defaults;
+        let xi = r.number(self.xi)?;
+        let d = r.number(self.delta_deg)?;
+        let rho = r.opt_number(self.rho)?.unwrap_or(rho);
+        let f = r.opt_number(self.f)?.unwrap_or(f);
+        let scene = Scene::new(xi, d, rho, f, CollisionLaw::Value(0.5)).map_err(|e| {
+            let col = match &e {
+                crate::scene::ParameterError::InvalidParameter { field, .. } => match *field {
+                    "xi" => Some(self.xi),
+                    "delta" | "delta_deg" => Some(self.delta_deg),
+                    "rho" => self.rho,
+                    "f" => self.f,
+                    _ => None,
+                },
+                _ => None,
+            };
+            match col {
+                Some(c) => r.err(c, e.to_string()),
+                None => InputError {
+                    file: r.source.to_string(),
+                    line: Some(r.line),
+                    column: None,
+                    value: None,
+                    message: e.to_string(),
+                },
+            }
+        })?;
+        let given = |c: Option<usize>| c.filter(|&c| !r.cell(c).is_empty());
+        let (v, sigma_v) = match self.v {
+            Some(c) => {
+                let v = positive(r, c, "v")?;
+                let s = match given(self.sigma_v) {
+                    Some(cs) => Some(positive(r, cs, "sigma_v")?),
+                    None => None,
+                };
+                (v, s)
+            }
+            None => {
+                let (c, cr) = (self.v_m_s.unwrap_or(0), self.r_m.unwrap_or(0));
+                let vms = positive(r, c, "v_m_s")?;
+                let radius = positive(r, cr, "R_m")?;
+                let gg = match given(self.g) {
+                    Some(cg) => positive(r, cg, "g")?,
+                    None => g,
+                };
+                let scale = (gg * radius * (1.0 + xi)).sqrt();
+                let s = match (given(self.sigma_v_m_s), given(self.sigma_v)) {
+                    (Some(cs), _) => Some(positive(r, cs, "sigma_v_m_s")? / scale),
+                    (_, Some(cs)) => Some(positive(r, cs, "sigma_v")?),
+                    _ => None,
+                };
+                (vms / scale, s)
+            }
+        };
+        Ok(Measured { scene, v, sigma_v })
+    }
+
+    /// Checks a read row against the rows before it, as `ledger` kept them: a series may not
+    /// mix ξ values (the error names the line of the series' first ξ).
+    pub fn check_series(
+        &self,
+        ledger: &mut SeriesLedger,
+        r: &Row<'_>,
+        m: &Measured,
+    ) -> Result<(), InputError> {
+        let series = self.series(r);
+        if self.series.is_none() || series.is_empty() {
+            return Ok(());
+        }
+        let xi = m.scene.xi();
+        match ledger.first_xi.get(series) {
+            Some(&(x0, line)) if x0 != xi => Err(r.err(
+                self.xi,
+                format!(
+                    "series '{series}' mixes xi values: {} on line {line}, {} here",
+                    fmt_f64(x0),
+                    fmt_f64(xi)
+                ),
+            )),
+            Some(_) => Ok(()),
+            None => {
+                ledger.first_xi.insert(series.to_string(), (xi, r.line));
+                Ok(())
+            }
+        }
+    }
+}
+
+fn positive(r: &Row<'_>, c: usize, what: &str) -> Result<f64, InputError> {
+    let x = r.number(c)?;
     if x > 0.0 {
         Ok(x)
     } else {
-        Err(t.err(r, c, format!("{what} must be > 0")))
+        Err(r.err(c, format!("{what} must be > 0")))
     }
 }
 
@@ -91,123 +276,18 @@ pub fn read_measurements(
     t: &Table,
     defaults: &MeasurementDefaults,
 ) -> Result<Vec<Measurement>, InputError> {
-    let MeasurementDefaults { rho, f, g } = *defaults;
-    let c_xi = t.require("xi")?;
-    let c_d = t.require("delta_deg")?;
-    let c_series = t.col("series");
-    let c_v = t.col("v");
-    let c_vms = t.col("v_m_s");
-    let c_sigma = t.col("sigma_v");
-    let c_sigma_ms = t.col("sigma_v_m_s");
-    let c_r = t.col("R_m");
-    let c_g = t.col("g");
-    let c_rho = t.col("rho");
-    let c_f = t.col("f");
-    if c_v.is_none() && c_vms.is_none() {
-        return Err(t.require("v").unwrap_err());
-    }
-    if let (Some(_), Some(cs)) = (c_v, c_sigma_ms) {
-        return Err(InputError {
-            file: t.source.clone(),
-            line: Some(1),
-            column: Some(t.headers[cs].clone()),
-            value: None,
-            message: "sigma_v_m_s is in m/s but v is dimensionless: give v_m_s and R_m with \
-                      sigma_v_m_s, or sigma_v with v"
-                .into(),
-        });
-    }
-    if c_v.is_none() && c_r.is_none() {
-        return Err(t.require("R_m").unwrap_err());
-    }
-    defaults.validate(&t.source)?;
-    let mut first_xi: std::collections::HashMap<String, (f64, u64)> = Default::default();
+    let cols = MeasurementColumns::new(t, defaults)?;
+    let mut ledger = SeriesLedger::default();
     let mut rows = Vec::with_capacity(t.rows.len());
     for r in 0..t.rows.len() {
-        let xi = t.number(r, c_xi)?;
-        let d = t.number(r, c_d)?;
-        let rho = t.opt_number(r, c_rho)?.unwrap_or(rho);
-        let f = t.opt_number(r, c_f)?.unwrap_or(f);
-        let scene = Scene::new(xi, d, rho, f, CollisionLaw::Value(0.5)).map_err(|e| {
-            let col = match &e {
-                crate::scene::ParameterError::InvalidParameter { field, .. } => match *field {
-                    "xi" => Some(c_xi),
-                    "delta" | "delta_deg" => Some(c_d),
-                    "rho" => c_rho,
-                    "f" => c_f,
-                    _ => None,
-                },
-                _ => None,
-            };
-            match col {
-                Some(c) => t.err(r, c, e.to_string()),
-                None => InputError {
-                    file: t.source.clone(),
-                    line: Some(t.lines[r]),
-                    column: None,
-                    value: None,
-                    message: e.to_string(),
-                },
-            }
-        })?;
-        let (v, sigma_v) = match c_v {
-            Some(c) => {
-                let v = positive(t, r, c, "v")?;
-                let s = match c_sigma {
-                    Some(cs) if !t.cell(r, cs).is_empty() => Some(positive(t, r, cs, "sigma_v")?),
-                    _ => None,
-                };
-                (v, s)
-            }
-            None => {
-                let (c, cr) = (c_vms.unwrap_or(0), c_r.unwrap_or(0));
-                let vms = positive(t, r, c, "v_m_s")?;
-                let radius = positive(t, r, cr, "R_m")?;
-                let gg = match c_g {
-                    Some(cg) if !t.cell(r, cg).is_empty() => positive(t, r, cg, "g")?,
-                    _ => g,
-                };
-                let scale = (gg * radius * (1.0 + xi)).sqrt();
-                let s = match (c_sigma_ms, c_sigma) {
-                    (Some(cs), _) if !t.cell(r, cs).is_empty() => {
-                        Some(positive(t, r, cs, "sigma_v_m_s")? / scale)
-                    }
-                    (_, Some(cs)) if !t.cell(r, cs).is_empty() => {
-                        Some(positive(t, r, cs, "sigma_v")?)
-                    }
-                    _ => None,
-                };
-                (vms / scale, s)
-            }
-        };
-        let series = c_series
-            .map(|c| t.cell(r, c).to_string())
-            .unwrap_or_default();
-        if let (Some(c), false) = (c_series, series.is_empty()) {
-            match first_xi.get(&series) {
-                Some(&(x0, line)) if x0 != xi => {
-                    return Err(t.err(
-                        r,
-                        c_xi,
-                        format!(
-                            "series '{series}' mixes xi values: {} on line {line}, {} here",
-                            fmt_f64(x0),
-                            fmt_f64(xi)
-                        ),
-                    ));
-                }
-                Some(_) => {}
-                None => {
-                    first_xi.insert(series.clone(), (xi, t.lines[r]));
-                }
-            }
-            let _ = c;
-        }
+        let row = t.row(r);
+        let m = cols.read(&row)?;
+        cols.check_series(&mut ledger, &row, &m)?;
         rows.push(Measurement {
-            series,
-            scene,
-            v,
-            sigma_v,
+            series: cols.series(&row).to_string(),
+            scene: m.scene,
+            v: m.v,
+            sigma_v: m.sigma_v,
         });
     }
     Ok(rows)

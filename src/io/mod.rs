@@ -1,8 +1,14 @@
-//! Files: CSV reading with errors that name file, line, column and value; atomic writing.
+//! Files: CSV reading with errors that name file, line, column and value; atomic writing;
+//! tables streamed through a per-row computation in bounded memory ([`stream`]), with the
+//! row plans of `fitbead forward` ([`forward`]) and `fitbead k` ([`kstream`]).
 
+pub mod cells;
+pub mod forward;
+pub mod kstream;
 pub mod measurements;
 pub mod reports;
 pub mod scenes;
+pub mod stream;
 
 pub use crate::numfmt::{fmt_f64, fmt_sig, push_f64};
 

@@ -119,6 +119,11 @@ impl<R: Read> TableReader<R> {
         require(&self.source, &self.headers, &self.index, name)
     }
 
+    /// Bytes of the input consumed so far (the header included).
+    pub fn bytes_read(&self) -> u64 {
+        self.rdr.position().byte()
+    }
+
     /// Reads up to `max` rows into `recs[..n]` (reusing the records already there, growing
     /// `recs` as needed) and returns `n`; fewer than `max` only at the end of the input.
     /// Cells are as in the file, not trimmed: read them through [`Row`], which trims them
@@ -223,13 +228,48 @@ impl<R: Read> TableReader<R> {
     }
 }
 
-fn require(
-    source: &str,
-    headers: &[String],
-    index: &HashMap<String, usize>,
-    name: &str,
-) -> Result<usize, InputError> {
-    index.get(name).copied().ok_or_else(|| InputError {
+/// What a table's header says: its source, its column names and where each column is; both
+/// [`Table`] and [`TableReader`] have one.
+pub trait Header {
+    /// Where the table came from (for messages).
+    fn source(&self) -> &str;
+    /// Column names.
+    fn headers(&self) -> &[String];
+    /// Index of a column, if present.
+    fn col(&self, name: &str) -> Option<usize>;
+    /// Index of a required column, or the error naming it and the columns there are.
+    fn require(&self, name: &str) -> Result<usize, InputError> {
+        self.col(name)
+            .ok_or_else(|| missing_column(self.source(), self.headers(), name))
+    }
+}
+
+impl<R: Read> Header for TableReader<R> {
+    fn source(&self) -> &str {
+        &self.source
+    }
+    fn headers(&self) -> &[String] {
+        &self.headers
+    }
+    fn col(&self, name: &str) -> Option<usize> {
+        self.index.get(name).copied()
+    }
+}
+
+impl Header for Table {
+    fn source(&self) -> &str {
+        &self.source
+    }
+    fn headers(&self) -> &[String] {
+        &self.headers
+    }
+    fn col(&self, name: &str) -> Option<usize> {
+        self.index.get(name).copied()
+    }
+}
+
+fn missing_column(source: &str, headers: &[String], name: &str) -> InputError {
+    InputError {
         file: source.to_string(),
         line: Some(1),
         column: Some(name.to_string()),
@@ -238,7 +278,19 @@ fn require(
             "missing required column (header has: {})",
             headers.join(",")
         ),
-    })
+    }
+}
+
+fn require(
+    source: &str,
+    headers: &[String],
+    index: &HashMap<String, usize>,
+    name: &str,
+) -> Result<usize, InputError> {
+    index
+        .get(name)
+        .copied()
+        .ok_or_else(|| missing_column(source, headers, name))
 }
 
 /// One row of a table with what its messages need: the source, the column names and the

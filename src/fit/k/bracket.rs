@@ -21,7 +21,10 @@ pub fn invertible(model: &Model) -> bool {
     )
 }
 
-pub(super) fn eval(
+/// The steady state of `model` at this scene with K = `k`, counting the evaluation in
+/// `evals`: for stick/slip without the forward model's map-slope and second-fixed-point
+/// diagnostics (the inversion and the K-law fits need v̄ and the final velocity only).
+pub(crate) fn eval(
     model: &Model,
     scene: &Scene,
     k: f64,

@@ -35,5 +35,5 @@ pub mod types;
 
 pub use bracket::{bracket, invertible};
 pub use estimate::estimate;
-pub use search::{estimate_in_k, solve};
+pub use search::{dv_dk, estimate_in_k, solve};
 pub use types::{KBracket, KEstimate, KFailure, KRoot, LowerLimit, UpperLimit};

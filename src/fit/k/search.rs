@@ -231,22 +231,34 @@ pub fn estimate_in_k(model: &Model, scene: &Scene, v: f64, sigma_v: Option<f64>)
     }
 }
 
-/// dv̄/dK at the root from v̄ at K_min + d e^{±h}, d = K − K_min, h = 1e-5 (steps uniform in
-/// s = ln(K − K_min), which keeps their size right where the slope in K is nearly infinite),
-/// differenced over the K values actually evaluated (a three-point Lagrange derivative at the
-/// root, second-order accurate on any spacing). Near the bracket's top, where K_min + d e^h
-/// is out of range, the step is shrunk to fit and, failing that, the points are taken at
-/// s − h and s − 2h (one-sided, still second order). With a first-order one-sided difference
-/// here the error below lift-off was 5e-4 (tests/k_inversion.rs, mpmath references).
+/// dv̄/dK at the root of an estimate, by [`dv_dk`] with the model's own steady states.
 fn slope(model: &Model, scene: &Scene, br: &KBracket, r: &KRoot) -> Option<f64> {
     let mut n = 0;
-    let d = r.k - br.lo;
+    dv_dk(br, r.k, r.steady.mean_velocity, |k| {
+        eval(model, scene, k, &mut n).ok().map(|s| s.mean_velocity)
+    })
+}
+
+/// dv̄/dK at K = `k0` inside the bracket `br`, where v̄ = `v0`, from `v_at` (v̄ at a K, or
+/// `None` where there is no steady state) at K_min + d e^{±h}, d = K − K_min, h = 1e-5
+/// (steps uniform in s = ln(K − K_min), which keeps their size right where the slope in K is
+/// nearly infinite), differenced over the K values actually evaluated (a three-point Lagrange
+/// derivative at `k0`, second-order accurate on any spacing). Near the bracket's top, where
+/// K_min + d e^h is out of range, the step is shrunk to fit and, failing that, the points are
+/// taken at s − h and s − 2h (one-sided, still second order). With a first-order one-sided
+/// difference here the error below lift-off was 5e-4 (tests/it/k_inversion.rs, mpmath
+/// references). Used by the K inversion (`dv_dK` of `fitbead k`) and by the K-law fits'
+/// Jacobian ([`crate::fit::klaw`]).
+pub fn dv_dk(
+    br: &KBracket,
+    k0: f64,
+    v0: f64,
+    mut v_at: impl FnMut(f64) -> Option<f64>,
+) -> Option<f64> {
+    let d = k0 - br.lo;
     if !(d > 0.0) {
         return None;
     }
-    let k0 = r.k;
-    let v0 = r.steady.mean_velocity;
-    let mut v_at = |k: f64| eval(model, scene, k, &mut n).ok().map(|s| s.mean_velocity);
     let h_max = if br.hi > k0 {
         ((br.hi - br.lo) / d).ln()
     } else {

@@ -1,0 +1,462 @@
+//! Scenes in, mean velocities out: the rows of a scenes table as typed scenes and models (a
+//! column map, [`SceneColumns`], and the settings rows fall back on, [`ForwardSettings`]),
+//! evaluated and formatted as `fitbead forward`'s output records by a [`ForwardPlan`] that
+//! [`super::stream::stream`] runs over a table of any size.
+//!
+//! Input columns `xi`, `delta_deg` (required), `K` (a number or a law name), `rho`, `f`,
+//! `lambda`, `mu` (Jan), `a1`, `a2`, `a3` (Jaeger) and `spin` (contact); an empty cell or an
+//! absent column takes the setting. Every input cell passes through (trimmed), an input column
+//! whose name is also an output column renamed `in_NAME`; then [`OUTPUT_COLUMNS`], then
+//! [`CONTACT_COLUMNS`] (contact model) or [`AUTO_COLUMNS`] (auto).
+//!
+//! Settings are named in messages as the command line's flags (`--rho` of
+//! [`SETTINGS_ORIGIN`]), since that is where they come from.
+
+use super::cells::Cells;
+use super::scenes::{Row, TableReader};
+use super::stream::RowPlan;
+use super::InputError;
+use crate::models::auto::{Auto, AutoOutcome};
+use crate::models::contact::{Contact, SpinRule, SteadyContact};
+use crate::models::jaeger::Jaeger;
+use crate::models::jan::Jan;
+use crate::models::{regime_of, ForwardModel, JaegerBranch, Model, ModelKind, Outcome};
+use crate::scene::ParameterError;
+use crate::scene::{CollisionLaw, Scene};
+use std::io::Read;
+
+/// Columns added after [`OUTPUT_COLUMNS`] by the contact model.
+pub const CONTACT_COLUMNS: [&str; 10] = [
+    "phase_sequence",
+    "phase_change_deg",
+    "initial_spin",
+    "final_spin",
+    "beads",
+    "collision_translation_frac",
+    "collision_spin_frac",
+    "friction_work_frac",
+    "energy_closure",
+    "spin_rule",
+];
+
+/// Columns added after [`OUTPUT_COLUMNS`] by `auto`: the model used and why.
+pub const AUTO_COLUMNS: [&str; 2] = ["model_used", "reason"];
+
+/// Output columns added to each row.
+pub const OUTPUT_COLUMNS: [&str; 12] = [
+    "v",
+    "regime",
+    "status",
+    "K_used",
+    "final_velocity",
+    "initial_velocity",
+    "contact_time",
+    "theta_G_deg",
+    "map_slope",
+    "other_fixed_point",
+    "phases",
+    "message",
+];
+
+/// Where the settings come from, as messages name it.
+pub const SETTINGS_ORIGIN: &str = "<command line>";
+
+/// An error about a setting (named `--NAME` of [`SETTINGS_ORIGIN`]).
+pub fn setting_error(name: &str, value: &str, message: impl Into<String>) -> InputError {
+    InputError {
+        file: SETTINGS_ORIGIN.into(),
+        line: None,
+        column: Some(format!("--{name}")),
+        value: Some(value.to_string()),
+        message: message.into(),
+    }
+}
+
+/// The values rows fall back on where their column is absent or their cell empty, and the
+/// model to evaluate.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ForwardSettings {
+    /// The model (every kind but md, which does not stream).
+    pub kind: ModelKind,
+    /// Collision law of rows without a `K` cell.
+    pub law: CollisionLaw,
+    /// ρ of rows without a `rho` cell.
+    pub rho: f64,
+    /// f of rows without an `f` cell.
+    pub f: f64,
+    /// Jan's λ of rows without a `lambda` cell (else the paper's eq 75 at the row's α).
+    pub lambda: Option<f64>,
+    /// Jan's μ of rows without a `mu` cell (else the paper's eq 76 at the row's α).
+    pub mu: Option<f64>,
+    /// Jaeger's a1, a2, a3 of rows without those cells (Jaeger needs all three).
+    pub a: [Option<f64>; 3],
+    /// Jaeger's root when there are two.
+    pub branch: JaegerBranch,
+    /// Spin rule of the contact model for rows without a `spin` cell.
+    pub spin: SpinRule,
+    /// Quadrature tolerance of the contact model; the target tolerance of `auto`.
+    pub tol: f64,
+}
+
+impl Default for ForwardSettings {
+    /// Stick, the adjusted law, ρ = 0.4, f = 0.1, Jan's and Jaeger's settings from the paper
+    /// (Jaeger's none), the upper root, rolling restarts, tolerance 1e-14.
+    fn default() -> Self {
+        ForwardSettings {
+            kind: ModelKind::Stick,
+            law: CollisionLaw::Adjusted,
+            rho: 0.4,
+            f: 0.1,
+            lambda: None,
+            mu: None,
+            a: [None; 3],
+            branch: JaegerBranch::Upper,
+            spin: SpinRule::Roll,
+            tol: 1e-14,
+        }
+    }
+}
+
+/// Where the scene columns are in a table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SceneColumns {
+    /// `xi`.
+    pub xi: usize,
+    /// `delta_deg`.
+    pub delta_deg: usize,
+    /// `K`.
+    pub k: Option<usize>,
+    /// `rho`.
+    pub rho: Option<usize>,
+    /// `f`.
+    pub f: Option<usize>,
+    /// `lambda`.
+    pub lambda: Option<usize>,
+    /// `mu`.
+    pub mu: Option<usize>,
+    /// `a1`, `a2`, `a3`.
+    pub a: [Option<usize>; 3],
+    /// `spin`.
+    pub spin: Option<usize>,
+}
+
+impl SceneColumns {
+    /// The columns of `reader`'s header; `xi` and `delta_deg` are required.
+    pub fn new<R: Read>(reader: &TableReader<R>) -> Result<Self, InputError> {
+        Ok(SceneColumns {
+            xi: reader.require("xi")?,
+            delta_deg: reader.require("delta_deg")?,
+            k: reader.col("K"),
+            rho: reader.col("rho"),
+            f: reader.col("f"),
+            lambda: reader.col("lambda"),
+            mu: reader.col("mu"),
+            a: [reader.col("a1"), reader.col("a2"), reader.col("a3")],
+            spin: reader.col("spin"),
+        })
+    }
+
+    /// The scene parameters' columns by name, for locating an error.
+    pub fn named(&self) -> [(&'static str, Option<usize>); 10] {
+        [
+            ("xi", Some(self.xi)),
+            ("delta_deg", Some(self.delta_deg)),
+            ("K", self.k),
+            ("rho", self.rho),
+            ("f", self.f),
+            ("lambda", self.lambda),
+            ("mu", self.mu),
+            ("a1", self.a[0]),
+            ("a2", self.a[1]),
+            ("a3", self.a[2]),
+        ]
+    }
+
+    /// The scene and model of one row, or the row's first bad value.
+    pub fn read(&self, r: &Row<'_>, s: &ForwardSettings) -> Result<(Scene, Model), InputError> {
+        let xi = r.number(self.xi)?;
+        let d = r.number(self.delta_deg)?;
+        let law = match self.k {
+            Some(c) if !r.cell(c).is_empty() => r
+                .cell(c)
+                .parse::<CollisionLaw>()
+                .map_err(|e| r.err(c, e.to_string()))?,
+            _ => s.law,
+        };
+        if let (CollisionLaw::Value(k), Some(c)) = (law, self.k) {
+            if !k.is_finite() {
+                return Err(r.err(c, "value must be a finite number"));
+            }
+        }
+        let rho = r.opt_number(self.rho)?.unwrap_or(s.rho);
+        let f = r.opt_number(self.f)?.unwrap_or(s.f);
+        let named = self.named();
+        let scene = Scene::new(xi, d, rho, f, law).map_err(|e| scene_error(r, e, &named))?;
+        let model = match (s.kind, s.kind.contact_model()) {
+            (ModelKind::Auto, _) => Model::Auto(Auto { tol: s.tol }),
+            (ModelKind::Contact, _) => {
+                let spin = match self.spin {
+                    Some(c) if !r.cell(c).is_empty() => r
+                        .cell(c)
+                        .parse::<SpinRule>()
+                        .map_err(|e| r.err(c, e.to_string()))?,
+                    _ => s.spin,
+                };
+                Model::Contact(Contact { spin, tol: s.tol })
+            }
+            (_, Some(m)) => m,
+            (ModelKind::Jan, None) => {
+                let paper = Jan::paper_fit(scene.alpha_rad());
+                let lambda = r
+                    .opt_number(self.lambda)?
+                    .or(s.lambda)
+                    .unwrap_or(paper.lambda);
+                let mu = r.opt_number(self.mu)?.or(s.mu).unwrap_or(paper.mu);
+                Model::Jan(Jan::new(lambda, mu).map_err(|e| scene_error(r, e, &named))?)
+            }
+            _ => {
+                let mut v = [0.0; 3];
+                for (i, vi) in v.iter_mut().enumerate() {
+                    *vi = match r.opt_number(self.a[i])?.or(s.a[i]) {
+                        Some(x) => x,
+                        None => {
+                            return Err(setting_error(
+                                &format!("a{}", i + 1),
+                                "",
+                                "jaeger needs a1, a2, a3 (flags or columns)",
+                            ))
+                        }
+                    };
+                }
+                Model::Jaeger(
+                    Jaeger::new(v[0], v[1], v[2], s.branch)
+                        .map_err(|e| scene_error(r, e, &named))?,
+                )
+            }
+        };
+        Ok((scene, model))
+    }
+}
+
+fn field_column(field: &str) -> &str {
+    match field {
+        "delta" => "delta_deg",
+        other => other,
+    }
+}
+
+/// The error of a scene or model that `Scene::new` (or a model's constructor) refused for row
+/// `r`: located at the offending cell when its column is among `cols` (name, index), else
+/// about the setting it came from.
+pub fn scene_error(r: &Row<'_>, e: ParameterError, cols: &[(&str, Option<usize>)]) -> InputError {
+    let field = match &e {
+        ParameterError::InvalidParameter { field, .. } => field_column(field).to_string(),
+        ParameterError::UnknownLaw(_) => "K".into(),
+        ParameterError::UnknownModel(_) => "model".into(),
+    };
+    match cols.iter().find(|(n, _)| *n == field).and_then(|(_, c)| *c) {
+        Some(c) => r.err(c, e.to_string()),
+        None => InputError {
+            file: SETTINGS_ORIGIN.into(),
+            line: None,
+            column: Some(format!("--{field}")),
+            value: None,
+            message: format!("{e} (line {} of {})", r.line, r.source),
+        },
+    }
+}
+
+/// `fitbead forward`'s rows as a [`RowPlan`]: each row's scene and model from its cells and
+/// the settings, its outcome, and its output record (module docs).
+#[derive(Debug, Clone)]
+pub struct ForwardPlan {
+    settings: ForwardSettings,
+    cols: SceneColumns,
+    headers: Vec<String>,
+}
+
+impl ForwardPlan {
+    /// The plan for a table with `reader`'s header and columns `cols`. The kind must not be
+    /// md (it has its own, whole-table path).
+    pub fn new<R: Read>(
+        reader: &TableReader<R>,
+        cols: SceneColumns,
+        settings: ForwardSettings,
+    ) -> Self {
+        ForwardPlan {
+            settings,
+            cols,
+            headers: reader.headers().to_vec(),
+        }
+    }
+}
+
+/// A row ready to evaluate.
+#[derive(Debug, Clone, Copy)]
+pub struct Job {
+    scene: Scene,
+    model: Model,
+}
+
+impl RowPlan for ForwardPlan {
+    type Ready = Job;
+    type Ledger = ();
+    type Note = ();
+
+    fn header(&self, out: &mut Vec<u8>) {
+        let kind = self.settings.kind;
+        let general = kind == ModelKind::Contact;
+        let mut w = Cells::new(out);
+        for h in &self.headers {
+            if OUTPUT_COLUMNS.contains(&h.as_str())
+                || general && CONTACT_COLUMNS.contains(&h.as_str())
+            {
+                w.text(&format!("in_{h}"));
+            } else {
+                w.text(h);
+            }
+        }
+        for c in OUTPUT_COLUMNS {
+            w.text(c);
+        }
+        if general {
+            for c in CONTACT_COLUMNS {
+                w.text(c);
+            }
+        }
+        if kind == ModelKind::Auto {
+            for c in AUTO_COLUMNS {
+                w.text(c);
+            }
+        }
+        w.end();
+    }
+
+    fn prepare(&self, row: &Row<'_>) -> Result<Job, InputError> {
+        let (scene, model) = self.cols.read(row, &self.settings)?;
+        Ok(Job { scene, model })
+    }
+
+    fn write(&self, row: &Row<'_>, job: Job, out: &mut Vec<u8>) {
+        let (o, d, au) = evaluate(&job);
+        let kind = self.settings.kind;
+        let general = kind == ModelKind::Contact;
+        let contact = !matches!(kind, ModelKind::Jan | ModelKind::Jaeger);
+        let mut w = Cells::new(out);
+        for cell in row.rec.iter() {
+            w.text(cell.trim());
+        }
+        let regime = regime_of(&o);
+        match &o {
+            Ok(s) => {
+                w.num(s.mean_velocity);
+                w.opt_show(regime);
+                w.text("ok");
+                if contact {
+                    w.num(job.scene.k());
+                    w.num(s.final_velocity);
+                    w.num(s.initial_velocity);
+                } else {
+                    w.empty();
+                    w.empty();
+                    w.empty();
+                }
+                w.num(s.contact_time);
+                w.opt(s.theta_g.map(f64::to_degrees));
+                w.opt(s.map_slope);
+                w.opt(s.other_fixed_point);
+                w.show(s.phases);
+                w.text(if s.other_fixed_point.is_some() {
+                    if contact {
+                        "bistable: another fixed point of the final-velocity map"
+                    } else {
+                        "two positive roots (eq 84): bistable band"
+                    }
+                } else {
+                    ""
+                });
+            }
+            Err(e) => {
+                w.empty();
+                w.opt_show(regime);
+                w.text(e.status());
+                if contact {
+                    w.num(job.scene.k());
+                } else {
+                    w.empty();
+                }
+                for _ in 0..7 {
+                    w.empty();
+                }
+                w.show(e);
+            }
+        }
+        if let (true, Some(d)) = (general, &d) {
+            contact_cells(&mut w, &job, d);
+        }
+        if kind == ModelKind::Auto {
+            match au {
+                Some(r) => {
+                    w.text(r.choice.name());
+                    w.show(r.reason);
+                }
+                None => {
+                    w.empty();
+                    w.empty();
+                }
+            }
+        }
+        w.end();
+    }
+}
+
+/// One row's outcome, with what the contact model and `auto` add.
+fn evaluate(j: &Job) -> (Outcome, Option<ContactDetail>, Option<AutoOutcome>) {
+    match j.model {
+        Model::Contact(c) => {
+            let r = c.steady_state(&j.scene);
+            (
+                Contact::outcome(&j.scene, &r),
+                Some(ContactDetail {
+                    rule: c.spin,
+                    steady: r.ok(),
+                }),
+                None,
+            )
+        }
+        // The auto choice travels with each outcome.
+        Model::Auto(au) => {
+            let r = au.choose(&j.scene);
+            (r.outcome, None, Some(r))
+        }
+        m => (m.evaluate(&j.scene), None, None),
+    }
+}
+
+/// What the contact model adds to a row.
+struct ContactDetail {
+    rule: SpinRule,
+    steady: Option<SteadyContact>,
+}
+
+fn contact_cells(w: &mut Cells, job: &Job, d: &ContactDetail) {
+    let Some(s) = &d.steady else {
+        for _ in 0..CONTACT_COLUMNS.len() - 1 {
+            w.empty();
+        }
+        w.show(d.rule);
+        return;
+    };
+    let e = s.energy(&job.scene);
+    let p = e.potential_drop;
+    w.show(s.run.phases);
+    w.text(&s.run.phases.changes_deg());
+    w.num(s.launch.spin);
+    w.num(s.final_spin);
+    w.show(s.beads);
+    w.num(e.collision_translation / p);
+    w.num(e.collision_spin / p);
+    w.num(e.friction_work / p);
+    w.num(e.closure());
+    w.show(d.rule);
+}

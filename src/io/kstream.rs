@@ -1,0 +1,311 @@
+//! Measurements in, K out: `fitbead k`'s rows as a [`KPlan`] that
+//! [`super::stream::stream`] runs over a table of any size. Each row is read and checked as
+//! [`super::measurements`] reads a whole file (the series check in input order, keeping one
+//! entry per series), inverted (eq 69: [`crate::fit::k::estimate`]) and written as one
+//! record of [`COLUMNS`], [`EXTRA_COLUMNS`], [`AUTO_COLUMNS`] (auto only), then the input's
+//! other columns (trimmed; a name clashing with an output column renamed `in_NAME`).
+
+use super::cells::Cells;
+use super::measurements::{Measured, MeasurementColumns, MeasurementDefaults, SeriesLedger};
+use super::scenes::{Header, Row};
+use super::stream::RowPlan;
+use super::InputError;
+use crate::fit::k::auto::{self as kauto, KChoice};
+use crate::fit::k::{estimate, KEstimate, KFailure, LowerLimit, UpperLimit};
+use crate::models::auto::Auto;
+use crate::models::Model;
+use crate::numfmt::fmt_f64;
+use crate::report::figures::{scatter_svg, PointSeries, Scatter};
+use crate::scene::CollisionLaw;
+use std::collections::HashMap;
+use std::fmt::Display;
+
+/// The contract columns, in order.
+pub const COLUMNS: [&str; 18] = [
+    "series",
+    "xi",
+    "delta_deg",
+    "v",
+    "sigma_v",
+    "model",
+    "K",
+    "K_lo",
+    "K_hi",
+    "dv_dK",
+    "final_velocity",
+    "theta_G_deg",
+    "K_cos2a",
+    "K_adjusted",
+    "K_impact",
+    "regime",
+    "status",
+    "iterations",
+];
+
+/// Columns added after the contract ones: the bracket of K, what sets its ends, and why a
+/// row has no K or how its interval was cut.
+pub const EXTRA_COLUMNS: [&str; 5] = ["K_min", "K_max", "lower_limit", "upper_limit", "message"];
+
+/// Columns added after [`EXTRA_COLUMNS`] by auto: the model each row was inverted with, and
+/// why.
+pub const AUTO_COLUMNS: [&str; 2] = ["model_used", "reason"];
+
+/// Input columns that have their own output column.
+const INPUT_OWN: [&str; 5] = ["series", "xi", "delta_deg", "v", "sigma_v"];
+
+/// How to invert the rows.
+#[derive(Debug, Clone, PartialEq)]
+pub struct KSettings {
+    /// The model every row is inverted with (ignored with `auto`).
+    pub model: Model,
+    /// Per row the model chosen at the row's stick K (eq 69 under stick first).
+    pub auto: Option<Auto>,
+    /// The text of the `model` column.
+    pub model_name: String,
+    /// Keep each inverted row's point (final velocity, K and its interval, per series) for
+    /// [`KLedger::plot_svg`]; memory then grows with the rows.
+    pub plot: bool,
+}
+
+/// What a stream of K rows keeps across rows: one entry per series for the ξ check, and the
+/// points of the plot when [`KSettings::plot`] asks for them.
+#[derive(Debug, Clone, Default)]
+pub struct KLedger {
+    series: SeriesLedger,
+    labels: HashMap<String, usize>,
+    plot: Vec<PointSeries>,
+}
+
+/// A row's point on the plot: final velocity, K, K_lo, K_hi, and K = cos 2α at its ξ.
+#[derive(Debug, Clone, Copy)]
+pub struct PlotNote {
+    point: (f64, f64, f64, f64),
+    cos2a: f64,
+}
+
+impl KLedger {
+    /// K against the steady final velocity, one colour per series (series label, or ξ where
+    /// there is none), with each series' K = cos 2α line (the paper's Fig. 5), as SVG.
+    pub fn plot_svg(&self, model_name: &str) -> Result<String, String> {
+        scatter_svg(&Scatter {
+            title: format!("K per measurement (eq 69), {model_name} model"),
+            x_label: "steady final velocity (units sqrt(g(R+r)))".into(),
+            y_label: "K".into(),
+            series: self.plot.clone(),
+        })
+    }
+}
+
+/// `fitbead k`'s rows as a [`RowPlan`] (module docs).
+#[derive(Debug, Clone)]
+pub struct KPlan {
+    settings: KSettings,
+    cols: MeasurementColumns,
+    headers: Vec<String>,
+    /// Input columns passed through, in order.
+    pass: Vec<usize>,
+}
+
+impl KPlan {
+    /// The plan for a table with `header`, checking its columns and `defaults` as
+    /// [`MeasurementColumns::new`] does.
+    pub fn new(
+        header: &impl Header,
+        defaults: &MeasurementDefaults,
+        settings: KSettings,
+    ) -> Result<Self, InputError> {
+        let cols = MeasurementColumns::new(header, defaults)?;
+        let headers = header.headers().to_vec();
+        let pass = (0..headers.len())
+            .filter(|&i| !INPUT_OWN.contains(&headers[i].as_str()))
+            .collect();
+        Ok(KPlan {
+            settings,
+            cols,
+            headers,
+            pass,
+        })
+    }
+
+    fn own_columns(&self) -> impl Iterator<Item = &'static str> + '_ {
+        let auto: &[&str] = if self.settings.auto.is_some() {
+            &AUTO_COLUMNS
+        } else {
+            &[]
+        };
+        COLUMNS
+            .iter()
+            .chain(EXTRA_COLUMNS.iter())
+            .chain(auto.iter())
+            .copied()
+    }
+
+    /// Inverts one measurement with the settings' model, or the one auto chooses for it.
+    pub fn invert(&self, m: &Measured) -> (KEstimate, Option<KChoice>) {
+        match &self.settings.auto {
+            Some(au) => {
+                let c = kauto::choose(au, &m.scene, m.v);
+                (estimate(&c.model, &m.scene, m.v, m.sigma_v), Some(c))
+            }
+            None => (
+                estimate(&self.settings.model, &m.scene, m.v, m.sigma_v),
+                None,
+            ),
+        }
+    }
+}
+
+fn lower_name(l: LowerLimit) -> &'static str {
+    match l {
+        LowerLimit::Crawl => "crawl-over-top",
+        LowerLimit::Zero => "K=0",
+        LowerLimit::Model => "model-limit",
+    }
+}
+
+fn upper_name(u: UpperLimit) -> &'static str {
+    match u {
+        UpperLimit::LiftOff => "lift-off",
+        UpperLimit::Model => "model-limit",
+    }
+}
+
+impl RowPlan for KPlan {
+    type Ready = Measured;
+    type Ledger = KLedger;
+    type Note = Option<PlotNote>;
+
+    fn header(&self, out: &mut Vec<u8>) {
+        let mut w = Cells::new(out);
+        for c in self.own_columns() {
+            w.text(c);
+        }
+        for &i in &self.pass {
+            let h = self.headers[i].as_str();
+            if self.own_columns().any(|c| c == h) {
+                w.text(&format!("in_{h}"));
+            } else {
+                w.text(h);
+            }
+        }
+        w.end();
+    }
+
+    fn prepare(&self, row: &Row<'_>) -> Result<Measured, InputError> {
+        self.cols.read(row)
+    }
+
+    fn in_order(&self) -> bool {
+        true
+    }
+
+    fn check(&self, ledger: &mut KLedger, row: &Row<'_>, m: &Measured) -> Result<(), InputError> {
+        self.cols.check_series(&mut ledger.series, row, m)
+    }
+
+    fn write(&self, row: &Row<'_>, m: Measured, out: &mut Vec<u8>) -> Option<PlotNote> {
+        let (e, choice) = self.invert(&m);
+        let s = &m.scene;
+        let mut w = Cells::new(out);
+        w.text(self.cols.series(row));
+        w.num(s.xi());
+        w.text(row.cell(self.cols.delta_deg()));
+        w.num(m.v);
+        w.opt(m.sigma_v);
+        w.text(&self.settings.model_name);
+        let root = e.root.as_ref().ok();
+        w.opt(root.map(|r| r.k));
+        w.opt(e.k_lo);
+        w.opt(e.k_hi);
+        w.opt(e.dv_dk);
+        w.opt(root.map(|r| r.steady.final_velocity));
+        w.opt(e.theta_g.map(f64::to_degrees));
+        let (alpha, rho) = (s.alpha_rad(), s.rho());
+        let cos2a = CollisionLaw::Cos2a.k(alpha, rho);
+        w.num(cos2a);
+        w.num(CollisionLaw::Adjusted.k(alpha, rho));
+        w.num(CollisionLaw::Impact.k(alpha, rho));
+        let (regime, status) = match &e.root {
+            Ok(_) => ("B", "ok"),
+            Err(KFailure::BelowRange) => ("A", "below-range"),
+            Err(KFailure::AboveRange) => ("C", "above-range"),
+            Err(KFailure::Invalid(_)) => ("", "invalid"),
+        };
+        w.text(regime);
+        w.text(status);
+        w.opt(root.map(|r| r.evals as f64));
+        match &e.bracket {
+            Some(b) => {
+                w.num(b.lo);
+                w.num(b.hi);
+                w.text(lower_name(b.lower));
+                w.text(upper_name(b.upper));
+            }
+            None => {
+                for _ in 0..4 {
+                    w.empty();
+                }
+            }
+        }
+        let failure = e.root.as_ref().err().map(|f| f as &dyn Display);
+        w.joined(
+            failure
+                .into_iter()
+                .chain(e.notes.iter().map(|n| n as &dyn Display)),
+            "; ",
+        );
+        if self.settings.auto.is_some() {
+            match &choice {
+                Some(c) => {
+                    w.text(c.choice.name());
+                    w.text(&c.reason);
+                }
+                None => {
+                    w.empty();
+                    w.empty();
+                }
+            }
+        }
+        for &c in &self.pass {
+            w.text(row.cell(c));
+        }
+        w.end();
+        match (self.settings.plot, root) {
+            (true, Some(r)) => Some(PlotNote {
+                point: (
+                    r.steady.final_velocity,
+                    r.k,
+                    e.k_lo.unwrap_or(r.k),
+                    e.k_hi.unwrap_or(r.k),
+                ),
+                cos2a,
+            }),
+            _ => None,
+        }
+    }
+
+    fn record(&self, ledger: &mut KLedger, row: &Row<'_>, note: Option<PlotNote>) {
+        let Some(n) = note else { return };
+        let series = self.cols.series(row);
+        let label = if series.is_empty() {
+            // The row passed its checks: its ξ reads back as a number.
+            let xi = row.number(self.cols.xi()).unwrap_or(f64::NAN);
+            format!("xi = {}", fmt_f64(xi))
+        } else {
+            format!("series {series}")
+        };
+        let i = match ledger.labels.get(&label) {
+            Some(&i) => i,
+            None => {
+                ledger.plot.push(PointSeries {
+                    label: label.clone(),
+                    points: Vec::new(),
+                    reference: Some((n.cos2a, format!("cos 2alpha = {:.4}", n.cos2a))),
+                });
+                ledger.labels.insert(label, ledger.plot.len() - 1);
+                ledger.plot.len() - 1
+            }
+        };
+        ledger.plot[i].points.push(n.point);
+    }
+}

@@ -1,0 +1,351 @@
+//! Streaming a CSV table through a per-row computation in bounded memory: rows are read
+//! [`CHUNK_ROWS`] at a time; each chunk is checked, computed and formatted in parallel (rayon
+//! tasks of [`TASK_ROWS`] rows writing straight into byte buffers) while the previous chunk's
+//! bytes are written and the next chunk is read. Memory stays at two chunks of input records
+//! and one of output bytes, whatever the number of rows; the output is in input order.
+//!
+//! What a row means is a [`RowPlan`]'s business: `fitbead forward`'s scenes
+//! ([`super::forward::ForwardPlan`]) and `fitbead k`'s measurements
+//! ([`super::kstream::KPlan`]) are two. The engine gives every plan the same error rules as
+//! reading the whole table first: a malformed row anywhere in the input (or an input with no
+//! rows) is reported before any bad value, then the first bad row in input order; a failed
+//! write is reported only once the whole input proved good, writing stopping at the failure.
+//! It reports its progress in input bytes to a [`Progress`] sink and stops between tasks when
+//! the caller's stop flag is raised.
+
+use super::scenes::{line_of, Row, TableReader};
+use super::InputError;
+use crate::progress::{Progress, ProgressEvent};
+use rayon::prelude::*;
+use std::io::{Read, Write};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
+/// Rows read, checked, computed and formatted per step.
+pub const CHUNK_ROWS: usize = 32 * 1024;
+/// Rows per parallel task within a chunk.
+pub const TASK_ROWS: usize = 512;
+
+/// What a stream does with each row: check its cells ([`prepare`](RowPlan::prepare), in
+/// parallel), optionally check it against the rows before it ([`check`](RowPlan::check), in
+/// input order, for rules that span the file), then compute and format it
+/// ([`write`](RowPlan::write), in parallel), handing a [`Note`](RowPlan::Note) to
+/// [`record`](RowPlan::record) in input order (for what is kept across the file).
+pub trait RowPlan: Sync {
+    /// A row whose cells passed their checks, ready to compute.
+    type Ready: Send;
+    /// What the plan keeps across the rows, in input order (a ledger per series, points for
+    /// a plot); `()` when nothing.
+    type Ledger: Send;
+    /// What [`write`](RowPlan::write) hands to [`record`](RowPlan::record); `()` when nothing.
+    type Note: Send;
+
+    /// Appends the output's header record.
+    fn header(&self, out: &mut Vec<u8>);
+
+    /// Checks the cells of one row, or reports its first bad value.
+    fn prepare(&self, row: &Row<'_>) -> Result<Self::Ready, InputError>;
+
+    /// Whether rows go through [`check`](RowPlan::check) (in input order) between
+    /// [`prepare`](RowPlan::prepare) and [`write`](RowPlan::write). When false (the
+    /// default), each task prepares and writes its rows in one pass.
+    fn in_order(&self) -> bool {
+        false
+    }
+
+    /// Checks a prepared row against what `ledger` kept of the rows before it.
+    fn check(
+        &self,
+        ledger: &mut Self::Ledger,
+        row: &Row<'_>,
+        ready: &Self::Ready,
+    ) -> Result<(), InputError> {
+        let _ = (ledger, row, ready);
+        Ok(())
+    }
+
+    /// Computes one row and appends its output record to `out`.
+    fn write(&self, row: &Row<'_>, ready: Self::Ready, out: &mut Vec<u8>) -> Self::Note;
+
+    /// Keeps what a written row's note says, in input order.
+    fn record(&self, ledger: &mut Self::Ledger, row: &Row<'_>, note: Self::Note) {
+        let _ = (ledger, row, note);
+    }
+}
+
+/// How to run a stream.
+#[derive(Debug, Clone)]
+pub struct StreamOptions {
+    /// Rows per chunk (at least 1).
+    pub chunk_rows: usize,
+    /// Rows per parallel task (at least 1).
+    pub task_rows: usize,
+    /// Raised by the caller (e.g. on Ctrl-C): the stream stops before its next task and
+    /// returns [`StreamError::Stopped`].
+    pub stop: Option<Arc<AtomicBool>>,
+    /// Where progress goes: a `Start` whose total is `input_bytes` (0 when unknown), the
+    /// input bytes consumed after each chunk, and `Finish`.
+    pub progress: Option<Progress>,
+    /// The label of the progress events.
+    pub label: String,
+    /// Size of the input in bytes, when known (for progress only).
+    pub input_bytes: Option<u64>,
+}
+
+impl Default for StreamOptions {
+    /// [`CHUNK_ROWS`], [`TASK_ROWS`], no stop flag, no progress.
+    fn default() -> Self {
+        StreamOptions {
+            chunk_rows: CHUNK_ROWS,
+            task_rows: TASK_ROWS,
+            stop: None,
+            progress: None,
+            label: String::new(),
+            input_bytes: None,
+        }
+    }
+}
+
+/// Why a stream ended early.
+#[derive(Debug)]
+pub enum StreamError {
+    /// Bad input (located): nothing more was written after it was found.
+    Input(InputError),
+    /// Writing the output failed (reported once the whole input proved good).
+    Write(std::io::Error),
+    /// The stop flag was raised.
+    Stopped,
+}
+
+impl From<InputError> for StreamError {
+    fn from(e: InputError) -> Self {
+        StreamError::Input(e)
+    }
+}
+
+/// What a finished stream returns: the plan's ledger and the number of rows.
+#[derive(Debug)]
+pub struct Streamed<L> {
+    /// What the plan kept across the rows.
+    pub ledger: L,
+    /// Data rows read.
+    pub rows: u64,
+}
+
+/// The source and column names every [`Row`] of the stream refers to.
+struct Context {
+    source: String,
+    headers: Vec<String>,
+}
+
+impl Context {
+    fn row<'a>(&'a self, rec: &'a csv::StringRecord) -> Row<'a> {
+        Row {
+            source: &self.source,
+            headers: &self.headers,
+            rec,
+            line: line_of(rec),
+        }
+    }
+}
+
+/// Reports `Finish` when dropped, whichever way the stream ends.
+struct Finish<'a>(Option<&'a Progress>);
+
+impl Drop for Finish<'_> {
+    fn drop(&mut self) {
+        if let Some(p) = self.0 {
+            p.report(ProgressEvent::Finish);
+        }
+    }
+}
+
+/// Streams the rows of `reader` through the plan that `make` builds from its header, writing
+/// the plan's header and then every row's record to `out` in input order; `ledger` starts
+/// what the plan keeps across rows. See the module docs for the order in which errors are
+/// reported.
+pub fn stream<R, P, F>(
+    mut reader: TableReader<R>,
+    make: F,
+    ledger: P::Ledger,
+    out: &mut (dyn Write + Send),
+    opts: &StreamOptions,
+) -> Result<Streamed<P::Ledger>, StreamError>
+where
+    R: Read + Send,
+    P: RowPlan,
+    F: FnOnce(&TableReader<R>) -> Result<P, InputError>,
+{
+    let mut ledger = ledger;
+    let plan = match make(&reader) {
+        Ok(p) => p,
+        Err(e) => return Err(first_error(&mut reader, e, opts)),
+    };
+    let chunk_rows = opts.chunk_rows.max(1);
+    let ctx = Context {
+        source: reader.source().to_string(),
+        headers: reader.headers().to_vec(),
+    };
+    let _finish = Finish(opts.progress.as_ref());
+    if let Some(p) = &opts.progress {
+        p.report(ProgressEvent::Start {
+            label: &opts.label,
+            total: opts.input_bytes.unwrap_or(0),
+            check_every: 0,
+        });
+    }
+    let mut cur = Vec::new();
+    let mut next = Vec::new();
+    let mut n_cur = reader.read_chunk(&mut cur, chunk_rows)?;
+    if n_cur == 0 {
+        return Err(reader.no_rows().into());
+    }
+    let mut header = Vec::new();
+    plan.header(&mut header);
+    let mut pending = vec![header];
+    let mut failed = None;
+    let mut rows = 0u64;
+    loop {
+        if stopped(opts) {
+            return Err(StreamError::Stopped);
+        }
+        let (read, done) = rayon::join(
+            || {
+                write_parts(out, &pending, &mut failed);
+                reader.read_chunk(&mut next, chunk_rows)
+            },
+            || chunk(&plan, &ctx, &cur[..n_cur], &mut ledger, opts),
+        );
+        let n_next = read?;
+        pending = match done {
+            Ok(parts) => parts,
+            Err(StreamError::Input(e)) => return Err(first_error(&mut reader, e, opts)),
+            Err(e) => return Err(e),
+        };
+        rows += n_cur as u64;
+        if let Some(p) = &opts.progress {
+            p.report(ProgressEvent::Position(reader.bytes_read()));
+        }
+        if n_next == 0 {
+            break;
+        }
+        std::mem::swap(&mut cur, &mut next);
+        n_cur = n_next;
+    }
+    write_parts(out, &pending, &mut failed);
+    match failed {
+        Some(e) => Err(StreamError::Write(e)),
+        None => Ok(Streamed { ledger, rows }),
+    }
+}
+
+fn stopped(opts: &StreamOptions) -> bool {
+    opts.stop
+        .as_ref()
+        .is_some_and(|s| s.load(Ordering::Relaxed))
+}
+
+/// The error to report when a check failed with `e`: a malformed row anywhere in the input,
+/// or an input without rows, is reported first (as when the whole table was read before any
+/// check); a stop raised meanwhile ends the stream instead.
+fn first_error<R: Read>(
+    reader: &mut TableReader<R>,
+    e: InputError,
+    opts: &StreamOptions,
+) -> StreamError {
+    if stopped(opts) {
+        return StreamError::Stopped;
+    }
+    StreamError::Input(reader.drain().unwrap_or(e))
+}
+
+fn write_parts(out: &mut dyn Write, parts: &[Vec<u8>], failed: &mut Option<std::io::Error>) {
+    for p in parts {
+        if failed.is_some() {
+            return;
+        }
+        if let Err(e) = out.write_all(p) {
+            *failed = Some(e);
+        }
+    }
+}
+
+/// One task's output: its bytes and its rows' notes.
+type Part<N> = (Vec<u8>, Vec<N>);
+
+/// One chunk of rows: their output bytes in order (one buffer per task), the notes recorded,
+/// or the first bad row's error.
+fn chunk<P: RowPlan>(
+    plan: &P,
+    ctx: &Context,
+    recs: &[csv::StringRecord],
+    ledger: &mut P::Ledger,
+    opts: &StreamOptions,
+) -> Result<Vec<Vec<u8>>, StreamError> {
+    let task = opts.task_rows.max(1);
+    let parts: Vec<Result<Part<P::Note>, StreamError>> = if plan.in_order() {
+        // Prepare in parallel, keeping each task's rows up to its first error.
+        let prepared: Vec<(Vec<P::Ready>, Option<InputError>)> = recs
+            .par_chunks(task)
+            .map(|rs| {
+                let mut ready = Vec::with_capacity(rs.len());
+                for rec in rs {
+                    match plan.prepare(&ctx.row(rec)) {
+                        Ok(r) => ready.push(r),
+                        Err(e) => return (ready, Some(e)),
+                    }
+                }
+                (ready, None)
+            })
+            .collect();
+        // Check in input order: the first failing row, by either check, is the error.
+        for ((ready, err), rs) in prepared.iter().zip(recs.chunks(task)) {
+            for (r, rec) in ready.iter().zip(rs) {
+                plan.check(ledger, &ctx.row(rec), r)?;
+            }
+            if let Some(e) = err {
+                return Err(StreamError::Input(e.clone()));
+            }
+        }
+        prepared
+            .into_par_iter()
+            .zip(recs.par_chunks(task))
+            .map(|((ready, _), rs)| {
+                if stopped(opts) {
+                    return Err(StreamError::Stopped);
+                }
+                let mut buf = Vec::with_capacity(rs.len() * 256);
+                let mut notes = Vec::with_capacity(rs.len());
+                for (r, rec) in ready.into_iter().zip(rs) {
+                    notes.push(plan.write(&ctx.row(rec), r, &mut buf));
+                }
+                Ok((buf, notes))
+            })
+            .collect()
+    } else {
+        recs.par_chunks(task)
+            .map(|rs| {
+                if stopped(opts) {
+                    return Err(StreamError::Stopped);
+                }
+                let mut buf = Vec::with_capacity(rs.len() * 192);
+                let mut notes = Vec::with_capacity(rs.len());
+                for rec in rs {
+                    let row = ctx.row(rec);
+                    let r = plan.prepare(&row)?;
+                    notes.push(plan.write(&row, r, &mut buf));
+                }
+                Ok((buf, notes))
+            })
+            .collect()
+    };
+    let mut out = Vec::with_capacity(parts.len());
+    for (p, rs) in parts.into_iter().zip(recs.chunks(task)) {
+        let (buf, notes) = p?;
+        for (n, rec) in notes.into_iter().zip(rs) {
+            plan.record(ledger, &ctx.row(rec), n);
+        }
+        out.push(buf);
+    }
+    Ok(out)
+}

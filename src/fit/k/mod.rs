@@ -10,7 +10,7 @@
 //!   sits at tan θ = f); there the bead crawls over the top and v̄ → 0;
 //! - the highest K is where the steady final speed reaches lift-off, Φ(w_d) = sqrt(cos Θf)
 //!   (eq 30a), K_d = w_d / sqrt(cos Θf) — below the runaway limits K < 1 (rolling) and
-//!   K² e^{4fα} < 1 (slip) of the issue, which lift-off always reaches first when δ > 0.
+//!   K² e^{4fα} < 1 (slip), which lift-off always reaches first when δ > 0.
 //!
 //! Each end is then checked against the forward model itself; where the model fails inside the
 //! analytic bracket (the approximate models' own validity limits, the stick/slip map's

@@ -565,7 +565,7 @@ const DD_DENOMINATOR_ABOVE: f64 = -1e-13;
 /// Steady final velocity squared of the slip model (eq 50 corrected):
 /// L'² = (b sin Θf + c cos Θf − (b sin Θ0 + c cos Θ0) e^{4fα}) / (1 − K² e^{4fα}), with the
 /// differences in product form (e^{4fα} − 1 by expm1), and from [`SlipDd`] where the
-/// denominator is below [`DD_DENOMINATOR_BELOW`]. `Err(Runaway)` when K² e^{4fα} ≥ 1.
+/// denominator is below `DD_DENOMINATOR_BELOW` (1e-2). `Err(Runaway)` when K² e^{4fα} ≥ 1.
 pub fn final_velocity_sq(scene: &Scene) -> Result<f64, NotSteady> {
     let (b, c) = slip_coefficients(scene.f);
     let em1 = (4.0 * scene.f * scene.alpha).exp_m1();

@@ -181,7 +181,7 @@ fn clamp_end(
     }
 }
 
-/// [`estimate`] by the general search in K: [`bracket`], then [`solve`] at v and v ± σ.
+/// [`estimate`](fn@super::estimate) by the general search in K: [`bracket`], then [`solve`] at v and v ± σ.
 pub fn estimate_in_k(model: &Model, scene: &Scene, v: f64, sigma_v: Option<f64>) -> KEstimate {
     let br = match bracket(model, scene) {
         Ok(b) => b,

@@ -1,7 +1,7 @@
 //! K inversion (eq 69) benchmarks: one measurement row — bracket, K, K_lo, K_hi (v ± σ, exact
 //! inverses), dv/dK — single-threaded, on the shipped default data (36 rows, 4 series); K
-//! alone; and K alone by the general search in K (src/fit/k.rs) for comparison with the
-//! launch-speed path that `estimate` takes for stick and stick/slip (src/fit/klaunch.rs).
+//! alone; and K alone by the general search in K (src/fit/k/search.rs) for comparison with the
+//! launch-speed path that `estimate` takes for stick and stick/slip (src/fit/k/launch.rs).
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use fitbead::fit::k::{bracket, estimate, solve};

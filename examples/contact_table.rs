@@ -1,6 +1,7 @@
-//! The README's comparison of the rolling, stick/slip and general contact models: mean
-//! velocities on the paper's Fig. 7 scenes, and the collision law fitted to the default data
-//! set under each model, with the phase sequences the contact model finds.
+//! The comparison of the rolling, stick/slip and general contact models in docs/ACCURACY.md
+//! ("General contact model"): mean velocities on the paper's Fig. 7 scenes, and the collision law
+//! fitted to the default data set under each model, with the phase sequences the contact model
+//! finds.
 //!
 //!     cargo run --release --example contact_table
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Random scenes for the batch timing of `fitbead forward` (README, "Batch:").
+"""Random scenes for the batch timing of `fitbead forward` (docs/PERFORMANCE.md, "Batch forward").
 
 Usage: python3 scripts/gen_scenes.py N SEED > scenes.csv
 

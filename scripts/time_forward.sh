@@ -1,5 +1,6 @@
 #!/bin/bash
-# Times `fitbead forward --model stick` on a scenes file, N runs (README, "Batch:").
+# Times `fitbead forward --model stick` on a scenes file, N runs
+# (docs/PERFORMANCE.md, "Batch forward").
 # usage: scripts/time_forward.sh BIN INPUT N [OUTPUT]   (OUTPUT default out.csv)
 # Prints per run: wall s, peak RSS KB, user s, sys s, and the machine's CPU use (all cores)
 # in the second before and after the run; a run is "idle" when both are <= 8 %, else "busy"

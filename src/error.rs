@@ -1,6 +1,6 @@
 //! The one error type of the public API. Each module keeps its own precise error (a scene
 //! parameter out of its domain, a bad cell in a file, a point that no K makes steady, …);
-//! [`Error`] wraps any of them, so `?` works across modules and into
+//! [`Error`](enum@Error) wraps any of them, so `?` works across modules and into
 //! `Box<dyn std::error::Error>`.
 
 use crate::fit::data::DataError;

@@ -2,11 +2,18 @@
 //!
 //! Forward models and inverse problems for a bead rolling down a row of beads, after Ancey,
 //! Evesque & Coussot, "Motion of a single bead on a bead row: theoretical investigations",
-//! J. Phys. I France 6 (1996) 725–751. Equation numbers in the docs are the paper's; where the
-//! printed text has typos, the corrected forms of the project's MODEL.md are used.
+//! J. Phys. I France 6 (1996) 725–751: from a scene (radius ratio ξ, slope δ, gyration ρ,
+//! friction f, collision law K) the steady mean velocity and regime under each of the paper's
+//! models; from measured mean velocities the collisional parameter K per point (eq 69), laws
+//! K(α), Jan's λ and μ and Jaeger's a1–a3, by least squares or MCMC.
+//!
+//! Equation numbers in the docs are the paper's. Where the printed paper has misprints,
+//! fitbead uses corrected forms; the repository's `docs/PHYSICS.md` lists each one with the
+//! check that confirmed it. `docs/GUIDE.md` describes the command line, `docs/ACCURACY.md` the
+//! measured errors and `docs/PERFORMANCE.md` the measured speed.
 //!
 //! Units are dimensionless: length R + r, time 1/ω0 with ω0² = g/(R+r); a velocity v converts
-//! to SI as v · sqrt(g (R + r)).
+//! to SI as v · sqrt(g (R + r)). Slopes given to [`Scene::new`] are in degrees.
 //!
 //! ## Layers
 //!
@@ -30,7 +37,9 @@
 //!
 //! ## Quickstart
 //!
-//! The program `examples/quickstart.rs` (`cargo run --release --example quickstart`):
+//! [`prelude`] imports what a typical program needs. The program `examples/quickstart.rs`
+//! (`cargo run --release --example quickstart`) evaluates one scene, inverts one measurement
+//! and fits a K(α) law to a data set by least squares and by MCMC:
 //!
 #![doc = "```"]
 #![doc = include_str!("../examples/quickstart.rs")]

@@ -44,7 +44,7 @@ pub enum CollisionLaw {
     /// The paper's fitted law K = cos 2α + ½ sin²α sin 2α (§3.6.1).
     Adjusted,
     /// No-slip impact conserving angular momentum about the new contact point:
-    /// K = (cos 2α + ρ)/(1 + ρ) (MODEL.md §4).
+    /// K = (cos 2α + ρ)/(1 + ρ) (docs/PHYSICS.md#collision-laws).
     Impact,
     /// K = cos 2α + c sin²α sin 2α with a free coefficient c (the form of §3.6.1).
     C(f64),
@@ -131,7 +131,7 @@ impl fmt::Display for CollisionLaw {
 }
 
 /// A validated scene with its derived geometry. Angles are in radians internally; every
-/// velocity is dimensionless (units sqrt(g (R + r)), MODEL.md §1).
+/// velocity is dimensionless (units sqrt(g (R + r)), docs/PHYSICS.md#geometry-and-units).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Scene {
     /// Radius ratio ξ = r/R of the mobile bead to the row beads.

@@ -27,10 +27,11 @@ pub struct FitArgs {
     /// The measurements CSV given as a plain argument (same as --input).
     #[arg(value_name = "DATA.csv", conflicts_with = "input")]
     pub data: Option<PathBuf>,
-    /// Gyration parameter ρ, for rows without a rho column.
+    /// Gyration parameter ρ, for rows without a rho column (klaw; jan and jaeger do not use it).
     #[arg(long, default_value_t = 0.4)]
     pub rho: f64,
-    /// Coulomb friction coefficient f, for rows without an f column.
+    /// Coulomb friction coefficient f, for rows without an f column (klaw; jan and jaeger do not
+    /// use it).
     #[arg(long, default_value_t = 0.1)]
     pub f: f64,
     /// Gravity g in m/s² for dimensional rows without a g column.
@@ -55,28 +56,30 @@ pub struct FitArgs {
     /// ci_low/ci_high = central posterior interval at --level, ci_method = posterior).
     #[arg(long, default_value = "lsq")]
     pub method: String,
-    /// MCMC: seed of every random stream (default 1); a run is bit-identical for a seed,
-    /// whatever the number of threads.
+    /// MCMC: seed of every random stream; a run is bit-identical for a seed, whatever the number
+    /// of threads [default: 1]
     #[arg(long)]
     pub seed: Option<u64>,
-    /// MCMC: number of walkers, even (default max(2·dim + 2, 32)).
+    /// MCMC: number of walkers, even [default: max(2·dim + 2, 32)]
     #[arg(long)]
     pub walkers: Option<usize>,
-    /// MCMC: run until every parameter's bulk and tail ESS reach this (default 1000) and its
-    /// rank-normalised split-R̂ is ≤ 1.01.
+    /// MCMC: run until every parameter's bulk and tail ESS reach this and its rank-normalised
+    /// split-R̂ is ≤ 1.01 [default: 1000]
     #[arg(long)]
     pub min_ess: Option<f64>,
     /// MCMC: stop after this many steps even if not converged, with a warning naming the
-    /// failing parameter (default 100000).
+    /// failing parameter [default: 100000]
     #[arg(long)]
     pub max_steps: Option<usize>,
-    /// MCMC: keep one step in THIN (default 1).
+    /// MCMC: keep one step in THIN [default: 1]
     #[arg(long)]
     pub thin: Option<usize>,
     /// MCMC: prior of a parameter, NAME=DIST, repeatable; DIST is flat, jeffreys,
-    /// uniform(a,b), normal(mean,sd), lognormal(mu,sigma) or halfnormal(scale). Defaults:
-    /// flat on the parameter's feasible box (every point in regime B), jeffreys for
-    /// sigma_scale. The support is always cut to the feasible region.
+    /// uniform(a,b), normal(mean,sd), lognormal(mu,sigma) or halfnormal(scale); quote it for
+    /// the shell ('c=normal(0.5,0.5)'). Defaults: flat on the parameter's feasible box (every
+    /// point in regime B), except Jaeger's a1, a2, a3: halfnormal(10), halfnormal(100),
+    /// halfnormal(10); jeffreys for sigma_scale. The support is always cut to the feasible
+    /// region.
     #[arg(long = "prior", value_name = "NAME=DIST")]
     pub priors: Vec<String>,
     /// MCMC: also sample an error scale sigma_scale multiplying every sigma_v (for data whose

@@ -39,8 +39,8 @@ pub struct Args {
     /// Slope δ of a single scene, degrees.
     #[arg(long = "delta-deg")]
     pub delta_deg: Option<f64>,
-    /// Collisional parameter: a number, cos2a, adjusted, impact or c=VALUE (default for rows
-    /// without a K column).
+    /// Collisional parameter for rows without a K column: a number, cos2a, adjusted, impact or
+    /// c=VALUE.
     #[arg(long = "K", default_value = "adjusted")]
     pub k: String,
     /// Gyration parameter ρ (2/5 sphere, 1/2 cylinder), for rows without a rho column.
@@ -49,22 +49,22 @@ pub struct Args {
     /// Coulomb friction coefficient f, for rows without an f column.
     #[arg(long, default_value_t = 0.1)]
     pub f: f64,
-    /// Jan's λ (eq 74); default: the paper's fit eq 75 at each row's α.
+    /// Jan's λ (eq 74) [default: the paper's fit, eq 75, at each row's α]
     #[arg(long)]
     pub lambda: Option<f64>,
-    /// Jan's μ (eq 74); default: the paper's fit eq 76 at each row's α.
+    /// Jan's μ (eq 74) [default: the paper's fit, eq 76, at each row's α]
     #[arg(long)]
     pub mu: Option<f64>,
-    /// Jaeger's a1 (eq 83).
+    /// Jaeger's a1 (eq 83); required by --model jaeger.
     #[arg(long)]
     pub a1: Option<f64>,
-    /// Jaeger's a2 (eq 83).
+    /// Jaeger's a2 (eq 83); required by --model jaeger.
     #[arg(long)]
     pub a2: Option<f64>,
-    /// Jaeger's a3 (eq 83).
+    /// Jaeger's a3 (eq 83); required by --model jaeger.
     #[arg(long)]
     pub a3: Option<f64>,
-    /// Jaeger root when there are two: upper (default) or lower.
+    /// Jaeger root when there are two: upper or lower.
     #[arg(long, default_value = "upper")]
     pub branch: String,
     /// Spin rule of the collision for --model contact: roll (rolling restarts, the paper's
@@ -75,7 +75,7 @@ pub struct Args {
     pub spin: String,
     /// Relative tolerance of the contact model's quadratures (time and spin during slip); with
     /// --model auto, the target relative tolerance T on v.
-    #[arg(long, default_value_t = 1e-14)]
+    #[arg(long, default_value = "1e-14")]
     pub tol: f64,
     /// Molecular-dynamics settings (`--model md`).
     #[command(flatten)]
@@ -305,53 +305,54 @@ fn stream_error(e: StreamError, target: &str, file: bool) -> CliError {
 /// wins over the flag for its row.
 #[derive(Debug, Clone, Default, clap::Args)]
 pub struct MdArgs {
-    /// md parameter set: ristow (default: E = 1e7 Pa, gamma_n = 1000/s, gamma_s = 100/s,
-    /// beta = 1.5, R = 2.5 mm, steel density) or steel (E = 2.1e11 Pa, the rest as ristow).
+    /// md parameter set: ristow (E = 1e7 Pa, gamma_n = 1000/s, gamma_s = 100/s, beta = 1.5,
+    /// R = 2.5 mm, steel density) or steel (E = 2.1e11 Pa, the rest as ristow).
     #[arg(long = "md-preset", default_value = "ristow")]
     pub md_preset: String,
-    /// md: radius R of the row beads, m (2.5e-3).
+    /// md: radius R of the row beads, m [default: 2.5e-3]
     #[arg(long = "row-radius-m")]
     pub row_radius_m: Option<f64>,
-    /// md: Young's modulus E, Pa (Ristow's k_n read as E, Hertz: 1e7).
+    /// md: Young's modulus E, Pa (Ristow's k_n read as E in Hertz's law) [default: 1e7]
     #[arg(long = "young-pa")]
     pub young_pa: Option<f64>,
-    /// md: Poisson ratio (0.3).
+    /// md: Poisson ratio [default: 0.3]
     #[arg(long)]
     pub poisson: Option<f64>,
-    /// md: bead density, kg/m^3 (7850).
+    /// md: bead density, kg/m^3 [default: 7850]
     #[arg(long)]
     pub density: Option<f64>,
-    /// md: exponent beta of the normal force k_n d^beta (1.5).
+    /// md: exponent beta of the normal force k_n d^beta [default: 1.5]
     #[arg(long)]
     pub beta: Option<f64>,
-    /// md: normal damping gamma_n, 1/s (1000).
+    /// md: normal damping gamma_n, 1/s [default: 1000]
     #[arg(long = "gamma-n")]
     pub gamma_n: Option<f64>,
-    /// md: tangential damping gamma_s, 1/s (100).
+    /// md: tangential damping gamma_s, 1/s [default: 100]
     #[arg(long = "gamma-s")]
     pub gamma_s: Option<f64>,
-    /// md: Coulomb cap mu_c on the tangential force (column mu_c); none by default (Ristow).
+    /// md: Coulomb cap mu_c on the tangential force (column mu_c) [default: none, as Ristow]
     #[arg(long)]
     pub coulomb: Option<f64>,
-    /// md: gravity, m/s^2 (9.81).
+    /// md: gravity, m/s^2 [default: 9.81]
     #[arg(long = "md-g")]
     pub md_g: Option<f64>,
-    /// md: reduced mass of eq 92: pair (m M/(m+M), default) or mobile (m).
+    /// md: reduced mass of eq 92: pair (m M/(m+M)) or mobile (m) [default: pair]
     #[arg(long = "reduced-mass")]
     pub reduced_mass: Option<String>,
-    /// md: row beads travelled (400).
+    /// Row beads travelled: by md, and by the contact transient of simulate --v0 [default: 400
+    /// for md, 50 for the transient]
     #[arg(long)]
     pub beads: Option<usize>,
-    /// md: row beads discarded as transient (100).
+    /// md: row beads discarded as transient [default: 100]
     #[arg(long)]
     pub transient: Option<usize>,
-    /// md: blocks for the standard error of v (10).
+    /// md: blocks for the standard error of v [default: 10]
     #[arg(long)]
     pub blocks: Option<usize>,
-    /// md: launch speed on the top of the first row bead, units sqrt(g(R+r)) (0.1).
+    /// md: launch speed on the top of the first row bead, units sqrt(g(R+r)) [default: 0.1]
     #[arg(long = "launch-velocity")]
     pub launch_velocity: Option<f64>,
-    /// md: time step as a fraction of the contact time (0.01).
+    /// md: time step as a fraction of the contact time [default: 0.01]
     #[arg(long = "step-fraction")]
     pub step_fraction: Option<f64>,
     /// md: run again at half the step and report the relative change of v (step_check_rel).

@@ -9,7 +9,7 @@ use fitbead::fit::summary::FitResult;
 /// Arguments of `fitbead jaeger`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Root of eq 84 to fit where there are two: upper (default) or lower.
+    /// Root of eq 84 to fit where there are two: upper or lower.
     #[arg(long, default_value = "upper")]
     pub branch: String,
     /// Input, output and interval flags.

@@ -42,7 +42,7 @@ pub struct Args {
     #[arg(long)]
     pub plot: Option<PathBuf>,
     /// With --model auto: the target relative tolerance T on v of the model chosen per row.
-    #[arg(long, default_value_t = 1e-10)]
+    #[arg(long, default_value = "1e-10")]
     pub tol: f64,
 }
 

@@ -17,8 +17,8 @@ use rayon::prelude::*;
 /// Arguments of `fitbead klaw`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Contact model: stick, slip or stickslip (stick-approx and slip-approx work too), or auto
-    /// (the most general model any point needs at its stick K; see --tol).
+    /// Contact model: stick, stick-approx, slip, slip-approx, stickslip, contact, or auto (the
+    /// most general model any point needs at its stick K; see --tol).
     #[arg(long)]
     pub model: String,
     /// The law: c (K = cos 2α + c sin²α sin 2α), impact (K = (cos 2α + ρ)/(1 + ρ), scored
@@ -33,7 +33,7 @@ pub struct Args {
     #[command(flatten)]
     pub io: FitArgs,
     /// With --model auto: the target relative tolerance T on v.
-    #[arg(long, default_value_t = 1e-10)]
+    #[arg(long, default_value = "1e-10")]
     pub tol: f64,
 }
 

@@ -18,32 +18,31 @@ pub struct Args {
     /// The measurements CSV given as a plain argument (same as --input).
     #[arg(value_name = "DATA.csv", conflicts_with = "input")]
     pub data: Option<PathBuf>,
-    /// Directory for the tables, figures and report.md (created if missing; default
-    /// `report`).
+    /// Directory for the tables, figures and report.md, created if missing [default: report]
     #[arg(long)]
     pub out_dir: Option<PathBuf>,
-    /// lsq (default) or mcmc (posteriors for every fit; adds corner.svg).
+    /// lsq or mcmc (posteriors for every fit; adds corner.svg) [default: lsq]
     #[arg(long)]
     pub method: Option<String>,
-    /// Gyration parameter ρ for rows without a rho column (default 0.4).
+    /// Gyration parameter ρ for rows without a rho column [default: 0.4]
     #[arg(long)]
     pub rho: Option<f64>,
-    /// Coulomb friction f for rows without an f column (default 0.1).
+    /// Coulomb friction f for rows without an f column [default: 0.1]
     #[arg(long)]
     pub f: Option<f64>,
-    /// Gravity g (m/s²) for dimensional rows (default 9.81).
+    /// Gravity g (m/s²) for dimensional rows without a g column [default: 9.81]
     #[arg(long)]
     pub g: Option<f64>,
-    /// Level of every interval (default 0.95).
+    /// Level of every interval [default: 0.95]
     #[arg(long)]
     pub level: Option<f64>,
-    /// MCMC seed (default 1).
+    /// MCMC seed [default: 1]
     #[arg(long)]
     pub seed: Option<u64>,
-    /// MCMC: minimum bulk and tail ESS per parameter (default 1000).
+    /// MCMC: minimum bulk and tail ESS per parameter [default: 1000]
     #[arg(long)]
     pub min_ess: Option<f64>,
-    /// MCMC: maximum steps per fit (default 100000).
+    /// MCMC: maximum steps per fit [default: 100000]
     #[arg(long)]
     pub max_steps: Option<usize>,
     /// A TOML recipe with any of the keys input, out_dir, method, rho, f, g, level, seed,

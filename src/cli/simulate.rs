@@ -20,7 +20,8 @@ use std::path::PathBuf;
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Forward model that makes the data: stick, stick-approx, slip, slip-approx, stickslip,
-    /// jan (see --jan), jaeger (see --jaeger), md (molecular dynamics, see the md-flags).
+    /// contact (with --v0: the bead-by-bead transient instead), jan (see --jan), jaeger (see
+    /// --jaeger), md (molecular dynamics, see the md flags).
     #[arg(long, default_value = "stickslip")]
     pub model: String,
     /// Collision law: a number, cos2a, adjusted, impact or c=VALUE.
@@ -45,19 +46,19 @@ pub struct Args {
     #[arg(long, default_value_t = 0.1)]
     pub f: f64,
     /// Jan's global laws λ0,λ1,μ0,μ1 (λ = λ0 e^{λ1 sin α}, μ = μ0 e^{μ1 sin α}) for
-    /// --model jan; default the paper's eqs 75–76 (0.063,4.96,0.0025,7.46).
+    /// --model jan [default: 0.063,4.96,0.0025,7.46, the paper's eqs 75–76]
     #[arg(long)]
     pub jan: Option<String>,
-    /// Jaeger's a1,a2,a3 (Jaeger units, eq 81) for --model jaeger, used for every series;
-    /// default the paper's Fig. 9 values of the series' ξ (0.8, 1, 1.6 or 2).
+    /// Jaeger's a1,a2,a3 (Jaeger units, eq 81) for --model jaeger, used for every series
+    /// [default: the paper's Fig. 9 values of the series' ξ, for ξ = 0.8, 1, 1.6 or 2]
     #[arg(long)]
     pub jaeger: Option<String>,
     /// Branch of eq 84 for --model jaeger: upper or lower.
     #[arg(long, default_value = "upper")]
     pub branch: String,
     /// Slopes LO,HI in degrees: the range is cut to the model's steady range and the points
-    /// spread over 5 %–95 % of it. Default: 5 %–95 % of the steady range for the contact models; for jan and
-    /// jaeger, whose steady range has no upper end, the onset to the onset + 12°.
+    /// spread over 5 %–95 % of it [default: the steady range; for jan and jaeger, whose steady
+    /// range has no upper end, the onset to the onset + 12°]
     #[arg(long)]
     pub delta_range: Option<String>,
     /// Output CSV (written atomically); stdout when absent.

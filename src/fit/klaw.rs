@@ -6,7 +6,7 @@
 //! (law c: a = cos 2α, b = sin²α sin 2α > 0, one group; free: a = 0, b = 1, one group per
 //! series). Hence:
 //! - the feasible box of each parameter is exact: point i stays in regime B for K in its
-//!   bracket (K_min, K_max] ([`crate::fit::k::bracket`]), so p_j must lie in the intersection
+//!   bracket (K_min, K_max] ([`crate::fit::k::bracket()`]), so p_j must lie in the intersection
 //!   of ((K_min,i − a_i)/b_i, (K_max,i − a_i)/b_i] over the points of group j. An empty
 //!   intersection means no value of the law keeps every point steady, and the fit says so
 //!   instead of searching;
@@ -14,7 +14,7 @@
 //!   mapped to p, clamped into the box;
 //! - the Jacobian costs two forward evaluations per point whatever the number of parameters:
 //!   ∂r_i/∂p_j = −(dv̄/dK)_i b_i/σ_i for j = g(i), else 0, with dv̄/dK by a central difference in
-//!   s = ln(K − K_min) (as in [`crate::fit::k::estimate`]; accurate where the slope in K is
+//!   s = ln(K − K_min) (as in [`crate::fit::k::estimate()`]; accurate where the slope in K is
 //!   nearly infinite).
 //!
 //! A point that leaves regime B during the search makes the residuals [`Infeasible`] (a

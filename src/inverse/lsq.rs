@@ -48,7 +48,7 @@
 //!
 //! The covariance comes from the SVD of the column-equilibrated Jacobian at the optimum,
 //! (JᵀJ)⁻¹ = V Σ⁻² Vᵀ, never from an explicitly formed JᵀJ. It is validated against the NIST
-//! Statistical Reference Datasets (StRD) for nonlinear regression — see `tests/nist.rs`.
+//! Statistical Reference Datasets (StRD) for nonlinear regression — see `tests/it/nist.rs`.
 
 // Index loops mirror the subscripts of the published algorithm (MINPACK-1).
 #![allow(clippy::needless_range_loop)]

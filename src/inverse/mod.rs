@@ -16,7 +16,7 @@
 //!   thresholds; the diagnostics ([`mcmc::diagnostics`]) work on any chains.
 //!
 //! The solver is validated on the 27 nonlinear problems of the NIST Statistical Reference
-//! Datasets (StRD), from both starting points (`tests/nist.rs`).
+//! Datasets (StRD), from both starting points (`tests/it/nist.rs`).
 
 mod lmpar;
 pub mod lsq;

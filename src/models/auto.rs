@@ -1,8 +1,9 @@
 //! `auto`: per scene, the cheapest model whose assumptions hold there and whose error bound
 //! is within a target tolerance T.
 //!
-//! The physics being approximated is the general contact model (MODEL.md §4, spin rule
-//! `roll` as the paper). The paper's cheaper models equal it where their assumptions hold:
+//! The physics being approximated is the general contact model
+//! (docs/PHYSICS.md#general-contact-model, spin rule `roll` as the paper). The paper's cheaper
+//! models equal it where their assumptions hold:
 //!
 //! 1. **Rolling exact** (eqs 11–27 corrected, elliptic closed form, error ~1e-15) when the
 //!    steady rolling contact never needs more friction than f: Θ_G ≥ Θf (eq 36), evaluated at

@@ -1,8 +1,8 @@
-//! The general contact model (MODEL.md §4, beyond the paper): on each row bead the mobile bead
-//! rolls or slips in either direction as Coulomb friction allows, may stop before the top or
-//! lift off, and the collision law acts on the translational velocity (K, eq 1) and on the
-//! spin (a named rule). The paper's stick/slip model (§4.4) is the special case "roll, then
-//! one forward slip after Θ_G"; when Θ0 < −Θ_G the true contact starts with a backward slip
+//! The general contact model (docs/PHYSICS.md#general-contact-model, beyond the paper): on each row
+//! bead the mobile bead rolls or slips in either direction as Coulomb friction allows, may stop
+//! before the top or lift off, and the collision law acts on the translational velocity (K, eq 1)
+//! and on the spin (a named rule). The paper's stick/slip model (§4.4) is the special case "roll,
+//! then one forward slip after Θ_G"; when Θ0 < −Θ_G the true contact starts with a backward slip
 //! (slip > roll > slip), which this model resolves.
 //!
 //! State on a bead: Θ, Θ̇ and the spin ω (units ω0); the contact-point slip velocity is

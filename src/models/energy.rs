@@ -1,6 +1,6 @@
-//! Energy per row bead in the steady state (§4.6, eqs 70–72; MODEL.md §4), in units of
-//! m g (R + r): the potential drop 2 sin α sin δ equals the collision loss (translation and
-//! spin) plus the friction work.
+//! Energy per row bead in the steady state (§4.6, eqs 70–72; docs/PHYSICS.md#energy-per-bead), in
+//! units of m g (R + r): the potential drop 2 sin α sin δ equals the collision loss (translation
+//! and spin) plus the friction work.
 
 use super::slip::SlipPhase;
 use super::stick;

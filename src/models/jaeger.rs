@@ -94,7 +94,7 @@ impl Jaeger {
     }
 
     /// Mean velocity v̄ = sqrt(2 cos δ X / ε) from the chosen positive root X of eq 84
-    /// (eqs 81, 83; eqs 87–89 as printed mix up a1, a2 and ε, MODEL.md §5).
+    /// (eqs 81, 83; eqs 87–89 as printed mix up a1, a2 and ε: docs/PHYSICS.md#jaeger).
     pub fn evaluate(&self, scene: &Scene) -> Outcome {
         let t = scene.sc_delta.s / scene.sc_delta.c;
         let roots = self.roots(t);

@@ -23,14 +23,15 @@
 //! material, Poisson ratio ν), R_eff = R r/(R + r) (for β = 3/2 this is (4/3) E* √R_eff d^{3/2}).
 //!
 //! **Units.** Parameters are SI ([`MdParams`]). The simulation itself runs in the paper's
-//! dimensionless units (MODEL.md §1): length R + r, time sqrt((R+r)/g), mass m; velocities in
-//! the results are in units sqrt(g (R + r)) like every other model's, with the SI value beside.
+//! dimensionless units (docs/PHYSICS.md#geometry-and-units): length R + r, time sqrt((R+r)/g), mass
+//! m; velocities in the results are in units sqrt(g (R + r)) like every other model's, with the SI
+//! value beside.
 //!
 //! **Integration.** Velocity Verlet, the velocity-dependent forces evaluated at the predicted
 //! velocity v + a dt. The step is `step_fraction` (default 1/100) of the Hertz contact time at
 //! the impact speed sqrt(g (R+r)) (or of the half period of the loaded contact if shorter),
 //! and small enough that the damping rates are resolved (dt · rate ≤ 0.1). The energy balance
-//! closes to second order in dt (tests/md.rs).
+//! closes to second order in dt (tests/it/md.rs).
 //!
 //! **Run.** The bead is launched on the top of a row bead (Θ = 0) rolling at `launch_velocity`,
 //! and followed for `beads` row beads; the first `transient` are discarded and the mean velocity
@@ -204,12 +205,12 @@ impl MdParams {
         (self.length_unit(xi) / self.g).sqrt()
     }
 
-    /// The rolling-limit set used to check the simulation against the rolling model with the
-    /// impact law (MODEL.md §4): Young's modulus `young`, everything else as Ristow's, and the
-    /// damping scaled with the contact time t_c at sqrt(g(R+r)) so that the normal contact is
-    /// over-damped (γ_n m_eff/m = 30/t_c: no rebound, e = 0) and slip dies out within the
-    /// impact (γ_s m_eff/m (1 + 1/ρ) = 30/t_c). As `young` → ∞ the impact becomes
-    /// instantaneous and the bead rolls without slip.
+    /// The rolling-limit set used to check the simulation against the rolling model with the impact
+    /// law (docs/PHYSICS.md#collision-laws): Young's modulus `young`, everything else as Ristow's,
+    /// and the damping scaled with the contact time t_c at sqrt(g(R+r)) so that the normal contact
+    /// is over-damped (γ_n m_eff/m = 30/t_c: no rebound, e = 0) and slip dies out within the impact
+    /// (γ_s m_eff/m (1 + 1/ρ) = 30/t_c). As `young` → ∞ the impact becomes instantaneous and the
+    /// bead rolls without slip.
     pub fn rolling_limit(young: f64, xi: f64, rho: f64) -> Self {
         let mut p = Self::ristow();
         p.young = young;

@@ -43,8 +43,8 @@ impl fmt::Display for Regime {
     }
 }
 
-/// A steady state (regime B) and its diagnostics. Velocities are dimensionless
-/// (units sqrt(g (R+r))), angles in radians, times in units 1/ω0 (MODEL.md §1).
+/// A steady state (regime B) and its diagnostics. Velocities are dimensionless (units sqrt(g
+/// (R+r))), angles in radians, times in units 1/ω0 (docs/PHYSICS.md#geometry-and-units).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Steady {
     /// Mean velocity v̄ = 2 sin α / τ (eq 10).
@@ -238,7 +238,8 @@ pub enum Model {
     Jan(jan::Jan),
     /// Jaeger's heuristic law (eqs 80–89).
     Jaeger(jaeger::Jaeger),
-    /// The general contact model: any sequence of rolling and slipping (MODEL.md §4).
+    /// The general contact model: any sequence of rolling and slipping
+    /// (docs/PHYSICS.md#general-contact-model).
     Contact(contact::Contact),
     /// Ristow's soft-contact molecular dynamics (§5.3, eqs 91–92).
     Md(md::Md),

@@ -127,7 +127,7 @@ pub fn friction_demand(scene: &Scene, w0sq: f64, theta: f64) -> f64 {
 
 /// Θ_G: the angle where rolling from Θ0 with squared speed `w0sq` first needs more friction
 /// than f (eq 36), radians, in the rationalised form that keeps its digits as f → 0:
-/// tan(Θ_G/2) = f (3+ρ−ϑ) / (ρ + sqrt(ρ² + f² ((3+ρ)² − ϑ²))) (MODEL.md §3).
+/// tan(Θ_G/2) = f (3+ρ−ϑ) / (ρ + sqrt(ρ² + f² ((3+ρ)² − ϑ²))) (docs/PHYSICS.md#friction-demand).
 /// `None` when no real Θ_G exists ((3+ρ)² < ϑ²: the normal force is negative everywhere), or
 /// when ρ = f = 0 (no friction is ever needed).
 pub fn theta_g(scene: &Scene, w0sq: f64) -> Option<f64> {

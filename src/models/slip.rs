@@ -105,9 +105,10 @@ impl SlipPhase {
 /// grows from θa (slope `ga` ≥ 0 of Θ̇² there): `None` unless QUADPACK's error estimate is
 /// within `tol` of the value (the caller then subdivides). The twenty off-centre abscissae come
 /// in pairs θc ± t, and each pair shares one sin_cos and one exp_m1 through the addition
-/// formulas, with Θ̇² in the cancellation-free form of [`SlipPhase::speed_sq_offset`]: about
-/// 0.5 µs where the adaptive 15-point rule needed about 2 µs (three panels) on the stick/slip
-/// scenes of `cargo bench --bench forward`, with the same value to 1e-15.
+/// formulas, with Θ̇² in the cancellation-free form of [`SlipPhase::speed_sq_offset`]: one
+/// panel where the adaptive 15-point rule takes three on the stick/slip scenes of
+/// `cargo bench --bench forward` (timings in docs/PERFORMANCE.md), with the same value to
+/// 1e-15.
 fn slip_time_panel(ph: &SlipPhase, a: f64, b: f64, ga: f64, tol: f64) -> Option<f64> {
     let m = ph.speed_sq(a);
     let h = 0.5 * (b - a);
@@ -201,9 +202,8 @@ pub fn speed_minimum(scene: &Scene) -> Result<(f64, f64), NotSteady> {
 /// of its O(1) terms, i.e. a relative error ~1e-16/m, and v̄ inherits about 0.02 of it
 /// (6.9e-12 at m = 5.4e-7 on the stop-limit rows of tests/reference/forward_refs.csv), so
 /// above 1e-4 the double form costs at most ~4e-14 (5.4e-14 measured at m ≈ 1.1e-4). The
-/// double-double path cost 2.4–2.7× the double one (17–19 µs against 7.1–7.3 µs on two
-/// crawling scenes of `cargo bench --bench forward`, measured before `SlipDd::new` went from
-/// 2.8 to 2.0 µs), hence the threshold.
+/// double-double path costs a few times the double one (docs/PERFORMANCE.md), hence the
+/// threshold.
 const DD_MINIMUM_BELOW: f64 = 1e-4;
 
 /// A double minimum below this is a stop whatever its rounding (its absolute error is a few
@@ -484,9 +484,8 @@ fn sin_minus_x(x: f64, inv: &[f64; 20]) -> f64 {
 /// Its relative error is a few ulp at every d, so the integrand keeps double precision even
 /// where Θ̇² is 1e-10 of its terms (a bead crawling over the top within 1e-9 of the stop
 /// limit), and no tolerance floor is needed.
-// Kept out of line, like `SlipDd::new`: inlined into `slip_time_in`, these rare paths made the
-// common double path about 45 % slower (median over the 850 steady slip scenes of
-// `fitbead bench --scenes 2000 --seed 1`: 4.9 µs against 3.3 µs at 1e-14).
+// Kept out of line, like `SlipDd::new`: inlined into `slip_time_in`, these rare paths slow the
+// common double path (measured in docs/PERFORMANCE.md).
 #[cold]
 #[inline(never)]
 fn slip_time_about_minimum(
@@ -566,7 +565,7 @@ const DD_DENOMINATOR_ABOVE: f64 = -1e-13;
 /// Steady final velocity squared of the slip model (eq 50 corrected):
 /// L'² = (b sin Θf + c cos Θf − (b sin Θ0 + c cos Θ0) e^{4fα}) / (1 − K² e^{4fα}), with the
 /// differences in product form (e^{4fα} − 1 by expm1), and from [`SlipDd`] where the
-/// denominator is below [`DD_DENOMINATOR_BELOW`]. `Err(Runaway)` when K² e^{4fα} ≥ 1.
+/// denominator is below `DD_DENOMINATOR_BELOW` (1e-2). `Err(Runaway)` when K² e^{4fα} ≥ 1.
 pub fn final_velocity_sq(scene: &Scene) -> Result<f64, NotSteady> {
     let (b, c) = slip_coefficients(scene.f);
     let em1 = (4.0 * scene.f * scene.alpha).exp_m1();

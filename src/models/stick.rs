@@ -96,9 +96,9 @@ pub fn rolling_velocities(scene: &Scene) -> Result<(f64, f64), NotSteady> {
     Ok((st.l2.sqrt(), st.w0sq.sqrt()))
 }
 
-/// Steady pure rolling, exact: τ = ∫_{Θ0}^{Θf} dθ / sqrt(A − B cos θ) (eq 11) in Carlson's
-/// form (see [`cos_integral`]; equal to eqs 21–27 with MODEL.md's corrections), v̄ = 2 sin α / τ
-/// (eq 27).
+/// Steady pure rolling, exact: τ = ∫_{Θ0}^{Θf} dθ / sqrt(A − B cos θ) (eq 11) in Carlson's form
+/// (see [`cos_integral`]; equal to eqs 21–27 as corrected in
+/// docs/PHYSICS.md#corrections-to-the-printed-paper), v̄ = 2 sin α / τ (eq 27).
 pub fn steady(scene: &Scene) -> Outcome {
     let st = rolling_state(scene)?;
     let tau = cos_integral(

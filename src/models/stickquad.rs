@@ -104,7 +104,8 @@ mod tests {
 
     #[test]
     fn quadrature_matches_the_elliptic_closed_form() {
-        // MODEL.md §2 checked scene: ξ = 1, δ = 12°, ρ = 0.4, fitted K.
+        // The checked scene of docs/PHYSICS.md#reference-figures: ξ = 1, δ = 12°, ρ = 0.4, fitted
+        // K.
         let s = Scene::new(1.0, 12.0, 0.4, 0.1, CollisionLaw::Adjusted).unwrap();
         let exact = stick::steady(&s).unwrap().mean_velocity;
         let q = steady_quad(&s, 1e-15).unwrap().mean_velocity;

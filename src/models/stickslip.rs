@@ -1,9 +1,9 @@
 //! Stick/slip model (§4.4, eqs 64–68): after each collision the bead rolls from Θ0 until the
 //! friction demand reaches f at Θ_G (eq 36), then slips forward to Θf (eqs 66–67). The steady
 //! state is a fixed point of the final-velocity map, found by following the map from the
-//! rolling steady state (MODEL.md §3): the map is not smooth and need not have a unique fixed
-//! point, so every root is checked for continuity and stability, and a second fixed point is
-//! looked for where the map's asymptotic slope K e^{2fα} is near or above 1.
+//! rolling steady state (docs/PHYSICS.md#stickslip): the map is not smooth and need not have a
+//! unique fixed point, so every root is checked for continuity and stability, and a second
+//! fixed point is looked for where the map's asymptotic slope K e^{2fα} is near or above 1.
 
 use super::regimes::theta_g;
 use super::slip::{slip_time, SlipPhase};
@@ -213,7 +213,7 @@ pub fn fixed_point_from(scene: &Scene, x0: f64) -> Result<f64, NotSteady> {
 }
 
 /// The stable fixed point below a saddle-node of the map, found in launch space (the view of
-/// src/fit/klaunch.rs): a launch at Θ0 with squared top speed y is the fixed point of
+/// src/fit/k/launch.rs): a launch at Θ0 with squared top speed y is the fixed point of
 /// K(y) = Θ̇0/Φ(Θ̇0), and K(y) rises from the crawl to a maximum K_sn at the saddle-node; the
 /// stable fixed point for K ≤ K_sn solves K(y) = K below that maximum, where K(y) is monotone
 /// (Brent). Within ~1e-9 of the saddle-node the map's slope is so close to 1 that following it

@@ -609,7 +609,7 @@ pub fn run_bench(scenes: &[(Scene, Draw)]) -> BenchResult {
         ));
     }
     // The same inversions through `k::estimate`, which takes the launch-speed path
-    // (src/fit/klaunch.rs) for stick and stick/slip where it applies.
+    // (src/fit/k/launch.rs) for stick and stick/slip where it applies.
     kmodels.push(("k-stick", "estimate-eq69".into(), None, Model::Stick));
     kmodels.push((
         "k-stickslip",

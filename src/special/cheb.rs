@@ -6,7 +6,7 @@
 //! points. It serves root searches that need F at a dozen abscissae of one interval (the
 //! contact model's slip → stick event): one set of 17 or 33 samples replaces a quadrature per
 //! abscissa (measured on the contact model: 270 integrand evaluations per contact fall to
-//! about 50, tests/contact.rs holds the results against an RK4 reference).
+//! about 50, tests/it/contact.rs holds the results against an RK4 reference).
 
 use std::sync::OnceLock;
 

@@ -1,7 +1,7 @@
 //! Double-double arithmetic (about 32 significant digits) for the few places where the physics
-//! cancels catastrophically: the squared velocity at the top of a row bead near the lower
-//! regime limit δ_m (MODEL.md §2). Written by hand because the operations needed are four lines
-//! each (error-free transforms with FMA) and a crate would bring a whole numeric tower; the
+//! cancels catastrophically: the squared velocity at the top of a row bead near the lower regime
+//! limit δ_m (docs/PHYSICS.md#pure-rolling). Written by hand because the operations needed are four
+//! lines each (error-free transforms with FMA) and a crate would bring a whole numeric tower; the
 //! accuracy is held by tests against mpmath values.
 
 use std::ops::{Add, Div, Mul, Neg, Sub};

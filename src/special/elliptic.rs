@@ -4,7 +4,7 @@
 //! Carlson's R_F is the duplication algorithm of Carlson (1995), as in the `ellip` crate (a port
 //! of Boost.Math, ≤ 4.5e-16 relative on Boost's test data) but without its per-call `powf` (see
 //! [`rf`]); the unit test below holds it against Carlson's (1995) published values,
-//! and `tests/reference_models.rs` holds the rolling models built on it against 40-digit mpmath
+//! and `tests/it/reference_models.rs` holds the rolling models built on it against 40-digit mpmath
 //! quadrature down to δ = δ_m (1 + 1e-9), where its log singularity is exercised.
 
 use super::SinCos;
@@ -16,11 +16,11 @@ use super::SinCos;
 /// Carlson's duplication algorithm (Carlson 1995; the series of DLMF 19.36.1 to 7th order, with
 /// the stopping rule Q = (3ε)^{-1/8} max|A0 − x_i|, as in Boost.Math and the `ellip` crate),
 /// written here rather than called from `ellip` because the crate evaluates (3ε)^{-1/8} with a
-/// `powf` and rescales on every call: on the stick scenes of `cargo bench --bench forward`,
-/// whose time is 87 % R_F, that was 75 ns per call against 58 ns here (same machine, same
-/// day). The arithmetic is otherwise the crate's, operation for operation, so the results are
-/// the same; the unit test below holds it against Carlson's published values and
-/// `tests/reference_models.rs` holds the rolling models against 40-digit mpmath quadrature.
+/// `powf` and rescales on every call, which the stick model, whose time is mostly R_F, pays for
+/// (measured in docs/PERFORMANCE.md, "Forward models"). The arithmetic is otherwise the
+/// crate's, operation for operation, so the results are the same; the unit test below holds it
+/// against Carlson's published values and `tests/it/reference_models.rs` holds the rolling
+/// models against 40-digit mpmath quadrature.
 /// Arguments outside [1e-30, 1e30] (never met by the models) go to the crate, which rescales.
 #[inline]
 pub fn rf(x: f64, y: f64, z: f64) -> f64 {
@@ -93,8 +93,9 @@ pub fn legendre_f(sc: SinCos, kc2: f64) -> f64 {
 /// T = 2 R_F(U₁₂², U₁₃², U₂₃²), where every U is a sum of positive products of s, c and w, so
 /// no cancellation. Across the top the integral splits at ψ = 0 and each half is
 /// 2 |s| R_F(c² w_t², w², w_t²): the log singularity as w_t → 0 comes out of R_F with full
-/// relative accuracy in its tiny arguments. MODEL.md §2 form (eqs 12–15, corrected) is the
-/// same integral in Legendre's form; this one needs no sign cases beyond the top.
+/// relative accuracy in its tiny arguments. The paper's Legendre form (eqs 12–15, corrected in
+/// docs/PHYSICS.md#corrections-to-the-printed-paper) is the same integral; this one needs no
+/// sign cases beyond the top.
 pub fn cos_integral(h0: SinCos, h1: SinCos, w0sq: f64, w1sq: f64, wtsq: f64, den: f64) -> f64 {
     if h1.s <= 0.0 {
         // Both ends at or before the top: reflect ψ → −ψ.

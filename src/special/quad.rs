@@ -282,7 +282,7 @@ fn quadpack_error(k_minus_g: f64, resasc: f64) -> f64 {
 /// `rel_tol`·|integral| (or 64 panels). Used where [`integrate`]'s deliberately pessimistic
 /// |K15 − G7| test would subdivide a smooth integrand far past double precision: on the contact
 /// model's spin integral it needs one panel where [`integrate`] needs about ten for 1e-14,
-/// with the same result to round-off (tests/contact.rs holds it against an RK4 reference).
+/// with the same result to round-off (tests/it/contact.rs holds it against an RK4 reference).
 pub fn integrate_smooth<F: FnMut(f64) -> f64>(mut f: F, a: f64, b: f64, rel_tol: f64) -> f64 {
     integrate_smooth_n(|x| [f(x)], a, b, rel_tol)[0]
 }

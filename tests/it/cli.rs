@@ -37,7 +37,7 @@ fn forward_single_scene_reports_v_regime_status() {
     let v: f64 = row[header.iter().position(|h| *h == "v").unwrap()]
         .parse()
         .unwrap();
-    // MODEL.md §2: v̄ = 0.39120827… at ξ = 1, δ = 12°, ρ = 0.4, fitted K.
+    // docs/PHYSICS.md#reference-figures: v̄ = 0.39120827… at ξ = 1, δ = 12°, ρ = 0.4, fitted K.
     assert!((v - 0.39120827).abs() < 1e-8, "{v}");
     assert_eq!(
         row[header.iter().position(|h| *h == "regime").unwrap()],
@@ -380,7 +380,8 @@ fn k_dimensional_input_matches_dimensionless() {
             .parse()
             .unwrap()
     };
-    // MODEL.md §2: v̄ = 0.39120827… at the paper's fitted law, K = cos 60° + ½ sin²30° sin 60°.
+    // docs/PHYSICS.md#reference-figures: v̄ = 0.39120827… at the paper's fitted law, K = cos 60° +
+    // ½ sin²30° sin 60°.
     let k_paper = 0.5 + 0.0625 * 3f64.sqrt();
     assert!((k(&ha, &ra) - k_paper).abs() < 1e-8, "{}", k(&ha, &ra));
     assert!((k(&ha, &ra) - k(&hb, &rb)).abs() < 1e-13);

@@ -75,7 +75,7 @@ pub fn col(h: &[String], name: &str) -> usize {
         .unwrap_or_else(|| panic!("missing column {name}: {h:?}"))
 }
 
-/// A table of tests/reference/ (see its README.md for how each was made).
+/// A table of tests/reference/ (docs/ACCURACY.md#reference-tables says how each was made).
 pub fn reference_table(name: &str) -> (Vec<String>, Vec<Vec<String>>) {
     read_table(&root().join("tests").join("reference").join(name))
 }

@@ -1,6 +1,6 @@
-//! The general contact model (MODEL.md §4): its limits (stick when no slip can happen, the
-//! paper's stick/slip where its assumed sequence is the true one), the energy balance per
-//! contact, and one contact against an independent time-stepping reference.
+//! The general contact model (docs/PHYSICS.md#general-contact-model): its limits (stick when no
+//! slip can happen, the paper's stick/slip where its assumed sequence is the true one), the energy
+//! balance per contact, and one contact against an independent time-stepping reference.
 
 use fitbead::models::contact::{Contact, ContactEnd, Launch, PhaseKind, SpinRule};
 use fitbead::models::{ForwardModel, Model, Phases};
@@ -31,7 +31,7 @@ fn rel(a: f64, b: f64) -> f64 {
 }
 
 /// When f is so large that rolling never needs more friction than f N (Θ_G ≥ Θf), the contact
-/// is pure rolling: the model equals `stick` (issue: ≤ 1e-12 relative).
+/// is pure rolling: the model equals `stick` (required: ≤ 1e-12 relative).
 #[test]
 fn reduces_to_stick_when_no_slip_can_happen() {
     let mut worst: f64 = 0.0;
@@ -98,7 +98,7 @@ fn reduces_to_stickslip_where_its_sequence_is_the_true_one() {
 }
 
 /// On ordinary scenes (ρ = 0.4, f = 0.1, ξ = 1) Θ0 < −Θ_G: the contact starts with a backward
-/// slip (MODEL.md §3's caveat), and the stick/slip model is then not exact.
+/// slip (the caveat of docs/PHYSICS.md#stickslip), and the stick/slip model is then not exact.
 #[test]
 fn ordinary_scenes_start_with_a_backward_slip() {
     let sc = scene(1.0, 12.0, 0.4, 0.1, CollisionLaw::Adjusted);
@@ -156,9 +156,10 @@ fn energy_balance_closes_per_contact() {
     assert!(worst <= 1e-12, "worst {worst:e}");
 }
 
-/// An independent reference: the equations of motion (MODEL.md §4) integrated in time by
-/// classical RK4 with a fixed small step, the events (stick → slip, slip → stick, collision)
-/// located by bisection on the step length. Nothing of the model's closed forms is used.
+/// An independent reference: the equations of motion (docs/PHYSICS.md#general-contact-model)
+/// integrated in time by classical RK4 with a fixed small step, the events (stick → slip, slip →
+/// stick, collision) located by bisection on the step length. Nothing of the model's closed forms
+/// is used.
 struct Reference {
     rho: f64,
     f: f64,

@@ -241,7 +241,7 @@ fn stickslip_within_1e_9_of_the_saddle_node() {
     assert!(r.is_ok(), "K = {k}: {r:?}");
 }
 
-/// The launch-speed path of `estimate` (src/fit/klaunch.rs) against the general search in K
+/// The launch-speed path of `estimate` (src/fit/k/launch.rs) against the general search in K
 /// (`estimate_in_k`, the path of every test above) and against the forward models: K, K_lo,
 /// K_hi to 1e-12 (or, where v̄ is flat in K, v̄ reproduced to 8 ulp), the same notes; dv̄/dK to
 /// 1e-6 of an extrapolated difference of the forward model; and the path must actually be

@@ -117,9 +117,9 @@ fn energy_bookkeeping_closes_to_second_order_in_dt() {
 
 #[test]
 fn stiff_damped_no_slip_limit_tends_to_rolling_with_the_impact_law() {
-    // MODEL.md §4: a collision that keeps rolling and conserves angular momentum about the new
-    // contact point gives K = (cos 2α + ρ)/(1+ρ). The closed-form rolling model with that K
-    // (stick::steady, eqs 11–27) is the reference; the simulation tends to it as the contact
+    // docs/PHYSICS.md#collision-laws: a collision that keeps rolling and conserves angular momentum
+    // about the new contact point gives K = (cos 2α + ρ)/(1+ρ). The closed-form rolling model with
+    // that K (stick::steady, eqs 11–27) is the reference; the simulation tends to it as the contact
     // stiffens, the normal contact over-damped (e = 0) and slip damped within the impact.
     let (xi, d) = (1.0, 12.0);
     let v_ref = stick_v(xi, d, CollisionLaw::Impact);

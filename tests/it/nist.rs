@@ -764,9 +764,9 @@ pub fn min_lres(p: &Problem, f: &Fit) -> (f64, f64) {
 /// reported as not converged rather than wrong.
 const UNREACHABLE: &[(&str, usize)] = &[];
 
-/// Smallest log relative errors over the 54 fits against NIST's certified values: README.md's
-/// figures (parameters 7.83, standard errors 6.99), the first floored to its last digit
-/// (measured 7.827).
+/// Smallest log relative errors over the 54 fits against NIST's certified values: the figures
+/// of docs/ACCURACY.md (parameters 7.83, standard errors 6.99), the first floored to its last
+/// digit (measured 7.827).
 const MIN_LRE_PARAMS: f64 = 7.82;
 const MIN_LRE_STDERR: f64 = 6.99;
 
@@ -978,7 +978,7 @@ fn nist_profile_intervals() {
     println!(
         "{found} of {total} profile ends found; {agree} confirmed by an independent cold-started fit"
     );
-    // README.md: 240 of 240 found, 239 confirmed.
+    // docs/ACCURACY.md: 240 of 240 found, 239 confirmed.
     assert_eq!(found, total);
     assert!(agree + 1 >= found, "{agree} of {found} confirmed");
 }

@@ -1,8 +1,8 @@
-//! The reference figures of MODEL.md §7 and the paper's own statements, reproduced.
+//! The paper's reference figures (docs/PHYSICS.md#reference-figures), reproduced.
 //! Sources: the paper (§3.6.2: critical ξ ≈ 0.62; Fig. 4 / Ristow: δ_m(ξ=1) ≈ 7.5°; §4.4:
-//! Θ_G "always close to 15°"; Fig. 7: stick/slip vs rolling ≈ 6 % and 15 %) and MODEL.md's
-//! checked values (0.6215, 7.469°, 1.061, 1.159), which tests/reference/make_refs.py
-//! recomputes at 40 digits by quadrature.
+//! Θ_G "always close to 15°"; Fig. 7: stick/slip vs rolling ≈ 6 % and 15 %) and the checked
+//! values (0.6215, 7.469°, 1.061, 1.159), which tests/reference/make_refs.py recomputes at 40
+//! digits by quadrature.
 
 use fitbead::models::regimes::{bulk_friction, critical_xi, delta_d, delta_m, theta_g};
 use fitbead::models::{stick, stickslip};
@@ -62,22 +62,22 @@ fn fig7_stickslip_over_rolling_ratios() {
         let r = v1 / v0;
         assert!(
             (r - want).abs() < 1e-3,
-            "xi {xi}: ratio {r}, MODEL.md {want}"
+            "xi {xi}: ratio {r}, expected {want}"
         );
     }
 }
 
-/// The bistable stick/slip scene against tests/reference/forward_refs.csv (case
-/// "bistable (MODEL.md 3)", mpmath at 40 digits): v̄ to 3e-13 relative (README.md's figure for
-/// that table), the stable fixed point to 1.2e-13 and the unstable one to 4.5e-15 (measured
-/// 7.6e-14 and 2.2e-15).
+/// The bistable stick/slip scene against tests/reference/forward_refs.csv (case of the bistable
+/// scene, mpmath at 40 digits): v̄ to 3e-13 relative (docs/ACCURACY.md's figure for that table),
+/// the stable fixed point to 1.2e-13 and the unstable one to 4.5e-15 (measured 7.6e-14 and
+/// 2.2e-15).
 #[test]
 fn bistable_stickslip_scene_of_model_md() {
-    // ξ = 10, ρ = 1, f = 0.2, K = 0.9842, δ = 5.767° (MODEL.md §3). MODEL.md quotes the stable
-    // fixed point as "≈ 0.770 (v̄ = 0.76955…)" and an unstable one "near 0.92". The reference
-    // gives 0.77783298050220538 (v̄ = 0.76864621159332382) and 0.92454042625848917, with a
-    // jump of the map (not a root) at 1.5076; MODEL.md's rounded figures are off by 1 % and
-    // 0.1 %.
+    // ξ = 10, ρ = 1, f = 0.2, K = 0.9842, δ = 5.767° (docs/PHYSICS.md#stickslip). The design
+    // notes quoted the stable fixed point as "≈ 0.770 (v̄ = 0.76955…)" and an unstable one
+    // "near 0.92". The reference gives 0.77783298050220538 (v̄ = 0.76864621159332382) and
+    // 0.92454042625848917, with a jump of the map (not a root) at 1.5076; the rounded figures
+    // are off by 1 % and 0.1 %.
     let s = Scene::new(10.0, 5.767, 1.0, 0.2, CollisionLaw::Value(0.9842)).unwrap();
     let st = stickslip::steady(&s).unwrap();
     let rel = |a: f64, b: f64| (a - b).abs() / b;

@@ -102,8 +102,8 @@ fn bulk_friction_table_contract_and_values() {
     let c = |n: &str| h.iter().position(|x| x == n).unwrap();
     for r in &rows {
         let f = |n: &str| r[c(n)].parse::<f64>().unwrap();
-        // eq 79 evaluated independently here (MODEL.md §5): μ = (1 − K²) sin α / ((1 + K²)
-        // cos α + 2K), α = asin(1/(1+ξ)).
+        // eq 79 evaluated independently here (docs/PHYSICS.md#regime-limits): μ = (1 − K²) sin α /
+        // ((1 + K²) cos α + 2K), α = asin(1/(1+ξ)).
         let (k, a) = (f("K"), (1.0 / (1.0 + f("xi"))).asin());
         let mu = (1.0 - k * k) * a.sin() / ((1.0 + k * k) * a.cos() + 2.0 * k);
         assert!(

@@ -89,7 +89,7 @@ fn model(name: &str) -> Model {
 }
 
 /// Relative error bound of v̄ on the steady rows of forward_refs.csv, every model: the figure
-/// README.md states (measured 2.97e-13, stick/slip; the other models ≤ 1.7e-13).
+/// docs/ACCURACY.md states (measured 2.97e-13, stick/slip; the other models ≤ 1.7e-13).
 const V_TOL: f64 = 3e-13;
 /// Relative error bound of the final velocity on the same rows (measured 3.0e-13, stick/slip).
 const FINAL_TOL: f64 = 4.5e-13;
@@ -271,13 +271,13 @@ fn slip_near_its_limits() {
 
 /// The slip models further into their limits (tests/reference/slip_limits_refs.csv, made by
 /// tests/reference/slip_limits_refs.py with make_refs.py's quadratures at exactly the double
-/// inputs): within 1e-3, 2e-4, 1e-6, 1e-9 and 1e-12 of the slip model's stop limit (least Θ̇²
-/// from ~5e-4, either side of the switch to double-double at 1e-4, down to ~5e-13 of its O(1)
-/// terms) for ξ from 0.65 to 10, f = 0.01 and 0.1 and two K laws, and
-/// 1 − K e^{2fα} = 1e-2 and 3e-3 (either side of the double-double switch at
-/// 1 − K² e^{4fα} = 1e-2), 1e-3, 5.5e-4, 1e-6, 1e-9, 1e-12 for slip and slip-approx at f up to 1.
-/// In regime B v̄ to the figures README.md states (5.9e-14 slip, 1.2e-14 slip-approx) and Θ̇f
-/// to 3e-14 and 7.5e-15 (measured 1.2e-14 and 4.4e-15); elsewhere the reference's regime.
+/// inputs): within 1e-3, 2e-4, 1e-6, 1e-9 and 1e-12 of the slip model's stop limit (least Θ̇² from
+/// ~5e-4, either side of the switch to double-double at 1e-4, down to ~5e-13 of its O(1) terms) for
+/// ξ from 0.65 to 10, f = 0.01 and 0.1 and two K laws, and 1 − K e^{2fα} = 1e-2 and 3e-3 (either
+/// side of the double-double switch at 1 − K² e^{4fα} = 1e-2), 1e-3, 5.5e-4, 1e-6, 1e-9, 1e-12 for
+/// slip and slip-approx at f up to 1. In regime B v̄ to the figures docs/ACCURACY.md states
+/// (5.9e-14 slip, 1.2e-14 slip-approx) and Θ̇f to 3e-14 and 7.5e-15 (measured 1.2e-14 and 4.4e-15);
+/// elsewhere the reference's regime.
 #[test]
 fn slip_deep_in_its_limits() {
     // (model, v̄ bound, Θ̇f bound)
@@ -342,7 +342,7 @@ fn slip_deep_in_its_limits() {
 /// Carlson's R_F (src/special/elliptic.rs) at the 85 hard points of
 /// tests/reference/elliptic_refs.csv (mpmath at 80 digits, cross-checked by a quadrature at 50
 /// digits in the `check` column): tiny, huge and equal arguments, one zero, ratios to 1e-300.
-/// Relative error ≤ 4.6e-16, the figure README.md states.
+/// Relative error ≤ 4.6e-16, the figure docs/ACCURACY.md states.
 #[test]
 fn carlson_rf_matches_mpmath_at_hard_points() {
     use fitbead::special::elliptic::rf;

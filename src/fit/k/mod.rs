@@ -1,7 +1,7 @@
 //! The collisional parameter K of one measurement (eq 69): find K with v̄_th(K; α, δ, ρ, f) =
 //! v̄_exp for the rolling, slip and stick/slip models.
 //!
-//! The search runs on a bracket of K that is derived, not guessed ([`bracket`]). Every contact
+//! The search runs on a bracket of K that is derived, not guessed ([`bracket`](mod@bracket)). Every contact
 //! model maps the speed Θ̇0 just after a collision to the speed Θ̇f at the next one by a
 //! function Φ that does not involve K; K enters only through Θ̇0 = K Θ̇f. Hence:
 //! - the lowest K is K_min = w_c / Φ(w_c), where w_c is the smallest launch speed that still
@@ -10,7 +10,7 @@
 //!   sits at tan θ = f); there the bead crawls over the top and v̄ → 0;
 //! - the highest K is where the steady final speed reaches lift-off, Φ(w_d) = sqrt(cos Θf)
 //!   (eq 30a), K_d = w_d / sqrt(cos Θf) — below the runaway limits K < 1 (rolling) and
-//!   K² e^{4fα} < 1 (slip) of the issue, which lift-off always reaches first when δ > 0.
+//!   K² e^{4fα} < 1 (slip), which lift-off always reaches first when δ > 0.
 //!
 //! Each end is then checked against the forward model itself; where the model fails inside the
 //! analytic bracket (the approximate models' own validity limits, the stick/slip map's
@@ -22,7 +22,7 @@
 //! crawls over the top, v̄ has an infinite slope in K), so in s the function is close to a
 //! straight line and the solver converges superlinearly at either end instead of stalling.
 //!
-//! Layout: [`types`] holds what every path shares; [`bracket`] derives the bracket of K;
+//! Layout: [`types`] holds what every path shares; [`bracket`](mod@bracket) derives the bracket of K;
 //! [`search`] solves eq 69 in K; [`launch`] solves it in the launch speed where that applies;
 //! [`estimate`](mod@estimate) picks the path; [`auto`] picks the model per point.
 

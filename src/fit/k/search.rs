@@ -10,7 +10,7 @@ use crate::special::root::brent;
 
 /// Solves v̄_th(K) = v (eq 69) on a bracket from [`bracket`]. Brent's method runs to full
 /// precision in s = ln(K − K_min), so |ΔK| ≈ 2ε |s| (K − K_min): about 1e-14 at most across
-/// the bracket (measured round trips: ≤ 3.4e-15, tests/k_inversion.rs). Where the bead crawls
+/// the bracket (measured round trips: ≤ 3.4e-15, tests/it/k_inversion.rs). Where the bead crawls
 /// so slowly that no K distinguishable from K_min gives v, the first steady K above K_min is
 /// returned (within 1e-12 of the root).
 pub fn solve(model: &Model, scene: &Scene, br: &KBracket, v: f64) -> Result<KRoot, KFailure> {
@@ -181,7 +181,7 @@ fn clamp_end(
     }
 }
 
-/// [`estimate`] by the general search in K: [`bracket`], then [`solve`] at v and v ± σ.
+/// [`estimate`](fn@super::estimate) by the general search in K: [`bracket`], then [`solve`] at v and v ± σ.
 pub fn estimate_in_k(model: &Model, scene: &Scene, v: f64, sigma_v: Option<f64>) -> KEstimate {
     let br = match bracket(model, scene) {
         Ok(b) => b,
@@ -245,8 +245,8 @@ fn slope(model: &Model, scene: &Scene, br: &KBracket, r: &KRoot) -> Option<f64> 
 /// nearly infinite), differenced over the K values actually evaluated (a three-point Lagrange
 /// derivative at `k0`, second-order accurate on any spacing). Near the bracket's top, where
 /// K_min + d e^h is out of range, the step is shrunk to fit and, failing that, the points are
-/// taken at s − h and s − 2h (one-sided, still second order). With a first-order one-sided
-/// difference here the error below lift-off was 5e-4 (tests/it/k_inversion.rs, mpmath
+/// taken at s − h and s − 2h (one-sided, still second order); a first-order one-sided
+/// difference would be off by 5e-4 below lift-off (tests/it/k_inversion.rs, mpmath
 /// references). Used by the K inversion (`dv_dK` of `fitbead k`) and by the K-law fits'
 /// Jacobian ([`crate::fit::klaw`]).
 pub fn dv_dk(

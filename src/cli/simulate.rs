@@ -80,28 +80,10 @@ pub struct Args {
     pub md: super::forward::MdArgs,
 }
 
-/// Columns of the `simulate --model contact --v0` transient.
-pub const TRACE_COLUMNS: [&str; 15] = [
-    "xi",
-    "delta_deg",
-    "bead",
-    "initial_velocity",
-    "initial_spin",
-    "final_velocity",
-    "final_spin",
-    "contact_time",
-    "mean_velocity",
-    "phase_sequence",
-    "phase_change_deg",
-    "friction_work",
-    "status",
-    "steady_mean_velocity",
-    "message",
-];
-
 /// `simulate --model contact --v0 V --beads N`: the bead-by-bead transient from a launch.
 fn trace(a: &Args, law: CollisionLaw, series: &[f64], v0: f64) -> Result<(), CliError> {
-    use fitbead::models::contact::{Contact, ContactEnd, Launch, SpinRule};
+    use fitbead::io::reports::transient_csv;
+    use fitbead::models::contact::{Contact, SpinRule};
     if !(v0.is_finite() && v0 >= 0.0) {
         return Err(super::flag_error(
             "--v0",
@@ -135,67 +117,15 @@ fn trace(a: &Args, law: CollisionLaw, series: &[f64], v0: f64) -> Result<(), Cli
         spin,
         ..Contact::default()
     };
-    let mut w = csv::Writer::from_writer(Vec::new());
-    let io = |e: csv::Error| CliError::Other(e.to_string());
-    w.write_record(TRACE_COLUMNS).map_err(io)?;
-    for &xi in series {
-        let scene = Scene::new(xi, d, a.rho, a.f, law).map_err(|e| {
-            super::flag_error("--series/--delta-deg", &xi.to_string(), e.to_string())
-        })?;
-        let steady = model
-            .evaluate(&scene)
-            .map(|s| fmt_f64(s.mean_velocity))
-            .unwrap_or_default();
-        let runs = model.transient(
-            &scene,
-            Launch {
-                theta_dot: v0,
-                spin: v0,
-            },
-            beads,
-        );
-        for (i, (l, r)) in runs.iter().enumerate() {
-            let (fv, fs, status, msg, v) = match r.end {
-                ContactEnd::Collision { theta_dot, spin } => (
-                    fmt_f64(theta_dot),
-                    fmt_f64(spin),
-                    "ok".to_string(),
-                    String::new(),
-                    fmt_f64(2.0 * scene.sin_alpha() / r.time),
-                ),
-                ContactEnd::Failed(e) => (
-                    String::new(),
-                    String::new(),
-                    e.status().to_string(),
-                    format!("{e} on bead {}", i + 1),
-                    String::new(),
-                ),
-            };
-            w.write_record([
-                fmt_f64(xi),
-                fmt_f64(d),
-                (i + 1).to_string(),
-                fmt_f64(l.theta_dot),
-                fmt_f64(l.spin),
-                fv,
-                fs,
-                if status == "ok" {
-                    fmt_f64(r.time)
-                } else {
-                    String::new()
-                },
-                v,
-                r.phases.to_string(),
-                r.phases.changes_deg(),
-                fmt_f64(r.friction_work),
-                status,
-                steady.clone(),
-                msg,
-            ])
-            .map_err(io)?;
-        }
-    }
-    let bytes = w.into_inner().map_err(|e| CliError::Other(e.to_string()))?;
+    let scenes = series
+        .iter()
+        .map(|&xi| {
+            Scene::new(xi, d, a.rho, a.f, law).map_err(|e| {
+                super::flag_error("--series/--delta-deg", &xi.to_string(), e.to_string())
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let bytes = transient_csv(&model, &scenes, d, v0, beads)?;
     emit(a.output.as_deref(), &bytes)
 }
 

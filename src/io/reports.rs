@@ -1,10 +1,13 @@
 //! The CSV schemas of the fit reports: one row per parameter (`--output`, params.csv), one row
-//! of statistics per fit (`--output-stats`, stats.csv), and the posterior draws (`--draws`).
+//! of statistics per fit (`--output-stats`, stats.csv), the posterior draws (`--draws`), and the
+//! contact model's bead-by-bead transient (`simulate --v0`).
 
 use crate::fit::posterior::draws_column;
 use crate::fit::summary::{FitResult, ParamRow, StatsRow};
 use crate::inverse::{ProfileEnd, SigmaKind};
+use crate::models::contact::{Contact, ContactEnd, Launch};
 use crate::numfmt::fmt_f64;
+use crate::scene::Scene;
 
 /// The contract columns of the parameter report, in order.
 pub const PARAM_COLUMNS: [&str; 9] = [
@@ -262,6 +265,95 @@ pub fn draws_csv(posteriors: &[&FitResult]) -> csv::Result<Vec<u8>> {
                 rec[header.len() - 1] = fmt_f64(d.log_posterior[wk][k]);
                 w.write_record(&rec)?;
             }
+        }
+    }
+    w.into_inner().map_err(|e| e.into_error().into())
+}
+
+/// Columns of the `simulate --model contact --v0` transient.
+pub const TRACE_COLUMNS: [&str; 15] = [
+    "xi",
+    "delta_deg",
+    "bead",
+    "initial_velocity",
+    "initial_spin",
+    "final_velocity",
+    "final_spin",
+    "contact_time",
+    "mean_velocity",
+    "phase_sequence",
+    "phase_change_deg",
+    "friction_work",
+    "status",
+    "steady_mean_velocity",
+    "message",
+];
+
+/// The bead-by-bead transient of the general contact model from the launch speed `v0` (and
+/// spin `v0`), over `beads` row beads for each scene (all at the slope `delta_deg`, degrees, as
+/// printed), as CSV ([`TRACE_COLUMNS`]), with each
+/// scene's steady mean velocity beside it.
+pub fn transient_csv(
+    model: &Contact,
+    scenes: &[Scene],
+    delta_deg: f64,
+    v0: f64,
+    beads: usize,
+) -> csv::Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(TRACE_COLUMNS)?;
+    for scene in scenes {
+        let (xi, d) = (scene.xi(), delta_deg);
+        let steady = model
+            .evaluate(&scene)
+            .map(|s| fmt_f64(s.mean_velocity))
+            .unwrap_or_default();
+        let runs = model.transient(
+            &scene,
+            Launch {
+                theta_dot: v0,
+                spin: v0,
+            },
+            beads,
+        );
+        for (i, (l, r)) in runs.iter().enumerate() {
+            let (fv, fs, status, msg, v) = match r.end {
+                ContactEnd::Collision { theta_dot, spin } => (
+                    fmt_f64(theta_dot),
+                    fmt_f64(spin),
+                    "ok".to_string(),
+                    String::new(),
+                    fmt_f64(2.0 * scene.sin_alpha() / r.time),
+                ),
+                ContactEnd::Failed(e) => (
+                    String::new(),
+                    String::new(),
+                    e.status().to_string(),
+                    format!("{e} on bead {}", i + 1),
+                    String::new(),
+                ),
+            };
+            w.write_record([
+                fmt_f64(xi),
+                fmt_f64(d),
+                (i + 1).to_string(),
+                fmt_f64(l.theta_dot),
+                fmt_f64(l.spin),
+                fv,
+                fs,
+                if status == "ok" {
+                    fmt_f64(r.time)
+                } else {
+                    String::new()
+                },
+                v,
+                r.phases.to_string(),
+                r.phases.changes_deg(),
+                fmt_f64(r.friction_work),
+                status,
+                steady.clone(),
+                msg,
+            ])?;
         }
     }
     w.into_inner().map_err(|e| e.into_error().into())

@@ -305,11 +305,11 @@ pub fn transient_csv(
     for scene in scenes {
         let (xi, d) = (scene.xi(), delta_deg);
         let steady = model
-            .evaluate(&scene)
+            .evaluate(scene)
             .map(|s| fmt_f64(s.mean_velocity))
             .unwrap_or_default();
         let runs = model.transient(
-            &scene,
+            scene,
             Launch {
                 theta_dot: v0,
                 spin: v0,

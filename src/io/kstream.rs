@@ -1,7 +1,7 @@
 //! Measurements in, K out: `fitbead k`'s rows as a [`KPlan`] that
 //! [`super::stream::stream`] runs over a table of any size. Each row is read and checked as
 //! [`super::measurements`] reads a whole file (the series check in input order, keeping one
-//! entry per series), inverted (eq 69: [`crate::fit::k::estimate`]) and written as one
+//! entry per series), inverted (eq 69: [`crate::fit::k::estimate()`]) and written as one
 //! record of [`COLUMNS`], [`EXTRA_COLUMNS`], [`AUTO_COLUMNS`] (auto only), then the input's
 //! other columns (trimmed; a name clashing with an output column renamed `in_NAME`).
 

@@ -42,6 +42,30 @@ impl<'b> Cells<'b> {
         self.sep();
     }
 
+    /// One or more cells already written as CSV (separated by commas, quoted where needed),
+    /// appended as they are.
+    pub fn raw(&mut self, cells: &[u8]) {
+        self.sep();
+        self.out.extend_from_slice(cells);
+    }
+
+    /// A whole number (as [`Cells::num`] writes it).
+    pub fn count(&mut self, n: u64) {
+        self.sep();
+        let mut digits = [0u8; 20];
+        let mut i = digits.len();
+        let mut n = n;
+        loop {
+            i -= 1;
+            digits[i] = b'0' + (n % 10) as u8;
+            n /= 10;
+            if n == 0 {
+                break;
+            }
+        }
+        self.out.extend_from_slice(&digits[i..]);
+    }
+
     /// A text cell, quoted when it holds a comma, a quote, a carriage return or a newline.
     pub fn text(&mut self, s: &str) {
         self.sep();

@@ -302,6 +302,7 @@ impl RowPlan for ForwardPlan {
     type Ready = Job;
     type Ledger = ();
     type Note = ();
+    type Scratch = ();
 
     fn header(&self, out: &mut Vec<u8>) {
         let kind = self.settings.kind;
@@ -337,14 +338,14 @@ impl RowPlan for ForwardPlan {
         Ok(Job { scene, model })
     }
 
-    fn write(&self, row: &Row<'_>, job: Job, out: &mut Vec<u8>) {
+    fn write(&self, row: &Row<'_>, job: Job, _: &mut (), out: &mut Vec<u8>) {
         let (o, d, au) = evaluate(&job);
         let kind = self.settings.kind;
         let general = kind == ModelKind::Contact;
         let contact = !matches!(kind, ModelKind::Jan | ModelKind::Jaeger);
         let mut w = Cells::new(out);
-        for cell in row.rec.iter() {
-            w.text(cell.trim());
+        for i in 0..row.rec.len() {
+            w.text(row.cell(i));
         }
         let regime = regime_of(&o);
         match &o {

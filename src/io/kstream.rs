@@ -14,9 +14,9 @@ use crate::fit::k::auto::{self as kauto, KChoice};
 use crate::fit::k::{estimate, KEstimate, KFailure, LowerLimit, UpperLimit};
 use crate::models::auto::Auto;
 use crate::models::Model;
-use crate::numfmt::fmt_f64;
+use crate::numfmt::{fmt_f64, push_f64};
 use crate::report::figures::{scatter_svg, PointSeries, Scatter};
-use crate::scene::CollisionLaw;
+use crate::scene::{CollisionLaw, Scene};
 use std::collections::HashMap;
 use std::fmt::Display;
 
@@ -74,6 +74,46 @@ pub struct KLedger {
     series: SeriesLedger,
     labels: HashMap<String, usize>,
     plot: Vec<PointSeries>,
+}
+
+/// What consecutive rows of one task share when they have the same ξ and ρ (rows of a
+/// series usually follow each other): ξ and the three named laws' K, formatted.
+#[derive(Debug, Clone, Default)]
+pub struct KScratch {
+    key: Option<(u64, u64)>,
+    cos2a: f64,
+    /// ξ as a cell.
+    xi: Vec<u8>,
+    /// K_cos2a, K_adjusted, K_impact as cells.
+    laws: Vec<u8>,
+}
+
+impl KScratch {
+    fn update(&mut self, s: &Scene) {
+        let key = (s.xi().to_bits(), s.rho().to_bits());
+        if self.key == Some(key) {
+            return;
+        }
+        self.key = Some(key);
+        let (alpha, rho) = (s.alpha_rad(), s.rho());
+        self.cos2a = CollisionLaw::Cos2a.k(alpha, rho);
+        self.xi.clear();
+        push_f64(&mut self.xi, s.xi());
+        self.laws.clear();
+        push_f64(&mut self.laws, self.cos2a);
+        self.laws.push(b',');
+        push_f64(&mut self.laws, CollisionLaw::Adjusted.k(alpha, rho));
+        self.laws.push(b',');
+        push_f64(&mut self.laws, CollisionLaw::Impact.k(alpha, rho));
+    }
+}
+
+/// What a written row hands on, in input order: its ξ (for the series check) and its point
+/// on the plot.
+#[derive(Debug, Clone, Copy)]
+pub struct KNote {
+    xi: f64,
+    plot: Option<PlotNote>,
 }
 
 /// A row's point on the plot: final velocity, K, K_lo, K_hi, and K = cos 2α at its ξ.
@@ -173,7 +213,8 @@ fn upper_name(u: UpperLimit) -> &'static str {
 impl RowPlan for KPlan {
     type Ready = Measured;
     type Ledger = KLedger;
-    type Note = Option<PlotNote>;
+    type Note = KNote;
+    type Scratch = KScratch;
 
     fn header(&self, out: &mut Vec<u8>) {
         let mut w = Cells::new(out);
@@ -195,20 +236,13 @@ impl RowPlan for KPlan {
         self.cols.read(row)
     }
 
-    fn in_order(&self) -> bool {
-        true
-    }
-
-    fn check(&self, ledger: &mut KLedger, row: &Row<'_>, m: &Measured) -> Result<(), InputError> {
-        self.cols.check_series(&mut ledger.series, row, m)
-    }
-
-    fn write(&self, row: &Row<'_>, m: Measured, out: &mut Vec<u8>) -> Option<PlotNote> {
+    fn write(&self, row: &Row<'_>, m: Measured, cache: &mut KScratch, out: &mut Vec<u8>) -> KNote {
         let (e, choice) = self.invert(&m);
         let s = &m.scene;
         let mut w = Cells::new(out);
+        cache.update(s);
         w.text(self.cols.series(row));
-        w.num(s.xi());
+        w.raw(&cache.xi);
         w.text(row.cell(self.cols.delta_deg()));
         w.num(m.v);
         w.opt(m.sigma_v);
@@ -220,11 +254,7 @@ impl RowPlan for KPlan {
         w.opt(e.dv_dk);
         w.opt(root.map(|r| r.steady.final_velocity));
         w.opt(e.theta_g.map(f64::to_degrees));
-        let (alpha, rho) = (s.alpha_rad(), s.rho());
-        let cos2a = CollisionLaw::Cos2a.k(alpha, rho);
-        w.num(cos2a);
-        w.num(CollisionLaw::Adjusted.k(alpha, rho));
-        w.num(CollisionLaw::Impact.k(alpha, rho));
+        w.raw(&cache.laws);
         let (regime, status) = match &e.root {
             Ok(_) => ("B", "ok"),
             Err(KFailure::BelowRange) => ("A", "below-range"),
@@ -233,7 +263,10 @@ impl RowPlan for KPlan {
         };
         w.text(regime);
         w.text(status);
-        w.opt(root.map(|r| r.evals as f64));
+        match root {
+            Some(r) => w.count(r.evals as u64),
+            None => w.empty(),
+        }
         match &e.bracket {
             Some(b) => {
                 w.num(b.lo);
@@ -270,7 +303,7 @@ impl RowPlan for KPlan {
             w.text(row.cell(c));
         }
         w.end();
-        match (self.settings.plot, root) {
+        let plot = match (self.settings.plot, root) {
             (true, Some(r)) => Some(PlotNote {
                 point: (
                     r.steady.final_velocity,
@@ -278,14 +311,16 @@ impl RowPlan for KPlan {
                     e.k_lo.unwrap_or(r.k),
                     e.k_hi.unwrap_or(r.k),
                 ),
-                cos2a,
+                cos2a: cache.cos2a,
             }),
             _ => None,
-        }
+        };
+        KNote { xi: s.xi(), plot }
     }
 
-    fn record(&self, ledger: &mut KLedger, row: &Row<'_>, note: Option<PlotNote>) {
-        let Some(n) = note else { return };
+    fn record(&self, ledger: &mut KLedger, row: &Row<'_>, note: KNote) -> Result<(), InputError> {
+        self.cols.check_series(&mut ledger.series, row, note.xi)?;
+        let Some(n) = note.plot else { return Ok(()) };
         let series = self.cols.series(row);
         let label = if series.is_empty() {
             // The row passed its checks: its ξ reads back as a number.
@@ -307,5 +342,6 @@ impl RowPlan for KPlan {
             }
         };
         ledger.plot[i].points.push(n.point);
+        Ok(())
     }
 }

@@ -112,6 +112,8 @@ pub struct Measured {
 #[derive(Debug, Clone, Default)]
 pub struct SeriesLedger {
     first_xi: HashMap<String, (f64, u64)>,
+    /// The last series checked, with its first ξ and line.
+    last: Option<(String, f64, u64)>,
 }
 
 impl MeasurementColumns {
@@ -230,34 +232,47 @@ impl MeasurementColumns {
         Ok(Measured { scene, v, sigma_v })
     }
 
-    /// Checks a read row against the rows before it, as `ledger` kept them: a series may not
-    /// mix ξ values (the error names the line of the series' first ξ).
+    /// Checks a read row (whose ξ is `xi`) against the rows before it, as `ledger` kept them:
+    /// a series may not mix ξ values (the error names the line of the series' first ξ).
     pub fn check_series(
         &self,
         ledger: &mut SeriesLedger,
         r: &Row<'_>,
-        m: &Measured,
+        xi: f64,
     ) -> Result<(), InputError> {
         let series = self.series(r);
         if self.series.is_none() || series.is_empty() {
             return Ok(());
         }
-        let xi = m.scene.xi();
-        match ledger.first_xi.get(series) {
-            Some(&(x0, line)) if x0 != xi => Err(r.err(
+        // Rows of a series usually follow each other: the last series answers most rows.
+        let (x0, line) = match &ledger.last {
+            Some((s, x0, line)) if s == series => (*x0, *line),
+            _ => {
+                let first = match ledger.first_xi.get(series) {
+                    Some(&first) => first,
+                    None => {
+                        ledger.first_xi.insert(series.to_string(), (xi, r.line));
+                        (xi, r.line)
+                    }
+                };
+                let last = ledger.last.get_or_insert_with(Default::default);
+                last.0.clear();
+                last.0.push_str(series);
+                (last.1, last.2) = first;
+                first
+            }
+        };
+        if x0 != xi {
+            return Err(r.err(
                 self.xi,
                 format!(
                     "series '{series}' mixes xi values: {} on line {line}, {} here",
                     fmt_f64(x0),
                     fmt_f64(xi)
                 ),
-            )),
-            Some(_) => Ok(()),
-            None => {
-                ledger.first_xi.insert(series.to_string(), (xi, r.line));
-                Ok(())
-            }
+            ));
         }
+        Ok(())
     }
 }
 
@@ -282,7 +297,7 @@ pub fn read_measurements(
     for r in 0..t.rows.len() {
         let row = t.row(r);
         let m = cols.read(&row)?;
-        cols.check_series(&mut ledger, &row, &m)?;
+        cols.check_series(&mut ledger, &row, m.scene.xi())?;
         rows.push(Measurement {
             series: cols.series(&row).to_string(),
             scene: m.scene,

@@ -31,6 +31,11 @@ pub struct TableReader<R: Read> {
     rdr: csv::Reader<Chain<Cursor<Vec<u8>>, R>>,
     rows_seen: u64,
     done: bool,
+    /// A record swapped with the caller's while one is read (so that reading allocates
+    /// nothing once the records have grown to the rows' size).
+    spare: Option<csv::StringRecord>,
+    /// Bytes of the longest row so far, to size new records.
+    row_bytes: usize,
 }
 
 /// 1-based line number where a record read by [`TableReader`] starts (0 when unknown).
@@ -96,6 +101,8 @@ impl<R: Read> TableReader<R> {
             rdr,
             rows_seen: 0,
             done: false,
+            spare: None,
+            row_bytes: 64,
         })
     }
 
@@ -137,7 +144,10 @@ impl<R: Read> TableReader<R> {
         let mut n = 0;
         while n < max && !self.done {
             if n == recs.len() {
-                recs.push(csv::StringRecord::new());
+                recs.push(csv::StringRecord::with_capacity(
+                    2 * self.row_bytes,
+                    self.headers.len(),
+                ));
             }
             if self.read_one(&mut recs[n])? {
                 n += 1;
@@ -163,7 +173,8 @@ impl<R: Read> TableReader<R> {
     /// UTF-8 is reported as when they were (the byte index counted from the trimmed cell).
     fn read_one(&mut self, rec: &mut csv::StringRecord) -> Result<bool, InputError> {
         let pos = self.rdr.position().clone();
-        let mut b = std::mem::take(rec).into_byte_record();
+        let spare = self.spare.take().unwrap_or_default();
+        let mut b = std::mem::replace(rec, spare).into_byte_record();
         let read = self.rdr.read_byte_record(&mut b);
         let utf8 = csv::StringRecord::from_byte_record(b);
         let more = match read {
@@ -173,7 +184,7 @@ impl<R: Read> TableReader<R> {
                 return Err(self.csv_error(e));
             }
         };
-        *rec = match utf8 {
+        let read = match utf8 {
             Ok(r) => r,
             Err(e) => {
                 self.done = true;
@@ -198,6 +209,8 @@ impl<R: Read> TableReader<R> {
                 });
             }
         };
+        self.spare = Some(std::mem::replace(rec, read));
+        self.row_bytes = self.row_bytes.max(rec.as_byte_record().as_slice().len());
         if !more {
             self.done = true;
             return Ok(false);
@@ -310,7 +323,14 @@ pub struct Row<'a> {
 impl<'a> Row<'a> {
     /// Text of a cell, without leading and trailing whitespace.
     pub fn cell(&self, col: usize) -> &'a str {
-        self.rec.get(col).unwrap_or("").trim()
+        let s = self.rec.get(col).unwrap_or("");
+        // Bytes in '!'..='~' are never whitespace: most cells need no trimming.
+        let plain = |b: Option<&u8>| b.is_some_and(|&b| b > b' ' && b < 0x7f);
+        if plain(s.as_bytes().first()) && plain(s.as_bytes().last()) {
+            s
+        } else {
+            s.trim()
+        }
     }
 
     /// A finite number from a cell, or an error naming file, line, column and value.

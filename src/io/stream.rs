@@ -26,11 +26,11 @@ pub const CHUNK_ROWS: usize = 32 * 1024;
 /// Rows per parallel task within a chunk.
 pub const TASK_ROWS: usize = 512;
 
-/// What a stream does with each row: check its cells ([`prepare`](RowPlan::prepare), in
-/// parallel), optionally check it against the rows before it ([`check`](RowPlan::check), in
-/// input order, for rules that span the file), then compute and format it
-/// ([`write`](RowPlan::write), in parallel), handing a [`Note`](RowPlan::Note) to
-/// [`record`](RowPlan::record) in input order (for what is kept across the file).
+/// What a stream does with each row: check its cells ([`prepare`](RowPlan::prepare)),
+/// compute and format it ([`write`](RowPlan::write)) — both in parallel, one pass per task —
+/// then, in input order, keep or check what the row's [`Note`](RowPlan::Note) says against
+/// the rows before it ([`record`](RowPlan::record): rules that span the file, such as a
+/// series that may not mix ξ values, and what is kept across it).
 pub trait RowPlan: Sync {
     /// A row whose cells passed their checks, ready to compute.
     type Ready: Send;
@@ -39,6 +39,9 @@ pub trait RowPlan: Sync {
     type Ledger: Send;
     /// What [`write`](RowPlan::write) hands to [`record`](RowPlan::record); `()` when nothing.
     type Note: Send;
+    /// Scratch space of one task, handed to each [`write`](RowPlan::write) of its rows (a
+    /// cache of what consecutive rows share); `()` when none.
+    type Scratch: Default + Send;
 
     /// Appends the output's header record.
     fn header(&self, out: &mut Vec<u8>);
@@ -46,30 +49,27 @@ pub trait RowPlan: Sync {
     /// Checks the cells of one row, or reports its first bad value.
     fn prepare(&self, row: &Row<'_>) -> Result<Self::Ready, InputError>;
 
-    /// Whether rows go through [`check`](RowPlan::check) (in input order) between
-    /// [`prepare`](RowPlan::prepare) and [`write`](RowPlan::write). When false (the
-    /// default), each task prepares and writes its rows in one pass.
-    fn in_order(&self) -> bool {
-        false
-    }
+    /// Computes one row and appends its output record to `out`.
+    fn write(
+        &self,
+        row: &Row<'_>,
+        ready: Self::Ready,
+        scratch: &mut Self::Scratch,
+        out: &mut Vec<u8>,
+    ) -> Self::Note;
 
-    /// Checks a prepared row against what `ledger` kept of the rows before it.
-    fn check(
+    /// Checks a written row against what `ledger` kept of the rows before it, and keeps what
+    /// its note says; called in input order, for every row before the first one that failed
+    /// [`prepare`](RowPlan::prepare). An error here is the row's error (the row's output is
+    /// then not written).
+    fn record(
         &self,
         ledger: &mut Self::Ledger,
         row: &Row<'_>,
-        ready: &Self::Ready,
+        note: Self::Note,
     ) -> Result<(), InputError> {
-        let _ = (ledger, row, ready);
-        Ok(())
-    }
-
-    /// Computes one row and appends its output record to `out`.
-    fn write(&self, row: &Row<'_>, ready: Self::Ready, out: &mut Vec<u8>) -> Self::Note;
-
-    /// Keeps what a written row's note says, in input order.
-    fn record(&self, ledger: &mut Self::Ledger, row: &Row<'_>, note: Self::Note) {
         let _ = (ledger, row, note);
+        Ok(())
     }
 }
 
@@ -203,25 +203,43 @@ where
     let mut header = Vec::new();
     plan.header(&mut header);
     let mut pending = vec![header];
+    // Output buffers come back here once written, and serve the chunk after next.
+    let mut spare: Vec<Vec<u8>> = Vec::new();
     let mut failed = None;
     let mut rows = 0u64;
+    // Output bytes per row to reserve (grown to what the rows so far needed).
+    let mut row_bytes = 192;
     loop {
         if stopped(opts) {
             return Err(StreamError::Stopped);
         }
+        let bufs = std::mem::take(&mut spare);
         let (read, done) = rayon::join(
             || {
                 write_parts(out, &pending, &mut failed);
                 reader.read_chunk(&mut next, chunk_rows)
             },
-            || chunk(&plan, &ctx, &cur[..n_cur], &mut ledger, opts),
+            || {
+                chunk(
+                    &plan,
+                    &ctx,
+                    &cur[..n_cur],
+                    bufs,
+                    row_bytes,
+                    &mut ledger,
+                    opts,
+                )
+            },
         );
         let n_next = read?;
-        pending = match done {
+        let parts = match done {
             Ok(parts) => parts,
             Err(StreamError::Input(e)) => return Err(first_error(&mut reader, e, opts)),
             Err(e) => return Err(e),
         };
+        let bytes: usize = parts.iter().map(Vec::len).sum();
+        row_bytes = row_bytes.max(bytes.div_ceil(n_cur) + 16);
+        spare = std::mem::replace(&mut pending, parts);
         rows += n_cur as u64;
         if let Some(p) = &opts.progress {
             p.report(ProgressEvent::Position(reader.bytes_read()));
@@ -270,80 +288,51 @@ fn write_parts(out: &mut dyn Write, parts: &[Vec<u8>], failed: &mut Option<std::
     }
 }
 
-/// One task's output: its bytes and its rows' notes.
-type Part<N> = (Vec<u8>, Vec<N>);
+/// One task's output: its bytes, its rows' notes, and the error of the row it stopped at.
+type Part<N> = (Vec<u8>, Vec<N>, Option<StreamError>);
 
-/// One chunk of rows: their output bytes in order (one buffer per task), the notes recorded,
-/// or the first bad row's error.
+/// One chunk of rows: their output bytes in order (one buffer per task, taken from `bufs`
+/// where there is one, with room for `row_bytes` per row), the notes recorded, or the first
+/// bad row's error.
 fn chunk<P: RowPlan>(
     plan: &P,
     ctx: &Context,
     recs: &[csv::StringRecord],
+    mut bufs: Vec<Vec<u8>>,
+    row_bytes: usize,
     ledger: &mut P::Ledger,
     opts: &StreamOptions,
 ) -> Result<Vec<Vec<u8>>, StreamError> {
     let task = opts.task_rows.max(1);
-    let parts: Vec<Result<Part<P::Note>, StreamError>> = if plan.in_order() {
-        // Prepare in parallel, keeping each task's rows up to its first error.
-        let prepared: Vec<(Vec<P::Ready>, Option<InputError>)> = recs
-            .par_chunks(task)
-            .map(|rs| {
-                let mut ready = Vec::with_capacity(rs.len());
-                for rec in rs {
-                    match plan.prepare(&ctx.row(rec)) {
-                        Ok(r) => ready.push(r),
-                        Err(e) => return (ready, Some(e)),
-                    }
-                }
-                (ready, None)
-            })
-            .collect();
-        // Check in input order: the first failing row, by either check, is the error.
-        for ((ready, err), rs) in prepared.iter().zip(recs.chunks(task)) {
-            for (r, rec) in ready.iter().zip(rs) {
-                plan.check(ledger, &ctx.row(rec), r)?;
+    bufs.resize_with(recs.len().div_ceil(task), Vec::new);
+    let parts: Vec<Part<P::Note>> = recs
+        .par_chunks(task)
+        .zip(bufs.into_par_iter())
+        .map(|(rs, mut buf)| {
+            buf.clear();
+            buf.reserve(rs.len() * row_bytes);
+            let mut notes = Vec::with_capacity(rs.len());
+            if stopped(opts) {
+                return (buf, notes, Some(StreamError::Stopped));
             }
-            if let Some(e) = err {
-                return Err(StreamError::Input(e.clone()));
+            let mut scratch = P::Scratch::default();
+            for rec in rs {
+                let row = ctx.row(rec);
+                match plan.prepare(&row) {
+                    Ok(r) => notes.push(plan.write(&row, r, &mut scratch, &mut buf)),
+                    Err(e) => return (buf, notes, Some(StreamError::Input(e))),
+                }
             }
-        }
-        prepared
-            .into_par_iter()
-            .zip(recs.par_chunks(task))
-            .map(|((ready, _), rs)| {
-                if stopped(opts) {
-                    return Err(StreamError::Stopped);
-                }
-                let mut buf = Vec::with_capacity(rs.len() * 256);
-                let mut notes = Vec::with_capacity(rs.len());
-                for (r, rec) in ready.into_iter().zip(rs) {
-                    notes.push(plan.write(&ctx.row(rec), r, &mut buf));
-                }
-                Ok((buf, notes))
-            })
-            .collect()
-    } else {
-        recs.par_chunks(task)
-            .map(|rs| {
-                if stopped(opts) {
-                    return Err(StreamError::Stopped);
-                }
-                let mut buf = Vec::with_capacity(rs.len() * 192);
-                let mut notes = Vec::with_capacity(rs.len());
-                for rec in rs {
-                    let row = ctx.row(rec);
-                    let r = plan.prepare(&row)?;
-                    notes.push(plan.write(&row, r, &mut buf));
-                }
-                Ok((buf, notes))
-            })
-            .collect()
-    };
+            (buf, notes, None)
+        })
+        .collect();
     let mut out = Vec::with_capacity(parts.len());
-    for (p, rs) in parts.into_iter().zip(recs.chunks(task)) {
-        let (buf, notes) = p?;
+    for ((buf, notes, err), rs) in parts.into_iter().zip(recs.chunks(task)) {
         for (n, rec) in notes.into_iter().zip(rs) {
-            plan.record(ledger, &ctx.row(rec), n);
+            plan.record(ledger, &ctx.row(rec), n)?;
+        }
+        if let Some(e) = err {
+            return Err(e);
         }
         out.push(buf);
     }

@@ -13,7 +13,6 @@ use fitbead::models::{regime_of, ForwardModel, JaegerBranch, Model, ModelKind, O
 use fitbead::scene::ParameterError as Error;
 use fitbead::scene::{CollisionLaw, Scene};
 use rayon::prelude::*;
-use std::fs::File;
 use std::io::{Cursor, Read, Write};
 use std::path::PathBuf;
 
@@ -184,12 +183,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
             super::DEFAULT_DATA_NAME.to_string(),
             Box::new(super::DEFAULT_DATA.as_bytes()),
         ),
-        (None, Some(p)) => {
-            let name = p.display().to_string();
-            let f =
-                File::open(p).map_err(|e| InputError::file(&name, format!("cannot read: {e}")))?;
-            (name, Box::new(f))
-        }
+        (None, Some(p)) => super::open_input(p)?,
     };
     let reader = TableReader::new(&source, input)?;
     match a.output.as_deref() {
@@ -331,6 +325,7 @@ struct Plan<'a> {
     c_spin: Option<usize>,
     flag_spin: SpinRule,
     flag_law: CollisionLaw,
+    c_cells: std::collections::HashMap<&'static str, usize>,
 }
 
 impl<'a> Plan<'a> {
@@ -373,6 +368,10 @@ impl<'a> Plan<'a> {
             c_spin: t.col("spin"),
             flag_spin,
             flag_law,
+            c_cells: super::SCENE_CELL_COLUMNS
+                .iter()
+                .filter_map(|n| t.col(n).map(|c| (*n, c)))
+                .collect(),
         })
     }
 
@@ -454,6 +453,7 @@ impl<'a> Plan<'a> {
                 )
             }
         };
+        super::check_scene_cells(r, &|n| self.c_cells.get(n).copied())?;
         Ok(Job { scene, model })
     }
 
@@ -984,16 +984,32 @@ fn run_md(a: &Args, t: &Table) -> Result<(), CliError> {
                 vals[i] = Some(x);
             }
         }
-        let md = build_md(&a.md, &vals, &|i, msg| match cols[i] {
-            Some(c) if !t.cell(r, c).is_empty() => t.err(r, c, msg).into(),
-            _ => super::flag_error(
-                &format!("--{}", md_flag_name(i)),
-                &vals[i].map(fmt_f64).unwrap_or_default(),
-                msg,
-            ),
+        let err = |i: usize, msg: String| -> CliError {
+            match cols[i] {
+                Some(c) if !t.cell(r, c).is_empty() => t.err(r, c, msg).into(),
+                _ => super::flag_error(
+                    &format!("--{}", md_flag_name(i)),
+                    &vals[i].map(fmt_f64).unwrap_or_default(),
+                    msg,
+                ),
+            }
+        };
+        let md = build_md(&a.md, &vals, &err)?;
+        md.check_scene(&scene).map_err(|e| match &e {
+            Error::InvalidParameter { field: "rho", .. } => match c_rho {
+                Some(c) if !t.cell(r, c).is_empty() => t.err(r, c, e.to_string()).into(),
+                _ => super::flag_error("--rho", &fmt_f64(rho), e.to_string()),
+            },
+            Error::InvalidParameter { field, .. } => match md_field_index(field) {
+                Some(i) => err(i, e.to_string()),
+                None => CliError::Other(e.to_string()),
+            },
+            _ => CliError::Other(e.to_string()),
         })?;
+        super::check_scene_cells(&t.row(r), &|n| t.col(n))?;
         jobs.push((scene, md));
     }
+    let stop = super::stop_flag();
     let reps: u64 = if a.md.check_step { 3 } else { 1 };
     let total: u64 = jobs.iter().map(|(_, m)| m.config.beads as u64 * reps).sum();
     let bar = if total >= 2000 {
@@ -1009,9 +1025,9 @@ fn run_md(a: &Args, t: &Table) -> Result<(), CliError> {
     let results: Vec<(MdResult, Option<f64>)> = jobs
         .par_iter()
         .map(|(scene, md)| {
-            let r = md.simulate(scene, 1.0, Some(&tick));
+            let r = md.simulate_until(scene, 1.0, Some(&tick), Some(&stop));
             let rel = if a.md.check_step {
-                let h = md.simulate(scene, 0.5, Some(&tick));
+                let h = md.simulate_until(scene, 0.5, Some(&tick), Some(&stop));
                 match (r.mean_velocity, h.mean_velocity) {
                     (Some(x), Some(y)) => Some(((y - x) / x).abs()),
                     _ => None,
@@ -1024,6 +1040,9 @@ fn run_md(a: &Args, t: &Table) -> Result<(), CliError> {
         .collect();
     if let Some(b) = bar {
         b.finish_and_clear();
+    }
+    if stop.load(std::sync::atomic::Ordering::SeqCst) {
+        return Err(CliError::Interrupted);
     }
     let bytes = render_md(t, &jobs, &results).map_err(|e| CliError::Other(e.to_string()))?;
     emit(a.output.as_deref(), &bytes)

@@ -133,6 +133,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let t = Table::parse(&source, &text)?;
     let defaults = super::measurement_defaults(a.rho, a.f, a.g)?;
     let rows = read_measurements(&t, &defaults)?;
+    super::warn_implausible(&t, &rows);
     let (results, autos): (Vec<KEstimate>, Vec<Option<KChoice>>) = rows
         .par_iter()
         .map(|r| match &auto {

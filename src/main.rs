@@ -7,9 +7,7 @@
 
 mod cli;
 
-use clap::Parser;
-
 fn main() {
-    let args = cli::Cli::parse();
+    let args = cli::parse();
     std::process::exit(cli::run(args));
 }

@@ -32,3 +32,22 @@ fn f64_str(b: &mut ryu::Buffer, x: f64) -> &str {
         ""
     }
 }
+
+/// Longest echo of a user's value in a message, in characters ([`clip`]).
+pub const ECHO_CHARS: usize = 80;
+
+/// `s` cut to at most `max` characters for a message: a longer text keeps its first
+/// `max` − 1 characters followed by `…` and its full length in bytes, so that a huge cell or
+/// argument is never echoed whole.
+pub fn clip(s: &str, max: usize) -> std::borrow::Cow<'_, str> {
+    match s.char_indices().nth(max) {
+        None => std::borrow::Cow::Borrowed(s),
+        Some(_) => {
+            let end = s
+                .char_indices()
+                .nth(max.saturating_sub(1))
+                .map_or(s.len(), |(i, _)| i);
+            std::borrow::Cow::Owned(format!("{}… ({} bytes)", &s[..end], s.len()))
+        }
+    }
+}

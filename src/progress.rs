@@ -1,6 +1,13 @@
 //! Progress of long computations, reported to whoever wants it: the library calls a
 //! [`Progress`] sink, a user interface (the command line's progress bar) renders it. Nothing
 //! in the library draws or prints.
+//!
+//! Stopping works the other way: a caller passes a stop flag (`AtomicBool`, usually in an
+//! `Arc`) to the long computations (least-squares iterations and profiles through
+//! `LsqOptions::stop`, the sampler through `McmcOptions::stop`, the work-precision bench, md
+//! runs), which poll it and end early; a computation with nothing useful to return then says
+//! [`Interrupted`]. The library never installs a signal handler: the command line raises the
+//! flag on SIGINT, SIGTERM and SIGHUP.
 
 use std::fmt;
 use std::sync::Arc;
@@ -44,3 +51,15 @@ impl fmt::Debug for Progress {
         f.write_str("Progress(..)")
     }
 }
+
+/// A computation stopped early because its caller raised the stop flag.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Interrupted;
+
+impl fmt::Display for Interrupted {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("interrupted")
+    }
+}
+
+impl std::error::Error for Interrupted {}

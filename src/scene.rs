@@ -1,5 +1,6 @@
 //! A scene: the mobile bead on the row (ξ, δ, ρ, f) and the collision law K; derived geometry.
 
+use crate::numfmt::{clip, ECHO_CHARS};
 use crate::special::dd::Dd;
 pub use crate::special::SinCos;
 use std::f64::consts::FRAC_PI_2;
@@ -21,11 +22,15 @@ pub enum ParameterError {
         /// What the domain is.
         reason: &'static str,
     },
-    /// A collision law name that fitbead does not know.
-    #[error("unknown collision law '{0}' (expected a number, cos2a, adjusted, impact or c=VALUE)")]
+    /// A collision law name that fitbead does not know (the text is cut for the message: the
+    /// value at [`ECHO_CHARS`] characters, a short description around it allowed).
+    #[error(
+        "unknown collision law '{}' (expected a number, cos2a, adjusted, impact or c=VALUE)",
+        clip(.0, ECHO_CHARS + 64)
+    )]
     UnknownLaw(String),
     /// A model name that fitbead does not know.
-    #[error("unknown model '{0}'")]
+    #[error("unknown model '{}'", clip(.0, ECHO_CHARS))]
     UnknownModel(String),
 }
 
@@ -202,7 +207,9 @@ impl Scene {
         Self::from_radians(xi, delta_deg.to_radians(), rho, f, law)
     }
 
-    /// Builds a scene from δ in radians.
+    /// Builds a scene from δ in radians. K must be in (0, 1): a number K ≥ 1 is refused (a
+    /// collision cannot return more tangential velocity than it receives); a law's K is < 1
+    /// at every ξ for the named laws.
     pub fn from_radians(xi: f64, delta: f64, rho: f64, f: f64, law: CollisionLaw) -> Result<Self> {
         check("xi", xi, xi > 0.0, "radius ratio must be > 0")?;
         check(
@@ -219,6 +226,16 @@ impl Scene {
         let alpha = (1.0 / (1.0 + xi)).asin();
         let k = law.k(alpha, rho);
         check("K", k, k > 0.0, "collisional parameter must be > 0")?;
+        if law.is_value() {
+            // A collision returns at most the tangential velocity it receives (eq 1).
+            check(
+                "K",
+                k,
+                k < 1.0,
+                "collisional parameter must be < 1 (a collision cannot return more velocity \
+                 than it receives)",
+            )?;
+        }
         let theta_0 = delta - alpha;
         let theta_f = delta + alpha;
         let sc_half_delta = SinCos::of(0.5 * delta);

@@ -2,8 +2,8 @@
 //! SVG.
 
 use super::{emit, CliError};
-use fitbead::io::write_atomic;
-use fitbead::report::workprecision::{draw_scenes, plot, render, run_bench, XCHECK_BOUNDS};
+use fitbead::io::write_atomic_all;
+use fitbead::report::workprecision::{draw_scenes, plot, render, run_bench_until, XCHECK_BOUNDS};
 use std::path::PathBuf;
 
 /// Arguments of `fitbead bench`.
@@ -41,7 +41,8 @@ pub fn run(a: Args) -> Result<(), CliError> {
             a.scenes
         )));
     }
-    let res = run_bench(&scenes);
+    let stop = super::stop_flag();
+    let res = run_bench_until(&scenes, &stop).map_err(|_| CliError::Interrupted)?;
     for r in res
         .rows
         .iter()
@@ -84,14 +85,26 @@ pub fn run(a: Args) -> Result<(), CliError> {
         res.auto_mix.0, res.auto_mix.1, res.auto_mix.2
     );
     let bytes = render(&res.rows).map_err(|e| CliError::Other(e.to_string()))?;
-    if let Some(p) = &a.plot {
-        let svg = plot(
+    let svg = match &a.plot {
+        Some(_) => plot(
             &res.rows,
             &format!("Work-precision, {} scenes (seed {})", scenes.len(), a.seed),
         )
-        .map_err(CliError::Other)?;
-        write_atomic(p, svg.as_bytes())
-            .map_err(|e| CliError::Other(format!("{}: cannot write: {e}", p.display())))?;
+        .map_err(CliError::Other)?,
+        None => String::new(),
+    };
+    // The plot and the CSV file are written as one group: both or neither.
+    let files: Vec<(&std::path::Path, &[u8])> = a
+        .plot
+        .iter()
+        .map(|p| (p.as_path(), svg.as_bytes()))
+        .chain(a.output.iter().map(|p| (p.as_path(), bytes.as_slice())))
+        .collect();
+    if !files.is_empty() {
+        write_atomic_all(&files).map_err(|e| CliError::Other(format!("cannot write: {e}")))?;
     }
-    emit(a.output.as_deref(), &bytes)
+    if a.output.is_none() {
+        emit(None, &bytes)?;
+    }
+    Ok(())
 }

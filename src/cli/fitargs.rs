@@ -2,18 +2,22 @@
 
 use super::{emit, read_input, CliError};
 use fitbead::fit::data::Dataset;
+use fitbead::fit::k::bracket;
 use fitbead::fit::posterior::{McmcSettings, Method, Prior, SCALE_NAME};
-use fitbead::fit::summary::{FitResult, ParamRow, StatsRow};
+use fitbead::fit::summary::{FitResult, McmcFailure, ParamRow, StatsRow};
 use fitbead::inverse::mcmc::McmcOptions;
 use fitbead::io::measurements::{dataset_of, read_measurements, Measurement};
 use fitbead::io::reports::{draws_csv, params_csv, stats_csv};
 use fitbead::io::scenes::Table;
-use fitbead::io::{fmt_sig, write_atomic_all};
+use fitbead::io::{fmt_f64, fmt_sig, write_atomic_all};
+use fitbead::models::Model;
 use fitbead::report::figures::{corner_svg, CornerBlock};
 use std::io::IsTerminal;
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
+
+/// Most walkers of a posterior run (`--walkers`): each step keeps one draw per walker in
+/// memory.
+pub const MAX_WALKERS: usize = 10_000;
 
 /// Flags common to every fit command.
 #[derive(Debug, clap::Args)]
@@ -105,7 +109,8 @@ pub struct MethodChoice {
 impl FitArgs {
     /// The method from `--method` and the MCMC flags; `params` are the names `--prior` may
     /// use (the fit's parameters and sigma_scale). MCMC flags without `--method mcmc` are an
-    /// error. For MCMC, installs a Ctrl-C handler that stops the sampler cleanly.
+    /// error. Installs the signal handler whose stop flag ([`super::stop_flag`]) stops the
+    /// solvers and the sampler cleanly.
     pub fn method(&self, params: &[&str]) -> Result<MethodChoice, CliError> {
         let mcmc_flags = [
             ("--seed", self.seed.is_some()),
@@ -118,7 +123,7 @@ impl FitArgs {
             ("--draws", self.draws.is_some()),
             ("--plot", self.plot.is_some()),
         ];
-        match self.method.as_str() {
+        match self.method.to_ascii_lowercase().as_str() {
             "lsq" => {
                 if let Some((flag, _)) = mcmc_flags.iter().find(|f| f.1) {
                     return Err(super::flag_error(flag, "", "applies to --method mcmc only"));
@@ -126,6 +131,7 @@ impl FitArgs {
                 return Ok(MethodChoice {
                     method: Method::Lsq {
                         profile: !self.no_profile,
+                        stop: Some(super::stop_flag()),
                     },
                 });
             }
@@ -140,11 +146,14 @@ impl FitArgs {
         }
         options.walkers = self.walkers;
         if let Some(w) = self.walkers {
-            if w < 4 || w % 2 == 1 {
+            if w < 4 || w % 2 == 1 || w > MAX_WALKERS {
                 return Err(super::flag_error(
                     "--walkers",
                     &w.to_string(),
-                    "must be even and at least 4 (and more than the parameters)",
+                    format!(
+                        "must be even, at least 4 (and more than the parameters) and at most \
+                         {MAX_WALKERS}"
+                    ),
                 ));
             }
         }
@@ -195,12 +204,7 @@ impl FitArgs {
                 .map_err(|e: String| super::flag_error("--prior", p, e))?;
             priors.push((name.to_string(), prior));
         }
-        let stop = Arc::new(AtomicBool::new(false));
-        let flag = stop.clone();
-        // A second handler cannot be installed in the same process; the first one (set by an
-        // earlier command run in-process) keeps working, so the error is ignored.
-        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
-        options.stop = Some(stop);
+        options.stop = Some(super::stop_flag());
         Ok(MethodChoice {
             method: Method::Mcmc(Box::new(McmcSettings {
                 options,
@@ -211,6 +215,20 @@ impl FitArgs {
                     .then(super::sampler_progress_bar),
             })),
         })
+    }
+
+    /// The input and the outputs named on the command line, by flag (for the check that no
+    /// output is an input or another output).
+    pub fn paths(&self) -> (super::NamedPaths<'_>, super::NamedPaths<'_>) {
+        (
+            vec![("--input", self.input.as_deref().or(self.data.as_deref()))],
+            vec![
+                ("--output", self.output.as_deref()),
+                ("--output-stats", self.output_stats.as_deref()),
+                ("--draws", self.draws.as_deref()),
+                ("--plot", self.plot.as_deref()),
+            ],
+        )
     }
 
     /// Validates the flags and reads the measurements.
@@ -228,6 +246,7 @@ impl FitArgs {
         let defaults = super::measurement_defaults(self.rho, self.f, self.g)?;
         let rows = read_measurements(&t, &defaults)?;
         let ds = dataset_of(&t, &rows)?;
+        super::warn_implausible(&t, &rows);
         Ok((t, rows, ds))
     }
 
@@ -244,6 +263,15 @@ impl FitArgs {
         stats: &[StatsRow],
         posteriors: &[&FitResult],
     ) -> Result<(), CliError> {
+        let interrupted = posteriors
+            .iter()
+            .any(|p| p.draws.as_ref().is_some_and(|d| d.interrupted));
+        // Least squares stopped by a signal: nothing is written.
+        if super::stop_requested() && !interrupted {
+            return Err(CliError::Interrupted);
+        }
+        posterior_faults(stats)?;
+        let stats = &flag_absurd(stats);
         let p_csv = params_csv(params).map_err(|e| CliError::Other(e.to_string()))?;
         let s = stats_csv(stats).map_err(|e| CliError::Other(e.to_string()))?;
         let d_csv = match &self.draws {
@@ -300,12 +328,139 @@ impl FitArgs {
                 eprintln!("fitbead: warning: {} [{}]: {}", r.fit, r.series, r.note);
             }
         }
-        if posteriors
-            .iter()
-            .any(|p| p.draws.as_ref().is_some_and(|d| d.interrupted))
-        {
-            return Err(CliError::Interrupted);
+        if interrupted {
+            return Err(CliError::InterruptedPartial);
         }
-        Ok(())
+        not_started(stats)
     }
+}
+
+/// A prior that leaves nothing to sample (its support misses the parameter's feasible box) is
+/// a bad flag: exit 2 naming the prior, its support and the box, before anything is written.
+pub fn posterior_faults(stats: &[StatsRow]) -> Result<(), CliError> {
+    for s in stats {
+        if let Some(
+            f @ McmcFailure::PriorOutsideBox {
+                parameter, prior, ..
+            },
+        ) = s.mcmc.as_ref().and_then(|m| m.failure.as_ref())
+        {
+            return Err(super::flag_error(
+                "--prior",
+                &format!("{parameter}={prior}"),
+                format!("{} [{}]: {f}", s.fit, s.series),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// A posterior run that could not start: the outputs hold the least-squares rows (marked),
+/// and the command exits 1 naming the fit and why.
+pub fn not_started(stats: &[StatsRow]) -> Result<(), CliError> {
+    let failed: Vec<String> = stats
+        .iter()
+        .filter_map(|s| {
+            s.mcmc
+                .as_ref()
+                .and_then(|m| m.failure.as_ref())
+                .map(|f| format!("{} [{}]: {f}", s.fit, s.series))
+        })
+        .collect();
+    if failed.is_empty() {
+        Ok(())
+    } else {
+        Err(CliError::NotConverged(format!(
+            "{} (the rows of these fits hold least-squares values, marked in their notes)",
+            failed.join("; ")
+        )))
+    }
+}
+
+/// The points of `ds` that no K makes steady under any of `models` (regime A or C for every
+/// K), with why under the first model.
+pub fn unsteady_points(models: &[Model], ds: &Dataset) -> Vec<(usize, String)> {
+    use rayon::prelude::*;
+    ds.points
+        .par_iter()
+        .enumerate()
+        .filter_map(|(i, p)| {
+            if super::stop_requested() {
+                return None;
+            }
+            let mut why = None;
+            for m in models {
+                match bracket(m, &p.scene) {
+                    Ok(_) => return None,
+                    Err(e) => {
+                        why.get_or_insert_with(|| e.to_string());
+                    }
+                }
+            }
+            why.map(|w| (i, w))
+        })
+        .collect()
+}
+
+/// Where point `i` of `ds` (read from `t`, in the same order) is: file, line, series, ξ and
+/// δ as written in the file.
+pub fn locate_point(t: &Table, ds: &Dataset, i: usize) -> String {
+    let p = &ds.points[i];
+    let d = t
+        .col("delta_deg")
+        .map(|c| t.cell(i, c).to_string())
+        .unwrap_or_else(|| fmt_f64(p.scene.delta_deg()));
+    format!(
+        "{}, line {} (series '{}', xi {}, delta_deg {})",
+        t.source,
+        t.lines[i],
+        fitbead::io::clip(&ds.labels[p.series], fitbead::io::ECHO_CHARS),
+        fmt_f64(p.scene.xi()),
+        d,
+    )
+}
+
+/// The lines of `t` that hold the points of series `s` of `ds`, as `2, 3, 5`.
+pub fn series_lines(t: &Table, ds: &Dataset, s: usize) -> String {
+    ds.series_index(s)
+        .iter()
+        .map(|&i| t.lines[i].to_string())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// A note of the fits that starts `series 'LABEL': ` located in the file: `FILE, lines …
+/// (series 'LABEL'): …`; other notes unchanged.
+pub fn locate_note(t: &Table, ds: &Dataset, note: &str) -> String {
+    for (s, label) in ds.labels.iter().enumerate() {
+        if let Some(rest) = note.strip_prefix(&format!("series '{label}': ")) {
+            return format!(
+                "{}, lines {} (series '{}'): {rest}",
+                t.source,
+                series_lines(t, ds, s),
+                fitbead::io::clip(label, fitbead::io::ECHO_CHARS)
+            );
+        }
+    }
+    note.to_string()
+}
+
+/// `stats` with every fit whose misfit is absurd for the σ given flagged in its note and on
+/// stderr ([`StatsRow::absurd_misfit`]).
+pub fn flag_absurd(stats: &[StatsRow]) -> Vec<StatsRow> {
+    stats
+        .iter()
+        .map(|s| {
+            let mut s = s.clone();
+            if let Some(w) = s.absurd_misfit() {
+                eprintln!("fitbead: warning: {} [{}]: {w}", s.fit, s.series);
+                s.note = if s.note.is_empty() {
+                    w
+                } else {
+                    format!("{}; {w}", s.note)
+                };
+            }
+            s
+        })
+        .collect()
 }

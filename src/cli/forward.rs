@@ -13,11 +13,8 @@ use fitbead::models::{regime_of, JaegerBranch, Model, ModelKind};
 use fitbead::scene::ParameterError as Error;
 use fitbead::scene::{CollisionLaw, Scene};
 use rayon::prelude::*;
-use std::fs::File;
 use std::io::{Cursor, Read, Write};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
 
 /// Arguments of `fitbead forward`.
 #[derive(Debug, clap::Args)]
@@ -180,11 +177,13 @@ pub(super) fn flag_input_error(flag: &str, value: &str, message: impl Into<Strin
 /// A streamed input: a file, the embedded default data, or text from the command line.
 pub(super) enum Input {
     /// A file.
-    File(File),
+    File(std::fs::File),
     /// Text held in memory.
     Text(Cursor<Vec<u8>>),
     /// The embedded default data.
     Static(&'static [u8]),
+    /// Standard input (`-`).
+    Stdin(std::io::Stdin),
 }
 
 impl Read for Input {
@@ -193,14 +192,16 @@ impl Read for Input {
             Input::File(f) => f.read(buf),
             Input::Text(c) => c.read(buf),
             Input::Static(s) => s.read(buf),
+            Input::Stdin(s) => s.read(buf),
         }
     }
 }
 
-/// Opens `path` for streaming (the embedded default data when `None`): its name in messages,
-/// the reader and its size in bytes.
+/// Opens `path` for streaming (the embedded default data when `None`, standard input when it
+/// is `-`): its name in messages, the reader and its size in bytes (0 when unknown).
 pub(super) fn open_input(path: Option<&Path>) -> Result<(String, Input, u64), CliError> {
     match path {
+        Some(p) if p == Path::new("-") => Ok(("<stdin>".to_string(), Input::Stdin(std::io::stdin()), 0)),
         None => Ok((
             super::DEFAULT_DATA_NAME.to_string(),
             Input::Static(super::DEFAULT_DATA.as_bytes()),
@@ -209,7 +210,7 @@ pub(super) fn open_input(path: Option<&Path>) -> Result<(String, Input, u64), Cl
         Some(p) => {
             let name = p.display().to_string();
             let f =
-                File::open(p).map_err(|e| InputError::file(&name, format!("cannot read: {e}")))?;
+                std::fs::File::open(p).map_err(|e| InputError::file(&name, format!("cannot read: {e}")))?;
             let size = f.metadata().map(|m| m.len()).unwrap_or(0);
             Ok((name, Input::File(f), size))
         }
@@ -220,13 +221,8 @@ pub(super) fn open_input(path: Option<&Path>) -> Result<(String, Input, u64), Cl
 /// tasks, `--output` untouched, exit 130) and a progress bar on a terminal's stderr for runs
 /// longer than a couple of seconds.
 pub(super) fn stream_options(label: &str, input_bytes: u64) -> StreamOptions {
-    let stop = Arc::new(AtomicBool::new(false));
-    let flag = stop.clone();
-    // One handler per process; a command runs once per process, so a failure here means one
-    // is already installed (and keeps its own flag): the stream then simply runs to its end.
-    let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
     StreamOptions {
-        stop: Some(stop),
+        stop: Some(super::stop_flag()),
         progress: super::delayed_progress_bar("bytes"),
         label: label.to_string(),
         input_bytes: Some(input_bytes),
@@ -575,16 +571,32 @@ fn run_md(a: &Args, t: &Table) -> Result<(), CliError> {
                 vals[i] = Some(x);
             }
         }
-        let md = build_md(&a.md, &vals, &|i, msg| match cols[i] {
-            Some(c) if !t.cell(r, c).is_empty() => t.err(r, c, msg).into(),
-            _ => super::flag_error(
-                &format!("--{}", md_flag_name(i)),
-                &vals[i].map(fmt_f64).unwrap_or_default(),
-                msg,
-            ),
+        let err = |i: usize, msg: String| -> CliError {
+            match cols[i] {
+                Some(c) if !t.cell(r, c).is_empty() => t.err(r, c, msg).into(),
+                _ => super::flag_error(
+                    &format!("--{}", md_flag_name(i)),
+                    &vals[i].map(fmt_f64).unwrap_or_default(),
+                    msg,
+                ),
+            }
+        };
+        let md = build_md(&a.md, &vals, &err)?;
+        md.check_scene(&scene).map_err(|e| match &e {
+            Error::InvalidParameter { field: "rho", .. } => match c_rho {
+                Some(c) if !t.cell(r, c).is_empty() => t.err(r, c, e.to_string()).into(),
+                _ => super::flag_error("--rho", &fmt_f64(rho), e.to_string()),
+            },
+            Error::InvalidParameter { field, .. } => match md_field_index(field) {
+                Some(i) => err(i, e.to_string()),
+                None => CliError::Other(e.to_string()),
+            },
+            _ => CliError::Other(e.to_string()),
         })?;
+        fitbead::io::forward::check_scene_cells(&t.row(r), &|n| t.col(n))?;
         jobs.push((scene, md));
     }
+    let stop = super::stop_flag();
     let reps: u64 = if a.md.check_step { 3 } else { 1 };
     let total: u64 = jobs.iter().map(|(_, m)| m.config.beads as u64 * reps).sum();
     let bar = if total >= 2000 {
@@ -600,9 +612,9 @@ fn run_md(a: &Args, t: &Table) -> Result<(), CliError> {
     let results: Vec<(MdResult, Option<f64>)> = jobs
         .par_iter()
         .map(|(scene, md)| {
-            let r = md.simulate(scene, 1.0, Some(&tick));
+            let r = md.simulate_until(scene, 1.0, Some(&tick), Some(&stop));
             let rel = if a.md.check_step {
-                let h = md.simulate(scene, 0.5, Some(&tick));
+                let h = md.simulate_until(scene, 0.5, Some(&tick), Some(&stop));
                 match (r.mean_velocity, h.mean_velocity) {
                     (Some(x), Some(y)) => Some(((y - x) / x).abs()),
                     _ => None,
@@ -615,6 +627,9 @@ fn run_md(a: &Args, t: &Table) -> Result<(), CliError> {
         .collect();
     if let Some(b) = bar {
         b.finish_and_clear();
+    }
+    if stop.load(std::sync::atomic::Ordering::SeqCst) {
+        return Err(CliError::Interrupted);
     }
     let bytes = render_md(t, &jobs, &results).map_err(|e| CliError::Other(e.to_string()))?;
     emit(a.output.as_deref(), &bytes)

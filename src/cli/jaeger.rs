@@ -1,7 +1,7 @@
 //! `fitbead jaeger`: Jaeger's a1, a2, a3 per series (Jaeger units, eq 81), the branch used and
 //! the points in the bistable band (eq 90), beside the paper's Fig. 9 values.
 
-use super::fitargs::FitArgs;
+use super::fitargs::{locate_note, FitArgs};
 use super::CliError;
 use fitbead::fit::jaeger::fit_jaeger_with;
 use fitbead::fit::summary::FitResult;
@@ -20,21 +20,23 @@ pub struct Args {
 /// Runs `fitbead jaeger`.
 pub fn run(a: Args) -> Result<(), CliError> {
     let branch = super::jaeger_branch(&a.branch)?;
-    let (_t, _rows, ds) = a.io.read()?;
+    let (t, _rows, ds) = a.io.read()?;
     let choice = a.io.method(&["a1", "a2", "a3"])?;
     let fits = fit_jaeger_with(&ds, branch, a.io.level, &choice.method);
-    for n in &fits.notes {
-        eprintln!("fitbead jaeger: {n}");
-    }
+    let notes: Vec<String> = fits.notes.iter().map(|n| locate_note(&t, &ds, n)).collect();
     let (mut params, mut stats) = (Vec::new(), Vec::new());
     for f in fits.series.iter().flatten() {
         params.extend(f.summary.params.iter().cloned());
         stats.push(f.summary.stats.clone());
     }
     if params.is_empty() {
-        return Err(CliError::Other(
-            "jaeger: no fit could be made (see the notes above)".into(),
-        ));
+        if super::stop_requested() {
+            return Err(CliError::Interrupted);
+        }
+        return Err(CliError::Other(format!(
+            "jaeger: no fit could be made: {}",
+            notes.join("; ")
+        )));
     }
     let posteriors: Vec<&FitResult> = fits
         .series
@@ -43,5 +45,8 @@ pub fn run(a: Args) -> Result<(), CliError> {
         .map(|f| &f.summary)
         .filter(|s| s.draws.is_some())
         .collect();
+    for n in &notes {
+        eprintln!("fitbead jaeger: {n}");
+    }
     a.io.write(&params, &stats, &posteriors)
 }

@@ -1,7 +1,7 @@
 //! `fitbead jan`: Jan's λ and μ per series (eq 74, fitted on v̄) and the global laws
 //! λ = λ0 e^{λ1 sin α}, μ = μ0 e^{μ1 sin α} (form of eqs 75–76), beside the paper's values.
 
-use super::fitargs::FitArgs;
+use super::fitargs::{locate_note, FitArgs};
 use super::CliError;
 use fitbead::fit::jan::fit_jan_with;
 use fitbead::fit::summary::FitResult;
@@ -16,13 +16,11 @@ pub struct Args {
 
 /// Runs `fitbead jan`.
 pub fn run(a: Args) -> Result<(), CliError> {
-    let (_t, _rows, ds) = a.io.read()?;
+    let (t, _rows, ds) = a.io.read()?;
     let choice =
         a.io.method(&["lambda", "mu", "lambda0", "lambda1", "mu0", "mu1"])?;
     let fits = fit_jan_with(&ds, a.io.level, &choice.method);
-    for n in &fits.notes {
-        eprintln!("fitbead jan: {n}");
-    }
+    let notes: Vec<String> = fits.notes.iter().map(|n| locate_note(&t, &ds, n)).collect();
     let all: Vec<&FitResult> = fits
         .series
         .iter()
@@ -36,9 +34,16 @@ pub fn run(a: Args) -> Result<(), CliError> {
     }
     let posteriors: Vec<&FitResult> = all.into_iter().filter(|s| s.draws.is_some()).collect();
     if params.is_empty() {
-        return Err(CliError::Other(
-            "jan: no fit could be made (see the notes above)".into(),
-        ));
+        if super::stop_requested() {
+            return Err(CliError::Interrupted);
+        }
+        return Err(CliError::Other(format!(
+            "jan: no fit could be made: {}",
+            notes.join("; ")
+        )));
+    }
+    for n in &notes {
+        eprintln!("fitbead jan: {n}");
     }
     a.io.write(&params, &stats, &posteriors)
 }

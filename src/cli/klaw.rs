@@ -1,12 +1,11 @@
 //! `fitbead klaw`: a law K(α) fitted to all series at once (law c, one K per series), and the
 //! parameter-free impact law scored beside it.
 
-use super::fitargs::FitArgs;
+use super::fitargs::{locate_point, unsteady_points, FitArgs};
 use super::k::parse_auto;
 use super::k::parse_model;
 use super::CliError;
 use fitbead::fit::k::auto::{self as kauto, KChoice};
-use fitbead::fit::k::bracket;
 use fitbead::fit::klaw::{fit_law, fit_law_with, KLaw, KLawError};
 use fitbead::fit::posterior::Method;
 use fitbead::fit::summary::FitResult;
@@ -90,26 +89,14 @@ pub fn run(a: Args) -> Result<(), CliError> {
         ));
     }
     // Points that no K makes steady: an error naming them, or left out with --skip-unsteady.
-    let unsteady: Vec<(usize, String)> = ds
-        .points
-        .par_iter()
-        .enumerate()
-        .filter_map(|(i, p)| bracket(&model, &p.scene).err().map(|e| (i, e.to_string())))
-        .collect();
-    let locate = |d: &fitbead::fit::data::Dataset, i: usize| {
-        let p = &d.points[i];
-        format!(
-            "{}, line {} (series '{}', xi {}, delta_deg {})",
-            t.source,
-            t.lines[i],
-            d.labels[p.series],
-            fmt_f64(p.scene.xi()),
-            fmt_f64(p.scene.delta_deg()),
-        )
-    };
-    let describe = |i: usize, why: &str| format!("{}: {why}", locate(&ds, i));
-    let mut skipped_note = String::new();
+    let unsteady = unsteady_points(&[model], &ds);
+    if super::stop_requested() {
+        return Err(CliError::Interrupted);
+    }
     let all = ds.clone();
+    let locate = |d: &fitbead::fit::data::Dataset, i: usize| locate_point(&t, d, i);
+    let describe = |i: usize, why: &str| format!("{}: {why}", locate(&all, i));
+    let mut skipped_note = String::new();
     let (ds, orig) = if unsteady.is_empty() {
         let n = ds.points.len();
         (ds, (0..n).collect::<Vec<_>>())
@@ -152,10 +139,19 @@ pub fn run(a: Args) -> Result<(), CliError> {
         )),
         e => CliError::Other(format!("klaw: {e}")),
     };
-    let main = fit_law_with(model, &ds, law, a.io.level, &choice.method).map_err(fail)?;
+    let interrupted = |e: CliError| {
+        if super::stop_requested() {
+            CliError::Interrupted
+        } else {
+            e
+        }
+    };
+    let main = fit_law_with(model, &ds, law, a.io.level, &choice.method)
+        .map_err(|e| interrupted(fail(e)))?;
     let mut stats = vec![main.summary.stats.clone()];
     if law != KLaw::Impact {
-        let imp = fit_law(model, &ds, KLaw::Impact, a.io.level, false).map_err(fail)?;
+        let imp = fit_law(model, &ds, KLaw::Impact, a.io.level, false)
+            .map_err(|e| interrupted(fail(e)))?;
         stats.push(imp.summary.stats);
     }
     if !auto_note.is_empty() {

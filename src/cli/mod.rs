@@ -12,12 +12,15 @@ pub mod report;
 pub mod simulate;
 
 use clap::{Parser, Subcommand};
-use fitbead::io::{write_atomic, InputError};
+use fitbead::io::{clip, same_file, write_atomic, InputError, ECHO_CHARS};
 use fitbead::progress::{Progress, ProgressEvent};
-use std::path::Path;
-use std::sync::Mutex;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex, OnceLock};
 
-use fitbead::io::measurements::{MeasurementDefaults, DEFAULT_DATA, DEFAULT_DATA_NAME};
+use fitbead::io::measurements::{
+    plausibility, MeasurementDefaults, DEFAULT_DATA, DEFAULT_DATA_NAME,
+};
 
 /// fitbead: a bead rolling down a row of beads (Ancey, Evesque & Coussot 1996) — forward
 /// models, regime limits and synthetic data. Velocities are dimensionless (units
@@ -57,19 +60,26 @@ pub enum Command {
 }
 
 /// Why a command failed: bad input (exit 2), an I/O failure (exit 2 as well: nothing was
-/// written), or an interruption by Ctrl-C after the outputs were written (exit 130).
+/// written), a fit that produced no converged estimate (exit 1, after writing its outputs), or
+/// an interruption by SIGINT or SIGTERM (exit 130).
 #[derive(Debug)]
 pub enum CliError {
     /// Bad input, located.
     Input(InputError),
     /// Any other failure, with a message.
     Other(String),
-    /// Stopped by Ctrl-C after writing what there was (exit 130).
+    /// The outputs were written but a fit did not converge: the message says which (exit 1).
+    NotConverged(String),
+    /// Stopped by SIGINT or SIGTERM before writing anything: existing outputs are untouched
+    /// (exit 130).
     Interrupted,
     /// Reading or writing failed (a closed pipe on stdout is not an error: exit 0).
     Io(std::io::Error),
     /// Stopped by Ctrl-C or SIGTERM before the end, saying what was (not) written (exit 130).
     Stopped(String),
+    /// Stopped by SIGINT or SIGTERM after writing what there was, every output marked
+    /// `interrupted` (exit 130).
+    InterruptedPartial,
 }
 
 impl From<std::io::Error> for CliError {
@@ -113,9 +123,13 @@ impl std::fmt::Display for CliError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             CliError::Input(e) => write!(f, "{e}"),
-            CliError::Other(s) => f.write_str(s),
+            CliError::Other(s) | CliError::NotConverged(s) => f.write_str(s),
             CliError::Interrupted => f.write_str(
-                "interrupted (Ctrl-C): the outputs hold the draws so far, marked interrupted",
+                "interrupted (SIGINT or SIGTERM): nothing written, existing outputs untouched",
+            ),
+            CliError::InterruptedPartial => f.write_str(
+                "interrupted (SIGINT or SIGTERM): the outputs hold the draws so far, every row \
+                 marked interrupted",
             ),
             CliError::Io(e) => write!(f, "{e}"),
             CliError::Stopped(s) => f.write_str(s),
@@ -123,8 +137,43 @@ impl std::fmt::Display for CliError {
     }
 }
 
+/// Longest error message printed, in characters; a run of more than [`ECHO_CHARS`]
+/// characters without a space (a value quoted whole) is cut as well.
+const MESSAGE_CHARS: usize = 2000;
+
+/// `message` with every word longer than [`ECHO_CHARS`] characters cut ([`clip`]) and the
+/// whole cut at [`MESSAGE_CHARS`].
+fn clip_message(message: &str) -> String {
+    let words: Vec<std::borrow::Cow<'_, str>> = message
+        .split(' ')
+        .map(|w| clip(w, 2 * ECHO_CHARS))
+        .collect();
+    clip(&words.join(" "), MESSAGE_CHARS).into_owned()
+}
+
+/// Parses the command line as [`Cli::parse`] does, with negative numbers allowed as the
+/// values of every flag (`--xi -1` is the value −1 given to `--xi`, refused by its check, not
+/// an unknown flag `-1`).
+pub fn parse() -> Cli {
+    use clap::{CommandFactory, FromArgMatches};
+    let mut cmd = Cli::command();
+    let names: Vec<String> = cmd
+        .get_subcommands()
+        .map(|s| s.get_name().to_string())
+        .collect();
+    for n in names {
+        cmd = cmd.mut_subcommand(n, |s| s.allow_negative_numbers(true));
+    }
+    let m = cmd.get_matches();
+    Cli::from_arg_matches(&m).unwrap_or_else(|e| e.exit())
+}
+
 /// Runs the parsed command line; returns the process exit code.
 pub fn run(cli: Cli) -> i32 {
+    if let Err(e) = check_stdout(&cli.command).and_then(|()| check_paths(&cli.command)) {
+        eprintln!("fitbead: error: {}", clip_message(&e.to_string()));
+        return 2;
+    }
     let r = match cli.command {
         Command::Forward(a) => forward::run(a),
         Command::K(a) => k::run(a),
@@ -136,27 +185,210 @@ pub fn run(cli: Cli) -> i32 {
         Command::Simulate(a) => simulate::run(a),
         Command::Bench(a) => bench::run(a),
     };
+    // A signal that arrived after the last check still means the run was cut short.
+    let r = match r {
+        Ok(()) if stop_requested() => Err(CliError::Interrupted),
+        r => r,
+    };
     match r {
         Ok(()) => 0,
         Err(CliError::Io(e)) if e.kind() == std::io::ErrorKind::BrokenPipe => 0,
-        Err(e @ (CliError::Interrupted | CliError::Stopped(_))) => {
+        Err(e @ (CliError::Interrupted | CliError::InterruptedPartial | CliError::Stopped(_))) => {
             eprintln!("fitbead: {e}");
             130
         }
+        Err(CliError::NotConverged(m)) => {
+            eprintln!("fitbead: not converged: {}", clip_message(&m));
+            1
+        }
         Err(e) => {
-            eprintln!("fitbead: error: {e}");
+            eprintln!("fitbead: error: {}", clip_message(&e.to_string()));
             2
         }
     }
 }
 
-/// Reads an input file (or the embedded default data when `path` is `None`).
+/// True when standard output was closed when fitbead started. Rust's runtime reopens a closed
+/// descriptor 1 on `/dev/null`, read-write, before `main`, so that the output would vanish
+/// without an error; that descriptor is recognised here (on Linux, from /proc: `/dev/null`
+/// opened read-write, which a shell's `>/dev/null` never does). Elsewhere only a descriptor
+/// that is not open at all counts.
+pub fn stdout_closed() -> bool {
+    static CLOSED: OnceLock<bool> = OnceLock::new();
+    *CLOSED.get_or_init(|| {
+        #[cfg(target_os = "linux")]
+        {
+            let null =
+                std::fs::read_link("/proc/self/fd/1").is_ok_and(|p| p == Path::new("/dev/null"));
+            if null {
+                let flags = std::fs::read_to_string("/proc/self/fdinfo/1")
+                    .ok()
+                    .and_then(|info| {
+                        info.lines()
+                            .find_map(|l| l.strip_prefix("flags:"))
+                            .and_then(|f| u32::from_str_radix(f.trim(), 8).ok())
+                    });
+                // O_ACCMODE = 3, O_RDWR = 2.
+                if flags.is_some_and(|f| f & 3 == 2) {
+                    return true;
+                }
+            }
+        }
+        #[cfg(unix)]
+        {
+            use std::os::fd::BorrowedFd;
+            // SAFETY: descriptor 1 is only duplicated (F_DUPFD_CLOEXEC), never closed or
+            // read; a descriptor that is not open makes the duplication fail with EBADF,
+            // which is what is tested.
+            let fd = unsafe { BorrowedFd::borrow_raw(1) };
+            if fd.try_clone_to_owned().is_err() {
+                return true;
+            }
+        }
+        false
+    })
+}
+
+/// Refuses a command whose result would go to a closed standard output.
+fn check_stdout(c: &Command) -> Result<(), CliError> {
+    let to_stdout = match c {
+        Command::Forward(a) => a.output.is_none(),
+        Command::K(a) => a.output.is_none(),
+        Command::Klaw(a) => a.io.output.is_none(),
+        Command::Jan(a) => a.io.output.is_none(),
+        Command::Jaeger(a) => a.io.output.is_none(),
+        Command::Regimes(a) => a.output.is_none(),
+        // The tables go to --out-dir; stdout only shows a summary of them.
+        Command::Report(_) => false,
+        Command::Simulate(a) => a.output.is_none(),
+        Command::Bench(a) => a.output.is_none(),
+    };
+    if stdout_closed() && to_stdout {
+        return Err(CliError::Other(
+            "standard output is closed: the result has nowhere to go (give --output FILE, or \
+             redirect stdout)"
+                .into(),
+        ));
+    }
+    Ok(())
+}
+
+/// Paths named by the flag that gives them (absent when the flag is not given).
+pub type NamedPaths<'a> = Vec<(&'static str, Option<&'a Path>)>;
+
+/// Refuses, before any work, an output that is also an input or another output of the same
+/// run (after following symbolic links), and an output that is a directory.
+fn check_paths(c: &Command) -> Result<(), CliError> {
+    fn opt(p: &Option<PathBuf>) -> Option<&Path> {
+        p.as_deref()
+    }
+    let (inputs, outputs): (NamedPaths<'_>, NamedPaths<'_>) = match c {
+        Command::Forward(a) => (
+            vec![("--input", opt(&a.input))],
+            vec![("--output", opt(&a.output))],
+        ),
+        Command::K(a) => (
+            vec![("--input", opt(&a.input).or(opt(&a.data)))],
+            vec![("--output", opt(&a.output)), ("--plot", opt(&a.plot))],
+        ),
+        Command::Klaw(a) => a.io.paths(),
+        Command::Jan(a) => a.io.paths(),
+        Command::Jaeger(a) => a.io.paths(),
+        Command::Regimes(a) => (vec![], vec![("--output", opt(&a.output))]),
+        Command::Report(a) => (
+            vec![
+                ("--input", opt(&a.input).or(opt(&a.data))),
+                ("--recipe", opt(&a.recipe)),
+            ],
+            vec![],
+        ),
+        Command::Simulate(a) => (vec![], vec![("--output", opt(&a.output))]),
+        Command::Bench(a) => (
+            vec![],
+            vec![("--output", opt(&a.output)), ("--plot", opt(&a.plot))],
+        ),
+    };
+    distinct_paths(&inputs, &outputs)
+}
+
+/// The check of [`check_paths`] on named paths (absent ones skipped).
+pub fn distinct_paths(
+    inputs: &[(&str, Option<&Path>)],
+    outputs: &[(&str, Option<&Path>)],
+) -> Result<(), CliError> {
+    let outs: Vec<(&str, &Path)> = outputs
+        .iter()
+        .filter_map(|(n, p)| p.map(|p| (*n, p)))
+        .collect();
+    for (i, (flag, p)) in outs.iter().enumerate() {
+        if p.is_dir() {
+            return Err(flag_error(flag, &p.display().to_string(), "is a directory"));
+        }
+        for (iflag, q) in inputs.iter().filter_map(|(n, q)| q.map(|q| (*n, q))) {
+            if q != Path::new("-") && same_file(p, q) {
+                return Err(flag_error(
+                    flag,
+                    &p.display().to_string(),
+                    format!("is the same file as {iflag}: the input would be overwritten"),
+                ));
+            }
+        }
+        for (oflag, q) in &outs[..i] {
+            if same_file(p, q) {
+                return Err(flag_error(
+                    flag,
+                    &p.display().to_string(),
+                    format!("is the same file as {oflag}: one output would overwrite the other"),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The stop flag raised by SIGINT (Ctrl-C), SIGTERM or SIGHUP: the handler is installed on the
+/// first call and every later call returns the same flag. Long computations poll it (the
+/// library takes it as an option) and stop within about a second.
+pub fn stop_flag() -> Arc<AtomicBool> {
+    STOP.get_or_init(|| {
+        let stop = Arc::new(AtomicBool::new(false));
+        let flag = stop.clone();
+        // Installing fails only if another handler is installed already (e.g. by a caller
+        // that runs commands in-process); the flag then stays down and the run is not
+        // interruptible this way, which is no worse than without it.
+        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
+        stop
+    })
+    .clone()
+}
+
+/// True once SIGINT, SIGTERM or SIGHUP arrived (false when [`stop_flag`] was never called).
+pub fn stop_requested() -> bool {
+    STOP.get().is_some_and(|f| f.load(Ordering::SeqCst))
+}
+
+/// The flag of [`stop_flag`], once installed.
+static STOP: OnceLock<Arc<AtomicBool>> = OnceLock::new();
+
+/// Reads an input file (or the embedded default data when `path` is `None`; standard input
+/// when it is `-`).
 pub fn read_input(path: Option<&Path>) -> Result<(String, Vec<u8>), CliError> {
     match path {
         None => Ok((
             DEFAULT_DATA_NAME.to_string(),
             DEFAULT_DATA.as_bytes().to_vec(),
         )),
+        Some(p) if p == Path::new("-") => {
+            use std::io::Read;
+            let mut b = Vec::new();
+            std::io::stdin()
+                .lock()
+                .read_to_end(&mut b)
+                .map(|_| ("<stdin>".to_string(), b))
+                .map_err(|e| {
+                    CliError::Input(InputError::file("<stdin>", format!("cannot read: {e}")))
+                })
+        }
         Some(p) => {
             let name = p.display().to_string();
             std::fs::read(p)
@@ -179,12 +411,30 @@ pub fn emit(output: Option<&Path>, bytes: &[u8]) -> Result<(), CliError> {
 /// [`CliError::Io`] with kind `BrokenPipe`, which [`run`] turns into a quiet exit 0.
 pub fn print_stdout(bytes: &[u8]) -> Result<(), CliError> {
     use std::io::Write;
+    if stdout_closed() {
+        return Err(CliError::Other(
+            "<stdout>: standard output is closed: the result has nowhere to go".into(),
+        ));
+    }
     let mut out = std::io::stdout().lock();
     match out.write_all(bytes).and_then(|_| out.flush()) {
         Ok(()) => Ok(()),
         Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Err(CliError::Io(e)),
         Err(e) => Err(CliError::Other(format!("<stdout>: {e}"))),
     }
+}
+
+/// Prints the plausibility warnings of measurements read from `t` (unit mistakes:
+/// [`plausibility`]) on stderr, and returns them.
+pub fn warn_implausible(
+    t: &fitbead::io::scenes::Table,
+    rows: &[fitbead::io::measurements::Measurement],
+) -> Vec<fitbead::io::measurements::Implausible> {
+    let w = plausibility(t, rows);
+    for x in &w {
+        eprintln!("fitbead: warning: {}: {x}", t.source);
+    }
+    w
 }
 
 /// Checks the `--rho`, `--f` and `--g` flags and makes them the measurement defaults.
@@ -331,7 +581,7 @@ pub fn parse_list(flag: &str, s: &str) -> Result<Vec<f64>, CliError> {
 /// The Jaeger root of `--branch` (`upper`, the default, or `lower`; eqs 80–89).
 pub fn jaeger_branch(value: &str) -> Result<fitbead::models::JaegerBranch, CliError> {
     use fitbead::models::JaegerBranch;
-    match value {
+    match value.to_ascii_lowercase().as_str() {
         "upper" => Ok(JaegerBranch::Upper),
         "lower" => Ok(JaegerBranch::Lower),
         b => Err(flag_error("--branch", b, "expected upper or lower")),

@@ -2,12 +2,36 @@
 //! friction μ of Jan's model against eq 79, energy budgets, the regime map, the model ranking —
 //! as a directory of CSV tables, SVG figures and a `report.md` that links them.
 
-use super::fitargs::FitArgs;
+use super::fitargs::{flag_absurd, locate_point, not_started, unsteady_points, FitArgs};
 use super::CliError;
 use fitbead::io::write_atomic_all;
 use fitbead::report::analysis::analyse;
 use fitbead::report::text::{markdown, terminal_summary};
 use std::path::{Path, PathBuf};
+
+/// Every file a report may write in its directory.
+const REPORT_FILES: [&str; 14] = [
+    "bulk_friction.csv",
+    "energy.csv",
+    "regime_map.csv",
+    "points.csv",
+    "models.csv",
+    "models_by_series.csv",
+    "params.csv",
+    "stats.csv",
+    "velocity.svg",
+    "jan_linear.svg",
+    "k_final_velocity.svg",
+    "regime_map.svg",
+    "corner.svg",
+    "report.md",
+];
+
+/// The contact models the report fits (a point must be steady under one of them).
+const CONTACT_MODELS: [fitbead::models::Model; 2] = [
+    fitbead::models::Model::Stick,
+    fitbead::models::Model::StickSlip,
+];
 
 /// Arguments of `fitbead report`.
 #[derive(Debug, clap::Args)]
@@ -145,9 +169,43 @@ pub fn run(a: Args) -> Result<(), CliError> {
         draws: None,
         plot: None,
     };
-    let (t, _rows, ds) = io.read()?;
+    // No file of the report may be the input (or the recipe).
+    let targets: Vec<PathBuf> = REPORT_FILES.iter().map(|f| out_dir.join(f)).collect();
+    let outputs: Vec<(&str, Option<&Path>)> = targets
+        .iter()
+        .map(|p| ("--out-dir", Some(p.as_path())))
+        .collect();
+    super::distinct_paths(
+        &[
+            ("--input", input.as_deref()),
+            ("--recipe", a.recipe.as_deref()),
+        ],
+        &outputs,
+    )?;
+    let (t, rows, ds) = io.read()?;
     let choice = io.method(&[])?;
+    // A point that no contact model of the report can make steady is an error, as in klaw.
+    let unsteady = unsteady_points(&CONTACT_MODELS, &ds);
+    if super::stop_requested() {
+        return Err(CliError::Interrupted);
+    }
+    if let Some((i, why)) = unsteady.first() {
+        return Err(CliError::Other(format!(
+            "{}: {why} (and {} more such point(s)); no K of the rolling or stick/slip model \
+             makes this point steady: leave it out of the data",
+            locate_point(&t, &ds, *i),
+            unsteady.len() - 1
+        )));
+    }
+    let implausible = fitbead::io::measurements::plausibility(&t, &rows);
     let an = analyse(&ds, io.level, &choice.method);
+    let interrupted = an
+        .posteriors()
+        .iter()
+        .any(|p| p.draws.as_ref().is_some_and(|d| d.interrupted));
+    if super::stop_requested() && !interrupted {
+        return Err(CliError::Interrupted);
+    }
     let mut files: Vec<(String, Vec<u8>)> = Vec::new();
     let csv_err = |e: csv::Error| CliError::Other(e.to_string());
     files.push(("bulk_friction.csv".into(), an.mu_csv().map_err(csv_err)?));
@@ -186,6 +244,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
             .flatten()
             .map(|f| f.summary.stats.clone()),
     );
+    let stats = flag_absurd(&stats);
     files.push((
         "params.csv".into(),
         fitbead::io::reports::params_csv(&params).map_err(csv_err)?,
@@ -214,6 +273,26 @@ pub fn run(a: Args) -> Result<(), CliError> {
         eprintln!("fitbead: warning: {w}");
     }
     let mut md = markdown(&an, shown.as_deref().unwrap_or(&t.source), &io.method);
+    let absurd: Vec<String> = stats
+        .iter()
+        .filter_map(|s| {
+            s.absurd_misfit()
+                .map(|w| format!("{} [{}]: {w}", s.fit, s.series))
+        })
+        .collect();
+    if !implausible.is_empty() || !absurd.is_empty() {
+        md.push_str("\n## Plausibility checks\n\n");
+        md.push_str(
+            "The data read fine but look like a unit mistake (thresholds in docs/GUIDE.md, \
+             \"Plausibility checks\"):\n\n",
+        );
+        for w in &implausible {
+            md.push_str(&format!("- {w}\n"));
+        }
+        for w in &absurd {
+            md.push_str(&format!("- {w}\n"));
+        }
+    }
     if !warnings.is_empty() {
         md.push_str(
             "
@@ -226,7 +305,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         }
     }
     files.push(("report.md".into(), md.into_bytes()));
-    std::fs::create_dir_all(&out_dir)
+    let created = create_dirs(&out_dir)
         .map_err(|e| CliError::Other(format!("{}: cannot create: {e}", out_dir.display())))?;
     let paths: Vec<PathBuf> = files.iter().map(|f| out_dir.join(&f.0)).collect();
     let staged: Vec<(&Path, &[u8])> = paths
@@ -234,14 +313,38 @@ pub fn run(a: Args) -> Result<(), CliError> {
         .zip(&files)
         .map(|(p, f)| (p.as_path(), f.1.as_slice()))
         .collect();
-    write_atomic_all(&staged).map_err(|e| CliError::Other(format!("cannot write: {e}")))?;
-    super::print_stdout(terminal_summary(&an, &out_dir.display().to_string()).as_bytes())?;
-    let interrupted = an
-        .posteriors()
-        .iter()
-        .any(|p| p.draws.as_ref().is_some_and(|d| d.interrupted));
-    if interrupted {
-        return Err(CliError::Interrupted);
+    if let Err(e) = write_atomic_all(&staged) {
+        // All or nothing: directories made for this report go as well.
+        for d in created.iter().rev() {
+            let _ = std::fs::remove_dir(d);
+        }
+        return Err(CliError::Other(format!("cannot write: {e}")));
     }
-    Ok(())
+    {
+        // The summary only repeats the files: a closed or broken stdout does not fail the
+        // report (print! would panic on a broken pipe).
+        use std::io::Write;
+        let _ = std::io::stdout()
+            .write_all(terminal_summary(&an, &out_dir.display().to_string()).as_bytes());
+    }
+    if interrupted {
+        return Err(CliError::InterruptedPartial);
+    }
+    not_started(&stats)
+}
+
+/// Creates `dir` and its missing parents; returns the directories it made, outermost first.
+fn create_dirs(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
+    let mut missing = Vec::new();
+    let mut p = Some(dir);
+    while let Some(d) = p {
+        if d.as_os_str().is_empty() || d.exists() {
+            break;
+        }
+        missing.push(d.to_path_buf());
+        p = d.parent();
+    }
+    missing.reverse();
+    std::fs::create_dir_all(dir)?;
+    Ok(missing)
 }

@@ -6,7 +6,7 @@ use fitbead::io::fmt_f64;
 use fitbead::models::jaeger::Jaeger;
 use fitbead::models::jan::Jan;
 use fitbead::models::md::{
-    regime_b_interval as md_regime_b_interval, MD_NARROW, MD_REFINE, MD_SCAN_POINTS,
+    regime_b_interval_until as md_regime_b_interval, MD_NARROW, MD_REFINE, MD_SCAN_POINTS,
 };
 use fitbead::models::regimes::regime_b_interval;
 use fitbead::models::{ForwardModel, Model, ModelKind};
@@ -15,6 +15,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Arguments of `fitbead simulate`.
 #[derive(Debug, clap::Args)]
@@ -79,6 +80,13 @@ pub struct Args {
     #[command(flatten)]
     pub md: super::forward::MdArgs,
 }
+
+/// Most points per series (`--points`).
+pub const MAX_POINTS: usize = 1_000_000;
+/// Most rows in all (series × points).
+pub const MAX_ROWS: usize = 10_000_000;
+/// Most series (`--series`).
+pub const MAX_SERIES: usize = 10_000;
 
 /// `simulate --model contact --v0 V --beads N`: the bead-by-bead transient from a launch.
 fn trace(a: &Args, law: CollisionLaw, series: &[f64], v0: f64) -> Result<(), CliError> {
@@ -155,6 +163,14 @@ pub fn run(a: Args) -> Result<(), CliError> {
         super::flag_error("--law", &a.law, e.to_string())
     })?;
     let series = parse_list("--series", &a.series)?;
+    if series.len() > MAX_SERIES {
+        return Err(super::flag_error(
+            "--series",
+            &format!("{} values", series.len()),
+            format!("expected at most {MAX_SERIES} series"),
+        ));
+    }
+    let stop = super::stop_flag();
     if let Some(v0) = a.v0 {
         if kind != ModelKind::Contact {
             return Err(super::flag_error(
@@ -165,11 +181,22 @@ pub fn run(a: Args) -> Result<(), CliError> {
         }
         return trace(&a, law, &series, v0);
     }
-    if a.points == 0 {
+    if a.points == 0 || a.points > MAX_POINTS {
         return Err(super::flag_error(
             "--points",
-            "0",
-            "need at least one point per series",
+            &a.points.to_string(),
+            format!("expected 1 to {MAX_POINTS} points per series"),
+        ));
+    }
+    if series.len().saturating_mul(a.points) > MAX_ROWS {
+        return Err(super::flag_error(
+            "--points",
+            &a.points.to_string(),
+            format!(
+                "{} series of {} points make more than {MAX_ROWS} rows",
+                series.len(),
+                a.points
+            ),
         ));
     }
     if !(a.noise.is_finite() && (0.0..0.5).contains(&a.noise)) {
@@ -180,7 +207,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         ));
     }
     if kind == ModelKind::Md {
-        return run_md(&a, &series);
+        return run_md(&a, &series, &stop);
     }
     let jan = a
         .jan
@@ -275,6 +302,9 @@ pub fn run(a: Args) -> Result<(), CliError> {
             None => (lo, hi, 0.05, 0.95),
         };
         for j in 0..a.points {
+            if stop.load(Ordering::Relaxed) {
+                return Err(CliError::Interrupted);
+            }
             let frac = if a.points == 1 {
                 0.5
             } else {
@@ -306,7 +336,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
     emit(a.output.as_deref(), &bytes)
 }
 
-fn run_md(a: &Args, series: &[f64]) -> Result<(), CliError> {
+fn run_md(a: &Args, series: &[f64], stop: &AtomicBool) -> Result<(), CliError> {
     use fitbead::models::md::{Md, MdResult};
     use fitbead::models::Regime;
     use rayon::prelude::*;
@@ -341,10 +371,14 @@ fn run_md(a: &Args, series: &[f64]) -> Result<(), CliError> {
     ])
     .map_err(io)?;
     for &xi in series {
-        Scene::new(xi, 1.0, a.rho, 0.1, CollisionLaw::Value(0.5))
+        let sc = Scene::new(xi, 1.0, a.rho, 0.1, CollisionLaw::Value(0.5))
             .map_err(|e| super::flag_error("--series", &xi.to_string(), e.to_string()))?;
-        let interval = md_regime_b_interval(&md, xi, a.rho, &tick)
+        md.check_scene(&sc).map_err(|e| md_error(a, xi, e))?;
+        let interval = md_regime_b_interval(&md, xi, a.rho, &tick, Some(stop))
             .map_err(|e| super::flag_error("--series", &xi.to_string(), e.to_string()))?;
+        if stop.load(Ordering::Relaxed) {
+            return Err(CliError::Interrupted);
+        }
         let Some((lo, hi)) = interval else {
             return Err(super::flag_error(
                 "--series",
@@ -391,11 +425,14 @@ fn run_md(a: &Args, series: &[f64]) -> Result<(), CliError> {
                 .map(|&d| {
                     let sc = Scene::new(xi, d, a.rho, 0.1, CollisionLaw::Value(0.5))
                         .map_err(|e| CliError::Other(e.to_string()))?;
-                    let r = md.simulate(&sc, 1.0, None);
+                    let r = md.simulate_until(&sc, 1.0, None, Some(stop));
                     tick();
                     Ok((d, lo, hi, r))
                 })
                 .collect::<Result<_, CliError>>()?;
+            if stop.load(Ordering::Relaxed) {
+                return Err(CliError::Interrupted);
+            }
             let bad: Vec<f64> = done
                 .iter()
                 .filter(|x| x.3.regime != Some(Regime::B))
@@ -458,4 +495,19 @@ fn run_md(a: &Args, series: &[f64]) -> Result<(), CliError> {
     }
     let bytes = w.into_inner().map_err(|e| CliError::Other(e.to_string()))?;
     emit(a.output.as_deref(), &bytes)
+}
+
+/// A scene outside the md model's domain, as the flag to change.
+fn md_error(a: &Args, xi: f64, e: fitbead::scene::ParameterError) -> CliError {
+    use fitbead::scene::ParameterError;
+    let (flag, value) = match &e {
+        ParameterError::InvalidParameter { field: "rho", .. } => ("--rho", fmt_f64(a.rho)),
+        ParameterError::InvalidParameter { field, value, .. } => (*field, value.clone()),
+        _ => ("--series", fmt_f64(xi)),
+    };
+    let flag = match flag {
+        "--rho" | "--series" => flag.to_string(),
+        f => format!("--{}", f.replace('_', "-")),
+    };
+    super::flag_error(&flag, &value, e.to_string())
 }

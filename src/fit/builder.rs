@@ -32,7 +32,7 @@ impl Default for Common {
     fn default() -> Self {
         Common {
             level: DEFAULT_LEVEL,
-            method: Method::Lsq { profile: true },
+            method: Method::lsq(true),
         }
     }
 }
@@ -58,7 +58,7 @@ macro_rules! common_setters {
         /// Least squares with covariance intervals, and profile-likelihood intervals when
         /// `profile` (the default).
         pub fn least_squares(mut self, profile: bool) -> Self {
-            self.common.method = Method::Lsq { profile };
+            self.common.method = Method::lsq(profile);
             self
         }
 

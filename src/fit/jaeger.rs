@@ -168,7 +168,7 @@ pub fn start(model: &JaegerModel, x: &[JaegerX], y: &[f64], s: &[f64]) -> Option
 
 /// Fits Jaeger's law to every series on `branch`, with intervals at `level`.
 pub fn fit_jaeger(data: &Dataset, branch: JaegerBranch, level: f64, profile: bool) -> JaegerFits {
-    fit_jaeger_with(data, branch, level, &Method::Lsq { profile })
+    fit_jaeger_with(data, branch, level, &Method::lsq(profile))
 }
 
 /// As [`fit_jaeger`], with the parameters estimated by `method` (least squares, or a
@@ -221,6 +221,7 @@ pub fn fit_jaeger_with(
         let opts = LsqOptions {
             lower: Some(vec![0.0, 0.0, 0.0]),
             sigma: data.sigma,
+            stop: method.stop().cloned(),
             ..Default::default()
         };
         let f = match fit(&problem, &p0, &opts) {

@@ -128,7 +128,7 @@ fn line(x: &[f64], y: &[f64], sigma: &[f64]) -> Option<(f64, f64)> {
 
 /// Fits Jan's model per series and globally, with intervals at `level`.
 pub fn fit_jan(data: &Dataset, level: f64, profile: bool) -> JanFits {
-    fit_jan_with(data, level, &Method::Lsq { profile })
+    fit_jan_with(data, level, &Method::lsq(profile))
 }
 
 /// As [`fit_jan`], with the parameters estimated by `method` (least squares, or a posterior
@@ -176,6 +176,7 @@ pub fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFits {
             lower: Some(vec![0.0, 0.0]),
             upper: Some(vec![f64::INFINITY, tmin]),
             sigma: data.sigma,
+            stop: method.stop().cloned(),
             ..Default::default()
         };
         let f = match fit(&problem, &[lam0, mu0], &opts) {
@@ -260,6 +261,7 @@ pub fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFits {
         let opts = LsqOptions {
             lower: Some(vec![0.0, f64::NEG_INFINITY, 0.0, f64::NEG_INFINITY]),
             sigma: data.sigma,
+            stop: method.stop().cloned(),
             ..Default::default()
         };
         let feasible = |p: &[f64]| x.iter().all(|q| JanGlobal.value(q, p).is_ok());

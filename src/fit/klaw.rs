@@ -29,6 +29,8 @@ use crate::models::{ForwardModel, Model};
 use faer::MatMut;
 use rayon::prelude::*;
 use std::fmt;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 /// Which law of K(α).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -55,12 +57,14 @@ impl KLaw {
 impl std::str::FromStr for KLaw {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        match s {
+        // Whole names only (any case): an abbreviation is refused with the choices.
+        match s.trim().to_ascii_lowercase().as_str() {
             "c" => Ok(KLaw::C),
             "impact" => Ok(KLaw::Impact),
-            "free-per-series" | "free" => Ok(KLaw::FreePerSeries),
+            "free-per-series" => Ok(KLaw::FreePerSeries),
             _ => Err(format!(
-                "unknown law '{s}': expected c, impact or free-per-series"
+                "unknown law '{}': expected c, impact or free-per-series",
+                crate::numfmt::clip(s, crate::numfmt::ECHO_CHARS)
             )),
         }
     }
@@ -88,6 +92,13 @@ pub enum KLawError {
     },
     /// The least-squares solver refused the problem (malformed input to it).
     Solver(String),
+    /// No point to fit (every point left out), or none in the group of parameter `param`.
+    NoPoints {
+        /// Parameter name (`c`, or `K of series '…'`).
+        param: String,
+    },
+    /// The caller's stop flag was raised before the fit could be made.
+    Interrupted,
 }
 
 impl std::error::Error for KLawError {}
@@ -128,6 +139,8 @@ impl fmt::Display for KLawError {
                 crate::numfmt::fmt_f64(upper.0)
             ),
             KLawError::Solver(s) => write!(f, "least-squares solver: {s}"),
+            KLawError::NoPoints { param } => write!(f, "no point left to fit {param}"),
+            KLawError::Interrupted => f.write_str("interrupted"),
         }
     }
 }
@@ -143,6 +156,8 @@ pub struct KLawProblem<'a> {
     group: Vec<usize>,
     n: usize,
     brackets: Vec<KBracket>,
+    /// Raised by the caller to cut the per-point work short ([`KLawError::Interrupted`]).
+    stop: Option<Arc<AtomicBool>>,
 }
 
 /// Points per rayon task: a stick/slip evaluation costs a few µs, so small batches already pay.
@@ -151,11 +166,26 @@ const MIN_CHUNK: usize = 4;
 impl<'a> KLawProblem<'a> {
     /// The problem for `law` under `model` (a contact model whose K can be inverted).
     pub fn new(model: Model, data: &'a Dataset, law: KLaw) -> Result<Self, KLawError> {
+        Self::new_until(model, data, law, None)
+    }
+
+    /// As [`KLawProblem::new`], the per-point work (here and in [`KLawProblem::start`]) cut
+    /// short with [`KLawError::Interrupted`] once `stop` is raised.
+    pub fn new_until(
+        model: Model,
+        data: &'a Dataset,
+        law: KLaw,
+        stop: Option<Arc<AtomicBool>>,
+    ) -> Result<Self, KLawError> {
+        let stopped = || stop.as_ref().is_some_and(|s| s.load(Ordering::Relaxed));
         let brackets = data
             .points
             .par_iter()
             .enumerate()
             .map(|(i, p)| {
+                if stopped() {
+                    return Err(KLawError::Interrupted);
+                }
                 bracket(&model, &p.scene).map_err(|e| KLawError::NoBracket {
                     index: i,
                     reason: e.to_string(),
@@ -198,7 +228,14 @@ impl<'a> KLawProblem<'a> {
             group,
             n,
             brackets,
+            stop,
         })
+    }
+
+    fn stopped(&self) -> bool {
+        self.stop
+            .as_ref()
+            .is_some_and(|s| s.load(Ordering::Relaxed))
     }
 
     /// The law.
@@ -255,11 +292,15 @@ impl<'a> KLawProblem<'a> {
             }
         }
         for j in 0..self.n {
+            let param = || match self.law {
+                KLaw::FreePerSeries => format!("K of series '{}'", self.data.labels[j]),
+                _ => "c".into(),
+            };
+            if self.group_points(j).next().is_none() {
+                return Err(KLawError::NoPoints { param: param() });
+            }
             if !(lo[j].0 < hi[j].0) {
-                let param = match self.law {
-                    KLaw::FreePerSeries => format!("K of series '{}'", self.data.labels[j]),
-                    _ => "c".into(),
-                };
+                let param = param();
                 return Err(KLawError::EmptyBox {
                     param,
                     lower: lo[j],
@@ -284,10 +325,16 @@ impl<'a> KLawProblem<'a> {
             .par_iter()
             .enumerate()
             .map(|(i, p)| {
+                if self.stopped() {
+                    return None;
+                }
                 let e = estimate(&self.model, &p.scene, p.v, None);
                 e.root.ok().map(|r| (r.k - self.a[i]) / self.b[i])
             })
             .collect();
+        if self.stopped() {
+            return Err(KLawError::Interrupted);
+        }
         Ok((0..self.n)
             .map(|j| {
                 let mut v: Vec<f64> = self.group_points(j).filter_map(|i| per_point[i]).collect();
@@ -299,7 +346,9 @@ impl<'a> KLawProblem<'a> {
                 } else {
                     v[v.len() / 2]
                 };
-                mid.clamp(l, h)
+                // The box is finite and non-empty (feasible_box); max/min, unlike clamp, also
+                // keep a NaN end from panicking.
+                mid.max(l).min(h)
             })
             .collect())
     }
@@ -363,6 +412,11 @@ impl Residuals for KLawProblem<'_> {
             .into_par_iter()
             .with_min_len(MIN_CHUNK)
             .map(|i| {
+                // A stop cuts the costliest step of an iteration short; the solver then
+                // stops at its next check.
+                if self.stopped() {
+                    return Err(Infeasible);
+                }
                 let pt = &self.data.points[i];
                 Ok(-self.dv_dk(i, self.k_of(i, p))? * self.b[i] / pt.sigma)
             })
@@ -401,7 +455,7 @@ pub fn fit_law(
     level: f64,
     profile: bool,
 ) -> Result<KLawFit, KLawError> {
-    fit_law_with(model, data, law, level, &Method::Lsq { profile })
+    fit_law_with(model, data, law, level, &Method::lsq(profile))
 }
 
 /// As [`fit_law`], with the parameters estimated by `method` (least squares, or a posterior
@@ -414,7 +468,7 @@ pub fn fit_law_with(
     level: f64,
     method: &Method,
 ) -> Result<KLawFit, KLawError> {
-    let problem = KLawProblem::new(model, data, law)?;
+    let problem = KLawProblem::new_until(model, data, law, method.stop().cloned())?;
     let fit_name = format!("klaw-{}", law.name());
     let m = data.points.len();
     if law == KLaw::Impact {
@@ -476,6 +530,7 @@ pub fn fit_law_with(
         lower: Some(lower),
         upper: Some(upper),
         sigma: data.sigma,
+        stop: method.stop().cloned(),
         ..Default::default()
     };
     let f = fit(&problem, &start, &opts).map_err(|e| KLawError::Solver(e.to_string()))?;

@@ -25,7 +25,7 @@
 //! the level asked (`ci_method = posterior`); the covariance interval of the least-squares
 //! optimum stays in `cov_low`/`cov_high` and the optimum in `lsq_value`.
 
-use super::summary::{summarise, FitResult, McmcStats, ParamRow, Solved};
+use super::summary::{summarise, FitResult, McmcFailure, McmcStats, ParamRow, Solved};
 use crate::inverse::mcmc::{summarise as mcmc_summarise, EnsembleSampler, StopReason};
 use crate::inverse::posterior::Posterior;
 pub use crate::inverse::posterior::{Draws, McmcSettings, Method, Prior, SCALE_NAME};
@@ -51,7 +51,7 @@ pub fn summarise_with<R: Residuals + Sync + ?Sized>(
     solved: Solved<'_, R>,
 ) -> FitResult {
     match method {
-        Method::Lsq { profile } => summarise(solved, *profile),
+        Method::Lsq { profile, .. } => summarise(solved, *profile),
         Method::Mcmc(s) => sample(s, solved),
     }
 }
@@ -106,6 +106,31 @@ fn sample<R: Residuals + Sync + ?Sized>(
             1.0
         }
     };
+    // A prior whose support misses the feasible box leaves nothing to sample.
+    for (j, p) in priors.iter().enumerate() {
+        let (a, b) = p.support();
+        if !(a.max(lower[j]) < b.min(upper[j])) {
+            let failure = McmcFailure::PriorOutsideBox {
+                parameter: specs[j].name.to_string(),
+                prior: p.to_string(),
+                support: (a, b),
+                feasible: (lower[j], upper[j]),
+            };
+            return failed(out, failure);
+        }
+    }
+    if let Some(p) = &scale_prior {
+        let (a, b) = p.support();
+        if !(a.max(0.0) < b) {
+            let failure = McmcFailure::PriorOutsideBox {
+                parameter: SCALE_NAME.to_string(),
+                prior: p.to_string(),
+                support: (a, b),
+                feasible: (0.0, f64::INFINITY),
+            };
+            return failed(out, failure);
+        }
+    }
     // The optimum may lie outside a prior's support (a prior narrower than the data): start
     // then just inside the support, cut to the box.
     let mut start: Vec<f64> = f
@@ -186,15 +211,7 @@ fn sample<R: Residuals + Sync + ?Sized>(
     });
     let (mut res, walkers) = match run {
         Ok(r) => r,
-        Err(e) => {
-            out.stats.note = join(&out.stats.note, &format!("MCMC could not start: {e}"));
-            out.stats.converged = false;
-            out.stats.mcmc = Some(McmcStats {
-                status: "failed".into(),
-                ..Default::default()
-            });
-            return out;
-        }
+        Err(e) => return failed(out, McmcFailure::NotStarted(e.to_string())),
     };
     // Back from sampling coordinates to parameters; the rank-based R̂ and ESS are unchanged by
     // the monotone map, the moments, quantiles and τ are recomputed on the parameters.
@@ -298,6 +315,10 @@ fn sample<R: Residuals + Sync + ?Sized>(
             "interrupted after {} steps: the draws so far, not converged",
             res.steps
         );
+        // Every row of an interrupted run says so.
+        for row in out.params.iter_mut() {
+            row.note = join(INTERRUPTED_NOTE, &row.note);
+        }
     } else if !res.converged {
         note = match res.failing_parameter {
             Some(k) => match res.diagnostics.get(k) {
@@ -345,6 +366,7 @@ fn sample<R: Residuals + Sync + ?Sized>(
         ess_min,
         rhat_max,
         waic: waic(problem, n, &res.chains),
+        failure: None,
     });
     out.draws = Some(Draws {
         chains: res.chains,
@@ -352,6 +374,29 @@ fn sample<R: Residuals + Sync + ?Sized>(
         burn_in: res.burn_in,
         thin,
         interrupted: res.reason == StopReason::Interrupted,
+    });
+    out
+}
+
+/// The note every parameter row of an interrupted posterior run starts with.
+pub const INTERRUPTED_NOTE: &str = "interrupted: posterior from the draws so far, not converged";
+
+/// The least-squares summary `out` marked as a posterior run that could not sample: status
+/// `failed`, the failure in the note and in [`McmcStats::failure`]; the rows keep the
+/// least-squares values and intervals.
+fn failed(mut out: FitResult, failure: McmcFailure) -> FitResult {
+    out.stats.note = join(&out.stats.note, &failure.to_string());
+    out.stats.converged = false;
+    for row in out.params.iter_mut() {
+        row.note = join(
+            "MCMC did not run: least-squares value and interval",
+            &row.note,
+        );
+    }
+    out.stats.mcmc = Some(McmcStats {
+        status: "failed".into(),
+        failure: Some(failure),
+        ..Default::default()
     });
     out
 }

@@ -15,7 +15,7 @@ pub use crate::inverse::posterior::Draws;
 use crate::inverse::{
     confidence_intervals, Fit, LsqOptions, ProfileEnd, Residuals, SigmaKind, Termination,
 };
-use crate::numfmt::fmt_f64;
+use crate::numfmt::{fmt_f64, fmt_sig};
 
 /// One fitted parameter.
 #[derive(Debug, Clone, PartialEq)]
@@ -115,6 +115,32 @@ pub struct StatsRow {
     pub mcmc: Option<McmcStats>,
 }
 
+/// A fit with σ given whose reduced χ² exceeds this is flagged ([`StatsRow::absurd_misfit`]):
+/// over 30 σ per point on average. The paper's models leave misfits of up to about 40 % of v̄
+/// (§5.3), some 20 σ at the usual 2 % errors (reduced χ² near 400); far beyond that the
+/// velocities or their σ are more likely in the wrong unit than the model wrong.
+pub const ABSURD_REDUCED_CHI2: f64 = 1000.0;
+
+impl StatsRow {
+    /// Why this fit's misfit is implausible for the σ given, if it is: reduced χ² above
+    /// [`ABSURD_REDUCED_CHI2`] with σ given (with unit weights χ² is in the units of v̄ and
+    /// says nothing of units); `None` for a law scored without fitting.
+    pub fn absurd_misfit(&self) -> Option<String> {
+        (self.sigma == SigmaKind::Absolute
+            && self.n_params > 0
+            && self.reduced_chi2.is_finite()
+            && self.reduced_chi2 > ABSURD_REDUCED_CHI2)
+            .then(|| {
+                format!(
+                    "reduced chi2 = {} with sigma given (over {}): are the velocities \
+                     dimensionless, and sigma_v in the same unit as v?",
+                    fmt_sig(self.reduced_chi2, 5),
+                    fmt_f64(ABSURD_REDUCED_CHI2)
+                )
+            })
+    }
+}
+
 /// What a posterior run did (the `method = mcmc` columns of the statistics report).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct McmcStats {
@@ -137,6 +163,52 @@ pub struct McmcStats {
     /// WAIC, its effective number of parameters p_waic and the standard error of WAIC (see
     /// [`super::posterior`]); `None` without draws.
     pub waic: Option<(f64, f64, f64)>,
+    /// Why the run did not sample at all (status `failed`), when it did not.
+    pub failure: Option<McmcFailure>,
+}
+
+/// Why a posterior run could not sample.
+#[derive(Debug, Clone, PartialEq)]
+pub enum McmcFailure {
+    /// A prior whose support does not meet the parameter's feasible box: the posterior is
+    /// zero everywhere. A fault of the prior given, not of the data.
+    PriorOutsideBox {
+        /// The parameter.
+        parameter: String,
+        /// The prior, as given (e.g. `uniform(10,20)`).
+        prior: String,
+        /// The prior's support.
+        support: (f64, f64),
+        /// The parameter's feasible box (where every point has a steady state, cut to the
+        /// parameter's domain).
+        feasible: (f64, f64),
+    },
+    /// The sampler refused to start (no walker with a finite posterior density, a bad
+    /// option, …), with why.
+    NotStarted(String),
+}
+
+impl std::fmt::Display for McmcFailure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            McmcFailure::PriorOutsideBox {
+                parameter,
+                prior,
+                support,
+                feasible,
+            } => write!(
+                f,
+                "the prior {parameter}={prior} has support [{}, {}], which does not meet the \
+                 feasible box [{}, {}] of {parameter} (where every point has a steady state): \
+                 the posterior is zero everywhere; give a prior that overlaps the box",
+                fmt_sig(support.0, 6),
+                fmt_sig(support.1, 6),
+                fmt_sig(feasible.0, 6),
+                fmt_sig(feasible.1, 6),
+            ),
+            McmcFailure::NotStarted(why) => write!(f, "MCMC could not start: {why}"),
+        }
+    }
 }
 
 /// One fit: its parameters with their uncertainties, its statistics, the correlations, every
@@ -346,6 +418,7 @@ fn termination_name(t: Termination) -> &'static str {
         Termination::InfeasibleStart => "infeasible_start",
         Termination::JacobianFailed => "jacobian_failed",
         Termination::Stalled => "stalled_at_feasibility_edge",
+        Termination::Interrupted => "interrupted",
     }
 }
 

@@ -54,6 +54,8 @@
 #![allow(clippy::needless_range_loop)]
 
 use faer::{Mat, MatMut};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use thiserror::Error;
 
 use super::lmpar::{norm2, Subproblem};
@@ -260,7 +262,7 @@ pub enum SigmaKind {
 
 /// Solver settings. `Default` gives tolerances of 10⁻¹², at most 1000 iterations, no restart,
 /// the Gauss–Newton polish, absolute σ and no bounds.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct LsqOptions {
     /// Relative-reduction tolerance: converged when both the actual and the predicted relative
     /// reductions of χ² are at most `ftol` (MINPACK's test). Taken as at least ε.
@@ -290,6 +292,10 @@ pub struct LsqOptions {
     pub sigma: SigmaKind,
     /// Refine a converged point by Gauss–Newton steps (see the module docs).
     pub polish: bool,
+    /// Checked before every iteration and every trial step: once raised, the solver stops
+    /// with [`Termination::Interrupted`] (e.g. from a signal handler). Profiles pass it on to
+    /// their constrained fits.
+    pub stop: Option<Arc<AtomicBool>>,
 }
 
 impl Default for LsqOptions {
@@ -307,6 +313,7 @@ impl Default for LsqOptions {
             restarts: 0,
             sigma: SigmaKind::Absolute,
             polish: true,
+            stop: None,
         }
     }
 }
@@ -335,6 +342,8 @@ pub enum Termination {
     /// small by infeasible trial points — the iteration is stuck against the edge of the
     /// feasible region, where the optimum of the model lies beyond.
     Stalled,
+    /// Not converged: the caller raised [`LsqOptions::stop`].
+    Interrupted,
 }
 
 impl Termination {
@@ -742,9 +751,17 @@ fn lm_run<R: Residuals + ?Sized>(
     // the feasible region speaking, not a minimum.
     let mut edge = false;
 
+    let stopped = || {
+        opts.stop
+            .as_ref()
+            .is_some_and(|s| s.load(Ordering::Relaxed))
+    };
     loop {
         if outer >= opts.max_iterations {
             return done(x, f, fnorm, Termination::MaxIterations, iterations);
+        }
+        if stopped() {
+            return done(x, f, fnorm, Termination::Interrupted, iterations);
         }
         outer += 1;
         if !ev.jacobian(&x, &f, &mut jac) {
@@ -795,6 +812,9 @@ fn lm_run<R: Residuals + ?Sized>(
 
         // Inner loop: until a step is accepted.
         loop {
+            if stopped() {
+                return done(x, f, fnorm, Termination::Interrupted, iterations);
+            }
             par = sp.lm_step(&ipvt, &diag, &qtf, delta, par);
             let mut projected = false;
             for j in 0..n {

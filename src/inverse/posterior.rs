@@ -18,6 +18,8 @@ use crate::progress::Progress;
 use statrs::distribution::{Continuous, LogNormal, Normal, Uniform};
 use std::fmt;
 use std::str::FromStr;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 /// Name of the error-scale parameter.
 pub const SCALE_NAME: &str = "sigma_scale";
@@ -200,9 +202,35 @@ pub enum Method {
     Lsq {
         /// Compute the profile-likelihood intervals.
         profile: bool,
+        /// Raised to stop every solver run of the fit ([`LsqOptions::stop`](super::LsqOptions)).
+        stop: Option<Arc<AtomicBool>>,
     },
-    /// Posterior sampling, started from the least-squares optimum.
+    /// Posterior sampling, started from the least-squares optimum (its stop flag,
+    /// [`McmcOptions::stop`], stops the least-squares start as well).
     Mcmc(Box<McmcSettings>),
+}
+
+impl Method {
+    /// Least squares, with profile-likelihood intervals when `profile`, never stopped.
+    pub fn lsq(profile: bool) -> Self {
+        Method::Lsq {
+            profile,
+            stop: None,
+        }
+    }
+
+    /// The flag that stops the fit's solvers and sampler, if any.
+    pub fn stop(&self) -> Option<&Arc<AtomicBool>> {
+        match self {
+            Method::Lsq { stop, .. } => stop.as_ref(),
+            Method::Mcmc(s) => s.options.stop.as_ref(),
+        }
+    }
+
+    /// True once the stop flag was raised.
+    pub fn stopped(&self) -> bool {
+        self.stop().is_some_and(|s| s.load(Ordering::SeqCst))
+    }
 }
 
 /// Settings of a posterior run.

@@ -337,6 +337,15 @@ impl<R: Residuals + ?Sized> Profiler<'_, R> {
     /// Δχ²(v) − threshold and the other parameters there, warm-started at `warm`; `None` if the
     /// constrained fit failed.
     fn eval(&mut self, v: f64, warm: &[f64]) -> Option<(f64, Vec<f64>)> {
+        // Once the caller's stop flag is up, every point counts as failed, at no cost.
+        if self
+            .opts
+            .stop
+            .as_ref()
+            .is_some_and(|s| s.load(std::sync::atomic::Ordering::Relaxed))
+        {
+            return None;
+        }
         let fixed = Fixed {
             inner: self.problem,
             k: self.index,

@@ -138,6 +138,8 @@ pub struct SceneColumns {
     pub a: [Option<usize>; 3],
     /// `spin`.
     pub spin: Option<usize>,
+    /// The columns of [`SCENE_CELL_COLUMNS`], in its order (checked on every row).
+    pub cells: [Option<usize>; 23],
 }
 
 impl SceneColumns {
@@ -153,6 +155,7 @@ impl SceneColumns {
             mu: reader.col("mu"),
             a: [reader.col("a1"), reader.col("a2"), reader.col("a3")],
             spin: reader.col("spin"),
+            cells: SCENE_CELL_COLUMNS.map(|n| reader.col(n)),
         })
     }
 
@@ -234,8 +237,99 @@ impl SceneColumns {
                 )
             }
         };
+        check_cells(r, SCENE_CELL_COLUMNS.into_iter().zip(self.cells))?;
         Ok((scene, model))
     }
+}
+
+/// The scene columns every `forward` row may carry, whatever the model: each present cell of
+/// them is checked ([`check_scene_cells`]), used by the model or not.
+pub const SCENE_CELL_COLUMNS: [&str; 23] = [
+    "K",
+    "rho",
+    "f",
+    "lambda",
+    "mu",
+    "a1",
+    "a2",
+    "a3",
+    "spin",
+    "row_radius_m",
+    "young_pa",
+    "poisson",
+    "density",
+    "beta",
+    "gamma_n",
+    "gamma_s",
+    "mu_c",
+    "g",
+    "beads",
+    "transient",
+    "blocks",
+    "launch_velocity",
+    "step_fraction",
+];
+
+/// Checks every non-empty cell of the scene columns of [`SCENE_CELL_COLUMNS`] that the row's
+/// table has, as the model that uses it would (K a law name or a number in (0, 1), ρ, f ≥ 0,
+/// λ > 0, μ ≥ 0, a1, a2 ≥ 0, a3 > 0, a spin rule, finite md settings, whole counts): a bad
+/// cell is an error even when the chosen model does not read it. `col` finds a column.
+pub fn check_scene_cells(
+    r: &Row<'_>,
+    col: &dyn Fn(&str) -> Option<usize>,
+) -> Result<(), InputError> {
+    check_cells(r, SCENE_CELL_COLUMNS.into_iter().map(|n| (n, col(n))))
+}
+
+/// [`check_scene_cells`] on the given (column name, column) pairs.
+fn check_cells(
+    r: &Row<'_>,
+    cols: impl Iterator<Item = (&'static str, Option<usize>)>,
+) -> Result<(), InputError> {
+    for (name, c) in cols {
+        let Some(c) = c else { continue };
+        let cell = r.cell(c);
+        if cell.is_empty() {
+            continue;
+        }
+        let bad = |m: &str| Err(r.err(c, m.to_string()));
+        match name {
+            "K" => match cell.parse::<CollisionLaw>() {
+                Err(e) => return Err(r.err(c, e.to_string())),
+                Ok(CollisionLaw::Value(k)) if !k.is_finite() => {
+                    return bad("value must be a finite number")
+                }
+                Ok(CollisionLaw::Value(k)) if !(k > 0.0 && k < 1.0) => {
+                    return bad("collisional parameter must be in (0, 1)")
+                }
+                Ok(_) => {}
+            },
+            "spin" => {
+                if let Err(e) = cell.parse::<SpinRule>() {
+                    return Err(r.err(c, e.to_string()));
+                }
+            }
+            _ => {
+                let x = r.number(c)?;
+                let ok = match name {
+                    "rho" | "f" | "mu" | "a1" | "a2" | "gamma_n" | "gamma_s" | "mu_c" => x >= 0.0,
+                    "lambda" | "a3" | "row_radius_m" | "young_pa" | "density" | "g" => x > 0.0,
+                    "beads" | "transient" | "blocks" => x >= 0.0 && x.fract() == 0.0,
+                    _ => true,
+                };
+                if !ok {
+                    return bad(match name {
+                        "beads" | "transient" | "blocks" => "must be a whole number",
+                        "lambda" | "a3" | "row_radius_m" | "young_pa" | "density" | "g" => {
+                            "must be > 0"
+                        }
+                        _ => "must be >= 0",
+                    });
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 fn field_column(field: &str) -> &str {

@@ -6,6 +6,11 @@
 //! optional `g` (m/s²) and an optional `sigma_v_m_s`, converted with
 //! v = v_m_s / sqrt(g R (1 + ξ)). Optional `series` (rows without one are grouped by ξ),
 //! `rho` and `f` (per-row values of the defaults). A series may not mix ξ values.
+//!
+//! Units are never guessed: `sigma_v_m_s` beside `v`, `sigma_v` beside `v_m_s`, and `v` beside
+//! `v_m_s` with `R_m` are errors. A file can still read fine in the wrong unit (slopes in
+//! radians, m/s in the column `v`, `R_m` in millimetres): [`plausibility`] looks for that with
+//! the physics of the rolling model and returns warnings.
 
 use super::scenes::{Header, Row, Table};
 use super::InputError;
@@ -139,6 +144,27 @@ impl MeasurementColumns {
         if c.v.is_none() && c.v_m_s.is_none() {
             return Err(t.require("v").unwrap_err());
         }
+        let header_error = |c: usize, message: &str| InputError {
+            file: t.source().to_string(),
+            line: Some(1),
+            column: Some(t.headers()[c].clone()),
+            value: None,
+            message: message.into(),
+        };
+        if let (Some(_), Some(cm), Some(_)) = (c.v, c.v_m_s, c.r_m) {
+            return Err(header_error(
+                cm,
+                "both v (dimensionless) and v_m_s with R_m (m/s) are given: keep one velocity \
+                 column, or rename the other",
+            ));
+        }
+        if let (None, Some(_), Some(cs)) = (c.v, c.v_m_s, c.sigma_v) {
+            return Err(header_error(
+                cs,
+                "sigma_v is dimensionless but the velocities are v_m_s (m/s): with SI velocities \
+                 the error column must be sigma_v_m_s (m/s)",
+            ));
+        }
         if let (Some(_), Some(cs)) = (c.v, c.sigma_v_m_s) {
             return Err(InputError {
                 file: t.source().to_string(),
@@ -221,10 +247,9 @@ impl MeasurementColumns {
                     None => g,
                 };
                 let scale = (gg * radius * (1.0 + xi)).sqrt();
-                let s = match (given(self.sigma_v_m_s), given(self.sigma_v)) {
-                    (Some(cs), _) => Some(positive(r, cs, "sigma_v_m_s")? / scale),
-                    (_, Some(cs)) => Some(positive(r, cs, "sigma_v")?),
-                    _ => None,
+                let s = match given(self.sigma_v_m_s) {
+                    Some(cs) => Some(positive(r, cs, "sigma_v_m_s")? / scale),
+                    None => None,
                 };
                 (vms / scale, s)
             }
@@ -394,4 +419,170 @@ impl Dataset {
         .map(|m| m.dataset)
         .unwrap_or_else(|e| unreachable!("the embedded data set is valid: {e}"))
     }
+}
+
+/// A warning about measurements that read fine but look like a unit mistake
+/// ([`plausibility`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Implausible {
+    /// The column in doubt.
+    pub column: String,
+    /// What looks wrong and its likely cause.
+    pub message: String,
+}
+
+impl std::fmt::Display for Implausible {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "column '{}': {}", self.column, self.message)
+    }
+}
+
+/// Slopes are doubted when every one is below this fraction of the stop slope δ_m (eq 32) of
+/// its ξ under the paper's fitted law: no K near the paper's moves a bead there, while the
+/// same numbers read as radians usually fall in the steady range.
+pub const SLOPE_FRACTION: f64 = 0.5;
+
+/// Velocities are doubted when their median ratio to the rolling model at the paper's fitted
+/// law (over the points inside its steady range) is below 1/`VELOCITY_FACTOR` or above
+/// `VELOCITY_FACTOR`. The paper's models agree with measurements within about 40 % (§5.3), and
+/// the factor sqrt(g (R + r)) between m/s and the dimensionless unit is below 0.5 for every
+/// bead row with R + r < 2.5 cm.
+pub const VELOCITY_FACTOR: f64 = 2.0;
+
+/// Row-bead radii above this (metres) are doubted: beads over 20 cm across; the experiments
+/// the paper discusses use millimetre beads (Ristow's R = 2.5 mm).
+pub const MAX_ROW_RADIUS_M: f64 = 0.1;
+
+/// Looks for unit mistakes in measurements read from `t`: slopes in radians, velocities in
+/// m/s in the dimensionless column, row-bead radii in millimetres. The thresholds come from
+/// the rolling model with the paper's fitted law K = cos 2α + ½ sin²α sin 2α
+/// ([`SLOPE_FRACTION`], [`VELOCITY_FACTOR`], [`MAX_ROW_RADIUS_M`]). Nothing is refused: the
+/// caller shows the warnings.
+pub fn plausibility(t: &Table, rows: &[Measurement]) -> Vec<Implausible> {
+    use crate::models::regimes::{delta_d_law, delta_m_law};
+    use crate::models::ForwardModel;
+    let mut out = Vec::new();
+    if rows.is_empty() {
+        return out;
+    }
+    let law = CollisionLaw::Adjusted;
+    let limits: Vec<(f64, f64)> = rows
+        .iter()
+        .map(|r| {
+            let (a, rho) = (r.scene.alpha_rad(), r.scene.rho());
+            (
+                delta_m_law(a, law, rho).to_degrees(),
+                delta_d_law(a, law, rho).to_degrees(),
+            )
+        })
+        .collect();
+    // Slopes: every one far below the stop slope of its ξ.
+    let low = rows
+        .iter()
+        .zip(&limits)
+        .all(|(r, (dm, _))| r.scene.delta_deg() < SLOPE_FRACTION * dm);
+    if low {
+        let (i, r) = rows
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.scene.delta_deg().total_cmp(&b.1.scene.delta_deg()))
+            .unwrap_or((0, &rows[0]));
+        let d = r.scene.delta_deg();
+        let as_rad = rows
+            .iter()
+            .all(|r| r.scene.delta_deg() < std::f64::consts::FRAC_PI_2);
+        let mut message = format!(
+            "every delta_deg is below {} of the stop slope delta_m of its xi at the paper's K \
+             (the largest, {} on line {}, against delta_m = {} deg at xi = {}): no steady \
+             motion there",
+            fmt_f64(SLOPE_FRACTION),
+            crate::numfmt::fmt_sig(d, 4),
+            t.lines[i],
+            crate::numfmt::fmt_sig(limits[i].0, 4),
+            fmt_f64(r.scene.xi()),
+        );
+        if as_rad {
+            message.push_str(&format!(
+                "; are these radians? ({} rad = {} deg)",
+                crate::numfmt::fmt_sig(d, 4),
+                crate::numfmt::fmt_sig(d.to_degrees(), 4)
+            ));
+        }
+        out.push(Implausible {
+            column: "delta_deg".into(),
+            message,
+        });
+        // The velocities cannot be judged against a model in which nothing moves.
+        return out;
+    }
+    // Velocities: against the rolling model at the paper's K, in its steady range.
+    let mut ratios: Vec<f64> = rows
+        .iter()
+        .zip(&limits)
+        .filter(|(r, (dm, dd))| r.scene.delta_deg() > *dm && r.scene.delta_deg() < *dd)
+        .filter_map(|(r, _)| {
+            let s = r.scene;
+            let sc = Scene::new(s.xi(), s.delta_deg(), s.rho(), s.f(), law).ok()?;
+            let v = crate::models::Model::Stick
+                .evaluate(&sc)
+                .ok()?
+                .mean_velocity;
+            (v > 0.0).then(|| r.v / v)
+        })
+        .collect();
+    if !ratios.is_empty() {
+        ratios.sort_by(|a, b| a.total_cmp(b));
+        let med = ratios[ratios.len() / 2];
+        let dimensional = t.col("v").is_none();
+        let what = format!(
+            "the velocities are on median {} times the rolling model's at the paper's K (over \
+             the {} point(s) in its steady range)",
+            crate::numfmt::fmt_sig(med, 3),
+            ratios.len()
+        );
+        let cause = match (dimensional, med < 1.0) {
+            (false, true) => Some(
+                "are these m/s? The column v is dimensionless (units sqrt(g (R + r))): give \
+                 v_m_s and R_m instead",
+            ),
+            (false, false) => Some("are these cm/s, or in another unit than sqrt(g (R + r))?"),
+            (true, true) => Some("is R_m in millimetres? It must be in metres"),
+            (true, false) => Some("is R_m too small (in km?) or v_m_s in cm/s or mm/s?"),
+        };
+        if !(1.0 / VELOCITY_FACTOR..=VELOCITY_FACTOR).contains(&med) {
+            out.push(Implausible {
+                column: if dimensional { "v_m_s" } else { "v" }.into(),
+                message: format!("{what}; {}", cause.unwrap_or_default()),
+            });
+        }
+    }
+    // Row-bead radii.
+    if let Some(c) = t.col("R_m") {
+        let big = (0..t.rows.len())
+            .filter_map(|r| t.cell(r, c).parse::<f64>().ok().map(|x| (r, x)))
+            .filter(|(_, x)| *x > MAX_ROW_RADIUS_M)
+            .max_by(|a, b| a.1.total_cmp(&b.1));
+        if let Some((r, x)) = big {
+            out.push(Implausible {
+                column: "R_m".into(),
+                message: format!(
+                    "R_m = {} m on line {}: row beads over {} m across; are these millimetres? \
+                     R_m is in metres ({} mm = {} m)",
+                    fmt_f64(x),
+                    t.lines[r],
+                    fmt_f64(2.0 * MAX_ROW_RADIUS_M),
+                    fmt_f64(x),
+                    fmt_f64(x / 1000.0),
+                ),
+            });
+        }
+    }
+    // Both velocity columns without R_m: the dimensionless one is used.
+    if let (Some(_), Some(_), None) = (t.col("v"), t.col("v_m_s"), t.col("R_m")) {
+        out.push(Implausible {
+            column: "v_m_s".into(),
+            message: "ignored: the dimensionless column v is used (v_m_s would need R_m)".into(),
+        });
+    }
+    out
 }

@@ -1,7 +1,9 @@
-//! Files: CSV reading with errors that name file, line, column and value; atomic writing;
+//! Files: CSV reading with errors that name file, line, column and value; atomic writing
+//! ([`AtomicFile`], [`write_atomic_all`]: whole files or none, modes kept, links followed);
 //! tables streamed through a per-row computation in bounded memory ([`stream`]), with the
 //! row plans of `fitbead forward` ([`forward`]) and `fitbead k` ([`kstream`]).
 
+mod atomic;
 pub mod cells;
 pub mod forward;
 pub mod kstream;
@@ -10,11 +12,11 @@ pub mod reports;
 pub mod scenes;
 pub mod stream;
 
-pub use crate::numfmt::{fmt_f64, fmt_sig, push_f64};
+pub use atomic::{same_file, write_atomic, write_atomic_all, write_atomic_all_then, AtomicFile};
+
+pub use crate::numfmt::{clip, fmt_f64, fmt_sig, push_f64, ECHO_CHARS};
 
 use std::fmt;
-use std::io::Write;
-use std::path::{Path, PathBuf};
 
 /// An input error located in a file.
 #[derive(Debug, Clone, PartialEq)]
@@ -61,104 +63,30 @@ impl InputError {
     }
 }
 
+/// Longest message shown by [`InputError`]'s `Display`, in characters: a message that quotes
+/// a huge cell is cut (the value itself is cut at [`ECHO_CHARS`]).
+pub const MESSAGE_CHARS: usize = 1000;
+
 impl fmt::Display for InputError {
+    /// `file, line L, column 'C', value 'V': message`, with the file name, the column name and
+    /// the value each cut at [`ECHO_CHARS`] characters and the message at [`MESSAGE_CHARS`]
+    /// ([`clip`]).
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}", self.file)?;
+        write!(f, "{}", clip(&self.file, 4 * ECHO_CHARS))?;
         if let Some(l) = self.line {
             write!(f, ", line {l}")?;
         }
         if let Some(c) = &self.column {
-            write!(f, ", column '{c}'")?;
+            write!(f, ", column '{}'", clip(c, ECHO_CHARS))?;
         }
         if let Some(v) = &self.value {
-            write!(f, ", value '{v}'")?;
+            write!(f, ", value '{}'", clip(v, ECHO_CHARS))?;
         }
-        write!(f, ": {}", self.message)
+        write!(f, ": {}", clip(&self.message, MESSAGE_CHARS))
     }
 }
 
 impl std::error::Error for InputError {}
-
-/// Writes `bytes` to `path` atomically: a temporary file in the same directory, flushed and
-/// synced, then renamed over the target. On any error the target is untouched.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    write_atomic_all(&[(path, bytes)])
-}
-
-/// Writes several files atomically as a group: every temporary file is written and synced
-/// first, and only then are they renamed into place — a failure while writing (missing
-/// directory, full disk) leaves every target untouched.
-pub fn write_atomic_all(files: &[(&Path, &[u8])]) -> std::io::Result<()> {
-    let mut staged = Vec::with_capacity(files.len());
-    for (path, bytes) in files {
-        let mut tmp = AtomicFile::create(path)?;
-        tmp.write_all(bytes)?;
-        tmp.sync()?;
-        staged.push(tmp);
-    }
-    for tmp in staged {
-        tmp.persist()?;
-    }
-    Ok(())
-}
-
-/// A file written under a temporary name in the target's directory and renamed over the
-/// target only by [`AtomicFile::commit`]; dropped uncommitted, the temporary file is removed
-/// and the target is untouched.
-pub struct AtomicFile {
-    tmp: tempfile::NamedTempFile,
-    path: PathBuf,
-}
-
-impl AtomicFile {
-    /// Creates the temporary file next to `path`.
-    pub fn create(path: &Path) -> std::io::Result<AtomicFile> {
-        let dir: PathBuf = match path.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
-        let tmp = tempfile::Builder::new()
-            .prefix(".fitbead-")
-            .suffix(".tmp")
-            .tempfile_in(&dir)
-            .map_err(|e| std::io::Error::new(e.kind(), format!("{}: {e}", path.display())))?;
-        Ok(AtomicFile {
-            tmp,
-            path: path.to_path_buf(),
-        })
-    }
-
-    /// Flushes the data to disk and renames the file over its target.
-    pub fn commit(self) -> std::io::Result<()> {
-        self.sync()?;
-        self.persist()
-    }
-
-    fn sync(&self) -> std::io::Result<()> {
-        self.tmp.as_file().sync_all()
-    }
-
-    fn persist(self) -> std::io::Result<()> {
-        let path = self.path;
-        self.tmp.persist(&path).map(|_| ()).map_err(|e| {
-            std::io::Error::new(e.error.kind(), format!("{}: {}", path.display(), e.error))
-        })
-    }
-}
-
-impl Write for AtomicFile {
-    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        self.tmp.write(buf)
-    }
-
-    fn write_all(&mut self, buf: &[u8]) -> std::io::Result<()> {
-        self.tmp.write_all(buf)
-    }
-
-    fn flush(&mut self) -> std::io::Result<()> {
-        self.tmp.flush()
-    }
-}
 
 /// Appends one CSV field to `out` as the `csv` crate's default writer does: quoted (with
 /// quotes doubled) when it holds a comma, a quote, a carriage return or a newline.

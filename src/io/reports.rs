@@ -223,7 +223,9 @@ pub fn stats_csv(rows: &[StatsRow]) -> csv::Result<Vec<u8>> {
 }
 
 /// The draws of every posterior as one CSV: fit, series, walker, step, the union of the
-/// parameter columns (empty where a fit has no such parameter), log_posterior.
+/// parameter columns (empty where a fit has no such parameter), log_posterior; when a run was
+/// interrupted, a last column `status` on every row (`interrupted`, or `complete` for a fit
+/// that finished before the signal).
 pub fn draws_csv(posteriors: &[&FitResult]) -> csv::Result<Vec<u8>> {
     let mut columns: Vec<String> = Vec::new();
     for p in posteriors {
@@ -241,6 +243,13 @@ pub fn draws_csv(posteriors: &[&FitResult]) -> csv::Result<Vec<u8>> {
         .collect();
     header.extend(columns.iter().cloned());
     header.push("log_posterior".into());
+    // An interrupted run marks every row of its draws.
+    let interrupted = posteriors
+        .iter()
+        .any(|p| p.draws.as_ref().is_some_and(|d| d.interrupted));
+    if interrupted {
+        header.push("status".into());
+    }
     w.write_record(&header)?;
     for p in posteriors {
         let Some(d) = &p.draws else { continue };
@@ -262,7 +271,15 @@ pub fn draws_csv(posteriors: &[&FitResult]) -> csv::Result<Vec<u8>> {
                 for (j, v) in x.iter().enumerate() {
                     rec[4 + idx[j]] = fmt_f64(*v);
                 }
-                rec[header.len() - 1] = fmt_f64(d.log_posterior[wk][k]);
+                let lp = header.len() - 1 - usize::from(interrupted);
+                rec[lp] = fmt_f64(d.log_posterior[wk][k]);
+                if interrupted {
+                    rec[lp + 1] = if d.interrupted {
+                        "interrupted".into()
+                    } else {
+                        "complete".into()
+                    };
+                }
                 w.write_record(&rec)?;
             }
         }

@@ -56,14 +56,19 @@ impl FromStr for SpinRule {
     type Err = Error;
     fn from_str(s: &str) -> Result<Self> {
         let t = s.trim();
-        match t {
+        let lower = t.to_ascii_lowercase();
+        match lower.as_str() {
             "roll" => Ok(SpinRule::Roll),
             "keep" => Ok(SpinRule::Keep),
             "impact" => Ok(SpinRule::Impact),
-            _ => match t.strip_prefix("factor=").map(|v| v.trim().parse::<f64>()) {
+            _ => match lower
+                .strip_prefix("factor=")
+                .map(|v| v.trim().parse::<f64>())
+            {
                 Some(Ok(l)) if l.is_finite() => Ok(SpinRule::Factor(l)),
                 _ => Err(Error::UnknownLaw(format!(
-                    "spin rule '{t}' (expected roll, keep, impact or factor=L)"
+                    "spin rule '{}' (expected roll, keep, impact or factor=L)",
+                    crate::numfmt::clip(t, crate::numfmt::ECHO_CHARS)
                 ))),
             },
         }

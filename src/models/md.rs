@@ -47,6 +47,7 @@ use super::{NotSteady, Outcome, Phases, Regime, Steady};
 use crate::scene::{CollisionLaw, Scene};
 use crate::scene::{ParameterError as Error, ParameterResult as Result};
 use std::f64::consts::PI;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// How the reduced mass m_eff of eq 92 is formed for a contact with a (fixed) row bead.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -365,7 +366,23 @@ pub enum MdFailure {
     TimeLimit,
     /// The scene is outside the model's domain (ρ = 0: no moment of inertia).
     NoInertia,
+    /// The scene or the parameters are outside the model's domain ([`Md::check_scene`]): the
+    /// time step would collapse.
+    OutsideDomain,
+    /// The caller's stop flag was raised.
+    Interrupted,
 }
+
+/// Smallest gyration parameter ρ the md model accepts. A bead's moment of inertia is ρ m r²
+/// with ρ = 2/5 for a homogeneous sphere, 1/2 for a cylinder, 2/3 for a thin shell; ρ → 0 is
+/// a point mass, whose spin relaxes at the rate γ_s (1 + 1/ρ) and would need an ever smaller
+/// time step.
+pub const MIN_RHO: f64 = 0.01;
+
+/// Largest factor by which the damping rates may shrink the time step below the contact-time
+/// step (`step_fraction` × contact time): beyond it the run's cost grows without bound as
+/// ρ → 0 or γ → ∞, and the scene is refused ([`Md::check_scene`]).
+pub const MAX_STEP_SHRINK: f64 = 100.0;
 
 /// Everything one simulation measures. Velocities in units sqrt(g (R+r)), lengths in units
 /// R + r unless named otherwise, times in sqrt((R+r)/g); dissipation as fractions of the
@@ -488,10 +505,14 @@ impl Nd {
         let omega_static = (p.beta / static_overlap).sqrt();
         let tc = tc_impact.min(PI / omega_static);
         let rate = gn.max(gs * (1.0 + 1.0 / rho));
-        let mut dt = c.step_fraction * tc;
+        let dt_contact = c.step_fraction * tc;
+        let mut dt = dt_contact;
         if rate > 0.0 {
             dt = dt.min(0.1 / rate);
         }
+        // The damping may shrink the step by MAX_STEP_SHRINK at most (Md::check_scene refuses
+        // the rest): the step never collapses.
+        dt = dt.max(dt_contact / MAX_STEP_SHRINK);
         Nd {
             s: 2.0 * scene.sin_alpha,
             rhat,
@@ -606,14 +627,77 @@ impl Md {
         self.config.validate()
     }
 
+    /// Checks that `scene` is inside the model's domain with these parameters: ρ ≥
+    /// [`MIN_RHO`], and damping rates that shrink the time step by at most
+    /// [`MAX_STEP_SHRINK`] below the contact-time step (the normal rate γ_n m_eff/m and the
+    /// spin relaxation rate γ_s m_eff/m (1 + 1/ρ), in units sqrt(g/(R+r)), each times the
+    /// step, at most 0.1). The error names the field to change.
+    pub fn check_scene(&self, scene: &Scene) -> Result<()> {
+        let rho = scene.rho;
+        if !(rho >= MIN_RHO) {
+            return Err(Error::InvalidParameter {
+                field: "rho",
+                value: rho.to_string(),
+                reason: "md needs rho >= 0.01 (a bead's moment of inertia rho m r^2: 0.4 for a \
+                         sphere, 0.5 for a cylinder; as rho -> 0 the spin's relaxation needs an \
+                         ever smaller time step)",
+            });
+        }
+        let p = &self.params;
+        let xi = scene.xi;
+        let tu = p.time_unit(xi);
+        let mu = p.reduced_mass_ratio(xi);
+        let (gn, gs) = (p.gamma_n * tu * mu, p.gamma_s * tu * mu);
+        let nd = Nd::new(p, &self.config, scene, 1.0);
+        let dt_contact = self.config.step_fraction * nd.tc;
+        if !(dt_contact > 0.0 && dt_contact.is_finite()) {
+            return Err(invalid(
+                "young_pa",
+                p.young,
+                "md: the contact time is not a positive number at these parameters",
+            ));
+        }
+        if gn * dt_contact > 0.1 * MAX_STEP_SHRINK {
+            return Err(invalid(
+                "gamma_n",
+                p.gamma_n,
+                "md: the normal damping is so fast that it needs a time step over 100 times \
+                 smaller than the contact time's: lower gamma_n",
+            ));
+        }
+        if gs * (1.0 + 1.0 / rho) * dt_contact > 0.1 * MAX_STEP_SHRINK {
+            return Err(invalid(
+                "gamma_s",
+                p.gamma_s,
+                "md: the spin relaxation rate gamma_s (1 + 1/rho) is so fast that it needs a \
+                 time step over 100 times smaller than the contact time's: lower gamma_s or \
+                 raise rho",
+            ));
+        }
+        Ok(())
+    }
+
     /// Simulates one scene (ξ, δ, ρ; K and f of the scene are not used). `dt_scale`
     /// multiplies the automatic step (1 normally; ½ for the step check). `progress` is called
-    /// with 1 each time the bead passes a row bead.
+    /// with 1 each time the bead passes a row bead. A scene outside the domain of
+    /// [`Md::check_scene`] fails at once ([`MdFailure::OutsideDomain`]).
     pub fn simulate(
         &self,
         scene: &Scene,
         dt_scale: f64,
         progress: Option<&(dyn Fn(u64) + Sync)>,
+    ) -> MdResult {
+        self.simulate_until(scene, dt_scale, progress, None)
+    }
+
+    /// As [`Md::simulate`], stopping early ([`MdFailure::Interrupted`]) once `stop` is
+    /// raised; the flag is polled every few thousand steps (well under a millisecond apart).
+    pub fn simulate_until(
+        &self,
+        scene: &Scene,
+        dt_scale: f64,
+        progress: Option<&(dyn Fn(u64) + Sync)>,
+        stop: Option<&AtomicBool>,
     ) -> MdResult {
         let nd = Nd::new(&self.params, &self.config, scene, dt_scale);
         let mut res = MdResult {
@@ -651,7 +735,11 @@ impl Md {
             res.failure = Some(MdFailure::NoInertia);
             return res;
         }
-        run(&nd, &self.config, scene, &mut res, progress);
+        if self.check_scene(scene).is_err() {
+            res.failure = Some(MdFailure::OutsideDomain);
+            return res;
+        }
+        run(&nd, &self.config, scene, &mut res, progress, stop);
         if let Some(v) = res.mean_velocity {
             res.mean_velocity_si = Some(v * self.params.velocity_unit(scene.xi));
         }
@@ -682,6 +770,13 @@ impl Md {
             }),
             (_, Some(MdFailure::TimeLimit)) => Err(NotSteady::Invalid {
                 reason: "md: time limit reached before the run's length",
+            }),
+            (_, Some(MdFailure::OutsideDomain)) => Err(NotSteady::Invalid {
+                reason: "md: outside the model's domain (rho >= 0.01; damping rates that keep \
+                         the time step within 100 times the contact time's)",
+            }),
+            (_, Some(MdFailure::Interrupted)) => Err(NotSteady::Invalid {
+                reason: "md: interrupted",
             }),
             (Some(Regime::A), _) => Err(NotSteady::Stops {
                 angle: r.stop.map(|s| s.angle).unwrap_or(scene.theta_0),
@@ -737,12 +832,16 @@ fn energy(nd: &Nd, xabs: f64, y: f64, vx: f64, vy: f64, w: f64, u_el: f64) -> f6
         + u_el
 }
 
+/// Steps between two looks at the stop flag.
+const STOP_POLL: u64 = 4096;
+
 fn run(
     nd: &Nd,
     c: &MdRunConfig,
     scene: &Scene,
     res: &mut MdResult,
     progress: Option<&(dyn Fn(u64) + Sync)>,
+    stop: Option<&AtomicBool>,
 ) {
     let s = nd.s;
     let dt = nd.dt;
@@ -957,6 +1056,10 @@ fn run(
             res.failure = Some(MdFailure::TimeLimit);
             break;
         }
+        if res.steps.is_multiple_of(STOP_POLL) && stop.is_some_and(|f| f.load(Ordering::Relaxed)) {
+            res.failure = Some(MdFailure::Interrupted);
+            break;
+        }
     }
     res.time = t;
     res.energy_error = if d_n + d_t > 0.0 {
@@ -1048,11 +1151,24 @@ pub fn regime_b_interval(
     rho: f64,
     tick: &(dyn Fn() + Sync),
 ) -> std::result::Result<Option<(f64, f64)>, Error> {
+    regime_b_interval_until(md, xi, rho, tick, None)
+}
+
+/// As [`regime_b_interval`], its runs stopped early once `stop` is raised (the result is then
+/// meaningless: the caller checks the flag).
+pub fn regime_b_interval_until(
+    md: &Md,
+    xi: f64,
+    rho: f64,
+    tick: &(dyn Fn() + Sync),
+    stop: Option<&AtomicBool>,
+) -> std::result::Result<Option<(f64, f64)>, Error> {
     use crate::models::Regime;
     use rayon::prelude::*;
     let is_b = |d: f64| -> std::result::Result<bool, Error> {
         let sc = Scene::new(xi, d, rho, 0.1, CollisionLaw::Value(0.5))?;
-        let r = md.simulate(&sc, 1.0, None);
+        md.check_scene(&sc)?;
+        let r = md.simulate_until(&sc, 1.0, None, stop);
         tick();
         Ok(r.regime == Some(Regime::B))
     };

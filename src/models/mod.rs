@@ -341,8 +341,9 @@ impl ModelKind {
 
 impl FromStr for ModelKind {
     type Err = Error;
+    /// A model by its whole name, in any case.
     fn from_str(s: &str) -> Result<Self> {
-        Ok(match s {
+        Ok(match s.trim().to_ascii_lowercase().as_str() {
             "stick" => ModelKind::Stick,
             "stick-approx" => ModelKind::StickApprox,
             "slip" => ModelKind::Slip,

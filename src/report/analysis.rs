@@ -98,11 +98,13 @@ fn chi2_at(problem: &KLawProblem<'_>, p: &[f64], m: usize) -> (f64, usize) {
 /// Fits every model to `data` by `method` at `level`.
 pub fn analyse(data: &Dataset, level: f64, method: &Method) -> Analysis {
     let mut contact = Vec::new();
+    // Once the stop flag is up, the per-point work is skipped (each fit then ends at once):
+    // the caller, who raised it, does not use a stopped analysis beyond its posteriors.
     for (model, name) in CONTACT {
         let keep: Vec<bool> = data
             .points
             .par_iter()
-            .map(|p| bracket(&model, &p.scene).is_ok())
+            .map(|p| !method.stopped() && bracket(&model, &p.scene).is_ok())
             .collect();
         let (sub, used) = data.filter(|i| keep[i]);
         let mut notes = Vec::new();
@@ -123,10 +125,11 @@ pub fn analyse(data: &Dataset, level: f64, method: &Method) -> Analysis {
         let law_c = fit(KLaw::C);
         let free = fit(KLaw::FreePerSeries);
         let m = sub.points.len();
-        let cos2a_chi2 = KLawProblem::new(model, &sub, KLaw::C)
+        let stop = method.stop().cloned();
+        let cos2a_chi2 = KLawProblem::new_until(model, &sub, KLaw::C, stop.clone())
             .map(|p| chi2_at(&p, &[0.0], m))
             .unwrap_or((f64::INFINITY, m));
-        let impact_chi2 = KLawProblem::new(model, &sub, KLaw::Impact)
+        let impact_chi2 = KLawProblem::new_until(model, &sub, KLaw::Impact, stop)
             .map(|p| chi2_at(&p, &[], m))
             .unwrap_or((f64::INFINITY, m));
         let energy = match &law_c {
@@ -135,6 +138,9 @@ pub fn analyse(data: &Dataset, level: f64, method: &Method) -> Analysis {
                 .par_iter()
                 .zip(&f.k)
                 .map(|(p, &k)| {
+                    if method.stopped() {
+                        return None;
+                    }
                     let sc = p.scene.with_k(k).ok()?;
                     let st = model.evaluate(&sc).ok()?;
                     match model {

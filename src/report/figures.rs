@@ -141,7 +141,11 @@ impl CornerBlock {
                     .first()
                     .is_some_and(|v| !v.is_empty())
                     .then(|| CornerBlock {
-                        title: format!("{} [{}]", p.stats.fit, p.stats.series),
+                        title: if d.interrupted {
+                            format!("{} [{}] (interrupted)", p.stats.fit, p.stats.series)
+                        } else {
+                            format!("{} [{}]", p.stats.fit, p.stats.series)
+                        },
                         names: p.params.iter().map(|r| draws_column(p, r)).collect(),
                         draws,
                     })

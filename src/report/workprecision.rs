@@ -11,11 +11,13 @@ use crate::models::contact::{Contact, PhaseKind, SpinRule};
 use crate::models::regimes::{alpha_of_xi, delta_d, k_at_delta_d, k_at_delta_m};
 use crate::models::slip::SlipPhase;
 use crate::models::{slip, stick, stickquad, stickslip, Model, Outcome, Phases};
+use crate::progress::Interrupted;
 use crate::scene::{CollisionLaw, Scene};
 use crate::special::quad::{integrate, QuadOptions};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::hint::black_box;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 /// The contract columns of the CSV.
@@ -472,7 +474,30 @@ pub struct BenchResult {
 
 /// Runs the whole bench on `scenes` (single thread).
 pub fn run_bench(scenes: &[(Scene, Draw)]) -> BenchResult {
-    let refs: Vec<References> = scenes.iter().map(|(s, _)| References::of(s)).collect();
+    match run_bench_until(scenes, &AtomicBool::new(false)) {
+        Ok(r) => r,
+        Err(Interrupted) => unreachable!("the stop flag is never raised"),
+    }
+}
+
+/// As [`run_bench`], stopping with [`Interrupted`] once `stop` is raised (polled before every
+/// scene of every variant: a few milliseconds apart at most).
+pub fn run_bench_until(
+    scenes: &[(Scene, Draw)],
+    stop: &AtomicBool,
+) -> Result<BenchResult, Interrupted> {
+    let check = || {
+        if stop.load(Ordering::Relaxed) {
+            Err(Interrupted)
+        } else {
+            Ok(())
+        }
+    };
+    let mut refs: Vec<References> = Vec::with_capacity(scenes.len());
+    for (s, _) in scenes {
+        check()?;
+        refs.push(References::of(s));
+    }
     let mut rows = Vec::new();
     // Cross-checks of the references.
     let mut xs: Vec<(&str, &str, Vec<f64>)> = vec![
@@ -517,6 +542,7 @@ pub fn run_bench(scenes: &[(Scene, Draw)]) -> BenchResult {
         let mut errs_c = Vec::new();
         let mut ns = Vec::new();
         for ((s, _), r) in scenes.iter().zip(&refs) {
+            check()?;
             let t0 = Instant::now();
             let o = (var.eval)(s);
             let first = t0.elapsed();
@@ -566,6 +592,7 @@ pub fn run_bench(scenes: &[(Scene, Draw)]) -> BenchResult {
     }
     let mut mix = (0, 0, 0);
     for (s, _) in scenes {
+        check()?;
         match (Auto { tol: 1e-10 }).choose(s).choice {
             crate::models::auto::Choice::Stick => mix.0 += 1,
             crate::models::auto::Choice::StickSlip => mix.1 += 1,
@@ -622,6 +649,7 @@ pub fn run_bench(scenes: &[(Scene, Draw)]) -> BenchResult {
         let mut ns = Vec::new();
         let by_estimate = method.starts_with("estimate");
         for ((s, _), r) in scenes.iter().take(nk).zip(&refs) {
+            check()?;
             let which = match model {
                 Model::Stick | Model::StickApprox => Ref::Stick,
                 Model::Slip | Model::SlipApprox => Ref::Slip,
@@ -645,11 +673,11 @@ pub fn run_bench(scenes: &[(Scene, Draw)]) -> BenchResult {
         }
         rows.push(row(name, method, *tol, errs, Some(ns)));
     }
-    BenchResult {
+    Ok(BenchResult {
         rows,
         cheapest,
         auto_mix: mix,
-    }
+    })
 }
 
 /// The CSV of the rows.

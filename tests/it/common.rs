@@ -5,9 +5,14 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-/// A command that runs the fitbead binary cargo built for these tests.
+/// A command that runs the fitbead binary cargo built for these tests, or the one named by
+/// the environment variable `FITBEAD_BIN` (to run the tests against another build, e.g. to
+/// check that a regression test fails on the code before its fix).
 pub fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_fitbead"))
+    match std::env::var_os("FITBEAD_BIN") {
+        Some(p) => Command::new(p),
+        None => Command::new(env!("CARGO_BIN_EXE_fitbead")),
+    }
 }
 
 /// The stdout of a run that must have succeeded; panics with its stderr otherwise.

@@ -8,6 +8,7 @@ mod bench_cli;
 mod cli;
 mod cli_mcmc;
 mod contact;
+mod faults;
 mod figures;
 mod fits;
 mod k_inversion;

@@ -100,6 +100,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let input = a.input.as_deref().or(a.data.as_deref());
     let (source, input, size) = open_input(input)?;
     let reader = TableReader::new(&source, input)?;
+    let ledger = KLedger::checking(&reader);
     // Checked here, reported after the table's own errors (as when it was read whole).
     let defaults = super::measurement_defaults(a.rho, a.f, a.g);
     let settings = KSettings {
@@ -123,10 +124,13 @@ pub fn run(a: Args) -> Result<(), CliError> {
     stream_to(
         reader,
         make,
-        KLedger::default(),
+        ledger,
         a.output.as_deref(),
         &opts,
         |ledger| {
+            for w in ledger.warnings() {
+                eprintln!("fitbead: warning: {source}: {w}");
+            }
             let Some((p, file)) = plot else {
                 return Ok(());
             };

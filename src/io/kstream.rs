@@ -6,7 +6,9 @@
 //! other columns (trimmed; a name clashing with an output column renamed `in_NAME`).
 
 use super::cells::Cells;
-use super::measurements::{Measured, MeasurementColumns, MeasurementDefaults, SeriesLedger};
+use super::measurements::{
+    Implausible, Measured, MeasurementColumns, MeasurementDefaults, Plausibility, SeriesLedger,
+};
 use super::scenes::{Header, Row};
 use super::stream::RowPlan;
 use super::InputError;
@@ -72,6 +74,7 @@ pub struct KSettings {
 #[derive(Debug, Clone, Default)]
 pub struct KLedger {
     series: SeriesLedger,
+    plausibility: Option<Plausibility>,
     labels: HashMap<String, usize>,
     plot: Vec<PointSeries>,
 }
@@ -112,7 +115,7 @@ impl KScratch {
 /// on the plot.
 #[derive(Debug, Clone, Copy)]
 pub struct KNote {
-    xi: f64,
+    measured: Measured,
     plot: Option<PlotNote>,
 }
 
@@ -124,6 +127,24 @@ pub struct PlotNote {
 }
 
 impl KLedger {
+    /// A ledger that also looks for unit mistakes ([`Plausibility`]) in a table with
+    /// `header`.
+    pub fn checking(header: &impl Header) -> Self {
+        KLedger {
+            plausibility: Some(Plausibility::new(header)),
+            ..KLedger::default()
+        }
+    }
+
+    /// The unit-mistake warnings of the rows so far (none unless made by
+    /// [`KLedger::checking`]).
+    pub fn warnings(&self) -> Vec<Implausible> {
+        self.plausibility
+            .as_ref()
+            .map(Plausibility::warnings)
+            .unwrap_or_default()
+    }
+
     /// K against the steady final velocity, one colour per series (series label, or ξ where
     /// there is none), with each series' K = cos 2α line (the paper's Fig. 5), as SVG.
     pub fn plot_svg(&self, model_name: &str) -> Result<String, String> {
@@ -315,11 +336,15 @@ impl RowPlan for KPlan {
             }),
             _ => None,
         };
-        KNote { xi: s.xi(), plot }
+        KNote { measured: m, plot }
     }
 
     fn record(&self, ledger: &mut KLedger, row: &Row<'_>, note: KNote) -> Result<(), InputError> {
-        self.cols.check_series(&mut ledger.series, row, note.xi)?;
+        self.cols
+            .check_series(&mut ledger.series, row, note.measured.scene.xi())?;
+        if let Some(p) = &mut ledger.plausibility {
+            p.add(row, &note.measured);
+        }
         let Some(n) = note.plot else { return Ok(()) };
         let series = self.cols.series(row);
         let label = if series.is_empty() {

@@ -453,136 +453,193 @@ pub const VELOCITY_FACTOR: f64 = 2.0;
 /// the paper discusses use millimetre beads (Ristow's R = 2.5 mm).
 pub const MAX_ROW_RADIUS_M: f64 = 0.1;
 
+/// Velocity ratios kept by a [`Plausibility`] at most (the first ones in file order): the
+/// median of 100,000 ratios is as telling as that of millions, and memory stays bounded on
+/// streamed files.
+pub const MAX_RATIOS: usize = 100_000;
+
 /// Looks for unit mistakes in measurements read from `t`: slopes in radians, velocities in
 /// m/s in the dimensionless column, row-bead radii in millimetres. The thresholds come from
 /// the rolling model with the paper's fitted law K = cos 2α + ½ sin²α sin 2α
 /// ([`SLOPE_FRACTION`], [`VELOCITY_FACTOR`], [`MAX_ROW_RADIUS_M`]). Nothing is refused: the
-/// caller shows the warnings.
+/// caller shows the warnings. A table streamed row by row gets the same checks from a
+/// [`Plausibility`].
 pub fn plausibility(t: &Table, rows: &[Measurement]) -> Vec<Implausible> {
-    use crate::models::regimes::{delta_d_law, delta_m_law};
-    use crate::models::ForwardModel;
-    let mut out = Vec::new();
-    if rows.is_empty() {
-        return out;
-    }
-    let law = CollisionLaw::Adjusted;
-    let limits: Vec<(f64, f64)> = rows
-        .iter()
-        .map(|r| {
-            let (a, rho) = (r.scene.alpha_rad(), r.scene.rho());
-            (
-                delta_m_law(a, law, rho).to_degrees(),
-                delta_d_law(a, law, rho).to_degrees(),
-            )
-        })
-        .collect();
-    // Slopes: every one far below the stop slope of its ξ.
-    let low = rows
-        .iter()
-        .zip(&limits)
-        .all(|(r, (dm, _))| r.scene.delta_deg() < SLOPE_FRACTION * dm);
-    if low {
-        let (i, r) = rows
-            .iter()
-            .enumerate()
-            .max_by(|a, b| a.1.scene.delta_deg().total_cmp(&b.1.scene.delta_deg()))
-            .unwrap_or((0, &rows[0]));
-        let d = r.scene.delta_deg();
-        let as_rad = rows
-            .iter()
-            .all(|r| r.scene.delta_deg() < std::f64::consts::FRAC_PI_2);
-        let mut message = format!(
-            "every delta_deg is below {} of the stop slope delta_m of its xi at the paper's K \
-             (the largest, {} on line {}, against delta_m = {} deg at xi = {}): no steady \
-             motion there",
-            fmt_f64(SLOPE_FRACTION),
-            crate::numfmt::fmt_sig(d, 4),
-            t.lines[i],
-            crate::numfmt::fmt_sig(limits[i].0, 4),
-            fmt_f64(r.scene.xi()),
-        );
-        if as_rad {
-            message.push_str(&format!(
-                "; are these radians? ({} rad = {} deg)",
-                crate::numfmt::fmt_sig(d, 4),
-                crate::numfmt::fmt_sig(d.to_degrees(), 4)
-            ));
-        }
-        out.push(Implausible {
-            column: "delta_deg".into(),
-            message,
-        });
-        // The velocities cannot be judged against a model in which nothing moves.
-        return out;
-    }
-    // Velocities: against the rolling model at the paper's K, in its steady range.
-    let mut ratios: Vec<f64> = rows
-        .iter()
-        .zip(&limits)
-        .filter(|(r, (dm, dd))| r.scene.delta_deg() > *dm && r.scene.delta_deg() < *dd)
-        .filter_map(|(r, _)| {
-            let s = r.scene;
-            let sc = Scene::new(s.xi(), s.delta_deg(), s.rho(), s.f(), law).ok()?;
-            let v = crate::models::Model::Stick
-                .evaluate(&sc)
-                .ok()?
-                .mean_velocity;
-            (v > 0.0).then(|| r.v / v)
-        })
-        .collect();
-    if !ratios.is_empty() {
-        ratios.sort_by(|a, b| a.total_cmp(b));
-        let med = ratios[ratios.len() / 2];
-        let dimensional = t.col("v").is_none();
-        let what = format!(
-            "the velocities are on median {} times the rolling model's at the paper's K (over \
-             the {} point(s) in its steady range)",
-            crate::numfmt::fmt_sig(med, 3),
-            ratios.len()
-        );
-        let cause = match (dimensional, med < 1.0) {
-            (false, true) => Some(
-                "are these m/s? The column v is dimensionless (units sqrt(g (R + r))): give \
-                 v_m_s and R_m instead",
-            ),
-            (false, false) => Some("are these cm/s, or in another unit than sqrt(g (R + r))?"),
-            (true, true) => Some("is R_m in millimetres? It must be in metres"),
-            (true, false) => Some("is R_m too small (in km?) or v_m_s in cm/s or mm/s?"),
+    let mut p = Plausibility::new(t);
+    for (i, m) in rows.iter().enumerate() {
+        let measured = Measured {
+            scene: m.scene,
+            v: m.v,
+            sigma_v: m.sigma_v,
         };
-        if !(1.0 / VELOCITY_FACTOR..=VELOCITY_FACTOR).contains(&med) {
-            out.push(Implausible {
-                column: if dimensional { "v_m_s" } else { "v" }.into(),
-                message: format!("{what}; {}", cause.unwrap_or_default()),
-            });
+        p.add(&t.row(i), &measured);
+    }
+    p.warnings()
+}
+
+/// The checks of [`plausibility`], fed one validated row at a time in file order; its memory
+/// is bounded (at most [`MAX_RATIOS`] velocity ratios). [`Plausibility::warnings`] says what it found.
+#[derive(Debug, Clone)]
+pub struct Plausibility {
+    /// The velocities are `v_m_s` (no column `v`).
+    dimensional: bool,
+    /// `v` and `v_m_s` without `R_m`: `v` is used.
+    both_without_radius: bool,
+    r_m: Option<usize>,
+    rows: usize,
+    all_low: bool,
+    all_below_half_pi: bool,
+    /// The row with the largest slope: δ (degrees), its line, δ_m there (degrees), ξ.
+    largest: Option<(f64, u64, f64, f64)>,
+    ratios: Vec<f64>,
+    /// The largest `R_m` and its line.
+    largest_radius: Option<(f64, u64)>,
+    /// δ_m and δ_d (degrees) of the last (ξ, ρ) seen.
+    limits: Option<((u64, u64), f64, f64)>,
+}
+
+impl Plausibility {
+    /// The checks for a table with `t`'s header.
+    pub fn new(t: &impl Header) -> Self {
+        Plausibility {
+            dimensional: t.col("v").is_none(),
+            both_without_radius: t.col("v").is_some()
+                && t.col("v_m_s").is_some()
+                && t.col("R_m").is_none(),
+            r_m: t.col("R_m"),
+            rows: 0,
+            all_low: true,
+            all_below_half_pi: true,
+            largest: None,
+            ratios: Vec::new(),
+            largest_radius: None,
+            limits: None,
         }
     }
-    // Row-bead radii.
-    if let Some(c) = t.col("R_m") {
-        let big = (0..t.rows.len())
-            .filter_map(|r| t.cell(r, c).parse::<f64>().ok().map(|x| (r, x)))
-            .filter(|(_, x)| *x > MAX_ROW_RADIUS_M)
-            .max_by(|a, b| a.1.total_cmp(&b.1));
-        if let Some((r, x)) = big {
+
+    /// Takes one validated row (`m` read from `r`).
+    pub fn add(&mut self, r: &Row<'_>, m: &Measured) {
+        use crate::models::regimes::{delta_d_law, delta_m_law};
+        use crate::models::ForwardModel;
+        let law = CollisionLaw::Adjusted;
+        let s = &m.scene;
+        let key = (s.xi().to_bits(), s.rho().to_bits());
+        let (dm, dd) = match self.limits {
+            Some((k, dm, dd)) if k == key => (dm, dd),
+            _ => {
+                let (a, rho) = (s.alpha_rad(), s.rho());
+                let dm = delta_m_law(a, law, rho).to_degrees();
+                let dd = delta_d_law(a, law, rho).to_degrees();
+                self.limits = Some((key, dm, dd));
+                (dm, dd)
+            }
+        };
+        self.rows += 1;
+        let d = s.delta_deg();
+        self.all_low &= d < SLOPE_FRACTION * dm;
+        self.all_below_half_pi &= d < std::f64::consts::FRAC_PI_2;
+        if self.largest.is_none_or(|l| d >= l.0) {
+            self.largest = Some((d, r.line, dm, s.xi()));
+        }
+        if self.ratios.len() < MAX_RATIOS && d > dm && d < dd {
+            let v = Scene::new(s.xi(), d, s.rho(), s.f(), law)
+                .ok()
+                .and_then(|sc| crate::models::Model::Stick.evaluate(&sc).ok())
+                .map(|o| o.mean_velocity);
+            if let Some(v) = v.filter(|&v| v > 0.0) {
+                self.ratios.push(m.v / v);
+            }
+        }
+        if let Some(x) = self.r_m.and_then(|c| r.cell(c).parse::<f64>().ok()) {
+            if x > MAX_ROW_RADIUS_M && self.largest_radius.is_none_or(|l| x > l.0) {
+                self.largest_radius = Some((x, r.line));
+            }
+        }
+    }
+
+    /// The warnings so far, in the order slopes, velocities, radii, columns.
+    pub fn warnings(&self) -> Vec<Implausible> {
+        let mut out = Vec::new();
+        if self.rows == 0 {
+            return out;
+        }
+        // Slopes: every one far below the stop slope of its ξ.
+        if self.all_low {
+            if let Some((d, line, dm, xi)) = self.largest {
+                let mut message = format!(
+                    "every delta_deg is below {} of the stop slope delta_m of its xi at the \
+                     paper's K (the largest, {} on line {}, against delta_m = {} deg at xi = \
+                     {}): no steady motion there",
+                    fmt_f64(SLOPE_FRACTION),
+                    crate::numfmt::fmt_sig(d, 4),
+                    line,
+                    crate::numfmt::fmt_sig(dm, 4),
+                    fmt_f64(xi),
+                );
+                if self.all_below_half_pi {
+                    message.push_str(&format!(
+                        "; are these radians? ({} rad = {} deg)",
+                        crate::numfmt::fmt_sig(d, 4),
+                        crate::numfmt::fmt_sig(d.to_degrees(), 4)
+                    ));
+                }
+                out.push(Implausible {
+                    column: "delta_deg".into(),
+                    message,
+                });
+            }
+            // The velocities cannot be judged against a model in which nothing moves.
+            return out;
+        }
+        // Velocities: against the rolling model at the paper's K, in its steady range.
+        if !self.ratios.is_empty() {
+            let mut ratios = self.ratios.clone();
+            ratios.sort_by(|a, b| a.total_cmp(b));
+            let med = ratios[ratios.len() / 2];
+            let what = format!(
+                "the velocities are on median {} times the rolling model's at the paper's K \
+                 (over the {} point(s) in its steady range)",
+                crate::numfmt::fmt_sig(med, 3),
+                ratios.len()
+            );
+            let cause = match (self.dimensional, med < 1.0) {
+                (false, true) => {
+                    "are these m/s? The column v is dimensionless (units sqrt(g (R + r))): \
+                     give v_m_s and R_m instead"
+                }
+                (false, false) => "are these cm/s, or in another unit than sqrt(g (R + r))?",
+                (true, true) => "is R_m in millimetres? It must be in metres",
+                (true, false) => "is R_m too small (in km?) or v_m_s in cm/s or mm/s?",
+            };
+            if !(1.0 / VELOCITY_FACTOR..=VELOCITY_FACTOR).contains(&med) {
+                out.push(Implausible {
+                    column: if self.dimensional { "v_m_s" } else { "v" }.into(),
+                    message: format!("{what}; {cause}"),
+                });
+            }
+        }
+        // Row-bead radii.
+        if let Some((x, line)) = self.largest_radius {
             out.push(Implausible {
                 column: "R_m".into(),
                 message: format!(
-                    "R_m = {} m on line {}: row beads over {} m across; are these millimetres? \
-                     R_m is in metres ({} mm = {} m)",
+                    "R_m = {} m on line {line}: row beads over {} m across; are these \
+                     millimetres? R_m is in metres ({} mm = {} m)",
                     fmt_f64(x),
-                    t.lines[r],
                     fmt_f64(2.0 * MAX_ROW_RADIUS_M),
                     fmt_f64(x),
                     fmt_f64(x / 1000.0),
                 ),
             });
         }
+        // Both velocity columns without R_m: the dimensionless one is used.
+        if self.both_without_radius {
+            out.push(Implausible {
+                column: "v_m_s".into(),
+                message: "ignored: the dimensionless column v is used (v_m_s would need R_m)"
+                    .into(),
+            });
+        }
+        out
     }
-    // Both velocity columns without R_m: the dimensionless one is used.
-    if let (Some(_), Some(_), None) = (t.col("v"), t.col("v_m_s"), t.col("R_m")) {
-        out.push(Implausible {
-            column: "v_m_s".into(),
-            message: "ignored: the dimensionless column v is used (v_m_s would need R_m)".into(),
-        });
-    }
-    out
 }

@@ -331,7 +331,7 @@ impl FitArgs {
         if interrupted {
             return Err(CliError::InterruptedPartial);
         }
-        not_started(stats)
+        not_converged(stats)
     }
 }
 
@@ -355,25 +355,31 @@ pub fn posterior_faults(stats: &[StatsRow]) -> Result<(), CliError> {
     Ok(())
 }
 
-/// A posterior run that could not start: the outputs hold the least-squares rows (marked),
-/// and the command exits 1 naming the fit and why.
-pub fn not_started(stats: &[StatsRow]) -> Result<(), CliError> {
+/// Exit 1 for fits that did not converge, once their outputs are written: a least-squares
+/// fit that stopped short of its tolerance, a posterior run that could not start (its rows
+/// hold the least-squares values, marked) or one that stopped at `--max-steps` before its
+/// R̂ and ESS targets. A law with no free parameter is scored, not fitted: a point it cannot
+/// make steady is said in its note, not in the exit code. The message names each fit, its
+/// series and why.
+pub fn not_converged(stats: &[StatsRow]) -> Result<(), CliError> {
     let failed: Vec<String> = stats
         .iter()
         .filter_map(|s| {
-            s.mcmc
-                .as_ref()
-                .and_then(|m| m.failure.as_ref())
-                .map(|f| format!("{} [{}]: {f}", s.fit, s.series))
+            let why = match s.mcmc.as_ref().and_then(|m| m.failure.as_ref()) {
+                Some(f) => {
+                    format!("{f} (its rows hold the least-squares values, marked in their notes)")
+                }
+                // A law with nothing to fit (impact, cos 2α) is scored, not solved.
+                None if !s.converged && s.n_params > 0 => s.note.clone(),
+                None => return None,
+            };
+            Some(format!("{} [{}]: {why}", s.fit, s.series))
         })
         .collect();
     if failed.is_empty() {
         Ok(())
     } else {
-        Err(CliError::NotConverged(format!(
-            "{} (the rows of these fits hold least-squares values, marked in their notes)",
-            failed.join("; ")
-        )))
+        Err(CliError::NotConverged(failed.join("; ")))
     }
 }
 

@@ -7,7 +7,9 @@ use fitbead::io::forward::{scene_error, ForwardPlan, ForwardSettings, SceneColum
 use fitbead::io::scenes::{Table, TableReader};
 use fitbead::io::stream::{stream, RowPlan, StreamError, StreamOptions, Streamed};
 use fitbead::io::{fmt_f64, AtomicFile, InputError};
-use fitbead::models::md::{Md, MdParams, MdResult, MdRunConfig, ReducedMass};
+use fitbead::models::md::{
+    Md, MdParams, MdResult, MdRunConfig, MdSetting, MdSettings, ReducedMass,
+};
 use fitbead::models::Regime;
 use fitbead::models::{regime_of, JaegerBranch, Model, ModelKind};
 use fitbead::scene::ParameterError as Error;
@@ -201,7 +203,9 @@ impl Read for Input {
 /// is `-`): its name in messages, the reader and its size in bytes (0 when unknown).
 pub(super) fn open_input(path: Option<&Path>) -> Result<(String, Input, u64), CliError> {
     match path {
-        Some(p) if p == Path::new("-") => Ok(("<stdin>".to_string(), Input::Stdin(std::io::stdin()), 0)),
+        Some(p) if p == Path::new("-") => {
+            Ok(("<stdin>".to_string(), Input::Stdin(std::io::stdin()), 0))
+        }
         None => Ok((
             super::DEFAULT_DATA_NAME.to_string(),
             Input::Static(super::DEFAULT_DATA.as_bytes()),
@@ -209,8 +213,8 @@ pub(super) fn open_input(path: Option<&Path>) -> Result<(String, Input, u64), Cl
         )),
         Some(p) => {
             let name = p.display().to_string();
-            let f =
-                std::fs::File::open(p).map_err(|e| InputError::file(&name, format!("cannot read: {e}")))?;
+            let f = std::fs::File::open(p)
+                .map_err(|e| InputError::file(&name, format!("cannot read: {e}")))?;
             let size = f.metadata().map(|m| m.len()).unwrap_or(0);
             Ok((name, Input::File(f), size))
         }
@@ -356,24 +360,6 @@ pub struct MdArgs {
     pub check_step: bool,
 }
 
-/// Column names of the md settings in a scenes CSV.
-pub const MD_COLUMNS: [&str; 14] = [
-    "row_radius_m",
-    "young_pa",
-    "poisson",
-    "density",
-    "beta",
-    "gamma_n",
-    "gamma_s",
-    "mu_c",
-    "g",
-    "beads",
-    "transient",
-    "blocks",
-    "launch_velocity",
-    "step_fraction",
-];
-
 /// md output columns added to each row.
 pub const MD_OUTPUT_COLUMNS: [&str; 29] = [
     "v",
@@ -410,116 +396,90 @@ pub const MD_OUTPUT_COLUMNS: [&str; 29] = [
 impl MdArgs {
     /// The model from the preset and the flags (no table).
     pub fn model(&self) -> Result<Md, CliError> {
-        let vals: Vec<Option<f64>> = self.flag_values();
-        build_md(self, &vals, &|i, msg| {
+        let given = self.settings();
+        build_md(self, &given, &|s: MdSetting, msg: String| {
             super::flag_error(
-                &format!("--{}", md_flag_name(i)),
-                &vals[i].map(fmt_f64).unwrap_or_default(),
+                &md_flag(s),
+                &given.get(s).map(fmt_f64).unwrap_or_default(),
                 msg,
             )
         })
     }
 
-    fn flag_values(&self) -> Vec<Option<f64>> {
-        vec![
-            self.row_radius_m,
-            self.young_pa,
-            self.poisson,
-            self.density,
-            self.beta,
-            self.gamma_n,
-            self.gamma_s,
-            self.coulomb,
-            self.md_g,
-            self.beads.map(|b| b as f64),
-            self.transient.map(|b| b as f64),
-            self.blocks.map(|b| b as f64),
-            self.launch_velocity,
-            self.step_fraction,
-        ]
+    /// The md settings the flags give.
+    fn settings(&self) -> MdSettings {
+        let count = |n: Option<usize>| n.map(|b| b as f64);
+        MdSettings {
+            row_radius_m: self.row_radius_m,
+            young_pa: self.young_pa,
+            poisson: self.poisson,
+            density: self.density,
+            beta: self.beta,
+            gamma_n: self.gamma_n,
+            gamma_s: self.gamma_s,
+            mu_c: self.coulomb,
+            g: self.md_g,
+            beads: count(self.beads),
+            transient: count(self.transient),
+            blocks: count(self.blocks),
+            launch_velocity: self.launch_velocity,
+            step_fraction: self.step_fraction,
+        }
     }
 }
 
-fn md_flag_name(i: usize) -> String {
-    match MD_COLUMNS[i] {
-        "mu_c" => "coulomb".into(),
-        "g" => "md-g".into(),
-        c => c.replace('_', "-"),
+/// The flag of an md setting: `--` and its column with `-` for `_`, except `--coulomb`
+/// (`mu_c`) and `--md-g` (`g`).
+fn md_flag(s: MdSetting) -> String {
+    match s {
+        MdSetting::Coulomb => "--coulomb".into(),
+        MdSetting::Gravity => "--md-g".into(),
+        s => format!("--{}", s.column().replace('_', "-")),
     }
 }
 
-fn md_field_index(field: &str) -> Option<usize> {
-    MD_COLUMNS.iter().position(|c| *c == field)
-}
-
-/// Builds the md model from the preset and the values (flags or cells) in MD_COLUMNS order;
-/// `err(i, message)` locates a bad value i.
+/// Builds the md model from the preset, `--reduced-mass` and the settings given (flags or
+/// cells); `err(setting, message)` locates a bad value.
 fn build_md(
     a: &MdArgs,
-    vals: &[Option<f64>],
-    err: &dyn Fn(usize, String) -> CliError,
+    given: &MdSettings,
+    err: &dyn Fn(MdSetting, String) -> CliError,
 ) -> Result<Md, CliError> {
-    let mut params = match a.md_preset.as_str() {
+    let mut params = match a.md_preset.to_ascii_lowercase().as_str() {
         "ristow" => MdParams::ristow(),
         "steel" => MdParams::steel(),
-        p => {
+        _ => {
             return Err(super::flag_error(
                 "--md-preset",
-                p,
+                &a.md_preset,
                 "expected ristow or steel",
             ))
         }
     };
-    match a.reduced_mass.as_deref() {
+    match a
+        .reduced_mass
+        .as_deref()
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
         None | Some("pair") => {}
         Some("mobile") => params.reduced_mass = ReducedMass::Mobile,
-        Some(o) => {
+        Some(_) => {
             return Err(super::flag_error(
                 "--reduced-mass",
-                o,
+                a.reduced_mass.as_deref().unwrap_or_default(),
                 "expected pair or mobile",
             ))
         }
     }
-    let mut config = MdRunConfig::default();
-    let count = |i: usize, x: f64| -> Result<usize, CliError> {
-        if x.is_finite() && x >= 0.0 && x.fract() == 0.0 && x <= 1e9 {
-            Ok(x as usize)
-        } else {
-            Err(err(i, "must be a whole number".into()))
-        }
+    let base = Md {
+        params,
+        config: MdRunConfig::default(),
     };
-    for (i, v) in vals.iter().enumerate() {
-        let Some(x) = *v else { continue };
-        match i {
-            0 => params.row_radius = x,
-            1 => params.young = x,
-            2 => params.poisson = x,
-            3 => params.density = x,
-            4 => params.beta = x,
-            5 => params.gamma_n = x,
-            6 => params.gamma_s = x,
-            7 => params.coulomb = Some(x),
-            8 => params.g = x,
-            9 => config.beads = count(i, x)?,
-            10 => config.transient = count(i, x)?,
-            11 => config.blocks = count(i, x)?,
-            12 => config.launch_velocity = x,
-            _ => config.step_fraction = x,
-        }
-    }
-    let md = Md { params, config };
-    if let Err(e) = md.validate() {
-        let i = match &e {
-            Error::InvalidParameter { field, .. } => md_field_index(field),
-            _ => None,
-        };
-        return Err(match i {
-            Some(i) => err(i, e.to_string()),
-            None => CliError::Other(e.to_string()),
-        });
-    }
-    Ok(md)
+    given.apply(base).map_err(|(s, e)| match s {
+        Some(s) => err(s, e.to_string()),
+        None => CliError::Other(e.to_string()),
+    })
 }
 
 /// A progress bar over `total` units on a terminal's stderr only.
@@ -543,8 +503,11 @@ fn run_md(a: &Args, t: &Table) -> Result<(), CliError> {
     let c_xi = t.require("xi")?;
     let c_d = t.require("delta_deg")?;
     let c_rho = t.col("rho");
-    let cols: Vec<Option<usize>> = MD_COLUMNS.iter().map(|c| t.col(c)).collect();
-    let flags = a.md.flag_values();
+    let cols: Vec<(MdSetting, usize)> = MdSetting::ALL
+        .into_iter()
+        .filter_map(|s| t.col(s.column()).map(|c| (s, c)))
+        .collect();
+    let flags = a.md.settings();
     let mut jobs: Vec<(Scene, Md)> = Vec::with_capacity(t.rows.len());
     for r in 0..t.rows.len() {
         let xi = t.number(r, c_xi)?;
@@ -565,30 +528,30 @@ fn run_md(a: &Args, t: &Table) -> Result<(), CliError> {
                 None => super::flag_error("--rho", &fmt_f64(rho), msg),
             });
         }
-        let mut vals = flags.clone();
-        for (i, c) in cols.iter().enumerate() {
-            if let Some(x) = t.opt_number(r, *c)? {
-                vals[i] = Some(x);
+        let mut given = flags;
+        for &(s, c) in &cols {
+            if let Some(x) = t.opt_number(r, Some(c))? {
+                given.set(s, x);
             }
         }
-        let err = |i: usize, msg: String| -> CliError {
-            match cols[i] {
-                Some(c) if !t.cell(r, c).is_empty() => t.err(r, c, msg).into(),
+        let err = |s: MdSetting, msg: String| -> CliError {
+            match cols.iter().find(|(x, _)| *x == s) {
+                Some(&(_, c)) if !t.cell(r, c).is_empty() => t.err(r, c, msg).into(),
                 _ => super::flag_error(
-                    &format!("--{}", md_flag_name(i)),
-                    &vals[i].map(fmt_f64).unwrap_or_default(),
+                    &md_flag(s),
+                    &given.get(s).map(fmt_f64).unwrap_or_default(),
                     msg,
                 ),
             }
         };
-        let md = build_md(&a.md, &vals, &err)?;
+        let md = build_md(&a.md, &given, &err)?;
         md.check_scene(&scene).map_err(|e| match &e {
             Error::InvalidParameter { field: "rho", .. } => match c_rho {
                 Some(c) if !t.cell(r, c).is_empty() => t.err(r, c, e.to_string()).into(),
                 _ => super::flag_error("--rho", &fmt_f64(rho), e.to_string()),
             },
-            Error::InvalidParameter { field, .. } => match md_field_index(field) {
-                Some(i) => err(i, e.to_string()),
+            Error::InvalidParameter { field, .. } => match MdSetting::from_column(field) {
+                Some(s) => err(s, e.to_string()),
                 None => CliError::Other(e.to_string()),
             },
             _ => CliError::Other(e.to_string()),

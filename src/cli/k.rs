@@ -121,26 +121,19 @@ pub fn run(a: Args) -> Result<(), CliError> {
     // (after the input proved good) before the output is committed.
     let plot = a.plot.as_deref().map(|p| (p, AtomicFile::create(p)));
     let opts = stream_options("k", size);
-    stream_to(
-        reader,
-        make,
-        ledger,
-        a.output.as_deref(),
-        &opts,
-        |ledger| {
-            for w in ledger.warnings() {
-                eprintln!("fitbead: warning: {source}: {w}");
-            }
-            let Some((p, file)) = plot else {
-                return Ok(());
-            };
-            let cannot =
-                |e: std::io::Error| CliError::Other(format!("{}: cannot write: {e}", p.display()));
-            let svg = ledger.plot_svg(&a.model).map_err(CliError::Other)?;
-            let mut f = file.map_err(cannot)?;
-            f.write_all(svg.as_bytes()).map_err(cannot)?;
-            f.commit().map_err(cannot)
-        },
-    )
+    stream_to(reader, make, ledger, a.output.as_deref(), &opts, |ledger| {
+        for w in ledger.warnings() {
+            eprintln!("fitbead: warning: {source}: {w}");
+        }
+        let Some((p, file)) = plot else {
+            return Ok(());
+        };
+        let cannot =
+            |e: std::io::Error| CliError::Other(format!("{}: cannot write: {e}", p.display()));
+        let svg = ledger.plot_svg(&a.model).map_err(CliError::Other)?;
+        let mut f = file.map_err(cannot)?;
+        f.write_all(svg.as_bytes()).map_err(cannot)?;
+        f.commit().map_err(cannot)
+    })
     .map(|_| ())
 }

@@ -2,7 +2,7 @@
 //! friction μ of Jan's model against eq 79, energy budgets, the regime map, the model ranking —
 //! as a directory of CSV tables, SVG figures and a `report.md` that links them.
 
-use super::fitargs::{flag_absurd, locate_point, not_started, unsteady_points, FitArgs};
+use super::fitargs::{flag_absurd, locate_point, not_converged, unsteady_points, FitArgs};
 use super::CliError;
 use fitbead::io::write_atomic_all;
 use fitbead::report::analysis::analyse;
@@ -330,7 +330,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
     if interrupted {
         return Err(CliError::InterruptedPartial);
     }
-    not_started(&stats)
+    not_converged(&stats)
 }
 
 /// Creates `dir` and its missing parents; returns the directories it made, outermost first.

@@ -339,6 +339,229 @@ impl MdRunConfig {
     }
 }
 
+/// A setting of the md model a caller may give (a flag, a column of a scenes table), named
+/// as its column and as the `field` of the [`crate::scene::ParameterError`] that refuses it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum MdSetting {
+    /// `row_radius_m`: radius R of the row beads, m.
+    RowRadius,
+    /// `young_pa`: Young's modulus E, Pa.
+    Young,
+    /// `poisson`: Poisson ratio.
+    Poisson,
+    /// `density`: bead density, kg/m³.
+    Density,
+    /// `beta`: exponent β of the normal force k_n d^β.
+    Beta,
+    /// `gamma_n`: normal damping, 1/s.
+    GammaN,
+    /// `gamma_s`: tangential damping, 1/s.
+    GammaS,
+    /// `mu_c`: Coulomb cap on the tangential force.
+    Coulomb,
+    /// `g`: gravity, m/s².
+    Gravity,
+    /// `beads`: row beads travelled (a whole number).
+    Beads,
+    /// `transient`: row beads discarded as transient (a whole number).
+    Transient,
+    /// `blocks`: blocks for the standard error of v̄ (a whole number).
+    Blocks,
+    /// `launch_velocity`: launch speed on the first row bead, units sqrt(g (R + r)).
+    LaunchVelocity,
+    /// `step_fraction`: time step as a fraction of the contact time.
+    StepFraction,
+}
+
+impl MdSetting {
+    /// Every setting, in the order of the scenes table's documentation.
+    pub const ALL: [MdSetting; 14] = [
+        MdSetting::RowRadius,
+        MdSetting::Young,
+        MdSetting::Poisson,
+        MdSetting::Density,
+        MdSetting::Beta,
+        MdSetting::GammaN,
+        MdSetting::GammaS,
+        MdSetting::Coulomb,
+        MdSetting::Gravity,
+        MdSetting::Beads,
+        MdSetting::Transient,
+        MdSetting::Blocks,
+        MdSetting::LaunchVelocity,
+        MdSetting::StepFraction,
+    ];
+
+    /// Its column name (and error field).
+    pub fn column(self) -> &'static str {
+        match self {
+            MdSetting::RowRadius => "row_radius_m",
+            MdSetting::Young => "young_pa",
+            MdSetting::Poisson => "poisson",
+            MdSetting::Density => "density",
+            MdSetting::Beta => "beta",
+            MdSetting::GammaN => "gamma_n",
+            MdSetting::GammaS => "gamma_s",
+            MdSetting::Coulomb => "mu_c",
+            MdSetting::Gravity => "g",
+            MdSetting::Beads => "beads",
+            MdSetting::Transient => "transient",
+            MdSetting::Blocks => "blocks",
+            MdSetting::LaunchVelocity => "launch_velocity",
+            MdSetting::StepFraction => "step_fraction",
+        }
+    }
+
+    /// The setting whose column (or error field) is `name`.
+    pub fn from_column(name: &str) -> Option<MdSetting> {
+        MdSetting::ALL.into_iter().find(|s| s.column() == name)
+    }
+
+    /// Whether it counts row beads or blocks (a whole number).
+    pub fn is_count(self) -> bool {
+        matches!(
+            self,
+            MdSetting::Beads | MdSetting::Transient | MdSetting::Blocks
+        )
+    }
+}
+
+/// Values given for some md settings, laid over a preset by [`MdSettings::apply`]; a setting
+/// left `None` keeps the preset's value. Counts are held as numbers so that a value such as
+/// 2.5 can be refused with the setting named.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct MdSettings {
+    /// Radius R of the row beads, m.
+    pub row_radius_m: Option<f64>,
+    /// Young's modulus E, Pa.
+    pub young_pa: Option<f64>,
+    /// Poisson ratio.
+    pub poisson: Option<f64>,
+    /// Bead density, kg/m³.
+    pub density: Option<f64>,
+    /// Exponent β of the normal force.
+    pub beta: Option<f64>,
+    /// Normal damping γ_n, 1/s.
+    pub gamma_n: Option<f64>,
+    /// Tangential damping γ_s, 1/s.
+    pub gamma_s: Option<f64>,
+    /// Coulomb cap μ_c on the tangential force.
+    pub mu_c: Option<f64>,
+    /// Gravity, m/s².
+    pub g: Option<f64>,
+    /// Row beads travelled.
+    pub beads: Option<f64>,
+    /// Row beads discarded as transient.
+    pub transient: Option<f64>,
+    /// Blocks for the standard error of v̄.
+    pub blocks: Option<f64>,
+    /// Launch speed on the first row bead, units sqrt(g (R + r)).
+    pub launch_velocity: Option<f64>,
+    /// Time step as a fraction of the contact time.
+    pub step_fraction: Option<f64>,
+}
+
+impl MdSettings {
+    /// The value given for `s`.
+    pub fn get(&self, s: MdSetting) -> Option<f64> {
+        *self.slot(s)
+    }
+
+    /// Gives `s` the value `x`.
+    pub fn set(&mut self, s: MdSetting, x: f64) {
+        *self.slot_mut(s) = Some(x);
+    }
+
+    fn slot(&self, s: MdSetting) -> &Option<f64> {
+        match s {
+            MdSetting::RowRadius => &self.row_radius_m,
+            MdSetting::Young => &self.young_pa,
+            MdSetting::Poisson => &self.poisson,
+            MdSetting::Density => &self.density,
+            MdSetting::Beta => &self.beta,
+            MdSetting::GammaN => &self.gamma_n,
+            MdSetting::GammaS => &self.gamma_s,
+            MdSetting::Coulomb => &self.mu_c,
+            MdSetting::Gravity => &self.g,
+            MdSetting::Beads => &self.beads,
+            MdSetting::Transient => &self.transient,
+            MdSetting::Blocks => &self.blocks,
+            MdSetting::LaunchVelocity => &self.launch_velocity,
+            MdSetting::StepFraction => &self.step_fraction,
+        }
+    }
+
+    fn slot_mut(&mut self, s: MdSetting) -> &mut Option<f64> {
+        match s {
+            MdSetting::RowRadius => &mut self.row_radius_m,
+            MdSetting::Young => &mut self.young_pa,
+            MdSetting::Poisson => &mut self.poisson,
+            MdSetting::Density => &mut self.density,
+            MdSetting::Beta => &mut self.beta,
+            MdSetting::GammaN => &mut self.gamma_n,
+            MdSetting::GammaS => &mut self.gamma_s,
+            MdSetting::Coulomb => &mut self.mu_c,
+            MdSetting::Gravity => &mut self.g,
+            MdSetting::Beads => &mut self.beads,
+            MdSetting::Transient => &mut self.transient,
+            MdSetting::Blocks => &mut self.blocks,
+            MdSetting::LaunchVelocity => &mut self.launch_velocity,
+            MdSetting::StepFraction => &mut self.step_fraction,
+        }
+    }
+
+    /// `base` with the values given here, validated ([`Md::validate`]); a refusal names the
+    /// setting at fault when it is one of these (a count must be a whole number ≤ 1e9).
+    pub fn apply(&self, base: Md) -> std::result::Result<Md, (Option<MdSetting>, Error)> {
+        let Md {
+            mut params,
+            mut config,
+        } = base;
+        for s in MdSetting::ALL {
+            let Some(x) = self.get(s) else { continue };
+            let count = || {
+                if x.is_finite() && x >= 0.0 && x.fract() == 0.0 && x <= 1e9 {
+                    Ok(x as usize)
+                } else {
+                    Err((
+                        Some(s),
+                        Error::InvalidParameter {
+                            field: s.column(),
+                            value: x.to_string(),
+                            reason: "must be a whole number",
+                        },
+                    ))
+                }
+            };
+            match s {
+                MdSetting::RowRadius => params.row_radius = x,
+                MdSetting::Young => params.young = x,
+                MdSetting::Poisson => params.poisson = x,
+                MdSetting::Density => params.density = x,
+                MdSetting::Beta => params.beta = x,
+                MdSetting::GammaN => params.gamma_n = x,
+                MdSetting::GammaS => params.gamma_s = x,
+                MdSetting::Coulomb => params.coulomb = Some(x),
+                MdSetting::Gravity => params.g = x,
+                MdSetting::Beads => config.beads = count()?,
+                MdSetting::Transient => config.transient = count()?,
+                MdSetting::Blocks => config.blocks = count()?,
+                MdSetting::LaunchVelocity => config.launch_velocity = x,
+                MdSetting::StepFraction => config.step_fraction = x,
+            }
+        }
+        let md = Md { params, config };
+        md.validate().map_err(|e| {
+            let s = match &e {
+                Error::InvalidParameter { field, .. } => MdSetting::from_column(field),
+                _ => None,
+            };
+            (s, e)
+        })?;
+        Ok(md)
+    }
+}
+
 /// The molecular-dynamics forward model: parameters and run settings.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Md {

@@ -185,11 +185,6 @@ fn jaeger_mcmc_reports_priors_and_names_what_did_not_converge() {
         "300",
     ];
     let a = run(dir.path(), "j", &args);
-    assert!(
-        a.out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&a.out.stderr)
-    );
     let (h, rows) = table(&a.report);
     assert_eq!(rows.len(), 12, "a1, a2, a3 for four series");
     for r in &rows {
@@ -208,6 +203,11 @@ fn jaeger_mcmc_reports_priors_and_names_what_did_not_converge() {
     }
     let (sh, srows) = table(&a.stats);
     let err = String::from_utf8_lossy(&a.out.stderr);
+    // Exit 0 when every series converged, 1 (outputs written) when one stopped at --max-steps.
+    let stopped = srows
+        .iter()
+        .any(|s| s[col(&sh, "mcmc_status")] == "max_steps");
+    assert_eq!(a.out.status.code(), Some(i32::from(stopped)), "{err}");
     for s in &srows {
         let status = &s[col(&sh, "mcmc_status")];
         assert!(status == "converged" || status == "max_steps", "{status}");

@@ -6,7 +6,7 @@ use super::k::parse_auto;
 use super::k::parse_model;
 use super::CliError;
 use fitbead::fit::k::auto::{self as kauto, KChoice};
-use fitbead::fit::klaw::{fit_law, fit_law_with, KLaw, KLawError};
+use fitbead::fit::klaw::{fit_law, fit_law_in, KLaw, KLawContext, KLawError};
 use fitbead::fit::posterior::Method;
 use fitbead::fit::summary::FitResult;
 use fitbead::io::fmt_f64;
@@ -146,7 +146,16 @@ pub fn run(a: Args) -> Result<(), CliError> {
             e
         }
     };
-    let main = fit_law_with(model, &ds, law, a.io.level, &choice.method)
+    // A least-squares fit shows its forward evaluations on a terminal once it has run for a
+    // couple of seconds; a posterior run shows the sampler's steps instead.
+    let context = KLawContext {
+        progress: match choice.method {
+            Method::Lsq { .. } => super::delayed_progress_bar("forward evaluations"),
+            Method::Mcmc(_) => None,
+        },
+        ..KLawContext::default()
+    };
+    let main = fit_law_in(model, &ds, law, a.io.level, &choice.method, context)
         .map_err(|e| interrupted(fail(e)))?;
     let mut stats = vec![main.summary.stats.clone()];
     if law != KLaw::Impact {

@@ -10,27 +10,42 @@
 //!   of ((K_min,i − a_i)/b_i, (K_max,i − a_i)/b_i] over the points of group j. An empty
 //!   intersection means no value of the law keeps every point steady, and the fit says so
 //!   instead of searching;
-//! - the start is derived: the median over the group of the per-point inversions of eq 69,
-//!   mapped to p, clamped into the box;
+//! - the start is derived: the median over the group of the per-point inversions of eq 69
+//!   (at most [`START_POINTS`] per group, evenly spread over its points), mapped to p, clamped
+//!   into the box;
 //! - the Jacobian costs two forward evaluations per point whatever the number of parameters:
-//!   ∂r_i/∂p_j = −(dv̄/dK)_i b_i/σ_i for j = g(i), else 0, with dv̄/dK by a central difference in
-//!   s = ln(K − K_min) (as in [`crate::fit::k::estimate()`]; accurate where the slope in K is
-//!   nearly infinite).
+//!   ∂r_i/∂p_j = −(dv̄/dK)_i b_i/σ_i for j = g(i), else 0, with dv̄/dK from
+//!   [`crate::fit::k::dv_dk`] (the derivative of the K inversion: steps uniform in
+//!   s = ln(K − K_min), accurate where the slope in K is nearly infinite, differenced over the
+//!   K values actually evaluated), v̄ at the point itself being the one the residuals just
+//!   computed there;
+//! - with one parameter per series the parameters are independent (each moves its own
+//!   series' residuals only): the profile of one is computed on its series' points alone,
+//!   the other series staying at their optimum, instead of refitting them at every step.
 //!
-//! A point that leaves regime B during the search makes the residuals [`Infeasible`] (a
-//! rejected step), never NaN.
+//! Memory grows with the points (a bracket, the law's coefficients and the last velocities
+//! per point), not with the iterations. The forward model is the lean steady state of the K
+//! inversion (stick/slip without its map-slope and second-fixed-point diagnostics). A point
+//! that leaves regime B during the search makes the residuals [`Infeasible`] (a rejected
+//! step), never NaN.
 
 use super::data::Dataset;
-use super::k::{bracket, estimate, KBracket};
+use super::k::bracket::eval;
+use super::k::{bracket, dv_dk, estimate, KBracket, KFailure};
 use super::posterior::{summarise_with, Method};
-use super::summary::{information_criteria, FitResult, ParamSpec, Solved, StatsRow};
-use crate::inverse::{fit, Infeasible, LsqOptions, Residuals};
-use crate::models::{ForwardModel, Model};
-use faer::MatMut;
+use super::summary::{
+    information_criteria, summarise_with_profiles, FitResult, ParamSpec, Solved, StatsRow,
+};
+use crate::inverse::{
+    fit, profile_interval, Covariance, Fit, Infeasible, LsqOptions, ProfileInterval, Residuals,
+};
+use crate::models::Model;
+use crate::progress::{Progress, ProgressEvent};
+use faer::{Mat, MatMut};
 use rayon::prelude::*;
 use std::fmt;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
 
 /// Which law of K(α).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -146,7 +161,7 @@ impl fmt::Display for KLawError {
 }
 
 /// The residuals (v_i − v̄_th(K_i(p)))/σ_i of a law over a dataset.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct KLawProblem<'a> {
     model: Model,
     data: &'a Dataset,
@@ -154,14 +169,35 @@ pub struct KLawProblem<'a> {
     a: Vec<f64>,
     b: Vec<f64>,
     group: Vec<usize>,
+    /// The points of each group, in order.
+    members: Vec<Vec<usize>>,
     n: usize,
     brackets: Vec<KBracket>,
     /// Raised by the caller to cut the per-point work short ([`KLawError::Interrupted`]).
     stop: Option<Arc<AtomicBool>>,
+    /// The parameters of the last successful residuals and v̄ of every point there (what the
+    /// Jacobian at the same parameters starts from).
+    last: Mutex<Option<(Vec<f64>, Vec<f64>)>>,
+    /// Forward evaluations so far, and where they are reported.
+    evals: AtomicU64,
+    progress: Option<Progress>,
 }
 
 /// Points per rayon task: a stick/slip evaluation costs a few µs, so small batches already pay.
 const MIN_CHUNK: usize = 4;
+
+/// Points per group whose inversions give the start (evenly spread over the group).
+pub const START_POINTS: usize = 255;
+
+/// The brackets of K of every point of `data` under `model` (in parallel), or why a point has
+/// none: what [`KLawProblem::with_brackets`] needs, and what tells which points no K makes
+/// steady.
+pub fn brackets(model: &Model, data: &Dataset) -> Vec<Result<KBracket, KFailure>> {
+    data.points
+        .par_iter()
+        .map(|p| bracket(model, &p.scene))
+        .collect()
+}
 
 impl<'a> KLawProblem<'a> {
     /// The problem for `law` under `model` (a contact model whose K can be inverted).
@@ -169,8 +205,8 @@ impl<'a> KLawProblem<'a> {
         Self::new_until(model, data, law, None)
     }
 
-    /// As [`KLawProblem::new`], the per-point work (here and in [`KLawProblem::start`]) cut
-    /// short with [`KLawError::Interrupted`] once `stop` is raised.
+    /// As [`KLawProblem::new`], the per-point work (here, in [`KLawProblem::start`] and in the
+    /// Jacobian) cut short with [`KLawError::Interrupted`] once `stop` is raised.
     pub fn new_until(
         model: Model,
         data: &'a Dataset,
@@ -192,6 +228,21 @@ impl<'a> KLawProblem<'a> {
                 })
             })
             .collect::<Result<Vec<_>, _>>()?;
+        Ok(Self::with_brackets(model, data, law, brackets).with_stop(stop))
+    }
+
+    /// The problem with the brackets of every point already known (from [`brackets`], in the
+    /// order of `data.points`).
+    ///
+    /// # Panics
+    /// When there are not as many brackets as points.
+    pub fn with_brackets(
+        model: Model,
+        data: &'a Dataset,
+        law: KLaw,
+        brackets: Vec<KBracket>,
+    ) -> Self {
+        assert_eq!(brackets.len(), data.points.len(), "one bracket per point");
         let (mut a, mut b, mut group) = (Vec::new(), Vec::new(), Vec::new());
         for p in &data.points {
             let s = &p.scene;
@@ -219,17 +270,38 @@ impl<'a> KLawProblem<'a> {
             KLaw::Impact => 0,
             KLaw::FreePerSeries => data.labels.len(),
         };
-        Ok(KLawProblem {
+        let mut members = vec![Vec::new(); n.max(1)];
+        for (i, &g) in group.iter().enumerate() {
+            members[g].push(i);
+        }
+        KLawProblem {
             model,
             data,
             law,
             a,
             b,
             group,
+            members,
             n,
             brackets,
-            stop,
-        })
+            stop: None,
+            last: Mutex::new(None),
+            evals: AtomicU64::new(0),
+            progress: None,
+        }
+    }
+
+    /// Reports the forward evaluations done (after each batch of them) to `progress`.
+    pub fn with_progress(mut self, progress: Option<Progress>) -> Self {
+        self.progress = progress;
+        self
+    }
+
+    /// Cuts the per-point work short once `stop` is raised ([`KLawError::Interrupted`] from
+    /// [`KLawProblem::start`], a rejected step from the Jacobian).
+    pub fn with_stop(mut self, stop: Option<Arc<AtomicBool>>) -> Self {
+        self.stop = stop;
+        self
     }
 
     fn stopped(&self) -> bool {
@@ -254,7 +326,7 @@ impl<'a> KLawProblem<'a> {
 
     /// Indices of the points of parameter `j`'s group.
     pub fn group_points(&self, j: usize) -> impl Iterator<Item = usize> + '_ {
-        (0..self.group.len()).filter(move |&i| self.group[i] == j)
+        self.members.get(j).into_iter().flatten().copied()
     }
 
     /// K of point `i` at parameters `p`.
@@ -314,30 +386,29 @@ impl<'a> KLawProblem<'a> {
         ))
     }
 
-    /// The start: per group, the median of the per-point inversions of eq 69 mapped to the
-    /// parameter, clamped into the open box (ends pulled in by 1e-6 of its width); the box's
-    /// middle when no point of the group inverts.
+    /// The start: per group, the median of the per-point inversions of eq 69 (at most
+    /// [`START_POINTS`] points, evenly spread over the group) mapped to the parameter, clamped
+    /// into the open box (ends pulled in by 1e-6 of its width); the box's middle when no point
+    /// of the group inverts.
     pub fn start(&self) -> Result<Vec<f64>, KLawError> {
         let (lo, hi) = self.feasible_box()?;
-        let per_point: Vec<Option<f64>> = self
-            .data
-            .points
-            .par_iter()
-            .enumerate()
-            .map(|(i, p)| {
-                if self.stopped() {
-                    return None;
-                }
-                let e = estimate(&self.model, &p.scene, p.v, None);
-                e.root.ok().map(|r| (r.k - self.a[i]) / self.b[i])
-            })
-            .collect();
         if self.stopped() {
             return Err(KLawError::Interrupted);
         }
         Ok((0..self.n)
             .map(|j| {
-                let mut v: Vec<f64> = self.group_points(j).filter_map(|i| per_point[i]).collect();
+                let pts = &self.members[j];
+                let step = pts.len().div_ceil(START_POINTS).max(1);
+                let mut v: Vec<f64> = pts
+                    .par_iter()
+                    .step_by(step)
+                    .filter_map(|&i| {
+                        let p = &self.data.points[i];
+                        let e = estimate(&self.model, &p.scene, p.v, None);
+                        e.root.ok().map(|r| (r.k - self.a[i]) / self.b[i])
+                    })
+                    .collect();
+                self.tick(v.len() as u64);
                 v.sort_by(|x, y| x.total_cmp(y));
                 let w = hi[j] - lo[j];
                 let (l, h) = (lo[j] + 1e-6 * w, hi[j] - 1e-6 * w);
@@ -353,38 +424,40 @@ impl<'a> KLawProblem<'a> {
             .collect())
     }
 
+    /// Counts `n` forward evaluations (more or less: inversions count one each) and reports
+    /// the total.
+    fn tick(&self, n: u64) {
+        let total = self.evals.fetch_add(n, Ordering::Relaxed) + n;
+        if let Some(p) = &self.progress {
+            p.report(ProgressEvent::Position(total));
+        }
+    }
+
+    /// v̄ of point `i` at K = `k` (the lean steady state of the K inversion).
     fn eval_v(&self, i: usize, k: f64) -> Result<f64, Infeasible> {
         let p = &self.data.points[i];
-        let scene = p.scene.with_k(k).map_err(|_| Infeasible)?;
-        match self.model.evaluate(&scene) {
+        let mut n = 0;
+        match eval(&self.model, &p.scene, k, &mut n) {
             Ok(s) if s.mean_velocity.is_finite() => Ok(s.mean_velocity),
             _ => Err(Infeasible),
         }
     }
 
-    /// dv̄/dK at point `i` and K = `k`: central difference in s = ln(K − K_min), step 1e-5,
-    /// one-sided (second order) where a side leaves the bracket.
-    fn dv_dk(&self, i: usize, k: f64) -> Result<f64, Infeasible> {
-        let br = &self.brackets[i];
-        let d = k - br.lo;
-        if !(d > 0.0) {
-            return Err(Infeasible);
+    /// ∂r_i/∂p at point `i`, at K = `k` where v̄ = `v0`.
+    fn slope(&self, i: usize, k: f64, v0: f64) -> Result<f64, Infeasible> {
+        let pt = &self.data.points[i];
+        let d = dv_dk(&self.brackets[i], k, v0, |k| self.eval_v(i, k).ok()).ok_or(Infeasible)?;
+        Ok(-d * self.b[i] / pt.sigma)
+    }
+
+    /// The points of parameter `j`'s group as a problem of its own, the other parameters held
+    /// at `p` (module docs: the parameters are independent with one per series).
+    fn group(&self, j: usize, p: &[f64]) -> GroupProblem<'_, 'a> {
+        GroupProblem {
+            parent: self,
+            j,
+            p: p.to_vec(),
         }
-        let h: f64 = 1e-5;
-        let at = |t: f64| self.eval_v(i, br.lo + d * t.exp());
-        let ds = match (at(h), at(-h)) {
-            (Ok(p), Ok(m)) => (p - m) / (2.0 * h),
-            (Err(_), Ok(m)) => {
-                let (v0, m2) = (self.eval_v(i, k)?, at(-2.0 * h)?);
-                (3.0 * v0 - 4.0 * m + m2) / (2.0 * h)
-            }
-            (Ok(p), Err(_)) => {
-                let (v0, p2) = (self.eval_v(i, k)?, at(2.0 * h)?);
-                (-3.0 * v0 + 4.0 * p - p2) / (2.0 * h)
-            }
-            _ => return Err(Infeasible),
-        };
-        Ok(ds / d)
     }
 }
 
@@ -396,18 +469,40 @@ impl Residuals for KLawProblem<'_> {
         self.data.points.len()
     }
     fn residuals(&self, p: &[f64], out: &mut [f64]) -> Result<(), Infeasible> {
-        out.par_iter_mut()
+        let m = self.data.points.len();
+        let mut last = self.last.lock().map(|mut l| l.take()).unwrap_or(None);
+        let mut v = match last.take() {
+            Some((_, v)) if v.len() == m => v,
+            _ => vec![0.0; m],
+        };
+        let r = out
+            .par_iter_mut()
+            .zip(v.par_iter_mut())
             .with_min_len(MIN_CHUNK)
             .enumerate()
-            .try_for_each(|(i, o)| {
+            .try_for_each(|(i, (o, vi))| {
                 let pt = &self.data.points[i];
-                let v = self.eval_v(i, self.k_of(i, p))?;
-                *o = (pt.v - v) / pt.sigma;
+                *vi = self.eval_v(i, self.k_of(i, p))?;
+                *o = (pt.v - *vi) / pt.sigma;
                 Ok(())
-            })
+            });
+        self.tick(m as u64);
+        if r.is_ok() {
+            if let Ok(mut l) = self.last.lock() {
+                *l = Some((p.to_vec(), v));
+            }
+        }
+        r
     }
     fn jacobian(&self, p: &[f64], mut out: MatMut<'_, f64>) -> Option<Result<(), Infeasible>> {
         let m = self.data.points.len();
+        // v̄ at p from the residuals just computed there, when they were.
+        let known = self
+            .last
+            .lock()
+            .ok()
+            .and_then(|mut l| l.take())
+            .filter(|(q, v)| q.as_slice() == p && v.len() == m);
         let d: Result<Vec<f64>, Infeasible> = (0..m)
             .into_par_iter()
             .with_min_len(MIN_CHUNK)
@@ -417,21 +512,137 @@ impl Residuals for KLawProblem<'_> {
                 if self.stopped() {
                     return Err(Infeasible);
                 }
-                let pt = &self.data.points[i];
-                Ok(-self.dv_dk(i, self.k_of(i, p))? * self.b[i] / pt.sigma)
+                let k = self.k_of(i, p);
+                let v0 = match &known {
+                    Some((_, v)) => v[i],
+                    None => self.eval_v(i, k)?,
+                };
+                self.slope(i, k, v0)
             })
             .collect();
+        self.tick(2 * m as u64 + if known.is_some() { 0 } else { m as u64 });
+        if let (Some(k), Ok(mut l)) = (known, self.last.lock()) {
+            *l = Some(k);
+        }
         let d = match d {
             Ok(d) => d,
             Err(e) => return Some(Err(e)),
         };
-        for i in 0..m {
-            for j in 0..self.n {
-                out[(i, j)] = if self.group[i] == j { d[i] } else { 0.0 };
+        for j in 0..self.n {
+            for i in 0..m {
+                out[(i, j)] = 0.0;
             }
+        }
+        for (i, di) in d.into_iter().enumerate() {
+            out[(i, self.group[i])] = di;
         }
         Some(Ok(()))
     }
+}
+
+/// The points of one group as a one-parameter problem (the group's own parameter), the
+/// others held where they are.
+struct GroupProblem<'p, 'a> {
+    parent: &'p KLawProblem<'a>,
+    j: usize,
+    p: Vec<f64>,
+}
+
+impl GroupProblem<'_, '_> {
+    fn at(&self, x: &[f64]) -> Vec<f64> {
+        let mut p = self.p.clone();
+        p[self.j] = x[0];
+        p
+    }
+}
+
+impl Residuals for GroupProblem<'_, '_> {
+    fn n_params(&self) -> usize {
+        1
+    }
+    fn n_residuals(&self) -> usize {
+        self.parent.members[self.j].len()
+    }
+    fn residuals(&self, x: &[f64], out: &mut [f64]) -> Result<(), Infeasible> {
+        let (q, pts) = (self.at(x), &self.parent.members[self.j]);
+        let r = out
+            .par_iter_mut()
+            .zip(pts.par_iter())
+            .with_min_len(MIN_CHUNK)
+            .try_for_each(|(o, &i)| {
+                let pt = &self.parent.data.points[i];
+                *o = (pt.v - self.parent.eval_v(i, self.parent.k_of(i, &q))?) / pt.sigma;
+                Ok(())
+            });
+        self.parent.tick(pts.len() as u64);
+        r
+    }
+    fn jacobian(&self, x: &[f64], mut out: MatMut<'_, f64>) -> Option<Result<(), Infeasible>> {
+        let (q, pts) = (self.at(x), &self.parent.members[self.j]);
+        let d: Result<Vec<f64>, Infeasible> = pts
+            .par_iter()
+            .with_min_len(MIN_CHUNK)
+            .map(|&i| {
+                let k = self.parent.k_of(i, &q);
+                self.parent.slope(i, k, self.parent.eval_v(i, k)?)
+            })
+            .collect();
+        self.parent.tick(3 * pts.len() as u64);
+        match d {
+            Ok(d) => {
+                for (r, di) in d.into_iter().enumerate() {
+                    out[(r, 0)] = di;
+                }
+                Some(Ok(()))
+            }
+            Err(e) => Some(Err(e)),
+        }
+    }
+}
+
+/// Profile intervals of a law with one parameter per series, each on its series' points
+/// alone (module docs): the same Δχ² threshold and covariance half-width as the full fit's,
+/// the constrained χ² of the others being their optimum's. `None` when one cannot be formed.
+fn separable_profiles(
+    problem: &KLawProblem<'_>,
+    fit: &Fit,
+    level: f64,
+    opts: &LsqOptions,
+) -> Option<Vec<ProfileInterval>> {
+    (0..problem.n)
+        .into_par_iter()
+        .map(|j| {
+            let group = problem.group(j, &fit.params);
+            let pts = &problem.members[j];
+            let residuals: Vec<f64> = pts.iter().map(|&i| fit.residuals[i]).collect();
+            let chi2 = residuals.iter().map(|r| r * r).sum();
+            let sub = Fit {
+                params: vec![fit.params[j]],
+                residuals,
+                chi2,
+                covariance: fit.covariance.as_ref().map(|c| {
+                    let se = c.std_errors[j];
+                    Covariance {
+                        matrix: Mat::from_fn(1, 1, |_, _| se * se),
+                        correlation: Mat::from_fn(1, 1, |_, _| 1.0),
+                        std_errors: vec![se],
+                        scale: c.scale,
+                        condition: 1.0,
+                    }
+                }),
+                at_bound: vec![fit.at_bound.get(j).copied().unwrap_or(false)],
+                ..fit.clone()
+            };
+            let one = |v: &Option<Vec<f64>>| v.as_ref().map(|v| vec![v[j]]);
+            let sub_opts = LsqOptions {
+                lower: one(&opts.lower),
+                upper: one(&opts.upper),
+                typical: one(&opts.typical),
+                ..opts.clone()
+            };
+            profile_interval(&group, &sub, 0, level, &sub_opts).ok()
+        })
+        .collect()
 }
 
 /// The fitted law with its reports.
@@ -468,62 +679,67 @@ pub fn fit_law_with(
     level: f64,
     method: &Method,
 ) -> Result<KLawFit, KLawError> {
-    let problem = KLawProblem::new_until(model, data, law, method.stop().cloned())?;
+    fit_law_in(model, data, law, level, method, KLawContext::default())
+}
+
+/// What a K-law fit may be given besides its model, data, law, level and method.
+#[derive(Debug, Clone, Default)]
+pub struct KLawContext {
+    /// The brackets of K of every point (from [`brackets`], in the order of the points), when
+    /// the caller already has them; computed otherwise.
+    pub brackets: Option<Vec<KBracket>>,
+    /// Where progress goes: a task labelled with the fit's name, of unknown total, whose
+    /// positions count the forward evaluations done.
+    pub progress: Option<Progress>,
+}
+
+/// Reports `Finish` to a progress sink when dropped.
+struct Finish<'p>(Option<&'p Progress>);
+
+impl Drop for Finish<'_> {
+    fn drop(&mut self) {
+        if let Some(p) = self.0 {
+            p.report(ProgressEvent::Finish);
+        }
+    }
+}
+
+/// As [`fit_law_with`], given the brackets or a progress sink (see [`KLawContext`]).
+pub fn fit_law_in(
+    model: Model,
+    data: &Dataset,
+    law: KLaw,
+    level: f64,
+    method: &Method,
+    context: KLawContext,
+) -> Result<KLawFit, KLawError> {
     let fit_name = format!("klaw-{}", law.name());
+    let progress = context.progress;
+    let _finish = Finish(progress.as_ref());
+    if let Some(p) = &progress {
+        p.report(ProgressEvent::Start {
+            label: &fit_name,
+            total: 0,
+            check_every: 0,
+        });
+    }
     let m = data.points.len();
     if law == KLaw::Impact {
-        let mut r = vec![0.0; m];
-        let (chi2, note, termination) = match problem.residuals(&[], &mut r) {
-            Ok(()) => (
-                r.iter().map(|x| x * x).sum::<f64>(),
-                String::new(),
-                "scored",
-            ),
-            Err(_) => {
-                let out = (0..m).filter(|&i| !problem.point_is_steady(i, &[])).count();
-                (
-                    f64::INFINITY,
-                    format!("{out} of {m} points have no steady state under the impact law"),
-                    "infeasible",
-                )
-            }
-        };
-        let (aic, bic) = if chi2.is_finite() {
-            information_criteria(&r, data.sigma)
-        } else {
-            (f64::INFINITY, f64::INFINITY)
-        };
-        let reduced = if m > 0 { chi2 / m as f64 } else { f64::NAN };
-        let k = (0..m).map(|i| problem.k_of(i, &[])).collect();
-        let mut summary = FitResult {
-            params: Vec::new(),
-            stats: StatsRow {
-                fit: fit_name,
-                series: "all".into(),
-                n_points: m,
-                n_params: 0,
-                chi2,
-                dof: m,
-                reduced_chi2: reduced,
-                aic,
-                bic,
-                termination: termination.into(),
-                converged: chi2.is_finite(),
-                iterations: 0,
-                residual_evals: 1,
-                sigma: data.sigma,
-                condition: None,
-                note,
-                mcmc: None,
-            },
-            draws: None,
-            correlation: None,
-            residuals: r,
-            points: Vec::new(),
-        };
-        summary.attach_points(data, &(0..m).collect::<Vec<_>>());
-        return Ok(KLawFit { law, summary, k });
+        return Ok(score_impact(model, data, fit_name));
     }
+    let problem = match context.brackets {
+        Some(b) => {
+            if b.len() != m {
+                return Err(KLawError::Solver(format!(
+                    "{} brackets for {m} points",
+                    b.len()
+                )));
+            }
+            KLawProblem::with_brackets(model, data, law, b).with_stop(method.stop().cloned())
+        }
+        None => KLawProblem::new_until(model, data, law, method.stop().cloned())?,
+    }
+    .with_progress(progress.clone());
     let (lower, upper) = problem.feasible_box()?;
     let start = problem.start()?;
     let opts = LsqOptions {
@@ -547,18 +763,24 @@ pub fn fit_law_with(
             default_prior: None,
         })
         .collect();
-    let mut summary = summarise_with(
-        method,
-        Solved {
-            name: &fit_name,
-            series: "all",
-            specs: &specs,
-            problem: &problem,
-            fit: &f,
-            level,
-            options: &opts,
-        },
-    );
+    let solved = Solved {
+        name: &fit_name,
+        series: "all",
+        specs: &specs,
+        problem: &problem,
+        fit: &f,
+        level,
+        options: &opts,
+    };
+    let mut summary = match method {
+        // Independent parameters: each profiled on its own series.
+        Method::Lsq { profile: true, .. } if law == KLaw::FreePerSeries && problem.n > 1 => {
+            summarise_with_profiles(solved, |s| {
+                separable_profiles(&problem, s.fit, s.level, s.options)
+            })
+        }
+        _ => summarise_with(method, solved),
+    };
     if law == KLaw::FreePerSeries {
         for (j, row) in summary.params.iter_mut().take(problem.n).enumerate() {
             row.series = data.labels[j].clone();
@@ -575,4 +797,85 @@ pub fn fit_law_with(
     let k = (0..m).map(|i| problem.k_of(i, &f.params)).collect();
     summary.attach_points(data, &(0..m).collect::<Vec<_>>());
     Ok(KLawFit { law, summary, k })
+}
+
+/// The impact law scored on `data` (nothing to fit): χ², AIC, BIC of its residuals, or how
+/// many points it leaves without a steady state.
+fn score_impact(model: Model, data: &Dataset, fit_name: String) -> KLawFit {
+    let m = data.points.len();
+    let k: Vec<f64> = data
+        .points
+        .iter()
+        .map(|p| {
+            let s = &p.scene;
+            let c2a = (2.0 * s.alpha).cos();
+            (c2a + s.rho) / (1.0 + s.rho)
+        })
+        .collect();
+    let r: Vec<Option<f64>> = data
+        .points
+        .par_iter()
+        .zip(&k)
+        .with_min_len(MIN_CHUNK)
+        .map(|(p, &k)| {
+            let mut n = 0;
+            match eval(&model, &p.scene, k, &mut n) {
+                Ok(s) if s.mean_velocity.is_finite() => Some((p.v - s.mean_velocity) / p.sigma),
+                _ => None,
+            }
+        })
+        .collect();
+    let out = r.iter().filter(|x| x.is_none()).count();
+    let r: Vec<f64> = r.into_iter().map(|x| x.unwrap_or(f64::NAN)).collect();
+    let (chi2, note, termination) = if out == 0 {
+        (
+            r.iter().map(|x| x * x).sum::<f64>(),
+            String::new(),
+            "scored",
+        )
+    } else {
+        (
+            f64::INFINITY,
+            format!("{out} of {m} points have no steady state under the impact law"),
+            "infeasible",
+        )
+    };
+    let (aic, bic) = if chi2.is_finite() {
+        information_criteria(&r, data.sigma)
+    } else {
+        (f64::INFINITY, f64::INFINITY)
+    };
+    let reduced = if m > 0 { chi2 / m as f64 } else { f64::NAN };
+    let mut summary = FitResult {
+        params: Vec::new(),
+        stats: StatsRow {
+            fit: fit_name,
+            series: "all".into(),
+            n_points: m,
+            n_params: 0,
+            chi2,
+            dof: m,
+            reduced_chi2: reduced,
+            aic,
+            bic,
+            termination: termination.into(),
+            converged: chi2.is_finite(),
+            iterations: 0,
+            residual_evals: 1,
+            sigma: data.sigma,
+            condition: None,
+            note,
+            mcmc: None,
+        },
+        draws: None,
+        correlation: None,
+        residuals: r,
+        points: Vec::new(),
+    };
+    summary.attach_points(data, &(0..m).collect::<Vec<_>>());
+    KLawFit {
+        law: KLaw::Impact,
+        summary,
+        k,
+    }
 }

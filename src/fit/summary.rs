@@ -13,7 +13,8 @@
 use crate::inverse::mcmc::ParameterDiagnostics;
 pub use crate::inverse::posterior::Draws;
 use crate::inverse::{
-    confidence_intervals, Fit, LsqOptions, ProfileEnd, Residuals, SigmaKind, Termination,
+    confidence_intervals, Fit, LsqOptions, ProfileEnd, ProfileInterval, Residuals, SigmaKind,
+    Termination,
 };
 use crate::numfmt::{fmt_f64, fmt_sig};
 
@@ -453,22 +454,36 @@ impl<R: ?Sized> Copy for Solved<'_, R> {}
 /// Builds the summary of a finished fit: covariance intervals, and profile intervals when
 /// `profile` is set and the fit converged.
 pub fn summarise<R: Residuals + ?Sized>(s: Solved<'_, R>, profile: bool) -> FitResult {
+    summarise_with_profiles(s, |s| {
+        if profile {
+            confidence_intervals(s.problem, s.fit, s.level, s.options)
+                .ok()
+                .map(|c| c.profile)
+        } else {
+            None
+        }
+    })
+}
+
+/// As [`summarise`], with the profile intervals (one per parameter) from `profiles`, called
+/// only when the fit converged (a problem whose parameters are independent of one another
+/// can profile each on its own residuals).
+pub fn summarise_with_profiles<R: Residuals + ?Sized>(
+    s: Solved<'_, R>,
+    profiles: impl FnOnce(&Solved<'_, R>) -> Option<Vec<ProfileInterval>>,
+) -> FitResult {
     let Solved {
         name: fit_name,
         series,
         specs,
-        problem,
+        problem: _,
         fit: f,
         level,
         options: opts,
     } = s;
     let mut note = String::new();
     let ci = if f.converged() && f.chi2.is_finite() {
-        if profile {
-            confidence_intervals(problem, f, level, opts).ok()
-        } else {
-            None
-        }
+        profiles(&s).filter(|p| p.len() == specs.len())
     } else {
         note = format!(
             "not converged ({}): values are where the solver stopped, no intervals",
@@ -496,11 +511,9 @@ pub fn summarise<R: Residuals + ?Sized>(s: Solved<'_, R>, profile: bool) -> FitR
         .iter()
         .enumerate()
         .map(|(j, s)| {
-            let prof = ci
-                .as_ref()
-                .map(|c| (c.profile[j].lower, c.profile[j].upper));
+            let prof = ci.as_ref().map(|c| (c[j].lower, c[j].upper));
             if let Some(c) = &ci {
-                evals += c.profile[j].residual_evals;
+                evals += c[j].residual_evals;
             }
             let bounds = (
                 opts.lower.as_ref().map_or(f64::NEG_INFINITY, |l| l[j]),
@@ -508,7 +521,7 @@ pub fn summarise<R: Residuals + ?Sized>(s: Solved<'_, R>, profile: bool) -> FitR
             );
             let mut pnote = String::new();
             let profile_closed = ci.as_ref().is_some_and(|c| {
-                closed_end(c.profile[j].lower).is_some() && closed_end(c.profile[j].upper).is_some()
+                closed_end(c[j].lower).is_some() && closed_end(c[j].upper).is_some()
             });
             if let Some((a, b)) = wald.as_ref().map(|w| (w[j].lower, w[j].upper)) {
                 if !profile_closed && (a < bounds.0 || b > bounds.1) {

@@ -2,6 +2,7 @@
 //! The rows stream through the library's engine (`fitbead::io::stream`) with the scene plan
 //! of `fitbead::io::forward`; md, whose runs are long and few, reads the whole table.
 
+use super::args::{ContactArgs, OutputArgs};
 use super::{emit, read_input, CliError};
 use fitbead::io::forward::{scene_error, ForwardPlan, ForwardSettings, SceneColumns};
 use fitbead::io::scenes::{Table, TableReader};
@@ -29,9 +30,9 @@ pub struct Args {
     /// pass through. Without --input and --xi: the embedded default data set.
     #[arg(long)]
     pub input: Option<PathBuf>,
-    /// Output CSV (written atomically); stdout when absent.
-    #[arg(long)]
-    pub output: Option<PathBuf>,
+    /// Where the result goes.
+    #[command(flatten)]
+    pub out: OutputArgs,
     /// Radius ratio ξ = r/R of a single scene.
     #[arg(long)]
     pub xi: Option<f64>,
@@ -42,12 +43,9 @@ pub struct Args {
     /// c=VALUE.
     #[arg(long = "K", default_value = "adjusted")]
     pub k: String,
-    /// Gyration parameter ρ (2/5 sphere, 1/2 cylinder), for rows without a rho column.
-    #[arg(long, default_value_t = 0.4)]
-    pub rho: f64,
-    /// Coulomb friction coefficient f, for rows without an f column.
-    #[arg(long, default_value_t = 0.1)]
-    pub f: f64,
+    /// ρ and f of rows without those columns.
+    #[command(flatten)]
+    pub contact: ContactArgs,
     /// Jan's λ (eq 74) [default: the paper's fit, eq 75, at each row's α]
     #[arg(long)]
     pub lambda: Option<f64>,
@@ -124,7 +122,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let reader = TableReader::new(&source, input)?;
     let opts = stream_options("forward", size);
     let make = |r: &TableReader<Input>| plan(&a, kind, branch, r);
-    stream_to(reader, make, (), a.output.as_deref(), &opts, |_| Ok(())).map(|_| ())
+    stream_to(reader, make, (), a.out.output.as_deref(), &opts, |_| Ok(())).map(|_| ())
 }
 
 /// The scene plan of `a` for a table with `r`'s header: the columns first, then the flags
@@ -153,8 +151,8 @@ fn plan<R: Read>(
     let settings = ForwardSettings {
         kind,
         law,
-        rho: a.rho,
-        f: a.f,
+        rho: a.contact.rho(),
+        f: a.contact.f(),
         lambda: a.lambda,
         mu: a.mu,
         a: [a.a1, a.a2, a.a3],
@@ -512,15 +510,16 @@ fn run_md(a: &Args, t: &Table) -> Result<(), CliError> {
     for r in 0..t.rows.len() {
         let xi = t.number(r, c_xi)?;
         let d = t.number(r, c_d)?;
-        let rho = t.opt_number(r, c_rho)?.unwrap_or(a.rho);
+        let rho = t.opt_number(r, c_rho)?.unwrap_or(a.contact.rho());
         // K and f do not enter the md model: a placeholder K keeps Scene's validation quiet.
-        let scene = Scene::new(xi, d, rho, a.f, CollisionLaw::Value(0.5)).map_err(|e| {
-            scene_error(
-                &t.row(r),
-                e,
-                &[("xi", Some(c_xi)), ("delta_deg", Some(c_d)), ("rho", c_rho)],
-            )
-        })?;
+        let scene =
+            Scene::new(xi, d, rho, a.contact.f(), CollisionLaw::Value(0.5)).map_err(|e| {
+                scene_error(
+                    &t.row(r),
+                    e,
+                    &[("xi", Some(c_xi)), ("delta_deg", Some(c_d)), ("rho", c_rho)],
+                )
+            })?;
         if !(rho > 0.0) {
             let msg = "md needs rho > 0 (the bead's moment of inertia)";
             return Err(match c_rho {
@@ -595,7 +594,7 @@ fn run_md(a: &Args, t: &Table) -> Result<(), CliError> {
         return Err(CliError::Interrupted);
     }
     let bytes = render_md(t, &jobs, &results).map_err(|e| CliError::Other(e.to_string()))?;
-    emit(a.output.as_deref(), &bytes)
+    emit(a.out.output.as_deref(), &bytes)
 }
 
 fn render_md(

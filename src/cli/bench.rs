@@ -1,10 +1,10 @@
 //! `fitbead bench`: the work-precision report of `fitbead::report::workprecision`, as CSV and
 //! SVG.
 
+use super::args::{OutputArgs, PlotArgs};
 use super::{emit, CliError};
 use fitbead::io::write_atomic_all;
 use fitbead::report::workprecision::{draw_scenes, plot, render, run_bench_until, XCHECK_BOUNDS};
-use std::path::PathBuf;
 
 /// Arguments of `fitbead bench`.
 #[derive(Debug, clap::Args)]
@@ -16,12 +16,13 @@ pub struct Args {
     /// Seed of the scene draw.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Output CSV (written atomically); stdout when absent.
-    #[arg(long)]
-    pub output: Option<PathBuf>,
-    /// SVG work-precision diagram: log time per evaluation against log maximum error.
-    #[arg(long)]
-    pub plot: Option<PathBuf>,
+    /// Where the result goes.
+    #[command(flatten)]
+    pub out: OutputArgs,
+    /// With --plot: the work-precision diagram, log time per evaluation against log maximum
+    /// error.
+    #[command(flatten)]
+    pub plot: PlotArgs,
 }
 
 /// Runs `fitbead bench`.
@@ -85,7 +86,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         res.auto_mix.0, res.auto_mix.1, res.auto_mix.2
     );
     let bytes = render(&res.rows).map_err(|e| CliError::Other(e.to_string()))?;
-    let svg = match &a.plot {
+    let svg = match &a.plot.plot {
         Some(_) => plot(
             &res.rows,
             &format!("Work-precision, {} scenes (seed {})", scenes.len(), a.seed),
@@ -96,14 +97,15 @@ pub fn run(a: Args) -> Result<(), CliError> {
     // The plot and the CSV file are written as one group: both or neither.
     let files: Vec<(&std::path::Path, &[u8])> = a
         .plot
+        .plot
         .iter()
         .map(|p| (p.as_path(), svg.as_bytes()))
-        .chain(a.output.iter().map(|p| (p.as_path(), bytes.as_slice())))
+        .chain(a.out.output.iter().map(|p| (p.as_path(), bytes.as_slice())))
         .collect();
     if !files.is_empty() {
         write_atomic_all(&files).map_err(|e| CliError::Other(format!("cannot write: {e}")))?;
     }
-    if a.output.is_none() {
+    if a.out.output.is_none() {
         emit(None, &bytes)?;
     }
     Ok(())

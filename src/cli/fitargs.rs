@@ -1,5 +1,6 @@
 //! Flags and I/O shared by the fit commands (`klaw`, `jan`, `jaeger`).
 
+use super::args::{DataArgs, LevelArgs, OutputArgs, PlotArgs};
 use super::{emit, read_input, CliError};
 use fitbead::fit::data::Dataset;
 use fitbead::fit::k::bracket;
@@ -22,35 +23,21 @@ pub const MAX_WALKERS: usize = 10_000;
 /// Flags common to every fit command.
 #[derive(Debug, clap::Args)]
 pub struct FitArgs {
-    /// Measurements CSV: series,xi,delta_deg,v[,sigma_v] (v dimensionless), or dimensional
-    /// v_m_s,R_m[,g][,sigma_v_m_s]. Without it: the embedded default data set. Either every row
-    /// has sigma_v (absolute errors) or none has (unit weights; the common scale is estimated
-    /// from the scatter, χ²/dof).
-    #[arg(long)]
-    pub input: Option<PathBuf>,
-    /// The measurements CSV given as a plain argument (same as --input).
-    #[arg(value_name = "DATA.csv", conflicts_with = "input")]
-    pub data: Option<PathBuf>,
-    /// Gyration parameter ρ, for rows without a rho column (klaw; jan and jaeger do not use it).
-    #[arg(long, default_value_t = 0.4)]
-    pub rho: f64,
-    /// Coulomb friction coefficient f, for rows without an f column (klaw; jan and jaeger do not
-    /// use it).
-    #[arg(long, default_value_t = 0.1)]
-    pub f: f64,
-    /// Gravity g in m/s² for dimensional rows without a g column.
-    #[arg(long, default_value_t = 9.81)]
-    pub g: f64,
-    /// Confidence level of the intervals, in (0, 1).
-    #[arg(long, default_value_t = 0.95)]
-    pub level: f64,
+    /// The measurements and the defaults of the columns they may leave out (jan and jaeger do
+    /// not use ρ and f). Either every row has sigma_v (absolute errors) or none has (unit
+    /// weights; the common scale is estimated from the scatter, χ²/dof).
+    #[command(flatten)]
+    pub data: DataArgs,
+    /// The level of the intervals.
+    #[command(flatten)]
+    pub level: LevelArgs,
     /// Covariance intervals only (skip the profile-likelihood ones, which cost more fits).
     #[arg(long)]
     pub no_profile: bool,
-    /// Parameter report CSV (written atomically): fit,series,parameter,value,stderr,ci_low,
-    /// ci_high,ci_method,unit, then extra columns. Stdout when absent.
-    #[arg(long)]
-    pub output: Option<PathBuf>,
+    /// The parameter report: fit,series,parameter,value,stderr,ci_low,ci_high,ci_method,unit,
+    /// then extra columns.
+    #[command(flatten)]
+    pub out: OutputArgs,
     /// Fit statistics CSV (written atomically): χ², dof, AIC, BIC, termination per fit.
     /// Printed to stderr as a table when absent.
     #[arg(long)]
@@ -94,9 +81,10 @@ pub struct FitArgs {
     /// step, one column per parameter, log_posterior.
     #[arg(long)]
     pub draws: Option<PathBuf>,
-    /// MCMC: corner plot (SVG) of every posterior: marginal histograms and pairwise scatter.
-    #[arg(long)]
-    pub plot: Option<PathBuf>,
+    /// MCMC: with --plot, a corner plot of every posterior (marginal histograms and pairwise
+    /// scatter).
+    #[command(flatten)]
+    pub plot: PlotArgs,
 }
 
 /// The estimation method asked for on the command line (a posterior run carries the stop
@@ -121,7 +109,7 @@ impl FitArgs {
             ("--prior", !self.priors.is_empty()),
             ("--fit-scatter", self.fit_scatter),
             ("--draws", self.draws.is_some()),
-            ("--plot", self.plot.is_some()),
+            ("--plot", self.plot.plot.is_some()),
         ];
         match self.method.to_ascii_lowercase().as_str() {
             "lsq" => {
@@ -221,29 +209,29 @@ impl FitArgs {
     /// output is an input or another output).
     pub fn paths(&self) -> (super::NamedPaths<'_>, super::NamedPaths<'_>) {
         (
-            vec![("--input", self.input.as_deref().or(self.data.as_deref()))],
+            vec![("--input", self.data.path())],
             vec![
-                ("--output", self.output.as_deref()),
+                ("--output", self.out.output.as_deref()),
                 ("--output-stats", self.output_stats.as_deref()),
                 ("--draws", self.draws.as_deref()),
-                ("--plot", self.plot.as_deref()),
+                ("--plot", self.plot.plot.as_deref()),
             ],
         )
     }
 
     /// Validates the flags and reads the measurements.
     pub fn read(&self) -> Result<(Table, Vec<Measurement>, Dataset), CliError> {
-        if !(self.level > 0.0 && self.level < 1.0) {
+        if !(self.level.level() > 0.0 && self.level.level() < 1.0) {
             return Err(super::flag_error(
                 "--level",
-                &self.level.to_string(),
+                &self.level.level().to_string(),
                 "must be in (0, 1), e.g. 0.95",
             ));
         }
-        let input = self.input.as_deref().or(self.data.as_deref());
+        let input = self.data.path();
         let (source, text) = read_input(input)?;
         let t = Table::parse(&source, &text)?;
-        let defaults = super::measurement_defaults(self.rho, self.f, self.g)?;
+        let defaults = self.data.defaults()?;
         let rows = read_measurements(&t, &defaults)?;
         let ds = dataset_of(&t, &rows)?;
         super::warn_implausible(&t, &rows);
@@ -278,13 +266,14 @@ impl FitArgs {
             Some(_) => draws_csv(posteriors).map_err(|e| CliError::Other(e.to_string()))?,
             None => Vec::new(),
         };
-        let corner = match &self.plot {
+        let corner = match &self.plot.plot {
             Some(_) => corner_svg(&CornerBlock::from_posteriors(posteriors))
                 .map_err(|e| CliError::Other(format!("corner plot: {e}")))?
                 .into_bytes(),
             None => Vec::new(),
         };
         let files: Vec<(&std::path::Path, &[u8])> = self
+            .out
             .output
             .iter()
             .map(|p| (p.as_path(), p_csv.as_slice()))
@@ -294,7 +283,12 @@ impl FitArgs {
                     .map(|q| (q.as_path(), s.as_slice())),
             )
             .chain(self.draws.iter().map(|q| (q.as_path(), d_csv.as_slice())))
-            .chain(self.plot.iter().map(|q| (q.as_path(), corner.as_slice())))
+            .chain(
+                self.plot
+                    .plot
+                    .iter()
+                    .map(|q| (q.as_path(), corner.as_slice())),
+            )
             .collect();
         if !files.is_empty() {
             write_atomic_all(&files).map_err(|e| CliError::Other(format!("cannot write: {e}")))?;
@@ -319,7 +313,7 @@ impl FitArgs {
                 );
             }
         }
-        if self.output.is_none() {
+        if self.out.output.is_none() {
             emit(None, &p_csv)?;
         }
         // Warnings of the posterior runs go to stderr even when the statistics go to a file.

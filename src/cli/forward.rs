@@ -2,18 +2,17 @@
 //! The rows stream through the library's engine (`fitbead::io::stream`) with the scene plan
 //! of `fitbead::io::forward`; md, whose runs are long and few, reads the whole table.
 
+use super::args::{ContactArgs, OutputArgs};
 use super::{emit, read_input, CliError};
-use fitbead::io::forward::{scene_error, ForwardPlan, ForwardSettings, SceneColumns};
+use fitbead::io::forward::{ForwardPlan, ForwardSettings, ForwardText};
+use fitbead::io::md::{md_csv, md_jobs, MdTable};
 use fitbead::io::scenes::{Table, TableReader};
 use fitbead::io::stream::{stream, RowPlan, StreamError, StreamOptions, Streamed};
 use fitbead::io::{fmt_f64, AtomicFile, InputError};
 use fitbead::models::md::{
     Md, MdParams, MdResult, MdRunConfig, MdSetting, MdSettings, ReducedMass,
 };
-use fitbead::models::Regime;
-use fitbead::models::{regime_of, JaegerBranch, Model, ModelKind};
-use fitbead::scene::ParameterError as Error;
-use fitbead::scene::{CollisionLaw, Scene};
+use fitbead::models::{JaegerBranch, Model, ModelKind};
 use rayon::prelude::*;
 use std::io::{Cursor, Read, Write};
 use std::path::{Path, PathBuf};
@@ -29,9 +28,9 @@ pub struct Args {
     /// pass through. Without --input and --xi: the embedded default data set.
     #[arg(long)]
     pub input: Option<PathBuf>,
-    /// Output CSV (written atomically); stdout when absent.
-    #[arg(long)]
-    pub output: Option<PathBuf>,
+    /// Where the result goes.
+    #[command(flatten)]
+    pub out: OutputArgs,
     /// Radius ratio ξ = r/R of a single scene.
     #[arg(long)]
     pub xi: Option<f64>,
@@ -42,12 +41,9 @@ pub struct Args {
     /// c=VALUE.
     #[arg(long = "K", default_value = "adjusted")]
     pub k: String,
-    /// Gyration parameter ρ (2/5 sphere, 1/2 cylinder), for rows without a rho column.
-    #[arg(long, default_value_t = 0.4)]
-    pub rho: f64,
-    /// Coulomb friction coefficient f, for rows without an f column.
-    #[arg(long, default_value_t = 0.1)]
-    pub f: f64,
+    /// ρ and f of rows without those columns.
+    #[command(flatten)]
+    pub contact: ContactArgs,
     /// Jan's λ (eq 74) [default: the paper's fit, eq 75, at each row's α]
     #[arg(long)]
     pub lambda: Option<f64>,
@@ -124,56 +120,32 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let reader = TableReader::new(&source, input)?;
     let opts = stream_options("forward", size);
     let make = |r: &TableReader<Input>| plan(&a, kind, branch, r);
-    stream_to(reader, make, (), a.output.as_deref(), &opts, |_| Ok(())).map(|_| ())
+    stream_to(reader, make, (), a.out.output.as_deref(), &opts, |_| Ok(())).map(|_| ())
 }
 
-/// The scene plan of `a` for a table with `r`'s header: the columns first, then the flags
-/// (`--spin`, `--tol`, `--K`), so that their errors come in that order.
+/// The scene plan of `a` for a table with `r`'s header ([`ForwardPlan::from_text`]).
 fn plan<R: Read>(
     a: &Args,
     kind: ModelKind,
     branch: JaegerBranch,
     r: &TableReader<R>,
 ) -> Result<ForwardPlan, InputError> {
-    let cols = SceneColumns::new(r)?;
-    let spin = a
-        .spin
-        .parse()
-        .map_err(|e: Error| flag_input_error("--spin", &a.spin, e.to_string()))?;
-    if !(a.tol > 0.0 && a.tol < 1.0) {
-        return Err(flag_input_error(
-            "--tol",
-            &a.tol.to_string(),
-            "expected a relative tolerance in (0, 1)",
-        ));
-    }
-    let law =
-        a.k.parse()
-            .map_err(|e: Error| flag_input_error("--K", &a.k, e.to_string()))?;
-    let settings = ForwardSettings {
-        kind,
-        law,
-        rho: a.rho,
-        f: a.f,
-        lambda: a.lambda,
-        mu: a.mu,
-        a: [a.a1, a.a2, a.a3],
-        branch,
-        spin,
-        tol: a.tol,
+    let text = ForwardText {
+        k: &a.k,
+        spin: &a.spin,
+        base: ForwardSettings {
+            kind,
+            rho: a.contact.rho(),
+            f: a.contact.f(),
+            lambda: a.lambda,
+            mu: a.mu,
+            a: [a.a1, a.a2, a.a3],
+            branch,
+            tol: a.tol,
+            ..ForwardSettings::default()
+        },
     };
-    Ok(ForwardPlan::new(r, cols, settings))
-}
-
-/// A flag error as the input error it is reported as.
-pub(super) fn flag_input_error(flag: &str, value: &str, message: impl Into<String>) -> InputError {
-    InputError {
-        file: "<command line>".into(),
-        line: None,
-        column: Some(flag.to_string()),
-        value: Some(value.to_string()),
-        message: message.into(),
-    }
+    ForwardPlan::from_text(r, &text)
 }
 
 /// A streamed input: a file, the embedded default data, or text from the command line.
@@ -360,46 +332,13 @@ pub struct MdArgs {
     pub check_step: bool,
 }
 
-/// md output columns added to each row.
-pub const MD_OUTPUT_COLUMNS: [&str; 29] = [
-    "v",
-    "regime",
-    "status",
-    "v_stderr",
-    "v_m_s",
-    "drift",
-    "beads_passed",
-    "stop_bead",
-    "stop_theta_deg",
-    "lift_offs_per_bead",
-    "lift_off_theta_deg",
-    "skipped_fraction",
-    "flight_height_max",
-    "flight_length_mean",
-    "flight_length_max",
-    "airborne_fraction",
-    "contacts_per_bead",
-    "bounces_per_contact",
-    "diss_normal",
-    "diss_tangential",
-    "energy_error",
-    "final_velocity",
-    "initial_velocity",
-    "K_eff",
-    "dt",
-    "contact_time",
-    "steps",
-    "step_check_rel",
-    "message",
-];
-
 impl MdArgs {
     /// The model from the preset and the flags (no table).
     pub fn model(&self) -> Result<Md, CliError> {
         let given = self.settings();
         build_md(self, &given, &|s: MdSetting, msg: String| {
             super::flag_error(
-                &md_flag(s),
+                &format!("--{}", s.flag()),
                 &given.get(s).map(fmt_f64).unwrap_or_default(),
                 msg,
             )
@@ -425,16 +364,6 @@ impl MdArgs {
             launch_velocity: self.launch_velocity,
             step_fraction: self.step_fraction,
         }
-    }
-}
-
-/// The flag of an md setting: `--` and its column with `-` for `_`, except `--coulomb`
-/// (`mu_c`) and `--md-g` (`g`).
-fn md_flag(s: MdSetting) -> String {
-    match s {
-        MdSetting::Coulomb => "--coulomb".into(),
-        MdSetting::Gravity => "--md-g".into(),
-        s => format!("--{}", s.column().replace('_', "-")),
     }
 }
 
@@ -500,65 +429,17 @@ pub fn md_progress_bar(total: u64, what: &str) -> Option<indicatif::ProgressBar>
 }
 
 fn run_md(a: &Args, t: &Table) -> Result<(), CliError> {
-    let c_xi = t.require("xi")?;
-    let c_d = t.require("delta_deg")?;
-    let c_rho = t.col("rho");
-    let cols: Vec<(MdSetting, usize)> = MdSetting::ALL
-        .into_iter()
-        .filter_map(|s| t.col(s.column()).map(|c| (s, c)))
-        .collect();
-    let flags = a.md.settings();
-    let mut jobs: Vec<(Scene, Md)> = Vec::with_capacity(t.rows.len());
-    for r in 0..t.rows.len() {
-        let xi = t.number(r, c_xi)?;
-        let d = t.number(r, c_d)?;
-        let rho = t.opt_number(r, c_rho)?.unwrap_or(a.rho);
-        // K and f do not enter the md model: a placeholder K keeps Scene's validation quiet.
-        let scene = Scene::new(xi, d, rho, a.f, CollisionLaw::Value(0.5)).map_err(|e| {
-            scene_error(
-                &t.row(r),
-                e,
-                &[("xi", Some(c_xi)), ("delta_deg", Some(c_d)), ("rho", c_rho)],
-            )
-        })?;
-        if !(rho > 0.0) {
-            let msg = "md needs rho > 0 (the bead's moment of inertia)";
-            return Err(match c_rho {
-                Some(c) => t.err(r, c, msg).into(),
-                None => super::flag_error("--rho", &fmt_f64(rho), msg),
-            });
-        }
-        let mut given = flags;
-        for &(s, c) in &cols {
-            if let Some(x) = t.opt_number(r, Some(c))? {
-                given.set(s, x);
-            }
-        }
-        let err = |s: MdSetting, msg: String| -> CliError {
-            match cols.iter().find(|(x, _)| *x == s) {
-                Some(&(_, c)) if !t.cell(r, c).is_empty() => t.err(r, c, msg).into(),
-                _ => super::flag_error(
-                    &md_flag(s),
-                    &given.get(s).map(fmt_f64).unwrap_or_default(),
-                    msg,
-                ),
-            }
-        };
-        let md = build_md(&a.md, &given, &err)?;
-        md.check_scene(&scene).map_err(|e| match &e {
-            Error::InvalidParameter { field: "rho", .. } => match c_rho {
-                Some(c) if !t.cell(r, c).is_empty() => t.err(r, c, e.to_string()).into(),
-                _ => super::flag_error("--rho", &fmt_f64(rho), e.to_string()),
-            },
-            Error::InvalidParameter { field, .. } => match MdSetting::from_column(field) {
-                Some(s) => err(s, e.to_string()),
-                None => CliError::Other(e.to_string()),
-            },
-            _ => CliError::Other(e.to_string()),
-        })?;
-        fitbead::io::forward::check_scene_cells(&t.row(r), &|n| t.col(n))?;
-        jobs.push((scene, md));
-    }
+    let base = MdTable {
+        md: build_md(
+            &a.md,
+            &MdSettings::default(),
+            &|s: MdSetting, msg: String| super::flag_error(&format!("--{}", s.flag()), "", msg),
+        )?,
+        flags: a.md.settings(),
+        rho: a.contact.rho(),
+        f: a.contact.f(),
+    };
+    let jobs = md_jobs(t, &base)?;
     let stop = super::stop_flag();
     let reps: u64 = if a.md.check_step { 3 } else { 1 };
     let total: u64 = jobs.iter().map(|(_, m)| m.config.beads as u64 * reps).sum();
@@ -594,352 +475,6 @@ fn run_md(a: &Args, t: &Table) -> Result<(), CliError> {
     if stop.load(std::sync::atomic::Ordering::SeqCst) {
         return Err(CliError::Interrupted);
     }
-    let bytes = render_md(t, &jobs, &results).map_err(|e| CliError::Other(e.to_string()))?;
-    emit(a.output.as_deref(), &bytes)
-}
-
-fn render_md(
-    t: &Table,
-    jobs: &[(Scene, Md)],
-    results: &[(MdResult, Option<f64>)],
-) -> csv::Result<Vec<u8>> {
-    let mut w = csv::Writer::from_writer(Vec::with_capacity(t.rows.len() * 400));
-    let mut header: Vec<String> = t
-        .headers
-        .iter()
-        .map(|h| {
-            if MD_OUTPUT_COLUMNS.contains(&h.as_str()) {
-                format!("in_{h}")
-            } else {
-                h.clone()
-            }
-        })
-        .collect();
-    header.extend(MD_OUTPUT_COLUMNS.iter().map(|s| s.to_string()));
-    w.write_record(&header)?;
-    let opt = |x: Option<f64>| x.map(fmt_f64).unwrap_or_default();
-    for ((rec, (scene, _)), (r, rel)) in t.rows.iter().zip(jobs).zip(results) {
-        let mut out: Vec<String> = rec.iter().map(|s| s.to_string()).collect();
-        let o = Md::outcome(scene, r);
-        let moving = matches!(r.regime, Some(Regime::B) | Some(Regime::C));
-        let deg = |x: Option<f64>| opt(x.map(f64::to_degrees));
-        out.push(if moving {
-            opt(r.mean_velocity)
-        } else {
-            String::new()
-        });
-        out.push(regime_of(&o).map(|g| g.to_string()).unwrap_or_default());
-        out.push(match &o {
-            Ok(_) => "ok".into(),
-            Err(e) => e.status().into(),
-        });
-        out.push(if moving { opt(r.stderr) } else { String::new() });
-        out.push(if moving {
-            opt(r.mean_velocity_si)
-        } else {
-            String::new()
-        });
-        out.push(opt(r.drift));
-        out.push(r.beads_passed.to_string());
-        out.push(r.stop.map(|s| s.bead.to_string()).unwrap_or_default());
-        out.push(deg(r.stop.map(|s| s.angle)));
-        let measured = r.mean_velocity.is_some();
-        let m = |x: f64| if measured { fmt_f64(x) } else { String::new() };
-        out.push(m(r.lift_offs_per_bead));
-        out.push(deg(r.lift_off_angle));
-        out.push(m(r.skipped_fraction));
-        out.push(m(r.flight_height_max));
-        out.push(opt(r.flight_length_mean));
-        out.push(m(r.flight_length_max));
-        out.push(m(r.airborne_fraction));
-        out.push(m(r.contacts_per_bead));
-        out.push(m(r.bounces_per_contact));
-        out.push(m(r.dissipation_normal));
-        out.push(m(r.dissipation_tangential));
-        out.push(fmt_f64(r.energy_error));
-        out.push(opt(r.final_velocity));
-        out.push(opt(r.initial_velocity));
-        out.push(opt(r.k_eff));
-        out.push(fmt_f64(r.dt));
-        out.push(fmt_f64(r.contact_time));
-        out.push(r.steps.to_string());
-        out.push(opt(*rel));
-        out.push(match &o {
-            Ok(_) => String::new(),
-            Err(e) => match r.stop {
-                Some(s) => format!("{e} (trapped after {} row beads)", s.bead),
-                None => e.to_string(),
-            },
-        });
-        w.write_record(&out)?;
-    }
-    w.into_inner().map_err(|e| csv::Error::from(e.into_error()))
-}
-
-#[cfg(test)]
-mod tests {
-    //! The streaming path against golden outputs (tests/golden/forward/, written by a separate
-    //! implementation of `forward` that read the whole table, evaluated it, then wrote it): the
-    //! same bytes on the shipped data and on a table with every kind of cell, for every model
-    //! but md, at chunk sizes from 1 row to [`CHUNK_ROWS`]; the same message for every kind of
-    //! bad input.
-
-    use super::*;
-    use clap::Parser;
-    use fitbead::io::stream::{CHUNK_ROWS, TASK_ROWS};
-
-    #[derive(Parser)]
-    struct Cmd {
-        #[command(flatten)]
-        a: Args,
-    }
-
-    fn args(flags: &[&str]) -> Args {
-        Cmd::parse_from(std::iter::once("forward").chain(flags.iter().copied())).a
-    }
-
-    fn kind_branch(a: &Args) -> (ModelKind, JaegerBranch) {
-        let kind = a.model.parse().unwrap();
-        let branch = match a.branch.as_str() {
-            "lower" => JaegerBranch::Lower,
-            _ => JaegerBranch::Upper,
-        };
-        (kind, branch)
-    }
-
-    fn new(a: &Args, text: &[u8], chunk: usize, task: usize) -> Result<Vec<u8>, String> {
-        let (kind, branch) = kind_branch(a);
-        let reader = TableReader::new("in.csv", text).map_err(|e| e.to_string())?;
-        let mut out = Vec::new();
-        let opts = StreamOptions {
-            chunk_rows: chunk,
-            task_rows: task,
-            ..StreamOptions::default()
-        };
-        match stream(reader, |r| plan(a, kind, branch, r), (), &mut out, &opts) {
-            Ok(_) => Ok(out),
-            Err(StreamError::Input(e)) => Err(e.to_string()),
-            Err(e) => panic!("writing to a Vec failed: {e:?}"),
-        }
-    }
-
-    const SIZES: [(usize, usize); 4] = [(1, 1), (7, 3), (64, 5), (CHUNK_ROWS, TASK_ROWS)];
-
-    /// The streaming output of `text` under `flags` equals `want` at every chunk size.
-    fn same(flags: &[&str], text: &[u8], want: &[u8]) {
-        let a = args(flags);
-        for (chunk, task) in SIZES {
-            let got = new(&a, text, chunk, task)
-                .unwrap_or_else(|e| panic!("{flags:?}, chunks of {chunk}: {e}"));
-            assert!(
-                want == got,
-                "{flags:?}, chunks of {chunk}: output differs\nwant:\n{}\ngot:\n{}",
-                String::from_utf8_lossy(want),
-                String::from_utf8_lossy(&got)
-            );
-        }
-    }
-
-    /// A golden file under tests/golden/forward/.
-    macro_rules! golden {
-        ($($part:literal),+) => {
-            include_bytes!(concat!(
-                env!("CARGO_MANIFEST_DIR"),
-                "/tests/golden/forward/",
-                $($part),+
-            ))
-        };
-    }
-
-    /// Each model's flags and its golden outputs on data/default.csv,
-    /// data/virtual/md_ristow.csv and tests/golden/forward/generated/input.csv.
-    macro_rules! models {
-        ($(($name:literal, $flags:expr)),* $(,)?) => {
-            [$(Golden {
-                flags: $flags,
-                default: golden!("default/", $name, ".csv"),
-                md_ristow: golden!("md_ristow/", $name, ".csv"),
-                generated: golden!("generated/", $name, ".csv"),
-            }),*]
-        };
-    }
-
-    struct Golden {
-        flags: &'static [&'static str],
-        default: &'static [u8],
-        md_ristow: &'static [u8],
-        generated: &'static [u8],
-    }
-
-    const MODELS: [Golden; 11] = models![
-        ("stick", &["--model", "stick"]),
-        (
-            "stick_cos2a_rho0.5",
-            &["--model", "stick", "--K", "cos2a", "--rho", "0.5"]
-        ),
-        ("stick-approx", &["--model", "stick-approx"]),
-        ("slip", &["--model", "slip"]),
-        ("slip-approx", &["--model", "slip-approx"]),
-        ("stickslip_f0.3", &["--model", "stickslip", "--f", "0.3"]),
-        ("contact_keep", &["--model", "contact", "--spin", "keep"]),
-        ("jan", &["--model", "jan"]),
-        (
-            "jaeger_upper",
-            &["--model", "jaeger", "--a1", "0.05", "--a2", "0.4", "--a3", "1.5"]
-        ),
-        (
-            "jaeger_lower",
-            &["--model", "jaeger", "--a1", "0.1", "--a2", "2", "--a3", "0.3", "--branch", "lower"]
-        ),
-        ("auto_tol1e-8", &["--model", "auto", "--tol", "1e-8"]),
-    ];
-
-    /// A table with every kind of cell the readers and writers meet: quoted cells (commas,
-    /// quotes, a newline), non-ASCII text, columns whose names clash with the output (`v`,
-    /// `regime`, `phase_sequence`), laws by name, empty cells falling back on the flags,
-    /// padded cells (ASCII and Unicode spaces), blank lines, and scenes in regimes A, B and C
-    /// with every outcome and phase sequence each model gives on them.
-    const GENERATED: &[u8] = golden!("generated/input.csv");
-    /// Rows of [`GENERATED`].
-    const GENERATED_ROWS: usize = 44;
-
-    #[test]
-    fn same_bytes_as_the_golden_outputs_on_the_shipped_data() {
-        for m in &MODELS {
-            same(m.flags, include_bytes!("../../data/default.csv"), m.default);
-            same(
-                m.flags,
-                include_bytes!("../../data/virtual/md_ristow.csv"),
-                m.md_ristow,
-            );
-        }
-    }
-
-    #[test]
-    fn same_bytes_as_the_golden_outputs_on_the_generated_table() {
-        for m in &MODELS {
-            same(m.flags, GENERATED, m.generated);
-        }
-        // A single scene on the command line goes through the same path.
-        same(
-            &["--model", "stick"],
-            b"xi,delta_deg\n1,12\n",
-            golden!("single_scene.csv"),
-        );
-    }
-
-    /// Several full-size chunks and a partial one: the generated table's body repeated, whose
-    /// output is the golden header and the golden body repeated (every row's output depends on
-    /// that row alone).
-    #[test]
-    fn same_bytes_over_several_full_chunks() {
-        let split = |b: &'static [u8]| {
-            let i = b.iter().position(|&c| c == b'\n').unwrap() + 1;
-            (&b[..i], &b[i..])
-        };
-        let reps = 3 * CHUNK_ROWS / GENERATED_ROWS + 1;
-        let (head, body) = split(GENERATED);
-        let text = [head, &body.repeat(reps)].concat();
-        let (head, body) = split(MODELS[0].generated);
-        let want = [head, &body.repeat(reps)].concat();
-        let rows = csv::Reader::from_reader(MODELS[0].generated)
-            .records()
-            .count();
-        assert_eq!(rows, GENERATED_ROWS);
-        same(MODELS[0].flags, &text, &want);
-    }
-
-    fn error_cases() -> Vec<(&'static [&'static str], Vec<u8>)> {
-        let good = "1,12\n".repeat(40);
-        let late_s = |bad: &str| format!("xi,delta_deg\n{good}{bad}{good}");
-        let late = |bad: &str| late_s(bad).into_bytes();
-        let stick: &[&str] = &["--model", "stick"];
-        vec![
-            (stick, Vec::new()),
-            (stick, " \n\t\n".into()),
-            (stick, "xi,delta_deg\n".into()),
-            (stick, "xi,delta_deg\n\n\n".into()),
-            (stick, "xi,,delta_deg\n1,2,3\n".into()),
-            (stick, "xi,xi,delta_deg\n1,2,3\n".into()),
-            (stick, "xi,K\n1,0.6\n".into()),
-            (stick, "xi,delta_deg\n1,abc\n".into()),
-            (stick, "xi,delta_deg\n1,10\n1,NaN\n".into()),
-            (stick, "xi,delta_deg\n1,inf\n".into()),
-            (stick, "xi,delta_deg\n-1,10\n".into()),
-            (stick, "xi,delta_deg\n1,95\n".into()),
-            (stick, "xi,delta_deg\n ,10\n".into()),
-            (stick, "xi,delta_deg,K\n1,10,smooth\n".into()),
-            (stick, "xi,delta_deg,K\n1,10,-0.5\n".into()),
-            (stick, "xi,delta_deg,K\n1,10,inf\n".into()),
-            (stick, "xi,delta_deg,K\n1,10,c=abc\n".into()),
-            (stick, "xi,delta_deg,rho\n1,10,-2\n".into()),
-            (stick, "xi,delta_deg,f\n1,10,x\n".into()),
-            // Bad rows after the first chunks; the first one is reported.
-            (stick, late("1,abc\n")),
-            (stick, late("1,10\n0,10\n1,abc\n")),
-            // A malformed row anywhere wins over a bad value before it.
-            (stick, late("1,10,3\n")),
-            (stick, format!("{}1,abc\n{good}1,10,3\n", late_s("")).into()),
-            (stick, format!("xi,delta_deg\n1,abc\n{good}\"1,10\n").into()),
-            // Invalid UTF-8, the byte index counted in the trimmed cell.
-            (stick, b"xi,delta_deg\n1,10\n1,\xff\n".to_vec()),
-            (stick, b"xi,delta_deg\n1,10\n1, \t \xc3\xa9\xff \n".to_vec()),
-            (stick, b"xi,delta_deg\n\n\n1,10\n\n1,\xc3\n".to_vec()),
-            (stick, late("1,\u{e9}\n")),
-            (stick, [late(""), b"  \xfe,1\n".to_vec()].concat()),
-            (stick, [late("1,abc\n"), b"  \xfe,1\n".to_vec()].concat()),
-            // Flag errors come after the table's own errors.
-            (&["--model", "stick", "--tol", "2"], "xi,delta_deg\n".into()),
-            (&["--model", "stick", "--tol", "2"], late("1,10,3\n")),
-            (&["--model", "stick", "--tol", "2"], late("")),
-            (&["--model", "stick", "--K", "bogus"], late("")),
-            (&["--model", "stick", "--spin", "bogus"], late("")),
-            (&["--model", "stick", "--rho=-1"], late("")),
-            (&["--model", "jaeger"], late("")),
-            (
-                &["--model", "jaeger", "--a1", "1", "--a2", "1"],
-                "xi,delta_deg,a3\n1,10,1\n1,10,\n".into(),
-            ),
-            (
-                &["--model", "jaeger", "--a1", "1", "--a2", "1", "--a3=-1"],
-                late(""),
-            ),
-            (
-                &["--model", "jan"],
-                "xi,delta_deg,lambda\n1,10,0.8\n1,10,-1\n".into(),
-            ),
-            (&["--model", "jan", "--mu=-1"], late("")),
-            (
-                &["--model", "contact"],
-                "xi,delta_deg,spin\n1,10,roll\n1,10,twirl\n".into(),
-            ),
-            (&["--model", "auto"], late("1,-3\n")),
-        ]
-    }
-
-    /// tests/golden/forward/errors.txt: one line per case of [`error_cases`], the message as a
-    /// Rust string literal (`{:?}`).
-    #[test]
-    fn same_error_as_the_golden_messages() {
-        let want: Vec<&str> = std::str::from_utf8(golden!("errors.txt"))
-            .unwrap()
-            .lines()
-            .collect();
-        let cases = error_cases();
-        assert_eq!(want.len(), cases.len());
-        for ((flags, bytes), want) in cases.into_iter().zip(want) {
-            let a = args(flags);
-            let text = String::from_utf8_lossy(&bytes);
-            for (chunk, task) in SIZES {
-                match new(&a, &bytes, chunk, task) {
-                    Ok(_) => panic!("{flags:?} {text:?}, chunks of {chunk}: should fail"),
-                    Err(e) => assert_eq!(
-                        format!("{e:?}"),
-                        want,
-                        "{flags:?} {text:?}, chunks of {chunk}"
-                    ),
-                }
-            }
-        }
-    }
+    let bytes = md_csv(t, &jobs, &results).map_err(|e| CliError::Other(e.to_string()))?;
+    emit(a.out.output.as_deref(), &bytes)
 }

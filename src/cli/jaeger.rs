@@ -22,7 +22,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let branch = super::jaeger_branch(&a.branch)?;
     let (t, _rows, ds) = a.io.read()?;
     let choice = a.io.method(&["a1", "a2", "a3"])?;
-    let fits = fit_jaeger_with(&ds, branch, a.io.level, &choice.method);
+    let fits = fit_jaeger_with(&ds, branch, a.io.level.level(), &choice.method);
     let notes: Vec<String> = fits.notes.iter().map(|n| locate_note(&t, &ds, n)).collect();
     let (mut params, mut stats) = (Vec::new(), Vec::new());
     for f in fits.series.iter().flatten() {

@@ -1,6 +1,7 @@
 //! `fitbead k`: the collisional parameter K of every measured point (eq 69), its interval at
 //! v ± σ, and why where there is none.
 
+use super::args::{DataArgs, OutputArgs, PlotArgs};
 use super::forward::{open_input, stream_options, stream_to, Input};
 use super::CliError;
 use fitbead::io::kstream::{KLedger, KPlan, KSettings};
@@ -9,7 +10,6 @@ use fitbead::io::{AtomicFile, InputError};
 use fitbead::models::auto::Auto;
 use fitbead::models::{Model, ModelKind};
 use std::io::Write;
-use std::path::PathBuf;
 
 /// Arguments of `fitbead k`.
 #[derive(Debug, clap::Args)]
@@ -18,29 +18,16 @@ pub struct Args {
     /// row the model chosen at the stick K; see --tol).
     #[arg(long)]
     pub model: String,
-    /// Measurements CSV: series,xi,delta_deg,v[,sigma_v] (v dimensionless), or dimensional
-    /// v_m_s,R_m[,g][,sigma_v_m_s] instead of v. Without it: the embedded default data set.
-    #[arg(long)]
-    pub input: Option<PathBuf>,
-    /// The measurements CSV given as a plain argument (same as --input).
-    #[arg(value_name = "DATA.csv", conflicts_with = "input")]
-    pub data: Option<PathBuf>,
-    /// Gyration parameter ρ (2/5 sphere, 1/2 cylinder), for rows without a rho column.
-    #[arg(long, default_value_t = 0.4)]
-    pub rho: f64,
-    /// Coulomb friction coefficient f, for rows without an f column.
-    #[arg(long, default_value_t = 0.1)]
-    pub f: f64,
-    /// Gravity g in m/s² for dimensional rows without a g column.
-    #[arg(long, default_value_t = 9.81)]
-    pub g: f64,
-    /// Output CSV (written atomically); stdout when absent.
-    #[arg(long)]
-    pub output: Option<PathBuf>,
-    /// SVG of K against the steady final velocity, one colour per series, with the cos 2α
+    /// The measurements and the defaults of the columns they may leave out.
+    #[command(flatten)]
+    pub data: DataArgs,
+    /// Where the table goes.
+    #[command(flatten)]
+    pub out: OutputArgs,
+    /// With --plot: K against the steady final velocity, one colour per series, with the cos 2α
     /// lines (as the paper's Fig. 5).
-    #[arg(long)]
-    pub plot: Option<PathBuf>,
+    #[command(flatten)]
+    pub plot: PlotArgs,
     /// With --model auto: the target relative tolerance T on v of the model chosen per row.
     #[arg(long, default_value = "1e-10")]
     pub tol: f64,
@@ -97,17 +84,17 @@ pub fn run(a: Args) -> Result<(), CliError> {
         Some(_) => Model::Stick,
         None => parse_model(&a.model)?,
     };
-    let input = a.input.as_deref().or(a.data.as_deref());
+    let input = a.data.path();
     let (source, input, size) = open_input(input)?;
     let reader = TableReader::new(&source, input)?;
     let ledger = KLedger::checking(&reader);
     // Checked here, reported after the table's own errors (as when it was read whole).
-    let defaults = super::measurement_defaults(a.rho, a.f, a.g);
+    let defaults = a.data.defaults();
     let settings = KSettings {
         model,
         auto,
         model_name: a.model.clone(),
-        plot: a.plot.is_some(),
+        plot: a.plot.plot.is_some(),
     };
     let make = |r: &TableReader<Input>| -> Result<KPlan, InputError> {
         let d = match defaults {
@@ -119,21 +106,28 @@ pub fn run(a: Args) -> Result<(), CliError> {
     };
     // The plot's file is created first so that a target that cannot be written is reported
     // (after the input proved good) before the output is committed.
-    let plot = a.plot.as_deref().map(|p| (p, AtomicFile::create(p)));
+    let plot = a.plot.plot.as_deref().map(|p| (p, AtomicFile::create(p)));
     let opts = stream_options("k", size);
-    stream_to(reader, make, ledger, a.output.as_deref(), &opts, |ledger| {
-        for w in ledger.warnings() {
-            eprintln!("fitbead: warning: {source}: {w}");
-        }
-        let Some((p, file)) = plot else {
-            return Ok(());
-        };
-        let cannot =
-            |e: std::io::Error| CliError::Other(format!("{}: cannot write: {e}", p.display()));
-        let svg = ledger.plot_svg(&a.model).map_err(CliError::Other)?;
-        let mut f = file.map_err(cannot)?;
-        f.write_all(svg.as_bytes()).map_err(cannot)?;
-        f.commit().map_err(cannot)
-    })
+    stream_to(
+        reader,
+        make,
+        ledger,
+        a.out.output.as_deref(),
+        &opts,
+        |ledger| {
+            for w in ledger.warnings() {
+                eprintln!("fitbead: warning: {source}: {w}");
+            }
+            let Some((p, file)) = plot else {
+                return Ok(());
+            };
+            let cannot =
+                |e: std::io::Error| CliError::Other(format!("{}: cannot write: {e}", p.display()));
+            let svg = ledger.plot_svg(&a.model).map_err(CliError::Other)?;
+            let mut f = file.map_err(cannot)?;
+            f.write_all(svg.as_bytes()).map_err(cannot)?;
+            f.commit().map_err(cannot)
+        },
+    )
     .map(|_| ())
 }

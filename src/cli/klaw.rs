@@ -155,11 +155,11 @@ pub fn run(a: Args) -> Result<(), CliError> {
         },
         ..KLawContext::default()
     };
-    let main = fit_law_in(model, &ds, law, a.io.level, &choice.method, context)
+    let main = fit_law_in(model, &ds, law, a.io.level.level(), &choice.method, context)
         .map_err(|e| interrupted(fail(e)))?;
     let mut stats = vec![main.summary.stats.clone()];
     if law != KLaw::Impact {
-        let imp = fit_law(model, &ds, KLaw::Impact, a.io.level, false)
+        let imp = fit_law(model, &ds, KLaw::Impact, a.io.level.level(), false)
             .map_err(|e| interrupted(fail(e)))?;
         stats.push(imp.summary.stats);
     }

@@ -1,5 +1,6 @@
 //! The command line: one module per subcommand. Errors are rendered here, once.
 
+pub mod args;
 pub mod bench;
 pub mod fitargs;
 pub mod forward;
@@ -252,16 +253,16 @@ pub fn stdout_closed() -> bool {
 /// Refuses a command whose result would go to a closed standard output.
 fn check_stdout(c: &Command) -> Result<(), CliError> {
     let to_stdout = match c {
-        Command::Forward(a) => a.output.is_none(),
-        Command::K(a) => a.output.is_none(),
-        Command::Klaw(a) => a.io.output.is_none(),
-        Command::Jan(a) => a.io.output.is_none(),
-        Command::Jaeger(a) => a.io.output.is_none(),
-        Command::Regimes(a) => a.output.is_none(),
+        Command::Forward(a) => a.out.output.is_none(),
+        Command::K(a) => a.out.output.is_none(),
+        Command::Klaw(a) => a.io.out.output.is_none(),
+        Command::Jan(a) => a.io.out.output.is_none(),
+        Command::Jaeger(a) => a.io.out.output.is_none(),
+        Command::Regimes(a) => a.out.output.is_none(),
         // The tables go to --out-dir; stdout only shows a summary of them.
         Command::Report(_) => false,
-        Command::Simulate(a) => a.output.is_none(),
-        Command::Bench(a) => a.output.is_none(),
+        Command::Simulate(a) => a.out.output.is_none(),
+        Command::Bench(a) => a.out.output.is_none(),
     };
     if stdout_closed() && to_stdout {
         return Err(CliError::Other(
@@ -285,27 +286,30 @@ fn check_paths(c: &Command) -> Result<(), CliError> {
     let (inputs, outputs): (NamedPaths<'_>, NamedPaths<'_>) = match c {
         Command::Forward(a) => (
             vec![("--input", opt(&a.input))],
-            vec![("--output", opt(&a.output))],
+            vec![("--output", opt(&a.out.output))],
         ),
         Command::K(a) => (
-            vec![("--input", opt(&a.input).or(opt(&a.data)))],
-            vec![("--output", opt(&a.output)), ("--plot", opt(&a.plot))],
+            vec![("--input", a.data.path())],
+            vec![
+                ("--output", opt(&a.out.output)),
+                ("--plot", opt(&a.plot.plot)),
+            ],
         ),
         Command::Klaw(a) => a.io.paths(),
         Command::Jan(a) => a.io.paths(),
         Command::Jaeger(a) => a.io.paths(),
-        Command::Regimes(a) => (vec![], vec![("--output", opt(&a.output))]),
+        Command::Regimes(a) => (vec![], vec![("--output", opt(&a.out.output))]),
         Command::Report(a) => (
-            vec![
-                ("--input", opt(&a.input).or(opt(&a.data))),
-                ("--recipe", opt(&a.recipe)),
-            ],
+            vec![("--input", a.data.path()), ("--recipe", opt(&a.recipe))],
             vec![],
         ),
-        Command::Simulate(a) => (vec![], vec![("--output", opt(&a.output))]),
+        Command::Simulate(a) => (vec![], vec![("--output", opt(&a.out.output))]),
         Command::Bench(a) => (
             vec![],
-            vec![("--output", opt(&a.output)), ("--plot", opt(&a.plot))],
+            vec![
+                ("--output", opt(&a.out.output)),
+                ("--plot", opt(&a.plot.plot)),
+            ],
         ),
     };
     distinct_paths(&inputs, &outputs)

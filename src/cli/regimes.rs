@@ -1,13 +1,13 @@
 //! `fitbead regimes`: δ_m (eq 32) and δ_d (eq 31) per ξ, the bulk friction μ (eq 79) and the
 //! critical ξ below which no steady regime exists.
 
+use super::args::OutputArgs;
 use super::{emit, CliError};
 use fitbead::io::fmt_f64;
 use fitbead::models::regimes::{
     alpha_of_xi, bulk_friction_law, critical_xi, delta_d_law, delta_m_law,
 };
 use fitbead::scene::CollisionLaw;
-use std::path::PathBuf;
 
 /// Arguments of `fitbead regimes`.
 #[derive(Debug, clap::Args)]
@@ -21,9 +21,9 @@ pub struct Args {
     /// Radius ratios ξ (comma-separated, or the flag repeated).
     #[arg(long, value_delimiter = ',', default_values_t = vec![0.8, 1.0, 1.6, 2.0])]
     pub xi: Vec<f64>,
-    /// Output CSV (written atomically); stdout when absent.
-    #[arg(long)]
-    pub output: Option<PathBuf>,
+    /// Where the result goes.
+    #[command(flatten)]
+    pub out: OutputArgs,
 }
 
 /// Runs `fitbead regimes`.
@@ -83,5 +83,5 @@ pub fn run(a: Args) -> Result<(), CliError> {
         .map_err(io)?;
     }
     let bytes = w.into_inner().map_err(|e| CliError::Other(e.to_string()))?;
-    emit(a.output.as_deref(), &bytes)
+    emit(a.out.output.as_deref(), &bytes)
 }

@@ -2,6 +2,7 @@
 //! friction μ of Jan's model against eq 79, energy budgets, the regime map, the model ranking —
 //! as a directory of CSV tables, SVG figures and a `report.md` that links them.
 
+use super::args::{ContactArgs, DataArgs, LevelArgs, OutputArgs, PlotArgs};
 use super::fitargs::{flag_absurd, locate_point, not_converged, unsteady_points, FitArgs};
 use super::CliError;
 use fitbead::io::write_atomic_all;
@@ -36,30 +37,18 @@ const CONTACT_MODELS: [fitbead::models::Model; 2] = [
 /// Arguments of `fitbead report`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Measurements CSV (as for `klaw`); without it, the embedded default data set.
-    #[arg(long)]
-    pub input: Option<PathBuf>,
-    /// The measurements CSV given as a plain argument (same as --input).
-    #[arg(value_name = "DATA.csv", conflicts_with = "input")]
-    pub data: Option<PathBuf>,
+    /// The measurements (as for `klaw`) and the defaults of the columns they may leave out.
+    #[command(flatten)]
+    pub data: DataArgs,
     /// Directory for the tables, figures and report.md, created if missing [default: report]
     #[arg(long)]
     pub out_dir: Option<PathBuf>,
     /// lsq or mcmc (posteriors for every fit; adds corner.svg) [default: lsq]
     #[arg(long)]
     pub method: Option<String>,
-    /// Gyration parameter ρ for rows without a rho column [default: 0.4]
-    #[arg(long)]
-    pub rho: Option<f64>,
-    /// Coulomb friction f for rows without an f column [default: 0.1]
-    #[arg(long)]
-    pub f: Option<f64>,
-    /// Gravity g (m/s²) for dimensional rows without a g column [default: 9.81]
-    #[arg(long)]
-    pub g: Option<f64>,
-    /// Level of every interval [default: 0.95]
-    #[arg(long)]
-    pub level: Option<f64>,
+    /// The level of every interval.
+    #[command(flatten)]
+    pub level: LevelArgs,
     /// MCMC seed [default: 1]
     #[arg(long)]
     pub seed: Option<u64>,
@@ -133,7 +122,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         Some(p) => read_recipe(p)?,
         None => Recipe::default(),
     };
-    let from_flags = a.input.clone().or(a.data.clone());
+    let from_flags = a.data.path().map(Path::to_path_buf);
     let shown = match (&from_flags, &r.shown_input) {
         (None, Some(s)) => Some(s.clone()),
         _ => None,
@@ -145,14 +134,20 @@ pub fn run(a: Args) -> Result<(), CliError> {
         .or(r.out_dir)
         .unwrap_or_else(|| PathBuf::from("report"));
     let io = FitArgs {
-        input: input.clone(),
-        data: None,
-        rho: a.rho.or(r.rho).unwrap_or(0.4),
-        f: a.f.or(r.f).unwrap_or(0.1),
-        g: a.g.or(r.g).unwrap_or(9.81),
-        level: a.level.or(r.level).unwrap_or(0.95),
+        data: DataArgs {
+            input: input.clone(),
+            data: None,
+            contact: ContactArgs {
+                rho: a.data.contact.rho.or(r.rho),
+                f: a.data.contact.f.or(r.f),
+            },
+            g: a.data.g.or(r.g),
+        },
+        level: LevelArgs {
+            level: a.level.level.or(r.level),
+        },
         no_profile: false,
-        output: None,
+        out: OutputArgs::default(),
         output_stats: None,
         method: a
             .method
@@ -167,7 +162,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         priors: Vec::new(),
         fit_scatter: false,
         draws: None,
-        plot: None,
+        plot: PlotArgs::default(),
     };
     // No file of the report may be the input (or the recipe).
     let targets: Vec<PathBuf> = REPORT_FILES.iter().map(|f| out_dir.join(f)).collect();
@@ -198,7 +193,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         )));
     }
     let implausible = fitbead::io::measurements::plausibility(&t, &rows);
-    let an = analyse(&ds, io.level, &choice.method);
+    let an = analyse(&ds, io.level.level(), &choice.method);
     let interrupted = an
         .posteriors()
         .iter()

@@ -1,6 +1,7 @@
 //! `fitbead simulate`: synthetic measurements spread inside regime B of each series, with
 //! multiplicative Gaussian noise, reproducible from the seed (ChaCha8 stream).
 
+use super::args::{ContactArgs, OutputArgs};
 use super::{emit, parse_list, CliError};
 use fitbead::io::fmt_f64;
 use fitbead::models::jaeger::Jaeger;
@@ -14,7 +15,6 @@ use fitbead::scene::{CollisionLaw, Scene};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
-use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Arguments of `fitbead simulate`.
@@ -40,12 +40,9 @@ pub struct Args {
     /// Seed of the random stream.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Gyration parameter ρ.
-    #[arg(long, default_value_t = 0.4)]
-    pub rho: f64,
-    /// Coulomb friction coefficient f.
-    #[arg(long, default_value_t = 0.1)]
-    pub f: f64,
+    /// ρ and f of rows without those columns.
+    #[command(flatten)]
+    pub contact: ContactArgs,
     /// Jan's global laws λ0,λ1,μ0,μ1 (λ = λ0 e^{λ1 sin α}, μ = μ0 e^{μ1 sin α}) for
     /// --model jan [default: 0.063,4.96,0.0025,7.46, the paper's eqs 75–76]
     #[arg(long)]
@@ -62,9 +59,9 @@ pub struct Args {
     /// range has no upper end, the onset to the onset + 12°]
     #[arg(long)]
     pub delta_range: Option<String>,
-    /// Output CSV (written atomically); stdout when absent.
-    #[arg(long)]
-    pub output: Option<PathBuf>,
+    /// Where the result goes.
+    #[command(flatten)]
+    pub out: OutputArgs,
     /// --model contact only: launch speed Θ̇0 on the first bead (dimensionless, rolling
     /// launch). With it, simulate writes the bead-by-bead transient of one scene per ξ of
     /// --series at --delta-deg instead of synthetic measurements.
@@ -128,13 +125,13 @@ fn trace(a: &Args, law: CollisionLaw, series: &[f64], v0: f64) -> Result<(), Cli
     let scenes = series
         .iter()
         .map(|&xi| {
-            Scene::new(xi, d, a.rho, a.f, law).map_err(|e| {
+            Scene::new(xi, d, a.contact.rho(), a.contact.f(), law).map_err(|e| {
                 super::flag_error("--series/--delta-deg", &xi.to_string(), e.to_string())
             })
         })
         .collect::<Result<Vec<_>, _>>()?;
     let bytes = transient_csv(&model, &scenes, d, v0, beads)?;
-    emit(a.output.as_deref(), &bytes)
+    emit(a.out.output.as_deref(), &bytes)
 }
 
 /// `--delta-range LO,HI` (degrees, LO < HI), when given.
@@ -241,7 +238,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
     w.write_record(["series", "xi", "delta_deg", "v", "sigma_v", "v_true"])
         .map_err(io)?;
     for &xi in &series {
-        let alpha = Scene::from_radians(xi, 0.1, a.rho, a.f, law)
+        let alpha = Scene::from_radians(xi, 0.1, a.contact.rho(), a.contact.f(), law)
             .map_err(|e| super::flag_error("--series", &xi.to_string(), e.to_string()))?
             .alpha_rad();
         let model = match (kind, kind.contact_model()) {
@@ -274,7 +271,8 @@ pub fn run(a: Args) -> Result<(), CliError> {
                 )
             }
         };
-        let Some((lo, hi)) = regime_b_interval(&model, xi, a.rho, a.f, law) else {
+        let Some((lo, hi)) = regime_b_interval(&model, xi, a.contact.rho(), a.contact.f(), law)
+        else {
             return Err(super::flag_error(
                 "--series",
                 &xi.to_string(),
@@ -313,7 +311,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
             let d = lo + (hi - lo) * frac;
             // Round the slope to 1e-4 degree, as a measured slope would be written.
             let d_deg = (d.to_degrees() * 1e4).round() / 1e4;
-            let scene = Scene::new(xi, d_deg, a.rho, a.f, law)
+            let scene = Scene::new(xi, d_deg, a.contact.rho(), a.contact.f(), law)
                 .map_err(|e| CliError::Other(e.to_string()))?;
             let v_true = match model.evaluate(&scene) {
                 Ok(s) => s.mean_velocity,
@@ -333,7 +331,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         }
     }
     let bytes = w.into_inner().map_err(|e| CliError::Other(e.to_string()))?;
-    emit(a.output.as_deref(), &bytes)
+    emit(a.out.output.as_deref(), &bytes)
 }
 
 fn run_md(a: &Args, series: &[f64], stop: &AtomicBool) -> Result<(), CliError> {
@@ -341,10 +339,10 @@ fn run_md(a: &Args, series: &[f64], stop: &AtomicBool) -> Result<(), CliError> {
     use fitbead::models::Regime;
     use rayon::prelude::*;
     let md: Md = a.md.model()?;
-    if !(a.rho > 0.0) {
+    if !(a.contact.rho() > 0.0) {
         return Err(super::flag_error(
             "--rho",
-            &fmt_f64(a.rho),
+            &fmt_f64(a.contact.rho()),
             "md needs rho > 0 (the bead's moment of inertia)",
         ));
     }
@@ -371,10 +369,10 @@ fn run_md(a: &Args, series: &[f64], stop: &AtomicBool) -> Result<(), CliError> {
     ])
     .map_err(io)?;
     for &xi in series {
-        let sc = Scene::new(xi, 1.0, a.rho, 0.1, CollisionLaw::Value(0.5))
+        let sc = Scene::new(xi, 1.0, a.contact.rho(), 0.1, CollisionLaw::Value(0.5))
             .map_err(|e| super::flag_error("--series", &xi.to_string(), e.to_string()))?;
         md.check_scene(&sc).map_err(|e| md_error(a, xi, e))?;
-        let interval = md_regime_b_interval(&md, xi, a.rho, &tick, Some(stop))
+        let interval = md_regime_b_interval(&md, xi, a.contact.rho(), &tick, Some(stop))
             .map_err(|e| super::flag_error("--series", &xi.to_string(), e.to_string()))?;
         if stop.load(Ordering::Relaxed) {
             return Err(CliError::Interrupted);
@@ -423,7 +421,7 @@ fn run_md(a: &Args, series: &[f64], stop: &AtomicBool) -> Result<(), CliError> {
             let done: Vec<(f64, f64, f64, MdResult)> = slopes
                 .par_iter()
                 .map(|&d| {
-                    let sc = Scene::new(xi, d, a.rho, 0.1, CollisionLaw::Value(0.5))
+                    let sc = Scene::new(xi, d, a.contact.rho(), 0.1, CollisionLaw::Value(0.5))
                         .map_err(|e| CliError::Other(e.to_string()))?;
                     let r = md.simulate_until(&sc, 1.0, None, Some(stop));
                     tick();
@@ -494,14 +492,16 @@ fn run_md(a: &Args, series: &[f64], stop: &AtomicBool) -> Result<(), CliError> {
         b.finish_and_clear();
     }
     let bytes = w.into_inner().map_err(|e| CliError::Other(e.to_string()))?;
-    emit(a.output.as_deref(), &bytes)
+    emit(a.out.output.as_deref(), &bytes)
 }
 
 /// A scene outside the md model's domain, as the flag to change.
 fn md_error(a: &Args, xi: f64, e: fitbead::scene::ParameterError) -> CliError {
     use fitbead::scene::ParameterError;
     let (flag, value) = match &e {
-        ParameterError::InvalidParameter { field: "rho", .. } => ("--rho", fmt_f64(a.rho)),
+        ParameterError::InvalidParameter { field: "rho", .. } => {
+            ("--rho", fmt_f64(a.contact.rho()))
+        }
         ParameterError::InvalidParameter { field, value, .. } => (*field, value.clone()),
         _ => ("--series", fmt_f64(xi)),
     };

@@ -369,7 +369,52 @@ pub struct ForwardPlan {
     headers: Vec<String>,
 }
 
+/// The settings of a forward run as a command line gives them: the collision law and the spin
+/// rule as text (parsed by [`ForwardPlan::from_text`], errors naming `--K` and `--spin`), the
+/// rest in `base` (whose `law` and `spin` are replaced).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ForwardText<'a> {
+    /// The collision law: a number, `cos2a`, `adjusted`, `impact` or `c=VALUE`.
+    pub k: &'a str,
+    /// The spin rule: `roll`, `keep`, `factor=L` or `impact`.
+    pub spin: &'a str,
+    /// Everything else.
+    pub base: ForwardSettings,
+}
+
 impl ForwardPlan {
+    /// The plan for a table with `reader`'s header and the settings `text`: the columns are
+    /// checked first, then `--spin`, `--tol` (in (0, 1)) and `--K`, so that their errors come
+    /// in that order.
+    pub fn from_text<R: Read>(
+        reader: &TableReader<R>,
+        text: &ForwardText<'_>,
+    ) -> Result<Self, InputError> {
+        let cols = SceneColumns::new(reader)?;
+        let spin = text
+            .spin
+            .parse()
+            .map_err(|e: ParameterError| setting_error("spin", text.spin, e.to_string()))?;
+        let tol = text.base.tol;
+        if !(tol > 0.0 && tol < 1.0) {
+            return Err(setting_error(
+                "tol",
+                &tol.to_string(),
+                "expected a relative tolerance in (0, 1)",
+            ));
+        }
+        let law = text
+            .k
+            .parse()
+            .map_err(|e: ParameterError| setting_error("K", text.k, e.to_string()))?;
+        let settings = ForwardSettings {
+            law,
+            spin,
+            ..text.base
+        };
+        Ok(ForwardPlan::new(reader, cols, settings))
+    }
+
     /// The plan for a table with `reader`'s header and columns `cols`. The kind must not be
     /// md (it has its own, whole-table path).
     pub fn new<R: Read>(

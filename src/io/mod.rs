@@ -7,6 +7,7 @@ mod atomic;
 pub mod cells;
 pub mod forward;
 pub mod kstream;
+pub mod md;
 pub mod measurements;
 pub mod reports;
 pub mod scenes;

@@ -412,6 +412,27 @@ impl MdSetting {
         }
     }
 
+    /// Its name as a command-line flag, without the leading `--`: the column with `-` for
+    /// `_`, except `coulomb` (`mu_c`) and `md-g` (`g`).
+    pub fn flag(self) -> &'static str {
+        match self {
+            MdSetting::RowRadius => "row-radius-m",
+            MdSetting::Young => "young-pa",
+            MdSetting::Poisson => "poisson",
+            MdSetting::Density => "density",
+            MdSetting::Beta => "beta",
+            MdSetting::GammaN => "gamma-n",
+            MdSetting::GammaS => "gamma-s",
+            MdSetting::Coulomb => "coulomb",
+            MdSetting::Gravity => "md-g",
+            MdSetting::Beads => "beads",
+            MdSetting::Transient => "transient",
+            MdSetting::Blocks => "blocks",
+            MdSetting::LaunchVelocity => "launch-velocity",
+            MdSetting::StepFraction => "step-fraction",
+        }
+    }
+
     /// The setting whose column (or error field) is `name`.
     pub fn from_column(name: &str) -> Option<MdSetting> {
         MdSetting::ALL.into_iter().find(|s| s.column() == name)

@@ -275,7 +275,7 @@ fn signals_stop_every_long_command() {
                 "stickslip",
                 "--law",
                 "free-per-series",
-                "big.csv",
+                "huge.csv",
                 "--output",
                 "o.csv",
             ],

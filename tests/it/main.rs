@@ -11,6 +11,7 @@ mod contact;
 mod faults;
 mod figures;
 mod fits;
+mod forward_stream;
 mod k_inversion;
 mod mcmc;
 mod md;

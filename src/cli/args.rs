@@ -63,7 +63,12 @@ impl DataArgs {
 
     /// The defaults, checked (ρ ≥ 0, f ≥ 0, g > 0).
     pub fn defaults(&self) -> Result<MeasurementDefaults, CliError> {
-        super::measurement_defaults(self.contact.rho(), self.contact.f(), self.g())
+        let d = MeasurementDefaults {
+            rho: self.contact.rho(),
+            f: self.contact.f(),
+            g: self.g(),
+        };
+        Ok(d.checked()?)
     }
 }
 

@@ -3,15 +3,13 @@
 use super::args::{DataArgs, LevelArgs, OutputArgs, PlotArgs};
 use super::{emit, read_input, CliError};
 use fitbead::fit::data::Dataset;
-use fitbead::fit::k::bracket;
 use fitbead::fit::posterior::{McmcSettings, Method, Prior, SCALE_NAME};
 use fitbead::fit::summary::{FitResult, McmcFailure, ParamRow, StatsRow};
 use fitbead::inverse::mcmc::McmcOptions;
 use fitbead::io::measurements::{dataset_of, read_measurements, Measurement};
 use fitbead::io::reports::{draws_csv, params_csv, stats_csv};
 use fitbead::io::scenes::Table;
-use fitbead::io::{fmt_f64, fmt_sig, write_atomic_all};
-use fitbead::models::Model;
+use fitbead::io::{fmt_sig, write_atomic_all};
 use fitbead::report::figures::{corner_svg, CornerBlock};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -375,74 +373,6 @@ pub fn not_converged(stats: &[StatsRow]) -> Result<(), CliError> {
     } else {
         Err(CliError::NotConverged(failed.join("; ")))
     }
-}
-
-/// The points of `ds` that no K makes steady under any of `models` (regime A or C for every
-/// K), with why under the first model.
-pub fn unsteady_points(models: &[Model], ds: &Dataset) -> Vec<(usize, String)> {
-    use rayon::prelude::*;
-    ds.points
-        .par_iter()
-        .enumerate()
-        .filter_map(|(i, p)| {
-            if super::stop_requested() {
-                return None;
-            }
-            let mut why = None;
-            for m in models {
-                match bracket(m, &p.scene) {
-                    Ok(_) => return None,
-                    Err(e) => {
-                        why.get_or_insert_with(|| e.to_string());
-                    }
-                }
-            }
-            why.map(|w| (i, w))
-        })
-        .collect()
-}
-
-/// Where point `i` of `ds` (read from `t`, in the same order) is: file, line, series, ξ and
-/// δ as written in the file.
-pub fn locate_point(t: &Table, ds: &Dataset, i: usize) -> String {
-    let p = &ds.points[i];
-    let d = t
-        .col("delta_deg")
-        .map(|c| t.cell(i, c).to_string())
-        .unwrap_or_else(|| fmt_f64(p.scene.delta_deg()));
-    format!(
-        "{}, line {} (series '{}', xi {}, delta_deg {})",
-        t.source,
-        t.lines[i],
-        fitbead::io::clip(&ds.labels[p.series], fitbead::io::ECHO_CHARS),
-        fmt_f64(p.scene.xi()),
-        d,
-    )
-}
-
-/// The lines of `t` that hold the points of series `s` of `ds`, as `2, 3, 5`.
-pub fn series_lines(t: &Table, ds: &Dataset, s: usize) -> String {
-    ds.series_index(s)
-        .iter()
-        .map(|&i| t.lines[i].to_string())
-        .collect::<Vec<_>>()
-        .join(", ")
-}
-
-/// A note of the fits that starts `series 'LABEL': ` located in the file: `FILE, lines …
-/// (series 'LABEL'): …`; other notes unchanged.
-pub fn locate_note(t: &Table, ds: &Dataset, note: &str) -> String {
-    for (s, label) in ds.labels.iter().enumerate() {
-        if let Some(rest) = note.strip_prefix(&format!("series '{label}': ")) {
-            return format!(
-                "{}, lines {} (series '{}'): {rest}",
-                t.source,
-                series_lines(t, ds, s),
-                fitbead::io::clip(label, fitbead::io::ECHO_CHARS)
-            );
-        }
-    }
-    note.to_string()
 }
 
 /// `stats` with every fit whose misfit is absurd for the σ given flagged in its note and on

@@ -1,10 +1,11 @@
 //! `fitbead jaeger`: Jaeger's a1, a2, a3 per series (Jaeger units, eq 81), the branch used and
 //! the points in the bistable band (eq 90), beside the paper's Fig. 9 values.
 
-use super::fitargs::{locate_note, FitArgs};
+use super::fitargs::FitArgs;
 use super::CliError;
 use fitbead::fit::jaeger::fit_jaeger_with;
 use fitbead::fit::summary::FitResult;
+use fitbead::io::measurements::locate_note;
 
 /// Arguments of `fitbead jaeger`.
 #[derive(Debug, clap::Args)]

@@ -1,10 +1,11 @@
 //! `fitbead jan`: Jan's λ and μ per series (eq 74, fitted on v̄) and the global laws
 //! λ = λ0 e^{λ1 sin α}, μ = μ0 e^{μ1 sin α} (form of eqs 75–76), beside the paper's values.
 
-use super::fitargs::{locate_note, FitArgs};
+use super::fitargs::FitArgs;
 use super::CliError;
 use fitbead::fit::jan::fit_jan_with;
 use fitbead::fit::summary::FitResult;
+use fitbead::io::measurements::locate_note;
 
 /// Arguments of `fitbead jan`.
 #[derive(Debug, clap::Args)]

@@ -1,15 +1,17 @@
 //! `fitbead klaw`: a law K(α) fitted to all series at once (law c, one K per series), and the
 //! parameter-free impact law scored beside it.
 
-use super::fitargs::{locate_point, unsteady_points, FitArgs};
+use super::fitargs::FitArgs;
 use super::k::parse_auto;
 use super::k::parse_model;
 use super::CliError;
 use fitbead::fit::k::auto::{self as kauto, KChoice};
+use fitbead::fit::k::unsteady_points;
 use fitbead::fit::klaw::{fit_law, fit_law_in, KLaw, KLawContext, KLawError};
 use fitbead::fit::posterior::Method;
 use fitbead::fit::summary::FitResult;
 use fitbead::io::fmt_f64;
+use fitbead::io::measurements::locate_point;
 use fitbead::models::Model;
 use rayon::prelude::*;
 
@@ -89,7 +91,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         ));
     }
     // Points that no K makes steady: an error naming them, or left out with --skip-unsteady.
-    let unsteady = unsteady_points(&[model], &ds);
+    let unsteady = unsteady_points(&[model], &ds, Some(&super::stop_flag()));
     if super::stop_requested() {
         return Err(CliError::Interrupted);
     }

@@ -13,15 +13,13 @@ pub mod report;
 pub mod simulate;
 
 use clap::{Parser, Subcommand};
-use fitbead::io::{clip, same_file, write_atomic, InputError, ECHO_CHARS};
+use fitbead::io::{clip, distinct_paths, write_atomic, InputError, ECHO_CHARS};
 use fitbead::progress::{Progress, ProgressEvent};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 
-use fitbead::io::measurements::{
-    plausibility, MeasurementDefaults, DEFAULT_DATA, DEFAULT_DATA_NAME,
-};
+use fitbead::io::measurements::{plausibility, DEFAULT_DATA, DEFAULT_DATA_NAME};
 
 /// fitbead: a bead rolling down a row of beads (Ancey, Evesque & Coussot 1996) — forward
 /// models, regime limits and synthetic data. Velocities are dimensionless (units
@@ -312,42 +310,7 @@ fn check_paths(c: &Command) -> Result<(), CliError> {
             ],
         ),
     };
-    distinct_paths(&inputs, &outputs)
-}
-
-/// The check of [`check_paths`] on named paths (absent ones skipped).
-pub fn distinct_paths(
-    inputs: &[(&str, Option<&Path>)],
-    outputs: &[(&str, Option<&Path>)],
-) -> Result<(), CliError> {
-    let outs: Vec<(&str, &Path)> = outputs
-        .iter()
-        .filter_map(|(n, p)| p.map(|p| (*n, p)))
-        .collect();
-    for (i, (flag, p)) in outs.iter().enumerate() {
-        if p.is_dir() {
-            return Err(flag_error(flag, &p.display().to_string(), "is a directory"));
-        }
-        for (iflag, q) in inputs.iter().filter_map(|(n, q)| q.map(|q| (*n, q))) {
-            if q != Path::new("-") && same_file(p, q) {
-                return Err(flag_error(
-                    flag,
-                    &p.display().to_string(),
-                    format!("is the same file as {iflag}: the input would be overwritten"),
-                ));
-            }
-        }
-        for (oflag, q) in &outs[..i] {
-            if same_file(p, q) {
-                return Err(flag_error(
-                    flag,
-                    &p.display().to_string(),
-                    format!("is the same file as {oflag}: one output would overwrite the other"),
-                ));
-            }
-        }
-    }
-    Ok(())
+    Ok(distinct_paths(&inputs, &outputs)?)
 }
 
 /// The stop flag raised by SIGINT (Ctrl-C), SIGTERM or SIGHUP: the handler is installed on the
@@ -439,23 +402,6 @@ pub fn warn_implausible(
         eprintln!("fitbead: warning: {}: {x}", t.source);
     }
     w
-}
-
-/// Checks the `--rho`, `--f` and `--g` flags and makes them the measurement defaults.
-pub fn measurement_defaults(rho: f64, f: f64, g: f64) -> Result<MeasurementDefaults, CliError> {
-    for (flag, x) in [("--rho", rho), ("--f", f)] {
-        if !(x >= 0.0 && x.is_finite()) {
-            return Err(flag_error(
-                flag,
-                &x.to_string(),
-                "must be a finite number >= 0",
-            ));
-        }
-    }
-    if !(g > 0.0 && g.is_finite()) {
-        return Err(flag_error("--g", &g.to_string(), "g must be > 0"));
-    }
-    Ok(MeasurementDefaults { rho, f, g })
 }
 
 /// A progress bar on stderr for posterior runs: one bar per run, drawn from the library's
@@ -584,12 +530,9 @@ pub fn parse_list(flag: &str, s: &str) -> Result<Vec<f64>, CliError> {
 
 /// The Jaeger root of `--branch` (`upper`, the default, or `lower`; eqs 80–89).
 pub fn jaeger_branch(value: &str) -> Result<fitbead::models::JaegerBranch, CliError> {
-    use fitbead::models::JaegerBranch;
-    match value.to_ascii_lowercase().as_str() {
-        "upper" => Ok(JaegerBranch::Upper),
-        "lower" => Ok(JaegerBranch::Lower),
-        b => Err(flag_error("--branch", b, "expected upper or lower")),
-    }
+    value
+        .parse()
+        .map_err(|e: String| flag_error("--branch", value, e))
 }
 
 /// An error about a command-line flag value.

@@ -3,30 +3,14 @@
 //! as a directory of CSV tables, SVG figures and a `report.md` that links them.
 
 use super::args::{ContactArgs, DataArgs, LevelArgs, OutputArgs, PlotArgs};
-use super::fitargs::{flag_absurd, locate_point, not_converged, unsteady_points, FitArgs};
+use super::fitargs::{flag_absurd, not_converged, FitArgs};
 use super::CliError;
+use fitbead::fit::k::unsteady_points;
+use fitbead::io::measurements::locate_point;
 use fitbead::io::write_atomic_all;
 use fitbead::report::analysis::analyse;
 use fitbead::report::text::{markdown, terminal_summary};
 use std::path::{Path, PathBuf};
-
-/// Every file a report may write in its directory.
-const REPORT_FILES: [&str; 14] = [
-    "bulk_friction.csv",
-    "energy.csv",
-    "regime_map.csv",
-    "points.csv",
-    "models.csv",
-    "models_by_series.csv",
-    "params.csv",
-    "stats.csv",
-    "velocity.svg",
-    "jan_linear.svg",
-    "k_final_velocity.svg",
-    "regime_map.svg",
-    "corner.svg",
-    "report.md",
-];
 
 /// The contact models the report fits (a point must be steady under one of them).
 const CONTACT_MODELS: [fitbead::models::Model; 2] = [
@@ -165,12 +149,15 @@ pub fn run(a: Args) -> Result<(), CliError> {
         plot: PlotArgs::default(),
     };
     // No file of the report may be the input (or the recipe).
-    let targets: Vec<PathBuf> = REPORT_FILES.iter().map(|f| out_dir.join(f)).collect();
+    let targets: Vec<PathBuf> = fitbead::report::REPORT_FILES
+        .iter()
+        .map(|f| out_dir.join(f))
+        .collect();
     let outputs: Vec<(&str, Option<&Path>)> = targets
         .iter()
         .map(|p| ("--out-dir", Some(p.as_path())))
         .collect();
-    super::distinct_paths(
+    fitbead::io::distinct_paths(
         &[
             ("--input", input.as_deref()),
             ("--recipe", a.recipe.as_deref()),
@@ -180,7 +167,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let (t, rows, ds) = io.read()?;
     let choice = io.method(&[])?;
     // A point that no contact model of the report can make steady is an error, as in klaw.
-    let unsteady = unsteady_points(&CONTACT_MODELS, &ds);
+    let unsteady = unsteady_points(&CONTACT_MODELS, &ds, Some(&super::stop_flag()));
     if super::stop_requested() {
         return Err(CliError::Interrupted);
     }

@@ -17,6 +17,7 @@
 //! if a rename fails, the files already renamed are put back as they were (the previous
 //! contents of a replaced file are kept under a hard link until the group succeeds).
 
+use super::InputError;
 use std::fs::{File, OpenOptions};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -420,4 +421,53 @@ pub fn write_atomic_all_then(
         d.forget();
     }
     Ok(())
+}
+
+/// Refuses, before any work, an output that is a directory, that is one of the `inputs`
+/// (after following symbolic links; `-`, standard input, is none) or that is another of the
+/// `outputs`. Paths are named by the flag that gives them (absent ones skipped); the error
+/// names the flag.
+pub fn distinct_paths(
+    inputs: &[(&str, Option<&Path>)],
+    outputs: &[(&str, Option<&Path>)],
+) -> Result<(), InputError> {
+    let outs: Vec<(&str, &Path)> = outputs
+        .iter()
+        .filter_map(|(n, p)| p.map(|p| (*n, p)))
+        .collect();
+    for (i, (flag, p)) in outs.iter().enumerate() {
+        if p.is_dir() {
+            return Err(path_error(flag, &p.display().to_string(), "is a directory"));
+        }
+        for (iflag, q) in inputs.iter().filter_map(|(n, q)| q.map(|q| (*n, q))) {
+            if q != Path::new("-") && same_file(p, q) {
+                return Err(path_error(
+                    flag,
+                    &p.display().to_string(),
+                    format!("is the same file as {iflag}: the input would be overwritten"),
+                ));
+            }
+        }
+        for (oflag, q) in &outs[..i] {
+            if same_file(p, q) {
+                return Err(path_error(
+                    flag,
+                    &p.display().to_string(),
+                    format!("is the same file as {oflag}: one output would overwrite the other"),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// An error about the path given by `flag`.
+fn path_error(flag: &str, value: &str, message: impl Into<String>) -> InputError {
+    InputError {
+        file: "<command line>".into(),
+        line: None,
+        column: Some(flag.to_string()),
+        value: Some(value.to_string()),
+        message: message.into(),
+    }
 }

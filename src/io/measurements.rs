@@ -48,6 +48,25 @@ impl Default for MeasurementDefaults {
 }
 
 impl MeasurementDefaults {
+    /// These defaults as a command line's settings: ρ ≥ 0, f ≥ 0 and g > 0, all finite, or an
+    /// error naming `--rho`, `--f` or `--g` with its value.
+    pub fn checked(self) -> Result<Self, InputError> {
+        use super::forward::setting_error;
+        for (name, x) in [("rho", self.rho), ("f", self.f)] {
+            if !(x >= 0.0 && x.is_finite()) {
+                return Err(setting_error(
+                    name,
+                    &x.to_string(),
+                    "must be a finite number >= 0",
+                ));
+            }
+        }
+        if !(self.g > 0.0 && self.g.is_finite()) {
+            return Err(setting_error("g", &self.g.to_string(), "g must be > 0"));
+        }
+        Ok(self)
+    }
+
     /// Checks ρ ≥ 0, f ≥ 0 and g > 0, all finite.
     pub fn validate(&self, source: &str) -> Result<(), InputError> {
         let bad = |name: &str, x: f64, message: &str| InputError {
@@ -419,6 +438,49 @@ impl Dataset {
         .map(|m| m.dataset)
         .unwrap_or_else(|e| unreachable!("the embedded data set is valid: {e}"))
     }
+}
+
+/// Where point `i` of `ds` (read from `t`, in the same order) is: file, line, series, ξ and
+/// δ as written in the file.
+pub fn locate_point(t: &Table, ds: &Dataset, i: usize) -> String {
+    let p = &ds.points[i];
+    let d = t
+        .col("delta_deg")
+        .map(|c| t.cell(i, c).to_string())
+        .unwrap_or_else(|| fmt_f64(p.scene.delta_deg()));
+    format!(
+        "{}, line {} (series '{}', xi {}, delta_deg {})",
+        t.source,
+        t.lines[i],
+        crate::numfmt::clip(&ds.labels[p.series], crate::numfmt::ECHO_CHARS),
+        fmt_f64(p.scene.xi()),
+        d,
+    )
+}
+
+/// The lines of `t` that hold the points of series `s` of `ds`, as `2, 3, 5`.
+pub fn series_lines(t: &Table, ds: &Dataset, s: usize) -> String {
+    ds.series_index(s)
+        .iter()
+        .map(|&i| t.lines[i].to_string())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// A note of the fits that starts `series 'LABEL': ` located in the file: `FILE, lines …
+/// (series 'LABEL'): …`; other notes unchanged.
+pub fn locate_note(t: &Table, ds: &Dataset, note: &str) -> String {
+    for (s, label) in ds.labels.iter().enumerate() {
+        if let Some(rest) = note.strip_prefix(&format!("series '{label}': ")) {
+            return format!(
+                "{}, lines {} (series '{}'): {rest}",
+                t.source,
+                series_lines(t, ds, s),
+                crate::numfmt::clip(label, crate::numfmt::ECHO_CHARS)
+            );
+        }
+    }
+    note.to_string()
 }
 
 /// A warning about measurements that read fine but look like a unit mistake

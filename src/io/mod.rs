@@ -13,7 +13,9 @@ pub mod reports;
 pub mod scenes;
 pub mod stream;
 
-pub use atomic::{same_file, write_atomic, write_atomic_all, write_atomic_all_then, AtomicFile};
+pub use atomic::{
+    distinct_paths, same_file, write_atomic, write_atomic_all, write_atomic_all_then, AtomicFile,
+};
 
 pub use crate::numfmt::{clip, fmt_f64, fmt_sig, push_f64, ECHO_CHARS};
 

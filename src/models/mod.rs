@@ -221,6 +221,18 @@ pub enum JaegerBranch {
     Lower,
 }
 
+impl std::str::FromStr for JaegerBranch {
+    type Err = String;
+    /// `upper` or `lower`, in any case.
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s.to_ascii_lowercase().as_str() {
+            "upper" => Ok(JaegerBranch::Upper),
+            "lower" => Ok(JaegerBranch::Lower),
+            _ => Err("expected upper or lower".into()),
+        }
+    }
+}
+
 /// Every forward model by name, with its own parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Model {

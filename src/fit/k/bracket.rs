@@ -2,11 +2,14 @@
 //! model, moved to the model's true boundary where it fails inside.
 
 use super::types::{KBracket, KFailure, LowerLimit, UpperLimit};
+use crate::fit::data::Dataset;
 use crate::models::regimes::theta_g;
 use crate::models::slip::SlipPhase;
 use crate::models::{stickslip, ForwardModel, Model, NotSteady, Steady};
 use crate::scene::Scene;
 use crate::special::root::brent;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// The models whose K can be inverted.
 pub fn invertible(model: &Model) -> bool {
@@ -308,4 +311,32 @@ pub fn bracket(model: &Model, scene: &Scene) -> Result<KBracket, KFailure> {
         upper,
         evals,
     })
+}
+
+/// The points of `ds` that no K makes steady under any of `models` (regime A or C for every
+/// K), with why under the first model; none once `stop` is raised.
+pub fn unsteady_points(
+    models: &[Model],
+    ds: &Dataset,
+    stop: Option<&AtomicBool>,
+) -> Vec<(usize, String)> {
+    ds.points
+        .par_iter()
+        .enumerate()
+        .filter_map(|(i, p)| {
+            if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
+                return None;
+            }
+            let mut why = None;
+            for m in models {
+                match bracket(m, &p.scene) {
+                    Ok(_) => return None,
+                    Err(e) => {
+                        why.get_or_insert_with(|| e.to_string());
+                    }
+                }
+            }
+            why.map(|w| (i, w))
+        })
+        .collect()
 }

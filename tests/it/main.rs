@@ -13,6 +13,7 @@ mod figures;
 mod fits;
 mod forward_stream;
 mod k_inversion;
+mod k_stream;
 mod mcmc;
 mod md;
 mod nist;

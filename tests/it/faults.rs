@@ -9,28 +9,44 @@ use std::process::{Child, Command, ExitStatus, Output, Stdio};
 use std::time::{Duration, Instant};
 
 /// Runs `cmd` to its end or until `limit`, then kills it; the output and whether it ended in
-/// time.
+/// time. Its stdout and stderr are read while it runs (a pipe left unread would block a
+/// command that writes more than the pipe holds).
 fn run_for(cmd: &mut Command, limit: Duration) -> (Output, bool) {
+    use std::io::Read;
     let mut child = cmd
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
+    let drain = |mut r: Box<dyn Read + Send>| {
+        std::thread::spawn(move || {
+            let mut b = Vec::new();
+            let _ = r.read_to_end(&mut b);
+            b
+        })
+    };
+    let out = drain(Box::new(child.stdout.take().unwrap()));
+    let err = drain(Box::new(child.stderr.take().unwrap()));
     let t0 = Instant::now();
     let mut in_time = true;
-    loop {
-        if child.try_wait().unwrap().is_some() {
-            break;
+    let status = loop {
+        if let Some(st) = child.try_wait().unwrap() {
+            break st;
         }
         if t0.elapsed() > limit {
             in_time = false;
             let _ = child.kill();
-            break;
+            break child.wait().unwrap();
         }
         std::thread::sleep(Duration::from_millis(20));
-    }
-    (child.wait_with_output().unwrap(), in_time)
+    };
+    let output = Output {
+        status,
+        stdout: out.join().unwrap(),
+        stderr: err.join().unwrap(),
+    };
+    (output, in_time)
 }
 
 /// Runs fitbead with `args` (at most 60 s) and returns its output.
@@ -856,9 +872,9 @@ fn unit_mistakes_are_flagged_loudly() {
 }
 
 /// The fuzz harness: mutated measurement and scene tables fed to every reading command; each
-/// run must end within its time limit with exit 0 or 2 and no panic. Ignored by default:
-/// `FITBEAD_FUZZ_RUNS=3000 cargo test --release --test it faults::fuzz -- --ignored
-/// --nocapture` (docs/GUIDE.md, "Exit codes").
+/// run must end within its time limit with exit 0 or 2 (or 1 for a fit that did not converge)
+/// and no panic. Ignored by default: `FITBEAD_FUZZ_RUNS=3000 cargo test --release --test it
+/// faults::fuzz -- --ignored --nocapture` (docs/GUIDE.md, "Exit codes").
 #[test]
 #[ignore]
 fn fuzz_mutated_inputs() {
@@ -1002,7 +1018,10 @@ fn fuzz_mutated_inputs() {
                 let code = out.status.code().unwrap_or(-1);
                 *counts.lock().unwrap().entry(code).or_default() += 1;
                 let e = stderr(&out);
-                if !in_time || !(code == 0 || code == 2) || e.contains("panicked") {
+                // Exit 1 (a fit that did not converge, outputs written) is an answer too.
+                let fit = matches!(args[0], "klaw" | "jan" | "jaeger" | "report");
+                let allowed = code == 0 || code == 2 || (fit && code == 1);
+                if !in_time || !allowed || e.contains("panicked") {
                     let keep = dir.path().join(format!("fail{i}.csv"));
                     let _ = std::fs::copy(&p, &keep);
                     bad.lock().unwrap().push(format!(

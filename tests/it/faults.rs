@@ -283,6 +283,19 @@ fn signals_stop_every_long_command() {
             ],
         ),
         ("-TERM", vec!["report", "big.csv", "--out-dir", "."]),
+        // Streaming commands: the temporary output is removed.
+        (
+            "-TERM",
+            vec![
+                "forward",
+                "--model",
+                "contact",
+                "--input",
+                "scenes.csv",
+                "--output",
+                "o.csv",
+            ],
+        ),
         (
             "-INT",
             vec![
@@ -318,6 +331,12 @@ fn signals_stop_every_long_command() {
     let data = tmpdir();
     let big = data.path().join("big.csv");
     let huge = data.path().join("huge.csv");
+    let scenes = data.path().join("scenes.csv");
+    std::fs::write(
+        &scenes,
+        format!("xi,delta_deg\n{}", "1,12\n1.6,9\n".repeat(200_000)),
+    )
+    .unwrap();
     for (p, n) in [(&big, "2000"), (&huge, "20000")] {
         let out = fb(&["simulate", "--points", n, "--output", s(p)]);
         expect(&out, 0, &[], "simulate");
@@ -327,6 +346,7 @@ fn signals_stop_every_long_command() {
         let dir = tmpdir();
         std::fs::copy(&big, dir.path().join("big.csv")).unwrap();
         std::fs::copy(&huge, dir.path().join("huge.csv")).unwrap();
+        std::fs::copy(&scenes, dir.path().join("scenes.csv")).unwrap();
         // An existing output (and, for report, an existing report.md) must survive.
         write(&dir, "o.csv", "old\n");
         write(&dir, "report.md", "old\n");

@@ -17,7 +17,7 @@
 //! if a rename fails, the files already renamed are put back as they were (the previous
 //! contents of a replaced file are kept under a hard link until the group succeeds).
 
-use super::InputError;
+use super::{setting_error, InputError};
 use std::fs::{File, OpenOptions};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -437,12 +437,16 @@ pub fn distinct_paths(
         .collect();
     for (i, (flag, p)) in outs.iter().enumerate() {
         if p.is_dir() {
-            return Err(path_error(flag, &p.display().to_string(), "is a directory"));
+            return Err(setting_error(
+                flag.trim_start_matches("--"),
+                &p.display().to_string(),
+                "is a directory",
+            ));
         }
         for (iflag, q) in inputs.iter().filter_map(|(n, q)| q.map(|q| (*n, q))) {
             if q != Path::new("-") && same_file(p, q) {
-                return Err(path_error(
-                    flag,
+                return Err(setting_error(
+                    flag.trim_start_matches("--"),
                     &p.display().to_string(),
                     format!("is the same file as {iflag}: the input would be overwritten"),
                 ));
@@ -450,8 +454,8 @@ pub fn distinct_paths(
         }
         for (oflag, q) in &outs[..i] {
             if same_file(p, q) {
-                return Err(path_error(
-                    flag,
+                return Err(setting_error(
+                    flag.trim_start_matches("--"),
                     &p.display().to_string(),
                     format!("is the same file as {oflag}: one output would overwrite the other"),
                 ));
@@ -459,15 +463,4 @@ pub fn distinct_paths(
         }
     }
     Ok(())
-}
-
-/// An error about the path given by `flag`.
-fn path_error(flag: &str, value: &str, message: impl Into<String>) -> InputError {
-    InputError {
-        file: "<command line>".into(),
-        line: None,
-        column: Some(flag.to_string()),
-        value: Some(value.to_string()),
-        message: message.into(),
-    }
 }

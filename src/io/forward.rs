@@ -58,19 +58,7 @@ pub const OUTPUT_COLUMNS: [&str; 12] = [
     "message",
 ];
 
-/// Where the settings come from, as messages name it.
-pub const SETTINGS_ORIGIN: &str = "<command line>";
-
-/// An error about a setting (named `--NAME` of [`SETTINGS_ORIGIN`]).
-pub fn setting_error(name: &str, value: &str, message: impl Into<String>) -> InputError {
-    InputError {
-        file: SETTINGS_ORIGIN.into(),
-        line: None,
-        column: Some(format!("--{name}")),
-        value: Some(value.to_string()),
-        message: message.into(),
-    }
-}
+pub use super::{setting_error, SETTINGS_ORIGIN};
 
 /// The values rows fall back on where their column is absent or their cell empty, and the
 /// model to evaluate.

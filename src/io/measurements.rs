@@ -51,7 +51,7 @@ impl MeasurementDefaults {
     /// These defaults as a command line's settings: ρ ≥ 0, f ≥ 0 and g > 0, all finite, or an
     /// error naming `--rho`, `--f` or `--g` with its value.
     pub fn checked(self) -> Result<Self, InputError> {
-        use super::forward::setting_error;
+        use super::setting_error;
         for (name, x) in [("rho", self.rho), ("f", self.f)] {
             if !(x >= 0.0 && x.is_finite()) {
                 return Err(setting_error(

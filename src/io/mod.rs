@@ -21,6 +21,20 @@ pub use crate::numfmt::{clip, fmt_f64, fmt_sig, push_f64, ECHO_CHARS};
 
 use std::fmt;
 
+/// Where the settings come from, as messages name it.
+pub const SETTINGS_ORIGIN: &str = "<command line>";
+
+/// An error about a setting (named `--NAME` of [`SETTINGS_ORIGIN`]).
+pub fn setting_error(name: &str, value: &str, message: impl Into<String>) -> InputError {
+    InputError {
+        file: SETTINGS_ORIGIN.into(),
+        line: None,
+        column: Some(format!("--{name}")),
+        value: Some(value.to_string()),
+        message: message.into(),
+    }
+}
+
 /// An input error located in a file.
 #[derive(Debug, Clone, PartialEq)]
 pub struct InputError {

@@ -314,15 +314,16 @@ impl FitArgs {
         if self.out.output.is_none() {
             emit(None, &p_csv)?;
         }
-        // Warnings of the posterior runs go to stderr even when the statistics go to a file.
-        if self.output_stats.is_some() {
-            for r in stats.iter().filter(|r| r.mcmc.is_some() && !r.converged) {
-                eprintln!("fitbead: warning: {} [{}]: {}", r.fit, r.series, r.note);
-            }
-        }
         if interrupted {
+            // The posterior runs cut short go to stderr even when the statistics go to a file.
+            if self.output_stats.is_some() {
+                for r in stats.iter().filter(|r| r.mcmc.is_some() && !r.converged) {
+                    eprintln!("fitbead: warning: {} [{}]: {}", r.fit, r.series, r.note);
+                }
+            }
             return Err(CliError::InterruptedPartial);
         }
+        // Every fit that did not converge is named once, with why, by the exit-1 message.
         not_converged(stats)
     }
 }

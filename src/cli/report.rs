@@ -251,8 +251,11 @@ pub fn run(a: Args) -> Result<(), CliError> {
         .filter(|s| s.mcmc.is_some() && !s.converged)
         .map(|s| format!("{} [{}]: {}", s.fit, s.series, s.note))
         .collect();
-    for w in &warnings {
-        eprintln!("fitbead: warning: {w}");
+    // Outside an interrupted run the exit-1 message names these fits ([`not_converged`]).
+    if interrupted {
+        for w in &warnings {
+            eprintln!("fitbead: warning: {w}");
+        }
     }
     let mut md = markdown(&an, shown.as_deref().unwrap_or(&t.source), &io.method);
     let absurd: Vec<String> = stats

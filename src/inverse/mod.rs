@@ -5,6 +5,10 @@
 //!   algorithm: implementation and theory", Lecture Notes in Mathematics 630, 1978) on any
 //!   [`Residuals`], with box bounds, infeasible regions, analytic or finite-difference
 //!   Jacobians, and the covariance from the SVD of the Jacobian at the optimum;
+//! * [`LevenbergMarquardt`] and [`LeastSquares`] — that solver as an argmin `Solver`, and the
+//!   problem as argmin's `Operator` + `Jacobian` (residuals) and `CostFunction` + `Gradient`
+//!   (χ²) on nalgebra vectors: [`fit`] runs under argmin's `Executor`, argmin's other solvers
+//!   run on fitbead's problems, and observers, timeouts and iteration limits apply to both;
 //! * [`confidence_intervals`] — covariance (Student-t / normal) and profile-likelihood
 //!   intervals;
 //! * [`WeightedData`] — a [`Model`] y = f(x; p) with data (x, y, σ) seen as residuals;
@@ -18,20 +22,25 @@
 //! The solver is validated on the 27 nonlinear problems of the NIST Statistical Reference
 //! Datasets (StRD), from both starting points (`tests/it/nist.rs`).
 
+pub mod estimate;
+pub mod lm;
 mod lmpar;
 pub mod lsq;
 pub mod mcmc;
 pub mod posterior;
+pub mod problem;
 pub mod profile;
 
+pub use estimate::{fit, Covariance, Fit};
+pub use lm::{LevenbergMarquardt, LmState};
 pub use lsq::{
-    fit, Covariance, Fit, Infeasible, LsqError, LsqOptions, Model, Residuals, SigmaKind,
-    Termination, WeightedData,
+    Infeasible, LsqError, LsqOptions, Model, Residuals, SigmaKind, Termination, WeightedData,
 };
 pub use mcmc::{
     EnsembleSampler, LogDensity, McmcError, McmcOptions, McmcResult, ParameterDiagnostics,
     StopReason,
 };
+pub use problem::LeastSquares;
 pub use profile::{
     confidence_intervals, covariance_intervals, profile_interval, ConfidenceIntervals, Interval,
     ProfileEnd, ProfileInterval, DEFAULT_LEVEL,

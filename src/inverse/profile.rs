@@ -25,9 +25,10 @@
 use faer::{Mat, MatMut};
 use statrs::distribution::{ContinuousCDF, Normal, StudentsT};
 
-use super::lsq::{
-    solve, validate, Evaluator, Fit, Infeasible, LsqError, LsqOptions, Residuals, SigmaKind,
-};
+use super::estimate::Fit;
+use super::lm::solve;
+use super::lsq::{validate, Infeasible, LsqError, LsqOptions, Residuals, SigmaKind};
+use super::problem::LeastSquares;
 use crate::special::root::brent;
 
 /// The customary confidence level, 0.95.
@@ -369,9 +370,8 @@ impl<R: Residuals + ?Sized> Profiler<'_, R> {
             typical: subset(&self.opts.typical, self.index),
             ..self.opts.clone()
         };
-        let setup = validate(&fixed, warm, &sub).ok()?;
-        let mut ev = Evaluator::new(&fixed, &setup);
-        let sol = solve(&mut ev, &setup, &sub);
+        let ls = LeastSquares::new(fixed, warm, &sub).ok()?;
+        let (sol, ev, _) = solve(ls, &sub).ok()?;
         self.evals += ev.nfev;
         if !sol.termination.converged() {
             return None;

@@ -8,6 +8,7 @@ mod bench_cli;
 mod cli;
 mod cli_mcmc;
 mod contact;
+mod cross_solvers;
 mod faults;
 mod figures;
 mod fits;

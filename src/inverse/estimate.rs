@@ -1,0 +1,785 @@
+//! The estimate of a least-squares fit: [`fit`] runs [`super::LevenbergMarquardt`] under
+//! argmin's `Executor` and adds the covariance, from the SVD of the column-equilibrated Jacobian
+//! at the optimum, (JᵀJ)⁻¹ = V Σ⁻² Vᵀ, never from an explicitly formed JᵀJ. Both are validated
+//! against the NIST Statistical Reference Datasets (StRD) for nonlinear regression — see
+//! `tests/it/nist.rs`.
+
+// Index loops mirror the subscripts of the matrix formulas.
+#![allow(clippy::needless_range_loop)]
+
+use faer::Mat;
+
+use super::lm::{solve, Solution};
+use super::lmpar::norm2;
+use super::lsq::{LsqError, LsqOptions, Residuals, SigmaKind, Termination};
+use super::problem::{Evaluator, LeastSquares};
+
+/// Covariance of the estimates, from the SVD of the Jacobian at the optimum.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Covariance {
+    /// The n × n covariance matrix: `scale`·(JᵀJ)⁻¹.
+    pub matrix: Mat<f64>,
+    /// The correlation matrix Cᵢⱼ / √(Cᵢᵢ Cⱼⱼ).
+    pub correlation: Mat<f64>,
+    /// Standard errors √Cᵢᵢ.
+    pub std_errors: Vec<f64>,
+    /// The factor applied to (JᵀJ)⁻¹: 1 for [`SigmaKind::Absolute`], s² = χ²/dof for
+    /// [`SigmaKind::Relative`].
+    pub scale: f64,
+    /// Condition number of the column-equilibrated Jacobian.
+    pub condition: f64,
+}
+
+/// The result of [`fit`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Fit {
+    /// Estimated parameters.
+    pub params: Vec<f64>,
+    /// Residuals at the estimate (empty if the start was infeasible).
+    pub residuals: Vec<f64>,
+    /// χ² = Σ rᵢ² at the estimate (+∞ if the start was infeasible).
+    pub chi2: f64,
+    /// Degrees of freedom m − n.
+    pub dof: usize,
+    /// χ²/dof (+∞ when dof = 0).
+    pub reduced_chi2: f64,
+    /// Covariance, correlation and standard errors; `None` when the Jacobian at the estimate is
+    /// rank deficient (or could not be formed), or with [`SigmaKind::Relative`] and dof = 0.
+    pub covariance: Option<Covariance>,
+    /// Scaling convention used for the covariance.
+    pub sigma: SigmaKind,
+    /// Akaike information criterion from the Gaussian likelihood, with k = n parameters and m
+    /// residuals:
+    /// * [`SigmaKind::Absolute`]: AIC = χ² + 2k (the constant Σ ln 2πσᵢ², the same for every
+    ///   model of the same data, is left out);
+    /// * [`SigmaKind::Relative`]: the common variance is a parameter too, estimated by χ²/m, so
+    ///   −2 ln L = m (ln(2π χ²/m) + 1) and AIC = −2 ln L + 2(k + 1) (as R's `AIC` of `nls`,
+    ///   weights' Σ ln wᵢ left out).
+    pub aic: f64,
+    /// Bayesian information criterion, as `aic` with the penalty 2k (2(k + 1)) replaced by
+    /// k ln m ((k + 1) ln m).
+    pub bic: f64,
+    /// Accepted steps: Levenberg–Marquardt steps of every run, plus Gauss–Newton polish
+    /// steps.
+    pub iterations: usize,
+    /// Residual evaluations, finite-difference ones included.
+    pub residual_evals: usize,
+    /// Jacobian evaluations (analytic or by differences).
+    pub jacobian_evals: usize,
+    /// Why the solver stopped.
+    pub termination: Termination,
+    /// Which parameters finish on a bound. The covariance ignores the bounds.
+    pub at_bound: Vec<bool>,
+}
+
+impl Fit {
+    /// True when the solver met a genuine convergence criterion.
+    pub fn converged(&self) -> bool {
+        self.termination.converged()
+    }
+
+    /// Standard errors, if the covariance exists.
+    pub fn std_errors(&self) -> Option<&[f64]> {
+        self.covariance.as_ref().map(|c| c.std_errors.as_slice())
+    }
+}
+
+/// Fits `problem` from `start`: bounded Levenberg–Marquardt with Moré scaling
+/// ([`super::LevenbergMarquardt`], run under argmin's `Executor`),
+/// then the covariance from the SVD of the Jacobian at the estimate.
+///
+/// Returns an error only for malformed input; numerical failure is reported in
+/// [`Fit::termination`] (check [`Fit::converged`]).
+///
+/// ```
+/// use fitbead::inverse::{fit, LsqOptions, Model, SigmaKind, WeightedData, Infeasible};
+/// struct Line;
+/// impl Model<f64> for Line {
+///     fn n_params(&self) -> usize { 2 }
+///     fn value(&self, x: &f64, p: &[f64]) -> Result<f64, Infeasible> { Ok(p[0] + p[1] * x) }
+/// }
+/// let data = WeightedData::new(Line, vec![0.0, 1.0, 2.0, 3.0], vec![1.1, 2.9, 5.2, 6.8], None).unwrap();
+/// let opts = LsqOptions { sigma: SigmaKind::Relative, ..Default::default() };
+/// let fit = fit(&data, &[0.0, 1.0], &opts).unwrap();
+/// assert!(fit.converged());
+/// assert!((fit.params[1] - 1.94).abs() < 1e-9);
+/// ```
+pub fn fit<R: Residuals + ?Sized>(
+    problem: &R,
+    start: &[f64],
+    opts: &LsqOptions,
+) -> Result<Fit, LsqError> {
+    let ls = LeastSquares::new(problem, start, opts)?;
+    let (sol, mut ev, ls) = solve(ls, opts).map_err(|e| LsqError::Solver(e.to_string()))?;
+    Ok(finish(&mut ev, &ls, sol, opts.sigma))
+}
+
+fn finish<R: Residuals>(
+    ev: &mut Evaluator,
+    ls: &LeastSquares<R>,
+    sol: Solution,
+    sigma: SigmaKind,
+) -> Fit {
+    let (m, n) = (ev.m, ev.n);
+    let dof = m - n;
+    let chi2 = if sol.fnorm.is_finite() {
+        sol.fnorm * sol.fnorm
+    } else {
+        f64::INFINITY
+    };
+    let reduced_chi2 = if dof > 0 {
+        chi2 / dof as f64
+    } else {
+        f64::INFINITY
+    };
+    let covariance = if chi2.is_finite() {
+        let mut jac = Mat::<f64>::zeros(m, n);
+        let scale = match sigma {
+            SigmaKind::Absolute => Some(1.0),
+            SigmaKind::Relative if dof > 0 => Some(reduced_chi2),
+            SigmaKind::Relative => None,
+        };
+        match scale {
+            Some(s) if ev.jacobian(ls, &sol.x, &sol.f, &mut jac) => {
+                // Rank is judged to the precision of the Jacobian: ε for an analytic one,
+                // ε^(2/3) (the central-difference error) for differences.
+                let rtol = if ev.differenced {
+                    10.0 * f64::EPSILON.powf(2.0 / 3.0)
+                } else {
+                    f64::EPSILON * m.max(n) as f64
+                };
+                covariance(&jac, s, rtol)
+            }
+            _ => None,
+        }
+    } else {
+        None
+    };
+    let (k, mf) = (n as f64, m as f64);
+    let (aic, bic) = match sigma {
+        SigmaKind::Absolute => (chi2 + 2.0 * k, chi2 + k * mf.ln()),
+        SigmaKind::Relative => {
+            let m2ll = mf * ((2.0 * std::f64::consts::PI * chi2 / mf).ln() + 1.0);
+            (m2ll + 2.0 * (k + 1.0), m2ll + (k + 1.0) * mf.ln())
+        }
+    };
+    let at_bound = (0..n)
+        .map(|j| sol.x[j] <= ls.setup.lower[j] || sol.x[j] >= ls.setup.upper[j])
+        .collect();
+    Fit {
+        params: sol.x,
+        residuals: sol.f,
+        chi2,
+        dof,
+        reduced_chi2,
+        covariance,
+        sigma,
+        aic,
+        bic,
+        iterations: sol.iterations,
+        residual_evals: ev.nfev,
+        jacobian_evals: ev.njev,
+        termination: sol.termination,
+        at_bound,
+    }
+}
+
+/// scale·(JᵀJ)⁻¹ from the SVD of J with unit-norm columns: J = J̃ C, J̃ = U Σ Vᵀ, so
+/// (JᵀJ)⁻¹ = C⁻¹ V Σ⁻² Vᵀ C⁻¹. `None` if J is numerically rank deficient: σ_min ≤ rtol·σ_max.
+pub(crate) fn covariance(jac: &Mat<f64>, scale: f64, rtol: f64) -> Option<Covariance> {
+    let (m, n) = (jac.nrows(), jac.ncols());
+    let mut c = vec![0.0; n];
+    let mut a = Mat::<f64>::zeros(m, n);
+    for j in 0..n {
+        let col: Vec<f64> = (0..m).map(|i| jac[(i, j)]).collect();
+        c[j] = norm2(&col);
+        if !(c[j] > 0.0 && c[j].is_finite()) {
+            return None;
+        }
+        for i in 0..m {
+            a[(i, j)] = jac[(i, j)] / c[j];
+        }
+    }
+    let svd = a.thin_svd().ok()?;
+    let s = svd.S().column_vector();
+    let v = svd.V();
+    let smax = s[0];
+    let smin = s[n - 1];
+    if !(smin > smax * rtol) {
+        return None;
+    }
+    let mut matrix = Mat::<f64>::zeros(n, n);
+    for i in 0..n {
+        for j in 0..=i {
+            let mut sum = 0.0;
+            for k in 0..n {
+                sum += v[(i, k)] * v[(j, k)] / (s[k] * s[k]);
+            }
+            let val = scale * sum / (c[i] * c[j]);
+            matrix[(i, j)] = val;
+            matrix[(j, i)] = val;
+        }
+    }
+    let std_errors: Vec<f64> = (0..n).map(|i| matrix[(i, i)].max(0.0).sqrt()).collect();
+    let mut correlation = Mat::<f64>::zeros(n, n);
+    for i in 0..n {
+        for j in 0..n {
+            let d = std_errors[i] * std_errors[j];
+            correlation[(i, j)] = if i == j {
+                1.0
+            } else if d > 0.0 {
+                matrix[(i, j)] / d
+            } else {
+                0.0
+            };
+        }
+    }
+    Some(Covariance {
+        matrix,
+        correlation,
+        std_errors,
+        scale,
+        condition: smax / smin,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::inverse::lsq::{Infeasible, Model, WeightedData};
+    use crate::inverse::profile::{confidence_intervals, ProfileEnd};
+    use std::cell::Cell;
+
+    /// y = a + b·x.
+    struct Line;
+    impl Model<f64> for Line {
+        fn n_params(&self) -> usize {
+            2
+        }
+        fn value(&self, x: &f64, p: &[f64]) -> Result<f64, Infeasible> {
+            Ok(p[0] + p[1] * x)
+        }
+        fn gradient(&self, x: &f64, _p: &[f64], g: &mut [f64]) -> Option<Result<(), Infeasible>> {
+            g[0] = 1.0;
+            g[1] = *x;
+            Some(Ok(()))
+        }
+    }
+
+    /// y = a·exp(b·x), gradient by the solver's differences.
+    struct Decay;
+    impl Model<f64> for Decay {
+        fn n_params(&self) -> usize {
+            2
+        }
+        fn value(&self, x: &f64, p: &[f64]) -> Result<f64, Infeasible> {
+            Ok(p[0] * (p[1] * x).exp())
+        }
+    }
+
+    /// y = exp(b·x): one parameter.
+    struct Exp1;
+    impl Model<f64> for Exp1 {
+        fn n_params(&self) -> usize {
+            1
+        }
+        fn value(&self, x: &f64, p: &[f64]) -> Result<f64, Infeasible> {
+            Ok((p[0] * x).exp())
+        }
+    }
+
+    fn line_data() -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+        let x = vec![0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
+        let y = vec![1.3, 2.9, 5.4, 6.8, 9.3, 10.7, 13.4];
+        let s = vec![0.2, 0.3, 0.2, 0.5, 0.4, 0.3, 0.6];
+        (x, y, s)
+    }
+
+    fn close(a: f64, b: f64, tol: f64) -> bool {
+        (a - b).abs() <= tol * b.abs().max(1e-300)
+    }
+
+    /// The weighted straight line against the textbook closed form (e.g. Press et al.,
+    /// Numerical Recipes §15.2): Δ = S·Sxx − Sx², a = (Sxx·Sy − Sx·Sxy)/Δ,
+    /// b = (S·Sxy − Sx·Sy)/Δ, var a = Sxx/Δ, var b = S/Δ, cov ab = −Sx/Δ.
+    #[test]
+    fn straight_line_matches_closed_form() {
+        let (x, y, s) = line_data();
+        let (mut s0, mut sx, mut sy, mut sxx, mut sxy) = (0.0, 0.0, 0.0, 0.0, 0.0);
+        for i in 0..x.len() {
+            let w = 1.0 / (s[i] * s[i]);
+            s0 += w;
+            sx += w * x[i];
+            sy += w * y[i];
+            sxx += w * x[i] * x[i];
+            sxy += w * x[i] * y[i];
+        }
+        let d = s0 * sxx - sx * sx;
+        let (a, b) = ((sxx * sy - sx * sxy) / d, (s0 * sxy - sx * sy) / d);
+        let (vaa, vbb, vab) = (sxx / d, s0 / d, -sx / d);
+        let chi2: f64 = (0..x.len())
+            .map(|i| ((y[i] - a - b * x[i]) / s[i]).powi(2))
+            .sum();
+        let data = WeightedData::new(Line, x, y, Some(s)).unwrap();
+        for sigma in [SigmaKind::Absolute, SigmaKind::Relative] {
+            let opts = LsqOptions {
+                sigma,
+                ..Default::default()
+            };
+            let f = fit(&data, &[0.0, 0.0], &opts).unwrap();
+            assert!(f.converged(), "{:?}", f.termination);
+            assert!(close(f.params[0], a, 1e-12) && close(f.params[1], b, 1e-12));
+            assert!(close(f.chi2, chi2, 1e-12));
+            assert_eq!(f.dof, 5);
+            let k = match sigma {
+                SigmaKind::Absolute => 1.0,
+                SigmaKind::Relative => chi2 / 5.0,
+            };
+            let c = f.covariance.as_ref().unwrap();
+            assert!(close(c.matrix[(0, 0)], k * vaa, 1e-12));
+            assert!(close(c.matrix[(1, 1)], k * vbb, 1e-12));
+            assert!(close(c.matrix[(0, 1)], k * vab, 1e-12));
+            assert!(close(c.matrix[(1, 0)], k * vab, 1e-12));
+            assert!(close(c.std_errors[1], (k * vbb).sqrt(), 1e-12));
+            assert!(close(
+                c.correlation[(0, 1)],
+                vab / (vaa * vbb).sqrt(),
+                1e-12
+            ));
+            assert_eq!(c.correlation[(0, 0)], 1.0);
+            // AIC/BIC as documented.
+            let m: f64 = 7.0;
+            match sigma {
+                SigmaKind::Absolute => {
+                    assert!(close(f.aic, chi2 + 4.0, 1e-12));
+                    assert!(close(f.bic, chi2 + 2.0 * m.ln(), 1e-12));
+                }
+                SigmaKind::Relative => {
+                    let m2ll = m * ((2.0 * std::f64::consts::PI * chi2 / m).ln() + 1.0);
+                    assert!(close(f.aic, m2ll + 6.0, 1e-12));
+                    assert!(close(f.bic, m2ll + 3.0 * m.ln(), 1e-12));
+                }
+            }
+        }
+    }
+
+    /// For a linear model Δχ² is exactly quadratic, so the profile interval equals the
+    /// covariance interval (z with absolute σ, Student-t with relative σ).
+    #[test]
+    fn linear_profile_equals_covariance_interval() {
+        let (x, y, s) = line_data();
+        let data = WeightedData::new(Line, x, y, Some(s)).unwrap();
+        for sigma in [SigmaKind::Absolute, SigmaKind::Relative] {
+            let opts = LsqOptions {
+                sigma,
+                ..Default::default()
+            };
+            let f = fit(&data, &[0.0, 0.0], &opts).unwrap();
+            for level in [0.683, 0.95, 0.99] {
+                let ci = confidence_intervals(&data, &f, level, &opts).unwrap();
+                let wald = ci.covariance.as_ref().unwrap();
+                for k in 0..2 {
+                    let lo = ci.profile[k].lower.value().unwrap();
+                    let hi = ci.profile[k].upper.value().unwrap();
+                    let w = wald[k].upper - wald[k].lower;
+                    assert!(
+                        (lo - wald[k].lower).abs() <= 1e-8 * w,
+                        "{sigma:?} {level} {k}: {lo} vs {}",
+                        wald[k].lower
+                    );
+                    assert!(
+                        (hi - wald[k].upper).abs() <= 1e-8 * w,
+                        "{sigma:?} {level} {k}: {hi} vs {}",
+                        wald[k].upper
+                    );
+                }
+            }
+        }
+    }
+
+    fn exp_data() -> (Vec<f64>, Vec<f64>) {
+        let x: Vec<f64> = (0..10).map(|i| 0.3 * i as f64).collect();
+        let noise = [0.05, -0.08, 0.1, -0.02, 0.07, -0.1, 0.04, 0.09, -0.06, 0.03];
+        let y = x
+            .iter()
+            .zip(noise)
+            .map(|(x, e)| (0.8 * x).exp() + e)
+            .collect();
+        (x, y)
+    }
+
+    /// y = exp(b·x): χ²(b) is far from quadratic, the profile interval is asymmetric, and its
+    /// ends are where Δχ² equals the threshold.
+    #[test]
+    fn exponential_profile_is_asymmetric() {
+        let (x, y) = exp_data();
+        let sigma = vec![1.5; x.len()];
+        let data = WeightedData::new(Exp1, x, y, Some(sigma)).unwrap();
+        let opts = LsqOptions::default();
+        let f = fit(&data, &[0.1], &opts).unwrap();
+        assert!(f.converged());
+        let ci = confidence_intervals(&data, &f, 0.95, &opts).unwrap();
+        let b = f.params[0];
+        let lo = ci.profile[0].lower.value().unwrap();
+        let hi = ci.profile[0].upper.value().unwrap();
+        assert!(lo < b && b < hi);
+        let (below, above) = (b - lo, hi - b);
+        assert!(below > 1.2 * above, "below {below}, above {above}");
+        // Δχ² at both ends equals the χ²₁ quantile 1.959964² = 3.841459.
+        let chi2 = |v: f64| {
+            let mut r = vec![0.0; 10];
+            data.residuals(&[v], &mut r).unwrap();
+            r.iter().map(|v| v * v).sum::<f64>()
+        };
+        assert!((ci.threshold - 3.841458820694124).abs() < 1e-9);
+        for end in [lo, hi] {
+            assert!((chi2(end) - f.chi2 - ci.threshold).abs() < 1e-7);
+        }
+        // The Wald interval is symmetric and differs from the profile one.
+        let wald = &ci.covariance.unwrap()[0];
+        assert!(((wald.upper - b) - (b - wald.lower)).abs() < 1e-12);
+        assert!((wald.lower - lo).abs() > 1e-3 * (hi - lo));
+    }
+
+    /// Two parameters: each profile point is a re-minimisation over the other.
+    #[test]
+    fn profile_with_reminimisation() {
+        let (x, y) = exp_data();
+        let sigma = vec![0.3; x.len()];
+        let data = WeightedData::new(Decay, x, y, Some(sigma)).unwrap();
+        let opts = LsqOptions::default();
+        let f = fit(&data, &[1.0, 0.1], &opts).unwrap();
+        assert!(f.converged());
+        let ci = confidence_intervals(&data, &f, 0.95, &opts).unwrap();
+        for k in 0..2 {
+            let p = ci.profile[k];
+            let (lo, hi) = (p.lower.value().unwrap(), p.upper.value().unwrap());
+            assert!(lo < f.params[k] && f.params[k] < hi);
+            // Check one end: fix parameter k there and re-fit the other from afar.
+            let other = 1 - k;
+            let mut lower = vec![f64::NEG_INFINITY; 2];
+            let mut upper = vec![f64::INFINITY; 2];
+            lower[k] = hi;
+            upper[k] = hi;
+            let mut start = f.params.clone();
+            start[k] = hi;
+            start[other] *= 0.7;
+            let o = LsqOptions {
+                lower: Some(lower),
+                upper: Some(upper),
+                ..opts.clone()
+            };
+            let g = fit(&data, &start, &o).unwrap();
+            assert!(g.converged());
+            assert!(
+                (g.chi2 - f.chi2 - ci.threshold).abs() < 1e-7,
+                "{k}: {}",
+                g.chi2 - f.chi2
+            );
+        }
+    }
+
+    #[test]
+    fn bounds_are_respected() {
+        let (x, y) = exp_data();
+        let data = WeightedData::new(Decay, x, y, None).unwrap();
+        // Unconstrained b ≈ 0.8; cap it at 0.7 and hold a ≥ 1.05.
+        let opts = LsqOptions {
+            lower: Some(vec![1.05, f64::NEG_INFINITY]),
+            upper: Some(vec![f64::INFINITY, 0.7]),
+            ..Default::default()
+        };
+        let evals = Cell::new(0usize);
+        struct Watch<'a, R> {
+            inner: R,
+            lo: [f64; 2],
+            hi: [f64; 2],
+            evals: &'a Cell<usize>,
+        }
+        impl<R: Residuals> Residuals for Watch<'_, R> {
+            fn n_params(&self) -> usize {
+                2
+            }
+            fn n_residuals(&self) -> usize {
+                self.inner.n_residuals()
+            }
+            fn residuals(&self, p: &[f64], out: &mut [f64]) -> Result<(), Infeasible> {
+                assert!(
+                    p[0] >= self.lo[0] && p[1] <= self.hi[1],
+                    "outside the box: {p:?}"
+                );
+                self.evals.set(self.evals.get() + 1);
+                self.inner.residuals(p, out)
+            }
+        }
+        let w = Watch {
+            inner: &data,
+            lo: [1.05, f64::NEG_INFINITY],
+            hi: [f64::INFINITY, 0.7],
+            evals: &evals,
+        };
+        // Start outside the box: projected.
+        let f = fit(&w, &[0.5, 2.0], &opts).unwrap();
+        assert!(f.converged(), "{:?}", f.termination);
+        assert_eq!(f.params[1], 0.7);
+        assert!(f.params[0] >= 1.05);
+        assert!(f.at_bound[1]);
+        assert_eq!(evals.get(), f.residual_evals);
+        // The bound on b is active: the unconstrained optimum has a larger χ².
+        let free = fit(&data, &[0.5, 2.0], &LsqOptions::default()).unwrap();
+        assert!(free.params[1] > 0.7 && free.chi2 < f.chi2);
+        assert!(!free.at_bound.iter().any(|b| *b));
+        // With the bound inactive the answer is the unconstrained one.
+        let loose = LsqOptions {
+            upper: Some(vec![10.0, 10.0]),
+            ..Default::default()
+        };
+        let g = fit(&data, &[0.5, 2.0], &loose).unwrap();
+        assert!(close(g.params[1], free.params[1], 1e-9));
+    }
+
+    /// y = √(c − x)·d, infeasible for c ≤ max x; the optimum is feasible but the first
+    /// trust-region steps from far away cross into the infeasible region.
+    struct Root;
+    impl Model<f64> for Root {
+        fn n_params(&self) -> usize {
+            2
+        }
+        fn value(&self, x: &f64, p: &[f64]) -> Result<f64, Infeasible> {
+            if p[0] - x <= 0.0 {
+                return Err(Infeasible);
+            }
+            Ok((p[0] - x).sqrt() * p[1])
+        }
+    }
+
+    #[test]
+    fn infeasible_region_is_a_rejected_step() {
+        let x: Vec<f64> = (0..8).map(|i| i as f64).collect();
+        let y: Vec<f64> = x.iter().map(|x| (7.5f64 - x).sqrt() * 2.0).collect();
+        let data = WeightedData::new(Root, x, y, None).unwrap();
+        let infeasible = Cell::new(0usize);
+        struct Count<'a, R> {
+            inner: R,
+            bad: &'a Cell<usize>,
+        }
+        impl<R: Residuals> Residuals for Count<'_, R> {
+            fn n_params(&self) -> usize {
+                self.inner.n_params()
+            }
+            fn n_residuals(&self) -> usize {
+                self.inner.n_residuals()
+            }
+            fn residuals(&self, p: &[f64], out: &mut [f64]) -> Result<(), Infeasible> {
+                let r = self.inner.residuals(p, out);
+                if r.is_err() {
+                    self.bad.set(self.bad.get() + 1);
+                }
+                r
+            }
+        }
+        let c = Count {
+            inner: &data,
+            bad: &infeasible,
+        };
+        let f = fit(&c, &[40.0, 0.1], &LsqOptions::default()).unwrap();
+        assert!(f.converged(), "{:?}", f.termination);
+        assert!(infeasible.get() > 0, "the test should cross the edge");
+        assert!(close(f.params[0], 7.5, 1e-9) && close(f.params[1], 2.0, 1e-9));
+        assert!(f.params.iter().chain(&f.residuals).all(|v| v.is_finite()));
+
+        // Infeasible start: reported, not converged, nothing NaN.
+        let g = fit(&data, &[3.0, 1.0], &LsqOptions::default()).unwrap();
+        assert_eq!(g.termination, Termination::InfeasibleStart);
+        assert!(!g.converged() && g.chi2 == f64::INFINITY && g.covariance.is_none());
+        assert!(g.params.iter().all(|v| v.is_finite()) && g.residuals.is_empty());
+    }
+
+    /// r = p + 1 wants p = −1, but p < 0 is infeasible: the solver must not claim convergence
+    /// at the edge, nor ever hand back a NaN.
+    #[test]
+    fn optimum_beyond_the_feasible_edge_is_not_convergence() {
+        struct Edge;
+        impl Residuals for Edge {
+            fn n_params(&self) -> usize {
+                1
+            }
+            fn n_residuals(&self) -> usize {
+                1
+            }
+            fn residuals(&self, p: &[f64], out: &mut [f64]) -> Result<(), Infeasible> {
+                if p[0] < 0.0 {
+                    return Err(Infeasible);
+                }
+                out[0] = p[0] + 1.0;
+                Ok(())
+            }
+        }
+        let f = fit(&Edge, &[5.0], &LsqOptions::default()).unwrap();
+        assert!(!f.converged(), "{:?}", f.termination);
+        assert!(f.params[0] >= 0.0 && f.params[0] < 1e-3);
+        // NaN residuals count as infeasible too.
+        struct NanBelow;
+        impl Residuals for NanBelow {
+            fn n_params(&self) -> usize {
+                1
+            }
+            fn n_residuals(&self) -> usize {
+                1
+            }
+            fn residuals(&self, p: &[f64], out: &mut [f64]) -> Result<(), Infeasible> {
+                out[0] = p[0].sqrt() + 1.0;
+                Ok(())
+            }
+        }
+        let f = fit(&NanBelow, &[5.0], &LsqOptions::default()).unwrap();
+        assert!(!f.converged(), "{:?}", f.termination);
+        assert!(f.params[0].is_finite() && f.chi2.is_finite());
+    }
+
+    #[test]
+    fn differences_agree_with_analytic_jacobian() {
+        struct LineNoGrad;
+        impl Model<f64> for LineNoGrad {
+            fn n_params(&self) -> usize {
+                2
+            }
+            fn value(&self, x: &f64, p: &[f64]) -> Result<f64, Infeasible> {
+                Ok(p[0] + p[1] * x)
+            }
+        }
+        let (x, y, s) = line_data();
+        let a = WeightedData::new(Line, x.clone(), y.clone(), Some(s.clone())).unwrap();
+        let b = WeightedData::new(LineNoGrad, x, y, Some(s)).unwrap();
+        let fa = fit(&a, &[0.0, 0.0], &LsqOptions::default()).unwrap();
+        let fb = fit(&b, &[0.0, 0.0], &LsqOptions::default()).unwrap();
+        for k in 0..2 {
+            assert!(close(fb.params[k], fa.params[k], 1e-10));
+            assert!(close(
+                fb.std_errors().unwrap()[k],
+                fa.std_errors().unwrap()[k],
+                1e-8
+            ));
+        }
+    }
+
+    #[test]
+    fn limits_and_rank_deficiency_are_reported() {
+        let (x, y) = exp_data();
+        let data = WeightedData::new(Decay, x.clone(), y.clone(), None).unwrap();
+        let opts = LsqOptions {
+            max_iterations: 1,
+            restarts: 0,
+            ..Default::default()
+        };
+        let f = fit(&data, &[0.01, 3.0], &opts).unwrap();
+        assert_eq!(f.termination, Termination::MaxIterations);
+        assert!(!f.converged());
+        // y = a + b (two names for one constant): J has rank 1, no covariance.
+        struct Twice;
+        impl Model<f64> for Twice {
+            fn n_params(&self) -> usize {
+                2
+            }
+            fn value(&self, _x: &f64, p: &[f64]) -> Result<f64, Infeasible> {
+                Ok(p[0] + p[1])
+            }
+            fn gradient(
+                &self,
+                _x: &f64,
+                _p: &[f64],
+                g: &mut [f64],
+            ) -> Option<Result<(), Infeasible>> {
+                g.fill(1.0);
+                Some(Ok(()))
+            }
+        }
+        let mean = y.iter().sum::<f64>() / y.len() as f64;
+        let d = WeightedData::new(Twice, x, y, None).unwrap();
+        let f = fit(&d, &[1.0, 1.0], &LsqOptions::default()).unwrap();
+        assert!(f.converged(), "{:?}", f.termination);
+        assert!(f.covariance.is_none());
+        assert!(close(f.params[0] + f.params[1], mean, 1e-12));
+    }
+
+    #[test]
+    fn bad_input_is_an_error() {
+        let (x, y) = exp_data();
+        let data = WeightedData::new(Decay, x.clone(), y.clone(), None).unwrap();
+        let o = LsqOptions::default();
+        assert!(matches!(
+            fit(&data, &[1.0], &o),
+            Err(LsqError::Length { .. })
+        ));
+        assert!(matches!(
+            fit(&data, &[1.0, f64::NAN], &o),
+            Err(LsqError::NonFinite { .. })
+        ));
+        let b = LsqOptions {
+            lower: Some(vec![0.0, 2.0]),
+            upper: Some(vec![1.0, 1.0]),
+            ..Default::default()
+        };
+        assert_eq!(fit(&data, &[0.5, 1.5], &b), Err(LsqError::Bounds(1)));
+        let t = LsqOptions {
+            ftol: -1.0,
+            ..Default::default()
+        };
+        assert!(matches!(
+            fit(&data, &[1.0, 1.0], &t),
+            Err(LsqError::Option { .. })
+        ));
+        assert!(WeightedData::new(Decay, x.clone(), y[..3].to_vec(), None).is_err());
+        assert!(WeightedData::new(Decay, x, y, Some(vec![0.0; 10])).is_err());
+        let few = WeightedData::new(Decay, vec![1.0], vec![1.0], None).unwrap();
+        assert_eq!(
+            fit(&few, &[1.0, 1.0], &o),
+            Err(LsqError::Shape { m: 1, n: 2 })
+        );
+    }
+
+    #[test]
+    fn one_sided_profile_end_at_a_bound() {
+        let (x, y) = exp_data();
+        let sigma = vec![0.3; x.len()];
+        let data = WeightedData::new(Exp1, x, y, Some(sigma)).unwrap();
+        let opts = LsqOptions {
+            upper: Some(vec![0.8]),
+            ..Default::default()
+        };
+        let f = fit(&data, &[0.1], &opts).unwrap();
+        assert!(f.converged());
+        let ci = confidence_intervals(&data, &f, 0.95, &opts).unwrap();
+        assert_eq!(ci.profile[0].upper, ProfileEnd::Bound(0.8));
+        assert!(ci.profile[0].lower.value().is_some());
+
+        // An infeasible region inside the interval: the end is the edge reached.
+        struct Capped(WeightedData<f64, Exp1>, f64);
+        impl Residuals for Capped {
+            fn n_params(&self) -> usize {
+                1
+            }
+            fn n_residuals(&self) -> usize {
+                self.0.n_residuals()
+            }
+            fn residuals(&self, p: &[f64], out: &mut [f64]) -> Result<(), Infeasible> {
+                if p[0] > self.1 {
+                    return Err(Infeasible);
+                }
+                self.0.residuals(p, out)
+            }
+        }
+        let free = fit(&data, &[0.1], &LsqOptions::default()).unwrap();
+        let ci = confidence_intervals(&data, &free, 0.95, &LsqOptions::default()).unwrap();
+        let hi = ci.profile[0].upper.value().unwrap();
+        let cap = free.params[0] + 0.5 * (hi - free.params[0]);
+        let capped = Capped(data, cap);
+        let f = fit(&capped, &[0.1], &LsqOptions::default()).unwrap();
+        assert!(f.converged());
+        let ci = confidence_intervals(&capped, &f, 0.95, &LsqOptions::default()).unwrap();
+        match ci.profile[0].upper {
+            ProfileEnd::Edge(v) => assert!(v <= cap && v > cap - 0.01 * (hi - f.params[0])),
+            other => panic!("{other:?}"),
+        }
+    }
+}

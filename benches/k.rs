@@ -72,9 +72,62 @@ fn bench(c: &mut Criterion) {
     g.finish();
 }
 
+/// Kepler's equation E − e sin E = M (e = 0.5, M = 1) on [0, π]: a function as cheap as the
+/// inner loops' (a few flops), so the root finder's own cost shows.
+struct Kepler;
+
+impl argmin::core::CostFunction for Kepler {
+    type Param = f64;
+    type Output = f64;
+    fn cost(&self, e: &f64) -> Result<f64, argmin::core::Error> {
+        Ok(e - 0.5 * e.sin() - 1.0)
+    }
+}
+
+/// fitbead's Brent (`special::root::brent`, allocation-free, called inside every stick/slip
+/// evaluation) against argmin's `BrentRoot` under its `Executor`, both to 1e-15 on the same
+/// root.
+fn roots(c: &mut Criterion) {
+    use argmin::core::{CostFunction, Executor, State};
+    use argmin::solver::brent::BrentRoot;
+    let f = |e: f64| Kepler.cost(&e).unwrap();
+    let (a, b) = (0.0, std::f64::consts::PI);
+    let ours = fitbead::special::root::brent(f, a, b, f(a), f(b), 1e-15, 200)
+        .unwrap()
+        .x;
+    let theirs = *Executor::new(Kepler, BrentRoot::new(a, b, 1e-15))
+        .configure(|s| s.param(1.0).max_iters(200))
+        .ctrlc(false)
+        .run()
+        .unwrap()
+        .state()
+        .get_best_param()
+        .unwrap();
+    assert!((ours - theirs).abs() <= 4e-15, "{ours} vs {theirs}");
+    let mut g = c.benchmark_group("root");
+    g.bench_function("brent (fitbead)", |bn| {
+        bn.iter(|| {
+            let (a, b) = (black_box(a), black_box(b));
+            fitbead::special::root::brent(f, a, b, f(a), f(b), 1e-15, 200).map(|r| r.x)
+        })
+    });
+    g.bench_function("BrentRoot (argmin)", |bn| {
+        bn.iter(|| {
+            let solver = BrentRoot::new(black_box(a), black_box(b), 1e-15);
+            let res = Executor::new(Kepler, solver)
+                .configure(|s| s.param(1.0).max_iters(200))
+                .ctrlc(false)
+                .run()
+                .unwrap();
+            *res.state().get_best_param().unwrap()
+        })
+    });
+    g.finish();
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(20).measurement_time(std::time::Duration::from_secs(3));
-    targets = bench
+    targets = bench, roots
 }
 criterion_main!(benches);

@@ -35,6 +35,25 @@
 //! the default feature `cli`; without it (`default-features = false`) the library has no
 //! command-line dependencies.
 //!
+//! ## Which crate does what
+//!
+//! | crate | what it does here |
+//! |---|---|
+//! | argmin | the optimisation framework: the least-squares solver is an argmin `Solver` ([`inverse::LevenbergMarquardt`]) run by argmin's `Executor`, and every least-squares problem is an argmin problem ([`inverse::LeastSquares`]), so argmin's other solvers, observers and termination rules apply |
+//! | nalgebra (with argmin-math's nalgebra backend) | the vectors and matrices of that argmin interface |
+//! | faer | dense linear algebra inside the solver: the column-pivoted QR of each Levenberg–Marquardt iteration and the SVD behind every covariance |
+//! | statrs | Student-t and normal quantiles of the confidence intervals and the MCMC diagnostics; the priors' densities |
+//! | rand, rand_chacha, rand_distr | random streams reproducible from a seed whatever the thread count: the MCMC sampler, simulated data |
+//! | rayon | parallel per-row and per-point work (`forward`, `k`, the K-law fits) |
+//! | csv, serde, ryu | the CSV formats; shortest round-trip printing of floats |
+//! | plotters | the SVG figures |
+//! | thiserror, tempfile | error types; atomic output files |
+//!
+//! What is hand-written instead, and the measurement that keeps it so, is said where it lives:
+//! Carlson's R_F ([`special::elliptic::rf`]), the Brent root finder ([`special::root`]), the
+//! double-double arithmetic ([`special::dd`]) and the Levenberg–Marquardt iteration itself
+//! (argmin has none; the NIST cross-checks in `docs/ACCURACY.md`).
+//!
 //! ## Quickstart
 //!
 //! [`prelude`] imports what a typical program needs. The program `examples/quickstart.rs`

@@ -9,7 +9,9 @@
 
 use faer::Mat;
 
-use super::lm::{solve, Solution};
+use argmin::core::OptimizationResult;
+
+use super::lm::{into_parts, solve, LevenbergMarquardt, LmState, Solution};
 use super::lmpar::norm2;
 use super::lsq::{LsqError, LsqOptions, Residuals, SigmaKind, Termination};
 use super::problem::{Evaluator, LeastSquares};
@@ -112,6 +114,20 @@ pub fn fit<R: Residuals + ?Sized>(
     let ls = LeastSquares::new(problem, start, opts)?;
     let (sol, mut ev, ls) = solve(ls, opts).map_err(|e| LsqError::Solver(e.to_string()))?;
     Ok(finish(&mut ev, &ls, sol, opts.sigma))
+}
+
+/// The [`Fit`] (estimate, statistics and covariance) of a run of
+/// [`super::LevenbergMarquardt`] under argmin's `Executor` built by hand, e.g. with observers or
+/// a timeout. A run that argmin stopped (iteration limit, timeout, target cost, interrupt)
+/// reports the point reached, with [`Termination::MaxIterations`] for the iteration limit,
+/// [`Termination::RelativeReduction`] for a target cost and [`Termination::Interrupted`] for the
+/// others.
+pub fn fit_result<R: Residuals>(
+    result: OptimizationResult<LeastSquares<R>, LevenbergMarquardt, LmState>,
+    sigma: SigmaKind,
+) -> Result<Fit, LsqError> {
+    let (sol, mut ev, ls) = into_parts(result).map_err(|e| LsqError::Solver(e.to_string()))?;
+    Ok(finish(&mut ev, &ls, sol, sigma))
 }
 
 fn finish<R: Residuals>(
@@ -700,6 +716,57 @@ mod tests {
         assert!(f.converged(), "{:?}", f.termination);
         assert!(f.covariance.is_none());
         assert!(close(f.params[0] + f.params[1], mean, 1e-12));
+    }
+
+    /// A run built by hand under argmin's `Executor` gives `fit`'s result; argmin's iteration
+    /// limit stops it where it is, as not converged; an observer sees every iteration.
+    #[test]
+    fn executor_runs_agree_with_fit() {
+        use argmin::core::observers::{Observe, ObserverMode};
+        use argmin::core::{Executor, KV};
+        use std::sync::{Arc, Mutex};
+
+        let (x, y) = exp_data();
+        let data = WeightedData::new(Decay, x, y, None).unwrap();
+        let opts = LsqOptions {
+            restarts: 2,
+            ..LsqOptions::default()
+        };
+        let direct = fit(&data, &[1.0, 0.0], &opts).unwrap();
+        let ls = LeastSquares::new(&data, &[1.0, 0.0], &opts).unwrap();
+        let run = Executor::new(ls, LevenbergMarquardt::new(&opts))
+            .run()
+            .unwrap();
+        assert_eq!(fit_result(run, opts.sigma).unwrap(), direct);
+
+        #[derive(Clone)]
+        struct Seen(Arc<Mutex<Vec<f64>>>);
+        impl Observe<LmState> for Seen {
+            fn observe_iter(
+                &mut self,
+                state: &LmState,
+                kv: &KV,
+            ) -> Result<(), argmin::core::Error> {
+                let chi2 = kv.get("chi2").and_then(|v| v.get_float()).unwrap();
+                assert_eq!(chi2, state.cost);
+                self.0.lock().unwrap().push(chi2);
+                Ok(())
+            }
+        }
+        let seen = Seen(Arc::new(Mutex::new(Vec::new())));
+        let ls = LeastSquares::new(&data, &[1.0, 0.0], &opts).unwrap();
+        let run = Executor::new(ls, LevenbergMarquardt::new(&opts).with_log(true))
+            .add_observer(seen.clone(), ObserverMode::Always)
+            .configure(|s| s.max_iters(2))
+            .run()
+            .unwrap();
+        let cut = fit_result(run, opts.sigma).unwrap();
+        assert_eq!(cut.termination, Termination::MaxIterations);
+        assert!(!cut.converged());
+        assert!(cut.chi2 > direct.chi2);
+        let chi2s = seen.0.lock().unwrap().clone();
+        assert_eq!(chi2s.len(), 2);
+        assert!(chi2s[1] <= chi2s[0]);
     }
 
     #[test]

@@ -16,7 +16,7 @@
 //! * **Radius update** by the ratio ρ of actual to predicted reduction of ‖f‖² (Moré 1978 §4):
 //!   ρ ≤ ¼ shrinks Δ (by the quadratic-interpolation factor, clamped to [0.1, 0.5]); ρ ≥ ¾ or
 //!   λ = 0 sets Δ = 2‖D s‖. A step is accepted when ρ ≥ 10⁻⁴.
-//! * **Infeasible points.** A residual evaluation may answer [`Infeasible`] (the model left its
+//! * **Infeasible points.** A residual evaluation may answer [`Infeasible`](super::Infeasible) (the model left its
 //!   valid range), and a non-finite residual counts the same. A trial point that is infeasible is
 //!   a rejected step with the strongest shrink of Δ (to at most ‖D s‖, ×0.1): the solver backs
 //!   off towards the current, feasible point and never propagates a NaN.
@@ -549,8 +549,8 @@ enum Stage {
 /// χ²; a `param` set on the initial state (`Executor::configure`) replaces the problem's start
 /// (projected onto the box). The solver's own reason for stopping is
 /// [`LevenbergMarquardt::termination`]; argmin's own stops (`max_iters`, a timeout, a target
-/// cost) end the run where it is and map onto [`Termination`] in
-/// [`LevenbergMarquardt::solution`].
+/// cost) end the run where it is; [`super::estimate::fit_result`] turns the executor's result
+/// into a [`super::Fit`] (argmin's reasons mapped onto [`Termination`]).
 ///
 /// ```
 /// use argmin::core::{Executor, State};
@@ -572,6 +572,9 @@ enum Stage {
 /// let p = result.state().get_param().unwrap();
 /// assert!((p[0] - 3.0).abs() < 1e-12 && (p[1] - 0.5).abs() < 1e-12);
 /// assert!(result.solver().termination().unwrap().converged());
+/// // The estimate with its statistics and covariance, as `fit` gives it.
+/// let fit = fitbead::inverse::fit_result(result, opts.sigma).unwrap();
+/// assert!(fit.converged() && fit.std_errors().is_some());
 /// ```
 #[derive(Debug, Clone)]
 pub struct LevenbergMarquardt {
@@ -893,6 +896,13 @@ pub(crate) fn solve<R: Residuals>(
     let result = argmin::core::Executor::new(ls, LevenbergMarquardt::new(opts))
         .ctrlc(false)
         .run()?;
+    into_parts(result)
+}
+
+/// The solution, the evaluator and the problem of an executor's result.
+pub(crate) fn into_parts<R: Residuals>(
+    result: argmin::core::OptimizationResult<LeastSquares<R>, LevenbergMarquardt, LmState>,
+) -> Result<(Solution, Evaluator, LeastSquares<R>), Error> {
     let reason = result.state.get_termination_reason();
     let sol = result
         .solver

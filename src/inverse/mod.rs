@@ -31,7 +31,7 @@ pub mod posterior;
 pub mod problem;
 pub mod profile;
 
-pub use estimate::{fit, Covariance, Fit};
+pub use estimate::{fit, fit_result, Covariance, Fit};
 pub use lm::{LevenbergMarquardt, LmState};
 pub use lsq::{
     Infeasible, LsqError, LsqOptions, Model, Residuals, SigmaKind, Termination, WeightedData,

@@ -1,8 +1,14 @@
 //! Double-double arithmetic (about 32 significant digits) for the few places where the physics
 //! cancels catastrophically: the squared velocity at the top of a row bead near the lower regime
-//! limit δ_m (docs/PHYSICS.md#pure-rolling). Written by hand because the operations needed are four
-//! lines each (error-free transforms with FMA) and a crate would bring a whole numeric tower; the
-//! accuracy is held by tests against mpmath values.
+//! limit δ_m (docs/PHYSICS.md#pure-rolling), and the slip model's speed near its minimum.
+//!
+//! Written by hand rather than taken from the `qd` crate, which is already in the dependency
+//! tree (through faer) and has a double-double type with the four operations, `sqrt`, `exp` and
+//! `ln`: the models need `sin`/`cos` of a double-double angle, `asin` and `expm1` (`Dd::sin_cos`,
+//! `Dd::sin_cos_dd`, `Dd::asin`, `Dd::exp_m1`), which `qd` 0.8 does not have, and they would
+//! have to be written here on top of it anyway; the arithmetic itself is the error-free
+//! transforms (two-sum, FMA two-product), a few lines each. The accuracy is held by tests
+//! against mpmath values.
 
 use std::ops::{Add, Div, Mul, Neg, Sub};
 

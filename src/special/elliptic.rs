@@ -21,7 +21,11 @@ use super::SinCos;
 /// crate's, operation for operation, so the results are the same; the unit test below holds it
 /// against Carlson's published values and `tests/it/reference_models.rs` holds the rolling
 /// models against 40-digit mpmath quadrature.
-/// Arguments outside [1e-30, 1e30] (never met by the models) go to the crate, which rescales.
+/// Arguments whose largest is outside [1e-30, 1e30] (never met by the models) are brought to
+/// about 1 by the homogeneity R_F(λx, λy, λz) = λ^{-1/2} R_F(x, y, z) with λ = 4^k, exact in
+/// binary (an argument below 2^-1074 after the scaling, 10^-300 times smaller than the largest,
+/// becomes 0, a relative change of R_F far below ε); the unit tests hold them against the
+/// `ellip` crate.
 #[inline]
 pub fn rf(x: f64, y: f64, z: f64) -> f64 {
     if !(x >= 0.0 && y >= 0.0 && z >= 0.0) {
@@ -36,7 +40,10 @@ pub fn rf(x: f64, y: f64, z: f64) -> f64 {
     }
     let scale = x.max(y).max(z);
     if !(1e-30..=1e30).contains(&scale) {
-        return ellip::carlson::elliprf_unchecked(x, y, z);
+        // λ = 4^k = 2^k · 2^k (two factors: 4^k alone may overflow), R_F = 2^k R_F(λ·).
+        let k = -(scale.log2() / 2.0).round() as i32;
+        let h = 2f64.powi(k);
+        return h * rf(x * h * h, y * h * h, z * h * h);
     }
     // (3 ε)^{-1/8} for ε = 2^-52.
     const STOP: f64 = 78.8959690786408;
@@ -158,6 +165,36 @@ mod tests {
         assert_eq!(rf(0.0, 0.0, 1.0), f64::INFINITY);
         assert_eq!(rf(f64::INFINITY, 1.0, 1.0), 0.0);
         assert!(rf(-1.0, 1.0, 1.0).is_nan() && rf(f64::NAN, 1.0, 1.0).is_nan());
+    }
+
+    /// Arguments beyond [1e-30, 1e30], which `rf` scales by its homogeneity, against the
+    /// `ellip` crate (Boost.Math's algorithm with its own rescaling, ≤ 4.5e-16 relative on
+    /// Boost's data): within 4ε relative (measured: at most 3.0e-16).
+    #[test]
+    fn rf_out_of_range_matches_the_ellip_crate() {
+        let mut worst: f64 = 0.0;
+        for &s in &[
+            1e-320, 1e-300, 1e-200, 1e-100, 1e-31, 1e31, 1e100, 1e200, 1e300, 5e307,
+        ] {
+            for &(x, y, z) in &[
+                (1.0, 2.0, 3.0),
+                (0.0, 1.0, 2.0),
+                (1e-5, 1.0, 1.0),
+                (0.25, 0.5, 0.75),
+                (1.0, 1.0, 1.0),
+            ] {
+                let (x, y, z) = (x * s, y * s, z * s);
+                let ours = rf(x, y, z);
+                let theirs = ellip::carlson::elliprf_unchecked(x, y, z);
+                let rel = ((ours - theirs) / theirs).abs();
+                assert!(
+                    rel <= 4.0 * f64::EPSILON,
+                    "R_F({x:e},{y:e},{z:e}): {ours:e} vs {theirs:e}"
+                );
+                worst = worst.max(rel);
+            }
+        }
+        println!("worst relative difference from ellip beyond [1e-30, 1e30]: {worst:.2e}");
     }
 
     #[test]

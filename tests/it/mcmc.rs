@@ -9,7 +9,7 @@ use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
 use fitbead::inverse::mcmc::diagnostics::{
-    ess_bulk, ess_mean, ess_tail, integrated_time, parameter_chains, rhat, SOKAL_C,
+    autocovariance, ess_bulk, ess_mean, ess_tail, integrated_time, parameter_chains, rhat, SOKAL_C,
 };
 use fitbead::inverse::mcmc::{
     EnsembleSampler, LogDensity, McmcError, McmcOptions, McmcResult, StopReason,
@@ -502,4 +502,41 @@ fn nan_stop_and_validation() {
     // parameter_chains extracts one parameter.
     let chains = vec![vec![vec![1.0, 2.0], vec![3.0, 4.0]]];
     assert_eq!(parameter_chains(&chains, 1), vec![vec![2.0, 4.0]]);
+}
+
+/// The FFT autocovariance against the direct O(n²) sum (1/n) Σ (xᵢ − x̄)(x_{i+t} − x̄), on
+/// random series of lengths 1 to 5,000, including lengths just past a power of two: agreement
+/// within 1e-13 of γ(0) at every lag (measured: at most 1.6e-15).
+#[test]
+fn autocovariance_matches_the_direct_sum() {
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    let mut worst: f64 = 0.0;
+    for n in [1, 2, 3, 7, 64, 65, 100, 1023, 1025, 5000] {
+        let x: Vec<f64> = (0..n)
+            .map(|_| {
+                let z: f64 = StandardNormal.sample(&mut rng);
+                3.0 + z
+            })
+            .collect();
+        let mean = x.iter().sum::<f64>() / n as f64;
+        let fft = autocovariance(&x);
+        assert_eq!(fft.len(), n);
+        let scale = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n as f64;
+        for t in 0..n {
+            let direct: f64 = (0..n - t)
+                .map(|i| (x[i] - mean) * (x[i + t] - mean))
+                .sum::<f64>()
+                / n as f64;
+            let err = if scale > 0.0 {
+                (fft[t] - direct).abs() / scale
+            } else {
+                fft[t].abs()
+            };
+            worst = worst.max(err);
+            assert!(err <= 1e-13, "n = {n}, lag {t}: {} vs {direct}", fft[t]);
+        }
+    }
+    println!("worst difference from the direct sum: {worst:.2e} of γ(0)");
+    assert!(autocovariance(&[]).is_empty());
+    assert!(autocovariance(&[2.0; 10]).iter().all(|v| *v == 0.0));
 }

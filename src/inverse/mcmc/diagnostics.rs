@@ -18,6 +18,8 @@
 //! * [`summarise`] — all of the above plus mean, standard deviation and quantiles of the pooled
 //!   draws, per parameter.
 
+use realfft::num_complex::Complex;
+use realfft::RealFftPlanner;
 use statrs::distribution::{ContinuousCDF, Normal};
 
 /// Sokal's window constant used by emcee: the window is the smallest M with M ≥ c·τ(M).
@@ -31,60 +33,18 @@ pub fn parameter_chains(chains: &[Vec<Vec<f64>>], k: usize) -> Vec<Vec<f64>> {
         .collect()
 }
 
-// ---------------------------------------------------------------------------------------------
-// FFT.
-//
-// The crate has no FFT dependency and the autocorrelation only needs one power-of-two complex
-// transform pair, so a ~40-line iterative radix-2 Cooley–Tukey FFT is written here rather than
-// pulling in a crate. Autocovariances are needed at all lags of chains of up to ~10⁵ steps, so
-// the direct O(n²) sum would be too slow for the convergence checks run during sampling.
-// ---------------------------------------------------------------------------------------------
-
-/// In-place radix-2 FFT of (re, im), length a power of two; `inverse` uses e^{+iθ} (unscaled).
-fn fft(re: &mut [f64], im: &mut [f64], inverse: bool) {
-    let n = re.len();
-    debug_assert!(n.is_power_of_two() && im.len() == n);
-    // Bit-reversal permutation.
-    let mut j = 0usize;
-    for i in 1..n {
-        let mut bit = n >> 1;
-        while j & bit != 0 {
-            j ^= bit;
-            bit >>= 1;
-        }
-        j |= bit;
-        if i < j {
-            re.swap(i, j);
-            im.swap(i, j);
-        }
-    }
-    let sign = if inverse { 1.0 } else { -1.0 };
-    // Twiddle table e^{∓2πik/n}, k < n/2, computed directly (not by recurrence) to keep
-    // rounding errors small; stage `len` uses every (n/len)-th entry.
-    let theta = sign * 2.0 * std::f64::consts::PI / n as f64;
-    let twiddles: Vec<(f64, f64)> = (0..n / 2).map(|k| (theta * k as f64).sin_cos()).collect();
-    let mut len = 2;
-    while len <= n {
-        let half = len / 2;
-        let stride = n / len;
-        for start in (0..n).step_by(len) {
-            for k in 0..half {
-                let (s, c) = twiddles[k * stride];
-                let (a, b) = (start + k, start + k + half);
-                let tr = re[b] * c - im[b] * s;
-                let ti = re[b] * s + im[b] * c;
-                re[b] = re[a] - tr;
-                im[b] = im[a] - ti;
-                re[a] += tr;
-                im[a] += ti;
-            }
-        }
-        len <<= 1;
-    }
+thread_local! {
+    /// FFT plans of `realfft`, kept per thread: the convergence checks transform chains of the
+    /// same few lengths again and again.
+    static PLANNER: std::cell::RefCell<RealFftPlanner<f64>> =
+        std::cell::RefCell::new(RealFftPlanner::new());
 }
 
-/// Biased autocovariance γ̂(t) = (1/n) Σ_{i<n−t} (xᵢ − x̄)(x_{i+t} − x̄), t = 0..n, by FFT with
-/// zero padding to avoid circular wrap-around.
+/// Biased autocovariance γ̂(t) = (1/n) Σ_{i<n−t} (xᵢ − x̄)(x_{i+t} − x̄), t = 0..n, by a real FFT
+/// (`realfft`) with zero padding to avoid circular wrap-around: O(n log n), where the direct sum
+/// is O(n²) (`cargo bench --bench mcmc -- autocovariance` times the three ways it has been done:
+/// at n = 10⁴, 0.42 ms here, 3.17 ms by a hand-written radix-2 complex FFT, 61 ms by the direct
+/// sum; criterion medians, 2-core AMD EPYC, 2026-11-23).
 pub fn autocovariance(x: &[f64]) -> Vec<f64> {
     let n = x.len();
     if n == 0 {
@@ -92,21 +52,31 @@ pub fn autocovariance(x: &[f64]) -> Vec<f64> {
     }
     let mean = x.iter().sum::<f64>() / n as f64;
     let m = (2 * n).next_power_of_two();
-    let mut re = vec![0.0; m];
-    let mut im = vec![0.0; m];
-    for (r, &v) in re.iter_mut().zip(x) {
+    let (r2c, c2r) = PLANNER.with(|p| {
+        let mut p = p.borrow_mut();
+        (p.plan_fft_forward(m), p.plan_fft_inverse(m))
+    });
+    let mut input = vec![0.0; m];
+    for (r, &v) in input.iter_mut().zip(x) {
         *r = v - mean;
     }
-    fft(&mut re, &mut im, false);
-    for (r, i) in re.iter_mut().zip(im.iter_mut()) {
-        *r = *r * *r + *i * *i;
-        *i = 0.0;
+    let mut spectrum = r2c.make_output_vec();
+    let mut out = c2r.make_output_vec();
+    // The buffers come from the plans, so neither transform can fail; if one did, NaN makes
+    // every diagnostic built on it say "not converged".
+    if r2c.process(&mut input, &mut spectrum).is_err() {
+        return vec![f64::NAN; n];
     }
-    fft(&mut re, &mut im, true);
-    re.truncate(n);
+    for z in spectrum.iter_mut() {
+        *z = Complex::new(z.norm_sqr(), 0.0);
+    }
+    if c2r.process(&mut spectrum, &mut out).is_err() {
+        return vec![f64::NAN; n];
+    }
+    out.truncate(n);
     let scale = 1.0 / (m as f64 * n as f64);
-    re.iter_mut().for_each(|v| *v *= scale);
-    re
+    out.iter_mut().for_each(|v| *v *= scale);
+    out
 }
 
 /// Normalised autocorrelation function ρ̂(t) = γ̂(t)/γ̂(0) (all zeros for a constant series).

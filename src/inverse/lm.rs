@@ -101,6 +101,10 @@ struct LmRun {
     step: Vec<f64>,
     ft: Vec<f64>,
     u: Vec<f64>,
+    /// Work space: a Jacobian column (m), a scaled vector and R·s (n).
+    col: Vec<f64>,
+    scaled: Vec<f64>,
+    rs: Vec<f64>,
     /// The Levenberg–Marquardt parameter λ.
     par: f64,
     /// The trust radius Δ.
@@ -162,6 +166,9 @@ impl LmRun {
             step: vec![0.0; n],
             ft: vec![0.0; m],
             u: vec![0.0; m],
+            col: vec![0.0; m],
+            scaled: vec![0.0; n],
+            rs: vec![0.0; n],
             par: 0.0,
             delta: 0.0,
             xnorm: 0.0,
@@ -219,6 +226,9 @@ impl LmRun {
             step,
             ft,
             u,
+            col,
+            scaled,
+            rs,
             par,
             delta,
             xnorm,
@@ -239,8 +249,10 @@ impl LmRun {
         }
         // Column norms, gradient Jᵀf and the active set.
         for j in 0..n {
-            let col: Vec<f64> = (0..m).map(|i| jac[(i, j)]).collect();
-            acnorm[j] = norm2(&col);
+            for (i, c) in col.iter_mut().enumerate() {
+                *c = jac[(i, j)];
+            }
+            acnorm[j] = norm2(col);
             grad[j] = (0..m).map(|i| jac[(i, j)] * f[i]).sum();
             free[j] = !((x[j] <= lo[j] && grad[j] > 0.0) || (x[j] >= hi[j] && grad[j] < 0.0));
             for i in 0..m {
@@ -251,7 +263,7 @@ impl LmRun {
             for j in 0..n {
                 diag[j] = if acnorm[j] != 0.0 { acnorm[j] } else { 1.0 };
             }
-            *xnorm = scaled_norm(diag, x);
+            *xnorm = scaled_norm(diag, x, scaled);
             *delta = opts.initial_radius_factor * *xnorm;
             if *delta == 0.0 {
                 *delta = opts.initial_radius_factor;
@@ -295,7 +307,7 @@ impl LmRun {
                 }
                 step[j] = trial[j] - x[j];
             }
-            let pnorm = scaled_norm(diag, step);
+            let pnorm = scaled_norm(diag, step, scaled);
             if *first {
                 *delta = delta.min(pnorm);
             }
@@ -312,7 +324,7 @@ impl LmRun {
             // Predicted reduction and scaled directional derivative.
             let (prered, dirder) = if !projected {
                 // The exact LM step: pred = ‖J s‖² + 2λ‖D s‖² (Moré 1978, eq. 4.4 ff.).
-                let mut rs = vec![0.0; n];
+                rs.fill(0.0);
                 for j in 0..n {
                     let l = ipvt[j];
                     let sl = step[l];
@@ -320,7 +332,7 @@ impl LmRun {
                         *v += sp.r[i + j * n] * sl;
                     }
                 }
-                let temp1 = norm2(&rs) / *fnorm;
+                let temp1 = norm2(rs) / *fnorm;
                 let temp2 = par.sqrt() * pnorm / *fnorm;
                 (
                     temp1 * temp1 + temp2 * temp2 / 0.5,
@@ -359,7 +371,7 @@ impl LmRun {
                 }
                 x.copy_from_slice(trial);
                 std::mem::swap(f, ft);
-                *xnorm = scaled_norm(diag, x);
+                *xnorm = scaled_norm(diag, x, scaled);
                 *fnorm = fnorm1;
                 *iterations += 1;
                 *first = false;
@@ -414,6 +426,8 @@ struct Polisher {
     trial: Vec<f64>,
     step: Vec<f64>,
     ft: Vec<f64>,
+    col: Vec<f64>,
+    scaled: Vec<f64>,
     previous: f64,
     steps: usize,
 }
@@ -430,6 +444,8 @@ impl Polisher {
             trial: vec![0.0; n],
             step: vec![0.0; n],
             ft: vec![0.0; m],
+            col: vec![0.0; m],
+            scaled: vec![0.0; n],
             previous: f64::INFINITY,
             steps: 0,
         }
@@ -461,6 +477,8 @@ impl Polisher {
             trial,
             step,
             ft,
+            col,
+            scaled,
             previous,
             steps: _,
         } = self;
@@ -468,8 +486,10 @@ impl Polisher {
             return false;
         }
         for j in 0..n {
-            let col: Vec<f64> = (0..m).map(|i| jac[(i, j)]).collect();
-            diag[j] = norm2(&col);
+            for (i, c) in col.iter_mut().enumerate() {
+                *c = jac[(i, j)];
+            }
+            diag[j] = norm2(col);
             if diag[j] == 0.0 {
                 diag[j] = 1.0;
             }
@@ -497,8 +517,9 @@ impl Polisher {
             trial[j] = t.clamp(lo[j], hi[j]);
             step[j] = trial[j] - sol.x[j];
         }
-        let snorm = scaled_norm(diag, step);
-        if !(snorm > xtol * scaled_norm(diag, &sol.x)) || !(snorm <= POLISH_CONTRACTION * *previous)
+        let snorm = scaled_norm(diag, step, scaled);
+        if !(snorm > xtol * scaled_norm(diag, &sol.x, scaled))
+            || !(snorm <= POLISH_CONTRACTION * *previous)
         {
             return false;
         }
@@ -590,10 +611,19 @@ impl LevenbergMarquardt {
     pub fn new(opts: &LsqOptions) -> Self {
         LevenbergMarquardt {
             opts: LsqOptions {
+                ftol: opts.ftol,
+                xtol: opts.xtol,
+                gtol: opts.gtol,
+                max_iterations: opts.max_iterations,
+                max_residual_evals: opts.max_residual_evals,
+                initial_radius_factor: opts.initial_radius_factor,
                 lower: None,
                 upper: None,
                 typical: None,
-                ..opts.clone()
+                restarts: opts.restarts,
+                sigma: opts.sigma,
+                polish: opts.polish,
+                stop: opts.stop.clone(),
             },
             ev: Evaluator::new(0, 0),
             stage: Stage::Idle,
@@ -632,29 +662,22 @@ impl LevenbergMarquardt {
     /// [`Termination`] (an interrupt or a timeout is [`Termination::Interrupted`], the
     /// iteration limit [`Termination::MaxIterations`], a target cost
     /// [`Termination::RelativeReduction`]).
-    pub(crate) fn solution(&self, reason: Option<&TerminationReason>) -> Option<Solution> {
+    pub(crate) fn solution(&mut self, reason: Option<&TerminationReason>) -> Option<Solution> {
         let mapped = match reason {
             Some(TerminationReason::MaxItersReached) => Termination::MaxIterations,
             Some(TerminationReason::TargetCostReached) => Termination::RelativeReduction,
             _ => Termination::Interrupted,
         };
-        match &self.stage {
+        match std::mem::take(&mut self.stage) {
             Stage::Idle => None,
-            Stage::Done(sol) => Some(sol.clone()),
-            Stage::Polish { sol, .. } => Some(sol.clone()),
+            Stage::Done(sol) | Stage::Polish { sol, .. } => Some(sol),
             Stage::Run { run, previous, .. } => {
-                let current = Solution {
-                    x: run.x.clone(),
-                    f: run.f.clone(),
-                    fnorm: run.fnorm,
-                    termination: mapped,
-                    iterations: run.iterations,
-                };
+                let current = run.into_solution(mapped);
                 Some(match previous {
                     Some(p) if p.fnorm <= current.fnorm => Solution {
                         iterations: p.iterations + current.iterations,
                         termination: mapped,
-                        ..p.clone()
+                        ..p
                     },
                     Some(p) => Solution {
                         iterations: p.iterations + current.iterations,
@@ -666,7 +689,8 @@ impl LevenbergMarquardt {
         }
     }
 
-    /// Moves the evaluator's counts into argmin's function counts.
+    /// Moves the evaluator's counts into argmin's function counts (every iteration when the
+    /// state counts, `IterState::counting`, else once the solver has finished).
     fn count<R>(&self, problem: &mut Problem<LeastSquares<R>>) {
         problem.counts.insert("operator_count", self.ev.nfev as u64);
         problem.counts.insert("jacobian_count", self.ev.njev as u64);
@@ -749,7 +773,16 @@ impl LevenbergMarquardt {
             Stage::Idle => return Err(Error::msg("the Levenberg–Marquardt solver has no state")),
         };
         let chi2 = fnorm * fnorm;
-        let mut state = state.param(DVector::from_column_slice(x)).cost(chi2);
+        // The vector of two iterations ago is overwritten, so that a run allocates none.
+        let mut state = state;
+        let p = match state.prev_param.take() {
+            Some(mut p) if p.len() == x.len() => {
+                p.copy_from_slice(x);
+                p
+            }
+            _ => DVector::from_column_slice(x),
+        };
+        let mut state = state.param(p).cost(chi2);
         if let Stage::Done(sol) = &self.stage {
             let reason = if sol.termination.converged() {
                 TerminationReason::SolverConverged
@@ -807,7 +840,9 @@ impl<R: Residuals> Solver<LeastSquares<R>, LmState> for LevenbergMarquardt {
             },
             Err(sol) => self.settle(ls, sol, 0, None),
         };
-        self.count(problem);
+        if state.counting_enabled || matches!(self.stage, Stage::Done(_)) {
+            self.count(problem);
+        }
         self.report(state)
     }
 
@@ -846,7 +881,9 @@ impl<R: Residuals> Solver<LeastSquares<R>, LmState> for LevenbergMarquardt {
             done @ Stage::Done(_) => done,
             Stage::Idle => return Err(Error::msg("the solver was not initialised")),
         };
-        self.count(problem);
+        if state.counting_enabled || matches!(self.stage, Stage::Done(_)) {
+            self.count(problem);
+        }
         self.report(state)
     }
 
@@ -881,9 +918,12 @@ fn load_r(
     }
 }
 
-fn scaled_norm(d: &[f64], x: &[f64]) -> f64 {
-    let v: Vec<f64> = d.iter().zip(x).map(|(a, b)| a * b).collect();
-    norm2(&v)
+/// ‖D x‖, with `work` (length n) for D x.
+fn scaled_norm(d: &[f64], x: &[f64], work: &mut [f64]) -> f64 {
+    for ((w, a), b) in work.iter_mut().zip(d).zip(x) {
+        *w = a * b;
+    }
+    norm2(work)
 }
 
 /// Runs [`LevenbergMarquardt`] on `ls` under argmin's `Executor` (argmin's Ctrl-C handling off:
@@ -903,6 +943,7 @@ pub(crate) fn solve<R: Residuals>(
 pub(crate) fn into_parts<R: Residuals>(
     result: argmin::core::OptimizationResult<LeastSquares<R>, LevenbergMarquardt, LmState>,
 ) -> Result<(Solution, Evaluator, LeastSquares<R>), Error> {
+    let mut result = result;
     let reason = result.state.get_termination_reason();
     let sol = result
         .solver

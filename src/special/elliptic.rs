@@ -40,11 +40,26 @@ pub fn rf(x: f64, y: f64, z: f64) -> f64 {
     }
     let scale = x.max(y).max(z);
     if !(1e-30..=1e30).contains(&scale) {
-        // λ = 4^k = 2^k · 2^k (two factors: 4^k alone may overflow), R_F = 2^k R_F(λ·).
-        let k = -(scale.log2() / 2.0).round() as i32;
-        let h = 2f64.powi(k);
-        return h * rf(x * h * h, y * h * h, z * h * h);
+        return rf_rescaled(x, y, z, scale);
     }
+    rf_in_range(x, y, z)
+}
+
+/// R_F of arguments whose largest is `scale`, outside [1e-30, 1e30]: by the homogeneity with
+/// λ = 4^k = 2^k · 2^k (two factors: 4^k alone may overflow), R_F = 2^k R_F(λx, λy, λz). Kept
+/// out of line so that [`rf`] stays small enough to inline into the models.
+#[cold]
+#[inline(never)]
+fn rf_rescaled(x: f64, y: f64, z: f64, scale: f64) -> f64 {
+    let k = -(scale.log2() / 2.0).round() as i32;
+    let h = 2f64.powi(k);
+    h * rf_in_range(x * h * h, y * h * h, z * h * h)
+}
+
+/// The duplication algorithm proper, for non-negative arguments at most one of which is zero
+/// and whose largest is in about [1e-30, 1e30].
+#[inline(always)]
+fn rf_in_range(x: f64, y: f64, z: f64) -> f64 {
     // (3 ε)^{-1/8} for ε = 2^-52.
     const STOP: f64 = 78.8959690786408;
     let (mut xn, mut yn, mut zn) = (x, y, z);

@@ -803,6 +803,14 @@ impl LevenbergMarquardt {
     }
 }
 
+/// The least-squares problem inside argmin's wrapper.
+fn inner<R>(problem: &Problem<LeastSquares<R>>) -> Result<&LeastSquares<R>, Error> {
+    problem
+        .problem
+        .as_ref()
+        .ok_or_else(|| Error::msg("no least-squares problem"))
+}
+
 impl<R: Residuals> Solver<LeastSquares<R>, LmState> for LevenbergMarquardt {
     fn name(&self) -> &str {
         "Levenberg-Marquardt (Moré 1978, bounded)"
@@ -813,10 +821,7 @@ impl<R: Residuals> Solver<LeastSquares<R>, LmState> for LevenbergMarquardt {
         problem: &mut Problem<LeastSquares<R>>,
         state: LmState,
     ) -> Result<(LmState, Option<KV>), Error> {
-        let ls = problem
-            .problem
-            .as_ref()
-            .ok_or_else(|| Error::msg("no least-squares problem"))?;
+        let ls = inner(problem)?;
         let (m, n) = (ls.n_residuals(), ls.n_params());
         let start = match state.get_param() {
             None => ls.setup.start.clone(),
@@ -851,10 +856,7 @@ impl<R: Residuals> Solver<LeastSquares<R>, LmState> for LevenbergMarquardt {
         problem: &mut Problem<LeastSquares<R>>,
         state: LmState,
     ) -> Result<(LmState, Option<KV>), Error> {
-        let ls = problem
-            .problem
-            .as_ref()
-            .ok_or_else(|| Error::msg("no least-squares problem"))?;
+        let ls = inner(problem)?;
         self.stage = match std::mem::take(&mut self.stage) {
             Stage::Run {
                 mut run,

@@ -54,9 +54,7 @@
 // Index loops mirror the subscripts of the published algorithm (MINPACK-1).
 #![allow(clippy::needless_range_loop)]
 
-use argmin::core::{
-    Error, IterState, Problem, Solver, State, TerminationReason, TerminationStatus, KV,
-};
+use argmin::core::{Error, IterState, Problem, Solver, State, TerminationReason, KV};
 use faer::Mat;
 use nalgebra::{DMatrix, DVector};
 use std::sync::atomic::Ordering;
@@ -887,10 +885,6 @@ impl<R: Residuals> Solver<LeastSquares<R>, LmState> for LevenbergMarquardt {
             self.count(problem);
         }
         self.report(state)
-    }
-
-    fn terminate(&mut self, _state: &LmState) -> TerminationStatus {
-        TerminationStatus::NotTerminated
     }
 }
 

@@ -51,3 +51,51 @@ pub fn clip(s: &str, max: usize) -> std::borrow::Cow<'_, str> {
         }
     }
 }
+
+/// Decimal places that show `stderr` to two significant digits (`None` when it is not a
+/// positive finite number or would need more than 15 places).
+fn pm_places(stderr: f64) -> Option<usize> {
+    if !(stderr.is_finite() && stderr > 0.0) {
+        return None;
+    }
+    let d = 1 - stderr.log10().floor() as i64;
+    (d <= 15).then_some(d.max(0) as usize)
+}
+
+/// `value ± stderr` as a reader quotes it: the standard error to two significant digits and
+/// the value to the same decimal place (0.493057 ± 0.00396831 → `0.4931 ± 0.0040`); the value
+/// to four significant digits when there is no standard error.
+pub fn fmt_value_pm(value: f64, stderr: Option<f64>) -> String {
+    match stderr.and_then(|se| pm_places(se).map(|d| (se, d))) {
+        Some((se, d)) if value.is_finite() => format!("{value:.d$} ± {se:.d$}"),
+        _ => fmt_sig(value, 4),
+    }
+}
+
+/// An interval's ends at the precision [`fmt_value_pm`] gives the value (one more place), or
+/// to four significant digits when there is no standard error.
+pub fn fmt_interval(lo: f64, hi: f64, stderr: Option<f64>) -> String {
+    match stderr.and_then(pm_places) {
+        Some(d) if lo.is_finite() && hi.is_finite() => {
+            let d = d + 1;
+            format!("[{lo:.d$}, {hi:.d$}]")
+        }
+        _ => format!("[{}, {}]", fmt_sig(lo, 4), fmt_sig(hi, 4)),
+    }
+}
+
+#[cfg(test)]
+mod pm_tests {
+    use super::*;
+
+    #[test]
+    fn value_and_error_are_rounded_to_the_errors_second_digit() {
+        assert_eq!(fmt_value_pm(0.493057, Some(0.00396831)), "0.4931 ± 0.0040");
+        assert_eq!(fmt_value_pm(0.6559352, Some(4.475993)), "0.7 ± 4.5");
+        assert_eq!(fmt_value_pm(123456.0, Some(1234.0)), "123456 ± 1234");
+        assert_eq!(fmt_value_pm(0.1486807989583846, None), "0.1487");
+        assert_eq!(fmt_value_pm(0.5, Some(f64::NAN)), "0.5");
+        assert_eq!(fmt_interval(0.4852888, 0.5008624, Some(0.00396831)), "[0.48529, 0.50086]");
+        assert_eq!(fmt_interval(0.0, 12.360202, None), "[0, 12.36]");
+    }
+}

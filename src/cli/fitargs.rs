@@ -1,6 +1,6 @@
 //! Flags and I/O shared by the fit commands (`klaw`, `jan`, `jaeger`).
 
-use super::args::{DataArgs, LevelArgs, OutputArgs, PlotArgs};
+use super::args::{DataArgs, LevelArgs, PlotArgs};
 use super::{emit, read_input, CliError};
 use fitbead::fit::data::Dataset;
 use fitbead::fit::posterior::{McmcSettings, Method, Prior, SCALE_NAME};
@@ -18,6 +18,24 @@ use std::path::PathBuf;
 /// memory.
 pub const MAX_WALKERS: usize = 10_000;
 
+/// `--output` of the fit commands: the parameter CSV, or the fit report on stdout.
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct FitOutputArgs {
+    /// The parameter report CSV (fit,series,parameter,value,stderr,ci_low,ci_high,ci_method,
+    /// unit, then extra columns), written atomically; `-` writes it to stdout. Without it, a
+    /// one-screen fit report per fit goes to stdout (values ± standard errors, intervals,
+    /// correlations, χ², AIC, BIC, convergence, warnings)
+    #[arg(long)]
+    pub output: Option<PathBuf>,
+}
+
+impl FitOutputArgs {
+    /// Whether the parameter CSV goes to stdout (`--output -`).
+    pub fn to_stdout(&self) -> bool {
+        self.output.as_deref() == Some(std::path::Path::new("-"))
+    }
+}
+
 /// Flags common to every fit command.
 #[derive(Debug, clap::Args)]
 pub struct FitArgs {
@@ -32,10 +50,9 @@ pub struct FitArgs {
     /// Covariance intervals only (skip the profile-likelihood ones, which cost more fits).
     #[arg(long)]
     pub no_profile: bool,
-    /// The parameter report: fit,series,parameter,value,stderr,ci_low,ci_high,ci_method,unit,
-    /// then extra columns.
+    /// The parameter report CSV.
     #[command(flatten)]
-    pub out: OutputArgs,
+    pub out: FitOutputArgs,
     /// Fit statistics CSV (written atomically): χ², dof, AIC, BIC, termination per fit.
     /// Printed to stderr as a table when absent.
     #[arg(long)]
@@ -243,12 +260,11 @@ impl FitArgs {
     /// `posteriors` are the fits sampled by MCMC: their draws go to `--draws` and their corner
     /// plots to `--plot`, in the same atomic group. A run stopped by Ctrl-C writes everything
     /// and then returns [`CliError::Interrupted`].
-    pub fn write(
-        &self,
-        params: &[ParamRow],
-        stats: &[StatsRow],
-        posteriors: &[&FitResult],
-    ) -> Result<(), CliError> {
+    pub fn write(&self, fits: &[&FitResult]) -> Result<(), CliError> {
+        let posteriors: Vec<&FitResult> = fits.iter().copied().filter(|f| f.draws.is_some()).collect();
+        let posteriors = posteriors.as_slice();
+        let params: Vec<ParamRow> = fits.iter().flat_map(|f| f.params.iter().cloned()).collect();
+        let stats: Vec<StatsRow> = fits.iter().map(|f| f.stats.clone()).collect();
         let interrupted = posteriors
             .iter()
             .any(|p| p.draws.as_ref().is_some_and(|d| d.interrupted));
@@ -256,9 +272,9 @@ impl FitArgs {
         if super::stop_requested() && !interrupted {
             return Err(CliError::Interrupted);
         }
-        posterior_faults(stats)?;
-        let stats = &flag_absurd(stats);
-        let p_csv = params_csv(params).map_err(|e| CliError::Other(e.to_string()))?;
+        posterior_faults(&stats)?;
+        let stats = &flag_absurd(&stats);
+        let p_csv = params_csv(&params).map_err(|e| CliError::Other(e.to_string()))?;
         let s = stats_csv(stats).map_err(|e| CliError::Other(e.to_string()))?;
         let d_csv = match &self.draws {
             Some(_) => draws_csv(posteriors).map_err(|e| CliError::Other(e.to_string()))?,
@@ -274,6 +290,7 @@ impl FitArgs {
             .out
             .output
             .iter()
+            .filter(|_| !self.out.to_stdout())
             .map(|p| (p.as_path(), p_csv.as_slice()))
             .chain(
                 self.output_stats
@@ -291,7 +308,8 @@ impl FitArgs {
         if !files.is_empty() {
             write_atomic_all(&files).map_err(|e| CliError::Other(format!("cannot write: {e}")))?;
         }
-        if self.output_stats.is_none() {
+        // Without --output the fit reports on stdout carry the statistics.
+        if self.output_stats.is_none() && self.out.output.is_some() {
             for r in stats {
                 eprintln!(
                     "{} [{}]: chi2 {} dof {} reduced {} AIC {} BIC {} ({}){}",
@@ -311,8 +329,10 @@ impl FitArgs {
                 );
             }
         }
-        if self.out.output.is_none() {
+        if self.out.to_stdout() {
             emit(None, &p_csv)?;
+        } else if self.out.output.is_none() {
+            emit(None, fit_reports(fits, stats).as_bytes())?;
         }
         if interrupted {
             // The posterior runs cut short go to stderr even when the statistics go to a file.
@@ -326,6 +346,29 @@ impl FitArgs {
         // Every fit that did not converge is named once, with why, by the exit-1 message.
         not_converged(stats)
     }
+}
+
+/// The fit report of every fit, one after another (`stats` are the fits' statistics as
+/// written, with any warning added to their notes).
+fn fit_reports(fits: &[&FitResult], stats: &[StatsRow]) -> String {
+    let mut out = String::new();
+    for (i, f) in fits.iter().enumerate() {
+        if i > 0 {
+            out.push('\n');
+        }
+        match stats.get(i) {
+            Some(s) if *s != f.stats => {
+                let mut g = FitResult {
+                    draws: None,
+                    ..(*f).clone()
+                };
+                g.stats = s.clone();
+                out.push_str(&g.to_string());
+            }
+            _ => out.push_str(&f.to_string()),
+        }
+    }
+    out
 }
 
 /// A prior that leaves nothing to sample (its support misses the parameter's feasible box) is

@@ -25,12 +25,8 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let choice = a.io.method(&["a1", "a2", "a3"])?;
     let fits = fit_jaeger_with(&ds, branch, a.io.level.level(), &choice.method);
     let notes: Vec<String> = fits.notes.iter().map(|n| locate_note(&t, &ds, n)).collect();
-    let (mut params, mut stats) = (Vec::new(), Vec::new());
-    for f in fits.series.iter().flatten() {
-        params.extend(f.summary.params.iter().cloned());
-        stats.push(f.summary.stats.clone());
-    }
-    if params.is_empty() {
+    let all: Vec<&FitResult> = fits.series.iter().flatten().map(|f| &f.summary).collect();
+    if all.iter().all(|f| f.params.is_empty()) {
         if super::stop_requested() {
             return Err(CliError::Interrupted);
         }
@@ -39,15 +35,8 @@ pub fn run(a: Args) -> Result<(), CliError> {
             notes.join("; ")
         )));
     }
-    let posteriors: Vec<&FitResult> = fits
-        .series
-        .iter()
-        .flatten()
-        .map(|f| &f.summary)
-        .filter(|s| s.draws.is_some())
-        .collect();
     for n in &notes {
         eprintln!("fitbead jaeger: {n}");
     }
-    a.io.write(&params, &stats, &posteriors)
+    a.io.write(&all)
 }

@@ -28,13 +28,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         .flatten()
         .chain(fits.global.iter())
         .collect();
-    let (mut params, mut stats) = (Vec::new(), Vec::new());
-    for s in &all {
-        params.extend(s.params.iter().cloned());
-        stats.push(s.stats.clone());
-    }
-    let posteriors: Vec<&FitResult> = all.into_iter().filter(|s| s.draws.is_some()).collect();
-    if params.is_empty() {
+    if all.iter().all(|f| f.params.is_empty()) {
         if super::stop_requested() {
             return Err(CliError::Interrupted);
         }
@@ -46,5 +40,5 @@ pub fn run(a: Args) -> Result<(), CliError> {
     for n in &notes {
         eprintln!("fitbead jan: {n}");
     }
-    a.io.write(&params, &stats, &posteriors)
+    a.io.write(&all)
 }

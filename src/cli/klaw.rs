@@ -9,7 +9,6 @@ use fitbead::fit::k::auto::{self as kauto, KChoice};
 use fitbead::fit::k::unsteady_points;
 use fitbead::fit::klaw::{fit_law, fit_law_in, KLaw, KLawContext, KLawError};
 use fitbead::fit::posterior::Method;
-use fitbead::fit::summary::FitResult;
 use fitbead::io::fmt_f64;
 use fitbead::io::measurements::locate_point;
 use fitbead::models::Model;
@@ -159,11 +158,11 @@ pub fn run(a: Args) -> Result<(), CliError> {
     };
     let main = fit_law_in(model, &ds, law, a.io.level.level(), &choice.method, context)
         .map_err(|e| interrupted(fail(e)))?;
-    let mut stats = vec![main.summary.stats.clone()];
+    let mut fits = vec![main.summary];
     if law != KLaw::Impact {
         let imp = fit_law(model, &ds, KLaw::Impact, a.io.level.level(), false)
             .map_err(|e| interrupted(fail(e)))?;
-        stats.push(imp.summary.stats);
+        fits.push(imp.summary);
     }
     if !auto_note.is_empty() {
         skipped_note = if skipped_note.is_empty() {
@@ -173,7 +172,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         };
     }
     if !skipped_note.is_empty() {
-        for s in stats.iter_mut() {
+        for s in fits.iter_mut().map(|f| &mut f.stats) {
             s.note = if s.note.is_empty() {
                 skipped_note.clone()
             } else {
@@ -181,9 +180,5 @@ pub fn run(a: Args) -> Result<(), CliError> {
             };
         }
     }
-    let posteriors: Vec<&FitResult> = [&main.summary]
-        .into_iter()
-        .filter(|s| s.draws.is_some())
-        .collect();
-    a.io.write(&main.summary.params, &stats, &posteriors)
+    a.io.write(&fits.iter().collect::<Vec<_>>())
 }

@@ -2,14 +2,15 @@
 //! friction μ of Jan's model against eq 79, energy budgets, the regime map, the model ranking —
 //! as a directory of CSV tables, SVG figures and a `report.md` that links them.
 
-use super::args::{ContactArgs, DataArgs, LevelArgs, OutputArgs, PlotArgs};
-use super::fitargs::{flag_absurd, not_converged, FitArgs};
+use super::args::{ContactArgs, DataArgs, LevelArgs, PlotArgs};
+use super::fitargs::{flag_absurd, not_converged, FitArgs, FitOutputArgs};
 use super::CliError;
 use fitbead::fit::k::unsteady_points;
 use fitbead::io::measurements::locate_point;
 use fitbead::io::write_atomic_all;
 use fitbead::report::analysis::analyse;
-use fitbead::report::text::{markdown, terminal_summary};
+use fitbead::io::measurements::{is_shipped_data, si_conversion};
+use fitbead::report::text::{markdown, terminal_summary, Provenance};
 use std::path::{Path, PathBuf};
 
 /// The contact models the report fits (a point must be steady under one of them).
@@ -131,7 +132,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
             level: a.level.level.or(r.level),
         },
         no_profile: false,
-        out: OutputArgs::default(),
+        out: FitOutputArgs::default(),
         output_stats: None,
         method: a
             .method
@@ -235,6 +236,16 @@ pub fn run(a: Args) -> Result<(), CliError> {
         "stats.csv".into(),
         fitbead::io::reports::stats_csv(&stats).map_err(csv_err)?,
     ));
+    let fits = an.fit_results();
+    let fit_refs: Vec<&fitbead::fit::summary::FitResult> = fits.iter().collect();
+    files.push((
+        "residuals.csv".into(),
+        fitbead::io::reports::residuals_csv(&fit_refs).map_err(csv_err)?,
+    ));
+    files.push((
+        "correlations.csv".into(),
+        fitbead::io::reports::correlations_csv(&fit_refs).map_err(csv_err)?,
+    ));
     let fig = |name: &str, r: Result<String, String>| {
         r.map(|s| (name.to_string(), s.into_bytes()))
             .map_err(|e| CliError::Other(format!("figure {name}: {e}")))
@@ -257,7 +268,12 @@ pub fn run(a: Args) -> Result<(), CliError> {
             eprintln!("fitbead: warning: {w}");
         }
     }
-    let mut md = markdown(&an, shown.as_deref().unwrap_or(&t.source), &io.method);
+    let provenance = Provenance {
+        source: shown.unwrap_or_else(|| t.source.clone()),
+        shipped_synthetic: is_shipped_data(&ds),
+        si: si_conversion(&t, &io.data.defaults()?),
+    };
+    let mut md = markdown(&an, &provenance, &io.method);
     let absurd: Vec<String> = stats
         .iter()
         .filter_map(|s| {

@@ -118,6 +118,11 @@ impl fmt::Display for FitResult {
                 num(m.rhat_max),
                 num(m.ess_min)
             )?,
+            None if s.n_params == 0 => writeln!(
+                f,
+                "    converged          = n/a (nothing fitted: the law is scored as it stands; {})",
+                s.termination
+            )?,
             None => writeln!(
                 f,
                 "    converged          = {} ({}, {} iterations, {} residual evaluations)",
@@ -168,7 +173,7 @@ impl fmt::Display for FitResult {
                 ));
             }
         }
-        if !s.converged {
+        if !s.converged && (s.n_params > 0 || s.mcmc.is_some()) {
             warnings.push("the fit did not converge: the values are not an optimum".into());
         }
         if !s.note.is_empty() {

@@ -276,6 +276,23 @@ impl MeasurementColumns {
         Ok(Measured { scene, v, sigma_v })
     }
 
+    /// For a row of dimensional velocities (`v_m_s` with `R_m`, no `v`): the row beads' radius
+    /// R in metres, g in m/s² and the velocity unit sqrt(g R (1 + ξ)) in m/s that
+    /// [`MeasurementColumns::read`] divides by; `None` for a dimensionless row or a cell that
+    /// does not read (which `read` reports).
+    pub fn velocity_unit(&self, r: &Row<'_>) -> Option<(f64, f64, f64)> {
+        if self.v.is_some() {
+            return None;
+        }
+        let xi = r.number(self.xi).ok()?;
+        let radius = positive(r, self.r_m?, "R_m").ok()?;
+        let g = match self.g.filter(|&c| !r.cell(c).is_empty()) {
+            Some(c) => positive(r, c, "g").ok()?,
+            None => self.defaults.g,
+        };
+        Some((radius, g, (g * radius * (1.0 + xi)).sqrt()))
+    }
+
     /// Checks a read row (whose ξ is `xi`) against the rows before it, as `ledger` kept them:
     /// a series may not mix ξ values (the error names the line of the series' first ξ).
     pub fn check_series(
@@ -350,6 +367,80 @@ pub fn read_measurements(
         });
     }
     Ok(rows)
+}
+
+/// Whether `ds` holds the measurements of the shipped synthetic data set ([`DEFAULT_DATA`]):
+/// the same series, ξ, δ, v and σ, whatever ρ and f it was read with.
+pub fn is_shipped_data(ds: &Dataset) -> bool {
+    let d = Dataset::default_data();
+    ds.labels == d.labels
+        && ds.sigma == d.sigma
+        && ds.points.len() == d.points.len()
+        && ds.points.iter().zip(&d.points).all(|(a, b)| {
+            a.series == b.series
+                && a.scene.xi == b.scene.xi
+                && a.scene.delta_deg() == b.scene.delta_deg()
+                && a.v == b.v
+                && a.sigma == b.sigma
+        })
+}
+
+/// How one series' velocities were made dimensionless (input in m/s): the ranges over its rows
+/// of the row beads' radius, of g and of the velocity unit sqrt(g R (1 + ξ)).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SiSeries {
+    /// Series label.
+    pub series: String,
+    /// Radius ratio ξ.
+    pub xi: f64,
+    /// Smallest and largest R over the series' rows, metres.
+    pub r_m: (f64, f64),
+    /// Smallest and largest g, m/s².
+    pub g: (f64, f64),
+    /// Smallest and largest velocity unit sqrt(g R (1 + ξ)), m/s.
+    pub unit_m_s: (f64, f64),
+}
+
+impl SiSeries {
+    /// The series' velocity unit in m/s when it is the same on every row.
+    pub fn unit(&self) -> Option<f64> {
+        (self.unit_m_s.0 == self.unit_m_s.1).then_some(self.unit_m_s.0)
+    }
+}
+
+/// Per series, in order of first appearance, how the velocities of a table in m/s were made
+/// dimensionless (v = v_m_s / sqrt(g R (1 + ξ))); `None` when the velocities were given
+/// dimensionless (column `v`). The rows must have been read by [`read_measurements`] with the
+/// same `defaults`.
+pub fn si_conversion(t: &Table, defaults: &MeasurementDefaults) -> Option<Vec<SiSeries>> {
+    let cols = MeasurementColumns::new(t, defaults).ok()?;
+    let mut out: Vec<SiSeries> = Vec::new();
+    for i in 0..t.rows.len() {
+        let row = t.row(i);
+        let (r, g, u) = cols.velocity_unit(&row)?;
+        let label = cols.series(&row);
+        let label = if label.is_empty() {
+            format!("xi={}", fmt_f64(row.number(cols.xi).ok()?))
+        } else {
+            label.to_string()
+        };
+        let widen = |a: (f64, f64), x: f64| (a.0.min(x), a.1.max(x));
+        match out.iter_mut().find(|s| s.series == label) {
+            Some(s) => {
+                s.r_m = widen(s.r_m, r);
+                s.g = widen(s.g, g);
+                s.unit_m_s = widen(s.unit_m_s, u);
+            }
+            None => out.push(SiSeries {
+                series: label,
+                xi: row.number(cols.xi).ok()?,
+                r_m: (r, r),
+                g: (g, g),
+                unit_m_s: (u, u),
+            }),
+        }
+    }
+    Some(out)
 }
 
 /// Groups validated measurements into a [`Dataset`]; `t` is the table they were read from

@@ -1,6 +1,7 @@
 //! The CSV schemas of the fit reports: one row per parameter (`--output`, params.csv), one row
 //! of statistics per fit (`--output-stats`, stats.csv), the posterior draws (`--draws`), and the
-//! contact model's bead-by-bead transient (`simulate --v0`).
+//! contact model's bead-by-bead transient (`simulate --v0`), and every point against its fit
+//! (residuals.csv) and every pair of parameters with its correlation (correlations.csv).
 
 use crate::fit::posterior::draws_column;
 use crate::fit::summary::{FitResult, ParamRow, StatsRow};
@@ -281,6 +282,84 @@ pub fn draws_csv(posteriors: &[&FitResult]) -> csv::Result<Vec<u8>> {
                     };
                 }
                 w.write_record(&rec)?;
+            }
+        }
+    }
+    w.into_inner().map_err(|e| e.into_error().into())
+}
+
+/// Columns of the per-point residuals report (`residuals.csv`).
+pub const RESIDUAL_COLUMNS: [&str; 9] = [
+    "fit",
+    "series",
+    "xi",
+    "delta_deg",
+    "v",
+    "sigma_v",
+    "v_fit",
+    "residual",
+    "normalised_residual",
+];
+
+/// A finite number, or an empty cell (no σ given; no steady state at the estimate).
+fn finite(x: f64) -> String {
+    if x.is_finite() {
+        fmt_f64(x)
+    } else {
+        String::new()
+    }
+}
+
+/// Every point of every fit against its fitted v̄, one row per fit and point
+/// ([`RESIDUAL_COLUMNS`]): the measured v̄ and σ, the fitted v̄ at the reported estimate, the
+/// residual v − v̄_fit and the normalised residual (v − v̄_fit)/σ (without σ, divided by the
+/// scatter estimated from the fit). Cells are empty where there is no σ or no steady state.
+pub fn residuals_csv(fits: &[&FitResult]) -> csv::Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(RESIDUAL_COLUMNS)?;
+    for f in fits {
+        for p in &f.points {
+            w.write_record([
+                f.stats.fit.clone(),
+                p.series.clone(),
+                fmt_f64(p.xi),
+                fmt_f64(p.delta_deg),
+                fmt_f64(p.v),
+                p.sigma_v.map(finite).unwrap_or_default(),
+                finite(p.v_fit),
+                finite(p.residual),
+                finite(p.normalised_residual),
+            ])?;
+        }
+    }
+    w.into_inner().map_err(|e| e.into_error().into())
+}
+
+/// Columns of the correlations report (`correlations.csv`).
+pub const CORRELATION_COLUMNS: [&str; 5] =
+    ["fit", "series", "parameter_1", "parameter_2", "correlation"];
+
+/// Every pair of parameters of every fit with its correlation ([`CORRELATION_COLUMNS`]), each
+/// pair once in the order of the fit's parameters: from the covariance at the least-squares
+/// optimum, or from the draws of a posterior run. Parameters of a fit with one per series are
+/// named `K[series]`. A fit whose correlation matrix does not exist (a rank-deficient
+/// Jacobian, a single parameter) has no rows.
+pub fn correlations_csv(fits: &[&FitResult]) -> csv::Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(CORRELATION_COLUMNS)?;
+    for f in fits {
+        let Some(c) = &f.correlation else { continue };
+        let names = f.param_names();
+        let n = names.len().min(c.len());
+        for i in 0..n {
+            for j in i + 1..n {
+                w.write_record([
+                    f.stats.fit.as_str(),
+                    f.stats.series.as_str(),
+                    names[i].as_str(),
+                    names[j].as_str(),
+                    &finite(c[i][j]),
+                ])?;
             }
         }
     }

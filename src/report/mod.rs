@@ -1,13 +1,15 @@
-//! Reports: the comparisons of `fitbead report` ([`analysis`]), its SVG figures ([`figures`]), its text ([`text`])
+//! Reports: the comparisons of `fitbead report` ([`analysis`]), the list of its fits ([`fits`]),
+//! its SVG figures ([`figures`]), its text ([`text`])
 //! and the work-precision engine of `fitbead bench` ([`workprecision`]).
 
 pub mod analysis;
 pub mod figures;
+pub mod fits;
 pub mod text;
 pub mod workprecision;
 
 /// Every file `fitbead report` may write in its directory.
-pub const REPORT_FILES: [&str; 14] = [
+pub const REPORT_FILES: [&str; 16] = [
     "bulk_friction.csv",
     "energy.csv",
     "regime_map.csv",
@@ -16,6 +18,8 @@ pub const REPORT_FILES: [&str; 14] = [
     "models_by_series.csv",
     "params.csv",
     "stats.csv",
+    "residuals.csv",
+    "correlations.csv",
     "velocity.svg",
     "jan_linear.svg",
     "k_final_velocity.svg",

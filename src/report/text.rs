@@ -1,7 +1,238 @@
 //! The report's text: report.md and the summary printed at the end of `fitbead report`.
 
 use super::analysis::{sig3, Analysis};
-use crate::numfmt::fmt_f64;
+use crate::fit::summary::ParamRow;
+use crate::io::measurements::SiSeries;
+use crate::models::JaegerBranch;
+use crate::numfmt::{fmt_f64, fmt_interval, fmt_sig, fmt_value_pm};
+
+/// Where the report's data came from, for the head of report.md.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Provenance {
+    /// How the data are named (a path, or the embedded data set's name).
+    pub source: String,
+    /// Whether the data are the shipped synthetic data set (data/default.csv), which is not a
+    /// measurement: report.md then opens with a banner saying so.
+    pub shipped_synthetic: bool,
+    /// When the velocities were given in m/s: how each series was made dimensionless.
+    pub si: Option<Vec<SiSeries>>,
+}
+
+/// A parameter's name in the report's tables: qualified by series where a fit across series
+/// has one per series (`K[1.6]`).
+fn param_name(r: &ParamRow, fit_series: &str) -> String {
+    if r.series == fit_series {
+        r.parameter.clone()
+    } else {
+        format!("{}[{}]", r.parameter, r.series)
+    }
+}
+
+/// `value ± stderr` of a row (the posterior median ± sd for a posterior run).
+fn value_pm(r: &ParamRow) -> String {
+    fmt_value_pm(r.value, r.stderr)
+}
+
+/// The reported interval of a row with its method, or a dash.
+fn interval_cell(r: &ParamRow) -> String {
+    match r.interval() {
+        (Some((lo, hi)), method) => format!("{} {method}", fmt_interval(lo, hi, r.stderr)),
+        (None, _) => "—".into(),
+    }
+}
+
+/// The report's opening table: every fitted parameter with its value ± standard error and its
+/// interval, the paper's value where there is one, and a flag for a parameter on its bound.
+fn parameter_table(an: &Analysis) -> String {
+    let mut m = String::new();
+    m.push_str("## Fitted parameters\n\n");
+    m.push_str(&format!(
+        "Every fitted parameter: value ± standard error{}, the {} % interval and how it was \
+         obtained (profile likelihood, covariance or posterior), and the paper's value where it \
+         gives one. Per-point fits and residuals: [residuals.csv](residuals.csv); correlations: \
+         [correlations.csv](correlations.csv); every column: [params.csv](params.csv); each \
+         fit's report: [Fit reports](#fit-reports) below.\n\n",
+        if an.mcmc {
+            " (posterior median ± standard deviation)"
+        } else {
+            ""
+        },
+        fmt_sig(100.0 * an.level, 6)
+    ));
+    m.push_str("| fit | series | parameter | value | interval | paper | note |\n");
+    m.push_str("|---|---|---|---|---|---|---|\n");
+    for f in an.fit_results() {
+        for r in &f.params {
+            let series = if r.series == f.stats.series {
+                r.series.clone()
+            } else {
+                f.stats.series.clone()
+            };
+            let note = if r.at_bound {
+                format!("on the bound {}", fmt_sig(bound_of(r), 4))
+            } else if r.stderr.is_none() && !an.mcmc {
+                if f.stats.note.contains("rank deficient") {
+                    "no standard error (rank-deficient Jacobian)".to_string()
+                } else {
+                    "no standard error".to_string()
+                }
+            } else {
+                String::new()
+            };
+            m.push_str(&format!(
+                "| {} | {series} | {} | {} | {} | {} | {note} |\n",
+                f.stats.fit,
+                param_name(r, &f.stats.series),
+                value_pm(r),
+                interval_cell(r),
+                r.paper_value.map_or("—".into(), |v| fmt_sig(v, 4)),
+            ));
+        }
+    }
+    m.push('\n');
+    let fits = an.fit_results();
+    let bad: Vec<String> = fits
+        .iter()
+        .filter(|f| !f.converged())
+        .map(|f| format!("{} [{}]", f.stats.fit, f.stats.series))
+        .collect();
+    if !bad.is_empty() {
+        m.push_str(&format!(
+            "**Not converged:** {} (their values are not an optimum; see the fit reports).\n\n",
+            bad.join(", ")
+        ));
+    }
+    m
+}
+
+/// The end of its box a parameter sits on.
+fn bound_of(r: &ParamRow) -> f64 {
+    if (r.value - r.bounds.0).abs() <= (r.value - r.bounds.1).abs() {
+        r.bounds.0
+    } else {
+        r.bounds.1
+    }
+}
+
+/// The Jaeger section: the fitted a1–a3 per series against the paper's Fig. 9, the branch, the
+/// points in the bistable band (eq 90), and what a2 on its bound 0 means.
+fn jaeger_section(an: &Analysis) -> String {
+    let mut m = String::new();
+    m.push_str("## Jaeger's law (eqs 80–90)\n\n");
+    m.push_str(
+        "tan δ = a3 u² + a1/(1 + a2 u²) with Jaeger's velocity u (eq 81), fitted per series on \
+         the branch of eq 84 named below; a1 is the friction at rest, a1/(1 + a2 u²) its decay \
+         with speed and a3 u² the collisional drag. Figure: [jaeger.svg](jaeger.svg) (Figs. \
+         9–10).\n\n",
+    );
+    m.push_str(
+        "| series | ξ | a1 | a2 | a3 | χ²/dof | branch | a1·a2 > a3 (eq 82) | points in the \
+         bistable band (eq 90) | paper a1, a2, a3 (Fig. 9) |\n|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    let mut on_bound = 0;
+    let mut fitted = 0;
+    for (s, f) in an.jaeger.series.iter().enumerate() {
+        let Some(f) = f else { continue };
+        fitted += 1;
+        let p = &f.summary.params;
+        let cell = |i: usize| p.get(i).map_or("—".to_string(), value_pm);
+        if p.get(1).is_some_and(|r| r.at_bound && r.value == 0.0) {
+            on_bound += 1;
+        }
+        let paper: Vec<String> = p
+            .iter()
+            .filter_map(|r| r.paper_value.map(|v| fmt_sig(v, 4)))
+            .collect();
+        m.push_str(&format!(
+            "| {} | {} | {} | {} | {} | {}/{} | {} | {} | {} | {} |\n",
+            an.data.labels[s],
+            fmt_f64(an.data.points[an.data.series_index(s)[0]].scene.xi),
+            cell(0),
+            cell(1),
+            cell(2),
+            sig3(f.summary.stats.chi2),
+            f.summary.stats.dof,
+            match f.branch {
+                JaegerBranch::Upper => "upper",
+                JaegerBranch::Lower => "lower",
+            },
+            if f.has_minimum { "yes" } else { "no" },
+            f.bistable_points,
+            if paper.is_empty() {
+                "—".to_string()
+            } else {
+                paper.join(", ")
+            }
+        ));
+    }
+    m.push('\n');
+    if on_bound > 0 {
+        m.push_str(&format!(
+            "**a2 sits on its bound 0 in {on_bound} of {fitted} series.** There the friction \
+             term does not decay with speed: the law reduces to tan δ = a1 + a3 u², one branch, \
+             no minimum of the resistance and no bistable band, and a1 is the slope below which \
+             the bead stops. The data of those series do not call for velocity weakening. \
+             Their fits report no covariance (the fit reports below say why), hence no \
+             standard errors: read their profile-likelihood intervals instead, in which a2's \
+             lower end is the bound itself.\n\n"
+        ));
+    }
+    for n in &an.jaeger.notes {
+        m.push_str(&format!("- {n}\n"));
+    }
+    if !an.jaeger.notes.is_empty() {
+        m.push('\n');
+    }
+    m
+}
+
+/// Every fit's one-screen report ([`crate::fit::summary::FitResult`]'s `Display`).
+fn fit_reports(an: &Analysis) -> String {
+    let mut m = String::from("## Fit reports\n\n");
+    for f in an.fit_results() {
+        m.push_str(&format!("```text\n{f}```\n\n"));
+    }
+    m
+}
+
+/// The banner of a report on the shipped synthetic data.
+const SYNTHETIC_BANNER: &str = "> **These data are synthetic.** They are fitbead's shipped data \
+     set (data/default.csv), simulated with the stick/slip model, the paper's law \
+     K = cos 2α + ½ sin²α sin 2α, ρ = 0.4, f = 0.1 and 2 % noise: the report shows what the fits \
+     recover, not a property of real beads.\n\n";
+
+/// How velocities given in m/s were made dimensionless, per series (empty for dimensionless
+/// input).
+fn si_units(p: &Provenance) -> String {
+    let mut m = String::new();
+    if let Some(si) = &p.si {
+        m.push_str(
+            "Velocities were given in m/s (`v_m_s`, `sigma_v_m_s`) and made dimensionless by \
+             v = v_m_s / sqrt(g R (1 + ξ)), R the row beads' radius (`R_m`); every fit works on \
+             the dimensionless v (unit sqrt(g (R + r))). Per series:\n\n\
+             | series | ξ | R (m) | g (m/s²) | unit sqrt(g R (1 + ξ)) (m/s) |\n|---|---|---|---|---|\n",
+        );
+        let range = |a: (f64, f64)| {
+            if a.0 == a.1 {
+                fmt_sig(a.0, 6)
+            } else {
+                format!("{} … {}", fmt_sig(a.0, 6), fmt_sig(a.1, 6))
+            }
+        };
+        for s in si {
+            m.push_str(&format!(
+                "| {} | {} | {} | {} | {} |\n",
+                s.series,
+                fmt_f64(s.xi),
+                range(s.r_m),
+                range(s.g),
+                range(s.unit_m_s)
+            ));
+        }
+        m.push('\n');
+    }
+    m
+}
 
 fn pct(x: f64) -> String {
     if x.is_finite() {
@@ -11,10 +242,28 @@ fn pct(x: f64) -> String {
     }
 }
 
-/// The report's summary for the terminal: the bulk friction table (Jan's μ against eq 79)
-/// and the models ranked by AIC, then where the files are (`dir`).
+/// The report's summary for the terminal: every fitted parameter, the bulk friction table
+/// (Jan's μ against eq 79) and the models ranked by AIC, then where the files are (`dir`).
 pub fn terminal_summary(an: &Analysis, dir: &str) -> String {
     let mut s = String::new();
+    s.push_str(&format!(
+        "Fitted parameters (value ± standard error, {} % interval)\n",
+        fmt_sig(100.0 * an.level, 6)
+    ));
+    for f in an.fit_results() {
+        for r in &f.params {
+            s.push_str(&format!(
+                "{:<31} {:<5} {:<8} {:>18}  {}{}\n",
+                f.stats.fit,
+                f.stats.series,
+                param_name(r, &f.stats.series),
+                value_pm(r),
+                interval_cell(r),
+                if r.at_bound { "  (on its bound)" } else { "" }
+            ));
+        }
+    }
+    s.push('\n');
     s.push_str("Bulk friction: Jan's mu (fitted) against eq 79 at the fitted K\n");
     s.push_str(&format!(
         "{:<8} {:>6} {:>22} {:<22} {:>22} {:>9}  overlap\n",
@@ -60,11 +309,15 @@ pub fn terminal_summary(an: &Analysis, dir: &str) -> String {
 
 /// report.md: the data, the bulk friction against eq 79, the energy budgets, the regime map and
 /// the model ranking, in Markdown; `source` names the data, `method` the estimation method.
-pub fn markdown(an: &Analysis, source: &str, method: &str) -> String {
+pub fn markdown(an: &Analysis, prov: &Provenance, method: &str) -> String {
+    let source = prov.source.as_str();
     let d = &an.data;
     let mut m = String::new();
     let p0 = &d.points[0].scene;
     m.push_str("# fitbead report\n\n");
+    if prov.shipped_synthetic {
+        m.push_str(SYNTHETIC_BANNER);
+    }
     m.push_str(&format!(
         "Data: `{source}`, {} points in {} series; rho = {}, f = {} (per row where given); \
          method `{method}`; intervals at level {}; sigma {}.\n\n",
@@ -79,6 +332,8 @@ pub fn markdown(an: &Analysis, source: &str, method: &str) -> String {
             "not given (unit weights, scale estimated)"
         }
     ));
+    m.push_str(&si_units(prov));
+    m.push_str(&parameter_table(an));
     // Bulk friction.
     let rows = an.mu_rows();
     m.push_str("## Bulk friction: Jan's μ against eq 79\n\n");
@@ -176,6 +431,7 @@ pub fn markdown(an: &Analysis, source: &str, method: &str) -> String {
         ));
     }
     m.push('\n');
+    m.push_str(&jaeger_section(an));
     // Models.
     m.push_str("## Model choice\n\n");
     m.push_str(
@@ -243,7 +499,9 @@ pub fn markdown(an: &Analysis, source: &str, method: &str) -> String {
     }
     m.push_str(
         "\nEvery fit's parameters and statistics: [params.csv](params.csv), \
-         [stats.csv](stats.csv).\n",
+         [stats.csv](stats.csv); every point against every fit: [residuals.csv](residuals.csv); \
+         every pair of parameters: [correlations.csv](correlations.csv).\n\n",
     );
+    m.push_str(&fit_reports(an));
     m
 }

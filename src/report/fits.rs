@@ -1,0 +1,93 @@
+//! Every fit the report makes, named as in params.csv and stats.csv: the list that residuals.csv,
+//! correlations.csv, the parameter table and the fit reports of report.md are made from.
+
+use super::analysis::Analysis;
+use crate::fit::summary::FitResult;
+
+/// A copy of `f` without its draws (the report's tables need the summaries only), with the
+/// fit's name prefixed by `prefix` (the contact model of a K(α) law) on the statistics and on
+/// every parameter row.
+fn named(f: &FitResult, prefix: Option<&str>) -> FitResult {
+    let rename = |name: &str| match prefix {
+        Some(p) => format!("{p}-{name}"),
+        None => name.to_string(),
+    };
+    let mut stats = f.stats.clone();
+    stats.fit = rename(&stats.fit);
+    FitResult {
+        params: f
+            .params
+            .iter()
+            .map(|r| {
+                let mut r = r.clone();
+                r.fit = rename(&r.fit);
+                r
+            })
+            .collect(),
+        stats,
+        draws: None,
+        correlation: f.correlation.clone(),
+        residuals: f.residuals.clone(),
+        points: f.points.clone(),
+    }
+}
+
+impl Analysis {
+    /// Every fit of the report, in the order of params.csv: per contact model its K(α) law c
+    /// and its one-K-per-series fit (named `rolling-klaw-c`, `stickslip-klaw-free-per-series`,
+    /// …), then Jan's per-series and global fits, then Jaeger's per-series fits. The copies
+    /// carry no draws.
+    pub fn fit_results(&self) -> Vec<FitResult> {
+        let mut v = Vec::new();
+        for c in &self.contact {
+            for f in c.law_c.iter().chain(c.free.iter()) {
+                v.push(named(&f.summary, Some(c.name)));
+            }
+        }
+        for f in self
+            .jan
+            .series
+            .iter()
+            .flatten()
+            .chain(self.jan.global.iter())
+        {
+            v.push(named(f, None));
+        }
+        for f in self.jaeger.series.iter().flatten() {
+            v.push(named(&f.summary, None));
+        }
+        v
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::fit::data::Dataset;
+    use crate::report::analysis::analyse;
+
+    /// The names and parameters of the fits list agree with params.csv's rows, one for one.
+    #[test]
+    fn fit_results_name_the_rows_of_params_csv() {
+        let data = Dataset::default_data();
+        let an = analyse(&data, 0.95, &crate::fit::posterior::Method::lsq(false));
+        let from_fits: Vec<(String, String, String)> = an
+            .fit_results()
+            .iter()
+            .flat_map(|f| {
+                f.params
+                    .iter()
+                    .map(|r| (r.fit.clone(), r.series.clone(), r.parameter.clone()))
+            })
+            .collect();
+        let from_params: Vec<(String, String, String)> = an
+            .params()
+            .iter()
+            .map(|r| (r.fit.clone(), r.series.clone(), r.parameter.clone()))
+            .collect();
+        assert_eq!(from_fits, from_params);
+        assert!(an
+            .fit_results()
+            .iter()
+            .all(|f| f.params.iter().all(|r| r.fit == f.stats.fit)));
+    }
+}

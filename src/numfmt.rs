@@ -95,7 +95,10 @@ mod pm_tests {
         assert_eq!(fmt_value_pm(123456.0, Some(1234.0)), "123456 ± 1234");
         assert_eq!(fmt_value_pm(0.1486807989583846, None), "0.1487");
         assert_eq!(fmt_value_pm(0.5, Some(f64::NAN)), "0.5");
-        assert_eq!(fmt_interval(0.4852888, 0.5008624, Some(0.00396831)), "[0.48529, 0.50086]");
+        assert_eq!(
+            fmt_interval(0.4852888, 0.5008624, Some(0.00396831)),
+            "[0.48529, 0.50086]"
+        );
         assert_eq!(fmt_interval(0.0, 12.360202, None), "[0, 12.36]");
     }
 }

@@ -261,7 +261,8 @@ impl FitArgs {
     /// plots to `--plot`, in the same atomic group. A run stopped by Ctrl-C writes everything
     /// and then returns [`CliError::Interrupted`].
     pub fn write(&self, fits: &[&FitResult]) -> Result<(), CliError> {
-        let posteriors: Vec<&FitResult> = fits.iter().copied().filter(|f| f.draws.is_some()).collect();
+        let posteriors: Vec<&FitResult> =
+            fits.iter().copied().filter(|f| f.draws.is_some()).collect();
         let posteriors = posteriors.as_slice();
         let params: Vec<ParamRow> = fits.iter().flat_map(|f| f.params.iter().cloned()).collect();
         let stats: Vec<StatsRow> = fits.iter().map(|f| f.stats.clone()).collect();

@@ -7,9 +7,9 @@ use super::fitargs::{flag_absurd, not_converged, FitArgs, FitOutputArgs};
 use super::CliError;
 use fitbead::fit::k::unsteady_points;
 use fitbead::io::measurements::locate_point;
+use fitbead::io::measurements::{is_shipped_data, si_conversion};
 use fitbead::io::write_atomic_all;
 use fitbead::report::analysis::analyse;
-use fitbead::io::measurements::{is_shipped_data, si_conversion};
 use fitbead::report::text::{markdown, terminal_summary, Provenance};
 use std::path::{Path, PathBuf};
 

@@ -209,7 +209,7 @@ fn k_auto_inverts_each_row_with_the_model_it_names() {
 #[test]
 fn klaw_auto_fits_with_the_most_general_model_any_point_needs_and_says_so() {
     let out = bin()
-        .args(["klaw", "--model", "auto", "--tol", "1e-10"])
+        .args(["klaw", "--model", "auto", "--tol", "1e-10", "--output", "-"])
         .output()
         .unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
@@ -222,7 +222,10 @@ fn klaw_auto_fits_with_the_most_general_model_any_point_needs_and_says_so() {
         "{err}"
     );
     // The same fit as --model contact at the auto's inner tolerance: c agrees closely.
-    let out = bin().args(["klaw", "--model", "contact"]).output().unwrap();
+    let out = bin()
+        .args(["klaw", "--model", "contact", "--output", "-"])
+        .output()
+        .unwrap();
     let (_, plain) = records(&String::from_utf8(out.stdout).unwrap());
     let p = plain.iter().find(|r| r["fit"] == "klaw-c").unwrap();
     let (ca, cp) = (num(c, "value"), num(p, "value"));

@@ -22,4 +22,5 @@ mod paper_figures;
 mod properties;
 mod recipes;
 mod reference_models;
+mod report;
 mod sbc;

@@ -1,0 +1,232 @@
+//! `fitbead report`'s fit reports and tables, and the fit commands' report on stdout:
+//! residuals.csv and correlations.csv (their contract columns and what their rows must
+//! satisfy), report.md stating every fitted value, and `klaw`/`jan`/`jaeger` printing a fit
+//! report without `--output`.
+
+use crate::common::{bin, col, read_table, records, stdout_ok, tmpdir, write};
+use std::path::Path;
+
+fn report_into(dir: &Path, extra: &[&str]) {
+    let mut args = vec!["report", "--out-dir", dir.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    stdout_ok(&bin().args(&args).output().unwrap());
+}
+
+fn num(s: &str) -> f64 {
+    s.parse().unwrap_or_else(|_| panic!("not a number: {s:?}"))
+}
+
+/// residuals.csv has the contract columns, one row per fit and point, and each row's residual
+/// is v − v_fit and its normalised residual (v − v_fit)/σ. The fitted v̄ of the stick/slip
+/// law-c fit is checked against `fitbead forward` run at the fitted c on the same points.
+#[test]
+fn residuals_csv_holds_every_point_of_every_fit() {
+    let dir = tmpdir();
+    report_into(dir.path(), &[]);
+    let (h, rows) = read_table(&dir.path().join("residuals.csv"));
+    assert_eq!(
+        h,
+        [
+            "fit",
+            "series",
+            "xi",
+            "delta_deg",
+            "v",
+            "sigma_v",
+            "v_fit",
+            "residual",
+            "normalised_residual"
+        ]
+    );
+    // Every fit of params.csv appears with all 36 points of the shipped data (every fit of
+    // the report uses every point of that set).
+    let (ph, prow) = read_table(&dir.path().join("params.csv"));
+    let mut fits: Vec<String> = prow.iter().map(|r| r[col(&ph, "fit")].clone()).collect();
+    fits.dedup();
+    // (Per-series fits, jan-series and jaeger, name 4 fits of 9 points each.)
+    for f in &fits {
+        let n = rows.iter().filter(|r| &r[0] == f).count();
+        assert_eq!(n, 36, "{f}: {n} rows");
+    }
+    for r in &rows {
+        let (v, s, vf, res, nr) = (num(&r[4]), num(&r[5]), num(&r[6]), num(&r[7]), num(&r[8]));
+        assert!((res - (v - vf)).abs() <= 1e-15, "{r:?}");
+        assert!((nr - res / s).abs() <= 1e-12 * nr.abs().max(1.0), "{r:?}");
+    }
+    // The stick/slip law-c fit's v̄ at each point, recomputed by the forward command at c.
+    let c = prow
+        .iter()
+        .find(|r| r[0] == "stickslip-klaw-c" && r[2] == "c")
+        .map(|r| r[col(&ph, "value")].clone())
+        .expect("stickslip law c in params.csv");
+    let pts: Vec<&Vec<String>> = rows.iter().filter(|r| r[0] == "stickslip-klaw-c").collect();
+    let mut scenes = String::from("xi,delta_deg\n");
+    for r in &pts {
+        scenes.push_str(&format!("{},{}\n", r[2], r[3]));
+    }
+    let input = write(dir.path(), "scenes.csv", &scenes);
+    let out = bin()
+        .args(["forward", "--model", "stickslip", "--input"])
+        .arg(&input)
+        .arg(format!("--K=c={c}"))
+        .output()
+        .unwrap();
+    let (_, fr) = records(&stdout_ok(&out));
+    assert_eq!(fr.len(), pts.len());
+    for (r, f) in pts.iter().zip(&fr) {
+        let v = num(&f["v"]);
+        assert!(
+            (v - num(&r[6])).abs() <= 1e-15 * v,
+            "forward {v} against v_fit {}",
+            r[6]
+        );
+    }
+}
+
+/// correlations.csv has the contract columns; every correlation lies in [−1, 1]; each fit with
+/// a matrix lists each pair once; one K per series fitted together has independent
+/// parameters (each residual depends on its own series' K only), so their correlations are 0.
+#[test]
+fn correlations_csv_lists_every_pair_once() {
+    let dir = tmpdir();
+    report_into(dir.path(), &[]);
+    let (h, rows) = read_table(&dir.path().join("correlations.csv"));
+    assert_eq!(
+        h,
+        ["fit", "series", "parameter_1", "parameter_2", "correlation"]
+    );
+    for r in &rows {
+        let c = num(&r[4]);
+        assert!((-1.0..=1.0).contains(&c), "{r:?}");
+    }
+    for model in ["rolling", "stickslip"] {
+        let fit = format!("{model}-klaw-free-per-series");
+        let sel: Vec<_> = rows.iter().filter(|r| r[0] == fit).collect();
+        assert_eq!(sel.len(), 6, "{fit}: 4 parameters make 6 pairs");
+        assert!(sel.iter().all(|r| num(&r[4]) == 0.0), "{sel:?}");
+    }
+    // Jan's per-series fits: λ and μ, one pair per series, and strongly anti-correlated (a
+    // larger drag λ is traded against a smaller friction μ along the measured v̄).
+    let jan: Vec<_> = rows.iter().filter(|r| r[0] == "jan-series").collect();
+    assert_eq!(jan.len(), 4);
+    assert!(jan.iter().all(|r| r[2] == "lambda" && r[3] == "mu"));
+    assert!(jan.iter().all(|r| num(&r[4]) < -0.5), "{jan:?}");
+}
+
+/// report.md opens (after the data line) with a table of every fitted parameter, one row per
+/// row of params.csv with its value; it has a Jaeger section that explains a2 on its bound,
+/// the banner of the shipped synthetic data, and each fit's report.
+#[test]
+fn report_md_states_every_fitted_value() {
+    let dir = tmpdir();
+    report_into(dir.path(), &[]);
+    let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
+    assert!(md.contains("**These data are synthetic.**"));
+    let table_at = md.find("## Fitted parameters").expect("parameter table");
+    assert!(table_at < md.find("## Bulk friction").unwrap());
+    let (ph, prow) = read_table(&dir.path().join("params.csv"));
+    for r in &prow {
+        let (fit, param, value) = (
+            &r[col(&ph, "fit")],
+            &r[col(&ph, "parameter")],
+            num(&r[col(&ph, "value")]),
+        );
+        let series = &r[col(&ph, "series")];
+        // A per-series fit's row names its series; a fit across series names the parameter
+        // by series (`K[1.6]`) in the row of `all`.
+        let line = md
+            .lines()
+            .find(|l| {
+                l.starts_with(&format!("| {fit} | {series} | {param} |"))
+                    || l.starts_with(&format!("| {fit} | all | {param}[{series}] |"))
+            })
+            .unwrap_or_else(|| panic!("no row for {fit} {series} {param}"));
+        // The value cell, rounded as printed, is within half a unit of its last digit.
+        let cell = line.split('|').nth(4).unwrap().trim();
+        let shown = cell.split(" ± ").next().unwrap();
+        let places = shown.split('.').nth(1).map_or(0, str::len) as i32;
+        let tol = 0.5 * 10f64.powi(-places) + 1e-12;
+        let rel = shown.contains('e');
+        assert!(
+            rel || (num(shown) - value).abs() <= tol * 1.0000001,
+            "{fit} {param}: shown {shown}, value {value}"
+        );
+    }
+    assert!(md.contains("## Jaeger's law"));
+    assert!(md.contains("a2 sits on its bound 0"));
+    assert!(md.contains("## Fit reports"));
+    assert_eq!(
+        md.matches("[[Fit ").count(),
+        {
+            let mut f: Vec<(String, String)> =
+                prow.iter().map(|r| (r[0].clone(), r[1].clone())).collect();
+            // A fit across series has one row per series parameter but one report.
+            for x in f.iter_mut() {
+                if x.0.contains("klaw") {
+                    x.1 = "all".into();
+                }
+            }
+            f.dedup();
+            f.len()
+        },
+        "one fit report per fit"
+    );
+}
+
+/// With velocities in m/s, report.md says how they were made dimensionless, per series; a
+/// file other than the shipped data gets no synthetic-data banner.
+#[test]
+fn report_md_states_the_si_conversion() {
+    let dir = tmpdir();
+    let input = write(
+        dir.path(),
+        "si.csv",
+        "series,xi,delta_deg,v_m_s,sigma_v_m_s,R_m\n\
+         A,1,8,0.068,0.0024,0.003\nA,1,10,0.092,0.0024,0.003\nA,1,12,0.109,0.0024,0.003\n\
+         A,1,14,0.124,0.0024,0.003\nB,2,4,0.098,0.0045,0.003\nB,2,6,0.137,0.0045,0.003\n\
+         B,2,8,0.163,0.0045,0.003\nB,2,10,0.187,0.0045,0.003\n",
+    );
+    let out_dir = dir.path().join("r");
+    report_into(&out_dir, &["--input", input.to_str().unwrap()]);
+    let md = std::fs::read_to_string(out_dir.join("report.md")).unwrap();
+    assert!(!md.contains("These data are synthetic"));
+    assert!(md.contains("made dimensionless by v = v_m_s / sqrt(g R (1 + ξ))"));
+    // sqrt(9.81 · 0.003 · 2) = 0.242611 m/s and sqrt(9.81 · 0.003 · 3) = 0.297136 m/s.
+    assert!(md.contains("| A | 1 | 0.003 | 9.81 | 0.242611 |"), "{md}");
+    assert!(md.contains("| B | 2 | 0.003 | 9.81 | 0.297136 |"), "{md}");
+}
+
+/// Without --output, klaw, jan and jaeger print a fit report per fit on stdout (and no
+/// statistics table on stderr, which the reports carry); `--output -` prints the parameter CSV.
+#[test]
+fn fit_commands_print_a_fit_report_without_output() {
+    for (cmd, extra, name) in [
+        ("klaw", vec!["--model", "stick"], "c "),
+        ("jan", vec![], "lambda "),
+        ("jaeger", vec![], "a2 "),
+    ] {
+        let out = bin().arg(cmd).args(&extra).output().unwrap();
+        let text = stdout_ok(&out);
+        assert!(text.starts_with("[[Fit "), "{cmd}: {text}");
+        assert!(text.contains("[[Variables]]"), "{cmd}");
+        assert!(text.contains(&format!("    {name}")), "{cmd}: {text}");
+        assert!(text.contains("reduced chi-square"), "{cmd}");
+        assert!(
+            !String::from_utf8_lossy(&out.stderr).contains(" dof "),
+            "{cmd}: statistics table on stderr"
+        );
+        let csv = stdout_ok(
+            &bin()
+                .arg(cmd)
+                .args(&extra)
+                .args(["--output", "-"])
+                .output()
+                .unwrap(),
+        );
+        assert!(
+            csv.starts_with("fit,series,parameter,value,stderr,ci_low,ci_high,ci_method,unit"),
+            "{cmd}: {csv}"
+        );
+        assert!(!Path::new("-").exists(), "a file named '-' was written");
+    }
+}

@@ -34,6 +34,7 @@ use crate::scene::{ParameterError as Error, ParameterResult as Result};
 use crate::special::cheb::ChebIntegral;
 use crate::special::quad::{integrate_smooth, integrate_smooth_n};
 use crate::special::root::brent;
+use nalgebra::{Matrix2, Vector2};
 use std::fmt;
 use std::str::FromStr;
 
@@ -999,8 +1000,9 @@ impl Contact {
         }
         for _ in 0..8 {
             let f0 = self.next_2d(scene, l)?;
-            let r = [f0.theta_dot - l.theta_dot, f0.spin - l.spin];
-            if r[0].abs() + r[1].abs() <= 4.0 * f64::EPSILON * (l.theta_dot + l.spin.abs()) {
+            // G(l) = F(l) − l, the residual of the fixed point.
+            let r = Vector2::new(f0.theta_dot - l.theta_dot, f0.spin - l.spin);
+            if r.abs().sum() <= 4.0 * f64::EPSILON * (l.theta_dot + l.spin.abs()) {
                 break;
             }
             let h = 1e-7 * l.theta_dot.max(1e-3);
@@ -1019,29 +1021,29 @@ impl Contact {
                 },
             )?;
             beads += 3;
-            // J of G(l) = F(l) − l.
-            let j = [
-                [
-                    (fy.theta_dot - f0.theta_dot) / h - 1.0,
-                    (fw.theta_dot - f0.theta_dot) / h,
-                ],
-                [(fy.spin - f0.spin) / h, (fw.spin - f0.spin) / h - 1.0],
-            ];
-            let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+            // The Jacobian of G by forward differences, and the Newton step −J⁻¹ G through
+            // the adjugate.
+            let jac = Matrix2::new(
+                (fy.theta_dot - f0.theta_dot) / h - 1.0,
+                (fw.theta_dot - f0.theta_dot) / h,
+                (fy.spin - f0.spin) / h,
+                (fw.spin - f0.spin) / h - 1.0,
+            );
+            let det = jac.determinant();
             if det == 0.0 || !det.is_finite() {
                 break;
             }
-            let dy = (-r[0] * j[1][1] + r[1] * j[0][1]) / det;
-            let dw = (-r[1] * j[0][0] + r[0] * j[1][0]) / det;
+            let adjugate = Matrix2::new(jac.m22, -jac.m12, -jac.m21, jac.m11);
+            let step = adjugate * (-r) / det;
             let cand = Launch {
-                theta_dot: l.theta_dot + dy,
-                spin: l.spin + dw,
+                theta_dot: l.theta_dot + step.x,
+                spin: l.spin + step.y,
             };
             let Ok(fc) = self.next_2d(scene, cand) else {
                 break;
             };
-            let rc = (fc.theta_dot - cand.theta_dot).abs() + (fc.spin - cand.spin).abs();
-            if rc < r[0].abs() + r[1].abs() {
+            let rc = Vector2::new(fc.theta_dot - cand.theta_dot, fc.spin - cand.spin);
+            if rc.abs().sum() < r.abs().sum() {
                 l = cand;
             } else {
                 break;

@@ -46,6 +46,7 @@
 use super::{NotSteady, Outcome, Phases, Regime, Steady};
 use crate::scene::{CollisionLaw, Scene};
 use crate::scene::{ParameterError as Error, ParameterResult as Result};
+use nalgebra::Vector2;
 use std::f64::consts::PI;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -720,8 +721,8 @@ const MAXC: usize = 8;
 
 #[derive(Debug, Clone, Copy)]
 struct Eval {
-    ax: f64,
-    ay: f64,
+    /// Acceleration of the centre.
+    a: Vector2<f64>,
     aw: f64,
     p_n: f64,
     p_t: f64,
@@ -786,11 +787,10 @@ impl Nd {
 
     /// Accelerations (per unit mass, units g), dissipated powers and elastic energy at a
     /// state; the contacts found (absolute row indices, ascending).
-    #[inline]
-    fn eval(&self, cell: i64, x: f64, y: f64, vx: f64, vy: f64, w: f64) -> Eval {
+    #[inline(always)]
+    fn eval(&self, cell: i64, pos: Vector2<f64>, v: Vector2<f64>, w: f64) -> Eval {
         let mut e = Eval {
-            ax: self.sin_d,
-            ay: -self.cos_d,
+            a: Vector2::new(self.sin_d, -self.cos_d),
             aw: 0.0,
             p_n: 0.0,
             p_t: 0.0,
@@ -798,36 +798,36 @@ impl Nd {
             n: 0,
             idx: [0; MAXC],
         };
-        if y >= 1.0 {
+        if pos.y >= 1.0 {
             return e;
         }
-        let lo = ((x - 1.0) / self.s).ceil() as i64;
-        let hi = ((x + 1.0) / self.s).floor() as i64;
+        let lo = ((pos.x - 1.0) / self.s).ceil() as i64;
+        let hi = ((pos.x + 1.0) / self.s).floor() as i64;
         for k in lo..=hi {
-            let dx = x - k as f64 * self.s;
-            let d2 = dx * dx + y * y;
+            // From the centre of row bead k to the mobile bead's.
+            let d = Vector2::new(pos.x - k as f64 * self.s, pos.y);
+            let d2 = d.norm_squared();
             if d2 >= 1.0 {
                 continue;
             }
             let dist = d2.sqrt();
             let ov = 1.0 - dist;
-            let (nx, ny) = (dx / dist, y / dist);
-            let (tx, ty) = (-ny, nx);
+            let n = d / dist;
+            let t = Vector2::new(-n.y, n.x);
             // Eq 91, normal row: elastic k_n d^β plus damping on the approach velocity,
             // never attractive.
-            let vapp = -(vx * nx + vy * ny);
+            let vapp = -v.dot(&n);
             let fe = self.kn * self.pow_beta(ov);
             let fnn = (fe + self.gn * vapp).max(0.0);
             // Eq 91, tangential row: viscous on the slip velocity (spins of both beads; the
             // row beads' is zero), optionally capped by Coulomb.
-            let slip = vx * tx + vy * ty - self.rhat * w;
+            let slip = v.dot(&t) - self.rhat * w;
             let mut ft = -self.gs * slip;
             let cap = self.mu_c * fnn;
             if ft.abs() > cap {
                 ft = cap.copysign(ft);
             }
-            e.ax += fnn * nx + ft * tx;
-            e.ay += fnn * ny + ft * ty;
+            e.a += n * fnn + t * ft;
             e.aw -= ft * self.inv_inertia_r;
             e.p_n += (fnn - fe) * vapp;
             e.p_t -= ft * slip;
@@ -1069,8 +1069,8 @@ impl super::ForwardModel for Md {
 
 /// Mechanical energy per unit m g (R+r): kinetic (translation and spin) + gravity + elastic.
 #[inline]
-fn energy(nd: &Nd, xabs: f64, y: f64, vx: f64, vy: f64, w: f64, u_el: f64) -> f64 {
-    0.5 * (vx * vx + vy * vy)
+fn energy(nd: &Nd, xabs: f64, y: f64, v: Vector2<f64>, w: f64, u_el: f64) -> f64 {
+    0.5 * v.norm_squared()
         + 0.5 * nd.rho * nd.rhat * nd.rhat * w * w
         + (-nd.sin_d * xabs + nd.cos_d * y)
         + u_el
@@ -1095,17 +1095,16 @@ fn run(
     // static overlap, rolling downslope at the launch speed.
     let phi = -delta;
     let rad = 1.0 - nd.static_overlap;
+    // The centre relative to row bead `cell` (x in [0, s)), its velocity and its spin.
     let mut xabs = rad * phi.sin();
     let mut cell = (xabs / s).floor() as i64;
-    let mut x = xabs - cell as f64 * s;
-    let mut y = rad * phi.cos();
+    let mut pos = Vector2::new(xabs - cell as f64 * s, rad * phi.cos());
     let v0 = c.launch_velocity;
-    let mut vx = v0 * phi.cos();
-    let mut vy = -v0 * phi.sin();
+    let mut v = Vector2::new(v0 * phi.cos(), -v0 * phi.sin());
     let mut w = -v0 / nd.rhat;
     let mut t = 0.0;
-    let mut e = nd.eval(cell, x, y, vx, vy, w);
-    let e0 = energy(nd, xabs, y, vx, vy, w, e.u_el);
+    let mut e = nd.eval(cell, pos, v, w);
+    let e0 = energy(nd, xabs, pos.y, v, w, e.u_el);
     let (mut d_n, mut d_t) = (0.0, 0.0);
     let mut err_max: f64 = 0.0;
 
@@ -1142,33 +1141,29 @@ fn run(
 
     loop {
         // Velocity Verlet, damping at the predicted velocity.
-        let (x_old, cell_old) = (x, cell);
-        let hx = vx + 0.5 * dt * e.ax;
-        let hy = vy + 0.5 * dt * e.ay;
+        let (x_old, cell_old) = (pos.x, cell);
+        let h = v + e.a * (0.5 * dt);
         let hw = w + 0.5 * dt * e.aw;
-        x += hx * dt;
-        y += hy * dt;
-        while x >= s {
-            x -= s;
+        pos += h * dt;
+        while pos.x >= s {
+            pos.x -= s;
             cell += 1;
         }
-        while x < 0.0 {
-            x += s;
+        while pos.x < 0.0 {
+            pos.x += s;
             cell -= 1;
         }
-        let pvx = hx + 0.5 * dt * e.ax;
-        let pvy = hy + 0.5 * dt * e.ay;
+        let pv = h + e.a * (0.5 * dt);
         let pw = hw + 0.5 * dt * e.aw;
-        let en = nd.eval(cell, x, y, pvx, pvy, pw);
-        vx = hx + 0.5 * dt * en.ax;
-        vy = hy + 0.5 * dt * en.ay;
+        let en = nd.eval(cell, pos, pv, pw);
+        v = h + en.a * (0.5 * dt);
         w = hw + 0.5 * dt * en.aw;
         d_n += 0.5 * dt * (e.p_n + en.p_n);
         d_t += 0.5 * dt * (e.p_t + en.p_t);
         t += dt;
         res.steps += 1;
-        xabs = cell as f64 * s + x;
-        let etot = energy(nd, xabs, y, vx, vy, w, en.u_el);
+        xabs = cell as f64 * s + pos.x;
+        let etot = energy(nd, xabs, pos.y, v, w, en.u_el);
         err_max = err_max.max((etot + d_n + d_t - e0).abs());
         let in_window = win_start.is_some();
 
@@ -1187,7 +1182,7 @@ fn run(
                             jumped = k > max_touched + 1;
                         }
                         max_touched = k;
-                        pending = Some((k, (vx * vx + vy * vy).sqrt()));
+                        pending = Some((k, v.norm()));
                     }
                 }
             }
@@ -1199,11 +1194,10 @@ fn run(
         }
         if let Some((k, vf)) = pending {
             let old = en.idx[..en.n].iter().any(|&j| j < k);
-            let dx = xabs - k as f64 * s;
-            let vapp = -(vx * dx + vy * y);
+            let vapp = -v.dot(&Vector2::new(xabs - k as f64 * s, pos.y));
             if !old && vapp <= 0.0 {
                 if in_window && vf > 0.0 {
-                    let vi = (vx * vx + vy * vy).sqrt();
+                    let vi = v.norm();
                     win.vf_sum += vf;
                     win.vi_sum += vi;
                     win.k_sum += vi / vf;
@@ -1219,13 +1213,13 @@ fn run(
                 flight_x0 = xabs;
                 flight_hmax = 0.0;
                 let dx = xabs - last_lost as f64 * s;
-                flight_angle = dx.atan2(y) + delta;
+                flight_angle = dx.atan2(pos.y) + delta;
                 // Lift-off (eq 30a): leaving a sustained contact in the second half of its arc
                 // (Θ > (Θ0 + Θf)/2 = δ); a rebound leaves soon after an impact, near Θ0.
                 flight_liftoff = t - last_contact_start > sustained && flight_angle > delta;
             }
-            let d0 = (x * x + y * y).sqrt();
-            let d1 = ((x - s) * (x - s) + y * y).sqrt();
+            let d0 = pos.norm();
+            let d1 = Vector2::new(pos.x - s, pos.y).norm();
             flight_hmax = flight_hmax.max(d0.min(d1) - 1.0);
             if in_window {
                 win.airborne_time += dt;
@@ -1281,7 +1275,7 @@ fn run(
             if xabs < x_top {
                 if xabs > climb_x {
                     climb_x = xabs;
-                    climb_y = y;
+                    climb_y = pos.y;
                 }
                 let v_top = 1.0 - nd.sin_d * s * k1;
                 if etot < v_top - margin {

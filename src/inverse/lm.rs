@@ -923,14 +923,16 @@ fn scaled_norm(d: &[f64], x: &[f64], work: &mut [f64]) -> f64 {
 }
 
 /// Runs [`LevenbergMarquardt`] on `ls` under argmin's `Executor` (argmin's Ctrl-C handling off:
-/// the stop flag of `opts` is the caller's); returns the solution, the evaluator (its counts and
-/// work space, for the covariance) and the problem.
+/// the stop flag of `opts` is the caller's; its timer off: nothing reads the iteration times,
+/// and the profiles' many small fits would pay two clock reads per iteration); returns the
+/// solution, the evaluator (its counts and work space, for the covariance) and the problem.
 pub(crate) fn solve<R: Residuals>(
     ls: LeastSquares<R>,
     opts: &LsqOptions,
 ) -> Result<(Solution, Evaluator, LeastSquares<R>), Error> {
     let result = argmin::core::Executor::new(ls, LevenbergMarquardt::new(opts))
         .ctrlc(false)
+        .timer(false)
         .run()?;
     into_parts(result)
 }

@@ -51,6 +51,13 @@ pub trait LogDensity: Sync {
     fn dim(&self) -> usize;
     /// log p(x) up to an additive constant, or −∞ where p(x) = 0.
     fn log_density(&self, x: &[f64]) -> f64;
+    /// What the sampler records of a point x, as many numbers as `dim`: x itself by default.
+    /// A density over transformed coordinates returns the quantities of interest (the
+    /// parameters the coordinates stand for), so that the chains, and the R̂, ESS and τ that
+    /// decide convergence and burn-in, are theirs.
+    fn observe(&self, x: &[f64]) -> Vec<f64> {
+        x.to_vec()
+    }
 }
 
 /// Options of an [`EnsembleSampler`]. [`Default`] gives the documented defaults.
@@ -195,7 +202,8 @@ pub enum StopReason {
 /// The outcome of [`EnsembleSampler::run`].
 #[derive(Debug, Clone)]
 pub struct McmcResult {
-    /// Kept draws after burn-in and thinning, indexed `[walker][kept step][parameter]`.
+    /// Kept draws after burn-in and thinning, as recorded by [`LogDensity::observe`], indexed
+    /// `[walker][kept step][parameter]`.
     pub chains: Vec<Vec<Vec<f64>>>,
     /// Log densities of the kept draws, `[walker][kept step]`.
     pub log_densities: Vec<Vec<f64>>,
@@ -509,7 +517,7 @@ impl<'a, D: LogDensity + ?Sized> EnsembleSampler<'a, D> {
             steps += 1;
             if steps.is_multiple_of(o.thin) {
                 for w in 0..nw {
-                    chains[w].push(pos[w].clone());
+                    chains[w].push(self.target.observe(&pos[w]));
                     lps[w].push(lp[w]);
                 }
             }
@@ -532,9 +540,14 @@ impl<'a, D: LogDensity + ?Sized> EnsembleSampler<'a, D> {
             _ => self.assess(&chains),
         };
         let burn = assessment.burn;
-        let kept_chains: Vec<Vec<Vec<f64>>> =
-            chains.into_iter().map(|c| c[burn..].to_vec()).collect();
-        let kept_lps: Vec<Vec<f64>> = lps.into_iter().map(|c| c[burn..].to_vec()).collect();
+        let kept_chains: Vec<Vec<Vec<f64>>> = chains
+            .into_iter()
+            .map(|mut c| c.split_off(burn.min(c.len())))
+            .collect();
+        let kept_lps: Vec<Vec<f64>> = lps
+            .into_iter()
+            .map(|mut c| c.split_off(burn.min(c.len())))
+            .collect();
         let diagnostics = if stored > burn {
             summarise(&kept_chains, o.level)
         } else {
@@ -605,12 +618,14 @@ impl<'a, D: LogDensity + ?Sized> EnsembleSampler<'a, D> {
         }
         let reliable = post >= o.tau_reliability * tau_max;
         out.burn = burn as usize;
-        let kept: Vec<Vec<Vec<f64>>> = chains.iter().map(|c| c[out.burn..].to_vec()).collect();
         let dim = self.target.dim();
         let scores: Vec<f64> = (0..dim)
             .into_par_iter()
             .map(|k| {
-                let p = diagnostics::parameter_chains(&kept, k);
+                let p: Vec<Vec<f64>> = chains
+                    .iter()
+                    .map(|c| c[out.burn..].iter().map(|x| x[k]).collect())
+                    .collect();
                 let ess = ess_bulk(&p).min(ess_tail(&p));
                 let score = (rhat(&p) / o.rhat_max).max(o.min_ess / ess);
                 if score.is_nan() {

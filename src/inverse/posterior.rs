@@ -282,6 +282,46 @@ impl Draws {
     pub fn step(&self, k: usize) -> usize {
         self.burn_in + (k + 1) * self.thin
     }
+
+    /// Number of draws kept (all walkers).
+    pub fn len(&self) -> usize {
+        self.chains.iter().map(Vec::len).sum()
+    }
+
+    /// Whether no draw is kept.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Thins the kept draws further to at most `max_draws` in all (at least one step per
+    /// walker): every walker keeps its k-th, 2k-th, … kept step, k the smallest stride that
+    /// fits, and `thin` is multiplied by k, so that [`Self::step`] still numbers them. A
+    /// summary computed before thinning is unchanged; the draws left are for what needs only
+    /// a sample of the posterior (plots, predictive bands).
+    pub fn thin_to(&mut self, max_draws: usize) {
+        let walkers = self.chains.len().max(1);
+        let per_walker = (max_draws / walkers).max(1);
+        let kept = self.chains.iter().map(Vec::len).max().unwrap_or(0);
+        if kept <= per_walker {
+            return;
+        }
+        let k = kept.div_ceil(per_walker);
+        for c in self.chains.iter_mut() {
+            *c = std::mem::take(c)
+                .into_iter()
+                .skip(k - 1)
+                .step_by(k)
+                .collect();
+        }
+        for l in self.log_posterior.iter_mut() {
+            *l = std::mem::take(l)
+                .into_iter()
+                .skip(k - 1)
+                .step_by(k)
+                .collect();
+        }
+        self.thin *= k;
+    }
 }
 
 /// A change of the coordinates in which a problem's parameters are sampled: a smooth bijection

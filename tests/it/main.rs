@@ -13,6 +13,7 @@ mod faults;
 mod figures;
 mod fits;
 mod forward_stream;
+mod jaeger_posterior;
 mod k_inversion;
 mod k_stream;
 mod mcmc;

@@ -23,4 +23,5 @@ mod paper_figures;
 mod properties;
 mod recipes;
 mod reference_models;
+mod report_mcmc;
 mod sbc;

@@ -37,8 +37,8 @@ use rayon::prelude::*;
 use thiserror::Error;
 
 pub use diagnostics::{
-    ess_basic, ess_bulk, ess_mean, ess_tail, integrated_time, integrated_times, rhat, summarise,
-    summarise_scalar, ParameterDiagnostics,
+    convergence, ess_basic, ess_bulk, ess_mean, ess_tail, integrated_time, integrated_times, rhat,
+    summarise, summarise_scalar, Convergence, ParameterDiagnostics,
 };
 
 /// An unnormalised log probability density on ℝⁿ.
@@ -524,7 +524,7 @@ impl<'a, D: LogDensity + ?Sized> EnsembleSampler<'a, D> {
             progress(steps, o.max_steps);
             if steps >= next_check {
                 next_check = steps + o.check_every.max(steps / 10);
-                let assessment = self.assess(&chains);
+                let assessment = self.assess(&chains, false);
                 let done = assessment.converged;
                 last = Some(assessment);
                 if done {
@@ -536,8 +536,8 @@ impl<'a, D: LogDensity + ?Sized> EnsembleSampler<'a, D> {
         // Reassess unless the last check saw exactly the stored draws.
         let stored = chains.first().map_or(0, Vec::len);
         let assessment = match last {
-            Some(a) if a.stored == stored => a,
-            _ => self.assess(&chains),
+            Some(a) if a.stored == stored && a.complete => a,
+            _ => self.assess(&chains, true),
         };
         let burn = assessment.burn;
         let kept_chains: Vec<Vec<Vec<f64>>> = chains
@@ -580,8 +580,9 @@ impl<'a, D: LogDensity + ?Sized> EnsembleSampler<'a, D> {
         })
     }
 
-    /// Burn-in and convergence of the stored (thinned) chains.
-    fn assess(&self, chains: &[Vec<Vec<f64>>]) -> Assessment {
+    /// Burn-in and convergence of the stored (thinned) chains; when `complete`, the failing
+    /// parameter is the one furthest from the thresholds even when τ is not yet reliable.
+    fn assess(&self, chains: &[Vec<Vec<f64>>], complete: bool) -> Assessment {
         let o = &self.options;
         let n = chains.first().map_or(0, Vec::len);
         let mut out = Assessment {
@@ -590,6 +591,7 @@ impl<'a, D: LogDensity + ?Sized> EnsembleSampler<'a, D> {
             tau_max: f64::NAN,
             converged: false,
             failing: None,
+            complete: true,
         };
         if n < 8 {
             out.failing = Some(0).filter(|_| n > 0);
@@ -618,6 +620,14 @@ impl<'a, D: LogDensity + ?Sized> EnsembleSampler<'a, D> {
         }
         let reliable = post >= o.tau_reliability * tau_max;
         out.burn = burn as usize;
+        // Without a reliable τ the run cannot have converged: a check during the run stops
+        // here, the final assessment goes on to name the parameter furthest from the
+        // thresholds.
+        if !reliable && !complete {
+            out.failing = Some(k_tau);
+            out.complete = false;
+            return out;
+        }
         let dim = self.target.dim();
         let scores: Vec<f64> = (0..dim)
             .into_par_iter()
@@ -626,8 +636,9 @@ impl<'a, D: LogDensity + ?Sized> EnsembleSampler<'a, D> {
                     .iter()
                     .map(|c| c[out.burn..].iter().map(|x| x[k]).collect())
                     .collect();
-                let ess = ess_bulk(&p).min(ess_tail(&p));
-                let score = (rhat(&p) / o.rhat_max).max(o.min_ess / ess);
+                let c = diagnostics::convergence(&p);
+                let ess = c.ess_bulk.min(c.ess_tail);
+                let score = (c.rhat / o.rhat_max).max(o.min_ess / ess);
                 if score.is_nan() {
                     f64::INFINITY
                 } else {
@@ -665,4 +676,6 @@ struct Assessment {
     tau_max: f64,
     converged: bool,
     failing: Option<usize>,
+    /// Whether `failing` is final (false for a check that stopped at an unreliable τ).
+    complete: bool,
 }

@@ -20,6 +20,13 @@
 //! has a steady state under the model: the log density is −∞ wherever the residuals are
 //! [`Infeasible`](crate::inverse::Infeasible), never NaN.
 //!
+//! Coordinates: a parameter whose box is [0, ∞), and the scale, is sampled as ln x; Jaeger's
+//! a1, a2, a3 in the coordinates of [`super::jaeger_coordinates`] (the velocity at the
+//! series' mean slope, the slope of the law there and a shape), through
+//! [`summarise_reparameterised`]. Either way the log density carries the Jacobian, so the
+//! priors are those of the parameters, and the sampler records the parameters: the draws and
+//! the R̂, ESS and τ that decide convergence are theirs.
+//!
 //! The report keeps the least-squares row format: `value` is the posterior median, `stderr`
 //! the posterior standard deviation, and `ci_low`/`ci_high` the central posterior interval at
 //! the level asked (`ci_method = posterior`); the covariance interval of the least-squares

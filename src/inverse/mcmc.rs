@@ -22,7 +22,9 @@
 //! tail effective sample sizes (A. Vehtari, A. Gelman, D. Simpson, B. Carpenter &
 //! P.-C. Bürkner, Bayesian Analysis 16, 2021), computed after discarding a burn-in of a few
 //! integrated autocorrelation times, meet the thresholds of [`McmcOptions`], or until
-//! `max_steps`, or until a caller raises the stop flag. The diagnostics are in
+//! `max_steps`, or until a caller raises the stop flag. The chains, and the diagnostics on
+//! them, are of what the density records of each point ([`LogDensity::observe`]: the point
+//! itself unless the density is over transformed coordinates). The diagnostics are in
 //! [`diagnostics`] and work on any chains.
 
 pub mod diagnostics;

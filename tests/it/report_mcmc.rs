@@ -3,9 +3,11 @@
 
 use crate::common::{bin, read_table, root, stderr, tmpdir};
 use fitbead::fit::posterior::{McmcSettings, Method};
+use fitbead::progress::{Progress, ProgressEvent};
 use fitbead::report::analysis::{analyse, REPORT_DRAWS};
 use fitbead::report::bands::{posterior_bands, BAND_DRAWS, BAND_GRID};
 use fitbead::Dataset;
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 #[test]
@@ -55,11 +57,37 @@ fn report_mcmc_on_the_default_data_converges() {
 #[test]
 fn posterior_bands_of_every_fit() {
     let data = Dataset::default_data();
-    let an = analyse(
-        &data,
-        0.95,
-        &Method::Mcmc(Box::new(McmcSettings::seeded(1))),
-    );
+    // The fits run concurrently; the progress sink must still see one task at a time.
+    let events: Arc<Mutex<Vec<String>>> = Arc::default();
+    let log = Arc::clone(&events);
+    let mut settings = McmcSettings::seeded(1);
+    settings.progress = Some(Progress::new(move |e| {
+        let tag = match e {
+            ProgressEvent::Start { label, .. } => format!("start {label}"),
+            ProgressEvent::Position(_) => "position".into(),
+            ProgressEvent::Finish => "finish".into(),
+        };
+        log.lock().unwrap().push(tag);
+    }));
+    let an = analyse(&data, 0.95, &Method::Mcmc(Box::new(settings)));
+    let events = events.lock().unwrap().clone();
+    let mut open = false;
+    let mut tasks = 0;
+    for e in &events {
+        match e.as_str() {
+            "finish" => {
+                assert!(open, "a finish without a start");
+                open = false;
+            }
+            "position" => assert!(open, "a position outside a task"),
+            start => {
+                assert!(!open, "{start} while another task holds the sink");
+                open = true;
+                tasks += 1;
+            }
+        }
+    }
+    assert!(!open && tasks >= 1, "{tasks} tasks reported");
     let b = posterior_bands(&an);
     // Per series: 2 contact models × 2 laws, Jan per series and global, Jaeger.
     assert_eq!(b.bands.len(), 4 * 7);

@@ -20,14 +20,22 @@
 //! has a steady state under the model: the log density is −∞ wherever the residuals are
 //! [`Infeasible`](crate::inverse::Infeasible), never NaN.
 //!
+//! Coordinates: a parameter whose box is [0, ∞), and the scale, is sampled as ln x; Jaeger's
+//! a1, a2, a3 in the coordinates of [`super::jaeger_coordinates`] (the velocity at the
+//! series' mean slope, the slope of the law there and a shape), through
+//! [`summarise_reparameterised`]. Either way the log density carries the Jacobian, so the
+//! priors are those of the parameters, and the sampler records the parameters: the draws and
+//! the R̂, ESS and τ that decide convergence are theirs.
+//!
 //! The report keeps the least-squares row format: `value` is the posterior median, `stderr`
 //! the posterior standard deviation, and `ci_low`/`ci_high` the central posterior interval at
 //! the level asked (`ci_method = posterior`); the covariance interval of the least-squares
 //! optimum stays in `cov_low`/`cov_high` and the optimum in `lsq_value`.
 
 use super::summary::{summarise, FitResult, McmcFailure, McmcStats, ParamRow, Solved};
-use crate::inverse::mcmc::{summarise as mcmc_summarise, EnsembleSampler, StopReason};
+use crate::inverse::mcmc::{EnsembleSampler, StopReason};
 use crate::inverse::posterior::Posterior;
+pub use crate::inverse::posterior::Reparameterisation;
 pub use crate::inverse::posterior::{Draws, McmcSettings, Method, Prior, SCALE_NAME};
 use crate::inverse::{Residuals, SigmaKind};
 use crate::numfmt::{fmt_f64, fmt_sig};
@@ -52,13 +60,33 @@ pub fn summarise_with<R: Residuals + Sync + ?Sized>(
 ) -> FitResult {
     match method {
         Method::Lsq { profile, .. } => summarise(solved, *profile),
-        Method::Mcmc(s) => sample(s, solved),
+        Method::Mcmc(s) => sample(s, solved, None),
     }
 }
+
+/// As [`summarise_with`], with a posterior run sampling the parameters in the coordinates of
+/// `transform` (the priors, draws and reported values stay those of the parameters; see
+/// [`Reparameterisation`]). Least squares ignores `transform`.
+pub fn summarise_reparameterised<R: Residuals + Sync + ?Sized>(
+    method: &Method,
+    solved: Solved<'_, R>,
+    transform: &dyn Reparameterisation,
+) -> FitResult {
+    match method {
+        Method::Lsq { profile, .. } => summarise(solved, *profile),
+        Method::Mcmc(s) => sample(s, solved, Some(transform)),
+    }
+}
+
+/// The standard deviation of the initial ball in every coordinate of a reparameterised
+/// posterior: the coordinates of a [`Reparameterisation`] are meant to be of order one
+/// (logarithms, dimensionless shapes), and the ensemble widens from a small ball by itself.
+const REPARAMETERISED_BALL: f64 = 1e-3;
 
 fn sample<R: Residuals + Sync + ?Sized>(
     settings: &McmcSettings,
     solved: Solved<'_, R>,
+    transform: Option<&dyn Reparameterisation>,
 ) -> FitResult {
     let Solved {
         name: fit_name,
@@ -90,13 +118,16 @@ fn sample<R: Residuals + Sync + ?Sized>(
             .cloned()
             .unwrap_or_else(Prior::jeffreys)
     });
-    let target = Posterior::new(
+    let mut target = Posterior::new(
         problem,
         lower.clone(),
         upper.clone(),
         priors.clone(),
         scale_prior.clone(),
     );
+    if let Some(t) = transform {
+        target = target.with_reparameterisation(t);
+    }
     // Start: the optimum; the scale at the scatter it implies, sqrt(χ²/dof).
     let s0 = {
         let s = (f.chi2 / f.dof.max(1) as f64).sqrt();
@@ -172,13 +203,21 @@ fn sample<R: Residuals + Sync + ?Sized>(
     }
     let ball: Vec<f64> = (0..start.len())
         .map(|j| match (target.is_log(j), se[j]) {
+            _ if j < n && transform.is_some() => REPARAMETERISED_BALL,
             (true, Some(s)) => (1e-2 * s / start[j]).clamp(1e-4, 1e-1),
             (true, None) => 1e-2,
             (false, Some(s)) => 1e-2 * s,
             (false, None) => 1e-4 * start[j].abs().max(1.0),
         })
         .collect();
-    let start = target.to_coordinates(&start);
+    let Some(start) = target.start_coordinates(&start) else {
+        return failed(
+            out,
+            McmcFailure::NotStarted(
+                "the least-squares optimum has no sampling coordinates".to_string(),
+            ),
+        );
+    };
     let mut options = settings.options.clone();
     options.level = level;
     options.init_scale = Some(ball);
@@ -209,20 +248,12 @@ fn sample<R: Residuals + Sync + ?Sized>(
         }
         r.map(|r| (r, sampler.walkers()))
     });
-    let (mut res, walkers) = match run {
+    let (res, walkers) = match run {
         Ok(r) => r,
         Err(e) => return failed(out, McmcFailure::NotStarted(e.to_string())),
     };
-    // Back from sampling coordinates to parameters; the rank-based R̂ and ESS are unchanged by
-    // the monotone map, the moments, quantiles and τ are recomputed on the parameters.
-    for chain in res.chains.iter_mut() {
-        for y in chain.iter_mut() {
-            *y = target.to_params(y);
-        }
-    }
-    if !res.diagnostics.is_empty() {
-        res.diagnostics = mcmc_summarise(&res.chains, level);
-    }
+    // The chains, and the diagnostics on them, are already in parameters
+    // (`Posterior` records them so).
     // Rows: the parameters, then the scale.
     if with_scale {
         out.params.push(ParamRow {

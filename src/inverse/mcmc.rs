@@ -22,7 +22,9 @@
 //! tail effective sample sizes (A. Vehtari, A. Gelman, D. Simpson, B. Carpenter &
 //! P.-C. Bürkner, Bayesian Analysis 16, 2021), computed after discarding a burn-in of a few
 //! integrated autocorrelation times, meet the thresholds of [`McmcOptions`], or until
-//! `max_steps`, or until a caller raises the stop flag. The diagnostics are in
+//! `max_steps`, or until a caller raises the stop flag. The chains, and the diagnostics on
+//! them, are of what the density records of each point ([`LogDensity::observe`]: the point
+//! itself unless the density is over transformed coordinates). The diagnostics are in
 //! [`diagnostics`] and work on any chains.
 
 pub mod diagnostics;
@@ -37,8 +39,8 @@ use rayon::prelude::*;
 use thiserror::Error;
 
 pub use diagnostics::{
-    ess_basic, ess_bulk, ess_mean, ess_tail, integrated_time, integrated_times, rhat, summarise,
-    summarise_scalar, ParameterDiagnostics,
+    convergence, ess_basic, ess_bulk, ess_mean, ess_tail, integrated_time, integrated_times, rhat,
+    summarise, summarise_scalar, Convergence, ParameterDiagnostics,
 };
 
 /// An unnormalised log probability density on ℝⁿ.
@@ -51,6 +53,13 @@ pub trait LogDensity: Sync {
     fn dim(&self) -> usize;
     /// log p(x) up to an additive constant, or −∞ where p(x) = 0.
     fn log_density(&self, x: &[f64]) -> f64;
+    /// What the sampler records of a point x, as many numbers as `dim`: x itself by default.
+    /// A density over transformed coordinates returns the quantities of interest (the
+    /// parameters the coordinates stand for), so that the chains, and the R̂, ESS and τ that
+    /// decide convergence and burn-in, are theirs.
+    fn observe(&self, x: &[f64]) -> Vec<f64> {
+        x.to_vec()
+    }
 }
 
 /// Options of an [`EnsembleSampler`]. [`Default`] gives the documented defaults.
@@ -195,7 +204,8 @@ pub enum StopReason {
 /// The outcome of [`EnsembleSampler::run`].
 #[derive(Debug, Clone)]
 pub struct McmcResult {
-    /// Kept draws after burn-in and thinning, indexed `[walker][kept step][parameter]`.
+    /// Kept draws after burn-in and thinning, as recorded by [`LogDensity::observe`], indexed
+    /// `[walker][kept step][parameter]`.
     pub chains: Vec<Vec<Vec<f64>>>,
     /// Log densities of the kept draws, `[walker][kept step]`.
     pub log_densities: Vec<Vec<f64>>,
@@ -509,14 +519,14 @@ impl<'a, D: LogDensity + ?Sized> EnsembleSampler<'a, D> {
             steps += 1;
             if steps.is_multiple_of(o.thin) {
                 for w in 0..nw {
-                    chains[w].push(pos[w].clone());
+                    chains[w].push(self.target.observe(&pos[w]));
                     lps[w].push(lp[w]);
                 }
             }
             progress(steps, o.max_steps);
             if steps >= next_check {
                 next_check = steps + o.check_every.max(steps / 10);
-                let assessment = self.assess(&chains);
+                let assessment = self.assess(&chains, false);
                 let done = assessment.converged;
                 last = Some(assessment);
                 if done {
@@ -528,13 +538,18 @@ impl<'a, D: LogDensity + ?Sized> EnsembleSampler<'a, D> {
         // Reassess unless the last check saw exactly the stored draws.
         let stored = chains.first().map_or(0, Vec::len);
         let assessment = match last {
-            Some(a) if a.stored == stored => a,
-            _ => self.assess(&chains),
+            Some(a) if a.stored == stored && a.complete => a,
+            _ => self.assess(&chains, true),
         };
         let burn = assessment.burn;
-        let kept_chains: Vec<Vec<Vec<f64>>> =
-            chains.into_iter().map(|c| c[burn..].to_vec()).collect();
-        let kept_lps: Vec<Vec<f64>> = lps.into_iter().map(|c| c[burn..].to_vec()).collect();
+        let kept_chains: Vec<Vec<Vec<f64>>> = chains
+            .into_iter()
+            .map(|mut c| c.split_off(burn.min(c.len())))
+            .collect();
+        let kept_lps: Vec<Vec<f64>> = lps
+            .into_iter()
+            .map(|mut c| c.split_off(burn.min(c.len())))
+            .collect();
         let diagnostics = if stored > burn {
             summarise(&kept_chains, o.level)
         } else {
@@ -567,8 +582,9 @@ impl<'a, D: LogDensity + ?Sized> EnsembleSampler<'a, D> {
         })
     }
 
-    /// Burn-in and convergence of the stored (thinned) chains.
-    fn assess(&self, chains: &[Vec<Vec<f64>>]) -> Assessment {
+    /// Burn-in and convergence of the stored (thinned) chains; when `complete`, the failing
+    /// parameter is the one furthest from the thresholds even when τ is not yet reliable.
+    fn assess(&self, chains: &[Vec<Vec<f64>>], complete: bool) -> Assessment {
         let o = &self.options;
         let n = chains.first().map_or(0, Vec::len);
         let mut out = Assessment {
@@ -577,6 +593,7 @@ impl<'a, D: LogDensity + ?Sized> EnsembleSampler<'a, D> {
             tau_max: f64::NAN,
             converged: false,
             failing: None,
+            complete: true,
         };
         if n < 8 {
             out.failing = Some(0).filter(|_| n > 0);
@@ -605,14 +622,25 @@ impl<'a, D: LogDensity + ?Sized> EnsembleSampler<'a, D> {
         }
         let reliable = post >= o.tau_reliability * tau_max;
         out.burn = burn as usize;
-        let kept: Vec<Vec<Vec<f64>>> = chains.iter().map(|c| c[out.burn..].to_vec()).collect();
+        // Without a reliable τ the run cannot have converged: a check during the run stops
+        // here, the final assessment goes on to name the parameter furthest from the
+        // thresholds.
+        if !reliable && !complete {
+            out.failing = Some(k_tau);
+            out.complete = false;
+            return out;
+        }
         let dim = self.target.dim();
         let scores: Vec<f64> = (0..dim)
             .into_par_iter()
             .map(|k| {
-                let p = diagnostics::parameter_chains(&kept, k);
-                let ess = ess_bulk(&p).min(ess_tail(&p));
-                let score = (rhat(&p) / o.rhat_max).max(o.min_ess / ess);
+                let p: Vec<Vec<f64>> = chains
+                    .iter()
+                    .map(|c| c[out.burn..].iter().map(|x| x[k]).collect())
+                    .collect();
+                let c = diagnostics::convergence(&p);
+                let ess = c.ess_bulk.min(c.ess_tail);
+                let score = (c.rhat / o.rhat_max).max(o.min_ess / ess);
                 if score.is_nan() {
                     f64::INFINITY
                 } else {
@@ -650,4 +678,6 @@ struct Assessment {
     tau_max: f64,
     converged: bool,
     failing: Option<usize>,
+    /// Whether `failing` is final (false for a check that stopped at an unreliable τ).
+    complete: bool,
 }

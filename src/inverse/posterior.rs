@@ -282,13 +282,79 @@ impl Draws {
     pub fn step(&self, k: usize) -> usize {
         self.burn_in + (k + 1) * self.thin
     }
+
+    /// Number of draws kept (all walkers).
+    pub fn len(&self) -> usize {
+        self.chains.iter().map(Vec::len).sum()
+    }
+
+    /// Whether no draw is kept.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Thins the kept draws further to at most `max_draws` in all (at least one step per
+    /// walker): every walker keeps its k-th, 2k-th, … kept step, k the smallest stride that
+    /// fits, and `thin` is multiplied by k, so that [`Self::step`] still numbers them. A
+    /// summary computed before thinning is unchanged; the draws left are for what needs only
+    /// a sample of the posterior (plots, predictive bands).
+    pub fn thin_to(&mut self, max_draws: usize) {
+        let walkers = self.chains.len().max(1);
+        let per_walker = (max_draws / walkers).max(1);
+        let kept = self.chains.iter().map(Vec::len).max().unwrap_or(0);
+        if kept <= per_walker {
+            return;
+        }
+        let k = kept.div_ceil(per_walker);
+        for c in self.chains.iter_mut() {
+            *c = std::mem::take(c)
+                .into_iter()
+                .skip(k - 1)
+                .step_by(k)
+                .collect();
+        }
+        for l in self.log_posterior.iter_mut() {
+            *l = std::mem::take(l)
+                .into_iter()
+                .skip(k - 1)
+                .step_by(k)
+                .collect();
+        }
+        self.thin *= k;
+    }
 }
 
-/// The log posterior of a least-squares problem (module docs), over sampling coordinates y:
-/// a parameter whose box is [0, ∞), and the scale, is sampled as y = ln x (the log density
-/// then gains the Jacobian term ln x = y), every other parameter as itself. Long right tails
-/// of positive parameters (Jaeger's a2, the scale) become short in ln x, where the ensemble
-/// moves mix far better.
+/// A change of the coordinates in which a problem's parameters are sampled: a smooth bijection
+/// y ↦ x = T(y) from an open set of ℝⁿ onto the parameters, chosen so that the posterior is
+/// closer to Gaussian in y than in x (a ridge of x straightened). The posterior density in y
+/// is p(T(y)) |det ∂T/∂y|, so that priors stated on x keep their meaning ([`Posterior`]).
+pub trait Reparameterisation: Sync {
+    /// The parameters x = T(y), written to `x`, and ln |det ∂T/∂y| at y; `None` where y is
+    /// outside the domain of T (the posterior density is zero there).
+    fn params(&self, y: &[f64], x: &mut [f64]) -> Option<f64>;
+
+    /// The coordinates y = T⁻¹(x), `None` where x is outside the image of T.
+    fn coordinates(&self, x: &[f64]) -> Option<Vec<f64>>;
+
+    /// The coordinates to start sampling from, given a start x in parameters (a least-squares
+    /// optimum, which may sit on a boundary where the coordinates are infinite): by default
+    /// [`Self::coordinates`].
+    fn start(&self, x: &[f64]) -> Option<Vec<f64>> {
+        self.coordinates(x)
+    }
+}
+
+/// The log posterior of a least-squares problem (module docs), over sampling coordinates y.
+/// By default a parameter whose box is [0, ∞), and the scale, is sampled as y = ln x (the log
+/// density then gains the Jacobian term ln x = y), every other parameter as itself: long right
+/// tails of positive parameters (the scale) become short in ln x, where the ensemble moves mix
+/// far better. With a [`Reparameterisation`] ([`Posterior::with_reparameterisation`]) the
+/// problem's parameters are sampled in its coordinates instead (the scale stays in ln s), and
+/// the log density gains its ln |det ∂x/∂y|.
+///
+/// Whatever the coordinates, the sampler records the parameters x (and the scale s): the
+/// draws, and the R̂ and ESS that decide convergence, are those of the reported parameters
+/// ([`LogDensity::observe`]).
 pub struct Posterior<'a, R: ?Sized> {
     problem: &'a R,
     lower: Vec<f64>,
@@ -296,6 +362,7 @@ pub struct Posterior<'a, R: ?Sized> {
     priors: Vec<Prior>,
     scale: Option<Prior>,
     log: Vec<bool>,
+    transform: Option<&'a dyn Reparameterisation>,
 }
 
 impl<'a, R: Residuals + Sync + ?Sized> Posterior<'a, R> {
@@ -322,28 +389,88 @@ impl<'a, R: Residuals + Sync + ?Sized> Posterior<'a, R> {
             priors,
             scale,
             log,
+            transform: None,
         }
     }
 
-    /// Whether coordinate `j` is sampled as ln x.
+    /// The same posterior with the problem's parameters sampled in the coordinates of
+    /// `transform` (the scale, if any, stays in ln s).
+    pub fn with_reparameterisation(mut self, transform: &'a dyn Reparameterisation) -> Self {
+        let n = self.problem.n_params();
+        self.log[..n].iter_mut().for_each(|l| *l = false);
+        self.transform = Some(transform);
+        self
+    }
+
+    /// The reparameterisation in use, if any.
+    pub fn reparameterisation(&self) -> Option<&'a dyn Reparameterisation> {
+        self.transform
+    }
+
+    /// Whether coordinate `j` is sampled as ln x (never for the parameters of a
+    /// reparameterised posterior).
     pub fn is_log(&self, j: usize) -> bool {
         self.log[j]
     }
 
-    /// Parameters x from sampling coordinates y.
-    pub fn to_params(&self, y: &[f64]) -> Vec<f64> {
-        y.iter()
+    /// Parameters x from sampling coordinates y, with ln |det ∂x/∂y|; `None` outside the
+    /// domain of the reparameterisation.
+    fn params_and_jacobian(&self, y: &[f64]) -> Option<(Vec<f64>, f64)> {
+        let n = self.problem.n_params();
+        let mut x: Vec<f64> = y
+            .iter()
             .zip(&self.log)
             .map(|(&v, &l)| if l { v.exp() } else { v })
-            .collect()
+            .collect();
+        // Jacobian of x = e^y: ln |dx/dy| = y.
+        let mut log_j: f64 = y
+            .iter()
+            .zip(&self.log)
+            .filter(|(_, &l)| l)
+            .map(|(&v, _)| v)
+            .sum();
+        if let Some(t) = self.transform {
+            log_j += t.params(&y[..n], &mut x[..n])?;
+        }
+        Some((x, log_j))
     }
 
-    /// Sampling coordinates y from parameters x (x > 0 where sampled as ln x).
-    pub fn to_coordinates(&self, x: &[f64]) -> Vec<f64> {
-        x.iter()
+    /// Parameters x from sampling coordinates y (NaN where y is outside the domain of the
+    /// reparameterisation).
+    pub fn to_params(&self, y: &[f64]) -> Vec<f64> {
+        self.params_and_jacobian(y)
+            .map(|(x, _)| x)
+            .unwrap_or_else(|| vec![f64::NAN; y.len()])
+    }
+
+    /// Sampling coordinates y from parameters x (x > 0 where sampled as ln x); `None` where
+    /// x is outside the image of the reparameterisation.
+    pub fn to_coordinates(&self, x: &[f64]) -> Option<Vec<f64>> {
+        self.coordinates_with(x, |t, p| t.coordinates(p))
+    }
+
+    /// Sampling coordinates to start from, given a start x (see
+    /// [`Reparameterisation::start`]); without a reparameterisation, [`Self::to_coordinates`].
+    pub fn start_coordinates(&self, x: &[f64]) -> Option<Vec<f64>> {
+        self.coordinates_with(x, |t, p| t.start(p))
+    }
+
+    fn coordinates_with(
+        &self,
+        x: &[f64],
+        f: impl Fn(&dyn Reparameterisation, &[f64]) -> Option<Vec<f64>>,
+    ) -> Option<Vec<f64>> {
+        let n = self.problem.n_params();
+        let mut y: Vec<f64> = x
+            .iter()
             .zip(&self.log)
             .map(|(&v, &l)| if l { v.ln() } else { v })
-            .collect()
+            .collect();
+        if let Some(t) = self.transform {
+            let c = f(t, &x[..n])?;
+            y[..n].copy_from_slice(&c);
+        }
+        Some(y)
     }
 }
 
@@ -354,14 +481,9 @@ impl<R: Residuals + Sync + ?Sized> LogDensity for Posterior<'_, R> {
 
     fn log_density(&self, y: &[f64]) -> f64 {
         let n = self.problem.n_params();
-        // Jacobian of x = e^y: ln |dx/dy| = y.
-        let mut lp: f64 = y
-            .iter()
-            .zip(&self.log)
-            .filter(|(_, &l)| l)
-            .map(|(&v, _)| v)
-            .sum();
-        let x = self.to_params(y);
+        let Some((x, mut lp)) = self.params_and_jacobian(y) else {
+            return f64::NEG_INFINITY;
+        };
         let p = &x[..n];
         for (((&x, &lo), &hi), prior) in
             p.iter().zip(&self.lower).zip(&self.upper).zip(&self.priors)
@@ -398,5 +520,10 @@ impl<R: Residuals + Sync + ?Sized> LogDensity for Posterior<'_, R> {
             None => lp - 0.5 * chi2,
             Some(s) => lp - m as f64 * s.ln() - 0.5 * chi2 / (s * s),
         }
+    }
+
+    /// The parameters (and the scale) at y: what the draws record.
+    fn observe(&self, y: &[f64]) -> Vec<f64> {
+        self.to_params(y)
     }
 }

@@ -15,8 +15,11 @@ use crate::io::fmt_f64;
 use crate::models::energy;
 use crate::models::regimes::{bulk_friction, critical_xi, delta_d_law, delta_m_law};
 use crate::models::{regime_of, ForwardModel, JaegerBranch, Model, Regime};
+use crate::progress::{Progress, ProgressEvent};
 use crate::scene::CollisionLaw;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
 
 /// The contract columns of the bulk-friction table, in order.
 pub const MU_COLUMNS: [&str; 12] = [
@@ -95,82 +98,188 @@ fn chi2_at(problem: &KLawProblem<'_>, p: &[f64], m: usize) -> (f64, usize) {
     }
 }
 
+/// Posterior draws the report keeps per fit at most, once the fit's summary is made from all
+/// of them: enough for its plots (a corner plot's 30 × 30 density grid and 36-bin marginals) and
+/// for [`super::bands`], which uses at most 1000. The fit commands' `--draws` keep every draw.
+pub const REPORT_DRAWS: usize = 10_000;
+
 /// Fits every model to `data` by `method` at `level`.
+///
+/// The fits are independent and run concurrently (rayon); each is reproducible on its own
+/// (the sampler's streams depend on the seed only), so the analysis is the same whatever the
+/// number of threads. Under MCMC a progress sink receives the events of one fit at a time
+/// (the first to start holds it until it finishes; the others run unseen), and each
+/// posterior keeps at most [`REPORT_DRAWS`] draws.
 pub fn analyse(data: &Dataset, level: f64, method: &Method) -> Analysis {
-    let mut contact = Vec::new();
-    // Once the stop flag is up, the per-point work is skipped (each fit then ends at once):
-    // the caller, who raised it, does not use a stopped analysis beyond its posteriors.
-    for (model, name) in CONTACT {
-        let keep: Vec<bool> = data
-            .points
-            .par_iter()
-            .map(|p| !method.stopped() && bracket(&model, &p.scene).is_ok())
-            .collect();
-        let (sub, used) = data.filter(|i| keep[i]);
-        let mut notes = Vec::new();
-        let dropped = data.points.len() - used.len();
-        if dropped > 0 {
-            notes.push(format!(
-                "{dropped} point(s) have no steady state for any K under the {name} model and \
-                 are left out of its fits"
-            ));
-        }
-        let mut fit = |law: KLaw| match fit_law_with(model, &sub, law, level, method) {
-            Ok(f) => Some(f),
-            Err(e) => {
-                notes.push(format!("{name} law {}: {e}", law.name()));
-                None
-            }
-        };
-        let law_c = fit(KLaw::C);
-        let free = fit(KLaw::FreePerSeries);
-        let m = sub.points.len();
-        let stop = method.stop().cloned();
-        let cos2a_chi2 = KLawProblem::new_until(model, &sub, KLaw::C, stop.clone())
-            .map(|p| chi2_at(&p, &[0.0], m))
-            .unwrap_or((f64::INFINITY, m));
-        let impact_chi2 = KLawProblem::new_until(model, &sub, KLaw::Impact, stop)
-            .map(|p| chi2_at(&p, &[], m))
-            .unwrap_or((f64::INFINITY, m));
-        let energy = match &law_c {
-            Some(f) => sub
-                .points
+    let shared = SharedProgress::of(method);
+    let (contact, (jan, jaeger)) = rayon::join(
+        || {
+            CONTACT
                 .par_iter()
-                .zip(&f.k)
-                .map(|(p, &k)| {
-                    if method.stopped() {
-                        return None;
+                .map(|&(model, name)| contact_fits(data, model, name, level, &shared.method()))
+                .collect::<Vec<_>>()
+        },
+        || {
+            rayon::join(
+                || {
+                    let mut j = fit_jan_with(data, level, &shared.method());
+                    for f in j.series.iter_mut().flatten().chain(j.global.iter_mut()) {
+                        thin_draws(f);
                     }
-                    let sc = p.scene.with_k(k).ok()?;
-                    let st = model.evaluate(&sc).ok()?;
-                    match model {
-                        Model::Stick => Some(energy::rolling(&sc, &st)),
-                        _ => energy::stickslip(&sc, &st).ok(),
+                    j
+                },
+                || {
+                    let mut j = fit_jaeger_with(data, JaegerBranch::Upper, level, &shared.method());
+                    for f in j.series.iter_mut().flatten() {
+                        thin_draws(&mut f.summary);
                     }
-                })
-                .collect(),
-            None => vec![None; sub.points.len()],
-        };
-        contact.push(ContactFits {
-            model,
-            name,
-            used,
-            data: sub,
-            law_c,
-            free,
-            cos2a_chi2,
-            impact_chi2,
-            energy,
-            notes,
-        });
-    }
+                    j
+                },
+            )
+        },
+    );
     Analysis {
         data: data.clone(),
         level,
         mcmc: matches!(method, Method::Mcmc(_)),
         contact,
-        jan: fit_jan_with(data, level, method),
-        jaeger: fit_jaeger_with(data, JaegerBranch::Upper, level, method),
+        jan,
+        jaeger,
+    }
+}
+
+fn thin_draws(f: &mut FitResult) {
+    if let Some(d) = f.draws.as_mut() {
+        d.thin_to(REPORT_DRAWS);
+    }
+}
+
+/// The laws of one contact model fitted on the points it can make steady.
+fn contact_fits(
+    data: &Dataset,
+    model: Model,
+    name: &'static str,
+    level: f64,
+    method: &Method,
+) -> ContactFits {
+    // Once the stop flag is up, the per-point work is skipped (each fit then ends at once):
+    // the caller, who raised it, does not use a stopped analysis beyond its posteriors.
+    let keep: Vec<bool> = data
+        .points
+        .par_iter()
+        .map(|p| !method.stopped() && bracket(&model, &p.scene).is_ok())
+        .collect();
+    let (sub, used) = data.filter(|i| keep[i]);
+    let mut notes = Vec::new();
+    let dropped = data.points.len() - used.len();
+    if dropped > 0 {
+        notes.push(format!(
+            "{dropped} point(s) have no steady state for any K under the {name} model and \
+             are left out of its fits"
+        ));
+    }
+    let fit = |law: KLaw| {
+        fit_law_with(model, &sub, law, level, method).map(|mut f| {
+            thin_draws(&mut f.summary);
+            f
+        })
+    };
+    let (law_c, free) = rayon::join(|| fit(KLaw::C), || fit(KLaw::FreePerSeries));
+    let mut keep_fit = |law: KLaw, r: Result<KLawFit, _>| match r {
+        Ok(f) => Some(f),
+        Err(e) => {
+            notes.push(format!("{name} law {}: {e}", law.name()));
+            None
+        }
+    };
+    let law_c = keep_fit(KLaw::C, law_c);
+    let free = keep_fit(KLaw::FreePerSeries, free);
+    let m = sub.points.len();
+    let stop = method.stop().cloned();
+    let cos2a_chi2 = KLawProblem::new_until(model, &sub, KLaw::C, stop.clone())
+        .map(|p| chi2_at(&p, &[0.0], m))
+        .unwrap_or((f64::INFINITY, m));
+    let impact_chi2 = KLawProblem::new_until(model, &sub, KLaw::Impact, stop)
+        .map(|p| chi2_at(&p, &[], m))
+        .unwrap_or((f64::INFINITY, m));
+    let energy = match &law_c {
+        Some(f) => sub
+            .points
+            .par_iter()
+            .zip(&f.k)
+            .map(|(p, &k)| {
+                if method.stopped() {
+                    return None;
+                }
+                let sc = p.scene.with_k(k).ok()?;
+                let st = model.evaluate(&sc).ok()?;
+                match model {
+                    Model::Stick => Some(energy::rolling(&sc, &st)),
+                    _ => energy::stickslip(&sc, &st).ok(),
+                }
+            })
+            .collect(),
+        None => vec![None; sub.points.len()],
+    };
+    ContactFits {
+        model,
+        name,
+        used,
+        data: sub,
+        law_c,
+        free,
+        cos2a_chi2,
+        impact_chi2,
+        energy,
+        notes,
+    }
+}
+
+/// A progress sink shared by fits that run concurrently: each fit gets its own sink
+/// ([`Self::method`]), and only the fit holding the shared one (the first to start while it
+/// is free, until it finishes) reaches it.
+struct SharedProgress<'a> {
+    method: &'a Method,
+    holder: Arc<Mutex<Option<usize>>>,
+    next: AtomicUsize,
+}
+
+impl<'a> SharedProgress<'a> {
+    fn of(method: &'a Method) -> Self {
+        SharedProgress {
+            method,
+            holder: Arc::new(Mutex::new(None)),
+            next: AtomicUsize::new(0),
+        }
+    }
+
+    /// The method for one more fit: `method` itself, with its own sink under MCMC.
+    fn method(&self) -> Method {
+        let Method::Mcmc(settings) = self.method else {
+            return self.method.clone();
+        };
+        let Some(outer) = settings.progress.clone() else {
+            return self.method.clone();
+        };
+        let id = self.next.fetch_add(1, Ordering::Relaxed);
+        let holder = Arc::clone(&self.holder);
+        let mut s = settings.clone();
+        s.progress = Some(Progress::new(move |e| {
+            let Ok(mut h) = holder.lock() else { return };
+            match (e, *h) {
+                (ProgressEvent::Start { .. }, None) => {
+                    *h = Some(id);
+                    outer.report(e);
+                }
+                (ProgressEvent::Finish, Some(k)) if k == id => {
+                    *h = None;
+                    outer.report(e);
+                }
+                (ProgressEvent::Position(_), Some(k)) if k == id => outer.report(e),
+                _ => {}
+            }
+        }));
+        Method::Mcmc(s)
     }
 }
 

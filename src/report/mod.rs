@@ -1,8 +1,9 @@
-//! Reports: the comparisons of `fitbead report` ([`analysis`]), the list of its fits ([`fits`]),
-//! its SVG figures ([`figures`]), its text ([`text`])
+//! Reports: the comparisons of `fitbead report` ([`analysis`]) and their posterior bands
+//! ([`bands`]), the list of its fits ([`fits`]), its SVG figures ([`figures`]), its text ([`text`])
 //! and the work-precision engine of `fitbead bench` ([`workprecision`]).
 
 pub mod analysis;
+pub mod bands;
 pub mod figures;
 pub mod fits;
 pub mod text;

@@ -14,7 +14,7 @@
 //!   "Rank-normalization, folding, and localization: an improved R̂ for assessing convergence
 //!   of MCMC", Bayesian Analysis 16, 2021, with Geyer's initial monotone sequence (C. J. Geyer,
 //!   "Practical Markov chain Monte Carlo", Statistical Science 7, 1992), as in Stan and the R
-//!   package `posterior`;
+//!   package `posterior`; [`convergence`] computes the three together, sharing their sorts;
 //! * [`summarise`] — all of the above plus mean, standard deviation and quantiles of the pooled
 //!   draws, per parameter.
 
@@ -160,20 +160,21 @@ pub fn split_chains(chains: &[Vec<f64>]) -> Vec<Vec<f64>> {
 /// Φ⁻¹((r − 3/8)/(S + 1/4)), r its rank among the S pooled draws (ties get their average
 /// rank), Φ the standard normal CDF (Vehtari et al. 2021, eq. 14).
 pub fn rank_normalise(chains: &[Vec<f64>]) -> Vec<Vec<f64>> {
-    let pooled: Vec<f64> = chains.iter().flatten().copied().collect();
-    let s = pooled.len();
-    let mut order: Vec<usize> = (0..s).collect();
-    order.sort_by(|&a, &b| pooled[a].total_cmp(&pooled[b]));
+    // Values with their pooled index, sorted by value (ties in any order: they share their
+    // average rank).
+    let mut order: Vec<(f64, usize)> = chains.iter().flatten().copied().zip(0..).collect();
+    let s = order.len();
+    order.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
     let mut ranks = vec![0.0; s];
     let mut i = 0;
     while i < s {
         let mut j = i;
-        while j + 1 < s && pooled[order[j + 1]] == pooled[order[i]] {
+        while j + 1 < s && order[j + 1].0 == order[i].0 {
             j += 1;
         }
         // 1-based ranks i+1..=j+1 share their average.
         let r = 0.5 * ((i + 1) + (j + 1)) as f64;
-        for &o in &order[i..=j] {
+        for &(_, o) in &order[i..=j] {
             ranks[o] = r;
         }
         i = j + 1;
@@ -230,14 +231,61 @@ pub fn rhat(chains: &[Vec<f64>]) -> f64 {
     if split.first().map_or(0, Vec::len) < 2 {
         return f64::NAN;
     }
-    let bulk = rhat_basic(&rank_normalise(&split));
-    let med = median_pooled(chains);
+    let mut sorted: Vec<f64> = chains.iter().flatten().copied().collect();
+    sorted.sort_by(f64::total_cmp);
+    rhat_ranked(
+        &split,
+        &rank_normalise(&split),
+        quantile_sorted(&sorted, 0.5),
+    )
+}
+
+/// [`rhat`] from the split chains, their rank normalisation and the median of the pooled
+/// draws.
+fn rhat_ranked(split: &[Vec<f64>], ranked: &[Vec<f64>], med: f64) -> f64 {
+    let bulk = rhat_basic(ranked);
     let folded: Vec<Vec<f64>> = split
         .iter()
         .map(|c| c.iter().map(|v| (v - med).abs()).collect())
         .collect();
     let tail = rhat_basic(&rank_normalise(&folded));
     bulk.max(tail)
+}
+
+/// [`rhat`], [`ess_bulk`] and [`ess_tail`] of one scalar quantity, computed together: the
+/// three share one sort of the pooled draws and one rank normalisation of the split chains,
+/// and return exactly what the three functions return on their own.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Convergence {
+    /// Rank-normalised split-R̂.
+    pub rhat: f64,
+    /// Bulk effective sample size.
+    pub ess_bulk: f64,
+    /// Tail effective sample size.
+    pub ess_tail: f64,
+}
+
+/// [`Convergence`] of chains (one vector of draws per chain).
+pub fn convergence(chains: &[Vec<f64>]) -> Convergence {
+    let mut sorted: Vec<f64> = chains.iter().flatten().copied().collect();
+    sorted.sort_by(f64::total_cmp);
+    convergence_sorted(chains, &sorted)
+}
+
+/// [`convergence`] given the pooled draws already sorted.
+fn convergence_sorted(chains: &[Vec<f64>], sorted: &[f64]) -> Convergence {
+    let split = split_chains(chains);
+    let ranked = rank_normalise(&split);
+    let rhat = if split.first().map_or(0, Vec::len) < 2 {
+        f64::NAN
+    } else {
+        rhat_ranked(&split, &ranked, quantile_sorted(sorted, 0.5))
+    };
+    Convergence {
+        rhat,
+        ess_bulk: ess_basic(&ranked),
+        ess_tail: ess_tail_sorted(&split, sorted),
+    }
 }
 
 /// Effective sample size of chains taken as they are (no splitting, no ranks), from the
@@ -314,14 +362,18 @@ pub fn ess_bulk(chains: &[Vec<f64>]) -> f64 {
 /// I(θ ≤ q₀.₀₅) and I(θ ≤ q₀.₉₅) (Vehtari et al. 2021, §4.3), measuring the efficiency of the
 /// 5 % and 95 % quantile estimates.
 pub fn ess_tail(chains: &[Vec<f64>]) -> f64 {
-    let pooled: Vec<f64> = chains.iter().flatten().copied().collect();
-    let mut sorted = pooled;
+    let mut sorted: Vec<f64> = chains.iter().flatten().copied().collect();
     sorted.sort_by(f64::total_cmp);
-    let split = split_chains(chains);
+    ess_tail_sorted(&split_chains(chains), &sorted)
+}
+
+/// [`ess_tail`] from the split chains and the pooled draws (of the chains before splitting)
+/// sorted.
+fn ess_tail_sorted(split: &[Vec<f64>], sorted: &[f64]) -> f64 {
     [0.05, 0.95]
         .iter()
         .map(|&p| {
-            let q = quantile_sorted(&sorted, p);
+            let q = quantile_sorted(sorted, p);
             let ind: Vec<Vec<f64>> = split
                 .iter()
                 .map(|c| c.iter().map(|&v| f64::from(u8::from(v <= q))).collect())
@@ -361,12 +413,6 @@ pub fn quantile_sorted(sorted: &[f64], p: f64) -> f64 {
     sorted[lo] + (h - lo as f64) * (sorted[hi] - sorted[lo])
 }
 
-fn median_pooled(chains: &[Vec<f64>]) -> f64 {
-    let mut sorted: Vec<f64> = chains.iter().flatten().copied().collect();
-    sorted.sort_by(f64::total_cmp);
-    quantile_sorted(&sorted, 0.5)
-}
-
 /// Diagnostics and summary of one parameter over all chains (pooled draws for the moments and
 /// quantiles).
 #[derive(Debug, Clone, PartialEq)]
@@ -402,6 +448,7 @@ pub fn summarise_scalar(chains: &[Vec<f64>], level: f64) -> ParameterDiagnostics
     let mean = sorted.iter().sum::<f64>() / s;
     let sd = (sorted.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (s - 1.0)).sqrt();
     sorted.sort_by(f64::total_cmp);
+    let c = convergence_sorted(chains, &sorted);
     let alpha = 0.5 * (1.0 - level);
     ParameterDiagnostics {
         mean,
@@ -414,9 +461,9 @@ pub fn summarise_scalar(chains: &[Vec<f64>], level: f64) -> ParameterDiagnostics
             quantile_sorted(&sorted, 1.0 - alpha),
         ),
         tau: integrated_time(chains, SOKAL_C),
-        rhat: rhat(chains),
-        ess_bulk: ess_bulk(chains),
-        ess_tail: ess_tail(chains),
+        rhat: c.rhat,
+        ess_bulk: c.ess_bulk,
+        ess_tail: c.ess_tail,
     }
 }
 

@@ -1,0 +1,273 @@
+//! Posterior bands of the mean velocity: for every fit of a posterior analysis
+//! ([`Analysis`] under `--method mcmc`) and every series it covers, the 5 %, 50 % and 95 %
+//! quantiles of the model's v̄(δ) over the posterior draws, on a grid of slopes spanning the
+//! series' measured slopes, and the posterior median of v̄ at each measured point.
+//!
+//! The band is that of the model's v̄ (the posterior of the mean curve): measurement noise is
+//! not added. It uses at most [`BAND_DRAWS`] draws, evenly spaced through the kept draws
+//! (step by step, every walker); a draw under which the model has no steady state at a slope
+//! is left out of the quantiles there.
+//!
+//! v̄ of a draw is the fit's own model at the series' ξ, ρ and f:
+//! - the K(α) laws (`rolling-klaw-c`, `stickslip-klaw-c`, `…-klaw-free-per-series`): the
+//!   contact model's v̄ with K = cos 2α + c sin²α sin 2α (law c) or the series' K;
+//! - Jan (`jan-series`, `jan-global`): eq 74 with the series' λ and μ, or with
+//!   λ = λ0 e^{λ1 sin α}, μ = μ0 e^{μ1 sin α};
+//! - Jaeger (`jaeger`): the root of eq 84 on the fitted branch, v̄ = √(2 cos δ X/ε) (eq 81).
+
+use super::analysis::Analysis;
+use crate::fit::data::{Dataset, Point};
+use crate::fit::jaeger::JaegerModel;
+use crate::fit::jan::{JanGlobal, JanSeries};
+use crate::fit::summary::FitResult;
+use crate::inverse::mcmc::diagnostics::quantile_sorted;
+use crate::inverse::Model as _;
+use crate::models::{ForwardModel, Model};
+use crate::scene::{CollisionLaw, Scene};
+use rayon::prelude::*;
+
+/// Draws used per fit at most.
+pub const BAND_DRAWS: usize = 1000;
+
+/// Slopes of the grid per series (equally spaced in degrees from the smallest measured slope
+/// to the largest).
+pub const BAND_GRID: usize = 41;
+
+/// The band of one fit over one series.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Band {
+    /// The fit, named as in params.csv (`rolling-klaw-c`, `jan-series`, `jaeger`, …).
+    pub fit: String,
+    /// The series label.
+    pub series: String,
+    /// The series' radius ratio ξ.
+    pub xi: f64,
+    /// The slopes of the grid, degrees.
+    pub delta_deg: Vec<f64>,
+    /// 5 % quantile of v̄ at each slope (NaN where no draw has a steady state).
+    pub q05: Vec<f64>,
+    /// Median of v̄ at each slope.
+    pub q50: Vec<f64>,
+    /// 95 % quantile of v̄ at each slope.
+    pub q95: Vec<f64>,
+    /// Draws used.
+    pub draws: usize,
+}
+
+/// The posterior median of one fit's v̄ at one measured point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointMedian {
+    /// The fit, named as in params.csv.
+    pub fit: String,
+    /// The series label.
+    pub series: String,
+    /// Index of the point in the analysis' data set ([`Analysis::data`]).
+    pub point: usize,
+    /// Its slope, degrees.
+    pub delta_deg: f64,
+    /// Posterior median of v̄ there (NaN where no draw has a steady state).
+    pub v_median: f64,
+}
+
+/// Every band and every point median of an analysis.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct PosteriorBands {
+    /// Per fit and series, fits in the order of params.csv.
+    pub bands: Vec<Band>,
+    /// Per fit and measured point the fit used, in the same order.
+    pub points: Vec<PointMedian>,
+}
+
+/// How a fit's draw gives v̄ at a point's ξ, ρ, f and a slope δ (radians); `column` is where
+/// the series' own parameters start in the draw.
+#[derive(Clone, Copy)]
+enum Curve {
+    LawC(Model),
+    FreeK(Model),
+    JanSeries,
+    JanGlobal,
+    Jaeger(JaegerModel),
+}
+
+impl Curve {
+    fn velocity(self, draw: &[f64], column: usize, p: &Point, delta: f64) -> Option<f64> {
+        let s = &p.scene;
+        let contact = |m: Model, law: CollisionLaw| {
+            Scene::from_radians(s.xi(), delta, s.rho(), s.f(), law)
+                .ok()
+                .and_then(|sc| m.evaluate(&sc).ok())
+                .map(|st| st.mean_velocity)
+        };
+        let v = match self {
+            Curve::LawC(m) => contact(m, CollisionLaw::C(draw[0]))?,
+            Curve::FreeK(m) => contact(m, CollisionLaw::Value(draw[column]))?,
+            Curve::JanSeries => JanSeries
+                .value(&(s.sin_alpha(), delta.sin(), delta.cos()), &draw[..2])
+                .ok()?,
+            Curve::JanGlobal => JanGlobal
+                .value(&(s.sin_alpha(), delta.sin(), delta.cos()), &draw[..4])
+                .ok()?,
+            Curve::Jaeger(m) => m
+                .value(&(delta.tan(), delta.cos(), s.eps()), &draw[..3])
+                .ok()?,
+        };
+        v.is_finite().then_some(v)
+    }
+}
+
+/// The posterior bands and point medians of every fit of `an` that kept draws (none under
+/// least squares). See the module docs.
+pub fn posterior_bands(an: &Analysis) -> PosteriorBands {
+    let mut out = PosteriorBands::default();
+    let all: Vec<usize> = (0..an.data.points.len()).collect();
+    for c in &an.contact {
+        let laws = [
+            (&c.law_c, Curve::LawC(c.model)),
+            (&c.free, Curve::FreeK(c.model)),
+        ];
+        for (fit, curve) in laws {
+            if let Some(f) = fit {
+                let name = format!("{}-{}", c.name, f.summary.stats.fit);
+                add(&mut out, &name, &f.summary, curve, &c.data, &c.used, None);
+            }
+        }
+    }
+    for (s, f) in an.jan.series.iter().enumerate() {
+        if let Some(f) = f {
+            add(
+                &mut out,
+                "jan-series",
+                f,
+                Curve::JanSeries,
+                &an.data,
+                &all,
+                Some(s),
+            );
+        }
+    }
+    if let Some(f) = &an.jan.global {
+        add(
+            &mut out,
+            "jan-global",
+            f,
+            Curve::JanGlobal,
+            &an.data,
+            &all,
+            None,
+        );
+    }
+    for (s, f) in an.jaeger.series.iter().enumerate() {
+        if let Some(f) = f {
+            let curve = Curve::Jaeger(JaegerModel(f.branch));
+            add(
+                &mut out,
+                "jaeger",
+                &f.summary,
+                curve,
+                &an.data,
+                &all,
+                Some(s),
+            );
+        }
+    }
+    out
+}
+
+/// Adds the bands and point medians of one fit: `data` is the data set it was fitted on,
+/// `index` maps its points to the analysis' data set, `only` restricts it to one series (a
+/// per-series fit).
+fn add(
+    out: &mut PosteriorBands,
+    name: &str,
+    fit: &FitResult,
+    curve: Curve,
+    data: &Dataset,
+    index: &[usize],
+    only: Option<usize>,
+) {
+    let Some(d) = &fit.draws else { return };
+    let draws = subset(&d.chains);
+    if draws.is_empty() {
+        return;
+    }
+    for (s, label) in data.labels.iter().enumerate() {
+        if only.is_some_and(|o| o != s) {
+            continue;
+        }
+        let pts: Vec<(usize, &Point)> = data
+            .points
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| p.series == s)
+            .collect();
+        let Some(&(_, first)) = pts.first() else {
+            continue;
+        };
+        // The free law's K of this series: the row of parameter K for its label.
+        let column = match curve {
+            Curve::FreeK(_) => match fit.params.iter().position(|r| r.series == *label) {
+                Some(j) => j,
+                None => continue,
+            },
+            _ => 0,
+        };
+        let (lo, hi) = pts.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, p| {
+            (a.0.min(p.1.scene.delta), a.1.max(p.1.scene.delta))
+        });
+        let grid: Vec<f64> = if hi > lo {
+            (0..BAND_GRID)
+                .map(|i| lo + (hi - lo) * i as f64 / (BAND_GRID - 1) as f64)
+                .collect()
+        } else {
+            vec![lo]
+        };
+        // The grid slopes at the series' first point, then every point at its own slope.
+        let at: Vec<(&Point, f64)> = grid
+            .iter()
+            .map(|&g| (first, g))
+            .chain(pts.iter().map(|&(_, p)| (p, p.scene.delta)))
+            .collect();
+        let q: Vec<[f64; 3]> = at
+            .par_iter()
+            .map(|&(p, delta)| {
+                let mut v: Vec<f64> = draws
+                    .iter()
+                    .filter_map(|x| curve.velocity(x, column, p, delta))
+                    .collect();
+                v.sort_by(f64::total_cmp);
+                [0.05, 0.5, 0.95].map(|pr| quantile_sorted(&v, pr))
+            })
+            .collect();
+        let (qg, qp) = q.split_at(grid.len());
+        out.bands.push(Band {
+            fit: name.to_string(),
+            series: label.clone(),
+            xi: first.scene.xi(),
+            delta_deg: grid.iter().map(|g| g.to_degrees()).collect(),
+            q05: qg.iter().map(|r| r[0]).collect(),
+            q50: qg.iter().map(|r| r[1]).collect(),
+            q95: qg.iter().map(|r| r[2]).collect(),
+            draws: draws.len(),
+        });
+        for (&(i, p), r) in pts.iter().zip(qp) {
+            out.points.push(PointMedian {
+                fit: name.to_string(),
+                series: label.clone(),
+                point: index[i],
+                delta_deg: p.scene.delta_deg(),
+                v_median: r[1],
+            });
+        }
+    }
+}
+
+/// At most [`BAND_DRAWS`] draws, evenly spaced through the kept draws taken step by step
+/// (every walker's first kept step, then every walker's second, …).
+fn subset(chains: &[Vec<Vec<f64>>]) -> Vec<&[f64]> {
+    let steps = chains.iter().map(Vec::len).min().unwrap_or(0);
+    let pooled: Vec<&[f64]> = (0..steps)
+        .flat_map(|k| chains.iter().map(move |c| c[k].as_slice()))
+        .collect();
+    let stride = pooled.len().div_ceil(BAND_DRAWS).max(1);
+    pooled.into_iter().step_by(stride).collect()
+}

@@ -1,13 +1,18 @@
-//! Reports: the comparisons of `fitbead report` ([`analysis`]), its SVG figures ([`figures`]), its text ([`text`])
-//! and the work-precision engine of `fitbead bench` ([`workprecision`]).
+//! Reports: the comparisons of `fitbead report` ([`analysis`]), its figures ([`plots`], drawn
+//! with the engine in [`figures`]), its text ([`text`]) and the work-precision engine of
+//! `fitbead bench` ([`workprecision`]).
 
 pub mod analysis;
 pub mod figures;
+pub mod plots;
 pub mod text;
 pub mod workprecision;
 
-/// Every file `fitbead report` may write in its directory.
-pub const REPORT_FILES: [&str; 14] = [
+/// Every file of fixed name `fitbead report` may write in its directory (with `--format png`
+/// or `both`, each figure `NAME.svg` also, or instead, as `NAME.png`; with `--method mcmc`, one
+/// corner plot per posterior, `corner_<fit>_<series>.svg` with the fit named as in
+/// `params.csv`).
+pub const REPORT_FILES: [&str; 17] = [
     "bulk_friction.csv",
     "energy.csv",
     "regime_map.csv",
@@ -20,6 +25,9 @@ pub const REPORT_FILES: [&str; 14] = [
     "jan_linear.svg",
     "k_final_velocity.svg",
     "regime_map.svg",
-    "corner.svg",
+    "jaeger.svg",
+    "k_alpha.svg",
+    "energy.svg",
+    "residuals.svg",
     "report.md",
 ];

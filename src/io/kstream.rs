@@ -360,7 +360,7 @@ impl RowPlan for KPlan {
                 ledger.plot.push(PointSeries {
                     label: label.clone(),
                     points: Vec::new(),
-                    reference: Some((n.cos2a, format!("cos 2α = {:.4}", n.cos2a))),
+                    reference: Some((n.cos2a, format!("K = cos 2α = {:.4}", n.cos2a))),
                 });
                 ledger.labels.insert(label, ledger.plot.len() - 1);
                 ledger.plot.len() - 1

@@ -30,6 +30,8 @@ const GRID_PLOT: (f64, f64) = (430.0, 300.0);
 const SINGLE_PLOT: (f64, f64) = (720.0, 470.0);
 /// Colour of the data where models take the palette.
 const DATA: &str = "#000000";
+/// Spacing in α (degrees) of a series' points on the K(α) figure.
+const SPREAD: f64 = 0.2;
 /// Light grey of reference curves.
 const REFERENCE: &str = "#7f7f7f";
 
@@ -267,11 +269,13 @@ impl Analysis {
         .to_svg())
     }
 
-    /// K per point (eq 69) under `model`, per series: (final velocity, α, K, K_lo, K_hi).
+    /// K per point (eq 69) under `model`, per series in the order of the slopes: (final
+    /// velocity, α in degrees, K, K_lo, K_hi).
     fn k_points(&self, model: Model) -> Vec<Vec<(f64, f64, f64, f64, f64)>> {
         (0..self.data.labels.len())
             .map(|s| {
-                let pts: Vec<_> = self.data.series(s).collect();
+                let mut pts: Vec<_> = self.data.series(s).collect();
+                pts.sort_by(|a, b| a.scene.delta.total_cmp(&b.scene.delta));
                 pts.par_iter()
                     .filter_map(|p| {
                         let sg = (self.data.sigma == SigmaKind::Absolute).then_some(p.sigma);
@@ -303,7 +307,7 @@ impl Analysis {
                 PointSeries {
                     label: self.series_title(s),
                     points: pts.iter().map(|q| (q.0, q.2, q.3, q.4)).collect(),
-                    reference: Some((c2, format!("cos 2α = {c2:.4}"))),
+                    reference: Some((c2, format!("K = cos 2α = {c2:.4}"))),
                 }
             })
             .collect();
@@ -365,8 +369,13 @@ impl Analysis {
             }
             for (s, pts) in ks.iter().enumerate() {
                 let (colour, mark) = series_style(s);
+                // The points of a series share α: spread by slope, SPREAD° apart.
+                let mid = (pts.len() as f64 - 1.0) / 2.0;
                 p.points(
-                    pts.iter().map(|q| (q.1, q.2, q.3, q.4)).collect(),
+                    pts.iter()
+                        .enumerate()
+                        .map(|(i, q)| (q.1 + (i as f64 - mid) * SPREAD, q.2, q.3, q.4))
+                        .collect(),
                     colour,
                     mark,
                 );
@@ -380,6 +389,10 @@ impl Analysis {
             panels,
         );
         f.legend = legend;
+        f.notes.push(format!(
+            "The points of a series share one α: they are spread {SPREAD}° apart in the order \
+             of their slopes."
+        ));
         Ok(f.to_svg())
     }
 
@@ -405,8 +418,12 @@ impl Analysis {
             let law = CollisionLaw::C(cv);
             // (α in degrees, lower limit, upper limit) in degrees; NaN where no steady range.
             let (limits, crit): (Vec<(f64, f64, f64)>, Option<f64>) = match c.model {
-                Model::Stick => (
-                    xis.iter()
+                Model::Stick => {
+                    let crit = critical_xi(law, rho);
+                    let mut grid = xis.clone();
+                    grid.extend(crit);
+                    grid.sort_by(f64::total_cmp);
+                    (grid.iter()
                         .map(|&xi| {
                             let a = alpha_of_xi(xi);
                             (
@@ -416,8 +433,8 @@ impl Analysis {
                             )
                         })
                         .collect(),
-                    critical_xi(law, rho),
-                ),
+                    crit)
+                }
                 model => scanned_limits(&model, &xis, rho, f, law),
             };
             let mut p = Panel::new(
@@ -425,7 +442,13 @@ impl Analysis {
                 Axis::new("contact angle α (°)"),
                 Axis::new(DELTA_LABEL),
             );
-            shade_regimes(&mut p, &limits, crit, c.model == Model::Stick);
+            let data_alpha: Vec<f64> = self
+                .data
+                .points
+                .iter()
+                .map(|q| q.scene.alpha.to_degrees())
+                .collect();
+            shade_regimes(&mut p, &limits, crit, c.model == Model::Stick, &data_alpha);
             if c.model == Model::Stick {
                 // The paper's adjusted law, for reference.
                 let adj = CollisionLaw::Adjusted;
@@ -490,7 +513,7 @@ impl Analysis {
         let fit_stroke = Stroke::solid(PALETTE[3], 2.2);
         let lower_stroke = Stroke::solid(PALETTE[3], 2.2).dashed(DASHES[0]);
         let paper_stroke = Stroke::solid(REFERENCE, 1.6).dashed(DASHES[1]);
-        let mut any_paper = false;
+        let (mut any_paper, mut any_lower) = (false, false);
         let mut panels = Vec::new();
         for s in 0..self.data.labels.len() {
             let p0 = self.data.series(s).next().expect("points").scene;
@@ -507,14 +530,23 @@ impl Analysis {
                 Axis::new("tan δ"),
                 Axis::new("Jaeger's velocity u = v / √(2gr cos δ)"),
             );
+            // tan δ from the data's least to 1.2 times their largest (curves beyond are cut).
+            let t0 = pts.iter().map(|q| q.0).fold(f64::INFINITY, f64::min);
+            let t1 = pts.iter().map(|q| q.0).fold(f64::NEG_INFINITY, f64::max);
+            let mut lo = t0;
             if let Some(j) = &self.jaeger.series[s] {
                 let a: Vec<f64> = j.summary.params.iter().take(3).map(lsq).collect();
-                jaeger_law(&mut p, [a[0], a[1], a[2]], umax, &fit_stroke, &lower_stroke, true);
+                lo = lo.min(a[0].min(t0));
+                any_lower |=
+                    jaeger_law(&mut p, [a[0], a[1], a[2]], umax, &fit_stroke, &lower_stroke, true);
             }
             if let Some(pv) = paper_values(p0.xi) {
                 any_paper = true;
+                lo = lo.min(pv[0]);
                 jaeger_law(&mut p, pv, umax, &paper_stroke, &paper_stroke, false);
             }
+            p.x.range = Some((lo - 0.06 * (t1 - lo), t1 + 0.2 * (t1 - lo)));
+            p.y.range = Some((0.0, umax));
             p.points(pts, DATA, Mark::Circle);
             panels.push(p);
         }
@@ -527,9 +559,18 @@ impl Analysis {
         f.legend = vec![
             LegendEntry::mark("data", Mark::Circle, DATA),
             LegendEntry::line("fit, upper branch of eq 84", &fit_stroke),
-            LegendEntry::line("fit, lower branch", &lower_stroke),
-            LegendEntry::patch("bistable band (eq 90)", PALETTE[3], 0.15),
         ];
+        if any_lower {
+            f.legend.extend([
+                LegendEntry::line("fit, lower branch", &lower_stroke),
+                LegendEntry::patch("bistable band of the fit (eq 90)", PALETTE[3], 0.15),
+            ]);
+        } else {
+            f.notes.push(
+                "No fit has a bistable band: each has a_{1}a_{2} ≤ a_{3} (eq 82), one branch only."
+                    .into(),
+            );
+        }
         if any_paper {
             f.legend
                 .push(LegendEntry::line("the paper's Fig. 9 values", &paper_stroke));
@@ -790,8 +831,15 @@ fn regime_legend() -> Vec<LegendEntry> {
 
 /// Shades regions A, B, C between `limits` (α°, lower δ°, upper δ°) and marks the critical
 /// ξ; `crossing` when the limits are curves that cross (rolling's δ_m and δ_d, drawn over
-/// the whole range) rather than ends of a steady interval (NaN where there is none).
-fn shade_regimes(p: &mut Panel, limits: &[(f64, f64, f64)], crit: Option<f64>, crossing: bool) {
+/// the whole range) rather than ends of a steady interval (NaN where there is none). The
+/// region letters keep away from the α (degrees) in `avoid`.
+fn shade_regimes(
+    p: &mut Panel,
+    limits: &[(f64, f64, f64)],
+    crit: Option<f64>,
+    crossing: bool,
+    avoid: &[f64],
+) {
     let top = limits
         .iter()
         .flat_map(|l| [l.1, l.2])
@@ -804,7 +852,7 @@ fn shade_regimes(p: &mut Panel, limits: &[(f64, f64, f64)], crit: Option<f64>, c
     p.y.range = Some((0.0, top));
     let steady: Vec<&(f64, f64, f64)> = limits
         .iter()
-        .filter(|l| l.1.is_finite() && l.2.is_finite() && l.1 < l.2)
+        .filter(|l| l.1.is_finite() && l.2.is_finite() && l.1 <= l.2 + 1e-9)
         .collect();
     let region = |k: usize, pts: Vec<(f64, f64)>| Item::Fill {
         pts,
@@ -823,15 +871,34 @@ fn shade_regimes(p: &mut Panel, limits: &[(f64, f64, f64)], crit: Option<f64>, c
         p.items.push(region(0, a));
         p.items.push(region(1, b));
         p.items.push(region(2, c));
-        // Region letters at the middle of the steady range.
-        let m = steady[steady.len() / 2];
-        for (y, t) in [
-            (0.45 * m.1, "A"),
-            (0.5 * (m.1 + m.2), "B"),
-            (0.5 * (m.2 + top), "C"),
+        // Each letter where its region is tallest, inside the inner 80 % of the steady
+        // range and, where possible, 2.5° or more from the data's α.
+        let (s0, s1) = (steady[0].0, steady[steady.len() - 1].0);
+        let inner: Vec<&(f64, f64, f64)> = steady
+            .iter()
+            .copied()
+            .filter(|l| (l.0 - s0).abs() >= 0.1 * (s1 - s0).abs())
+            .filter(|l| (l.0 - s1).abs() >= 0.1 * (s1 - s0).abs())
+            .collect();
+        let clear = |l: &&(f64, f64, f64)| avoid.iter().all(|a| (a - l.0).abs() >= 2.5);
+        let by = |f: &dyn Fn(&(f64, f64, f64)) -> f64| -> (f64, f64, f64) {
+            let best = |it: &mut dyn Iterator<Item = &&(f64, f64, f64)>| {
+                it.max_by(|a, b| f(a).total_cmp(&f(b))).map(|l| **l)
+            };
+            best(&mut inner.iter().filter(|l| clear(l)))
+                .or_else(|| best(&mut inner.iter()))
+                .unwrap_or(*steady[steady.len() / 2])
+        };
+        let a = by(&|l| l.1);
+        let b = by(&|l| l.2 - l.1);
+        let c = by(&|l| top - l.2);
+        for (x, y, t) in [
+            (a.0, 0.4 * a.1, "A"),
+            (b.0, 0.5 * (b.1 + b.2), "B"),
+            (c.0, 0.5 * (c.2 + top), "C"),
         ] {
             p.items.push(Item::Text {
-                at: (m.0, y),
+                at: (x, y),
                 text: t.into(),
                 anchor: Anchor::Middle,
                 colour: "#000000".into(),
@@ -908,13 +975,29 @@ fn scanned_limits(
             Some(hi.exp())
         }
     };
+    // The steady interval at the critical ξ closes the shaded regions there.
+    let mut lims = lims;
+    if let Some(xc) = crit {
+        if let Some((lo, hi)) = regime_b_interval(model, xc, rho, f, law) {
+            let a = alpha_of_xi(xc).to_degrees();
+            lims.push((a, lo.to_degrees(), hi.to_degrees()));
+            lims.sort_by(|p, q| q.0.total_cmp(&p.0));
+        }
+    }
     (lims, crit)
 }
 
 /// Jaeger's law with coefficients `a` in Jaeger's plane: tan δ(u) (eq 83) drawn as u against
 /// tan δ, split at the minimum of tan δ(u) into the upper (`upper`) and lower (`lower`)
-/// branches of eq 84, and, when `band`, the bistable band of eq 90 shaded.
-fn jaeger_law(p: &mut Panel, a: [f64; 3], umax: f64, upper: &Stroke, lower: &Stroke, band: bool) {
+/// branches of eq 84, and, when `band`, the bistable band of eq 90 shaded. Returns whether the law has a lower branch.
+fn jaeger_law(
+    p: &mut Panel,
+    a: [f64; 3],
+    umax: f64,
+    upper: &Stroke,
+    lower: &Stroke,
+    band: bool,
+) -> bool {
     let [a1, a2, a3] = a;
     let t = |u: f64| a3 * u * u + a1 / (1.0 + a2 * u * u);
     // d tan δ/du = 0 at u*² = (sqrt(a1 a2/a3) − 1)/a2 when a1 a2 > a3 (eq 82).
@@ -944,4 +1027,5 @@ fn jaeger_law(p: &mut Panel, a: [f64; 3], umax: f64, upper: &Stroke, lower: &Str
         p.curve(sample(0.0, ustar), lower.clone());
     }
     p.curve(sample(ustar, umax), upper.clone());
+    ustar > 0.0
 }

@@ -58,6 +58,8 @@ pub fn scatter_panel(fig: &Scatter) -> Panel {
     let mut p = Panel::new("", Axis::new(&fig.x_label), Axis::new(&fig.y_label));
     for (i, s) in fig.series.iter().enumerate() {
         let (colour, mark) = series_style(i);
+        p.points(s.points.clone(), colour, mark);
+        p.legend.push(LegendEntry::mark(&s.label, mark, colour));
         if let Some((y, label)) = &s.reference {
             let st = Stroke::solid(colour, 1.5).dashed(DASHES[0]);
             p.items.push(Item::HLine {
@@ -66,8 +68,6 @@ pub fn scatter_panel(fig: &Scatter) -> Panel {
             });
             p.legend.push(LegendEntry::line(label, &st));
         }
-        p.points(s.points.clone(), colour, mark);
-        p.legend.push(LegendEntry::mark(&s.label, mark, colour));
     }
     p
 }

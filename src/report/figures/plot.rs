@@ -427,7 +427,7 @@ fn ticks(axis: &Axis, lo: f64, hi: f64, target: usize) -> Vec<(f64, String)> {
 
 /// A tick label with the decimals `step` needs, and a true minus sign.
 fn linear_label(v: f64, step: f64) -> String {
-    let dec = (-(step.log10() - 1e-9).floor()).max(0.0) as usize;
+    let dec = (-(step.log10() + 1e-9).floor()).max(0.0) as usize;
     let dec = if (step * 10f64.powi(dec as i32)).fract().abs() > 1e-6 {
         dec + 1
     } else {
@@ -1049,7 +1049,22 @@ impl Figure {
             .iter()
             .map(|n| text_width(n, LEGEND_SIZE) + 4.0 * GAP)
             .fold(0.0, f64::max);
-        let width = (grid_w + if lw > 0.0 { lw + 3.0 * GAP } else { GAP })
+        // The shared legend goes into the empty cells that end the last row when it fits
+        // there, else to the right of the grid.
+        let used = self.panels.len() - (rows - 1) * cols;
+        let in_cells = (lw > 0.0 && used < cols).then(|| {
+            let x0 = xs[used] - left[used];
+            let y0 = ys[rows - 1] - top[rows - 1];
+            (x0 + 2.0 * GAP, y0 + top[rows - 1], grid_w - x0, h + bottom[rows - 1])
+        });
+        let legend_at = match in_cells {
+            Some((x, y, aw, ah)) if lw + 2.0 * GAP <= aw && lh <= ah => Some((x, y)),
+            _ if lw > 0.0 => None,
+            _ => Some((0.0, 0.0)),
+        };
+        let extra = if legend_at.is_none() { lw + 3.0 * GAP } else { GAP };
+        let legend_at = legend_at.unwrap_or((grid_w + GAP, ys[0]));
+        let width = (grid_w + extra)
             .max(notes_w)
             .max(text_width(&self.title, TITLE_SIZE) + 4.0 * GAP);
         let height = (y + notes_h + GAP).max(title_h + lh + 2.0 * GAP);
@@ -1057,7 +1072,7 @@ impl Figure {
             lays,
             xs,
             ys,
-            grid_w,
+            legend_at,
             grid_h: y,
             width,
             height,
@@ -1095,8 +1110,7 @@ impl Figure {
             p.draw(svg, l, f, (g.xs[c] + w + 2.0 * GAP, g.ys[r]));
         }
         if !self.legend.is_empty() {
-            let top = g.ys.first().copied().unwrap_or(0.0);
-            draw_legend(svg, &self.legend, g.grid_w + GAP, top);
+            draw_legend(svg, &self.legend, g.legend_at.0, g.legend_at.1);
         }
         for (k, n) in self.notes.iter().enumerate() {
             let yy = g.grid_h + (k as f64) * (line_height(LEGEND_SIZE) + 2.0) + ascent(LEGEND_SIZE);
@@ -1132,7 +1146,7 @@ struct Grid {
     lays: Vec<Option<Layout>>,
     xs: Vec<f64>,
     ys: Vec<f64>,
-    grid_w: f64,
+    legend_at: (f64, f64),
     grid_h: f64,
     width: f64,
     height: f64,

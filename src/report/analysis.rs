@@ -1030,7 +1030,6 @@ impl Analysis {
         }
         v
     }
-
 }
 
 /// One candidate model of the ranking.

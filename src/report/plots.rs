@@ -15,7 +15,9 @@ use crate::fit::k::estimate;
 use crate::fit::summary::FitResult;
 use crate::inverse::{Model as _, SigmaKind};
 use crate::io::fmt_sig;
-use crate::models::regimes::{alpha_of_xi, critical_xi, delta_d_law, delta_m_law, regime_b_interval};
+use crate::models::regimes::{
+    alpha_of_xi, critical_xi, delta_d_law, delta_m_law, regime_b_interval,
+};
 use crate::models::{ForwardModel, JaegerBranch, Model};
 use crate::scene::CollisionLaw;
 use rayon::prelude::*;
@@ -85,7 +87,12 @@ impl Analysis {
     /// The fitted v̄(δ) of each velocity model for series `s` on `grid` (radians), as
     /// (δ in degrees, v̄) with NaN where a model has no steady state.
     fn model_curves(&self, s: usize, grid: &[f64]) -> [Vec<(f64, f64)>; 4] {
-        let s0 = self.data.series(s).next().expect("a series has points").scene;
+        let s0 = self
+            .data
+            .series(s)
+            .next()
+            .expect("a series has points")
+            .scene;
         let none = || grid.iter().map(|&d| (d.to_degrees(), f64::NAN)).collect();
         let contact = |i: usize| -> Vec<(f64, f64)> {
             let Some(c) = self.contact.get(i) else {
@@ -97,10 +104,11 @@ impl Analysis {
             let k = k_of_c(s0.alpha, lsq(r));
             grid.par_iter()
                 .map(|&d| {
-                    let v = crate::Scene::from_radians(s0.xi, d, s0.rho, s0.f, CollisionLaw::Value(k))
-                        .ok()
-                        .and_then(|sc| c.model.evaluate(&sc).ok())
-                        .map_or(f64::NAN, |st| st.mean_velocity);
+                    let v =
+                        crate::Scene::from_radians(s0.xi, d, s0.rho, s0.f, CollisionLaw::Value(k))
+                            .ok()
+                            .and_then(|sc| c.model.evaluate(&sc).ok())
+                            .map_or(f64::NAN, |st| st.mean_velocity);
                     (d.to_degrees(), v)
                 })
                 .collect()
@@ -239,16 +247,18 @@ impl Analysis {
         );
         for s in 0..self.data.labels.len() {
             let (colour, mark) = series_style(s);
-            let pts = self.series_points(s, |q, v| {
-                (q.scene.delta.tan(), v * v / q.scene.delta.cos())
-            });
+            let pts =
+                self.series_points(s, |q, v| (q.scene.delta.tan(), v * v / q.scene.delta.cos()));
             let stroke = Stroke::solid(colour, 2.0);
             if let Some(j) = &self.jan.series[s] {
                 let (l, m) = (lsq(&j.params[0]), lsq(&j.params[1]));
                 let sa = self.data.series(s).next().expect("points").scene.sin_alpha;
                 let t1 = pts.iter().map(|q| q.0).fold(f64::NEG_INFINITY, f64::max) * 1.04;
                 // v̄²/cos δ = (2 sin α/λ)(tan δ − μ): a straight line from tan δ = μ (eq 74).
-                p.curve(vec![(m, 0.0), (t1, 2.0 * sa / l * (t1 - m))], stroke.clone());
+                p.curve(
+                    vec![(m, 0.0), (t1, 2.0 * sa / l * (t1 - m))],
+                    stroke.clone(),
+                );
                 p.legend.push(LegendEntry::mark_line(
                     &format!("{}: data, Jan's line", self.series_title(s)),
                     mark,
@@ -411,7 +421,11 @@ impl Analysis {
         let reg = self.point_regimes();
         let mut panels = Vec::new();
         for (ci, c) in self.contact.iter().enumerate() {
-            let Some(cv) = c.law_c.as_ref().and_then(|f| f.summary.params.first()).map(lsq)
+            let Some(cv) = c
+                .law_c
+                .as_ref()
+                .and_then(|f| f.summary.params.first())
+                .map(lsq)
             else {
                 continue;
             };
@@ -423,17 +437,19 @@ impl Analysis {
                     let mut grid = xis.clone();
                     grid.extend(crit);
                     grid.sort_by(f64::total_cmp);
-                    (grid.iter()
-                        .map(|&xi| {
-                            let a = alpha_of_xi(xi);
-                            (
-                                a.to_degrees(),
-                                delta_m_law(a, law, rho).to_degrees(),
-                                delta_d_law(a, law, rho).to_degrees(),
-                            )
-                        })
-                        .collect(),
-                    crit)
+                    (
+                        grid.iter()
+                            .map(|&xi| {
+                                let a = alpha_of_xi(xi);
+                                (
+                                    a.to_degrees(),
+                                    delta_m_law(a, law, rho).to_degrees(),
+                                    delta_d_law(a, law, rho).to_degrees(),
+                                )
+                            })
+                            .collect(),
+                        crit,
+                    )
                 }
                 model => scanned_limits(&model, &xis, rho, f, law),
             };
@@ -537,8 +553,14 @@ impl Analysis {
             if let Some(j) = &self.jaeger.series[s] {
                 let a: Vec<f64> = j.summary.params.iter().take(3).map(lsq).collect();
                 lo = lo.min(a[0].min(t0));
-                any_lower |=
-                    jaeger_law(&mut p, [a[0], a[1], a[2]], umax, &fit_stroke, &lower_stroke, true);
+                any_lower |= jaeger_law(
+                    &mut p,
+                    [a[0], a[1], a[2]],
+                    umax,
+                    &fit_stroke,
+                    &lower_stroke,
+                    true,
+                );
             }
             if let Some(pv) = paper_values(p0.xi) {
                 any_paper = true;
@@ -572,8 +594,10 @@ impl Analysis {
             );
         }
         if any_paper {
-            f.legend
-                .push(LegendEntry::line("the paper's Fig. 9 values", &paper_stroke));
+            f.legend.push(LegendEntry::line(
+                "the paper's Fig. 9 values",
+                &paper_stroke,
+            ));
         }
         Ok(f.to_svg())
     }
@@ -637,7 +661,7 @@ impl Analysis {
                         .iter()
                         .map(|(d, f)| {
                             let base: f64 = f[..k].iter().sum();
-                            (d - half, d + half, base, base + f[k], 0.9)
+                            (d - half, d + half, base, base + f[k], 1.0)
                         })
                         .collect();
                     p.items.push(Item::Rects {
@@ -656,7 +680,7 @@ impl Analysis {
         );
         f.legend = parts
             .iter()
-            .map(|(l, c)| LegendEntry::patch(l, c, 0.9))
+            .map(|(l, c)| LegendEntry::patch(l, c, 1.0))
             .collect();
         Ok(f.to_svg())
     }
@@ -667,7 +691,10 @@ impl Analysis {
         let mut out = Vec::new();
         for c in &self.contact {
             for f in c.law_c.iter().chain(c.free.iter()) {
-                out.push((format!("{}-{}", c.name, f.summary.stats.fit), vec![&f.summary]));
+                out.push((
+                    format!("{}-{}", c.name, f.summary.stats.fit),
+                    vec![&f.summary],
+                ));
             }
         }
         let jan: Vec<&FitResult> = self.jan.series.iter().flatten().collect();
@@ -761,7 +788,10 @@ impl Analysis {
         for (name, fits) in self.named_fits() {
             for f in fits {
                 if let Some(mut b) = CornerBlock::from_posterior(f) {
-                    b.title = format!("{} [{}]", fit_title(&name), f.stats.series);
+                    b.title = fit_title(&name).replace(", per series", "");
+                    if f.stats.series != "all" {
+                        b.title.push_str(&format!(", series {}", f.stats.series));
+                    }
                     if f.draws.as_ref().is_some_and(|d| d.interrupted) {
                         b.title.push_str(" (interrupted)");
                     }

@@ -770,7 +770,9 @@ pub fn plot(rows: &[WpRow], title: &str) -> Result<String, String> {
             colour,
             mark,
         );
-        panel.legend.push(LegendEntry::mark_line(&label, mark, &stroke));
+        panel
+            .legend
+            .push(LegendEntry::mark_line(&label, mark, &stroke));
     }
     // Every entry outside the data: the legend goes to the figure.
     let legend = std::mem::take(&mut panel.legend);

@@ -66,6 +66,8 @@ const BINS: usize = 36;
 const CELLS: usize = 30;
 /// Draws drawn as points per pair panel at most.
 pub const MAX_POINTS: usize = 400;
+/// Steps of shading of the two-dimensional density.
+const SHADES: usize = 8;
 /// Probability mass inside the 1σ and 2σ contours of a two-dimensional normal,
 /// 1 − e^{−k²/2} for k = 1, 2.
 pub const CONTOUR_MASS: [f64; 2] = [0.393_469_340_287_366_6, 0.864_664_716_763_387_3];
@@ -349,13 +351,27 @@ fn pair(x: &[f64], y: &[f64], xr: (f64, f64), yr: (f64, f64), xa: Axis, ya: Axis
     let lv = levels(&d);
     let peak = d.iter().flatten().copied().fold(0.0, f64::max);
     let (dx, dy) = ((xr.1 - xr.0) / CELLS as f64, (yr.1 - yr.0) / CELLS as f64);
+    // Cells inside the outer contour, shaded in SHADES steps of density; a run of cells of
+    // one shade along x is one rectangle.
+    let shade = |v: f64| -> Option<usize> {
+        (peak > 0.0 && v >= lv[1])
+            .then(|| ((v / peak * SHADES as f64).ceil() as usize).clamp(1, SHADES))
+    };
     let mut rects = Vec::new();
     for (j, row) in d.iter().enumerate() {
-        for (i, &v) in row.iter().enumerate() {
-            if peak > 0.0 && v >= lv[1] {
-                let (a, b) = (xr.0 + i as f64 * dx, yr.0 + j as f64 * dy);
-                rects.push((a, a + dx, b, b + dy, 0.12 + 0.5 * v / peak));
+        let mut i = 0;
+        while i < CELLS {
+            let Some(k) = shade(row[i]) else {
+                i += 1;
+                continue;
+            };
+            let start = i;
+            while i < CELLS && shade(row[i]) == Some(k) {
+                i += 1;
             }
+            let (a, b) = (xr.0 + start as f64 * dx, yr.0 + j as f64 * dy);
+            let e = xr.0 + i as f64 * dx;
+            rects.push((a, e, b, b + dy, 0.12 + 0.5 * k as f64 / SHADES as f64));
         }
     }
     let mut p = Panel::new("", xa, ya);
@@ -378,16 +394,10 @@ fn pair(x: &[f64], y: &[f64], xr: (f64, f64), yr: (f64, f64), xa: Axis, ya: Axis
         .map(|(a, b)| (*a, *b))
         .collect();
     let stride = outside.len().div_ceil(MAX_POINTS).max(1);
-    p.items.push(Item::Points {
-        pts: outside
-            .iter()
-            .step_by(stride)
-            .map(|&(a, b)| (a, b, f64::NAN, f64::NAN))
-            .collect(),
+    p.items.push(Item::Dots {
+        pts: outside.iter().step_by(stride).copied().collect(),
         colour: DRAWS.to_string(),
-        mark: Mark::Circle,
-        radius: 1.2,
-        fill_opacity: 0.6,
+        radius: 1.3,
     });
     for l in lv {
         if l.is_finite() && l > 0.0 {

@@ -17,8 +17,8 @@ pub mod svg;
 
 pub use corner::{corner_svg, CornerBlock};
 pub use plot::{
-    coincide, stack_svg, Axis, ErrPoint, Figure, Item, LegendEntry, Panel, Scale, Swatch,
-    DASHES, PALETTE,
+    coincide, stack_svg, Axis, ErrPoint, Figure, Item, LegendEntry, Panel, Scale, Swatch, DASHES,
+    PALETTE,
 };
 pub use svg::{Anchor, Mark, Stroke, MARKS};
 

@@ -125,6 +125,15 @@ pub enum Item {
         /// Opacity of the marker's fill (its outline is opaque).
         fill_opacity: f64,
     },
+    /// Small filled dots, many of them (one path in the document).
+    Dots {
+        /// Centres.
+        pts: Vec<(f64, f64)>,
+        /// Colour.
+        colour: String,
+        /// Radius, px.
+        radius: f64,
+    },
     /// A shaded band between two curves over x: (x, y_low, y_high) samples (a posterior
     /// band under a curve, say).
     Band {
@@ -311,7 +320,7 @@ impl Panel {
         };
         for it in &self.items {
             match it {
-                Item::Curve { pts, .. } | Item::Fill { pts, .. } => {
+                Item::Curve { pts, .. } | Item::Fill { pts, .. } | Item::Dots { pts, .. } => {
                     for p in pts {
                         add(if pick_x { p.0 } else { p.1 });
                     }
@@ -684,6 +693,12 @@ impl Panel {
                         o.segment(loc(s[0]), loc(s[1]), 3.0);
                     }
                 }
+                Item::Dots { pts, radius, .. } => {
+                    for &p in pts {
+                        let c = loc(p);
+                        o.mark(c.0, c.1, radius + 1.0);
+                    }
+                }
                 Item::Points { pts, radius, .. } => {
                     for p in pts {
                         let c = loc((p.0, p.1));
@@ -825,6 +840,17 @@ impl Panel {
             }
         }
         for it in &self.items {
+            if let Item::Dots {
+                pts,
+                colour,
+                radius,
+            } = it
+            {
+                let px: Vec<(f64, f64)> = pts.iter().map(|&p| f.p(p)).collect();
+                svg.dots(&px, *radius, colour);
+            }
+        }
+        for it in &self.items {
             if let Item::Points {
                 pts,
                 colour,
@@ -842,8 +868,7 @@ impl Panel {
                 }
                 for p in pts {
                     let (x, lo, hi) = (f.px(p.0), f.py(p.2), f.py(p.3));
-                    if x.is_finite() && lo.is_finite() && hi.is_finite() && (lo - hi).abs() > 0.5
-                    {
+                    if x.is_finite() && lo.is_finite() && hi.is_finite() && (lo - hi).abs() > 0.5 {
                         let cap = 4.0;
                         svg.segments(
                             &[
@@ -972,10 +997,10 @@ impl Figure {
         }
     }
 
-    /// Width and height of the figure, px.
+    /// Width and height of the figure, whole px.
     pub fn size(&self) -> (f64, f64) {
         let g = self.grid();
-        (g.width, g.height)
+        (g.width.ceil(), g.height.ceil())
     }
 
     fn grid(&self) -> Grid {
@@ -1055,14 +1080,23 @@ impl Figure {
         let in_cells = (lw > 0.0 && used < cols).then(|| {
             let x0 = xs[used] - left[used];
             let y0 = ys[rows - 1] - top[rows - 1];
-            (x0 + 2.0 * GAP, y0 + top[rows - 1], grid_w - x0, h + bottom[rows - 1])
+            (
+                x0 + 2.0 * GAP,
+                y0 + top[rows - 1],
+                grid_w - x0,
+                h + bottom[rows - 1],
+            )
         });
         let legend_at = match in_cells {
             Some((x, y, aw, ah)) if lw + 2.0 * GAP <= aw && lh <= ah => Some((x, y)),
             _ if lw > 0.0 => None,
             _ => Some((0.0, 0.0)),
         };
-        let extra = if legend_at.is_none() { lw + 3.0 * GAP } else { GAP };
+        let extra = if legend_at.is_none() {
+            lw + 3.0 * GAP
+        } else {
+            GAP
+        };
         let legend_at = legend_at.unwrap_or((grid_w + GAP, ys[0]));
         let width = (grid_w + extra)
             .max(notes_w)
@@ -1165,7 +1199,11 @@ pub fn coincide(a: &[(f64, f64)], b: &[(f64, f64)], tol: f64) -> bool {
             if !inside || !(p.1.is_finite() && q.1.is_finite()) {
                 return None;
             }
-            let t = if q.0 == p.0 { 0.0 } else { (x - p.0) / (q.0 - p.0) };
+            let t = if q.0 == p.0 {
+                0.0
+            } else {
+                (x - p.0) / (q.0 - p.0)
+            };
             Some(p.1 + t * (q.1 - p.1))
         })
     };
@@ -1199,13 +1237,25 @@ mod tests {
     fn log_ticks_are_decades() {
         let t = ticks(&Axis::log("x"), -3.2, 1.1, 6);
         let v: Vec<&str> = t.iter().map(|p| p.1.as_str()).collect();
-        assert_eq!(v, ["10^{\u{2212}3}", "10^{\u{2212}2}", "10^{\u{2212}1}", "10^{0}", "10^{1}"]);
+        assert_eq!(
+            v,
+            [
+                "10^{\u{2212}3}",
+                "10^{\u{2212}2}",
+                "10^{\u{2212}1}",
+                "10^{0}",
+                "10^{1}"
+            ]
+        );
     }
 
     #[test]
     fn coincident_curves_are_found() {
         let a: Vec<(f64, f64)> = (0..50).map(|i| (i as f64, (i as f64).sqrt())).collect();
-        let b: Vec<(f64, f64)> = a.iter().map(|p| (p.0 + 0.5, (p.0 + 0.5).sqrt() + 1e-3)).collect();
+        let b: Vec<(f64, f64)> = a
+            .iter()
+            .map(|p| (p.0 + 0.5, (p.0 + 0.5).sqrt() + 1e-3))
+            .collect();
         assert!(coincide(&a, &b, 0.01));
         let c: Vec<(f64, f64)> = a.iter().map(|p| (p.0, p.1 + 0.5)).collect();
         assert!(!coincide(&a, &c, 0.01));

@@ -33,7 +33,11 @@ pub fn parse(svg: &str) -> Result<usvg::Tree, String> {
 /// pixmap.
 pub fn render_pixmap(svg: &str, scale: f32) -> Result<tiny_skia::Pixmap, String> {
     let tree = parse(svg)?;
-    let size = tree.size().to_int_size().scale_by(scale).ok_or("empty figure")?;
+    let size = tree
+        .size()
+        .to_int_size()
+        .scale_by(scale)
+        .ok_or("empty figure")?;
     let mut pixmap = tiny_skia::Pixmap::new(size.width(), size.height())
         .ok_or_else(|| format!("cannot allocate {}×{} px", size.width(), size.height()))?;
     pixmap.fill(tiny_skia::Color::WHITE);

@@ -318,6 +318,26 @@ impl Svg {
         let _ = writeln!(self.body, "<path d=\"{d}\" {}/>", stroke.attrs());
     }
 
+    /// Filled dots of radius `r`, one path.
+    pub fn dots(&mut self, pts: &[(f64, f64)], r: f64, colour: &str) {
+        let mut d = String::new();
+        let (rs, ds) = (num(r), num(2.0 * r));
+        for p in pts.iter().filter(|p| p.0.is_finite() && p.1.is_finite()) {
+            let _ = write!(
+                d,
+                "M{} {}a{rs} {rs} 0 1 0 {ds} 0a{rs} {rs} 0 1 0 -{ds} 0",
+                num(p.0 - r),
+                num(p.1)
+            );
+        }
+        if !d.is_empty() {
+            let _ = writeln!(
+                self.body,
+                "<path d=\"{d}\" fill=\"{colour}\" stroke=\"none\"/>"
+            );
+        }
+    }
+
     /// A filled polygon.
     pub fn polygon(&mut self, pts: &[(f64, f64)], fill: &str, opacity: f64) {
         if pts.len() < 3 {
@@ -356,7 +376,14 @@ impl Svg {
 
     /// A marker of radius `r` centred at (x, y): outlined in `colour`, filled with it at
     /// `fill_opacity`.
-    pub fn marker(&mut self, mark: Mark, (x, y): (f64, f64), r: f64, colour: &str, fill_opacity: f64) {
+    pub fn marker(
+        &mut self,
+        mark: Mark,
+        (x, y): (f64, f64),
+        r: f64,
+        colour: &str,
+        fill_opacity: f64,
+    ) {
         let style = format!(
             "fill=\"{colour}\" fill-opacity=\"{}\" stroke=\"{colour}\" stroke-width=\"1.5\"",
             num(fill_opacity)

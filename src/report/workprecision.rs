@@ -749,12 +749,11 @@ pub fn plot(rows: &[WpRow], title: &str) -> Result<String, String> {
     );
     for (i, (m, meth)) in groups.iter().enumerate() {
         let (colour, mark) = series_style(i);
-        let mut sel: Vec<(f64, f64, bool)> = pts
+        let sel: Vec<(f64, f64, bool)> = pts
             .iter()
             .filter(|p| p.0.model == *m && p.0.method == *meth)
             .map(|p| (p.1, p.2, p.3))
             .collect();
-        sel.sort_by(|a, b| a.0.total_cmp(&b.0));
         let mut label = if *meth == "auto" || *meth == "quadrature" {
             format!("{m} (tolerances)")
         } else {

@@ -326,3 +326,17 @@ fn bench_plot_renders() {
         &[rgb(PALETTE[0], 1.0), rgb(PALETTE[1], 1.0)],
     );
 }
+
+/// The overlap check sees overlapping text (and not text side by side).
+#[test]
+fn overlap_check_sees_overlapping_text() {
+    let doc = |x2: f64| {
+        format!(
+            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"300\" height=\"60\">\
+             <text x=\"10\" y=\"30\" font-size=\"16\">slope δ</text>\
+             <text x=\"{x2}\" y=\"34\" font-size=\"16\">K</text></svg>"
+        )
+    };
+    assert_eq!(overlapping_texts(&doc(40.0), 0.5).len(), 1);
+    assert!(overlapping_texts(&doc(150.0), 0.5).is_empty());
+}

@@ -391,14 +391,14 @@ fn ticks(axis: &Axis, lo: f64, hi: f64, target: usize) -> Vec<(f64, String)> {
     let target = if axis.ticks > 0 { axis.ticks } else { target }.max(2);
     if axis.scale == Scale::Log {
         let (a, b) = (lo.ceil() as i64, hi.floor() as i64);
-        if b - a >= 1 {
+        if b - a >= 2 {
             let step = (((b - a) as f64 / target as f64).ceil() as i64).max(1);
             return (a..=b)
                 .filter(|k| (k - a) % step == 0)
                 .map(|k| (k as f64, format!("10^{{{}}}", minus(&k.to_string()))))
                 .collect();
         }
-        // Less than a decade: 1, 2, 5 times powers of ten.
+        // Less than two decades: 1, 2, 5 times powers of ten, written out.
         let mut out = Vec::new();
         for k in (lo.floor() as i64)..=(hi.ceil() as i64) {
             for m in [1.0, 2.0, 5.0] {
@@ -1231,6 +1231,13 @@ mod tests {
         let t = ticks(&Axis::new("x"), -2.2, 2.2, 5);
         assert_eq!(t[0].1, "\u{2212}2");
         assert!(t.iter().any(|p| p.1 == "0"));
+    }
+
+    #[test]
+    fn short_log_ranges_get_written_out_ticks() {
+        let t = ticks(&Axis::log("x"), 1.7, 3.75, 6);
+        let v: Vec<&str> = t.iter().map(|p| p.1.as_str()).collect();
+        assert_eq!(v, ["100", "200", "500", "1000", "2000", "5000"]);
     }
 
     #[test]

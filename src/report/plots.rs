@@ -22,6 +22,9 @@ use crate::models::{ForwardModel, JaegerBranch, Model};
 use crate::scene::CollisionLaw;
 use rayon::prelude::*;
 
+/// K per point for the figures: (final velocity, α in degrees, K, K_lo, K_hi).
+type KPoint = (f64, f64, f64, f64, f64);
+
 /// v̄ in its units.
 const V_LABEL: &str = "mean velocity v\u{304} / √(g(R + r))";
 /// δ in degrees.
@@ -281,7 +284,7 @@ impl Analysis {
 
     /// K per point (eq 69) under `model`, per series in the order of the slopes: (final
     /// velocity, α in degrees, K, K_lo, K_hi).
-    fn k_points(&self, model: Model) -> Vec<Vec<(f64, f64, f64, f64, f64)>> {
+    fn k_points(&self, model: Model) -> Vec<Vec<KPoint>> {
         (0..self.data.labels.len())
             .map(|s| {
                 let mut pts: Vec<_> = self.data.series(s).collect();

@@ -31,7 +31,7 @@ impl CornerBlock {
         let draws: Vec<Vec<f64>> = (0..p.params.len())
             .map(|j| d.chains.iter().flatten().map(|x| x[j]).collect())
             .collect();
-        if !draws.first().is_some_and(|v| !v.is_empty()) {
+        if draws.first().is_none_or(|v| v.is_empty()) {
             return None;
         }
         let title = format!("{} [{}]", p.stats.fit, p.stats.series);
@@ -115,7 +115,7 @@ pub fn quantile(sorted: &[f64], q: f64) -> f64 {
 /// decimal place.
 pub fn value_pm(value: f64, err: f64) -> String {
     if !(err.is_finite() && err > 0.0) {
-        return format!("{}", crate::io::fmt_sig(value, 4));
+        return crate::io::fmt_sig(value, 4);
     }
     let dec = (1 - err.log10().floor() as i32).max(0) as usize;
     let s = format!("{value:.dec$} ± {err:.dec$}");
@@ -154,8 +154,8 @@ fn density(x: &[f64], y: &[f64], xr: (f64, f64), yr: (f64, f64)) -> (Grid2, Grid
     let k: Vec<f64> = (-2i32..=2).map(|d| (-0.5 * (d * d) as f64).exp()).collect();
     let blur = |src: &Vec<Vec<f64>>, along_x: bool| {
         let mut out = vec![vec![0.0; CELLS]; CELLS];
-        for j in 0..CELLS {
-            for i in 0..CELLS {
+        for (j, row) in out.iter_mut().enumerate() {
+            for (i, cell) in row.iter_mut().enumerate() {
                 let mut s = 0.0;
                 for (o, w) in k.iter().enumerate() {
                     let d = o as i64 - 2;
@@ -168,7 +168,7 @@ fn density(x: &[f64], y: &[f64], xr: (f64, f64), yr: (f64, f64)) -> (Grid2, Grid
                         s += w * src[jj as usize][ii as usize];
                     }
                 }
-                out[j][i] = s;
+                *cell = s;
             }
         }
         out

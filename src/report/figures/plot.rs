@@ -1196,7 +1196,7 @@ pub fn coincide(a: &[(f64, f64)], b: &[(f64, f64)], tol: f64) -> bool {
         a.windows(2).find_map(|w| {
             let (p, q) = (w[0], w[1]);
             let inside = (p.0 <= x && x <= q.0) || (q.0 <= x && x <= p.0);
-            if !inside || !(p.1.is_finite() && q.1.is_finite()) {
+            if !(inside && p.1.is_finite() && q.1.is_finite()) {
                 return None;
             }
             let t = if q.0 == p.0 {

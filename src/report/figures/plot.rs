@@ -264,7 +264,8 @@ pub struct Panel {
     pub x: Axis,
     /// y axis.
     pub y: Axis,
-    /// Content, drawn in order (shaded items first, whatever their place: see [`Panel::draw`]).
+    /// Content: shading (bands, fills, rectangles) first, then lines, then dots and markers
+    /// with their error bars, then texts, each kind in the order given.
     pub items: Vec<Item>,
     /// The panel's own legend.
     pub legend: Vec<LegendEntry>,

@@ -1,6 +1,7 @@
 //! The SVG writer under every figure: coordinates kept to a hundredth of a pixel, text with
 //! sub- and superscripts, and text measured with the advance widths of the font the document
-//! names first (the embedded DejaVu Sans, [`super::metrics`]).
+//! names first (the embedded DejaVu Sans; the table is generated from the font file by
+//! `scripts/font_metrics.py`).
 //!
 //! The figures are written here rather than through a plotting crate's SVG backend because
 //! that backend (plotters') rounds every coordinate to a whole pixel, which draws smooth

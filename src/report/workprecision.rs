@@ -713,6 +713,48 @@ pub fn render(rows: &[WpRow]) -> csv::Result<Vec<u8>> {
     w.into_inner().map_err(|e| csv::Error::from(e.into_error()))
 }
 
+/// Reads back the rows [`render`] wrote (a `bench --output` file), to re-plot measured rows
+/// without measuring again. An empty error cell reads as NaN, `inf` as infinity.
+pub fn read_rows(csv_bytes: &[u8]) -> Result<Vec<WpRow>, String> {
+    let mut r = csv::Reader::from_reader(csv_bytes);
+    let h = r.headers().map_err(|e| e.to_string())?.clone();
+    if h.iter().collect::<Vec<_>>() != COLUMNS {
+        return Err(format!("expected the columns {}", COLUMNS.join(",")));
+    }
+    let num = |s: &str| -> Result<f64, String> {
+        match s {
+            "" => Ok(f64::NAN),
+            "inf" => Ok(f64::INFINITY),
+            _ => s.parse().map_err(|_| format!("not a number: {s:?}")),
+        }
+    };
+    let opt = |s: &str| -> Result<Option<f64>, String> {
+        if s.is_empty() {
+            Ok(None)
+        } else {
+            num(s).map(Some)
+        }
+    };
+    let mut rows = Vec::new();
+    for rec in r.records() {
+        let rec = rec.map_err(|e| e.to_string())?;
+        rows.push(WpRow {
+            model: rec[0].to_string(),
+            method: rec[1].to_string(),
+            tol: opt(&rec[2])?,
+            scenes: rec[3]
+                .parse()
+                .map_err(|_| format!("not a count: {:?}", &rec[3]))?,
+            err_median: num(&rec[4])?,
+            err_p99: num(&rec[5])?,
+            err_max: num(&rec[6])?,
+            ns_median: opt(&rec[7])?,
+            ns_p99: opt(&rec[8])?,
+        });
+    }
+    Ok(rows)
+}
+
 /// The work-precision diagram on log–log axes: median time per evaluation against maximum
 /// relative error, one curve per model and method (its tolerances joined), single methods as
 /// points, the legend outside the plot. A method that is invalid on some scenes (infinite

@@ -185,6 +185,29 @@ fn corner_plot_of_many_draws_stays_small() {
         &[rgb(PALETTE[0], 1.0), rgb(PALETTE[1], 1.0)],
     );
     assert!(l.width >= 600 && l.height >= 600);
+    // One parameter, and four with long names (one K per series).
+    for names in [vec!["c"], vec!["K[0.8]", "K[1]", "K[1.6]", "K[2]"]] {
+        let n = names.len();
+        let block = CornerBlock {
+            title: "stick/slip, K per series".into(),
+            names: names.iter().map(|s| s.to_string()).collect(),
+            draws: (0..n)
+                .map(|k| {
+                    z.iter()
+                        .map(|d| 0.5 + 0.1 * k as f64 + 0.01 * d[k % 3])
+                        .collect()
+                })
+                .collect(),
+            optimum: (0..n).map(|k| 0.5 + 0.1 * k as f64).collect(),
+        };
+        let svg = corner_figure(&block).to_svg();
+        look(
+            &format!("corner_synthetic_{n}"),
+            &svg,
+            &out_dir().join(format!("corner_synthetic_{n}.png")),
+            &[rgb(PALETTE[0], 1.0), rgb(PALETTE[1], 1.0)],
+        );
+    }
 }
 
 #[test]

@@ -304,12 +304,21 @@ pub fn corner_figure(b: &CornerBlock) -> Figure {
     let mut f = Figure::new(&b.title, n, (210.0, 210.0), Vec::new());
     f.panels = panels;
     let draws: usize = b.draws.first().map_or(0, Vec::len);
-    f.legend = vec![
-        LegendEntry::patch(&format!("posterior ({draws} draws)"), DRAWS, 0.5),
-        LegendEntry::line("1σ and 2σ contours", &Stroke::solid(DRAWS, 1.6)),
+    f.legend = vec![LegendEntry::patch(
+        &format!("posterior ({draws} draws)"),
+        DRAWS,
+        0.5,
+    )];
+    if n > 1 {
+        f.legend.push(LegendEntry::line(
+            "1σ and 2σ contours",
+            &Stroke::solid(DRAWS, 1.6),
+        ));
+    }
+    f.legend.extend([
         LegendEntry::line("16, 50, 84 % quantiles", &q_stroke),
         LegendEntry::mark_line("least-squares optimum", Mark::Square, &opt_stroke),
-    ];
+    ]);
     f
 }
 

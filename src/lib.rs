@@ -46,11 +46,12 @@
 //! | rand, rand_chacha, rand_distr | random streams reproducible from a seed whatever the thread count: the MCMC sampler, simulated data |
 //! | rayon | parallel per-row and per-point work (`forward`, `k`, the K-law fits) |
 //! | csv, serde, ryu | the CSV formats; shortest round-trip printing of floats |
-//! | plotters | the SVG figures |
+//! | resvg (feature `png`, in `cli`) | PNG rendering of the figures, with the embedded font |
 //! | thiserror, tempfile | error types; atomic output files |
 //!
 //! What is hand-written instead, and the measurement that keeps it so, is said where it lives:
-//! Carlson's R_F ([`special::elliptic::rf`]), the Brent root finder ([`special::root`]), the
+//! the SVG figures ([`report::figures::svg`]: a plotting crate's backend rounds coordinates to
+//! whole pixels and cannot measure text), Carlson's R_F ([`special::elliptic::rf`]), the Brent root finder ([`special::root`]), the
 //! double-double arithmetic ([`special::dd`]) and the Levenberg–Marquardt iteration itself
 //! (argmin has none; the NIST cross-checks in `docs/ACCURACY.md`).
 //!

@@ -10,6 +10,7 @@ use fitbead::io::measurements::locate_point;
 use fitbead::io::measurements::{is_shipped_data, si_conversion};
 use fitbead::io::write_atomic_all;
 use fitbead::report::analysis::analyse;
+use fitbead::report::figures::FigureFormat;
 use fitbead::report::text::{markdown, terminal_summary, Provenance};
 use std::path::{Path, PathBuf};
 
@@ -28,9 +29,13 @@ pub struct Args {
     /// Directory for the tables, figures and report.md, created if missing [default: report]
     #[arg(long)]
     pub out_dir: Option<PathBuf>,
-    /// lsq or mcmc (posteriors for every fit; adds corner.svg) [default: lsq]
+    /// lsq or mcmc (posteriors for every fit; adds one corner_<fit>_<series>.svg per
+    /// posterior) [default: lsq]
     #[arg(long)]
     pub method: Option<String>,
+    /// Figure files: svg, png (rendered from the SVG) or both [default: svg]
+    #[arg(long)]
+    pub format: Option<String>,
     /// The level of every interval.
     #[command(flatten)]
     pub level: LevelArgs,
@@ -43,8 +48,8 @@ pub struct Args {
     /// MCMC: maximum steps per fit [default: 100000]
     #[arg(long)]
     pub max_steps: Option<usize>,
-    /// A TOML recipe with any of the keys input, out_dir, method, rho, f, g, level, seed,
-    /// min_ess, max_steps (paths relative to the recipe's directory); flags given on the
+    /// A TOML recipe with any of the keys input, out_dir, method, format, rho, f, g, level,
+    /// seed, min_ess, max_steps (paths relative to the recipe's directory); flags given on the
     /// command line win.
     #[arg(long)]
     pub recipe: Option<PathBuf>,
@@ -60,6 +65,8 @@ pub struct Recipe {
     pub out_dir: Option<PathBuf>,
     /// lsq or mcmc.
     pub method: Option<String>,
+    /// svg, png or both.
+    pub format: Option<String>,
     /// ρ.
     pub rho: Option<f64>,
     /// f.
@@ -113,6 +120,13 @@ pub fn run(a: Args) -> Result<(), CliError> {
         _ => None,
     };
     let input = from_flags.or(r.input);
+    let format_text = a.format.clone().or(r.format);
+    let format: FigureFormat = match &format_text {
+        Some(f) => f
+            .parse()
+            .map_err(|e: String| super::flag_error("--format", f, e))?,
+        None => FigureFormat::Svg,
+    };
     let out_dir = a
         .out_dir
         .clone()
@@ -152,6 +166,13 @@ pub fn run(a: Args) -> Result<(), CliError> {
     // No file of the report may be the input (or the recipe).
     let targets: Vec<PathBuf> = fitbead::report::REPORT_FILES
         .iter()
+        .flat_map(|f| {
+            if f.ends_with(".svg") {
+                format.names(f)
+            } else {
+                vec![f.to_string()]
+            }
+        })
         .map(|f| out_dir.join(f))
         .collect();
     let outputs: Vec<(&str, Option<&Path>)> = targets
@@ -254,8 +275,12 @@ pub fn run(a: Args) -> Result<(), CliError> {
     files.push(fig("jan_linear.svg", an.jan_figure())?);
     files.push(fig("k_final_velocity.svg", an.k_figure())?);
     files.push(fig("regime_map.svg", an.regime_figure())?);
-    if an.mcmc {
-        files.push(fig("corner.svg", an.corner_figure())?);
+    files.push(fig("jaeger.svg", an.jaeger_figure())?);
+    files.push(fig("k_alpha.svg", an.k_alpha_figure())?);
+    files.push(fig("energy.svg", an.energy_figure())?);
+    files.push(fig("residuals.svg", an.residuals_figure())?);
+    for (name, svg) in an.corner_figures() {
+        files.push((name, svg.into_bytes()));
     }
     let warnings: Vec<String> = stats
         .iter()
@@ -306,6 +331,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         }
     }
     files.push(("report.md".into(), md.into_bytes()));
+    let files = format.apply(files).map_err(CliError::Other)?;
     let created = create_dirs(&out_dir)
         .map_err(|e| CliError::Other(format!("{}: cannot create: {e}", out_dir.display())))?;
     let paths: Vec<PathBuf> = files.iter().map(|f| out_dir.join(&f.0)).collect();

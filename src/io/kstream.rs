@@ -150,7 +150,7 @@ impl KLedger {
     pub fn plot_svg(&self, model_name: &str) -> Result<String, String> {
         scatter_svg(&Scatter {
             title: format!("K per measurement (eq 69), {model_name} model"),
-            x_label: "steady final velocity (units sqrt(g(R+r)))".into(),
+            x_label: "steady final velocity v_{f} / √(g(R + r))".into(),
             y_label: "K".into(),
             series: self.plot.clone(),
         })
@@ -350,7 +350,7 @@ impl RowPlan for KPlan {
         let label = if series.is_empty() {
             // The row passed its checks: its ξ reads back as a number.
             let xi = row.number(self.cols.xi()).unwrap_or(f64::NAN);
-            format!("xi = {}", fmt_f64(xi))
+            format!("ξ = {}", fmt_f64(xi))
         } else {
             format!("series {series}")
         };
@@ -360,7 +360,7 @@ impl RowPlan for KPlan {
                 ledger.plot.push(PointSeries {
                     label: label.clone(),
                     points: Vec::new(),
-                    reference: Some((n.cos2a, format!("cos 2alpha = {:.4}", n.cos2a))),
+                    reference: Some((n.cos2a, format!("K = cos 2α = {:.4}", n.cos2a))),
                 });
                 ledger.labels.insert(label, ledger.plot.len() - 1);
                 ledger.plot.len() - 1

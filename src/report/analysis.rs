@@ -2,11 +2,10 @@
 //! bulk friction of Jan's model against the closed form eq 79, the energy budgets, the regime
 //! map and the model ranking. Tables are CSV bytes; nothing here touches files.
 
-use super::figures::{corner_svg, panels_svg, scatter_svg, CornerBlock, Panel, PointSeries};
 use crate::fit::data::Dataset;
-use crate::fit::jaeger::{fit_jaeger_with, JaegerFits, JaegerModel};
-use crate::fit::jan::{fit_jan_with, velocity as jan_velocity, JanFits};
-use crate::fit::k::{bracket, estimate};
+use crate::fit::jaeger::{fit_jaeger_with, JaegerFits};
+use crate::fit::jan::{fit_jan_with, JanFits};
+use crate::fit::k::bracket;
 use crate::fit::klaw::{fit_law_with, KLaw, KLawFit, KLawProblem};
 use crate::fit::posterior::Method;
 use crate::fit::summary::{FitResult, ParamRow};
@@ -284,16 +283,16 @@ impl<'a> SharedProgress<'a> {
 }
 
 /// The reported interval of a row, or the value itself when there is none.
-fn interval(r: &ParamRow) -> (f64, f64) {
+pub(crate) fn interval(r: &ParamRow) -> (f64, f64) {
     r.interval().0.unwrap_or((r.value, r.value))
 }
 
 /// The least-squares value of a row (the optimum also under MCMC).
-fn lsq(r: &ParamRow) -> f64 {
+pub(crate) fn lsq(r: &ParamRow) -> f64 {
     r.lsq_value.unwrap_or(r.value)
 }
 
-fn k_of_c(alpha: f64, c: f64) -> f64 {
+pub(crate) fn k_of_c(alpha: f64, c: f64) -> f64 {
     let (s2a, c2a) = (2.0 * alpha).sin_cos();
     let sa = alpha.sin();
     c2a + c * sa * sa * s2a
@@ -551,7 +550,7 @@ impl Analysis {
     }
 
     /// The laws of the regime map: name and law.
-    fn map_laws(&self) -> Vec<(String, CollisionLaw)> {
+    pub(crate) fn map_laws(&self) -> Vec<(String, CollisionLaw)> {
         let mut laws = vec![
             ("cos2a".to_string(), CollisionLaw::Cos2a),
             ("paper-adjusted".to_string(), CollisionLaw::Adjusted),
@@ -568,7 +567,7 @@ impl Analysis {
         laws
     }
 
-    fn rho(&self) -> f64 {
+    pub(crate) fn rho(&self) -> f64 {
         self.data.points.first().map_or(0.4, |p| p.scene.rho)
     }
 
@@ -1139,252 +1138,6 @@ impl Analysis {
             v.extend(f.summary.params.iter().cloned());
         }
         v
-    }
-
-    /// Figure: v̄ against δ per series with every fitted model (Figs. 2–3, 8, 9 style).
-    pub fn velocity_figure(&self) -> Result<String, String> {
-        let mut panels = Vec::new();
-        for (s, label) in self.data.labels.iter().enumerate() {
-            let pts: Vec<_> = self.data.series(s).collect();
-            let d0 = pts
-                .iter()
-                .map(|p| p.scene.delta)
-                .fold(f64::INFINITY, f64::min);
-            let d1 = pts
-                .iter()
-                .map(|p| p.scene.delta)
-                .fold(f64::NEG_INFINITY, f64::max);
-            let pad = 0.1 * (d1 - d0).max(1f64.to_radians());
-            let grid: Vec<f64> = (0..=120)
-                .map(|i| (d0 - pad).max(1e-4) + (d1 - d0 + 2.0 * pad) * i as f64 / 120.0)
-                .collect();
-            let s0 = pts[0].scene;
-            let mut curves = Vec::new();
-            for c in &self.contact {
-                if let Some(r) = c.law_c.as_ref().and_then(|f| f.summary.params.first()) {
-                    let k = k_of_c(s0.alpha, lsq(r));
-                    let ys: Vec<(f64, f64)> = grid
-                        .par_iter()
-                        .map(|&d| {
-                            let v = crate::Scene::from_radians(
-                                s0.xi,
-                                d,
-                                s0.rho,
-                                s0.f,
-                                CollisionLaw::Value(k),
-                            )
-                            .ok()
-                            .and_then(|sc| c.model.evaluate(&sc).ok())
-                            .map_or(f64::NAN, |st| st.mean_velocity);
-                            (d.to_degrees(), v)
-                        })
-                        .collect();
-                    curves.push((format!("{} law c", c.name), ys));
-                }
-            }
-            if let Some(j) = &self.jan.series[s] {
-                let (l, m) = (lsq(&j.params[0]), lsq(&j.params[1]));
-                let ys = grid
-                    .iter()
-                    .map(|&d| {
-                        let v = jan_velocity(&(s0.sin_alpha, d.sin(), d.cos()), l, m)
-                            .map_or(f64::NAN, |r| r.0);
-                        (d.to_degrees(), v)
-                    })
-                    .collect();
-                curves.push(("jan".to_string(), ys));
-            }
-            if let Some(j) = &self.jaeger.series[s] {
-                let p: Vec<f64> = j.summary.params.iter().take(3).map(lsq).collect();
-                let model = JaegerModel(JaegerBranch::Upper);
-                let ys = grid
-                    .iter()
-                    .map(|&d| {
-                        let v = model
-                            .value(&(d.tan(), d.cos(), s0.eps), &p)
-                            .unwrap_or(f64::NAN);
-                        (d.to_degrees(), v)
-                    })
-                    .collect();
-                curves.push(("jaeger".to_string(), ys));
-            }
-            panels.push(Panel {
-                title: format!("series {label} (xi = {})", fmt_f64(s0.xi)),
-                x_label: "slope delta (deg)".into(),
-                y_label: "mean velocity v (units sqrt(g(R+r)))".into(),
-                points: vec![PointSeries {
-                    label: "data".into(),
-                    points: pts
-                        .iter()
-                        .map(|p| {
-                            let e = if self.data.sigma == SigmaKind::Absolute {
-                                p.sigma
-                            } else {
-                                0.0
-                            };
-                            (p.scene.delta_deg(), p.v, p.v - e, p.v + e)
-                        })
-                        .collect(),
-                    reference: None,
-                }],
-                curves,
-                curve_colours: Vec::new(),
-            });
-        }
-        panels_svg(
-            "Mean velocity against slope: data and fitted models",
-            2,
-            &panels,
-        )
-    }
-
-    /// Figure: v̄²/cos δ against tan δ with Jan's straight lines (Fig. 8).
-    pub fn jan_figure(&self) -> Result<String, String> {
-        let mut points = Vec::new();
-        let mut curves = Vec::new();
-        for (s, label) in self.data.labels.iter().enumerate() {
-            let pts: Vec<_> = self.data.series(s).collect();
-            points.push(PointSeries {
-                label: format!("series {label}"),
-                points: pts
-                    .iter()
-                    .map(|p| {
-                        let c = p.scene.delta.cos();
-                        let y = p.v * p.v / c;
-                        let e = if self.data.sigma == SigmaKind::Absolute {
-                            2.0 * p.v * p.sigma / c
-                        } else {
-                            0.0
-                        };
-                        (p.scene.delta.tan(), y, y - e, y + e)
-                    })
-                    .collect(),
-                reference: None,
-            });
-            if let Some(j) = &self.jan.series[s] {
-                let (l, m) = (lsq(&j.params[0]), lsq(&j.params[1]));
-                let sa = pts[0].scene.sin_alpha;
-                let t1 = pts
-                    .iter()
-                    .map(|p| p.scene.delta.tan())
-                    .fold(f64::NEG_INFINITY, f64::max);
-                // v̄²/cos δ = (2 sin α/λ)(tan δ − μ): a straight line from tan δ = μ.
-                curves.push((
-                    format!("jan, series {label}"),
-                    vec![(m, 0.0), (t1 * 1.05, 2.0 * sa / l * (t1 * 1.05 - m))],
-                ));
-            }
-        }
-        panels_svg(
-            "Jan's linearised plot (paper Fig. 8)",
-            1,
-            &[Panel {
-                title: String::new(),
-                x_label: "tan delta".into(),
-                y_label: "v^2 / cos delta (units g(R+r))".into(),
-                points,
-                curves,
-                curve_colours: Vec::new(),
-            }],
-        )
-    }
-
-    /// Figure: K per point (eq 69, stick/slip) against the steady final velocity (Figs. 5–6).
-    pub fn k_figure(&self) -> Result<String, String> {
-        let mut series: Vec<PointSeries> = Vec::new();
-        for (s, label) in self.data.labels.iter().enumerate() {
-            let pts: Vec<_> = self.data.series(s).collect();
-            let est: Vec<_> = pts
-                .par_iter()
-                .map(|p| {
-                    let sg = (self.data.sigma == SigmaKind::Absolute).then_some(p.sigma);
-                    estimate(&Model::StickSlip, &p.scene, p.v, sg)
-                })
-                .collect();
-            let c2 = CollisionLaw::Cos2a.k(pts[0].scene.alpha, pts[0].scene.rho);
-            series.push(PointSeries {
-                label: format!("series {label}"),
-                points: est
-                    .iter()
-                    .filter_map(|e| {
-                        let r = e.root.as_ref().ok()?;
-                        Some((
-                            r.steady.final_velocity,
-                            r.k,
-                            e.k_lo.unwrap_or(r.k),
-                            e.k_hi.unwrap_or(r.k),
-                        ))
-                    })
-                    .collect(),
-                reference: Some((c2, format!("cos 2alpha = {c2:.4}"))),
-            });
-        }
-        scatter_svg(&super::figures::Scatter {
-            title: "K per measurement (eq 69), stick/slip model (paper Figs. 5-6)".into(),
-            x_label: "steady final velocity (units sqrt(g(R+r)))".into(),
-            y_label: "K".into(),
-            series,
-        })
-    }
-
-    /// Figure: the regime map δ_m, δ_d against α with the points by regime (Fig. 4).
-    pub fn regime_figure(&self) -> Result<String, String> {
-        let rho = self.rho();
-        let mut curves = Vec::new();
-        let mut colours = Vec::new();
-        for (li, (name, law)) in self.map_laws().into_iter().enumerate() {
-            let (mut lm, mut ld) = (Vec::new(), Vec::new());
-            for i in 0..=100 {
-                let xi = 0.5 * 40f64.powf(i as f64 / 100.0);
-                let a = crate::models::regimes::alpha_of_xi(xi);
-                lm.push((a.to_degrees(), delta_m_law(a, law, rho).to_degrees()));
-                ld.push((a.to_degrees(), delta_d_law(a, law, rho).to_degrees()));
-            }
-            curves.push((format!("delta_m (thick), delta_d (thin): {name}"), lm));
-            curves.push((String::new(), ld));
-            colours.extend([li, li]);
-        }
-        let reg = self.point_regimes();
-        let mut points = Vec::new();
-        if let Some(r) = reg.first() {
-            for g in ["A", "B", "C", "invalid", "no-fit"] {
-                let pts: Vec<_> = self
-                    .data
-                    .points
-                    .iter()
-                    .zip(r)
-                    .filter(|(_, x)| x.as_str() == g)
-                    .map(|(p, _)| {
-                        let (a, d) = (p.scene.alpha.to_degrees(), p.scene.delta_deg());
-                        (a, d, d, d)
-                    })
-                    .collect();
-                if !pts.is_empty() {
-                    points.push(PointSeries {
-                        label: format!("data, regime {g} (rolling law c)"),
-                        points: pts,
-                        reference: None,
-                    });
-                }
-            }
-        }
-        panels_svg(
-            "Regime map (paper Fig. 4): steady between delta_m (eq 32) and delta_d (eq 31)",
-            1,
-            &[Panel {
-                title: String::new(),
-                x_label: "contact angle alpha (deg)".into(),
-                y_label: "slope delta (deg)".into(),
-                points,
-                curves,
-                curve_colours: colours,
-            }],
-        )
-    }
-
-    /// Corner plots of every posterior.
-    pub fn corner_figure(&self) -> Result<String, String> {
-        corner_svg(&CornerBlock::from_posteriors(&self.posteriors()))
     }
 }
 

@@ -713,14 +713,57 @@ pub fn render(rows: &[WpRow]) -> csv::Result<Vec<u8>> {
     w.into_inner().map_err(|e| csv::Error::from(e.into_error()))
 }
 
-/// The work-precision diagram: log10 median time per evaluation against log10 maximum
+/// Reads back the rows [`render`] wrote (a `bench --output` file), to re-plot measured rows
+/// without measuring again. An empty error cell reads as NaN, `inf` as infinity.
+pub fn read_rows(csv_bytes: &[u8]) -> Result<Vec<WpRow>, String> {
+    let mut r = csv::Reader::from_reader(csv_bytes);
+    let h = r.headers().map_err(|e| e.to_string())?.clone();
+    if h.iter().collect::<Vec<_>>() != COLUMNS {
+        return Err(format!("expected the columns {}", COLUMNS.join(",")));
+    }
+    let num = |s: &str| -> Result<f64, String> {
+        match s {
+            "" => Ok(f64::NAN),
+            "inf" => Ok(f64::INFINITY),
+            _ => s.parse().map_err(|_| format!("not a number: {s:?}")),
+        }
+    };
+    let opt = |s: &str| -> Result<Option<f64>, String> {
+        if s.is_empty() {
+            Ok(None)
+        } else {
+            num(s).map(Some)
+        }
+    };
+    let mut rows = Vec::new();
+    for rec in r.records() {
+        let rec = rec.map_err(|e| e.to_string())?;
+        rows.push(WpRow {
+            model: rec[0].to_string(),
+            method: rec[1].to_string(),
+            tol: opt(&rec[2])?,
+            scenes: rec[3]
+                .parse()
+                .map_err(|_| format!("not a count: {:?}", &rec[3]))?,
+            err_median: num(&rec[4])?,
+            err_p99: num(&rec[5])?,
+            err_max: num(&rec[6])?,
+            ns_median: opt(&rec[7])?,
+            ns_p99: opt(&rec[8])?,
+        });
+    }
+    Ok(rows)
+}
+
+/// The work-precision diagram on log–log axes: median time per evaluation against maximum
 /// relative error, one curve per model and method (its tolerances joined), single methods as
-/// points. A method that is invalid on some scenes (infinite maximum error) is drawn at its
-/// median error and says so in its label.
+/// points, the legend outside the plot. A method that is invalid on some scenes (infinite
+/// maximum error) is drawn at its median error and says so in its label; errors below 1e-17
+/// are drawn at 1e-17.
 pub fn plot(rows: &[WpRow], title: &str) -> Result<String, String> {
-    use plotters::prelude::*;
+    use super::figures::{series_style, Axis, Figure, LegendEntry, Panel, Stroke};
     let floor = 1e-17f64;
-    // (row, x, y, drawn at the median error)
+    // (row, error, time, drawn at the median error)
     let pts: Vec<(&WpRow, f64, f64, bool)> = rows
         .iter()
         .filter(|r| !r.method.starts_with("crosscheck") && !r.model.starts_with("k-"))
@@ -731,77 +774,50 @@ pub fn plot(rows: &[WpRow], title: &str) -> Result<String, String> {
             } else {
                 (r.err_median, true)
             };
-            (e.is_finite() && t > 0.0).then(|| (r, e.max(floor).log10(), t.log10(), median))
+            (e.is_finite() && t > 0.0).then(|| (r, e.max(floor), t, median))
         })
         .collect();
-    let (mut x0, mut x1, mut y0, mut y1) = (-17.0f64, 0.0f64, f64::INFINITY, f64::NEG_INFINITY);
+    let mut groups: Vec<(&str, &str)> = Vec::new();
     for p in &pts {
-        x0 = x0.min(p.1);
-        x1 = x1.max(p.1);
-        y0 = y0.min(p.2);
-        y1 = y1.max(p.2);
-    }
-    if !y0.is_finite() {
-        (y0, y1) = (1.0, 6.0);
-    }
-    let mut out = String::new();
-    {
-        let root = SVGBackend::with_string(&mut out, (900, 620)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 18))
-            .margin(16)
-            .x_label_area_size(44)
-            .y_label_area_size(60)
-            .build_cartesian_2d((x0 - 0.5)..(x1 + 0.5), (y0 - 0.2)..(y1 + 0.2))
-            .map_err(|e| e.to_string())?;
-        chart
-            .configure_mesh()
-            .x_desc("log10 max relative error of v (below 1e-17 drawn at -17)")
-            .y_desc("log10 median time per evaluation (ns)")
-            .draw()
-            .map_err(|e| e.to_string())?;
-        let mut groups: Vec<(&str, &str)> = Vec::new();
-        for p in &pts {
-            let g = (p.0.model.as_str(), p.0.method.as_str());
-            if !groups.contains(&g) {
-                groups.push(g);
-            }
+        let g = (p.0.model.as_str(), p.0.method.as_str());
+        if !groups.contains(&g) {
+            groups.push(g);
         }
-        for (i, (m, meth)) in groups.iter().enumerate() {
-            let colour = Palette99::pick(i).to_rgba();
-            let sel: Vec<&(&WpRow, f64, f64, bool)> = pts
-                .iter()
-                .filter(|p| p.0.model == *m && p.0.method == *meth)
-                .collect();
-            let line: Vec<(f64, f64)> = sel.iter().map(|p| (p.1, p.2)).collect();
-            let mut label = if *meth == "auto" || *meth == "quadrature" {
-                format!("{m} (tolerances)")
-            } else {
-                format!("{m} ({meth})")
-            };
-            if sel.iter().any(|p| p.3) {
-                label.push_str(": median error, invalid on some scenes");
-            }
-            chart
-                .draw_series(LineSeries::new(line.clone(), colour.stroke_width(2)))
-                .map_err(|e| e.to_string())?
-                .label(label)
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 16, y)], colour.stroke_width(2))
-                });
-            chart
-                .draw_series(line.iter().map(|&p| Circle::new(p, 4, colour.filled())))
-                .map_err(|e| e.to_string())?;
-        }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(|e| e.to_string())?;
-        root.present().map_err(|e| e.to_string())?;
     }
-    Ok(out)
+    let mut panel = Panel::new(
+        "",
+        Axis::log("maximum relative error of v\u{304} (below 10^{−17} drawn at 10^{−17})"),
+        Axis::log("median time per evaluation (ns)"),
+    );
+    for (i, (m, meth)) in groups.iter().enumerate() {
+        let (colour, mark) = series_style(i);
+        let sel: Vec<(f64, f64, bool)> = pts
+            .iter()
+            .filter(|p| p.0.model == *m && p.0.method == *meth)
+            .map(|p| (p.1, p.2, p.3))
+            .collect();
+        let mut label = if *meth == "auto" || *meth == "quadrature" {
+            format!("{m} (tolerances)")
+        } else {
+            format!("{m} ({meth})")
+        };
+        if sel.iter().any(|p| p.2) {
+            label.push_str(": median error, invalid on some scenes");
+        }
+        let stroke = Stroke::solid(colour, 2.0);
+        panel.curve(sel.iter().map(|p| (p.0, p.1)).collect(), stroke.clone());
+        panel.points(
+            sel.iter().map(|p| (p.0, p.1, f64::NAN, f64::NAN)).collect(),
+            colour,
+            mark,
+        );
+        panel
+            .legend
+            .push(LegendEntry::mark_line(&label, mark, &stroke));
+    }
+    // Every entry outside the data: the legend goes to the figure.
+    let legend = std::mem::take(&mut panel.legend);
+    let mut f = Figure::new(title, 1, (640.0, 460.0), vec![panel]);
+    f.legend = legend;
+    Ok(f.to_svg())
 }

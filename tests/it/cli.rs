@@ -493,11 +493,12 @@ fn k_plot_writes_an_svg() {
     assert!(out.status.success());
     let s = std::fs::read_to_string(&svg).unwrap();
     assert!(
-        s.starts_with("<svg") && s.contains("cos 2alpha"),
+        s.starts_with("<svg") && s.contains("K = cos 2α"),
         "{}",
         &s[..200]
     );
-    assert!(s.matches("<circle").count() >= 36);
+    // One marker per point (circles and polygons: each series has its shape).
+    assert!(s.matches("<circle").count() + s.matches("<polygon").count() >= 36);
 }
 
 const FIT_COLUMNS: [&str; 9] = [

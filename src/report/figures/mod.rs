@@ -1,0 +1,150 @@
+//! The figures: SVG documents written by the crate's own engine ([`svg`] for the document
+//! and its text, [`plot`] for axes, legends and grids of panels), the corner plots of
+//! posteriors ([`corner`]), and the scatter figure of `fitbead k`. [`png`] (feature `png`)
+//! renders any of them to PNG with resvg and the embedded font.
+//!
+//! Labels are markup: `_{…}` sets a subscript and `^{…}` a superscript (written as `tspan`s
+//! shifted with `dy`, which every SVG viewer supports); Greek letters and symbols are Unicode.
+//! Every document names the font family list [`svg::FONT_FAMILY`], whose first member is the
+//! embedded DejaVu Sans (`assets/fonts/`), whose advance widths the layout measures text with.
+
+pub mod corner;
+mod metrics;
+pub mod plot;
+#[cfg(feature = "png")]
+pub mod png;
+pub mod svg;
+
+pub use corner::{corner_svg, CornerBlock};
+pub use plot::{
+    coincide, stack_svg, Axis, ErrPoint, Figure, Item, LegendEntry, Panel, Scale, Swatch, DASHES,
+    PALETTE,
+};
+pub use svg::{Anchor, Mark, Stroke, MARKS};
+
+/// One series of points with optional vertical error bars, and an optional horizontal
+/// reference line drawn in the same colour.
+#[derive(Debug, Clone, Default)]
+pub struct PointSeries {
+    /// Legend label (markup).
+    pub label: String,
+    /// (x, y, y_low, y_high) per point; y_low/y_high equal y when there is no interval.
+    pub points: Vec<ErrPoint>,
+    /// A horizontal reference line y = value, with its own legend label.
+    pub reference: Option<(f64, String)>,
+}
+
+/// A scatter figure: title, axis labels, series.
+#[derive(Debug, Clone, Default)]
+pub struct Scatter {
+    /// Caption above the plot (markup).
+    pub title: String,
+    /// x-axis label (markup).
+    pub x_label: String,
+    /// y-axis label (markup).
+    pub y_label: String,
+    /// The data.
+    pub series: Vec<PointSeries>,
+}
+
+/// Series `i`'s colour and marker.
+pub fn series_style(i: usize) -> (&'static str, Mark) {
+    (PALETTE[i % PALETTE.len()], MARKS[i % MARKS.len()])
+}
+
+/// The scatter figure as a panel: series `i` in [`series_style`]`(i)`, its reference line
+/// dashed in the same colour.
+pub fn scatter_panel(fig: &Scatter) -> Panel {
+    let mut p = Panel::new("", Axis::new(&fig.x_label), Axis::new(&fig.y_label));
+    for (i, s) in fig.series.iter().enumerate() {
+        let (colour, mark) = series_style(i);
+        p.points(s.points.clone(), colour, mark);
+        p.legend.push(LegendEntry::mark(&s.label, mark, colour));
+        if let Some((y, label)) = &s.reference {
+            let st = Stroke::solid(colour, 1.5).dashed(DASHES[0]);
+            p.items.push(Item::HLine {
+                y: *y,
+                stroke: st.clone(),
+            });
+            p.legend.push(LegendEntry::line(label, &st));
+        }
+    }
+    p
+}
+
+/// Renders a scatter figure to an SVG document.
+pub fn scatter_svg(fig: &Scatter) -> Result<String, String> {
+    Ok(Figure::new(&fig.title, 1, (720.0, 460.0), vec![scatter_panel(fig)]).to_svg())
+}
+
+/// The file formats of a report's figures.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum FigureFormat {
+    /// SVG only.
+    #[default]
+    Svg,
+    /// PNG only (rendered from the SVG).
+    Png,
+    /// SVG and PNG.
+    Both,
+}
+
+impl std::str::FromStr for FigureFormat {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "svg" => Ok(FigureFormat::Svg),
+            "png" => Ok(FigureFormat::Png),
+            "both" => Ok(FigureFormat::Both),
+            _ => Err("must be svg, png or both".into()),
+        }
+    }
+}
+
+impl FigureFormat {
+    /// The file names a figure `NAME.svg` is written as.
+    pub fn names(self, svg_name: &str) -> Vec<String> {
+        let png = || format!("{}.png", svg_name.trim_end_matches(".svg"));
+        match self {
+            FigureFormat::Svg => vec![svg_name.to_string()],
+            FigureFormat::Png => vec![png()],
+            FigureFormat::Both => vec![svg_name.to_string(), png()],
+        }
+    }
+
+    /// `files` (name, bytes) with every `*.svg` written in this format: kept, replaced by its
+    /// PNG rendering ([`png::svg_to_png`] at [`png::REPORT_SCALE`]), or both. Without the
+    /// `png` feature a PNG format is an error.
+    pub fn apply(self, files: Vec<(String, Vec<u8>)>) -> Result<Vec<(String, Vec<u8>)>, String> {
+        if self == FigureFormat::Svg {
+            return Ok(files);
+        }
+        let mut out = Vec::with_capacity(files.len() * 2);
+        for (name, bytes) in files {
+            if !name.ends_with(".svg") {
+                out.push((name, bytes));
+                continue;
+            }
+            let png = render_png(&name, &bytes)?;
+            let png_name = format!("{}.png", name.trim_end_matches(".svg"));
+            if self == FigureFormat::Both {
+                out.push((name, bytes));
+            }
+            out.push((png_name, png));
+        }
+        Ok(out)
+    }
+}
+
+#[cfg(feature = "png")]
+fn render_png(name: &str, svg: &[u8]) -> Result<Vec<u8>, String> {
+    let text = std::str::from_utf8(svg).map_err(|e| format!("{name}: {e}"))?;
+    png::svg_to_png(text, png::REPORT_SCALE).map_err(|e| format!("{name}: {e}"))
+}
+
+#[cfg(not(feature = "png"))]
+fn render_png(name: &str, _svg: &[u8]) -> Result<Vec<u8>, String> {
+    Err(format!(
+        "{name}: PNG figures need the crate feature `png` (built without it)"
+    ))
+}

@@ -11,7 +11,7 @@ use fitbead::io::measurements::{is_shipped_data, si_conversion};
 use fitbead::io::write_atomic_all;
 use fitbead::report::analysis::analyse;
 use fitbead::report::figures::FigureFormat;
-use fitbead::report::text::{markdown, terminal_summary, Provenance};
+use fitbead::report::text::{markdown, terminal_summary, ReportContext};
 use std::path::{Path, PathBuf};
 
 /// The contact models the report fits (a point must be steady under one of them).
@@ -257,7 +257,11 @@ pub fn run(a: Args) -> Result<(), CliError> {
         "stats.csv".into(),
         fitbead::io::reports::stats_csv(&stats).map_err(csv_err)?,
     ));
-    let fits = an.fit_results();
+    // Under a posterior run: the bands of v̄(δ) and the posterior median at every point.
+    let bands = an
+        .mcmc
+        .then(|| fitbead::report::bands::posterior_bands(&an));
+    let fits = an.fit_results_at(bands.as_ref());
     let fit_refs: Vec<&fitbead::fit::summary::FitResult> = fits.iter().collect();
     files.push((
         "residuals.csv".into(),
@@ -271,15 +275,20 @@ pub fn run(a: Args) -> Result<(), CliError> {
         r.map(|s| (name.to_string(), s.into_bytes()))
             .map_err(|e| CliError::Other(format!("figure {name}: {e}")))
     };
-    files.push(fig("velocity.svg", an.velocity_figure())?);
+    files.push(fig(
+        "velocity.svg",
+        an.velocity_figure_with(bands.as_ref()),
+    )?);
     files.push(fig("jan_linear.svg", an.jan_figure())?);
     files.push(fig("k_final_velocity.svg", an.k_figure())?);
     files.push(fig("regime_map.svg", an.regime_figure())?);
     files.push(fig("jaeger.svg", an.jaeger_figure())?);
     files.push(fig("k_alpha.svg", an.k_alpha_figure())?);
     files.push(fig("energy.svg", an.energy_figure())?);
-    files.push(fig("residuals.svg", an.residuals_figure())?);
+    files.push(fig("residuals.svg", an.residuals_figure_with(&fits))?);
+    let mut corner_files = Vec::new();
     for (name, svg) in an.corner_figures() {
+        corner_files.push(name.clone());
         files.push((name, svg.into_bytes()));
     }
     let warnings: Vec<String> = stats
@@ -293,12 +302,14 @@ pub fn run(a: Args) -> Result<(), CliError> {
             eprintln!("fitbead: warning: {w}");
         }
     }
-    let provenance = Provenance {
+    let context = ReportContext {
         source: shown.unwrap_or_else(|| t.source.clone()),
         shipped_synthetic: is_shipped_data(&ds),
         si: si_conversion(&t, &io.data.defaults()?),
+        figure_format: format,
+        corner_files,
     };
-    let mut md = markdown(&an, &provenance, &io.method);
+    let mut md = markdown(&an, &context, &io.method);
     let absurd: Vec<String> = stats
         .iter()
         .filter_map(|s| {

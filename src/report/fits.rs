@@ -2,6 +2,7 @@
 //! correlations.csv, the parameter table and the fit reports of report.md are made from.
 
 use super::analysis::Analysis;
+use super::bands::PosteriorBands;
 use crate::fit::summary::FitResult;
 
 /// A copy of `f` without its draws (the report's tables need the summaries only), with the
@@ -33,6 +34,29 @@ fn named(f: &FitResult, prefix: Option<&str>) -> FitResult {
 }
 
 impl Analysis {
+    /// [`Analysis::fit_results`] with, for a posterior run, every point's fitted v̄ replaced by
+    /// its posterior median (`medians`, from
+    /// [`posterior_bands`](super::bands::posterior_bands)), and its residuals recomputed from
+    /// it: v − v̄, divided by σ (without σ, by the scatter sqrt(χ²/dof) of the fit).
+    pub fn fit_results_at(&self, medians: Option<&PosteriorBands>) -> Vec<FitResult> {
+        let mut fits = self.fit_results();
+        let Some(b) = medians else { return fits };
+        for f in fits.iter_mut() {
+            let scatter = f.stats.reduced_chi2.sqrt();
+            for p in f.points.iter_mut() {
+                let m = b.points.iter().find(|m| {
+                    m.fit == f.stats.fit && m.series == p.series && m.delta_deg == p.delta_deg
+                });
+                if let Some(m) = m {
+                    p.v_fit = m.v_median;
+                    p.residual = p.v - m.v_median;
+                    p.normalised_residual = p.residual / p.sigma_v.unwrap_or(scatter);
+                }
+            }
+        }
+        fits
+    }
+
     /// Every fit of the report, in the order of params.csv: per contact model its K(α) law c
     /// and its one-K-per-series fit (named `rolling-klaw-c`, `stickslip-klaw-free-per-series`,
     /// …), then Jan's per-series and global fits, then Jaeger's per-series fits. The copies

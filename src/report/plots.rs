@@ -4,6 +4,7 @@
 //! residuals and one corner plot per posterior.
 
 use super::analysis::{k_of_c, lsq, Analysis};
+use super::bands::PosteriorBands;
 use super::figures::corner::{corner_figure, CornerBlock};
 use super::figures::{
     coincide, scatter_panel, series_style, Anchor, Axis, Figure, Item, LegendEntry, Mark, Panel,
@@ -44,6 +45,9 @@ const REFERENCE: &str = "#7f7f7f";
 fn g4(x: f64) -> String {
     fmt_sig(x, 4).replace('-', "\u{2212}")
 }
+
+/// The fits behind [`VELOCITY_MODELS`], named as in params.csv (their posterior bands).
+const VELOCITY_FITS: [&str; 4] = ["rolling-klaw-c", "stickslip-klaw-c", "jan-series", "jaeger"];
 
 /// The models of the velocity figure, in drawing order: name in the legend and colour.
 const VELOCITY_MODELS: [(&str, &str); 4] = [
@@ -151,6 +155,13 @@ impl Analysis {
     /// and 9). A model whose curve lies on an earlier one is dashed, and its legend entry
     /// says on which. [`Panel::band`] adds a shaded band under a curve.
     pub fn velocity_figure(&self) -> Result<String, String> {
+        self.velocity_figure_with(None)
+    }
+
+    /// [`Analysis::velocity_figure`] with, for a posterior run, each model's 90 % posterior
+    /// band of v̄(δ) (from [`posterior_bands`](super::bands::posterior_bands): the 5 % and 95 %
+    /// quantiles of the model's v̄ over the draws) shaded under its curve.
+    pub fn velocity_figure_with(&self, bands: Option<&PosteriorBands>) -> Result<String, String> {
         let mut panels = Vec::new();
         let mut curves_by_panel = Vec::new();
         for s in 0..self.data.labels.len() {
@@ -198,6 +209,7 @@ impl Analysis {
             DATA,
         )];
         let mut dash_count = 0;
+        let mut banded = false;
         for (m, (name, colour)) in VELOCITY_MODELS.iter().enumerate() {
             if curves_by_panel
                 .iter()
@@ -225,10 +237,34 @@ impl Analysis {
                     VELOCITY_MODELS[a].0.split([',', ' ']).next().unwrap_or("")
                 );
             }
-            for (p, cs) in panels.iter_mut().zip(&curves_by_panel) {
+            for (s, (p, cs)) in panels.iter_mut().zip(&curves_by_panel).enumerate() {
+                if let Some(b) = bands.and_then(|b| {
+                    b.bands
+                        .iter()
+                        .find(|b| b.fit == VELOCITY_FITS[m] && b.series == self.data.labels[s])
+                }) {
+                    let pts: Vec<(f64, f64, f64)> = b
+                        .delta_deg
+                        .iter()
+                        .zip(b.q05.iter().zip(&b.q95))
+                        .filter(|(_, (lo, hi))| lo.is_finite() && hi.is_finite())
+                        .map(|(&d, (&lo, &hi))| (d, lo, hi))
+                        .collect();
+                    if pts.len() > 1 {
+                        p.band(pts, colour, 0.18);
+                        banded = true;
+                    }
+                }
                 p.curve(cs[m].clone(), stroke.clone());
             }
             legend.push(LegendEntry::line(&label, &stroke));
+        }
+        if banded {
+            legend.push(LegendEntry::patch(
+                "shaded: 90 % posterior band of v\u{304}(δ) (5–95 % of the draws)",
+                "#808080",
+                0.3,
+            ));
         }
         let mut f = Figure::new(
             "Mean velocity against slope: data and fitted models",
@@ -723,8 +759,22 @@ impl Analysis {
     /// Figure: normalised residuals (v − v̄_fit)/σ against δ, one panel per fit, points
     /// coloured by series, with the ±2 lines.
     pub fn residuals_figure(&self) -> Result<String, String> {
+        self.residuals_figure_with(&self.fit_results())
+    }
+
+    /// [`Analysis::residuals_figure`] of `fits` as [`Analysis::fit_results`] or
+    /// [`Analysis::fit_results_at`] give them (under a posterior run, residuals at the
+    /// posterior medians); fits of one name make one panel.
+    pub fn residuals_figure_with(&self, fits: &[FitResult]) -> Result<String, String> {
+        let mut groups: Vec<(String, Vec<&FitResult>)> = Vec::new();
+        for f in fits {
+            match groups.iter_mut().find(|g| g.0 == f.stats.fit) {
+                Some(g) => g.1.push(f),
+                None => groups.push((f.stats.fit.clone(), vec![f])),
+            }
+        }
         let mut panels = Vec::new();
-        for (name, fits) in self.named_fits() {
+        for (name, fits) in groups {
             let chi2: f64 = fits.iter().map(|f| f.stats.chi2).sum();
             let mut p = Panel::new(
                 &format!("{} (χ^{{2}} = {})", fit_title(&name), fmt_sig(chi2, 3)),

@@ -1,14 +1,16 @@
 //! The report's text: report.md and the summary printed at the end of `fitbead report`.
 
 use super::analysis::{sig3, Analysis};
+use super::figures::FigureFormat;
 use crate::fit::summary::ParamRow;
 use crate::io::measurements::SiSeries;
 use crate::models::JaegerBranch;
 use crate::numfmt::{fmt_f64, fmt_interval, fmt_sig, fmt_value_pm};
 
-/// Where the report's data came from, for the head of report.md.
+/// What report.md says besides the analysis: where the data came from and which figure files
+/// were written.
 #[derive(Debug, Clone, Default, PartialEq)]
-pub struct Provenance {
+pub struct ReportContext {
     /// How the data are named (a path, or the embedded data set's name).
     pub source: String,
     /// Whether the data are the shipped synthetic data set (data/default.csv), which is not a
@@ -16,6 +18,10 @@ pub struct Provenance {
     pub shipped_synthetic: bool,
     /// When the velocities were given in m/s: how each series was made dimensionless.
     pub si: Option<Vec<SiSeries>>,
+    /// The format of the figure files (report.md links to them).
+    pub figure_format: FigureFormat,
+    /// The corner plots written (their SVG names, `corner_<fit>_<series>.svg`).
+    pub corner_files: Vec<String>,
 }
 
 /// A parameter's name in the report's tables: qualified by series where a fit across series
@@ -195,6 +201,50 @@ fn fit_reports(an: &Analysis) -> String {
     m
 }
 
+/// The report's figures of fixed name, with what each shows.
+const FIGURES: [(&str, &str); 8] = [
+    (
+        "velocity.svg",
+        "v̄ against δ per series with every fitted model (the paper's Figs. 2–3, 8, 9)",
+    ),
+    (
+        "residuals.svg",
+        "normalised residuals against δ, one panel per fit",
+    ),
+    (
+        "jan_linear.svg",
+        "v̄²/cos δ against tan δ with Jan's lines (Fig. 8)",
+    ),
+    (
+        "jaeger.svg",
+        "Jaeger's u against tan δ with both branches and the bistable band of eq 90 (Figs. 9–10)",
+    ),
+    (
+        "k_final_velocity.svg",
+        "K per point (eq 69, stick/slip) against the final velocity (Figs. 5–6)",
+    ),
+    (
+        "k_alpha.svg",
+        "K per point (eq 69) against α with the fitted laws and cos 2α",
+    ),
+    (
+        "energy.svg",
+        "the energy partition of every point: collision translation, collision spin, friction",
+    ),
+    (
+        "regime_map.svg",
+        "regions A, B, C between each contact model's limits against α, with the points (Fig. 4)",
+    ),
+];
+
+/// A Markdown link to figure `svg_name` in the format the report writes (the PNG when it
+/// writes PNG only).
+fn figure_link(ctx: &ReportContext, svg_name: &str) -> String {
+    let names = ctx.figure_format.names(svg_name);
+    let shown: Vec<String> = names.iter().map(|n| format!("[{n}]({n})")).collect();
+    shown.join(" / ")
+}
+
 /// The banner of a report on the shipped synthetic data.
 const SYNTHETIC_BANNER: &str = "> **These data are synthetic.** They are fitbead's shipped data \
      set (data/default.csv), simulated with the stick/slip model, the paper's law \
@@ -203,7 +253,7 @@ const SYNTHETIC_BANNER: &str = "> **These data are synthetic.** They are fitbead
 
 /// How velocities given in m/s were made dimensionless, per series (empty for dimensionless
 /// input).
-fn si_units(p: &Provenance) -> String {
+fn si_units(p: &ReportContext) -> String {
     let mut m = String::new();
     if let Some(si) = &p.si {
         m.push_str(
@@ -309,13 +359,13 @@ pub fn terminal_summary(an: &Analysis, dir: &str) -> String {
 
 /// report.md: the data, the bulk friction against eq 79, the energy budgets, the regime map and
 /// the model ranking, in Markdown; `source` names the data, `method` the estimation method.
-pub fn markdown(an: &Analysis, prov: &Provenance, method: &str) -> String {
-    let source = prov.source.as_str();
+pub fn markdown(an: &Analysis, ctx: &ReportContext, method: &str) -> String {
+    let source = ctx.source.as_str();
     let d = &an.data;
     let mut m = String::new();
     let p0 = &d.points[0].scene;
     m.push_str("# fitbead report\n\n");
-    if prov.shipped_synthetic {
+    if ctx.shipped_synthetic {
         m.push_str(SYNTHETIC_BANNER);
     }
     m.push_str(&format!(
@@ -332,7 +382,7 @@ pub fn markdown(an: &Analysis, prov: &Provenance, method: &str) -> String {
             "not given (unit weights, scale estimated)"
         }
     ));
-    m.push_str(&si_units(prov));
+    m.push_str(&si_units(ctx));
     m.push_str(&parameter_table(an));
     // Bulk friction.
     let rows = an.mu_rows();
@@ -485,17 +535,21 @@ pub fn markdown(an: &Analysis, prov: &Provenance, method: &str) -> String {
             m.push_str(&format!("- {n}\n"));
         }
     }
-    m.push_str(
-        "\n## Figures\n\n\
-         - [velocity.svg](velocity.svg): v̄ against δ per series with every fitted model \
-         (paper Figs. 2–3, 8, 9)\n\
-         - [jan_linear.svg](jan_linear.svg): v̄²/cos δ against tan δ with Jan's lines (Fig. 8)\n\
-         - [k_final_velocity.svg](k_final_velocity.svg): K per point (eq 69, stick/slip) \
-         against the final velocity (Figs. 5–6)\n\
-         - [regime_map.svg](regime_map.svg): δ_m and δ_d against α with the points (Fig. 4)\n",
-    );
-    if an.mcmc {
-        m.push_str("- [corner.svg](corner.svg): posterior corner plots\n");
+    m.push_str("\n## Figures\n\n");
+    for (name, what) in FIGURES {
+        m.push_str(&format!("- {}: {what}\n", figure_link(ctx, name)));
+    }
+    if !ctx.corner_files.is_empty() {
+        let links: Vec<String> = ctx
+            .corner_files
+            .iter()
+            .map(|n| figure_link(ctx, n))
+            .collect();
+        m.push_str(&format!(
+            "- posterior corner plots, one per fit (marginals with 16/50/84 % quantiles, pair \
+             densities with 1σ and 2σ contours, the least-squares optimum marked): {}\n",
+            links.join(", ")
+        ));
     }
     m.push_str(
         "\nEvery fit's parameters and statistics: [params.csv](params.csv), \

@@ -36,6 +36,10 @@ pub struct Args {
     /// Figure files: svg, png (rendered from the SVG) or both [default: svg]
     #[arg(long)]
     pub format: Option<String>,
+    /// Velocities on the figures: dimensionless (units of sqrt(g (R + r))) or si (m/s, for
+    /// data given in m/s with R_m) [default: dimensionless]
+    #[arg(long)]
+    pub units: Option<String>,
     /// The level of every interval.
     #[command(flatten)]
     pub level: LevelArgs,
@@ -48,8 +52,8 @@ pub struct Args {
     /// MCMC: maximum steps per fit [default: 100000]
     #[arg(long)]
     pub max_steps: Option<usize>,
-    /// A TOML recipe with any of the keys input, out_dir, method, format, rho, f, g, level,
-    /// seed, min_ess, max_steps (paths relative to the recipe's directory); flags given on the
+    /// A TOML recipe with any of the keys input, out_dir, method, format, units, rho, f, g,
+    /// level, seed, min_ess, max_steps (paths relative to the recipe's directory); flags given on the
     /// command line win.
     #[arg(long)]
     pub recipe: Option<PathBuf>,
@@ -67,6 +71,8 @@ pub struct Recipe {
     pub method: Option<String>,
     /// svg, png or both.
     pub format: Option<String>,
+    /// dimensionless or si.
+    pub units: Option<String>,
     /// ρ.
     pub rho: Option<f64>,
     /// f.
@@ -108,6 +114,15 @@ fn read_recipe(path: &Path) -> Result<Recipe, CliError> {
     Ok(r)
 }
 
+/// The unit of the velocities on the report's figures (`--units`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Units {
+    /// Units of sqrt(g (R + r)).
+    Dimensionless,
+    /// m/s.
+    Si,
+}
+
 /// Runs `fitbead report`.
 pub fn run(a: Args) -> Result<(), CliError> {
     let r = match &a.recipe {
@@ -120,6 +135,18 @@ pub fn run(a: Args) -> Result<(), CliError> {
         _ => None,
     };
     let input = from_flags.or(r.input);
+    let units = match a.units.clone().or(r.units.clone()).as_deref() {
+        None => Units::Dimensionless,
+        Some(u) if u.eq_ignore_ascii_case("dimensionless") => Units::Dimensionless,
+        Some(u) if u.eq_ignore_ascii_case("si") => Units::Si,
+        Some(u) => {
+            return Err(super::flag_error(
+                "--units",
+                u,
+                "expected dimensionless or si",
+            ))
+        }
+    };
     let format_text = a.format.clone().or(r.format);
     let format: FigureFormat = match &format_text {
         Some(f) => f
@@ -257,6 +284,39 @@ pub fn run(a: Args) -> Result<(), CliError> {
         "stats.csv".into(),
         fitbead::io::reports::stats_csv(&stats).map_err(csv_err)?,
     ));
+    // Velocities in m/s on the figures (--units si): each series' unit sqrt(g R (1 + ξ)).
+    let si = si_conversion(&t, &io.data.defaults()?);
+    let units_m_s: Option<Vec<f64>> = match units {
+        Units::Dimensionless => None,
+        Units::Si => {
+            let si = si.as_ref().ok_or_else(|| {
+                super::flag_error(
+                    "--units",
+                    "si",
+                    "the velocities were given dimensionless (column v): figures in m/s need \
+                     v_m_s with R_m",
+                )
+            })?;
+            let mut u = Vec::new();
+            for label in &ds.labels {
+                let s = si.iter().find(|s| &s.series == label);
+                match s.and_then(|s| s.unit()) {
+                    Some(x) => u.push(x),
+                    None => {
+                        return Err(super::flag_error(
+                            "--units",
+                            "si",
+                            format!(
+                                "series {label} has rows of different R_m or g, so no one unit \
+                                 converts its velocities to m/s"
+                            ),
+                        ))
+                    }
+                }
+            }
+            Some(u)
+        }
+    };
     // Under a posterior run: the bands of v̄(δ) and the posterior median at every point.
     let bands = an
         .mcmc
@@ -277,7 +337,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
     };
     files.push(fig(
         "velocity.svg",
-        an.velocity_figure_with(bands.as_ref()),
+        an.velocity_figure_with(bands.as_ref(), units_m_s.as_deref()),
     )?);
     files.push(fig("jan_linear.svg", an.jan_figure())?);
     files.push(fig("k_final_velocity.svg", an.k_figure())?);
@@ -305,7 +365,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let context = ReportContext {
         source: shown.unwrap_or_else(|| t.source.clone()),
         shipped_synthetic: is_shipped_data(&ds),
-        si: si_conversion(&t, &io.data.defaults()?),
+        si,
         figure_format: format,
         corner_files,
     };

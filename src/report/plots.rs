@@ -155,13 +155,25 @@ impl Analysis {
     /// and 9). A model whose curve lies on an earlier one is dashed, and its legend entry
     /// says on which. [`Panel::band`] adds a shaded band under a curve.
     pub fn velocity_figure(&self) -> Result<String, String> {
-        self.velocity_figure_with(None)
+        self.velocity_figure_with(None, None)
     }
 
     /// [`Analysis::velocity_figure`] with, for a posterior run, each model's 90 % posterior
     /// band of v̄(δ) (from [`posterior_bands`](super::bands::posterior_bands): the 5 % and 95 %
-    /// quantiles of the model's v̄ over the draws) shaded under its curve.
-    pub fn velocity_figure_with(&self, bands: Option<&PosteriorBands>) -> Result<String, String> {
+    /// quantiles of the model's v̄ over the draws) shaded under its curve; with `units_m_s`
+    /// (per series, in the order of [`Dataset::labels`](crate::fit::data::Dataset::labels),
+    /// the velocity unit sqrt(g R (1 + ξ)) in m/s of velocities given in m/s), in m/s.
+    pub fn velocity_figure_with(
+        &self,
+        bands: Option<&PosteriorBands>,
+        units_m_s: Option<&[f64]>,
+    ) -> Result<String, String> {
+        let unit = |s: usize| units_m_s.and_then(|u| u.get(s).copied()).unwrap_or(1.0);
+        let v_label = if units_m_s.is_some() {
+            "mean velocity v\u{304} (m/s)"
+        } else {
+            V_LABEL
+        };
         let mut panels = Vec::new();
         let mut curves_by_panel = Vec::new();
         for s in 0..self.data.labels.len() {
@@ -172,14 +184,20 @@ impl Analysis {
             let grid: Vec<f64> = (0..=160)
                 .map(|i| (d0 - pad).max(1e-4) + (d1 - d0 + 2.0 * pad) * i as f64 / 160.0)
                 .collect();
-            curves_by_panel.push(self.model_curves(s, &grid));
+            let u = unit(s);
+            let curves = self.model_curves(s, &grid);
+            curves_by_panel.push(curves.map(|c| {
+                c.into_iter()
+                    .map(|(d, v)| (d, v * u))
+                    .collect::<Vec<(f64, f64)>>()
+            }));
             let mut p = Panel::new(
                 &self.series_title(s),
                 Axis::new(DELTA_LABEL),
-                Axis::new(V_LABEL),
+                Axis::new(v_label),
             );
             p.points(
-                self.series_points(s, |q, v| (q.scene.delta_deg(), v)),
+                self.series_points(s, |q, v| (q.scene.delta_deg(), v * u)),
                 DATA,
                 Mark::Circle,
             );
@@ -248,7 +266,7 @@ impl Analysis {
                         .iter()
                         .zip(b.q05.iter().zip(&b.q95))
                         .filter(|(_, (lo, hi))| lo.is_finite() && hi.is_finite())
-                        .map(|(&d, (&lo, &hi))| (d, lo, hi))
+                        .map(|(&d, (&lo, &hi))| (d, lo * unit(s), hi * unit(s)))
                         .collect();
                     if pts.len() > 1 {
                         p.band(pts, colour, 0.18);

@@ -194,6 +194,25 @@ fn report_md_states_the_si_conversion() {
     // sqrt(9.81 · 0.003 · 2) = 0.242611 m/s and sqrt(9.81 · 0.003 · 3) = 0.297136 m/s.
     assert!(md.contains("| A | 1 | 0.003 | 9.81 | 0.242611 |"), "{md}");
     assert!(md.contains("| B | 2 | 0.003 | 9.81 | 0.297136 |"), "{md}");
+    // Without --units the velocity figure is dimensionless; with --units si, in m/s.
+    let fig = std::fs::read_to_string(out_dir.join("velocity.svg")).unwrap();
+    assert!(fig.contains("√(g(R + r))") && !fig.contains("(m/s)"));
+    let si_dir = dir.path().join("si");
+    report_into(
+        &si_dir,
+        &["--input", input.to_str().unwrap(), "--units", "si"],
+    );
+    let fig = std::fs::read_to_string(si_dir.join("velocity.svg")).unwrap();
+    assert!(fig.contains("(m/s)"), "velocity.svg is not in m/s");
+    // The dimensionless data are refused with --units si.
+    let out = bin()
+        .args(["report", "--units", "si", "--out-dir"])
+        .arg(dir.path().join("no"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--units"));
+    assert!(!dir.path().join("no").exists());
 }
 
 /// Without --output, klaw, jan and jaeger print a fit report per fit on stdout (and no

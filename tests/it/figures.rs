@@ -271,8 +271,21 @@ fn report_figures_render() {
     assert_eq!(names, want);
     for (name, colours) in figs {
         let svg = std::fs::read_to_string(dir.join(format!("{name}.svg"))).unwrap();
-        // Sub-pixel coordinates, a light major grid, the embedded font named first.
+        // The embedded font named first.
         assert!(svg.contains("font-family=\"DejaVu Sans,"), "{name}");
+        // Curves at sub-pixel coordinates (no stairs): most polyline coordinates are not
+        // whole pixels.
+        let coords: Vec<&str> = svg
+            .split("<polyline points=\"")
+            .skip(1)
+            .flat_map(|p| p.split('"').next().unwrap().split([' ', ',']))
+            .collect();
+        let whole = coords.iter().filter(|c| !c.contains('.')).count();
+        assert!(
+            (whole as f64) < 0.5 * coords.len() as f64,
+            "{name}: {whole} of {} coordinates whole",
+            coords.len()
+        );
         let l = look(
             &format!("report {name}"),
             &svg,

@@ -45,6 +45,24 @@ fn g4(x: f64) -> String {
     fmt_sig(x, 4).replace('-', "\u{2212}")
 }
 
+/// A shaded band of the velocity figure: under model `model` (the index in the figure's
+/// order: 0 rolling law c, 1 stick/slip law c, 2 Jan, 3 Jaeger) in series `series` (the data
+/// set's series index), samples (δ in degrees, v̄ low, v̄ high).
+#[derive(Debug, Clone)]
+pub struct VelocityBand {
+    /// Series index.
+    pub series: usize,
+    /// Model index.
+    pub model: usize,
+    /// Samples (δ°, low, high).
+    pub pts: Vec<(f64, f64, f64)>,
+    /// Legend label (markup), e.g. "Jaeger, 90 % posterior predictive band".
+    pub label: String,
+}
+
+/// Opacity of the velocity figure's bands.
+const BAND_OPACITY: f64 = 0.2;
+
 /// The models of the velocity figure, in drawing order: name in the legend and colour.
 const VELOCITY_MODELS: [(&str, &str); 4] = [
     ("rolling, law c", PALETTE[0]),
@@ -149,8 +167,14 @@ impl Analysis {
 
     /// Figure: v̄ against δ per series with every fitted model (the paper's Figs. 2–3, 8
     /// and 9). A model whose curve lies on an earlier one is dashed, and its legend entry
-    /// says on which. [`Panel::band`] adds a shaded band under a curve.
+    /// says on which.
     pub fn velocity_figure(&self) -> Result<String, String> {
+        self.velocity_figure_with(&[])
+    }
+
+    /// [`Analysis::velocity_figure`] with shaded bands under the models' curves (a posterior
+    /// predictive band, say), each in its model's colour, with one legend entry per label.
+    pub fn velocity_figure_with(&self, bands: &[VelocityBand]) -> Result<String, String> {
         let mut panels = Vec::new();
         let mut curves_by_panel = Vec::new();
         for s in 0..self.data.labels.len() {
@@ -229,6 +253,15 @@ impl Analysis {
                 p.curve(cs[m].clone(), stroke.clone());
             }
             legend.push(LegendEntry::line(&label, &stroke));
+        }
+        for b in bands {
+            let colour = VELOCITY_MODELS[b.model % VELOCITY_MODELS.len()].1;
+            if let Some(p) = panels.get_mut(b.series) {
+                p.band(b.pts.clone(), colour, BAND_OPACITY);
+            }
+            if !legend.iter().any(|e| e.label == b.label) {
+                legend.push(LegendEntry::patch(&b.label, colour, BAND_OPACITY));
+            }
         }
         let mut f = Figure::new(
             "Mean velocity against slope: data and fitted models",

@@ -387,3 +387,40 @@ fn wp_table_reads_back_byte_for_byte() {
     assert!(rows.len() > 20);
     assert_eq!(render(&rows).unwrap(), bytes);
 }
+
+/// A band under a model's curve in the velocity figure is drawn in that model's colour, under
+/// the data, with its legend entry.
+#[test]
+fn velocity_band_renders_under_the_curve() {
+    use fitbead::fit::data::Dataset;
+    use fitbead::fit::posterior::Method;
+    use fitbead::report::analysis::analyse;
+    use fitbead::report::plots::VelocityBand;
+    let ds = Dataset::default_data();
+    let an = analyse(&ds, 0.95, &Method::lsq(false));
+    let pts: Vec<(f64, f64, f64)> = (0..=20)
+        .map(|i| {
+            let d = 11.0 + 2.5 * i as f64 / 20.0;
+            (d, 0.30 + 0.03 * (d - 11.0), 0.34 + 0.03 * (d - 11.0))
+        })
+        .collect();
+    let label = "Jaeger, 90 % band";
+    let svg = an
+        .velocity_figure_with(&[VelocityBand {
+            series: 0,
+            model: 3,
+            pts,
+            label: label.into(),
+        }])
+        .unwrap();
+    assert!(svg.contains(label));
+    let band = svg.find("fill-opacity=\"0.2\"").expect("a band");
+    let first_marker = svg.find("<circle").expect("markers");
+    assert!(band < first_marker, "the band is drawn under the data");
+    look(
+        "velocity_band",
+        &svg,
+        &out_dir().join("velocity_band.png"),
+        &[rgb(PALETTE[3], 0.2), rgb(PALETTE[3], 1.0)],
+    );
+}

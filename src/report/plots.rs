@@ -153,7 +153,7 @@ impl Analysis {
 
     /// Figure: v̄ against δ per series with every fitted model (the paper's Figs. 2–3, 8
     /// and 9). A model whose curve lies on an earlier one is dashed, and its legend entry
-    /// says on which. [`Panel::band`] adds a shaded band under a curve.
+    /// says on which.
     pub fn velocity_figure(&self) -> Result<String, String> {
         self.velocity_figure_with(None, None)
     }
@@ -729,6 +729,13 @@ impl Analysis {
                 panels.push(p);
             }
         }
+        // One y axis per row: the panels right of the first share it.
+        for (i, p) in panels.iter_mut().enumerate() {
+            if i % 4 != 0 {
+                p.y.label.clear();
+                p.y.hide_tick_labels = true;
+            }
+        }
         let mut f = Figure::new(
             "Energy partition per point at each model's law-c fit (§4.6, eqs 70–72)",
             4,
@@ -739,6 +746,27 @@ impl Analysis {
             .iter()
             .map(|(l, c)| LegendEntry::patch(l, c, 1.0))
             .collect();
+        // The friction share is too thin to read off the bars: say how large it gets.
+        let shares: Vec<String> = self
+            .contact
+            .iter()
+            .filter_map(|c| {
+                let m = c
+                    .energy
+                    .iter()
+                    .flatten()
+                    .map(|e| e.friction_work / e.potential_drop)
+                    .fold(f64::NEG_INFINITY, f64::max);
+                m.is_finite()
+                    .then(|| format!("{} {} %", model_title(c.name), fmt_sig(100.0 * m, 2)))
+            })
+            .collect();
+        if !shares.is_empty() {
+            f.notes.push(format!(
+                "Largest friction work, as a share of the potential drop: {}.",
+                shares.join(", ")
+            ));
+        }
         Ok(f.to_svg())
     }
 

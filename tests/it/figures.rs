@@ -271,8 +271,21 @@ fn report_figures_render() {
     assert_eq!(names, want);
     for (name, colours) in figs {
         let svg = std::fs::read_to_string(dir.join(format!("{name}.svg"))).unwrap();
-        // Sub-pixel coordinates, a light major grid, the embedded font named first.
+        // The embedded font named first.
         assert!(svg.contains("font-family=\"DejaVu Sans,"), "{name}");
+        // Curves at sub-pixel coordinates (no stairs): most polyline coordinates are not
+        // whole pixels.
+        let coords: Vec<&str> = svg
+            .split("<polyline points=\"")
+            .skip(1)
+            .flat_map(|p| p.split('"').next().unwrap().split([' ', ',']))
+            .collect();
+        let whole = coords.iter().filter(|c| !c.contains('.')).count();
+        assert!(
+            (whole as f64) < 0.5 * coords.len() as f64,
+            "{name}: {whole} of {} coordinates whole",
+            coords.len()
+        );
         let l = look(
             &format!("report {name}"),
             &svg,
@@ -373,4 +386,42 @@ fn wp_table_reads_back_byte_for_byte() {
     let rows = read_rows(&bytes).unwrap();
     assert!(rows.len() > 20);
     assert_eq!(render(&rows).unwrap(), bytes);
+}
+
+/// A posterior band under a model's curve in the velocity figure is drawn in that model's
+/// colour, under the data, with its legend entry.
+#[test]
+fn velocity_band_renders_under_the_curve() {
+    use fitbead::fit::data::Dataset;
+    use fitbead::fit::posterior::Method;
+    use fitbead::report::analysis::analyse;
+    use fitbead::report::bands::{Band, PosteriorBands};
+    let ds = Dataset::default_data();
+    let an = analyse(&ds, 0.95, &Method::lsq(false));
+    let delta_deg: Vec<f64> = (0..=20).map(|i| 11.0 + 2.5 * i as f64 / 20.0).collect();
+    let line = |a: f64| -> Vec<f64> { delta_deg.iter().map(|d| a + 0.03 * (d - 11.0)).collect() };
+    let bands = PosteriorBands {
+        bands: vec![Band {
+            fit: "jaeger".into(),
+            series: ds.labels[0].clone(),
+            xi: 0.8,
+            q05: line(0.30),
+            q50: line(0.32),
+            q95: line(0.34),
+            delta_deg: delta_deg.clone(),
+            draws: 1000,
+        }],
+        points: Vec::new(),
+    };
+    let svg = an.velocity_figure_with(Some(&bands), None).unwrap();
+    assert!(svg.contains("posterior band"));
+    let band = svg.find("fill-opacity=\"0.18\"").expect("a band");
+    let first_marker = svg.find("<circle").expect("markers");
+    assert!(band < first_marker, "the band is drawn under the data");
+    look(
+        "velocity_band",
+        &svg,
+        &out_dir().join("velocity_band.png"),
+        &[rgb(PALETTE[3], 0.18), rgb(PALETTE[3], 1.0)],
+    );
 }

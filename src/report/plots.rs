@@ -69,6 +69,16 @@ impl Analysis {
         }
     }
 
+    /// One legend entry per series in its [`series_style`], its title followed by `suffix`.
+    fn series_legend(&self, suffix: &str) -> Vec<LegendEntry> {
+        (0..self.data.labels.len())
+            .map(|s| {
+                let (c, m) = series_style(s);
+                LegendEntry::mark(&format!("{}{suffix}", self.series_title(s)), m, c)
+            })
+            .collect()
+    }
+
     /// Series `s`'s points as (x, y, y ∓ σ) through `f`, which maps (point, v) to (x, y);
     /// the bar is σ mapped the same way (none without absolute σ).
     fn series_points(
@@ -403,12 +413,7 @@ impl Analysis {
             .map(|&a| (a.to_degrees(), CollisionLaw::Cos2a.k(a, rho)))
             .collect();
         let cos_stroke = Stroke::solid(REFERENCE, 1.8).dashed(DASHES[0]);
-        let mut legend: Vec<LegendEntry> = (0..self.data.labels.len())
-            .map(|s| {
-                let (c, m) = series_style(s);
-                LegendEntry::mark(&format!("{}: K per point", self.series_title(s)), m, c)
-            })
-            .collect();
+        let mut legend = self.series_legend(": K per point");
         legend.push(LegendEntry::line("K = cos 2α", &cos_stroke));
         let law_stroke = Stroke::solid("#000000", 2.2);
         legend.push(LegendEntry::line(
@@ -867,12 +872,7 @@ impl Analysis {
             (330.0, 220.0),
             panels,
         );
-        f.legend = (0..self.data.labels.len())
-            .map(|s| {
-                let (c, m) = series_style(s);
-                LegendEntry::mark(&self.series_title(s), m, c)
-            })
-            .collect();
+        f.legend = self.series_legend("");
         f.legend.push(LegendEntry::line(
             "±2",
             &Stroke::solid(REFERENCE, 1.2).dashed(DASHES[0]),

@@ -1075,23 +1075,35 @@ impl Figure {
             .iter()
             .map(|n| text_width(n, LEGEND_SIZE) + 4.0 * GAP)
             .fold(0.0, f64::max);
-        // The shared legend goes into the empty cells that end the last row when it fits
-        // there, else to the right of the grid.
-        let used = self.panels.len() - (rows - 1) * cols;
-        let in_cells = (lw > 0.0 && used < cols).then(|| {
-            let x0 = xs[used] - left[used];
-            let y0 = ys[rows - 1] - top[rows - 1];
-            (
-                x0 + 2.0 * GAP,
-                y0 + top[rows - 1],
-                grid_w - x0,
-                h + bottom[rows - 1],
-            )
-        });
-        let legend_at = match in_cells {
-            Some((x, y, aw, ah)) if lw + 2.0 * GAP <= aw && lh <= ah => Some((x, y)),
-            _ if lw > 0.0 => None,
-            _ => Some((0.0, 0.0)),
+        // The shared legend goes into empty cells when it fits there — those that end the last
+        // row, or those that end the first (above a corner plot's diagonal) — else to the
+        // right of the grid.
+        let used_last = self.panels.len() - (rows - 1) * cols;
+        let used_first = cols
+            - self.panels[..cols.min(self.panels.len())]
+                .iter()
+                .rev()
+                .take_while(|p| p.is_none())
+                .count();
+        let cells = |row: usize, used: usize| -> Option<(f64, f64, f64, f64)> {
+            (used > 0 && used < cols).then(|| {
+                let x0 = xs[used] - left[used];
+                (
+                    x0 + 2.0 * GAP,
+                    ys[row],
+                    grid_w - x0 - 2.0 * GAP,
+                    h + bottom[row],
+                )
+            })
+        };
+        let fits = |c: Option<(f64, f64, f64, f64)>| {
+            c.filter(|&(_, _, aw, ah)| lw + GAP <= aw && lh <= ah)
+                .map(|c| (c.0, c.1))
+        };
+        let legend_at = if lw > 0.0 {
+            fits(cells(rows - 1, used_last)).or_else(|| fits(cells(0, used_first)))
+        } else {
+            Some((0.0, 0.0))
         };
         let extra = if legend_at.is_none() {
             lw + 3.0 * GAP

@@ -7,7 +7,8 @@
 
 use super::cells::Cells;
 use super::measurements::{
-    Implausible, Measured, MeasurementColumns, MeasurementDefaults, Plausibility, SeriesLedger,
+    Implausible, Measured, MeasurementColumns, MeasurementDefaults, Plausibility, PlausiblePoint,
+    SeriesLedger,
 };
 use super::scenes::{Header, Row};
 use super::stream::RowPlan;
@@ -111,11 +112,11 @@ impl KScratch {
     }
 }
 
-/// What a written row hands on, in input order: its ξ (for the series check) and its point
-/// on the plot.
+/// What a written row hands on, in input order: what the series and plausibility checks need
+/// of it, and its point on the plot.
 #[derive(Debug, Clone, Copy)]
 pub struct KNote {
-    measured: Measured,
+    point: PlausiblePoint,
     plot: Option<PlotNote>,
 }
 
@@ -336,14 +337,17 @@ impl RowPlan for KPlan {
             }),
             _ => None,
         };
-        KNote { measured: m, plot }
+        KNote {
+            point: PlausiblePoint::from(&m),
+            plot,
+        }
     }
 
     fn record(&self, ledger: &mut KLedger, row: &Row<'_>, note: KNote) -> Result<(), InputError> {
         self.cols
-            .check_series(&mut ledger.series, row, note.measured.scene.xi())?;
+            .check_series(&mut ledger.series, row, note.point.xi)?;
         if let Some(p) = &mut ledger.plausibility {
-            p.add(row, &note.measured);
+            p.add_point(row, &note.point);
         }
         let Some(n) = note.plot else { return Ok(()) };
         let series = self.cols.series(row);

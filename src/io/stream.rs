@@ -203,8 +203,10 @@ where
     let mut header = Vec::new();
     plan.header(&mut header);
     let mut pending = vec![header];
-    // Output buffers come back here once written, and serve the chunk after next.
+    // Output buffers come back here once written, and serve the chunk after next; the notes'
+    // vectors come back once recorded, and serve the next chunk.
     let mut spare: Vec<Vec<u8>> = Vec::new();
+    let mut note_bufs: Vec<Vec<P::Note>> = Vec::new();
     let mut failed = None;
     let mut rows = 0u64;
     // Output bytes per row to reserve (grown to what the rows so far needed).
@@ -224,7 +226,7 @@ where
                     &plan,
                     &ctx,
                     &cur[..n_cur],
-                    bufs,
+                    (bufs, &mut note_bufs),
                     row_bytes,
                     &mut ledger,
                     opts,
@@ -292,26 +294,30 @@ fn write_parts(out: &mut dyn Write, parts: &[Vec<u8>], failed: &mut Option<std::
 type Part<N> = (Vec<u8>, Vec<N>, Option<StreamError>);
 
 /// One chunk of rows: their output bytes in order (one buffer per task, taken from `bufs`
-/// where there is one, with room for `row_bytes` per row), the notes recorded, or the first
-/// bad row's error.
+/// where there is one, with room for `row_bytes` per row), the notes recorded (their
+/// vectors taken from and returned to `note_bufs`), or the first bad row's error.
 fn chunk<P: RowPlan>(
     plan: &P,
     ctx: &Context,
     recs: &[csv::StringRecord],
-    mut bufs: Vec<Vec<u8>>,
+    (mut bufs, note_bufs): (Vec<Vec<u8>>, &mut Vec<Vec<P::Note>>),
     row_bytes: usize,
     ledger: &mut P::Ledger,
     opts: &StreamOptions,
 ) -> Result<Vec<Vec<u8>>, StreamError> {
     let task = opts.task_rows.max(1);
-    bufs.resize_with(recs.len().div_ceil(task), Vec::new);
+    let tasks = recs.len().div_ceil(task);
+    bufs.resize_with(tasks, Vec::new);
+    note_bufs.resize_with(tasks.max(note_bufs.len()), Vec::new);
+    let note_vecs: Vec<Vec<P::Note>> = note_bufs.drain(..tasks).collect();
     let parts: Vec<Part<P::Note>> = recs
         .par_chunks(task)
-        .zip(bufs.into_par_iter())
-        .map(|(rs, mut buf)| {
+        .zip(bufs.into_par_iter().zip(note_vecs))
+        .map(|(rs, (mut buf, mut notes))| {
             buf.clear();
             buf.reserve(rs.len() * row_bytes);
-            let mut notes = Vec::with_capacity(rs.len());
+            notes.clear();
+            notes.reserve(rs.len());
             if stopped(opts) {
                 return (buf, notes, Some(StreamError::Stopped));
             }
@@ -327,10 +333,11 @@ fn chunk<P: RowPlan>(
         })
         .collect();
     let mut out = Vec::with_capacity(parts.len());
-    for ((buf, notes, err), rs) in parts.into_iter().zip(recs.chunks(task)) {
-        for (n, rec) in notes.into_iter().zip(rs) {
+    for ((buf, mut notes, err), rs) in parts.into_iter().zip(recs.chunks(task)) {
+        for (n, rec) in notes.drain(..).zip(rs) {
             plan.record(ledger, &ctx.row(rec), n)?;
         }
+        note_bufs.push(notes);
         if let Some(e) = err {
             return Err(e);
         }

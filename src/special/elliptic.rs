@@ -80,6 +80,14 @@ fn rf_in_range(x: f64, y: f64, z: f64) -> f64 {
             break;
         }
     }
+    rf_series([x, y, z], a0, an, f)
+}
+
+/// The end of the duplication algorithm: the series of DLMF 19.36.1 to 7th order at the
+/// last iterate `an` (after steps that multiplied `f` by 4 each), from the arguments and
+/// their mean `a0`.
+#[inline(always)]
+fn rf_series([x, y, _]: [f64; 3], a0: f64, an: f64, f: f64) -> f64 {
     let xs = (a0 - x) / (an * f);
     let ys = (a0 - y) / (an * f);
     let zs = -xs - ys;
@@ -129,10 +137,78 @@ pub fn cos_integral(h0: SinCos, h1: SinCos, w0sq: f64, w1sq: f64, wtsq: f64, den
     if h0.s >= 0.0 {
         return same_side(h0, h1, w0sq, w1sq, den);
     }
-    // Across the top.
+    // Across the top: the two halves' R_F run side by side (`rf_pair`).
     let wt2 = wtsq;
-    let half = |h: SinCos, wsq: f64| -> f64 { h.s.abs() * rf(h.c * h.c * wt2, wsq, wt2) };
-    2.0 * (half(h1, w1sq) + half(h0, w0sq))
+    let (r1, r0) = rf_pair(
+        [h1.c * h1.c * wt2, w1sq, wt2],
+        [h0.c * h0.c * wt2, w0sq, wt2],
+    );
+    2.0 * (h1.s.abs() * r1 + h0.s.abs() * r0)
+}
+
+/// [`rf`] of two argument triples, `(rf(a), rf(b))` to the last bit: where both are in the
+/// range of the duplication algorithm proper, its two iterations run in one loop, each
+/// stopping after its own number of steps with the operations of [`rf`], so that the
+/// processor overlaps the two chains of dependent square roots (one R_F is bound by their
+/// latency); elsewhere two calls of [`rf`].
+#[inline]
+pub fn rf_pair(a: [f64; 3], b: [f64; 3]) -> (f64, f64) {
+    if !(in_range(a) && in_range(b)) {
+        return (rf(a[0], a[1], a[2]), rf(b[0], b[1], b[2]));
+    }
+    // (3 ε)^{-1/8} for ε = 2^-52, as in `rf_in_range`.
+    const STOP: f64 = 78.8959690786408;
+    let start = |[x, y, z]: [f64; 3]| {
+        let a0 = (x + y + z) / 3.0;
+        let q = STOP * (a0 - x).abs().max((a0 - y).abs()).max((a0 - z).abs());
+        (a0, q)
+    };
+    let (a0a, mut qa) = start(a);
+    let (a0b, mut qb) = start(b);
+    let (mut na, mut nb) = (a, b);
+    let (mut ana, mut anb) = (a0a, a0b);
+    let (mut fa, mut fb) = (1.0f64, 1.0f64);
+    let (mut live_a, mut live_b) = (true, true);
+    for _ in 0..11 {
+        if live_a {
+            let (rx, ry, rz) = (na[0].sqrt(), na[1].sqrt(), na[2].sqrt());
+            let lambda = rx * ry + rx * rz + ry * rz;
+            ana = (ana + lambda) / 4.0;
+            na = [
+                (na[0] + lambda) / 4.0,
+                (na[1] + lambda) / 4.0,
+                (na[2] + lambda) / 4.0,
+            ];
+            qa /= 4.0;
+            fa *= 4.0;
+            live_a = !(qa < ana.abs());
+        }
+        if live_b {
+            let (rx, ry, rz) = (nb[0].sqrt(), nb[1].sqrt(), nb[2].sqrt());
+            let lambda = rx * ry + rx * rz + ry * rz;
+            anb = (anb + lambda) / 4.0;
+            nb = [
+                (nb[0] + lambda) / 4.0,
+                (nb[1] + lambda) / 4.0,
+                (nb[2] + lambda) / 4.0,
+            ];
+            qb /= 4.0;
+            fb *= 4.0;
+            live_b = !(qb < anb.abs());
+        }
+        if !(live_a || live_b) {
+            break;
+        }
+    }
+    (rf_series(a, a0a, ana, fa), rf_series(b, a0b, anb, fb))
+}
+
+/// Arguments that [`rf`] hands to the duplication algorithm proper unchanged: non-negative,
+/// at most one zero, none infinite, the largest in [1e-30, 1e30].
+#[inline(always)]
+fn in_range([x, y, z]: [f64; 3]) -> bool {
+    let zeros = (x == 0.0) as u8 + (y == 0.0) as u8 + (z == 0.0) as u8;
+    x >= 0.0 && y >= 0.0 && z >= 0.0 && zeros < 2 && (1e-30..=1e30).contains(&x.max(y).max(z))
 }
 
 #[inline]
@@ -180,6 +256,47 @@ mod tests {
         assert_eq!(rf(0.0, 0.0, 1.0), f64::INFINITY);
         assert_eq!(rf(f64::INFINITY, 1.0, 1.0), 0.0);
         assert!(rf(-1.0, 1.0, 1.0).is_nan() && rf(f64::NAN, 1.0, 1.0).is_nan());
+    }
+
+    /// `rf_pair` is two calls of `rf`, to the last bit, wherever the lanes stop: argument
+    /// triples over 24 decades (so that the two lanes take different numbers of steps),
+    /// across-the-top triples as `cos_integral` forms them, and the special and out-of-range
+    /// triples that fall back to `rf`.
+    #[test]
+    fn rf_pair_is_two_rf_calls_to_the_bit() {
+        let mut triples = vec![
+            [0.0, 1.0, 2.0],
+            [0.0, 0.0, 1.0],
+            [f64::INFINITY, 1.0, 1.0],
+            [-1.0, 1.0, 1.0],
+            [f64::NAN, 1.0, 1.0],
+            [1e-40, 2e-40, 3e-40],
+            [1e31, 1.0, 2.0],
+            [1.0, 1.0, 1.0],
+        ];
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut uniform = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..400 {
+            let e = |u: f64| 10f64.powf(-12.0 + 24.0 * u);
+            triples.push([e(uniform()), e(uniform()), e(uniform())]);
+            // Across the top: c² w_t², w², w_t² with w_t² from 1e-14 to 1.
+            let wt2 = 10f64.powf(-14.0 * uniform());
+            let c = 0.8 + 0.2 * uniform();
+            triples.push([c * c * wt2, wt2 + uniform(), wt2]);
+        }
+        for a in &triples {
+            for b in triples.iter().step_by(7) {
+                let (p, q) = rf_pair(*a, *b);
+                let (x, y) = (rf(a[0], a[1], a[2]), rf(b[0], b[1], b[2]));
+                assert_eq!(p.to_bits(), x.to_bits(), "{a:?}");
+                assert_eq!(q.to_bits(), y.to_bits(), "{b:?}");
+            }
+        }
     }
 
     /// Arguments beyond [1e-30, 1e30], which `rf` scales by its homogeneity, against the

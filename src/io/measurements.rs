@@ -220,33 +220,40 @@ impl MeasurementColumns {
     /// Reads and validates one row (dimensional input converted with
     /// v = v_m_s / sqrt(g R (1 + ξ))), or reports its first bad value.
     pub fn read(&self, r: &Row<'_>) -> Result<Measured, InputError> {
+        self.read_like(r, None)
+    }
+
+    /// [`MeasurementColumns::read`], its scene built by [`Scene::new_like`] from `like` (the
+    /// scene of a row read before, usually the one before it).
+    pub fn read_like(&self, r: &Row<'_>, like: Option<&Scene>) -> Result<Measured, InputError> {
         let MeasurementDefaults { rho, f, g } = self.defaults;
         let xi = r.number(self.xi)?;
         let d = r.number(self.delta_deg)?;
         let rho = r.opt_number(self.rho)?.unwrap_or(rho);
         let f = r.opt_number(self.f)?.unwrap_or(f);
-        let scene = Scene::new(xi, d, rho, f, CollisionLaw::Value(0.5)).map_err(|e| {
-            let col = match &e {
-                crate::scene::ParameterError::InvalidParameter { field, .. } => match *field {
-                    "xi" => Some(self.xi),
-                    "delta" | "delta_deg" => Some(self.delta_deg),
-                    "rho" => self.rho,
-                    "f" => self.f,
+        let scene =
+            Scene::new_like(like, xi, d, rho, f, CollisionLaw::Value(0.5)).map_err(|e| {
+                let col = match &e {
+                    crate::scene::ParameterError::InvalidParameter { field, .. } => match *field {
+                        "xi" => Some(self.xi),
+                        "delta" | "delta_deg" => Some(self.delta_deg),
+                        "rho" => self.rho,
+                        "f" => self.f,
+                        _ => None,
+                    },
                     _ => None,
-                },
-                _ => None,
-            };
-            match col {
-                Some(c) => r.err(c, e.to_string()),
-                None => InputError {
-                    file: r.source.to_string(),
-                    line: Some(r.line),
-                    column: None,
-                    value: None,
-                    message: e.to_string(),
-                },
-            }
-        })?;
+                };
+                match col {
+                    Some(c) => r.err(c, e.to_string()),
+                    None => InputError {
+                        file: r.source.to_string(),
+                        line: Some(r.line),
+                        column: None,
+                        value: None,
+                        message: e.to_string(),
+                    },
+                }
+            })?;
         let given = |c: Option<usize>| c.filter(|&c| !r.cell(c).is_empty());
         let (v, sigma_v) = match self.v {
             Some(c) => {

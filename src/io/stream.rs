@@ -46,8 +46,13 @@ pub trait RowPlan: Sync {
     /// Appends the output's header record.
     fn header(&self, out: &mut Vec<u8>);
 
-    /// Checks the cells of one row, or reports its first bad value.
-    fn prepare(&self, row: &Row<'_>) -> Result<Self::Ready, InputError>;
+    /// Checks the cells of one row, or reports its first bad value; `scratch` is the task's,
+    /// as [`write`](RowPlan::write) gets it.
+    fn prepare(
+        &self,
+        row: &Row<'_>,
+        scratch: &mut Self::Scratch,
+    ) -> Result<Self::Ready, InputError>;
 
     /// Computes one row and appends its output record to `out`.
     fn write(
@@ -324,7 +329,7 @@ fn chunk<P: RowPlan>(
             let mut scratch = P::Scratch::default();
             for rec in rs {
                 let row = ctx.row(rec);
-                match plan.prepare(&row) {
+                match plan.prepare(&row, &mut scratch) {
                     Ok(r) => notes.push(plan.write(&row, r, &mut scratch, &mut buf)),
                     Err(e) => return (buf, notes, Some(StreamError::Input(e))),
                 }

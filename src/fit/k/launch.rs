@@ -585,7 +585,10 @@ pub fn estimate(model: &Model, scene: &Scene, v: f64, sigma_v: Option<f64>) -> O
     }
     let steady = steady_of(scene, &p, y, map_slope);
     let theta_g = match l.mech {
-        Mechanics::Roll => scene.with_k(k).ok().and_then(|s| theta_g(&s, p.w0 * p.w0)),
+        // Θ_G does not involve K: the scene's own serves (K checked as `Scene::with_k` would).
+        Mechanics::Roll => (k.is_finite() && k > 0.0)
+            .then_some(())
+            .and_then(|()| theta_g(scene, p.w0 * p.w0)),
         Mechanics::RollSlip => steady.theta_g,
     };
     Some(KEstimate {

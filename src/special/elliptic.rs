@@ -137,70 +137,91 @@ pub fn cos_integral(h0: SinCos, h1: SinCos, w0sq: f64, w1sq: f64, wtsq: f64, den
     if h0.s >= 0.0 {
         return same_side(h0, h1, w0sq, w1sq, den);
     }
-    // Across the top: the two halves' R_F run side by side (`rf_pair`).
-    let wt2 = wtsq;
-    let (r1, r0) = rf_pair(
-        [h1.c * h1.c * wt2, w1sq, wt2],
-        [h0.c * h0.c * wt2, w0sq, wt2],
-    );
+    // Across the top: the two halves' R_F run side by side (`rf_lanes`).
+    let [r1, r0] = rf_lanes(across_top(h0, h1, [w0sq, w1sq, wtsq]));
     2.0 * (h1.s.abs() * r1 + h0.s.abs() * r0)
 }
 
-/// [`rf`] of two argument triples, `(rf(a), rf(b))` to the last bit: where both are in the
-/// range of the duplication algorithm proper, its two iterations run in one loop, each
-/// stopping after its own number of steps with the operations of [`rf`], so that the
-/// processor overlaps the two chains of dependent square roots (one R_F is bound by their
-/// latency); elsewhere two calls of [`rf`].
+/// The R_F arguments of the two halves of [`cos_integral`] across the top, (Θ1 side, Θ0 side),
+/// from the squared speeds `[w0sq, w1sq, wtsq]`.
+#[inline(always)]
+fn across_top(h0: SinCos, h1: SinCos, [w0sq, w1sq, wt2]: [f64; 3]) -> [[f64; 3]; 2] {
+    [
+        [h1.c * h1.c * wt2, w1sq, wt2],
+        [h0.c * h0.c * wt2, w0sq, wt2],
+    ]
+}
+
+/// [`cos_integral`] of two motions between the same angles (`h0`, `h1`, `den`) with the squared
+/// speeds `a` and `b` (each `[w0sq, w1sq, wtsq]`), each to the last bit; across the top their
+/// four R_F run side by side ([`rf_lanes`]).
 #[inline]
-pub fn rf_pair(a: [f64; 3], b: [f64; 3]) -> (f64, f64) {
-    if !(in_range(a) && in_range(b)) {
-        return (rf(a[0], a[1], a[2]), rf(b[0], b[1], b[2]));
+pub fn cos_integral_pair(h0: SinCos, h1: SinCos, a: [f64; 3], b: [f64; 3], den: f64) -> [f64; 2] {
+    if !(h1.s > 0.0 && h0.s < 0.0) {
+        return [a, b].map(|[w0sq, w1sq, wtsq]| cos_integral(h0, h1, w0sq, w1sq, wtsq, den));
+    }
+    let [a1, a0] = across_top(h0, h1, a);
+    let [b1, b0] = across_top(h0, h1, b);
+    let [ra1, ra0, rb1, rb0] = rf_lanes([a1, a0, b1, b0]);
+    [
+        2.0 * (h1.s.abs() * ra1 + h0.s.abs() * ra0),
+        2.0 * (h1.s.abs() * rb1 + h0.s.abs() * rb0),
+    ]
+}
+
+/// [`rf`] of `N` argument triples, each to the last bit: where all are in the range of the
+/// duplication algorithm proper, their iterations run in one loop, each stopping after its own
+/// number of steps with the operations of [`rf`], so that the processor overlaps the chains of
+/// dependent square roots (one R_F is bound by their latency: two side by side cost about
+/// 1.3 times one, four about 1.4 times two; docs/PERFORMANCE.md); elsewhere `N` calls of
+/// [`rf`].
+#[inline]
+pub fn rf_lanes<const N: usize>(a: [[f64; 3]; N]) -> [f64; N] {
+    if !a.iter().all(|t| in_range(*t)) {
+        return a.map(|[x, y, z]| rf(x, y, z));
     }
     // (3 ε)^{-1/8} for ε = 2^-52, as in `rf_in_range`.
     const STOP: f64 = 78.8959690786408;
-    let start = |[x, y, z]: [f64; 3]| {
-        let a0 = (x + y + z) / 3.0;
-        let q = STOP * (a0 - x).abs().max((a0 - y).abs()).max((a0 - z).abs());
-        (a0, q)
-    };
-    let (a0a, mut qa) = start(a);
-    let (a0b, mut qb) = start(b);
-    let (mut na, mut nb) = (a, b);
-    let (mut ana, mut anb) = (a0a, a0b);
-    let (mut fa, mut fb) = (1.0f64, 1.0f64);
-    let (mut live_a, mut live_b) = (true, true);
+    let mut a0 = [0.0; N];
+    let mut q = [0.0; N];
+    for l in 0..N {
+        let [x, y, z] = a[l];
+        a0[l] = (x + y + z) / 3.0;
+        q[l] = STOP
+            * (a0[l] - x)
+                .abs()
+                .max((a0[l] - y).abs())
+                .max((a0[l] - z).abs());
+    }
+    let mut n = a;
+    let mut an = a0;
+    let mut f = [1.0f64; N];
+    let mut live = [true; N];
     for _ in 0..11 {
-        if live_a {
-            let (rx, ry, rz) = (na[0].sqrt(), na[1].sqrt(), na[2].sqrt());
-            let lambda = rx * ry + rx * rz + ry * rz;
-            ana = (ana + lambda) / 4.0;
-            na = [
-                (na[0] + lambda) / 4.0,
-                (na[1] + lambda) / 4.0,
-                (na[2] + lambda) / 4.0,
-            ];
-            qa /= 4.0;
-            fa *= 4.0;
-            live_a = !(qa < ana.abs());
+        for l in 0..N {
+            if live[l] {
+                let (rx, ry, rz) = (n[l][0].sqrt(), n[l][1].sqrt(), n[l][2].sqrt());
+                let lambda = rx * ry + rx * rz + ry * rz;
+                an[l] = (an[l] + lambda) / 4.0;
+                n[l] = [
+                    (n[l][0] + lambda) / 4.0,
+                    (n[l][1] + lambda) / 4.0,
+                    (n[l][2] + lambda) / 4.0,
+                ];
+                q[l] /= 4.0;
+                f[l] *= 4.0;
+                live[l] = !(q[l] < an[l].abs());
+            }
         }
-        if live_b {
-            let (rx, ry, rz) = (nb[0].sqrt(), nb[1].sqrt(), nb[2].sqrt());
-            let lambda = rx * ry + rx * rz + ry * rz;
-            anb = (anb + lambda) / 4.0;
-            nb = [
-                (nb[0] + lambda) / 4.0,
-                (nb[1] + lambda) / 4.0,
-                (nb[2] + lambda) / 4.0,
-            ];
-            qb /= 4.0;
-            fb *= 4.0;
-            live_b = !(qb < anb.abs());
-        }
-        if !(live_a || live_b) {
+        if !live.iter().any(|&x| x) {
             break;
         }
     }
-    (rf_series(a, a0a, ana, fa), rf_series(b, a0b, anb, fb))
+    let mut out = [0.0; N];
+    for l in 0..N {
+        out[l] = rf_series(a[l], a0[l], an[l], f[l]);
+    }
+    out
 }
 
 /// Arguments that [`rf`] hands to the duplication algorithm proper unchanged: non-negative,
@@ -258,12 +279,12 @@ mod tests {
         assert!(rf(-1.0, 1.0, 1.0).is_nan() && rf(f64::NAN, 1.0, 1.0).is_nan());
     }
 
-    /// `rf_pair` is two calls of `rf`, to the last bit, wherever the lanes stop: argument
+    /// `rf_lanes` is `rf` lane by lane, to the last bit, wherever the lanes stop: argument
     /// triples over 24 decades (so that the two lanes take different numbers of steps),
     /// across-the-top triples as `cos_integral` forms them, and the special and out-of-range
     /// triples that fall back to `rf`.
     #[test]
-    fn rf_pair_is_two_rf_calls_to_the_bit() {
+    fn rf_lanes_are_rf_calls_to_the_bit() {
         let mut triples = vec![
             [0.0, 1.0, 2.0],
             [0.0, 0.0, 1.0],
@@ -289,12 +310,23 @@ mod tests {
             let c = 0.8 + 0.2 * uniform();
             triples.push([c * c * wt2, wt2 + uniform(), wt2]);
         }
-        for a in &triples {
+        let one = |[x, y, z]: [f64; 3]| rf(x, y, z).to_bits();
+        for (i, a) in triples.iter().enumerate() {
             for b in triples.iter().step_by(7) {
-                let (p, q) = rf_pair(*a, *b);
-                let (x, y) = (rf(a[0], a[1], a[2]), rf(b[0], b[1], b[2]));
-                assert_eq!(p.to_bits(), x.to_bits(), "{a:?}");
-                assert_eq!(q.to_bits(), y.to_bits(), "{b:?}");
+                let [p, q] = rf_lanes([*a, *b]);
+                assert_eq!(
+                    [p.to_bits(), q.to_bits()],
+                    [one(*a), one(*b)],
+                    "{a:?} {b:?}"
+                );
+                let c = triples[(i * 13 + 5) % triples.len()];
+                let d = triples[(i * 29 + 11) % triples.len()];
+                let four = rf_lanes([*a, *b, c, d]).map(f64::to_bits);
+                assert_eq!(
+                    four,
+                    [one(*a), one(*b), one(c), one(d)],
+                    "{a:?} {b:?} {c:?} {d:?}"
+                );
             }
         }
     }
@@ -347,6 +379,28 @@ mod tests {
             let t = cos_integral(h0, h1, w(p0), w(p1), a - b, den);
             let q = by_quadrature(a, b, p0, p1);
             assert!((t - q).abs() <= 1e-14 * q, "{a} {b} {p0} {p1}: {t} vs {q}");
+        }
+    }
+
+    /// `cos_integral_pair` is two calls of `cos_integral`, to the last bit: across the top
+    /// (four R_F side by side) with top speeds from 1e-14 to 1, and on one side (two calls).
+    #[test]
+    fn cos_integral_pair_is_two_calls_to_the_bit() {
+        for &(p0, p1) in &[(-0.3, 0.8), (-1.2, 0.05), (0.2, 0.8), (-0.9, -0.1)] {
+            let (h0, h1) = (SinCos::of(0.5 * p0), SinCos::of(0.5 * p1));
+            let den = (0.5 * (p1 + p0)).sin() * (0.5 * (p1 - p0)).sin();
+            let speeds = |wt: f64| {
+                let (a, b) = (1.0 + wt, 1.0);
+                [a - b * f64::cos(p0), a - b * f64::cos(p1), wt]
+            };
+            for i in 0..=14 {
+                for j in [0, 3, 7, 14] {
+                    let (a, b) = (speeds(10f64.powi(-i)), speeds(10f64.powi(-j)));
+                    let one = |[w0, w1, wt]: [f64; 3]| cos_integral(h0, h1, w0, w1, wt, den);
+                    let pair = cos_integral_pair(h0, h1, a, b, den);
+                    assert_eq!(pair.map(f64::to_bits), [one(a).to_bits(), one(b).to_bits()]);
+                }
+            }
         }
     }
 }

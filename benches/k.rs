@@ -125,9 +125,98 @@ fn roots(c: &mut Criterion) {
     g.finish();
 }
 
+/// The contact times of two rolling launches from the top of each shipped scene (speeds² y and
+/// 2y at the top, y from 1e-6 to 1, as the launch-speed path evaluates them): two
+/// `cos_integral` calls, each the next one's input (as in a root search), against
+/// `cos_integral_pair` (the four R_F side by side, as for the top and first root pass, the
+/// dτ/du side passes and the K_lo, K_hi searches); and a row's scene built alone against one
+/// that takes what depends on ξ alone from the row before.
+fn lanes(c: &mut Criterion) {
+    use fitbead::special::elliptic::{cos_integral, cos_integral_pair};
+    use fitbead::special::SinCos;
+    let rows = rows();
+    let args: Vec<(SinCos, SinCos, f64, f64, f64)> = rows
+        .iter()
+        .enumerate()
+        .map(|(i, (s, _, _))| {
+            let (t0, tf) = (s.theta_0_rad(), s.theta_f_rad());
+            let drop = 2.0 * s.b() * s.sin_delta_sin_alpha();
+            let wc2 = 2.0 * s.b() * (0.5 * t0).sin().powi(2);
+            let y = 10f64.powf(-6.0 * (i % 7) as f64 / 6.0);
+            (SinCos::of(0.5 * t0), SinCos::of(0.5 * tf), wc2, drop, y)
+        })
+        .filter(|a| a.0.s < 0.0)
+        .collect();
+    let den = |h0: SinCos, h1: SinCos| (h1.s - h0.s) * (h1.s + h0.s);
+    let mut g = c.benchmark_group("launch-passes");
+    g.throughput(criterion::Throughput::Elements(2 * args.len() as u64));
+    g.bench_function("two cos_integral, chained", |b| {
+        b.iter(|| {
+            let mut acc = 0.0;
+            for &(h0, h1, wc2, drop, y) in &args {
+                let y = black_box(y) + 0.0 * acc;
+                let t1 = cos_integral(h0, h1, y + wc2, y + wc2 + drop, y, den(h0, h1));
+                let y2 = 2.0 * y + 0.0 * t1;
+                let t2 = cos_integral(h0, h1, y2 + wc2, y2 + wc2 + drop, y2, den(h0, h1));
+                acc += t1 + t2;
+            }
+            acc
+        })
+    });
+    g.bench_function("cos_integral_pair", |b| {
+        b.iter(|| {
+            let mut acc = 0.0;
+            for &(h0, h1, wc2, drop, y) in &args {
+                let y = black_box(y) + 0.0 * acc;
+                let y2 = 2.0 * y;
+                let [t1, t2] = cos_integral_pair(
+                    h0,
+                    h1,
+                    [y + wc2, y + wc2 + drop, y],
+                    [y2 + wc2, y2 + wc2 + drop, y2],
+                    den(h0, h1),
+                );
+                acc += t1 + t2;
+            }
+            acc
+        })
+    });
+    g.finish();
+    let mut g = c.benchmark_group("row-scene");
+    g.throughput(criterion::Throughput::Elements(rows.len() as u64));
+    let cells: Vec<(f64, f64)> = rows
+        .iter()
+        .map(|(s, _, _)| (s.xi(), s.delta_deg()))
+        .collect();
+    let law = CollisionLaw::Value(0.5);
+    g.bench_function("Scene::new", |b| {
+        b.iter(|| {
+            cells
+                .iter()
+                .map(|&(xi, d)| Scene::new(black_box(xi), d, 0.4, 0.1, law).unwrap().b())
+                .sum::<f64>()
+        })
+    });
+    g.bench_function("Scene::new_like (the row before)", |b| {
+        b.iter(|| {
+            let mut like: Option<Scene> = None;
+            cells
+                .iter()
+                .map(|&(xi, d)| {
+                    let s =
+                        Scene::new_like(like.as_ref(), black_box(xi), d, 0.4, 0.1, law).unwrap();
+                    like = Some(s);
+                    s.b()
+                })
+                .sum::<f64>()
+        })
+    });
+    g.finish();
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(20).measurement_time(std::time::Duration::from_secs(3));
-    targets = bench, roots
+    targets = bench, roots, lanes
 }
 criterion_main!(benches);

@@ -10,6 +10,7 @@
 //! flag on SIGINT, SIGTERM and SIGHUP.
 
 use std::fmt;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
 /// What a long computation reports.
@@ -49,6 +50,37 @@ impl Progress {
 impl fmt::Debug for Progress {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str("Progress(..)")
+    }
+}
+
+/// A count of work units shared by the parts of one task (clones share the count), each
+/// addition reported to a [`Progress`] sink as the task's [`ProgressEvent::Position`]. The
+/// caller reports the task's `Start` and `Finish`; the computations it hands a tally to (e.g.
+/// the least-squares runs of a fit, through `LsqOptions::progress`) only add to it.
+#[derive(Clone, Debug)]
+pub struct Tally {
+    sink: Progress,
+    done: Arc<AtomicU64>,
+}
+
+impl Tally {
+    /// A count from 0, reported to `sink`.
+    pub fn new(sink: Progress) -> Self {
+        Tally {
+            sink,
+            done: Arc::new(AtomicU64::new(0)),
+        }
+    }
+
+    /// Adds `n` units and reports the total.
+    pub fn add(&self, n: u64) {
+        let total = self.done.fetch_add(n, Ordering::Relaxed) + n;
+        self.sink.report(ProgressEvent::Position(total));
+    }
+
+    /// The units counted so far.
+    pub fn done(&self) -> u64 {
+        self.done.load(Ordering::Relaxed)
     }
 }
 

@@ -195,22 +195,74 @@ fn check(field: &'static str, value: f64, ok: bool, reason: &'static str) -> Res
     }
 }
 
+/// What a scene derives from ξ alone with transcendental functions.
+struct OfXi {
+    alpha: f64,
+    cos_alpha: f64,
+    sc_half_alpha: SinCos,
+    tan_half_alpha: Dd,
+}
+
+impl OfXi {
+    fn new(xi: f64) -> Self {
+        let alpha = (1.0 / (1.0 + xi)).asin();
+        // tan(α/2) = sin α / (1 + cos α) = 1 / (1 + ξ + sqrt(ξ (2 + ξ))).
+        let one_xi = Dd::from(1.0) + Dd::from(xi);
+        let root = (Dd::from(xi) * (Dd::from(2.0) + Dd::from(xi))).sqrt();
+        OfXi {
+            alpha,
+            cos_alpha: alpha.cos(),
+            sc_half_alpha: SinCos::of(0.5 * alpha),
+            tan_half_alpha: Dd::from(1.0) / (one_xi + root),
+        }
+    }
+}
+
 impl Scene {
     /// Builds a scene from δ in degrees (the unit of the command line and of the CSV files).
     pub fn new(xi: f64, delta_deg: f64, rho: f64, f: f64, law: CollisionLaw) -> Result<Self> {
+        Self::new_like(None, xi, delta_deg, rho, f, law)
+    }
+
+    /// [`Scene::new`], taking what depends on ξ alone (α, its sine, cosine and half-angle,
+    /// tan(α/2)) from `like` when `like` has the same ξ: the same scene to the last bit,
+    /// without the inverse sine, the sines and cosines and the double-double square root of
+    /// α. For rows of one series read one after the other.
+    pub fn new_like(
+        like: Option<&Scene>,
+        xi: f64,
+        delta_deg: f64,
+        rho: f64,
+        f: f64,
+        law: CollisionLaw,
+    ) -> Result<Self> {
         check(
             "delta_deg",
             delta_deg,
             (0.0..90.0).contains(&delta_deg),
             "slope must be in [0, 90) degrees",
         )?;
-        Self::from_radians(xi, delta_deg.to_radians(), rho, f, law)
+        let like = like.filter(|s| s.xi.to_bits() == xi.to_bits());
+        Self::build(xi, delta_deg.to_radians(), rho, f, law, like)
     }
 
     /// Builds a scene from δ in radians. K must be in (0, 1): a number K ≥ 1 is refused (a
     /// collision cannot return more tangential velocity than it receives); a law's K is < 1
     /// at every ξ for the named laws.
     pub fn from_radians(xi: f64, delta: f64, rho: f64, f: f64, law: CollisionLaw) -> Result<Self> {
+        Self::build(xi, delta, rho, f, law, None)
+    }
+
+    /// [`Scene::from_radians`], with the quantities of ξ alone taken from `same_xi` (a scene
+    /// of the same ξ) when given.
+    fn build(
+        xi: f64,
+        delta: f64,
+        rho: f64,
+        f: f64,
+        law: CollisionLaw,
+        same_xi: Option<&Scene>,
+    ) -> Result<Self> {
         check("xi", xi, xi > 0.0, "radius ratio must be > 0")?;
         check(
             "delta",
@@ -223,7 +275,16 @@ impl Scene {
         if let CollisionLaw::C(c) = law {
             check("K", c, true, "law coefficient must be finite")?;
         }
-        let alpha = (1.0 / (1.0 + xi)).asin();
+        let of_xi = match same_xi {
+            Some(s) => OfXi {
+                alpha: s.alpha,
+                cos_alpha: s.cos_alpha,
+                sc_half_alpha: s.sc_half_alpha,
+                tan_half_alpha: s.tan_half_alpha,
+            },
+            None => OfXi::new(xi),
+        };
+        let alpha = of_xi.alpha;
         let k = law.k(alpha, rho);
         check("K", k, k > 0.0, "collisional parameter must be > 0")?;
         if law.is_value() {
@@ -239,7 +300,7 @@ impl Scene {
         let theta_0 = delta - alpha;
         let theta_f = delta + alpha;
         let sc_half_delta = SinCos::of(0.5 * delta);
-        let sc_half_alpha = SinCos::of(0.5 * alpha);
+        let sc_half_alpha = of_xi.sc_half_alpha;
         // Half angles of Θ0 and Θf by the addition formulas: no rounding of δ − α enters.
         let (sd, cd, sa, ca) = (
             sc_half_delta.s,
@@ -263,10 +324,6 @@ impl Scene {
             s: 2.0 * sc_half_f.s * sc_half_f.c,
             c: 1.0 - 2.0 * sc_half_f.s * sc_half_f.s,
         };
-        // tan(α/2) = sin α / (1 + cos α) = 1 / (1 + ξ + sqrt(ξ (2 + ξ))).
-        let one_xi = Dd::from(1.0) + Dd::from(xi);
-        let root = (Dd::from(xi) * (Dd::from(2.0) + Dd::from(xi))).sqrt();
-        let tan_half_alpha = Dd::from(1.0) / (one_xi + root);
         Ok(Scene {
             xi,
             delta,
@@ -276,7 +333,7 @@ impl Scene {
             k,
             alpha,
             sin_alpha: 1.0 / (1.0 + xi),
-            cos_alpha: alpha.cos(),
+            cos_alpha: of_xi.cos_alpha,
             eps: (1.0 + xi) / xi,
             theta_0,
             theta_f,
@@ -287,7 +344,7 @@ impl Scene {
             sc_half_f,
             sc_0,
             sc_f,
-            tan_half_alpha,
+            tan_half_alpha: of_xi.tan_half_alpha,
             b: 2.0 / (1.0 + rho),
         })
     }
@@ -303,7 +360,7 @@ impl Scene {
 
     /// The same scene at another slope δ (radians).
     pub fn with_delta(&self, delta: f64) -> Result<Self> {
-        Self::from_radians(self.xi, delta, self.rho, self.f, self.law)
+        Self::build(self.xi, delta, self.rho, self.f, self.law, Some(self))
     }
 
     /// Radius ratio ξ = r/R of the mobile bead to the row beads.

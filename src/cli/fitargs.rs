@@ -135,6 +135,7 @@ impl FitArgs {
                     method: Method::Lsq {
                         profile: !self.no_profile,
                         stop: Some(super::stop_flag()),
+                        progress: None,
                     },
                 });
             }

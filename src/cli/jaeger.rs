@@ -23,7 +23,9 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let branch = super::jaeger_branch(&a.branch)?;
     let (t, _rows, ds) = a.io.read()?;
     let choice = a.io.method(&["a1", "a2", "a3"])?;
-    let fits = fit_jaeger_with(&ds, branch, a.io.level.level(), &choice.method);
+    let (method, task) = super::counted_fit("jaeger", choice.method);
+    let fits = fit_jaeger_with(&ds, branch, a.io.level.level(), &method);
+    drop(task);
     let notes: Vec<String> = fits.notes.iter().map(|n| locate_note(&t, &ds, n)).collect();
     let all: Vec<&FitResult> = fits.series.iter().flatten().map(|f| &f.summary).collect();
     if all.iter().all(|f| f.params.is_empty()) {

@@ -20,7 +20,9 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let (t, _rows, ds) = a.io.read()?;
     let choice =
         a.io.method(&["lambda", "mu", "lambda0", "lambda1", "mu0", "mu1"])?;
-    let fits = fit_jan_with(&ds, a.io.level.level(), &choice.method);
+    let (method, task) = super::counted_fit("jan", choice.method);
+    let fits = fit_jan_with(&ds, a.io.level.level(), &method);
+    drop(task);
     let notes: Vec<String> = fits.notes.iter().map(|n| locate_note(&t, &ds, n)).collect();
     let all: Vec<&FitResult> = fits
         .series

@@ -4,8 +4,9 @@
 use super::args::{DataArgs, OutputArgs, PlotArgs};
 use super::forward::{open_input, stream_options, stream_to, Input};
 use super::CliError;
-use fitbead::io::kstream::{KLedger, KPlan, KSettings};
+use fitbead::io::kstream::{self, KLedger, KPlan, KSettings};
 use fitbead::io::scenes::TableReader;
+use fitbead::io::stream::StreamOptions;
 use fitbead::io::{AtomicFile, InputError};
 use fitbead::models::auto::Auto;
 use fitbead::models::{Model, ModelKind};
@@ -107,7 +108,10 @@ pub fn run(a: Args) -> Result<(), CliError> {
     // The plot's file is created first so that a target that cannot be written is reported
     // (after the input proved good) before the output is committed.
     let plot = a.plot.plot.as_deref().map(|p| (p, AtomicFile::create(p)));
-    let opts = stream_options("k", size);
+    let opts = StreamOptions {
+        chunk_rows: kstream::CHUNK_ROWS,
+        ..stream_options("k", size)
+    };
     stream_to(
         reader,
         make,

@@ -13,6 +13,7 @@ pub mod report;
 pub mod simulate;
 
 use clap::{Parser, Subcommand};
+use fitbead::fit::posterior::Method;
 use fitbead::io::{clip, distinct_paths, write_atomic, InputError, ECHO_CHARS};
 use fitbead::progress::{Progress, ProgressEvent};
 use std::path::{Path, PathBuf};
@@ -451,6 +452,7 @@ pub fn delayed_progress_bar(unit: &'static str) -> Option<Progress> {
     if !std::io::stderr().is_terminal() {
         return None;
     }
+    let delay = progress_delay();
     struct State {
         label: String,
         total: u64,
@@ -474,7 +476,7 @@ pub fn delayed_progress_bar(unit: &'static str) -> Option<Progress> {
             }
             ProgressEvent::Position(p) => {
                 let Some(s) = slot.as_mut() else { return };
-                if s.bar.is_none() && s.started.elapsed() >= Duration::from_secs(2) {
+                if s.bar.is_none() && s.started.elapsed() >= delay {
                     let (b, template) = if s.total > 0 {
                         (
                             indicatif::ProgressBar::new(s.total),
@@ -505,6 +507,49 @@ pub fn delayed_progress_bar(unit: &'static str) -> Option<Progress> {
             }
         }
     }))
+}
+
+/// How long a task runs before [`delayed_progress_bar`] draws it: two seconds, or the
+/// milliseconds of the environment variable `FITBEAD_PROGRESS_DELAY_MS`.
+fn progress_delay() -> std::time::Duration {
+    std::env::var("FITBEAD_PROGRESS_DELAY_MS")
+        .ok()
+        .and_then(|s| s.trim().parse::<u64>().ok())
+        .map_or(
+            std::time::Duration::from_secs(2),
+            std::time::Duration::from_millis,
+        )
+}
+
+/// A task on a progress sink, reported finished when dropped.
+pub struct Task(Option<Progress>);
+
+impl Drop for Task {
+    fn drop(&mut self) {
+        if let Some(p) = self.0.take() {
+            p.report(ProgressEvent::Finish);
+        }
+    }
+}
+
+/// The least-squares runs of a fit command counted on a terminal's delayed progress bar
+/// ([`delayed_progress_bar`], task `label`, in model evaluations: residual vectors and
+/// Jacobians over the data); a posterior run keeps its sampler's own bar. The bar goes when
+/// the returned [`Task`] is dropped.
+pub fn counted_fit(label: &str, method: Method) -> (Method, Task) {
+    let bar = match method {
+        Method::Lsq { .. } => delayed_progress_bar("model evaluations"),
+        Method::Mcmc(_) => None,
+    };
+    if let Some(p) = &bar {
+        p.report(ProgressEvent::Start {
+            label,
+            total: 0,
+            check_every: 0,
+        });
+    }
+    let tally = bar.clone().map(fitbead::progress::Tally::new);
+    (method.with_progress(tally), Task(bar))
 }
 
 /// Parses a comma-separated list of numbers given on the command line.

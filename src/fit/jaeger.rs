@@ -230,6 +230,7 @@ pub fn fit_jaeger_with(
             lower: Some(vec![0.0, 0.0, 0.0]),
             sigma: data.sigma,
             stop: method.stop().cloned(),
+            progress: method.progress().cloned(),
             ..Default::default()
         };
         let f = match fit(&problem, &p0, &opts) {

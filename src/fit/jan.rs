@@ -177,6 +177,7 @@ pub fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFits {
             upper: Some(vec![f64::INFINITY, tmin]),
             sigma: data.sigma,
             stop: method.stop().cloned(),
+            progress: method.progress().cloned(),
             ..Default::default()
         };
         let f = match fit(&problem, &[lam0, mu0], &opts) {
@@ -262,6 +263,7 @@ pub fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFits {
             lower: Some(vec![0.0, f64::NEG_INFINITY, 0.0, f64::NEG_INFINITY]),
             sigma: data.sigma,
             stop: method.stop().cloned(),
+            progress: method.progress().cloned(),
             ..Default::default()
         };
         let feasible = |p: &[f64]| x.iter().all(|q| JanGlobal.value(q, p).is_ok());

@@ -457,6 +457,42 @@ mod tests {
         assert!((wald.lower - lo).abs() > 1e-3 * (hi - lo));
     }
 
+    /// `LsqOptions::progress` counts every residual evaluation of the fit and of its profiles'
+    /// constrained fits (a model without a gradient: its Jacobians are differences), each
+    /// reported as the running total.
+    #[test]
+    fn progress_counts_the_fit_and_its_profiles() {
+        use crate::progress::{Progress, ProgressEvent, Tally};
+        use std::sync::{Arc, Mutex};
+        let (x, y) = exp_data();
+        let data = WeightedData::new(Decay, x, y, Some(vec![0.3; 10])).unwrap();
+        let seen = Arc::new(Mutex::new(Vec::new()));
+        let sink = {
+            let seen = seen.clone();
+            Progress::new(move |e| {
+                if let ProgressEvent::Position(p) = e {
+                    seen.lock().unwrap().push(p);
+                }
+            })
+        };
+        let tally = Tally::new(sink);
+        let opts = LsqOptions {
+            progress: Some(tally.clone()),
+            ..Default::default()
+        };
+        let f = fit(&data, &[1.0, 0.1], &opts).unwrap();
+        assert!(f.converged());
+        assert_eq!(tally.done() as usize, f.residual_evals);
+        let ci = confidence_intervals(&data, &f, 0.95, &opts).unwrap();
+        let profiled: usize = ci.profile.iter().map(|p| p.residual_evals).sum();
+        assert!(profiled > 0);
+        assert_eq!(tally.done() as usize, f.residual_evals + profiled);
+        // One position per evaluation, each total once (the profiles may run in parallel).
+        let mut seen = seen.lock().unwrap().clone();
+        seen.sort_unstable();
+        assert!(seen.iter().copied().eq(1..=tally.done()));
+    }
+
     /// Two parameters: each profile point is a re-minimisation over the other.
     #[test]
     fn profile_with_reminimisation() {

@@ -622,6 +622,7 @@ impl LevenbergMarquardt {
                 sigma: opts.sigma,
                 polish: opts.polish,
                 stop: opts.stop.clone(),
+                progress: opts.progress.clone(),
             },
             ev: Evaluator::new(0, 0),
             stage: Stage::Idle,
@@ -835,6 +836,7 @@ impl<R: Residuals> Solver<LeastSquares<R>, LmState> for LevenbergMarquardt {
             }
         };
         self.ev = Evaluator::new(m, n);
+        self.ev.tally = self.opts.progress.clone();
         self.stage = match LmRun::start(&mut self.ev, ls, start) {
             Ok(run) => Stage::Run {
                 run: Box::new(run),

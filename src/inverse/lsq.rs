@@ -7,6 +7,7 @@
 //! [`super::LeastSquares`] (module `problem`), and the estimate [`super::fit`] (module
 //! `estimate`).
 
+use crate::progress::Tally;
 use faer::MatMut;
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
@@ -252,6 +253,10 @@ pub struct LsqOptions {
     /// with [`Termination::Interrupted`] (e.g. from a signal handler). Profiles pass it on to
     /// their constrained fits.
     pub stop: Option<Arc<AtomicBool>>,
+    /// Counts every evaluation of the residual vector and of the Jacobian (one each, a
+    /// finite-difference Jacobian by its residual evaluations) as the position of the caller's
+    /// task. Profiles pass it on to their constrained fits.
+    pub progress: Option<Tally>,
 }
 
 impl Default for LsqOptions {
@@ -270,6 +275,7 @@ impl Default for LsqOptions {
             sigma: SigmaKind::Absolute,
             polish: true,
             stop: None,
+            progress: None,
         }
     }
 }

@@ -14,7 +14,7 @@
 use super::mcmc::{LogDensity, McmcOptions};
 use super::Residuals;
 use crate::numfmt::fmt_f64;
-use crate::progress::Progress;
+use crate::progress::{Progress, Tally};
 use statrs::distribution::{Continuous, LogNormal, Normal, Uniform};
 use std::fmt;
 use std::str::FromStr;
@@ -204,6 +204,9 @@ pub enum Method {
         profile: bool,
         /// Raised to stop every solver run of the fit ([`LsqOptions::stop`](super::LsqOptions)).
         stop: Option<Arc<AtomicBool>>,
+        /// Counts the residual and Jacobian evaluations of every solver run of the fit, profiles
+        /// included ([`LsqOptions::progress`](super::LsqOptions)).
+        progress: Option<Tally>,
     },
     /// Posterior sampling, started from the least-squares optimum (its stop flag,
     /// [`McmcOptions::stop`], stops the least-squares start as well).
@@ -216,6 +219,30 @@ impl Method {
         Method::Lsq {
             profile,
             stop: None,
+            progress: None,
+        }
+    }
+
+    /// The same method, its least-squares runs counted by `progress` (a posterior run reports
+    /// its sampler's steps through [`McmcSettings::progress`] instead, and is returned as it
+    /// is).
+    pub fn with_progress(self, progress: Option<Tally>) -> Self {
+        match self {
+            Method::Lsq { profile, stop, .. } => Method::Lsq {
+                profile,
+                stop,
+                progress,
+            },
+            m => m,
+        }
+    }
+
+    /// Where the fit's least-squares runs count their evaluations, if anywhere
+    /// ([`LsqOptions::progress`](super::LsqOptions)).
+    pub fn progress(&self) -> Option<&Tally> {
+        match self {
+            Method::Lsq { progress, .. } => progress.as_ref(),
+            Method::Mcmc(_) => None,
         }
     }
 

@@ -10,6 +10,7 @@
 //! [`CostFunction::cost`], so that derivative-free solvers step back from them; the
 //! Levenberg–Marquardt solver never sees them as errors (they are rejected steps).
 
+use crate::progress::Tally;
 use argmin::core::{CostFunction, Error, Gradient, Jacobian, Operator};
 use faer::Mat;
 use nalgebra::{DMatrix, DVector};
@@ -176,6 +177,8 @@ pub(crate) struct Evaluator {
     pub njev: usize,
     /// Whether the last Jacobian came by finite differences.
     pub differenced: bool,
+    /// Where each residual and analytic Jacobian evaluation is counted, if anywhere.
+    pub tally: Option<Tally>,
     work: Vec<f64>,
     work2: Vec<f64>,
     xp: Vec<f64>,
@@ -189,6 +192,7 @@ impl Evaluator {
             nfev: 0,
             njev: 0,
             differenced: false,
+            tally: None,
             work: vec![0.0; m],
             work2: vec![0.0; m],
             xp: vec![0.0; n],
@@ -203,6 +207,9 @@ impl Evaluator {
         out: &mut [f64],
     ) -> bool {
         self.nfev += 1;
+        if let Some(t) = &self.tally {
+            t.add(1);
+        }
         match ls.problem.residuals(x, out) {
             Ok(()) => out.iter().all(|v| v.is_finite()),
             Err(Infeasible) => false,
@@ -219,7 +226,11 @@ impl Evaluator {
     ) -> bool {
         self.njev += 1;
         self.differenced = false;
-        match ls.problem.jacobian(x, jac.as_mut()) {
+        let analytic = ls.problem.jacobian(x, jac.as_mut());
+        if let (Some(_), Some(t)) = (&analytic, &self.tally) {
+            t.add(1);
+        }
+        match analytic {
             Some(Ok(())) => {
                 for j in 0..self.n {
                     for i in 0..self.m {

@@ -358,6 +358,9 @@ impl<R: Residuals + ?Sized> Profiler<'_, R> {
             // One parameter: nothing to re-minimise.
             let mut r = vec![0.0; self.problem.n_residuals()];
             self.evals += 1;
+            if let Some(t) = &self.opts.progress {
+                t.add(1);
+            }
             self.problem.residuals(&[v], &mut r).ok()?;
             let chi2: f64 = r.iter().map(|x| x * x).sum();
             return chi2

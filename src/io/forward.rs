@@ -460,7 +460,7 @@ impl RowPlan for ForwardPlan {
         w.end();
     }
 
-    fn prepare(&self, row: &Row<'_>) -> Result<Job, InputError> {
+    fn prepare(&self, row: &Row<'_>, _: &mut ()) -> Result<Job, InputError> {
         let (scene, model) = self.cols.read(row, &self.settings)?;
         Ok(Job { scene, model })
     }

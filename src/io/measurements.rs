@@ -220,33 +220,40 @@ impl MeasurementColumns {
     /// Reads and validates one row (dimensional input converted with
     /// v = v_m_s / sqrt(g R (1 + ξ))), or reports its first bad value.
     pub fn read(&self, r: &Row<'_>) -> Result<Measured, InputError> {
+        self.read_like(r, None)
+    }
+
+    /// [`MeasurementColumns::read`], its scene built by [`Scene::new_like`] from `like` (the
+    /// scene of a row read before, usually the one before it).
+    pub fn read_like(&self, r: &Row<'_>, like: Option<&Scene>) -> Result<Measured, InputError> {
         let MeasurementDefaults { rho, f, g } = self.defaults;
         let xi = r.number(self.xi)?;
         let d = r.number(self.delta_deg)?;
         let rho = r.opt_number(self.rho)?.unwrap_or(rho);
         let f = r.opt_number(self.f)?.unwrap_or(f);
-        let scene = Scene::new(xi, d, rho, f, CollisionLaw::Value(0.5)).map_err(|e| {
-            let col = match &e {
-                crate::scene::ParameterError::InvalidParameter { field, .. } => match *field {
-                    "xi" => Some(self.xi),
-                    "delta" | "delta_deg" => Some(self.delta_deg),
-                    "rho" => self.rho,
-                    "f" => self.f,
+        let scene =
+            Scene::new_like(like, xi, d, rho, f, CollisionLaw::Value(0.5)).map_err(|e| {
+                let col = match &e {
+                    crate::scene::ParameterError::InvalidParameter { field, .. } => match *field {
+                        "xi" => Some(self.xi),
+                        "delta" | "delta_deg" => Some(self.delta_deg),
+                        "rho" => self.rho,
+                        "f" => self.f,
+                        _ => None,
+                    },
                     _ => None,
-                },
-                _ => None,
-            };
-            match col {
-                Some(c) => r.err(c, e.to_string()),
-                None => InputError {
-                    file: r.source.to_string(),
-                    line: Some(r.line),
-                    column: None,
-                    value: None,
-                    message: e.to_string(),
-                },
-            }
-        })?;
+                };
+                match col {
+                    Some(c) => r.err(c, e.to_string()),
+                    None => InputError {
+                        file: r.source.to_string(),
+                        line: Some(r.line),
+                        column: None,
+                        value: None,
+                        message: e.to_string(),
+                    },
+                }
+            })?;
         let given = |c: Option<usize>| c.filter(|&c| !r.cell(c).is_empty());
         let (v, sigma_v) = match self.v {
             Some(c) => {
@@ -631,6 +638,38 @@ pub fn plausibility(t: &Table, rows: &[Measurement]) -> Vec<Implausible> {
     p.warnings()
 }
 
+/// What the checks of [`Plausibility`] need of one validated row: its scene's ξ, δ (radians),
+/// ρ, f and α, and its dimensionless v.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlausiblePoint {
+    /// Radius ratio ξ.
+    pub xi: f64,
+    /// Slope δ (radians).
+    pub delta: f64,
+    /// Gyration parameter ρ.
+    pub rho: f64,
+    /// Friction coefficient f.
+    pub f: f64,
+    /// α = asin(1/(1+ξ)) (eq 2).
+    pub alpha: f64,
+    /// Dimensionless mean velocity.
+    pub v: f64,
+}
+
+impl From<&Measured> for PlausiblePoint {
+    fn from(m: &Measured) -> Self {
+        let s = &m.scene;
+        PlausiblePoint {
+            xi: s.xi(),
+            delta: s.delta_rad(),
+            rho: s.rho(),
+            f: s.f(),
+            alpha: s.alpha_rad(),
+            v: m.v,
+        }
+    }
+}
+
 /// The checks of [`plausibility`], fed one validated row at a time in file order; its memory
 /// is bounded (at most [`MAX_RATIOS`] velocity ratios). [`Plausibility::warnings`] says what it found.
 #[derive(Debug, Clone)]
@@ -673,15 +712,20 @@ impl Plausibility {
 
     /// Takes one validated row (`m` read from `r`).
     pub fn add(&mut self, r: &Row<'_>, m: &Measured) {
+        self.add_point(r, &PlausiblePoint::from(m));
+    }
+
+    /// Takes one validated row (read from `r`) by what the checks need of it.
+    pub fn add_point(&mut self, r: &Row<'_>, m: &PlausiblePoint) {
         use crate::models::regimes::{delta_d_law, delta_m_law};
         use crate::models::ForwardModel;
         let law = CollisionLaw::Adjusted;
-        let s = &m.scene;
-        let key = (s.xi().to_bits(), s.rho().to_bits());
+        let s = m;
+        let key = (s.xi.to_bits(), s.rho.to_bits());
         let (dm, dd) = match self.limits {
             Some((k, dm, dd)) if k == key => (dm, dd),
             _ => {
-                let (a, rho) = (s.alpha_rad(), s.rho());
+                let (a, rho) = (s.alpha, s.rho);
                 let dm = delta_m_law(a, law, rho).to_degrees();
                 let dd = delta_d_law(a, law, rho).to_degrees();
                 self.limits = Some((key, dm, dd));
@@ -689,14 +733,14 @@ impl Plausibility {
             }
         };
         self.rows += 1;
-        let d = s.delta_deg();
+        let d = s.delta.to_degrees();
         self.all_low &= d < SLOPE_FRACTION * dm;
         self.all_below_half_pi &= d < std::f64::consts::FRAC_PI_2;
         if self.largest.is_none_or(|l| d >= l.0) {
-            self.largest = Some((d, r.line, dm, s.xi()));
+            self.largest = Some((d, r.line, dm, s.xi));
         }
         if self.ratios.len() < MAX_RATIOS && d > dm && d < dd {
-            let v = Scene::new(s.xi(), d, s.rho(), s.f(), law)
+            let v = Scene::new(s.xi, d, s.rho, s.f, law)
                 .ok()
                 .and_then(|sc| crate::models::Model::Stick.evaluate(&sc).ok())
                 .map(|o| o.mean_velocity);

@@ -46,8 +46,13 @@ pub trait RowPlan: Sync {
     /// Appends the output's header record.
     fn header(&self, out: &mut Vec<u8>);
 
-    /// Checks the cells of one row, or reports its first bad value.
-    fn prepare(&self, row: &Row<'_>) -> Result<Self::Ready, InputError>;
+    /// Checks the cells of one row, or reports its first bad value; `scratch` is the task's,
+    /// as [`write`](RowPlan::write) gets it.
+    fn prepare(
+        &self,
+        row: &Row<'_>,
+        scratch: &mut Self::Scratch,
+    ) -> Result<Self::Ready, InputError>;
 
     /// Computes one row and appends its output record to `out`.
     fn write(
@@ -203,8 +208,10 @@ where
     let mut header = Vec::new();
     plan.header(&mut header);
     let mut pending = vec![header];
-    // Output buffers come back here once written, and serve the chunk after next.
+    // Output buffers come back here once written, and serve the chunk after next; the notes'
+    // vectors come back once recorded, and serve the next chunk.
     let mut spare: Vec<Vec<u8>> = Vec::new();
+    let mut note_bufs: Vec<Vec<P::Note>> = Vec::new();
     let mut failed = None;
     let mut rows = 0u64;
     // Output bytes per row to reserve (grown to what the rows so far needed).
@@ -224,7 +231,7 @@ where
                     &plan,
                     &ctx,
                     &cur[..n_cur],
-                    bufs,
+                    (bufs, &mut note_bufs),
                     row_bytes,
                     &mut ledger,
                     opts,
@@ -292,33 +299,37 @@ fn write_parts(out: &mut dyn Write, parts: &[Vec<u8>], failed: &mut Option<std::
 type Part<N> = (Vec<u8>, Vec<N>, Option<StreamError>);
 
 /// One chunk of rows: their output bytes in order (one buffer per task, taken from `bufs`
-/// where there is one, with room for `row_bytes` per row), the notes recorded, or the first
-/// bad row's error.
+/// where there is one, with room for `row_bytes` per row), the notes recorded (their
+/// vectors taken from and returned to `note_bufs`), or the first bad row's error.
 fn chunk<P: RowPlan>(
     plan: &P,
     ctx: &Context,
     recs: &[csv::StringRecord],
-    mut bufs: Vec<Vec<u8>>,
+    (mut bufs, note_bufs): (Vec<Vec<u8>>, &mut Vec<Vec<P::Note>>),
     row_bytes: usize,
     ledger: &mut P::Ledger,
     opts: &StreamOptions,
 ) -> Result<Vec<Vec<u8>>, StreamError> {
     let task = opts.task_rows.max(1);
-    bufs.resize_with(recs.len().div_ceil(task), Vec::new);
+    let tasks = recs.len().div_ceil(task);
+    bufs.resize_with(tasks, Vec::new);
+    note_bufs.resize_with(tasks.max(note_bufs.len()), Vec::new);
+    let note_vecs: Vec<Vec<P::Note>> = note_bufs.drain(..tasks).collect();
     let parts: Vec<Part<P::Note>> = recs
         .par_chunks(task)
-        .zip(bufs.into_par_iter())
-        .map(|(rs, mut buf)| {
+        .zip(bufs.into_par_iter().zip(note_vecs))
+        .map(|(rs, (mut buf, mut notes))| {
             buf.clear();
             buf.reserve(rs.len() * row_bytes);
-            let mut notes = Vec::with_capacity(rs.len());
+            notes.clear();
+            notes.reserve(rs.len());
             if stopped(opts) {
                 return (buf, notes, Some(StreamError::Stopped));
             }
             let mut scratch = P::Scratch::default();
             for rec in rs {
                 let row = ctx.row(rec);
-                match plan.prepare(&row) {
+                match plan.prepare(&row, &mut scratch) {
                     Ok(r) => notes.push(plan.write(&row, r, &mut scratch, &mut buf)),
                     Err(e) => return (buf, notes, Some(StreamError::Input(e))),
                 }
@@ -327,10 +338,11 @@ fn chunk<P: RowPlan>(
         })
         .collect();
     let mut out = Vec::with_capacity(parts.len());
-    for ((buf, notes, err), rs) in parts.into_iter().zip(recs.chunks(task)) {
-        for (n, rec) in notes.into_iter().zip(rs) {
+    for ((buf, mut notes, err), rs) in parts.into_iter().zip(recs.chunks(task)) {
+        for (n, rec) in notes.drain(..).zip(rs) {
             plan.record(ledger, &ctx.row(rec), n)?;
         }
+        note_bufs.push(notes);
         if let Some(e) = err {
             return Err(e);
         }

@@ -80,6 +80,14 @@ fn rf_in_range(x: f64, y: f64, z: f64) -> f64 {
             break;
         }
     }
+    rf_series([x, y, z], a0, an, f)
+}
+
+/// The end of the duplication algorithm: the series of DLMF 19.36.1 to 7th order at the
+/// last iterate `an` (after steps that multiplied `f` by 4 each), from the arguments and
+/// their mean `a0`.
+#[inline(always)]
+fn rf_series([x, y, _]: [f64; 3], a0: f64, an: f64, f: f64) -> f64 {
     let xs = (a0 - x) / (an * f);
     let ys = (a0 - y) / (an * f);
     let zs = -xs - ys;
@@ -129,10 +137,99 @@ pub fn cos_integral(h0: SinCos, h1: SinCos, w0sq: f64, w1sq: f64, wtsq: f64, den
     if h0.s >= 0.0 {
         return same_side(h0, h1, w0sq, w1sq, den);
     }
-    // Across the top.
-    let wt2 = wtsq;
-    let half = |h: SinCos, wsq: f64| -> f64 { h.s.abs() * rf(h.c * h.c * wt2, wsq, wt2) };
-    2.0 * (half(h1, w1sq) + half(h0, w0sq))
+    // Across the top: the two halves' R_F run side by side (`rf_lanes`).
+    let [r1, r0] = rf_lanes(across_top(h0, h1, [w0sq, w1sq, wtsq]));
+    2.0 * (h1.s.abs() * r1 + h0.s.abs() * r0)
+}
+
+/// The R_F arguments of the two halves of [`cos_integral`] across the top, (Θ1 side, Θ0 side),
+/// from the squared speeds `[w0sq, w1sq, wtsq]`.
+#[inline(always)]
+fn across_top(h0: SinCos, h1: SinCos, [w0sq, w1sq, wt2]: [f64; 3]) -> [[f64; 3]; 2] {
+    [
+        [h1.c * h1.c * wt2, w1sq, wt2],
+        [h0.c * h0.c * wt2, w0sq, wt2],
+    ]
+}
+
+/// [`cos_integral`] of two motions between the same angles (`h0`, `h1`, `den`) with the squared
+/// speeds `a` and `b` (each `[w0sq, w1sq, wtsq]`), each to the last bit; across the top their
+/// four R_F run side by side ([`rf_lanes`]).
+#[inline]
+pub fn cos_integral_pair(h0: SinCos, h1: SinCos, a: [f64; 3], b: [f64; 3], den: f64) -> [f64; 2] {
+    if !(h1.s > 0.0 && h0.s < 0.0) {
+        return [a, b].map(|[w0sq, w1sq, wtsq]| cos_integral(h0, h1, w0sq, w1sq, wtsq, den));
+    }
+    let [a1, a0] = across_top(h0, h1, a);
+    let [b1, b0] = across_top(h0, h1, b);
+    let [ra1, ra0, rb1, rb0] = rf_lanes([a1, a0, b1, b0]);
+    [
+        2.0 * (h1.s.abs() * ra1 + h0.s.abs() * ra0),
+        2.0 * (h1.s.abs() * rb1 + h0.s.abs() * rb0),
+    ]
+}
+
+/// [`rf`] of `N` argument triples, each to the last bit: where all are in the range of the
+/// duplication algorithm proper, their iterations run in one loop, each stopping after its own
+/// number of steps with the operations of [`rf`], so that the processor overlaps the chains of
+/// dependent square roots (one R_F is bound by their latency: two side by side cost about
+/// 1.3 times one, four about 1.4 times two; docs/PERFORMANCE.md); elsewhere `N` calls of
+/// [`rf`].
+#[inline]
+pub fn rf_lanes<const N: usize>(a: [[f64; 3]; N]) -> [f64; N] {
+    if !a.iter().all(|t| in_range(*t)) {
+        return a.map(|[x, y, z]| rf(x, y, z));
+    }
+    // (3 ε)^{-1/8} for ε = 2^-52, as in `rf_in_range`.
+    const STOP: f64 = 78.8959690786408;
+    let mut a0 = [0.0; N];
+    let mut q = [0.0; N];
+    for l in 0..N {
+        let [x, y, z] = a[l];
+        a0[l] = (x + y + z) / 3.0;
+        q[l] = STOP
+            * (a0[l] - x)
+                .abs()
+                .max((a0[l] - y).abs())
+                .max((a0[l] - z).abs());
+    }
+    let mut n = a;
+    let mut an = a0;
+    let mut f = [1.0f64; N];
+    let mut live = [true; N];
+    for _ in 0..11 {
+        for l in 0..N {
+            if live[l] {
+                let (rx, ry, rz) = (n[l][0].sqrt(), n[l][1].sqrt(), n[l][2].sqrt());
+                let lambda = rx * ry + rx * rz + ry * rz;
+                an[l] = (an[l] + lambda) / 4.0;
+                n[l] = [
+                    (n[l][0] + lambda) / 4.0,
+                    (n[l][1] + lambda) / 4.0,
+                    (n[l][2] + lambda) / 4.0,
+                ];
+                q[l] /= 4.0;
+                f[l] *= 4.0;
+                live[l] = !(q[l] < an[l].abs());
+            }
+        }
+        if !live.iter().any(|&x| x) {
+            break;
+        }
+    }
+    let mut out = [0.0; N];
+    for l in 0..N {
+        out[l] = rf_series(a[l], a0[l], an[l], f[l]);
+    }
+    out
+}
+
+/// Arguments that [`rf`] hands to the duplication algorithm proper unchanged: non-negative,
+/// at most one zero, none infinite, the largest in [1e-30, 1e30].
+#[inline(always)]
+fn in_range([x, y, z]: [f64; 3]) -> bool {
+    let zeros = (x == 0.0) as u8 + (y == 0.0) as u8 + (z == 0.0) as u8;
+    x >= 0.0 && y >= 0.0 && z >= 0.0 && zeros < 2 && (1e-30..=1e30).contains(&x.max(y).max(z))
 }
 
 #[inline]
@@ -180,6 +277,58 @@ mod tests {
         assert_eq!(rf(0.0, 0.0, 1.0), f64::INFINITY);
         assert_eq!(rf(f64::INFINITY, 1.0, 1.0), 0.0);
         assert!(rf(-1.0, 1.0, 1.0).is_nan() && rf(f64::NAN, 1.0, 1.0).is_nan());
+    }
+
+    /// `rf_lanes` is `rf` lane by lane, to the last bit, wherever the lanes stop: argument
+    /// triples over 24 decades (so that the two lanes take different numbers of steps),
+    /// across-the-top triples as `cos_integral` forms them, and the special and out-of-range
+    /// triples that fall back to `rf`.
+    #[test]
+    fn rf_lanes_are_rf_calls_to_the_bit() {
+        let mut triples = vec![
+            [0.0, 1.0, 2.0],
+            [0.0, 0.0, 1.0],
+            [f64::INFINITY, 1.0, 1.0],
+            [-1.0, 1.0, 1.0],
+            [f64::NAN, 1.0, 1.0],
+            [1e-40, 2e-40, 3e-40],
+            [1e31, 1.0, 2.0],
+            [1.0, 1.0, 1.0],
+        ];
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut uniform = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..400 {
+            let e = |u: f64| 10f64.powf(-12.0 + 24.0 * u);
+            triples.push([e(uniform()), e(uniform()), e(uniform())]);
+            // Across the top: c² w_t², w², w_t² with w_t² from 1e-14 to 1.
+            let wt2 = 10f64.powf(-14.0 * uniform());
+            let c = 0.8 + 0.2 * uniform();
+            triples.push([c * c * wt2, wt2 + uniform(), wt2]);
+        }
+        let one = |[x, y, z]: [f64; 3]| rf(x, y, z).to_bits();
+        for (i, a) in triples.iter().enumerate() {
+            for b in triples.iter().step_by(7) {
+                let [p, q] = rf_lanes([*a, *b]);
+                assert_eq!(
+                    [p.to_bits(), q.to_bits()],
+                    [one(*a), one(*b)],
+                    "{a:?} {b:?}"
+                );
+                let c = triples[(i * 13 + 5) % triples.len()];
+                let d = triples[(i * 29 + 11) % triples.len()];
+                let four = rf_lanes([*a, *b, c, d]).map(f64::to_bits);
+                assert_eq!(
+                    four,
+                    [one(*a), one(*b), one(c), one(d)],
+                    "{a:?} {b:?} {c:?} {d:?}"
+                );
+            }
+        }
     }
 
     /// Arguments beyond [1e-30, 1e30], which `rf` scales by its homogeneity, against the
@@ -230,6 +379,28 @@ mod tests {
             let t = cos_integral(h0, h1, w(p0), w(p1), a - b, den);
             let q = by_quadrature(a, b, p0, p1);
             assert!((t - q).abs() <= 1e-14 * q, "{a} {b} {p0} {p1}: {t} vs {q}");
+        }
+    }
+
+    /// `cos_integral_pair` is two calls of `cos_integral`, to the last bit: across the top
+    /// (four R_F side by side) with top speeds from 1e-14 to 1, and on one side (two calls).
+    #[test]
+    fn cos_integral_pair_is_two_calls_to_the_bit() {
+        for &(p0, p1) in &[(-0.3, 0.8), (-1.2, 0.05), (0.2, 0.8), (-0.9, -0.1)] {
+            let (h0, h1) = (SinCos::of(0.5 * p0), SinCos::of(0.5 * p1));
+            let den = (0.5 * (p1 + p0)).sin() * (0.5 * (p1 - p0)).sin();
+            let speeds = |wt: f64| {
+                let (a, b) = (1.0 + wt, 1.0);
+                [a - b * f64::cos(p0), a - b * f64::cos(p1), wt]
+            };
+            for i in 0..=14 {
+                for j in [0, 3, 7, 14] {
+                    let (a, b) = (speeds(10f64.powi(-i)), speeds(10f64.powi(-j)));
+                    let one = |[w0, w1, wt]: [f64; 3]| cos_integral(h0, h1, w0, w1, wt, den);
+                    let pair = cos_integral_pair(h0, h1, a, b, den);
+                    assert_eq!(pair.map(f64::to_bits), [one(a).to_bits(), one(b).to_bits()]);
+                }
+            }
         }
     }
 }

@@ -683,3 +683,51 @@ fn simulate_jan_and_jaeger_with_their_flags() {
         );
     }
 }
+
+/// `jan` and `jaeger` show a progress bar of their model evaluations on a terminal only. With
+/// the bar's delay at 0 (`FITBEAD_PROGRESS_DELAY_MS`, so that even a short run would draw it),
+/// a piped stderr gets no bar; the same run under a pseudo-terminal (util-linux `script`, where
+/// it is installed) draws it, which shows that the first check could have failed.
+#[test]
+fn jan_and_jaeger_draw_their_progress_bar_on_a_terminal_only() {
+    let d = tmpdir();
+    for cmd in ["jan", "jaeger"] {
+        let (o, s) = (d.path().join("o.csv"), d.path().join("s.csv"));
+        let out = bin()
+            .arg(cmd)
+            .arg("--output")
+            .arg(&o)
+            .arg("--output-stats")
+            .arg(&s)
+            .env("FITBEAD_PROGRESS_DELAY_MS", "0")
+            .output()
+            .unwrap();
+        let err = crate::common::stderr(&out);
+        assert!(out.status.success(), "{cmd}: {err}");
+        assert!(
+            !err.contains("model evaluations") && !err.contains('\r'),
+            "{cmd}: a bar on a piped stderr: {err:?}"
+        );
+        let exe = std::env::var("FITBEAD_BIN").unwrap_or(env!("CARGO_BIN_EXE_fitbead").into());
+        let shell = format!(
+            "'{exe}' {cmd} --output '{}' --output-stats '{}'",
+            o.display(),
+            s.display()
+        );
+        let Ok(pty) = std::process::Command::new("script")
+            .args(["-qec", &shell, "/dev/null"])
+            .env("FITBEAD_PROGRESS_DELAY_MS", "0")
+            .stdin(std::process::Stdio::null())
+            .output()
+        else {
+            eprintln!("no `script` here: the terminal side of {cmd}'s bar is not checked");
+            continue;
+        };
+        let shown = String::from_utf8_lossy(&pty.stdout);
+        assert!(pty.status.success(), "{cmd} under script: {shown}");
+        assert!(
+            shown.contains(&format!("{cmd} ")) && shown.contains("model evaluations"),
+            "{cmd}: no bar on a terminal: {shown:?}"
+        );
+    }
+}

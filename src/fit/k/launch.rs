@@ -30,7 +30,7 @@ use crate::models::regimes::theta_g;
 use crate::models::stickslip::{self, Branch};
 use crate::models::{Model, NotSteady, Phases, Steady};
 use crate::scene::Scene;
-use crate::special::elliptic::cos_integral;
+use crate::special::elliptic::{cos_integral, cos_integral_pair};
 use crate::special::root::{brent, golden_max};
 
 /// Which contact mechanics the launch follows.
@@ -345,85 +345,223 @@ impl<'a> Launch<'a> {
         (u, slope)
     }
 
-    /// Solves τ(e^u) = τ* by the secant method from `u0` (first step with `slope0` ≈ dτ/du),
-    /// kept inside (−∞, u_d] with bisection once both sides are known. Returns u and, when
-    /// the last iterate was evaluated there, its pass.
-    ///
-    /// With C = τ''/(2τ') — given as `curv` (K_lo, K_hi: from the root's differences) or
-    /// estimated from the divided differences of the last three iterates — a secant iterate
-    /// whose predicted error |C| |Δ_n| |Δ_{n−1}| (the secant method's error recursion) is
-    /// below one ulp of u is returned without its own evaluation.
+    /// Two whole contacts, [`Launch::pass`] at `ya` and at `yb` to the last bit (uncounted):
+    /// for rolling, the four R_F of their contact times run side by side
+    /// ([`cos_integral_pair`]).
+    fn pass_pair(&self, ya: f64, yb: f64) -> [Option<Pass>; 2] {
+        let mut n = 0;
+        match self.mech {
+            Mechanics::RollSlip => [self.pass(ya, &mut n), self.pass(yb, &mut n)],
+            Mechanics::Roll => {
+                let sc = self.scene;
+                let w0sq = [ya + self.wc2, yb + self.wc2];
+                let wf2 = w0sq.map(|w| w + self.drop);
+                let tau = cos_integral_pair(
+                    sc.sc_half_0,
+                    sc.sc_half_f,
+                    [w0sq[0], wf2[0], ya],
+                    [w0sq[1], wf2[1], yb],
+                    sc.sin_delta_sin_alpha(),
+                );
+                [0, 1].map(|i| Self::roll_pass(tau[i], w0sq[i], wf2[i]))
+            }
+        }
+    }
+
+    /// A rolling contact of time `tau` from squared speed `w0sq` to `wf2`, if the time is one.
+    fn roll_pass(tau: f64, w0sq: f64, wf2: f64) -> Option<Pass> {
+        (tau.is_finite() && tau > 0.0).then(|| Pass {
+            tau,
+            w0: w0sq.sqrt(),
+            wf: wf2.sqrt(),
+            theta_g: None,
+            branch: None,
+        })
+    }
+
+    /// Solves τ(e^u) = τ* by [`Secant`] from `u0`; `first`, when given, is the pass at the
+    /// secant's first point, evaluated by the caller.
     fn solve(
         &self,
+        mut secant: Secant,
+        first: Option<Option<Pass>>,
+        evals: &mut usize,
+    ) -> Option<(f64, Option<Pass>)> {
+        let mut p = match first {
+            Some(p) => p,
+            None => self.pass(secant.x.exp(), evals),
+        };
+        loop {
+            match secant.feed(p) {
+                Step::Eval(x) => p = self.pass(x.exp(), evals),
+                Step::Done(r) => return r,
+            }
+        }
+    }
+
+    /// Two independent [`Launch::solve`]s run side by side, each pair of their passes by
+    /// [`Launch::pass_pair`]: the same results, to the last bit.
+    fn solve_two(
+        &self,
+        (a, b): (Secant, Secant),
+        evals: &mut usize,
+    ) -> [Option<(f64, Option<Pass>)>; 2] {
+        let mut secants = [a, b];
+        let [pa, pb] = self.pass_pair(secants[0].x.exp(), secants[1].x.exp());
+        *evals += 2;
+        let mut steps = [secants[0].feed(pa), secants[1].feed(pb)];
+        loop {
+            match steps {
+                [Step::Eval(xa), Step::Eval(xb)] => {
+                    let [pa, pb] = self.pass_pair(xa.exp(), xb.exp());
+                    *evals += 2;
+                    steps = [secants[0].feed(pa), secants[1].feed(pb)];
+                }
+                [Step::Done(ra), Step::Done(rb)] => return [ra, rb],
+                [Step::Done(ra), Step::Eval(xb)] => {
+                    let p = self.pass(xb.exp(), evals);
+                    let [_, b] = secants;
+                    return [ra, self.solve(b, Some(p), evals)];
+                }
+                [Step::Eval(xa), Step::Done(rb)] => {
+                    let p = self.pass(xa.exp(), evals);
+                    let [a, _] = secants;
+                    return [self.solve(a, Some(p), evals), rb];
+                }
+            }
+        }
+    }
+}
+
+/// What a [`Secant`] asks for next.
+#[derive(Debug, Clone, Copy)]
+enum Step {
+    /// The pass at this u.
+    Eval(f64),
+    /// The end of the search: u and, when the last iterate was evaluated there, its pass;
+    /// `None` when it failed.
+    Done(Option<(f64, Option<Pass>)>),
+}
+
+/// The root search of τ(e^u) = τ* by the secant method, kept inside (−∞, u_d] with bisection
+/// once both sides are known, as a state machine that asks for one pass at a time (so that two
+/// searches can share the work of their passes, [`Launch::solve_two`]).
+///
+/// With C = τ''/(2τ') — given as `curv` (K_lo, K_hi: from the root's differences) or
+/// estimated from the divided differences of the last three iterates — a secant iterate whose
+/// predicted error |C| |Δ_n| |Δ_{n−1}| (the secant method's error recursion) is below one ulp
+/// of u is returned without its own evaluation.
+#[derive(Debug, Clone, Copy)]
+struct Secant {
+    tau_star: f64,
+    slope0: f64,
+    curv: Option<f64>,
+    /// Bracket: g = τ − τ* > 0 below the root (slower), < 0 above.
+    lo: f64,
+    hi: f64,
+    /// The point whose pass comes next.
+    x: f64,
+    prev: Option<(f64, f64)>,
+    before: Option<(f64, f64)>,
+    /// Iterations done.
+    it: usize,
+}
+
+impl Secant {
+    /// The search from `u0` (first step with `slope0` ≈ dτ/du) below the end of the range
+    /// (u_d, τ_d); `None` when τ_d ≥ τ* (no root below).
+    fn new(
         tau_star: f64,
         u0: f64,
         slope0: f64,
         (u_d, tau_d): (f64, f64),
         curv: Option<f64>,
-        evals: &mut usize,
-    ) -> Option<(f64, Option<Pass>)> {
-        // Bracket: g = τ − τ* > 0 below the root (slower), < 0 above.
-        let mut lo = f64::NEG_INFINITY;
-        let mut hi = u_d;
+    ) -> Option<Self> {
         let g_hi = tau_d - tau_star;
         if g_hi >= 0.0 {
             return None;
         }
-        let mut x = u0.min(u_d);
+        let x = Self::first_point(u0, u_d);
+        Some(Secant {
+            tau_star,
+            slope0,
+            curv,
+            lo: f64::NEG_INFINITY,
+            hi: u_d,
+            x,
+            prev: None,
+            before: None,
+            it: 0,
+        })
+    }
+
+    /// The first point of a search from `u0` below `u_d` (as [`Secant::new`] sets it).
+    fn first_point(u0: f64, u_d: f64) -> f64 {
+        let x = u0.min(u_d);
         if x == u_d {
-            x -= 1e-3;
+            x - 1e-3
+        } else {
+            x
         }
-        let mut p = self.pass(x.exp(), evals)?;
-        let mut gx = p.tau - tau_star;
-        let mut prev: Option<(f64, f64)> = None;
-        let mut before: Option<(f64, f64)> = None;
-        for it in 0..80 {
-            // |τ − τ*| at the rounding level of τ itself: no iterate can do better.
-            if gx.abs() <= 4.0 * f64::EPSILON * tau_star {
-                return Some((x, Some(p)));
-            }
-            if gx > 0.0 {
-                lo = x;
+    }
+
+    /// Takes the pass at the point asked for (`None`: the pass failed, and so does the
+    /// search) and says what comes next.
+    fn feed(&mut self, p: Option<Pass>) -> Step {
+        const MAX_ITERATIONS: usize = 80;
+        let Some(p) = p else {
+            return Step::Done(None);
+        };
+        let (x, tau_star) = (self.x, self.tau_star);
+        let gx = p.tau - tau_star;
+        // |τ − τ*| at the rounding level of τ itself: no iterate can do better.
+        if gx.abs() <= 4.0 * f64::EPSILON * tau_star {
+            return Step::Done(Some((x, Some(p))));
+        }
+        if gx > 0.0 {
+            self.lo = x;
+        } else {
+            self.hi = x;
+        }
+        let (lo, hi) = (self.lo, self.hi);
+        let tol = 4.0 * f64::EPSILON * x.abs().max(1.0);
+        let mut next = match self.prev {
+            Some((xp, gp)) if gp != gx && self.it < 30 => x - gx * (x - xp) / (gx - gp),
+            None => x - gx / self.slope0,
+            _ => f64::NAN,
+        };
+        if !(next > lo && next < hi) {
+            next = if lo.is_finite() {
+                0.5 * (lo + hi)
             } else {
-                hi = x;
-            }
-            let tol = 4.0 * f64::EPSILON * x.abs().max(1.0);
-            let mut next = match prev {
-                Some((xp, gp)) if gp != gx && it < 30 => x - gx * (x - xp) / (gx - gp),
-                None => x - gx / slope0,
-                _ => f64::NAN,
+                // The slow side is not bracketed yet: step down in u.
+                x - 2.0 * (1.0 + (x - self.prev.map_or(x, |q| q.0)).abs())
             };
-            if !(next > lo && next < hi) {
-                next = if lo.is_finite() {
-                    0.5 * (lo + hi)
-                } else {
-                    // The slow side is not bracketed yet: step down in u.
-                    x - 2.0 * (1.0 + (x - prev.map_or(x, |q| q.0)).abs())
-                };
-            } else if let Some((xp, gp)) = prev {
-                let c = curv.or_else(|| {
-                    let (xb, gb) = before?;
-                    let d1 = (gx - gp) / (x - xp);
-                    let d2 = (d1 - (gp - gb) / (xp - xb)) / (x - xb);
-                    Some(d2 / d1)
-                });
-                if let Some(c) = c.filter(|c| c.is_finite()) {
-                    if (c * (next - x) * (x - xp)).abs() <= 0.5 * tol {
-                        return Some((next, None));
-                    }
+        } else if let Some((xp, gp)) = self.prev {
+            let c = self.curv.or_else(|| {
+                let (xb, gb) = self.before?;
+                let d1 = (gx - gp) / (x - xp);
+                let d2 = (d1 - (gp - gb) / (xp - xb)) / (x - xb);
+                Some(d2 / d1)
+            });
+            if let Some(c) = c.filter(|c| c.is_finite()) {
+                if (c * (next - x) * (x - xp)).abs() <= 0.5 * tol {
+                    return Step::Done(Some((next, None)));
                 }
             }
-            // The last step is the error of x: x is the root to within `tol`.
-            if (next - x).abs() <= tol || hi - lo <= tol {
-                return Some((x, Some(p)));
-            }
-            before = prev;
-            prev = Some((x, gx));
-            x = next;
-            p = self.pass(x.exp(), evals)?;
-            gx = p.tau - tau_star;
         }
-        None
+        // The last step is the error of x: x is the root to within `tol`.
+        if (next - x).abs() <= tol || hi - lo <= tol {
+            return Step::Done(Some((x, Some(p))));
+        }
+        self.before = self.prev;
+        self.prev = Some((x, gx));
+        self.x = next;
+        self.it += 1;
+        if self.it == MAX_ITERATIONS {
+            return Step::Done(None);
+        }
+        Step::Eval(next)
     }
 }
 
@@ -441,6 +579,14 @@ fn steady_of(scene: &Scene, p: &Pass, y: f64, map_slope: f64) -> Steady {
     s
 }
 
+/// How an end of the interval at v ± σ is found.
+enum End {
+    /// A bracket end (v ∓ σ outside the steady range).
+    At(f64),
+    /// A root search.
+    Search(Secant),
+}
+
 /// [`super::estimate()`](super::estimate::estimate) by the launch speed, when this path applies (`None`: use the
 /// general search). Same outputs and statuses as the general path.
 pub fn estimate(model: &Model, scene: &Scene, v: f64, sigma_v: Option<f64>) -> Option<KEstimate> {
@@ -449,9 +595,21 @@ pub fn estimate(model: &Model, scene: &Scene, v: f64, sigma_v: Option<f64>) -> O
     }
     let l = Launch::new(model, scene)?;
     let mut evals = 0;
-    let top = l.pass(l.y_d, &mut evals)?;
     let u_d = l.y_d.ln();
     let sin_alpha = scene.sin_alpha;
+    let tau_star = 2.0 * sin_alpha / v;
+    // Rolling: the pass at the top of the range and the root search's first one (from the
+    // asinh start, which needs no pass) side by side; stick/slip takes them one by one, the
+    // second only when the root is searched.
+    let (top, first) = match l.mech {
+        Mechanics::Roll => {
+            let (u0, s0) = l.guess(tau_star);
+            let [top, first] = l.pass_pair(l.y_d, Secant::first_point(u0, u_d).exp());
+            evals += 1;
+            (top?, Some((u0, s0, first)))
+        }
+        Mechanics::RollSlip => (l.pass(l.y_d, &mut evals)?, None),
+    };
     let br = KBracket {
         lo: l.k_min,
         hi: top.k(),
@@ -468,7 +626,6 @@ pub fn estimate(model: &Model, scene: &Scene, v: f64, sigma_v: Option<f64>) -> O
     };
     let end = (u_d, top.tau);
     let mut notes = Vec::new();
-    let tau_star = 2.0 * sin_alpha / v;
     // Near a saddle-node the range's end is where the forward model's status search puts it:
     // measurements within 1e-6 of the fastest stable motion, or whose v + σ passes it, are
     // left to the general search, whose bracket (and so whose statuses there) is that one.
@@ -488,8 +645,16 @@ pub fn estimate(model: &Model, scene: &Scene, v: f64, sigma_v: Option<f64>) -> O
     }
     // The root.
     let mut n_root = 0;
-    let (u0, s0) = l.guess(tau_star);
-    let (u, p) = l.solve(tau_star, u0, s0, end, None, &mut n_root)?;
+    let (u0, s0, first) = match first {
+        Some((u0, s0, p)) => (u0, s0, Some(p)),
+        None => {
+            let (u0, s0) = l.guess(tau_star);
+            (u0, s0, None)
+        }
+    };
+    let secant = Secant::new(tau_star, u0, s0, end, None)?;
+    n_root += usize::from(first.is_some());
+    let (u, p) = l.solve(secant, first, &mut n_root)?;
     let y = u.exp();
     // Keep the crawl end to the general search: there K rounds to K_min.
     if y < 1e-12 * l.wc2 {
@@ -507,18 +672,13 @@ pub fn estimate(model: &Model, scene: &Scene, v: f64, sigma_v: Option<f64>) -> O
     let k = p.k();
     // dτ/du and d²τ/du² by central differences, h = 1e-5 in u (one-sided at lift-off).
     let h = 1e-5;
-    let mut n_side = 0;
-    let (pm, pp) = if u + h <= u_d {
-        (
-            l.pass((u - h).exp(), &mut n_side)?,
-            l.pass((u + h).exp(), &mut n_side)?,
-        )
+    let mut n_side = 2;
+    let [pm, pp] = if u + h <= u_d {
+        l.pass_pair((u - h).exp(), (u + h).exp())
     } else {
-        (
-            l.pass((u - 2.0 * h).exp(), &mut n_side)?,
-            l.pass((u - h).exp(), &mut n_side)?,
-        )
+        l.pass_pair((u - 2.0 * h).exp(), (u - h).exp())
     };
+    let (pm, pp) = (pm?, pp?);
     let (d1, d2) = if u + h <= u_d {
         (
             (pp.tau - pm.tau) / (2.0 * h),
@@ -533,8 +693,9 @@ pub fn estimate(model: &Model, scene: &Scene, v: f64, sigma_v: Option<f64>) -> O
     let (dk, map_slope) = l.dk_du(y, &p)?;
     // v̄ = 2 sin α / τ: dv̄/du = −v̄ τ'/τ.
     let dv_dk = -(2.0 * sin_alpha / p.tau) * d1 / p.tau / dk;
-    // K at v ± σ: a second-order Taylor step in τ off the root, then the secant method.
-    let mut end_k = |vs: f64, name: &'static str, notes: &mut Vec<String>| -> Option<f64> {
+    // K at v ± σ: a second-order Taylor step in τ off the root, then the secant method (the
+    // two searches side by side).
+    let plan_end = |vs: f64, name: &'static str, notes: &mut Vec<String>| -> Option<End> {
         let side = if name == "K_lo" {
             "v - sigma_v"
         } else {
@@ -542,36 +703,41 @@ pub fn estimate(model: &Model, scene: &Scene, v: f64, sigma_v: Option<f64>) -> O
         };
         if vs <= 0.0 {
             notes.push(format!("{name} is the bracket's lower end: {side} <= 0"));
-            return Some(br.lo);
+            return Some(End::At(br.lo));
         }
         if vs > br.v_hi {
             notes.push(format!(
                 "{name} is the bracket's upper end: {side} is above the steady range"
             ));
-            return Some(br.hi);
+            return Some(End::At(br.hi));
         }
         let t = 2.0 * sin_alpha / vs;
         let dt = t - p.tau;
         let du = dt / d1;
         let du = du - 0.5 * d2 * du * du / d1;
-        let (ue, pe) = l.solve(
-            t,
-            u + du,
-            d1 + d2 * du,
-            end,
-            Some(0.5 * d2 / d1),
-            &mut n_side,
-        )?;
+        Secant::new(t, u + du, d1 + d2 * du, end, Some(0.5 * d2 / d1)).map(End::Search)
+    };
+    let k_at = |r: Option<(f64, Option<Pass>)>| -> Option<f64> {
+        let (ue, pe) = r?;
         match pe {
             Some(pe) => Some(pe.k()),
             None => l.k_of_launch(ue.exp()),
         }
     };
     let (k_lo, k_hi) = match sigma_v {
-        Some(sg) => (
-            end_k(v - sg, "K_lo", &mut notes)?,
-            end_k(v + sg, "K_hi", &mut notes)?,
-        ),
+        Some(sg) => {
+            let lo = plan_end(v - sg, "K_lo", &mut notes)?;
+            let hi = plan_end(v + sg, "K_hi", &mut notes)?;
+            match (lo, hi) {
+                (End::Search(a), End::Search(b)) => {
+                    let [ra, rb] = l.solve_two((a, b), &mut n_side);
+                    (k_at(ra)?, k_at(rb)?)
+                }
+                (End::Search(a), End::At(kh)) => (k_at(l.solve(a, None, &mut n_side))?, kh),
+                (End::At(kl), End::Search(b)) => (kl, k_at(l.solve(b, None, &mut n_side))?),
+                (End::At(kl), End::At(kh)) => (kl, kh),
+            }
+        }
         None => (f64::NAN, f64::NAN),
     };
     if l.saddle {
@@ -585,7 +751,10 @@ pub fn estimate(model: &Model, scene: &Scene, v: f64, sigma_v: Option<f64>) -> O
     }
     let steady = steady_of(scene, &p, y, map_slope);
     let theta_g = match l.mech {
-        Mechanics::Roll => scene.with_k(k).ok().and_then(|s| theta_g(&s, p.w0 * p.w0)),
+        // Θ_G does not involve K: the scene's own serves (K checked as `Scene::with_k` would).
+        Mechanics::Roll => (k.is_finite() && k > 0.0)
+            .then_some(())
+            .and_then(|()| theta_g(scene, p.w0 * p.w0)),
         Mechanics::RollSlip => steady.theta_g,
     };
     Some(KEstimate {

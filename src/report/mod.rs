@@ -1,4 +1,5 @@
-//! Reports: the comparisons of `fitbead report` ([`analysis`]), its SVG figures ([`figures`]), its text ([`text`])
+//! Reports: the comparisons of `fitbead report` ([`analysis`]) and their posterior bands
+//! ([`bands`]), its SVG figures ([`figures`]), its text ([`text`])
 //! and the work-precision engine of `fitbead bench` ([`workprecision`]).
 
 pub mod analysis;

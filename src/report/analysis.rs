@@ -1102,15 +1102,11 @@ impl Analysis {
 
     /// Posterior blocks for the corner plot (MCMC only).
     pub fn posteriors(&self) -> Vec<&FitResult> {
-        let mut v: Vec<&FitResult> = Vec::new();
-        for c in &self.contact {
-            v.extend(c.law_c.iter().map(|f| &f.summary));
-            v.extend(c.free.iter().map(|f| &f.summary));
-        }
-        v.extend(self.jan.series.iter().flatten());
-        v.extend(self.jan.global.iter());
-        v.extend(self.jaeger.series.iter().flatten().map(|f| &f.summary));
-        v.into_iter().filter(|s| s.draws.is_some()).collect()
+        self.each_fit()
+            .into_iter()
+            .map(|(_, f)| f)
+            .filter(|s| s.draws.is_some())
+            .collect()
     }
 
     /// The parameter rows of every fit (the `--output` format of the fit commands).

@@ -5,23 +5,18 @@ use super::analysis::Analysis;
 use super::bands::PosteriorBands;
 use crate::fit::summary::FitResult;
 
-/// A copy of `f` without its draws (the report's tables need the summaries only), with the
-/// fit's name prefixed by `prefix` (the contact model of a K(α) law) on the statistics and on
-/// every parameter row.
-fn named(f: &FitResult, prefix: Option<&str>) -> FitResult {
-    let rename = |name: &str| match prefix {
-        Some(p) => format!("{p}-{name}"),
-        None => name.to_string(),
-    };
+/// A copy of `f` without its draws (the report's tables need the summaries only), named `name`
+/// on the statistics and on every parameter row.
+fn named(f: &FitResult, name: &str) -> FitResult {
     let mut stats = f.stats.clone();
-    stats.fit = rename(&stats.fit);
+    stats.fit = name.to_string();
     FitResult {
         params: f
             .params
             .iter()
             .map(|r| {
                 let mut r = r.clone();
-                r.fit = rename(&r.fit);
+                r.fit = name.to_string();
                 r
             })
             .collect(),
@@ -34,6 +29,29 @@ fn named(f: &FitResult, prefix: Option<&str>) -> FitResult {
 }
 
 impl Analysis {
+    /// Every fit of the report in the order of params.csv, with its name there: per contact
+    /// model its K(α) law c and its one-K-per-series fit (`rolling-klaw-c`, …), then Jan's
+    /// per-series and global fits, then Jaeger's per-series fits (a per-series model names
+    /// each of its fits alike).
+    pub fn each_fit(&self) -> Vec<(String, &FitResult)> {
+        let mut v = Vec::new();
+        for c in &self.contact {
+            for f in c.law_c.iter().chain(c.free.iter()) {
+                v.push((format!("{}-{}", c.name, f.summary.stats.fit), &f.summary));
+            }
+        }
+        let jan = self
+            .jan
+            .series
+            .iter()
+            .flatten()
+            .chain(self.jan.global.iter());
+        v.extend(jan.map(|f| (f.stats.fit.clone(), f)));
+        let jaeger = self.jaeger.series.iter().flatten().map(|f| &f.summary);
+        v.extend(jaeger.map(|f| (f.stats.fit.clone(), f)));
+        v
+    }
+
     /// [`Analysis::fit_results`] with, for a posterior run, every point's fitted v̄ replaced by
     /// its posterior median (`medians`, from
     /// [`posterior_bands`](super::bands::posterior_bands)), and its residuals recomputed from
@@ -62,25 +80,10 @@ impl Analysis {
     /// …), then Jan's per-series and global fits, then Jaeger's per-series fits. The copies
     /// carry no draws.
     pub fn fit_results(&self) -> Vec<FitResult> {
-        let mut v = Vec::new();
-        for c in &self.contact {
-            for f in c.law_c.iter().chain(c.free.iter()) {
-                v.push(named(&f.summary, Some(c.name)));
-            }
-        }
-        for f in self
-            .jan
-            .series
-            .iter()
-            .flatten()
-            .chain(self.jan.global.iter())
-        {
-            v.push(named(f, None));
-        }
-        for f in self.jaeger.series.iter().flatten() {
-            v.push(named(&f.summary, None));
-        }
-        v
+        self.each_fit()
+            .into_iter()
+            .map(|(name, f)| named(f, &name))
+            .collect()
     }
 }
 

@@ -778,31 +778,12 @@ impl Analysis {
     /// The fits of the report with their names as in `params.csv`: (name, fits) where a
     /// per-series model has one fit per series.
     pub fn named_fits(&self) -> Vec<(String, Vec<&FitResult>)> {
-        let mut out = Vec::new();
-        for c in &self.contact {
-            for f in c.law_c.iter().chain(c.free.iter()) {
-                out.push((
-                    format!("{}-{}", c.name, f.summary.stats.fit),
-                    vec![&f.summary],
-                ));
+        let mut out: Vec<(String, Vec<&FitResult>)> = Vec::new();
+        for (name, f) in self.each_fit() {
+            match out.last_mut() {
+                Some(g) if g.0 == name => g.1.push(f),
+                _ => out.push((name, vec![f])),
             }
-        }
-        let jan: Vec<&FitResult> = self.jan.series.iter().flatten().collect();
-        if let Some(first) = jan.first() {
-            out.push((first.stats.fit.clone(), jan));
-        }
-        if let Some(g) = &self.jan.global {
-            out.push((g.stats.fit.clone(), vec![g]));
-        }
-        let jaeger: Vec<&FitResult> = self
-            .jaeger
-            .series
-            .iter()
-            .flatten()
-            .map(|f| &f.summary)
-            .collect();
-        if let Some(first) = jaeger.first() {
-            out.push((first.stats.fit.clone(), jaeger));
         }
         out
     }

@@ -251,30 +251,13 @@ pub fn run(a: Args) -> Result<(), CliError> {
         "models_by_series.csv".into(),
         an.models_by_series_csv().map_err(csv_err)?,
     ));
+    // Under a posterior run: the bands of v̄(δ) and the posterior median at every point.
+    let bands = an
+        .mcmc
+        .then(|| fitbead::report::bands::posterior_bands(&an));
+    let fits = an.fit_results_at(bands.as_ref());
     let params = an.params();
-    let mut stats = Vec::new();
-    for c in &an.contact {
-        for f in c.law_c.iter().chain(c.free.iter()) {
-            let mut s = f.summary.stats.clone();
-            s.fit = format!("{}-{}", c.name, s.fit);
-            stats.push(s);
-        }
-    }
-    stats.extend(
-        an.jan
-            .series
-            .iter()
-            .flatten()
-            .chain(an.jan.global.iter())
-            .map(|s| s.stats.clone()),
-    );
-    stats.extend(
-        an.jaeger
-            .series
-            .iter()
-            .flatten()
-            .map(|f| f.summary.stats.clone()),
-    );
+    let stats: Vec<_> = fits.iter().map(|f| f.stats.clone()).collect();
     let stats = flag_absurd(&stats);
     files.push((
         "params.csv".into(),
@@ -317,11 +300,6 @@ pub fn run(a: Args) -> Result<(), CliError> {
             Some(u)
         }
     };
-    // Under a posterior run: the bands of v̄(δ) and the posterior median at every point.
-    let bands = an
-        .mcmc
-        .then(|| fitbead::report::bands::posterior_bands(&an));
-    let fits = an.fit_results_at(bands.as_ref());
     let fit_refs: Vec<&fitbead::fit::summary::FitResult> = fits.iter().collect();
     files.push((
         "residuals.csv".into(),

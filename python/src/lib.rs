@@ -1,0 +1,1183 @@
+//! The compiled core of the `fitbead` Python package: numpy arrays in and out of fitbead's
+//! forward models, the K inversion of eq 69, the regime limits and the fits.
+//!
+//! The Python package (`python/fitbead/`) wraps these functions in a documented API; the
+//! functions here take flat, contiguous float64 arrays of equal length (the Python layer
+//! broadcasts) and return dictionaries of arrays. Text columns come back as codes into a list
+//! of categories (`(codes, names)`), which the Python layer turns into string arrays. Every
+//! number is computed by the Rust library exactly as the command line computes it.
+
+use fitbead::fit::builder::{JaegerFitter, JanFitter, KLawFitter};
+use fitbead::fit::data::Dataset as RsDataset;
+use fitbead::fit::k::{estimate, KFailure, LowerLimit, UpperLimit};
+use fitbead::fit::klaw::KLaw;
+use fitbead::fit::report::FitSet;
+use fitbead::fit::summary::FitResult as RsFitResult;
+use fitbead::inverse::posterior::McmcSettings;
+use fitbead::io::measurements::{MeasurementDefaults, MeasurementFile};
+use fitbead::models::auto::Auto;
+use fitbead::models::contact::{Contact, SpinRule};
+use fitbead::models::jaeger::Jaeger;
+use fitbead::models::jan::Jan;
+use fitbead::models::regimes::{
+    alpha_of_xi, bulk_friction_law, critical_xi, delta_d_law, delta_m_law,
+};
+use fitbead::models::{regime_of, ForwardModel, JaegerBranch, Model, ModelKind, Outcome};
+use fitbead::scene::{CollisionLaw, Scene};
+use numpy::{PyArray1, PyArray3, PyReadonlyArray1};
+use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use rayon::prelude::*;
+use std::borrow::Cow;
+use std::collections::HashMap;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Condvar, Mutex};
+use std::time::Duration;
+
+/// Rows evaluated per parallel block: bounds the memory of the per-row records.
+const BLOCK: usize = 1 << 16;
+
+fn value_error(msg: impl Into<String>) -> PyErr {
+    PyValueError::new_err(msg.into())
+}
+
+/// A contiguous view of a 1-D float64 array.
+fn slice<'a>(a: &'a PyReadonlyArray1<'_, f64>, name: &str) -> PyResult<&'a [f64]> {
+    a.as_slice()
+        .map_err(|_| value_error(format!("{name}: expected a contiguous float64 array")))
+}
+
+fn opt_slice<'a>(
+    a: &'a Option<PyReadonlyArray1<'_, f64>>,
+    name: &str,
+    n: usize,
+) -> PyResult<Option<&'a [f64]>> {
+    match a {
+        None => Ok(None),
+        Some(a) => {
+            let s = slice(a, name)?;
+            check_len(name, s.len(), n)?;
+            Ok(Some(s))
+        }
+    }
+}
+
+fn check_len(name: &str, len: usize, n: usize) -> PyResult<()> {
+    if len == n {
+        Ok(())
+    } else {
+        Err(value_error(format!(
+            "{name}: length {len}, expected {n} (the length of xi)"
+        )))
+    }
+}
+
+/// Python's repr of a float (shortest round trip), for error messages.
+fn show(x: f64) -> String {
+    fitbead::numfmt::fmt_f64(x)
+}
+
+/// A text column: one code per row into a list of distinct values.
+#[derive(Default)]
+struct TextColumn {
+    codes: Vec<u32>,
+    names: Vec<String>,
+    index: HashMap<String, u32>,
+    last: Option<u32>,
+}
+
+impl TextColumn {
+    fn push(&mut self, s: &str) {
+        if let Some(c) = self.last {
+            if self.names[c as usize] == s {
+                self.codes.push(c);
+                return;
+            }
+        }
+        let c = match self.index.get(s) {
+            Some(&c) => c,
+            None => {
+                let c = self.names.len() as u32;
+                self.names.push(s.to_string());
+                self.index.insert(s.to_string(), c);
+                c
+            }
+        };
+        self.last = Some(c);
+        self.codes.push(c);
+    }
+}
+
+/// Columns being filled: numbers and texts, by name, in output order.
+struct Columns {
+    num_names: Vec<&'static str>,
+    num_idx: Vec<usize>,
+    nums: Vec<Vec<f64>>,
+    text_names: Vec<&'static str>,
+    text_idx: Vec<usize>,
+    texts: Vec<TextColumn>,
+}
+
+impl Columns {
+    /// Every field of the row records, in order.
+    fn new(num_names: &[&'static str], text_names: &[&'static str], n: usize) -> Self {
+        let (nn, tn) = (num_names.len(), text_names.len());
+        Columns::pick(num_names, (0..nn).collect(), text_names, (0..tn).collect(), n)
+    }
+
+    /// The fields `num_idx` and `text_idx` of the row records (whose fields are named by
+    /// `num_names` and `text_names`).
+    fn pick(
+        num_names: &[&'static str],
+        num_idx: Vec<usize>,
+        text_names: &[&'static str],
+        text_idx: Vec<usize>,
+        n: usize,
+    ) -> Self {
+        Columns {
+            num_names: num_idx.iter().map(|&i| num_names[i]).collect(),
+            nums: num_idx.iter().map(|_| Vec::with_capacity(n)).collect(),
+            num_idx,
+            text_names: text_idx.iter().map(|&i| text_names[i]).collect(),
+            texts: text_idx.iter().map(|_| TextColumn::default()).collect(),
+            text_idx,
+        }
+    }
+
+    fn push(&mut self, nums: &[f64], texts: &[Cow<'_, str>]) {
+        for (c, &i) in self.nums.iter_mut().zip(&self.num_idx) {
+            c.push(nums[i]);
+        }
+        for (c, &i) in self.texts.iter_mut().zip(&self.text_idx) {
+            c.push(&texts[i]);
+        }
+    }
+
+    fn into_dict(self, py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+        let d = PyDict::new(py);
+        for (name, v) in self.num_names.into_iter().zip(self.nums) {
+            d.set_item(name, PyArray1::from_vec(py, v))?;
+        }
+        for (name, t) in self.text_names.into_iter().zip(self.texts) {
+            let codes = PyArray1::from_vec(py, t.codes);
+            d.set_item(name, (codes, PyList::new(py, t.names)?))?;
+        }
+        Ok(d)
+    }
+}
+
+/// Evaluates `rows` in parallel blocks, each row giving fixed-size number and text records,
+/// and fills `cols` in row order. The first row error (lowest index) is returned.
+fn fill<const NF: usize, const NT: usize, F>(
+    n: usize,
+    cols: &mut Columns,
+    row: F,
+) -> Result<(), String>
+where
+    F: Fn(usize) -> Result<([f64; NF], [Cow<'static, str>; NT]), String> + Sync,
+{
+    let mut buf = Vec::with_capacity(BLOCK.min(n));
+    let mut start = 0;
+    while start < n {
+        let end = (start + BLOCK).min(n);
+        (start..end)
+            .into_par_iter()
+            .with_min_len(256)
+            .map(&row)
+            .collect_into_vec(&mut buf);
+        for r in buf.drain(..) {
+            let (nums, texts) = r?;
+            cols.push(&nums, &texts);
+        }
+        start = end;
+    }
+    Ok(())
+}
+
+fn opt(x: Option<f64>) -> f64 {
+    x.unwrap_or(f64::NAN)
+}
+
+/// The collision law of row `i`: a number from `k`, else the named law.
+fn law_of(k: Option<&[f64]>, law: CollisionLaw, i: usize) -> Result<CollisionLaw, String> {
+    match k {
+        Some(k) => {
+            let x = k[i];
+            if !x.is_finite() {
+                return Err(format!("K[{i}] = {}: value must be a finite number", show(x)));
+            }
+            Ok(CollisionLaw::Value(x))
+        }
+        None => Ok(law),
+    }
+}
+
+fn scene_of(
+    i: usize,
+    xi: &[f64],
+    d: &[f64],
+    rho: &[f64],
+    f: &[f64],
+    law: CollisionLaw,
+) -> Result<Scene, String> {
+    Scene::new(xi[i], d[i], rho[i], f[i], law).map_err(|e| {
+        format!(
+            "row {i} (xi = {}, delta_deg = {}, rho = {}, f = {}): {e}",
+            show(xi[i]),
+            show(d[i]),
+            show(rho[i]),
+            show(f[i])
+        )
+    })
+}
+
+fn parse_law(law: &str) -> PyResult<CollisionLaw> {
+    law.parse()
+        .map_err(|e: fitbead::scene::ParameterError| value_error(format!("K = '{law}': {e}")))
+}
+
+const FORWARD_NUMS: [&str; 8] = [
+    "v",
+    "K_used",
+    "final_velocity",
+    "initial_velocity",
+    "contact_time",
+    "theta_G_deg",
+    "map_slope",
+    "other_fixed_point",
+];
+const FORWARD_TEXTS: [&str; 4] = ["regime", "status", "phases", "message"];
+const CONTACT_NUMS: [&str; 7] = [
+    "initial_spin",
+    "final_spin",
+    "beads",
+    "collision_translation_frac",
+    "collision_spin_frac",
+    "friction_work_frac",
+    "energy_closure",
+];
+const CONTACT_TEXTS: [&str; 3] = ["phase_sequence", "phase_change_deg", "spin_rule"];
+const AUTO_TEXTS: [&str; 2] = ["model_used", "reason"];
+
+/// The per-row parameters of the phenomenological models and the contact model.
+struct ModelArgs<'a> {
+    kind: ModelKind,
+    lambda: Option<&'a [f64]>,
+    mu: Option<&'a [f64]>,
+    a: [Option<&'a [f64]>; 3],
+    branch: JaegerBranch,
+    spin: SpinRule,
+    tol: f64,
+}
+
+impl ModelArgs<'_> {
+    /// The model of row `i` (the command line's `forward` builds it the same way from cells).
+    fn model(&self, i: usize, scene: &Scene) -> Result<Model, String> {
+        let at = |a: Option<&[f64]>| a.map(|a| a[i]).filter(|x| !x.is_nan());
+        Ok(match (self.kind, self.kind.contact_model()) {
+            (ModelKind::Auto, _) => Model::Auto(Auto { tol: self.tol }),
+            (ModelKind::Contact, _) => Model::Contact(Contact {
+                spin: self.spin,
+                tol: self.tol,
+            }),
+            (_, Some(m)) => m,
+            (ModelKind::Jan, None) => {
+                let paper = Jan::paper_fit(scene.alpha_rad());
+                let lambda = at(self.lambda).unwrap_or(paper.lambda);
+                let mu = at(self.mu).unwrap_or(paper.mu);
+                Model::Jan(Jan::new(lambda, mu).map_err(|e| format!("row {i}: {e}"))?)
+            }
+            _ => {
+                let mut v = [0.0; 3];
+                for (j, vj) in v.iter_mut().enumerate() {
+                    *vj = at(self.a[j]).ok_or_else(|| {
+                        format!("row {i}: jaeger needs a1, a2, a3 (a{} is missing)", j + 1)
+                    })?;
+                }
+                Model::Jaeger(
+                    Jaeger::new(v[0], v[1], v[2], self.branch)
+                        .map_err(|e| format!("row {i}: {e}"))?,
+                )
+            }
+        })
+    }
+}
+
+type ForwardRow = ([f64; 15], [Cow<'static, str>; 9]);
+
+fn forward_row(scene: &Scene, model: &Model) -> ForwardRow {
+    let mut nums = [f64::NAN; 15];
+    let mut texts: [Cow<'static, str>; 9] = Default::default();
+    let (o, contact, auto): (Outcome, _, _) = match model {
+        Model::Contact(c) => {
+            let r = c.steady_state(scene);
+            (Contact::outcome(scene, &r), Some((c.spin, r.ok())), None)
+        }
+        Model::Auto(au) => {
+            let r = au.choose(scene);
+            (r.outcome, None, Some((r.choice, r.reason)))
+        }
+        m => (m.evaluate(scene), None, None),
+    };
+    let has_k = !matches!(model, Model::Jan(_) | Model::Jaeger(_));
+    texts[0] = Cow::Owned(regime_of(&o).map(|r| r.to_string()).unwrap_or_default());
+    if has_k {
+        nums[1] = scene.k();
+    }
+    match &o {
+        Ok(s) => {
+            nums[0] = s.mean_velocity;
+            if has_k {
+                nums[2] = s.final_velocity;
+                nums[3] = s.initial_velocity;
+            }
+            nums[4] = s.contact_time;
+            nums[5] = opt(s.theta_g.map(f64::to_degrees));
+            nums[6] = opt(s.map_slope);
+            nums[7] = opt(s.other_fixed_point);
+            texts[1] = Cow::Borrowed("ok");
+            texts[2] = Cow::Owned(s.phases.to_string());
+            if s.other_fixed_point.is_some() {
+                texts[3] = Cow::Borrowed(if has_k {
+                    "bistable: another fixed point of the final-velocity map"
+                } else {
+                    "two positive roots (eq 84): bistable band"
+                });
+            }
+        }
+        Err(e) => {
+            texts[1] = Cow::Borrowed(e.status());
+            texts[3] = Cow::Owned(e.to_string());
+        }
+    }
+    if let Some((rule, steady)) = contact {
+        texts[8] = Cow::Owned(rule.to_string());
+        if let Some(s) = steady {
+            let e = s.energy(scene);
+            let p = e.potential_drop;
+            texts[6] = Cow::Owned(s.run.phases.to_string());
+            texts[7] = Cow::Owned(s.run.phases.changes_deg());
+            nums[8] = s.launch.spin;
+            nums[9] = s.final_spin;
+            nums[10] = s.beads as f64;
+            nums[11] = e.collision_translation / p;
+            nums[12] = e.collision_spin / p;
+            nums[13] = e.friction_work / p;
+            nums[14] = e.closure();
+        }
+    }
+    if let Some((choice, reason)) = auto {
+        texts[4] = Cow::Borrowed(choice.name());
+        texts[5] = Cow::Owned(reason.to_string());
+    }
+    (nums, texts)
+}
+
+/// Forward model over flat arrays (see the Python `fitbead.forward`).
+#[pyfunction]
+#[pyo3(signature = (model, xi, delta_deg, rho, f, k=None, law="adjusted", lam=None, mu=None, a1=None, a2=None, a3=None, branch="upper", spin="roll", tol=1e-14))]
+#[allow(clippy::too_many_arguments)]
+fn forward<'py>(
+    py: Python<'py>,
+    model: &str,
+    xi: PyReadonlyArray1<'py, f64>,
+    delta_deg: PyReadonlyArray1<'py, f64>,
+    rho: PyReadonlyArray1<'py, f64>,
+    f: PyReadonlyArray1<'py, f64>,
+    k: Option<PyReadonlyArray1<'py, f64>>,
+    law: &str,
+    lam: Option<PyReadonlyArray1<'py, f64>>,
+    mu: Option<PyReadonlyArray1<'py, f64>>,
+    a1: Option<PyReadonlyArray1<'py, f64>>,
+    a2: Option<PyReadonlyArray1<'py, f64>>,
+    a3: Option<PyReadonlyArray1<'py, f64>>,
+    branch: &str,
+    spin: &str,
+    tol: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let kind = model
+        .parse::<ModelKind>()
+        .map_err(|e| value_error(e.to_string()))?;
+    if kind == ModelKind::Md {
+        return Err(value_error(
+            "model md is not vectorised (it integrates each scene's bead row); use the command line's `forward --model md`",
+        ));
+    }
+    let xi_s = slice(&xi, "xi")?;
+    let n = xi_s.len();
+    let d_s = slice(&delta_deg, "delta_deg")?;
+    check_len("delta_deg", d_s.len(), n)?;
+    let rho_s = slice(&rho, "rho")?;
+    check_len("rho", rho_s.len(), n)?;
+    let f_s = slice(&f, "f")?;
+    check_len("f", f_s.len(), n)?;
+    let k_s = opt_slice(&k, "K", n)?;
+    let base_law = parse_law(law)?;
+    let spin: SpinRule = spin
+        .parse()
+        .map_err(|e: fitbead::scene::ParameterError| value_error(format!("spin = '{spin}': {e}")))?;
+    if !(tol > 0.0 && tol < 1.0) {
+        return Err(value_error(format!(
+            "tol = {}: expected a relative tolerance in (0, 1)",
+            show(tol)
+        )));
+    }
+    let branch: JaegerBranch = branch
+        .parse()
+        .map_err(|e: String| value_error(format!("branch = '{branch}': {e}")))?;
+    let args = ModelArgs {
+        kind,
+        lambda: opt_slice(&lam, "lam", n)?,
+        mu: opt_slice(&mu, "mu", n)?,
+        a: [
+            opt_slice(&a1, "a1", n)?,
+            opt_slice(&a2, "a2", n)?,
+            opt_slice(&a3, "a3", n)?,
+        ],
+        branch,
+        spin,
+        tol,
+    };
+    let contact = kind == ModelKind::Contact;
+    let auto = kind == ModelKind::Auto;
+    // Columns of the row records: FORWARD_NUMS then CONTACT_NUMS; FORWARD_TEXTS, AUTO_TEXTS,
+    // CONTACT_TEXTS. The model's own are kept.
+    let mut num_idx: Vec<usize> = (0..FORWARD_NUMS.len()).collect();
+    let mut text_idx: Vec<usize> = (0..FORWARD_TEXTS.len()).collect();
+    if auto {
+        text_idx.extend(4..6);
+    }
+    if contact {
+        num_idx.extend(8..15);
+        text_idx.extend(6..9);
+    }
+    let all_nums: Vec<&'static str> = FORWARD_NUMS.iter().chain(&CONTACT_NUMS).copied().collect();
+    let all_texts: Vec<&'static str> = FORWARD_TEXTS
+        .iter()
+        .chain(&AUTO_TEXTS)
+        .chain(&CONTACT_TEXTS)
+        .copied()
+        .collect();
+    let mut cols = Columns::pick(&all_nums, num_idx, &all_texts, text_idx, n);
+    let r = py.detach(|| {
+        fill(n, &mut cols, |i| {
+            let law = law_of(k_s, base_law, i)?;
+            let scene = scene_of(i, xi_s, d_s, rho_s, f_s, law)?;
+            let m = args.model(i, &scene)?;
+            Ok(forward_row(&scene, &m))
+        })
+    });
+    r.map_err(value_error)?;
+    cols.into_dict(py)
+}
+
+const K_NUMS: [&str; 11] = [
+    "K",
+    "K_lo",
+    "K_hi",
+    "dv_dK",
+    "final_velocity",
+    "theta_G_deg",
+    "K_cos2a",
+    "K_adjusted",
+    "K_impact",
+    "iterations",
+    "K_min",
+];
+const K_NUMS2: [&str; 1] = ["K_max"];
+const K_TEXTS: [&str; 5] = ["regime", "status", "lower_limit", "upper_limit", "message"];
+
+fn lower_name(l: LowerLimit) -> &'static str {
+    match l {
+        LowerLimit::Crawl => "crawl-over-top",
+        LowerLimit::Zero => "K=0",
+        LowerLimit::Model => "model-limit",
+    }
+}
+
+fn upper_name(u: UpperLimit) -> &'static str {
+    match u {
+        UpperLimit::LiftOff => "lift-off",
+        UpperLimit::Model => "model-limit",
+    }
+}
+
+/// The model of `k`'s `--model` (the five contact models, contact, or auto).
+fn k_model(name: &str, tol: f64) -> PyResult<(Model, Option<Auto>)> {
+    if name == "auto" {
+        if !(tol > 0.0 && tol < 1.0) {
+            return Err(value_error(format!(
+                "tol = {}: expected a relative tolerance in (0, 1)",
+                show(tol)
+            )));
+        }
+        return Ok((Model::Stick, Some(Auto { tol })));
+    }
+    let err = || {
+        value_error(format!(
+            "model = '{name}': expected one of stick, stick-approx, slip, slip-approx, stickslip, contact, auto"
+        ))
+    };
+    let kind: ModelKind = name.parse().map_err(|_| err())?;
+    match kind {
+        ModelKind::Md | ModelKind::Auto => Err(err()),
+        k => k.contact_model().map(|m| (m, None)).ok_or_else(err),
+    }
+}
+
+/// The K inversion of eq 69 over flat arrays (see the Python `fitbead.invert_k`).
+#[pyfunction]
+#[pyo3(signature = (model, xi, delta_deg, v, sigma_v, rho, f, tol=1e-10))]
+#[allow(clippy::too_many_arguments)]
+fn invert_k<'py>(
+    py: Python<'py>,
+    model: &str,
+    xi: PyReadonlyArray1<'py, f64>,
+    delta_deg: PyReadonlyArray1<'py, f64>,
+    v: PyReadonlyArray1<'py, f64>,
+    sigma_v: PyReadonlyArray1<'py, f64>,
+    rho: PyReadonlyArray1<'py, f64>,
+    f: PyReadonlyArray1<'py, f64>,
+    tol: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (model, auto) = k_model(model, tol)?;
+    let xi_s = slice(&xi, "xi")?;
+    let n = xi_s.len();
+    let d_s = slice(&delta_deg, "delta_deg")?;
+    check_len("delta_deg", d_s.len(), n)?;
+    let v_s = slice(&v, "v")?;
+    check_len("v", v_s.len(), n)?;
+    let s_s = slice(&sigma_v, "sigma_v")?;
+    check_len("sigma_v", s_s.len(), n)?;
+    let rho_s = slice(&rho, "rho")?;
+    check_len("rho", rho_s.len(), n)?;
+    let f_s = slice(&f, "f")?;
+    check_len("f", f_s.len(), n)?;
+    let nums: Vec<&'static str> = K_NUMS.iter().chain(&K_NUMS2).copied().collect();
+    let mut texts: Vec<&'static str> = K_TEXTS.to_vec();
+    if auto.is_some() {
+        texts.extend(AUTO_TEXTS);
+    }
+    let mut cols = Columns::new(&nums, &texts, n);
+    let r = py.detach(|| {
+        fill(n, &mut cols, |i| -> Result<([f64; 12], [Cow<'static, str>; 7]), String> {
+            let scene = scene_of(i, xi_s, d_s, rho_s, f_s, CollisionLaw::Value(0.5))?;
+            let vi = v_s[i];
+            if !(vi > 0.0 && vi.is_finite()) {
+                return Err(format!("v[{i}] = {}: must be a finite number > 0", show(vi)));
+            }
+            let si = s_s[i];
+            let sigma = if si.is_nan() {
+                None
+            } else if si > 0.0 && si.is_finite() {
+                Some(si)
+            } else {
+                return Err(format!(
+                    "sigma_v[{i}] = {}: must be a finite number > 0 (NaN for none)",
+                    show(si)
+                ));
+            };
+            let (e, choice) = match &auto {
+                Some(au) => {
+                    let c = fitbead::fit::k::auto::choose(au, &scene, vi);
+                    (estimate(&c.model, &scene, vi, sigma), Some(c))
+                }
+                None => (estimate(&model, &scene, vi, sigma), None),
+            };
+            let (alpha, rho) = (scene.alpha_rad(), scene.rho());
+            let root = e.root.as_ref().ok();
+            let mut nums = [f64::NAN; 12];
+            nums[0] = opt(root.map(|r| r.k));
+            nums[1] = opt(e.k_lo);
+            nums[2] = opt(e.k_hi);
+            nums[3] = opt(e.dv_dk);
+            nums[4] = opt(root.map(|r| r.steady.final_velocity));
+            nums[5] = opt(e.theta_g.map(f64::to_degrees));
+            nums[6] = CollisionLaw::Cos2a.k(alpha, rho);
+            nums[7] = CollisionLaw::Adjusted.k(alpha, rho);
+            nums[8] = CollisionLaw::Impact.k(alpha, rho);
+            nums[9] = opt(root.map(|r| r.evals as f64));
+            let mut texts: [Cow<'static, str>; 7] = Default::default();
+            let (regime, status) = match &e.root {
+                Ok(_) => ("B", "ok"),
+                Err(KFailure::BelowRange) => ("A", "below-range"),
+                Err(KFailure::AboveRange) => ("C", "above-range"),
+                Err(KFailure::Invalid(_)) => ("", "invalid"),
+            };
+            texts[0] = Cow::Borrowed(regime);
+            texts[1] = Cow::Borrowed(status);
+            if let Some(b) = &e.bracket {
+                nums[10] = b.lo;
+                nums[11] = b.hi;
+                texts[2] = Cow::Borrowed(lower_name(b.lower));
+                texts[3] = Cow::Borrowed(upper_name(b.upper));
+            }
+            let mut message: Vec<String> = Vec::new();
+            if let Err(fail) = &e.root {
+                message.push(fail.to_string());
+            }
+            message.extend(e.notes.iter().cloned());
+            if !message.is_empty() {
+                texts[4] = Cow::Owned(message.join("; "));
+            }
+            if let Some(c) = choice {
+                texts[5] = Cow::Borrowed(c.choice.name());
+                texts[6] = Cow::Owned(c.reason);
+            }
+            Ok((nums, texts))
+        })
+    });
+    r.map_err(value_error)?;
+    cols.into_dict(py)
+}
+
+/// δ_m (eq 32), δ_d (eq 31), the bulk friction of eq 79 and the critical ξ of a law.
+#[pyfunction]
+#[pyo3(signature = (xi, law="adjusted", rho=0.4))]
+fn regimes<'py>(
+    py: Python<'py>,
+    xi: PyReadonlyArray1<'py, f64>,
+    law: &str,
+    rho: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let l = parse_law(law)?;
+    if !(rho.is_finite() && rho >= 0.0) {
+        return Err(value_error(format!("rho = {}: must be >= 0", show(rho))));
+    }
+    let xs = slice(&xi, "xi")?;
+    let n = xs.len();
+    let mut cols = Columns::new(
+        &["alpha_deg", "K", "delta_m_deg", "delta_d_deg", "mu_eq79"],
+        &["steady_range"],
+        n,
+    );
+    for (i, &x) in xs.iter().enumerate() {
+        if !(x.is_finite() && x > 0.0) {
+            return Err(value_error(format!(
+                "xi[{i}] = {}: radius ratio must be > 0",
+                show(x)
+            )));
+        }
+        let al = alpha_of_xi(x);
+        let k = l.k(al, rho);
+        if !(k.is_finite() && k > 0.0) {
+            return Err(value_error(format!(
+                "K = '{law}': K = {} at xi = {}: must be > 0",
+                show(k),
+                show(x)
+            )));
+        }
+        let (dm, dd) = (delta_m_law(al, l, rho), delta_d_law(al, l, rho));
+        cols.push(
+            &[
+                al.to_degrees(),
+                k,
+                dm.to_degrees(),
+                dd.to_degrees(),
+                bulk_friction_law(al, l, rho),
+            ],
+            &[Cow::Borrowed(if dm < dd { "yes" } else { "no" })],
+        );
+    }
+    let d = cols.into_dict(py)?;
+    d.set_item("critical_xi", critical_xi(l, rho))?;
+    Ok(d)
+}
+
+/// Measured mean velocities grouped in series (the library's `Dataset`).
+#[pyclass(module = "fitbead._fitbead", name = "_Dataset", frozen)]
+struct PyDataset {
+    inner: RsDataset,
+}
+
+#[pymethods]
+impl PyDataset {
+    /// Reads a measurement CSV exactly as the command line does (same columns, units and
+    /// error messages).
+    #[staticmethod]
+    #[pyo3(signature = (path, rho=0.4, f=0.1, g=9.81))]
+    fn from_csv(path: &str, rho: f64, f: f64, g: f64) -> PyResult<Self> {
+        let d = MeasurementDefaults { rho, f, g }
+            .checked()
+            .map_err(|e| value_error(e.to_string()))?;
+        let m = MeasurementFile::read(std::path::Path::new(path), &d)
+            .map_err(|e| value_error(e.to_string()))?;
+        Ok(PyDataset { inner: m.dataset })
+    }
+
+    /// Parses CSV text (named `source` in errors), as `from_csv` reads a file.
+    #[staticmethod]
+    #[pyo3(signature = (text, source, rho=0.4, f=0.1, g=9.81))]
+    fn from_text(text: &str, source: &str, rho: f64, f: f64, g: f64) -> PyResult<Self> {
+        let d = MeasurementDefaults { rho, f, g }
+            .checked()
+            .map_err(|e| value_error(e.to_string()))?;
+        let m = MeasurementFile::parse(source, text.as_bytes(), &d)
+            .map_err(|e| value_error(e.to_string()))?;
+        Ok(PyDataset { inner: m.dataset })
+    }
+
+    /// The shipped synthetic data set (data/default.csv).
+    #[staticmethod]
+    fn default_data() -> Self {
+        PyDataset {
+            inner: RsDataset::default_data(),
+        }
+    }
+
+    /// From flat arrays; `sigma_v` NaN everywhere for no σ (then relative weights).
+    #[staticmethod]
+    #[allow(clippy::too_many_arguments)]
+    fn from_arrays(
+        series: Vec<String>,
+        xi: PyReadonlyArray1<'_, f64>,
+        delta_deg: PyReadonlyArray1<'_, f64>,
+        v: PyReadonlyArray1<'_, f64>,
+        sigma_v: PyReadonlyArray1<'_, f64>,
+        rho: PyReadonlyArray1<'_, f64>,
+        f: PyReadonlyArray1<'_, f64>,
+    ) -> PyResult<Self> {
+        let xs = slice(&xi, "xi")?;
+        let n = xs.len();
+        check_len("series", series.len(), n)?;
+        let (d, vs, ss, rs, fs) = (
+            slice(&delta_deg, "delta_deg")?,
+            slice(&v, "v")?,
+            slice(&sigma_v, "sigma_v")?,
+            slice(&rho, "rho")?,
+            slice(&f, "f")?,
+        );
+        for (name, a) in [("delta_deg", d), ("v", vs), ("sigma_v", ss), ("rho", rs), ("f", fs)] {
+            check_len(name, a.len(), n)?;
+        }
+        let mut rows = Vec::with_capacity(n);
+        for (i, label) in series.into_iter().enumerate() {
+            let scene =
+                scene_of(i, xs, d, rs, fs, CollisionLaw::Value(0.5)).map_err(value_error)?;
+            if !(vs[i] > 0.0 && vs[i].is_finite()) {
+                return Err(value_error(format!(
+                    "v[{i}] = {}: must be a finite number > 0",
+                    show(vs[i])
+                )));
+            }
+            let s = if ss[i].is_nan() {
+                None
+            } else if ss[i] > 0.0 && ss[i].is_finite() {
+                Some(ss[i])
+            } else {
+                return Err(value_error(format!(
+                    "sigma_v[{i}] = {}: must be a finite number > 0 (NaN for none)",
+                    show(ss[i])
+                )));
+            };
+            rows.push((label, scene, vs[i], s));
+        }
+        let inner = RsDataset::new(rows).map_err(|e| value_error(e.to_string()))?;
+        Ok(PyDataset { inner })
+    }
+
+    /// Number of points.
+    fn __len__(&self) -> usize {
+        self.inner.points.len()
+    }
+
+    /// The series labels, in order of first appearance.
+    #[getter]
+    fn labels(&self) -> Vec<String> {
+        self.inner.labels.clone()
+    }
+
+    /// Whether the points carry absolute σ (else relative weights).
+    #[getter]
+    fn has_sigma(&self) -> bool {
+        self.inner.sigma == fitbead::inverse::SigmaKind::Absolute
+    }
+
+    /// The points as columns: series index, ξ, δ (degrees), v, σ (NaN without), ρ, f.
+    fn columns<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let p = &self.inner.points;
+        let abs = self.has_sigma();
+        let d = PyDict::new(py);
+        let col = |g: &dyn Fn(&fitbead::fit::data::Point) -> f64| -> Vec<f64> {
+            p.iter().map(g).collect()
+        };
+        d.set_item(
+            "series_index",
+            PyArray1::from_vec(py, p.iter().map(|q| q.series as i64).collect()),
+        )?;
+        d.set_item("xi", PyArray1::from_vec(py, col(&|q| q.scene.xi())))?;
+        d.set_item(
+            "delta_deg",
+            PyArray1::from_vec(py, col(&|q| q.scene.delta_deg())),
+        )?;
+        d.set_item("v", PyArray1::from_vec(py, col(&|q| q.v)))?;
+        d.set_item(
+            "sigma_v",
+            PyArray1::from_vec(py, col(&|q| if abs { q.sigma } else { f64::NAN })),
+        )?;
+        d.set_item("rho", PyArray1::from_vec(py, col(&|q| q.scene.rho())))?;
+        d.set_item("f", PyArray1::from_vec(py, col(&|q| q.scene.f())))?;
+        Ok(d)
+    }
+}
+
+/// One fit's result: the library's `FitResult`.
+#[pyclass(module = "fitbead._fitbead", name = "_FitResult", frozen)]
+struct PyFitResult {
+    inner: RsFitResult,
+}
+
+#[pymethods]
+impl PyFitResult {
+    /// The fit report (as the command line prints it).
+    fn report(&self) -> String {
+        self.inner.to_string()
+    }
+
+    /// The fit's name (e.g. `stickslip law c`) and series (empty for a global fit).
+    fn name(&self) -> (String, String) {
+        (self.inner.stats.fit.clone(), self.inner.stats.series.clone())
+    }
+
+    /// One dict per parameter.
+    fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        let l = PyList::empty(py);
+        for p in &self.inner.params {
+            let d = PyDict::new(py);
+            let (iv, method) = p.interval();
+            d.set_item("name", &p.parameter)?;
+            d.set_item("value", p.value)?;
+            d.set_item("stderr", p.stderr)?;
+            d.set_item("low", iv.map(|x| x.0))?;
+            d.set_item("high", iv.map(|x| x.1))?;
+            d.set_item("method", method)?;
+            d.set_item("level", p.level)?;
+            d.set_item("unit", p.unit)?;
+            d.set_item("at_bound", p.at_bound)?;
+            d.set_item("bounds", p.bounds)?;
+            d.set_item("paper_value", p.paper_value)?;
+            d.set_item("paper_source", p.paper_source)?;
+            d.set_item("lsq_value", p.lsq_value)?;
+            d.set_item("note", &p.note)?;
+            if let Some(pd) = &p.posterior {
+                d.set_item("rhat", pd.rhat)?;
+                d.set_item("ess_bulk", pd.ess_bulk)?;
+                d.set_item("ess_tail", pd.ess_tail)?;
+            }
+            l.append(d)?;
+        }
+        Ok(l)
+    }
+
+    /// Fit statistics.
+    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let s = &self.inner.stats;
+        let d = PyDict::new(py);
+        d.set_item("n_points", s.n_points)?;
+        d.set_item("n_params", s.n_params)?;
+        d.set_item("dof", s.dof)?;
+        d.set_item("chi2", self.inner.chi2())?;
+        d.set_item("reduced_chi2", self.inner.reduced_chi2())?;
+        d.set_item("aic", s.aic)?;
+        d.set_item("bic", s.bic)?;
+        d.set_item("termination", &s.termination)?;
+        d.set_item("converged", self.inner.converged())?;
+        d.set_item("iterations", s.iterations)?;
+        d.set_item("residual_evals", s.residual_evals)?;
+        d.set_item("condition", s.condition)?;
+        d.set_item("note", &s.note)?;
+        if let Some(m) = &s.mcmc {
+            d.set_item("mcmc_status", &m.status)?;
+            d.set_item("walkers", m.walkers)?;
+            d.set_item("steps", m.steps)?;
+            d.set_item("burn_in", m.burn_in)?;
+            d.set_item("draws", m.draws)?;
+            d.set_item("acceptance", m.acceptance)?;
+            d.set_item("ess_min", m.ess_min)?;
+            d.set_item("rhat_max", m.rhat_max)?;
+        }
+        Ok(d)
+    }
+
+    /// The correlation matrix of the parameters (rows in the order of `params`), or None.
+    fn correlation(&self) -> Option<Vec<Vec<f64>>> {
+        self.inner.correlation.clone()
+    }
+
+    /// The fitted points as columns.
+    fn points<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let p = &self.inner.points;
+        let d = PyDict::new(py);
+        let col = |g: &dyn Fn(&fitbead::fit::summary::PointFit) -> f64| -> Vec<f64> {
+            p.iter().map(g).collect()
+        };
+        d.set_item(
+            "series",
+            PyList::new(py, p.iter().map(|q| q.series.as_str()))?,
+        )?;
+        d.set_item("xi", PyArray1::from_vec(py, col(&|q| q.xi)))?;
+        d.set_item("delta_deg", PyArray1::from_vec(py, col(&|q| q.delta_deg)))?;
+        d.set_item("v", PyArray1::from_vec(py, col(&|q| q.v)))?;
+        d.set_item(
+            "sigma_v",
+            PyArray1::from_vec(py, col(&|q| opt(q.sigma_v))),
+        )?;
+        d.set_item("v_fit", PyArray1::from_vec(py, col(&|q| q.v_fit)))?;
+        d.set_item("residual", PyArray1::from_vec(py, col(&|q| q.residual)))?;
+        d.set_item(
+            "normalised_residual",
+            PyArray1::from_vec(py, col(&|q| q.normalised_residual)),
+        )?;
+        Ok(d)
+    }
+
+    /// The posterior draws `[walker, kept step, parameter]`, their log posterior
+    /// `[walker, kept step]`, the burn-in, the thinning and whether the run was interrupted;
+    /// None for a least-squares fit.
+    #[allow(clippy::type_complexity)]
+    fn draws<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<
+        Option<(
+            Bound<'py, PyArray3<f64>>,
+            Bound<'py, numpy::PyArray2<f64>>,
+            usize,
+            usize,
+            bool,
+        )>,
+    > {
+        let Some(d) = &self.inner.draws else {
+            return Ok(None);
+        };
+        let chains = PyArray3::from_vec3(py, &d.chains)
+            .map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
+        let lp = numpy::PyArray2::from_vec2(py, &d.log_posterior)
+            .map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
+        Ok(Some((chains, lp, d.burn_in, d.thin, d.interrupted)))
+    }
+}
+
+/// A list of fits with the notes of the run (Jan's and Jaeger's per-series fits).
+fn fit_set(set: FitSet) -> (Vec<PyFitResult>, Vec<String>) {
+    (
+        set.fits
+            .into_iter()
+            .map(|inner| PyFitResult { inner })
+            .collect(),
+        set.notes,
+    )
+}
+
+/// Method settings shared by the fit functions.
+struct MethodArgs {
+    mcmc: Option<McmcSettings>,
+    profile: bool,
+    level: f64,
+    stop: Arc<AtomicBool>,
+}
+
+fn method_args(
+    method: &str,
+    level: f64,
+    profile: bool,
+    seed: u64,
+    walkers: Option<usize>,
+    max_steps: Option<usize>,
+) -> PyResult<MethodArgs> {
+    let stop = Arc::new(AtomicBool::new(false));
+    let mcmc = match method {
+        "lsq" => None,
+        "mcmc" => {
+            let mut s = McmcSettings::seeded(seed);
+            if let Some(w) = walkers {
+                s.options.walkers = Some(w);
+            }
+            if let Some(m) = max_steps {
+                s.options.max_steps = m;
+            }
+            s.options.stop = Some(stop.clone());
+            Some(s)
+        }
+        _ => {
+            return Err(value_error(format!(
+                "method = '{method}': expected lsq or mcmc"
+            )))
+        }
+    };
+    Ok(MethodArgs {
+        mcmc,
+        profile,
+        level,
+        stop,
+    })
+}
+
+/// Runs `work` without the GIL on a scoped thread, checking for Ctrl-C every 100 ms; on an
+/// interrupt the stop flag is raised, the run finishes cleanly and `KeyboardInterrupt` is
+/// raised.
+fn interruptible<T: Send>(
+    py: Python<'_>,
+    stop: &AtomicBool,
+    work: impl FnOnce() -> T + Send,
+) -> PyResult<T> {
+    let slot: (Mutex<Option<T>>, Condvar) = (Mutex::new(None), Condvar::new());
+    std::thread::scope(|s| {
+        let worker = s.spawn(|| {
+            let r = work();
+            *slot.0.lock().unwrap_or_else(|e| e.into_inner()) = Some(r);
+            slot.1.notify_all();
+        });
+        let mut interrupted = false;
+        loop {
+            let got = py.detach(|| {
+                let g = slot.0.lock().unwrap_or_else(|e| e.into_inner());
+                let (mut g, _) = slot
+                    .1
+                    .wait_timeout_while(g, Duration::from_millis(100), |v| v.is_none())
+                    .unwrap_or_else(|e| e.into_inner());
+                g.take()
+            });
+            if let Some(r) = got {
+                return if interrupted {
+                    Err(PyKeyboardInterrupt::new_err(
+                        "fit interrupted (the run stopped cleanly)",
+                    ))
+                } else {
+                    Ok(r)
+                };
+            }
+            if worker.is_finished() && slot.0.lock().map(|g| g.is_none()).unwrap_or(true) {
+                let _ = worker.join();
+                return Err(PyRuntimeError::new_err("the fit failed unexpectedly (panic)"));
+            }
+            if !interrupted && py.check_signals().is_err() {
+                stop.store(true, Ordering::SeqCst);
+                interrupted = true;
+            }
+        }
+    })
+}
+
+fn fit_error(e: fitbead::fit::error::FitError) -> PyErr {
+    value_error(e.to_string())
+}
+
+/// A K(α) law fitted across series (see the Python `fitbead.fit_klaw`).
+#[pyfunction]
+#[pyo3(signature = (data, model="stickslip", law="c", method="lsq", level=0.95, profile=true, seed=1, walkers=None, max_steps=None, tol=1e-10))]
+#[allow(clippy::too_many_arguments)]
+fn fit_klaw(
+    py: Python<'_>,
+    data: &PyDataset,
+    model: &str,
+    law: &str,
+    method: &str,
+    level: f64,
+    profile: bool,
+    seed: u64,
+    walkers: Option<usize>,
+    max_steps: Option<usize>,
+    tol: f64,
+) -> PyResult<PyFitResult> {
+    let (m, auto) = k_model(model, tol)?;
+    if auto.is_some() {
+        return Err(value_error(
+            "model = 'auto' is not available for the law fits here; choose a contact model",
+        ));
+    }
+    let l: KLaw = law
+        .parse()
+        .map_err(|e: String| value_error(format!("law = '{law}': {e}")))?;
+    let a = method_args(method, level, profile, seed, walkers, max_steps)?;
+    let mut fitter = KLawFitter::new(m, l).level(a.level);
+    fitter = match a.mcmc {
+        Some(s) => fitter.mcmc(s),
+        None => fitter.least_squares(a.profile),
+    };
+    let ds = &data.inner;
+    let r = interruptible(py, &a.stop, || fitter.fit(ds))?;
+    r.map(|inner| PyFitResult { inner }).map_err(fit_error)
+}
+
+/// Jan's λ and μ per series and the global laws (see the Python `fitbead.fit_jan`).
+#[pyfunction]
+#[pyo3(signature = (data, method="lsq", level=0.95, profile=true, seed=1, walkers=None, max_steps=None))]
+#[allow(clippy::too_many_arguments)]
+fn fit_jan(
+    py: Python<'_>,
+    data: &PyDataset,
+    method: &str,
+    level: f64,
+    profile: bool,
+    seed: u64,
+    walkers: Option<usize>,
+    max_steps: Option<usize>,
+) -> PyResult<(Vec<PyFitResult>, Vec<String>)> {
+    let a = method_args(method, level, profile, seed, walkers, max_steps)?;
+    let mut fitter = JanFitter::new().level(a.level);
+    fitter = match a.mcmc {
+        Some(s) => fitter.mcmc(s),
+        None => fitter.least_squares(a.profile),
+    };
+    let ds = &data.inner;
+    let r = interruptible(py, &a.stop, || fitter.fit(ds))?;
+    r.map(fit_set).map_err(fit_error)
+}
+
+/// Jaeger's a1–a3 per series (see the Python `fitbead.fit_jaeger`).
+#[pyfunction]
+#[pyo3(signature = (data, branch="upper", method="lsq", level=0.95, profile=true, seed=1, walkers=None, max_steps=None))]
+#[allow(clippy::too_many_arguments)]
+fn fit_jaeger(
+    py: Python<'_>,
+    data: &PyDataset,
+    branch: &str,
+    method: &str,
+    level: f64,
+    profile: bool,
+    seed: u64,
+    walkers: Option<usize>,
+    max_steps: Option<usize>,
+) -> PyResult<(Vec<PyFitResult>, Vec<String>)> {
+    let b: JaegerBranch = branch
+        .parse()
+        .map_err(|e: String| value_error(format!("branch = '{branch}': {e}")))?;
+    let a = method_args(method, level, profile, seed, walkers, max_steps)?;
+    let mut fitter = JaegerFitter::new().branch(b).level(a.level);
+    fitter = match a.mcmc {
+        Some(s) => fitter.mcmc(s),
+        None => fitter.least_squares(a.profile),
+    };
+    let ds = &data.inner;
+    let r = interruptible(py, &a.stop, || fitter.fit(ds))?;
+    r.map(fit_set).map_err(fit_error)
+}
+
+/// The version of the Rust library.
+#[pyfunction]
+fn version() -> &'static str {
+    env!("CARGO_PKG_VERSION")
+}
+
+/// Threads rayon uses (set `RAYON_NUM_THREADS` before the first call to change it).
+#[pyfunction]
+fn threads() -> usize {
+    rayon::current_num_threads()
+}
+
+#[pymodule]
+fn _fitbead(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(forward, m)?)?;
+    m.add_function(wrap_pyfunction!(invert_k, m)?)?;
+    m.add_function(wrap_pyfunction!(regimes, m)?)?;
+    m.add_function(wrap_pyfunction!(fit_klaw, m)?)?;
+    m.add_function(wrap_pyfunction!(fit_jan, m)?)?;
+    m.add_function(wrap_pyfunction!(fit_jaeger, m)?)?;
+    m.add_function(wrap_pyfunction!(version, m)?)?;
+    m.add_function(wrap_pyfunction!(threads, m)?)?;
+    m.add_class::<PyDataset>()?;
+    m.add_class::<PyFitResult>()?;
+    Ok(())
+}

@@ -1,0 +1,145 @@
+"""Fits through the bindings equal the command line's: the same report text and the same
+parameter values bit for bit; data from CSV, arrays and DataFrames; errors as the command
+line words them; posteriors to ArviZ; Ctrl-C stops an MCMC run."""
+
+import _thread
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import fitbead
+from conftest import DEFAULT_DATA, assert_bits_equal, read_csv_text
+
+
+@pytest.fixture(scope="module")
+def data():
+    return fitbead.Dataset.read_csv(str(DEFAULT_DATA))
+
+
+def params_csv(cli, *args):
+    _, text, _ = cli(*args, "--output", "-")
+    return read_csv_text(text)
+
+
+def test_klaw_report_and_values_equal_cli(cli, data):
+    for model, law in [("stickslip", "c"), ("stick", "free-per-series"), ("slip", "c")]:
+        fit = fitbead.fit_klaw(data, model=model, law=law)
+        _, report, _ = cli("klaw", "--model", model, "--law", law, "--input", DEFAULT_DATA)
+        assert str(fit) in report
+        cols = params_csv(cli, "klaw", "--model", model, "--law", law, "--input", DEFAULT_DATA)
+        rows = [i for i, (f, s) in enumerate(zip(cols["fit"], cols["series"])) if f == fit.name and s == fit.series]
+        assert [cols["parameter"][i] for i in rows] == fit.param_names
+        assert_bits_equal("value", [p.value for p in fit.params.values()], [cols["value"][i] for i in rows])
+        assert fit.converged
+
+
+def test_jan_and_jaeger_reports_equal_cli(cli, data):
+    jan = fitbead.fit_jan(data)
+    _, report, _ = cli("jan", "--input", DEFAULT_DATA)
+    assert len(jan) == 5
+    for fr in jan:
+        assert str(fr) in report
+    jae = fitbead.fit_jaeger(data)
+    _, report, _ = cli("jaeger", "--input", DEFAULT_DATA)
+    assert len(jae) == 4
+    for fr in jae:
+        assert str(fr) in report
+    cols = params_csv(cli, "jaeger", "--input", DEFAULT_DATA)
+    want = [cols["value"][i] for i in range(len(cols["value"]))]
+    got = [p.value for fr in jae for p in fr.params.values()]
+    assert_bits_equal("jaeger values", got, want)
+
+
+def test_result_object(data):
+    fit = fitbead.fit_klaw(data, model="stickslip", law="c")
+    c = fit["c"]
+    assert c.low < c.value < c.high and c.method == "profile" and c.stderr > 0
+    assert c.paper_value == 0.5
+    r = fit.residuals
+    assert np.allclose(r["residual"], r["v"] - r["v_fit"], rtol=0, atol=0)
+    assert np.array_equal(r["normalised_residual"], r["residual"] / r["sigma_v"])
+    assert fit.stats["n_points"] == len(data) == 36
+    assert "klaw" in fit._repr_html_() and "<table>" in fit._repr_html_()
+    jan = fitbead.fit_jan(data)
+    g = [fr for fr in jan if fr.correlation is not None and len(fr.params) == 2][0]
+    (pair, r), = g.correlations.items()
+    assert -1.0 <= r <= 1.0 and pair == tuple(g.param_names)
+
+
+def test_to_pandas(data):
+    pd = pytest.importorskip("pandas")
+    fit = fitbead.fit_klaw(data, model="stick", law="c")
+    df = fit.to_pandas()
+    assert list(df.index) == ["c"] and df.loc["c", "value"] == fit["c"].value
+    res = fit.to_pandas("residuals")
+    assert len(res) == 36 and set(res.columns) >= {"v", "v_fit", "residual"}
+    # A DataFrame in: the same data set, the same fit, bit for bit.
+    frame = pd.read_csv(DEFAULT_DATA)
+    again = fitbead.fit_klaw(frame, model="stick", law="c")
+    assert again["c"].value == fit["c"].value
+    # Arrays in.
+    c = data.columns()
+    arr = fitbead.Dataset.from_arrays(c["xi"], c["delta_deg"], c["v"], c["sigma_v"], series=c["series"])
+    assert fitbead.fit_klaw(arr, model="stick", law="c")["c"].value == fit["c"].value
+
+
+def test_mcmc_draws_and_arviz(data):
+    az = pytest.importorskip("arviz")
+    post = fitbead.fit_klaw(data, model="stick", law="c", method="mcmc", seed=3)
+    w, s, k = post.draws.shape
+    assert k == 1 and w >= 32 and s > 100 and post.log_posterior.shape == (w, s)
+    assert post.stats["mcmc_status"] == "converged"
+    # The reported median is the draws' median.
+    assert post["c"].value == pytest.approx(np.median(post.draws[:, :, 0]), rel=1e-12)
+    idata = post.to_arviz()
+    assert {"posterior", "sample_stats", "observed_data"} <= set(idata.groups())
+    summ = az.summary(idata, kind="stats")
+    assert summ.loc["c", "mean"] == pytest.approx(post.draws[:, :, 0].mean(), abs=1e-3)
+    assert summ.loc["c", "sd"] == pytest.approx(post.draws[:, :, 0].std(), rel=1e-2)
+    assert idata.posterior["c"].shape == (w, s)
+    assert np.array_equal(idata.observed_data["v"].values, post.residuals["v"])
+    # Same seed, same draws.
+    again = fitbead.fit_klaw(data, model="stick", law="c", method="mcmc", seed=3)
+    assert np.array_equal(again.draws, post.draws)
+    with pytest.raises(ValueError, match="needs an MCMC fit"):
+        fitbead.fit_klaw(data, model="stick", law="c").to_arviz()
+
+
+def test_keyboard_interrupt_stops_mcmc(data):
+    timer = threading.Timer(0.3, _thread.interrupt_main)
+    t0 = time.perf_counter()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        fitbead.fit_jaeger(data, method="mcmc", max_steps=10_000_000)
+    timer.cancel()
+    assert time.perf_counter() - t0 < 5.0
+
+
+def test_bad_input_raises_with_the_cli_message(cli, tmp_path):
+    bad = tmp_path / "bad.csv"
+    bad.write_text("series,xi,delta_deg,v,sigma_v\na,1,12,0.3,0.01\na,1,13,-0.3,0.01\n")
+    code, _, err = cli("klaw", "--model", "stick", "--input", bad, check=False)
+    assert code == 2
+    with pytest.raises(ValueError) as e:
+        fitbead.Dataset.read_csv(str(bad))
+    msg = str(e.value)
+    assert msg == f"{bad}, line 3, column 'v', value '-0.3': v must be > 0"
+    assert msg in err
+    with pytest.raises(ValueError, match="cannot read"):
+        fitbead.Dataset.read_csv(str(tmp_path / "missing.csv"))
+    with pytest.raises(ValueError, match="method = 'bayes'"):
+        fitbead.fit_klaw(fitbead.Dataset.default(), model="stick", method="bayes")
+    with pytest.raises(ValueError, match="law = 'd'"):
+        fitbead.fit_klaw(fitbead.Dataset.default(), model="stick", law="d")
+
+
+def test_regimes_equal_cli(cli):
+    _, text, _ = cli("regimes", "--law", "adjusted", "--xi", "0.8,1,1.6,2", "--output", "-")
+    cols = read_csv_text(text)
+    t = fitbead.regimes([0.8, 1, 1.6, 2], law="adjusted")
+    for c in ["xi", "alpha_deg", "K", "delta_m_deg", "delta_d_deg", "mu_eq79"]:
+        assert_bits_equal(c, t[c], cols[c])
+    assert list(t["steady_range"]) == cols["steady_range"]
+    assert_bits_equal("critical_xi", [t.critical_xi] * 4, cols["critical_xi"])

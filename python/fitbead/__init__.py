@@ -259,8 +259,8 @@ def invert_k(
     if model not in K_MODELS:
         raise ValueError(f"model = {model!r}: expected one of {', '.join(K_MODELS)}")
     if isinstance(xi, Dataset):
-        c = xi.columns()
-        xi, delta_deg, v, sigma_v, rho, f = (c["xi"], c["delta_deg"], c["v"], c["sigma_v"], c["rho"], c["f"])
+        raw = xi._core.invert_k(model, tol=tol)
+        return _table(raw, (len(xi),))
     if delta_deg is None or v is None:
         raise ValueError("invert_k needs xi, delta_deg and v (or a Dataset)")
     if sigma_v is None:
@@ -355,7 +355,11 @@ class Dataset:
 
     def columns(self) -> Dict[str, np.ndarray]:
         """The points as arrays: series (labels), series_index, xi, delta_deg, v, sigma_v
-        (NaN without), rho, f; velocities dimensionless."""
+        (NaN without), rho, f; velocities dimensionless.
+
+        The data set holds δ in radians: ``delta_deg`` is converted back and may differ from
+        the file's degrees in the last bit (:func:`invert_k` on a Dataset uses the radians
+        themselves)."""
         c = dict(self._core.columns())
         labels = np.asarray(self.labels, dtype=object)
         c["series"] = labels[c["series_index"]]
@@ -390,6 +394,8 @@ class Param:
     """One fitted parameter."""
 
     name: str
+    series: str
+    """The series the parameter belongs to (``all`` for a parameter of every series)."""
     value: float
     """Least-squares optimum, or the posterior median."""
     stderr: Optional[float]
@@ -425,8 +431,11 @@ class FitResult:
         self._core = core
         self.name, self.series = core.name()
         rows = core.params()
-        self.params: Dict[str, Param] = {r["name"]: Param(**r) for r in rows}
-        """The parameters by name, in the fit's order."""
+        names = [r["name"] for r in rows]
+        unique = len(set(names)) == len(names)
+        self.params: Dict[str, Param] = {(r["name"] if unique else f"{r['name']}[{r['series']}]"): Param(**r) for r in rows}
+        """The parameters in the fit's order, by name; where a name repeats (one K per
+        series), by ``name[series]``."""
         self.stats: Dict[str, Any] = dict(core.stats())
         """χ², reduced χ², AIC, BIC, termination, iterations, ... (and MCMC diagnostics)."""
         corr = core.correlation()

@@ -75,7 +75,11 @@ fn check_len(name: &str, len: usize, n: usize) -> PyResult<()> {
 
 /// Python's repr of a float (shortest round trip), for error messages.
 fn show(x: f64) -> String {
-    fitbead::numfmt::fmt_f64(x)
+    if x.is_nan() {
+        "NaN".to_string()
+    } else {
+        fitbead::numfmt::fmt_f64(x)
+    }
 }
 
 /// A text column: one code per row into a list of distinct values.
@@ -561,7 +565,7 @@ fn invert_k<'py>(
     }
     let mut cols = Columns::new(&nums, &texts, n);
     let r = py.detach(|| {
-        fill(n, &mut cols, |i| -> Result<([f64; 12], [Cow<'static, str>; 7]), String> {
+        fill(n, &mut cols, |i| -> Result<KRow, String> {
             let scene = scene_of(i, xi_s, d_s, rho_s, f_s, CollisionLaw::Value(0.5))?;
             let vi = v_s[i];
             if !(vi > 0.0 && vi.is_finite()) {
@@ -578,58 +582,65 @@ fn invert_k<'py>(
                     show(si)
                 ));
             };
-            let (e, choice) = match &auto {
-                Some(au) => {
-                    let c = fitbead::fit::k::auto::choose(au, &scene, vi);
-                    (estimate(&c.model, &scene, vi, sigma), Some(c))
-                }
-                None => (estimate(&model, &scene, vi, sigma), None),
-            };
-            let (alpha, rho) = (scene.alpha_rad(), scene.rho());
-            let root = e.root.as_ref().ok();
-            let mut nums = [f64::NAN; 12];
-            nums[0] = opt(root.map(|r| r.k));
-            nums[1] = opt(e.k_lo);
-            nums[2] = opt(e.k_hi);
-            nums[3] = opt(e.dv_dk);
-            nums[4] = opt(root.map(|r| r.steady.final_velocity));
-            nums[5] = opt(e.theta_g.map(f64::to_degrees));
-            nums[6] = CollisionLaw::Cos2a.k(alpha, rho);
-            nums[7] = CollisionLaw::Adjusted.k(alpha, rho);
-            nums[8] = CollisionLaw::Impact.k(alpha, rho);
-            nums[9] = opt(root.map(|r| r.evals as f64));
-            let mut texts: [Cow<'static, str>; 7] = Default::default();
-            let (regime, status) = match &e.root {
-                Ok(_) => ("B", "ok"),
-                Err(KFailure::BelowRange) => ("A", "below-range"),
-                Err(KFailure::AboveRange) => ("C", "above-range"),
-                Err(KFailure::Invalid(_)) => ("", "invalid"),
-            };
-            texts[0] = Cow::Borrowed(regime);
-            texts[1] = Cow::Borrowed(status);
-            if let Some(b) = &e.bracket {
-                nums[10] = b.lo;
-                nums[11] = b.hi;
-                texts[2] = Cow::Borrowed(lower_name(b.lower));
-                texts[3] = Cow::Borrowed(upper_name(b.upper));
-            }
-            let mut message: Vec<String> = Vec::new();
-            if let Err(fail) = &e.root {
-                message.push(fail.to_string());
-            }
-            message.extend(e.notes.iter().cloned());
-            if !message.is_empty() {
-                texts[4] = Cow::Owned(message.join("; "));
-            }
-            if let Some(c) = choice {
-                texts[5] = Cow::Borrowed(c.choice.name());
-                texts[6] = Cow::Owned(c.reason);
-            }
-            Ok((nums, texts))
+            Ok(k_row(&model, auto.as_ref(), &scene, vi, sigma))
         })
     });
     r.map_err(value_error)?;
     cols.into_dict(py)
+}
+
+type KRow = ([f64; 12], [Cow<'static, str>; 7]);
+
+/// One measurement's K estimate as the `k` command's columns.
+fn k_row(model: &Model, auto: Option<&Auto>, scene: &Scene, vi: f64, sigma: Option<f64>) -> KRow {
+    let (e, choice) = match auto {
+        Some(au) => {
+            let c = fitbead::fit::k::auto::choose(au, scene, vi);
+            (estimate(&c.model, scene, vi, sigma), Some(c))
+        }
+        None => (estimate(model, scene, vi, sigma), None),
+    };
+    let (alpha, rho) = (scene.alpha_rad(), scene.rho());
+    let root = e.root.as_ref().ok();
+    let mut nums = [f64::NAN; 12];
+    nums[0] = opt(root.map(|r| r.k));
+    nums[1] = opt(e.k_lo);
+    nums[2] = opt(e.k_hi);
+    nums[3] = opt(e.dv_dk);
+    nums[4] = opt(root.map(|r| r.steady.final_velocity));
+    nums[5] = opt(e.theta_g.map(f64::to_degrees));
+    nums[6] = CollisionLaw::Cos2a.k(alpha, rho);
+    nums[7] = CollisionLaw::Adjusted.k(alpha, rho);
+    nums[8] = CollisionLaw::Impact.k(alpha, rho);
+    nums[9] = opt(root.map(|r| r.evals as f64));
+    let mut texts: [Cow<'static, str>; 7] = Default::default();
+    let (regime, status) = match &e.root {
+        Ok(_) => ("B", "ok"),
+        Err(KFailure::BelowRange) => ("A", "below-range"),
+        Err(KFailure::AboveRange) => ("C", "above-range"),
+        Err(KFailure::Invalid(_)) => ("", "invalid"),
+    };
+    texts[0] = Cow::Borrowed(regime);
+    texts[1] = Cow::Borrowed(status);
+    if let Some(b) = &e.bracket {
+        nums[10] = b.lo;
+        nums[11] = b.hi;
+        texts[2] = Cow::Borrowed(lower_name(b.lower));
+        texts[3] = Cow::Borrowed(upper_name(b.upper));
+    }
+    let mut message: Vec<String> = Vec::new();
+    if let Err(fail) = &e.root {
+        message.push(fail.to_string());
+    }
+    message.extend(e.notes.iter().cloned());
+    if !message.is_empty() {
+        texts[4] = Cow::Owned(message.join("; "));
+    }
+    if let Some(c) = choice {
+        texts[5] = Cow::Borrowed(c.choice.name());
+        texts[6] = Cow::Owned(c.reason);
+    }
+(nums, texts)
 }
 
 /// δ_m (eq 32), δ_d (eq 31), the bulk friction of eq 79 and the critical ξ of a law.
@@ -777,6 +788,30 @@ impl PyDataset {
         Ok(PyDataset { inner })
     }
 
+    /// The K inversion of every point (as `invert_k` over arrays, from the points' own
+    /// scenes: no round trip of δ through degrees).
+    #[pyo3(signature = (model, tol=1e-10))]
+    fn invert_k<'py>(&self, py: Python<'py>, model: &str, tol: f64) -> PyResult<Bound<'py, PyDict>> {
+        let (model, auto) = k_model(model, tol)?;
+        let mut texts: Vec<&'static str> = K_TEXTS.to_vec();
+        if auto.is_some() {
+            texts.extend(AUTO_TEXTS);
+        }
+        let nums: Vec<&'static str> = K_NUMS.iter().chain(&K_NUMS2).copied().collect();
+        let p = &self.inner.points;
+        let mut cols = Columns::new(&nums, &texts, p.len());
+        let abs = self.has_sigma();
+        let r: Result<(), String> = py.detach(|| {
+            fill(p.len(), &mut cols, |i| {
+                let q = &p[i];
+                let sigma = abs.then_some(q.sigma);
+                Ok(k_row(&model, auto.as_ref(), &q.scene, q.v, sigma))
+            })
+        });
+        r.map_err(value_error)?;
+        cols.into_dict(py)
+    }
+
     /// Number of points.
     fn __len__(&self) -> usize {
         self.inner.points.len()
@@ -847,6 +882,7 @@ impl PyFitResult {
             let d = PyDict::new(py);
             let (iv, method) = p.interval();
             d.set_item("name", &p.parameter)?;
+            d.set_item("series", &p.series)?;
             d.set_item("value", p.value)?;
             d.set_item("stderr", p.stderr)?;
             d.set_item("low", iv.map(|x| x.0))?;

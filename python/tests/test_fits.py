@@ -24,13 +24,14 @@ def params_csv(cli, *args):
 
 
 def test_klaw_report_and_values_equal_cli(cli, data):
-    for model, law in [("stickslip", "c"), ("stick", "free-per-series"), ("slip", "c")]:
+    for model, law in [("stickslip", "c"), ("stick", "free-per-series"), ("stick-approx", "c")]:
         fit = fitbead.fit_klaw(data, model=model, law=law)
         _, report, _ = cli("klaw", "--model", model, "--law", law, "--input", DEFAULT_DATA)
         assert str(fit) in report
         cols = params_csv(cli, "klaw", "--model", model, "--law", law, "--input", DEFAULT_DATA)
-        rows = [i for i, (f, s) in enumerate(zip(cols["fit"], cols["series"])) if f == fit.name and s == fit.series]
-        assert [cols["parameter"][i] for i in rows] == fit.param_names
+        rows = [i for i, f in enumerate(cols["fit"]) if f == fit.name]
+        assert [cols["parameter"][i] for i in rows] == [p.name for p in fit.params.values()]
+        assert [cols["series"][i] for i in rows] == [p.series for p in fit.params.values()]
         assert_bits_equal("value", [p.value for p in fit.params.values()], [cols["value"][i] for i in rows])
         assert fit.converged
 
@@ -76,12 +77,12 @@ def test_to_pandas(data):
     res = fit.to_pandas("residuals")
     assert len(res) == 36 and set(res.columns) >= {"v", "v_fit", "residual"}
     # A DataFrame in: the same data set, the same fit, bit for bit.
-    frame = pd.read_csv(DEFAULT_DATA)
+    frame = pd.read_csv(DEFAULT_DATA, float_precision="round_trip")
     again = fitbead.fit_klaw(frame, model="stick", law="c")
     assert again["c"].value == fit["c"].value
-    # Arrays in.
-    c = data.columns()
-    arr = fitbead.Dataset.from_arrays(c["xi"], c["delta_deg"], c["v"], c["sigma_v"], series=c["series"])
+    # Arrays in (the file's numbers: Dataset.columns() gives δ back from radians).
+    c = {k: frame[k].to_numpy() for k in ("xi", "delta_deg", "v", "sigma_v")}
+    arr = fitbead.Dataset.from_arrays(c["xi"], c["delta_deg"], c["v"], c["sigma_v"], series=frame["series"].astype(str))
     assert fitbead.fit_klaw(arr, model="stick", law="c")["c"].value == fit["c"].value
 
 
@@ -91,11 +92,13 @@ def test_mcmc_draws_and_arviz(data):
     w, s, k = post.draws.shape
     assert k == 1 and w >= 32 and s > 100 and post.log_posterior.shape == (w, s)
     assert post.stats["mcmc_status"] == "converged"
-    # The reported median is the draws' median.
-    assert post["c"].value == pytest.approx(np.median(post.draws[:, :, 0]), rel=1e-12)
+    # The reported value is the posterior median (over every draw after burn-in; the result
+    # keeps at most 10,000 of them, so their median is close, not equal).
+    sd = post.draws[:, :, 0].std()
+    assert abs(post["c"].value - np.median(post.draws[:, :, 0])) < 0.05 * sd
     idata = post.to_arviz()
     assert {"posterior", "sample_stats", "observed_data"} <= set(idata.groups())
-    summ = az.summary(idata, kind="stats")
+    summ = az.summary(idata, kind="stats", round_to="none")
     assert summ.loc["c", "mean"] == pytest.approx(post.draws[:, :, 0].mean(), abs=1e-3)
     assert summ.loc["c", "sd"] == pytest.approx(post.draws[:, :, 0].std(), rel=1e-2)
     assert idata.posterior["c"].shape == (w, s)
@@ -136,7 +139,7 @@ def test_bad_input_raises_with_the_cli_message(cli, tmp_path):
 
 
 def test_regimes_equal_cli(cli):
-    _, text, _ = cli("regimes", "--law", "adjusted", "--xi", "0.8,1,1.6,2", "--output", "-")
+    _, text, _ = cli("regimes", "--law", "adjusted", "--xi", "0.8,1,1.6,2")
     cols = read_csv_text(text)
     t = fitbead.regimes([0.8, 1, 1.6, 2], law="adjusted")
     for c in ["xi", "alpha_deg", "K", "delta_m_deg", "delta_d_deg", "mu_eq79"]:

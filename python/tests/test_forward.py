@@ -19,7 +19,8 @@ CONTACT_NUMERIC = [
     "energy_closure",
 ]
 CONTACT_TEXT = ["phase_sequence", "phase_change_deg", "spin_rule"]
-JAEGER = {"a1": 0.9, "a2": 0.4, "a3": 0.3}
+# Jaeger's coefficients fitted to the shipped data's series ξ = 1 (fits/default/params.csv).
+JAEGER = {"a1": 0.09419073430371148, "a2": 0.6559352309781119, "a3": 0.6253411142653952}
 
 
 def random_scenes(n, seed):
@@ -61,19 +62,23 @@ def test_random_scenes_equal_cli(model, cli, tmp_path):
     path = tmp_path / "scenes.csv"
     write_csv(path, s)
     kw, flags = model_args(model)
-    _, text, _ = cli("forward", "--model", model, "--input", path, "--output", "-", *flags)
+    _, text, _ = cli("forward", "--model", model, "--input", path, *flags)
     out = fitbead.forward(model, s["xi"], s["delta_deg"], K=s["K"], rho=s["rho"], f=s["f"], **kw)
     cols = compare(out, text, model)
-    # The sample reaches every regime.
-    assert {"A", "B", "C"} <= set(cols["regime"]), model
+    # The sample reaches regime B and at least one other (A, C, or both for the contact models).
+    regimes = set(cols["regime"])
+    assert "B" in regimes and len(regimes - {""}) >= 2, (model, regimes)
+    if model not in ("jan", "jaeger"):
+        assert {"A", "B", "C"} <= regimes, (model, regimes)
 
 
 @pytest.mark.parametrize("model", fitbead.MODELS)
 def test_default_data_equal_cli(model, cli):
     kw, flags = model_args(model)
-    _, text, _ = cli("forward", "--model", model, "--input", DEFAULT_DATA, "--output", "-", *flags)
-    d = fitbead.Dataset.default().columns()
-    out = fitbead.forward(model, d["xi"], d["delta_deg"], rho=d["rho"], f=d["f"], **kw)
+    _, text, _ = cli("forward", "--model", model, "--input", DEFAULT_DATA, *flags)
+    d = read_csv_text(DEFAULT_DATA.read_text())
+    xi, delta = (np.array([float(x) for x in d[c]]) for c in ("xi", "delta_deg"))
+    out = fitbead.forward(model, xi, delta, **kw)
     compare(out, text, model)
 
 
@@ -83,7 +88,7 @@ def test_named_law_and_spin_rule_equal_cli(cli, tmp_path):
     path = tmp_path / "scenes.csv"
     write_csv(path, s)
     for law, spin in [("cos2a", "keep"), ("c=0.45", "factor=0.5"), ("impact", "impact")]:
-        _, text, _ = cli("forward", "--model", "contact", "--K", law, "--spin", spin, "--input", path, "--output", "-")
+        _, text, _ = cli("forward", "--model", "contact", "--K", law, "--spin", spin, "--input", path)
         out = fitbead.forward("contact", s["xi"], s["delta_deg"], K=law, rho=s["rho"], f=s["f"], spin=spin)
         compare(out, text, "contact")
 
@@ -107,5 +112,5 @@ def test_bad_values_raise():
         fitbead.forward("stick", [1.0, 2.0], [10.0, 11.0, 12.0])
     with pytest.raises(ValueError, match="jaeger needs a1, a2, a3"):
         fitbead.forward("jaeger", 1.0, 12.0)
-    with pytest.raises(ValueError, match="K\\[0\\] = NaN|K\\[0\\] = nan"):
+    with pytest.raises(ValueError, match=r"K\[0\] = NaN: value must be a finite number"):
         fitbead.forward("stick", 1.0, 12.0, K=np.nan)

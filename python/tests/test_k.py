@@ -52,7 +52,7 @@ def compare(out, text, model):
 
 @pytest.mark.parametrize("model", fitbead.K_MODELS)
 def test_default_data_equal_cli(model, cli):
-    _, text, _ = cli("k", "--model", model, "--input", DEFAULT_DATA, "--output", "-")
+    _, text, _ = cli("k", "--model", model, "--input", DEFAULT_DATA)
     out = fitbead.invert_k(model, fitbead.Dataset.default())
     compare(out, text, model)
 
@@ -74,7 +74,7 @@ def test_random_rows_equal_cli(model, n, cli, tmp_path):
             fh.write(
                 f"s{i},{float(r['xi'][i])!r},{float(r['delta_deg'][i])!r},{float(r['v'][i])!r},{s},{float(r['rho'][i])!r},{float(r['f'][i])!r}\n"
             )
-    _, text, _ = cli("k", "--model", model, "--input", path, "--output", "-")
+    _, text, _ = cli("k", "--model", model, "--input", path)
     out = fitbead.invert_k(model, r["xi"], r["delta_deg"], r["v"], r["sigma_v"], rho=r["rho"], f=r["f"])
     got = compare(out, text, model)
     statuses = set(got["status"])

@@ -77,8 +77,8 @@ its error against the degree input (columns 3 and 4) is the rounding of radians(
 conditioning, below sens on every row. The peer's error grows like the conditioning, to 8.6e-6 at
 ε = 1e-12. Redoing the peer's formula in mpmath with one quantity rounded to a double, at
 ε = 1e-12: α = arcsin(1/(1+ξ)) rounded gives 1.0e-6 … 4.0e-6, the parameter m of ellipkinc rounded
-3.8e-7 … 8.4e-7 (ε = 1e-10: 4.4e-8 … 4.7e-8 and 1.2e-9 … 8.9e-9); the rest is the squared top
-speed Θ̇0² − 2B sin²(Θ0/2) formed in double.
+3.8e-7 … 8.4e-7, and the squared top speed Θ̇0² − 2B sin²(Θ0/2) formed in double (at the same
+double α) 1.6e-6 … 5.8e-6 (ε = 1e-10: 1.2e-8 … 4.7e-8, 1.2e-9 … 8.9e-9 and 4.4e-9 … 5.5e-8).
 """
 import csv
 import math

@@ -32,16 +32,19 @@ def rel(a, b):
 
 
 def cause(f):
-    """Where a disagreeing row sits, from fitbead's row: `near-crawl` when K (or, without K,
-    the velocity) is within 1e-8 relative of a crawl end (the peer computes the launch speed
-    from K, so w0^2 - 2B sin^2(Theta0/2) cancels and scipy's contact time keeps few digits,
-    while fitbead solves in the top speed itself); `ill-conditioned` when |v / (K dv/dK)| > 1e4
+    """Where a disagreeing row sits, from fitbead's row: `near-crawl` when K or K_lo is within
+    1e-4 relative of a crawl end (or, without K, v < 0.05 there). The peer works in K: its
+    launch speed w0^2 - 2B sin^2(Theta0/2) cancels as K -> K_min, so scipy's contact time keeps
+    few digits within ~1e-8 of K_min (statuses, K_lo), and its dv/dK steps d h (d = K - K_min,
+    h = 1e-5) carry a rounding error eps K / (d h), above 1e-6 within ~1e-4 of K_min; fitbead
+    takes the launch-speed path there (src/fit/k/launch.rs: the unknown is the top speed
+    itself, differences in its logarithm). `ill-conditioned` when |v / (K dv/dK)| > 1e4
     (a relative error e of v moves K by e times that: at K -> 0 with Theta0 > 0 v hardly
     depends on K); else `other`."""
     k, lo, dv, v = num(f["K"]), num(f["K_min"]), num(f["dv_dK"]), num(f["v"])
     if f["lower_limit"] == "crawl-over-top" and lo:
         ks = [x for x in (k, num(f["K_lo"])) if x is not None]
-        if any((x - lo) / lo < 1e-8 for x in ks) or (k is None and v < 0.05):
+        if any((x - lo) / lo < 1e-4 for x in ks) or (k is None and v < 0.05):
             return "near-crawl"
     if k and dv and abs(v / (k * dv)) > 1e4:
         return "ill-conditioned"

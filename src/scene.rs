@@ -29,6 +29,13 @@ pub enum ParameterError {
         clip(.0, ECHO_CHARS + 64)
     )]
     UnknownLaw(String),
+    /// A spin rule of the contact model that fitbead does not know (the text is cut for the
+    /// message at [`ECHO_CHARS`] characters).
+    #[error(
+        "unknown spin rule '{}' (expected roll, keep, impact or factor=L)",
+        clip(.0, ECHO_CHARS)
+    )]
+    UnknownSpinRule(String),
     /// A model name that fitbead does not know.
     #[error("unknown model '{}'", clip(.0, ECHO_CHARS))]
     UnknownModel(String),

@@ -334,6 +334,7 @@ pub fn scene_error(r: &Row<'_>, e: ParameterError, cols: &[(&str, Option<usize>)
     let field = match &e {
         ParameterError::InvalidParameter { field, .. } => field_column(field).to_string(),
         ParameterError::UnknownLaw(_) => "K".into(),
+        ParameterError::UnknownSpinRule(_) => "spin".into(),
         ParameterError::UnknownModel(_) => "model".into(),
     };
     match cols.iter().find(|(n, _)| *n == field).and_then(|(_, c)| *c) {

@@ -67,10 +67,7 @@ impl FromStr for SpinRule {
                 .map(|v| v.trim().parse::<f64>())
             {
                 Some(Ok(l)) if l.is_finite() => Ok(SpinRule::Factor(l)),
-                _ => Err(Error::UnknownLaw(format!(
-                    "spin rule '{}' (expected roll, keep, impact or factor=L)",
-                    crate::numfmt::clip(t, crate::numfmt::ECHO_CHARS)
-                ))),
+                _ => Err(Error::UnknownSpinRule(t.to_string())),
             },
         }
     }

@@ -136,6 +136,44 @@ fn bad_inputs_exit_2_with_file_line_column_value() {
     );
 }
 
+/// A bad `--spin` (and a bad `spin` cell) says what is wrong with the spin rule, and only that;
+/// `--K` keeps its own message. Exact stderr, exit 2.
+#[test]
+fn unknown_spin_rule_is_reported_as_a_spin_rule() {
+    let run = |args: &[&str]| {
+        let out = bin().args(args).output().unwrap();
+        (out.status.code(), String::from_utf8(out.stderr).unwrap())
+    };
+    let scene = ["--xi", "1", "--delta-deg", "12"];
+    let (code, err) = run(&[
+        &["forward", "--model", "contact", "--spin", "reset"][..],
+        &scene,
+    ]
+    .concat());
+    assert_eq!(code, Some(2));
+    assert_eq!(
+        err,
+        "fitbead: error: <command line>, column '--spin', value 'reset': unknown spin rule \
+         'reset' (expected roll, keep, impact or factor=L)\n"
+    );
+    let (code, err) = run(&[&["forward", "--model", "stick", "--K", "bogus"][..], &scene].concat());
+    assert_eq!(code, Some(2));
+    assert_eq!(
+        err,
+        "fitbead: error: <command line>, column '--K', value 'bogus': unknown collision law \
+         'bogus' (expected a number, cos2a, adjusted, impact or c=VALUE)\n"
+    );
+    expect_error(
+        &["forward", "--model", "contact"],
+        "xi,delta_deg,spin\n1,10,factor=x\n",
+        &[
+            "line 2",
+            "'spin'",
+            ": unknown spin rule 'factor=x' (expected roll, keep, impact or factor=L)",
+        ],
+    );
+}
+
 /// The streaming `forward` (chunks of 32,768 rows): a bad row far past the first chunk is
 /// still reported with its line, and nothing is left at --output.
 #[test]

@@ -117,7 +117,13 @@ def _broadcast(named: Mapping[str, Any]) -> Tuple[Tuple[int, ...], Dict[str, Opt
 def _table(raw: Mapping[str, Any], shape: Tuple[int, ...]) -> Table:
     t = Table()
     for k, v in raw.items():
-        if isinstance(v, tuple):
+        if isinstance(v, tuple) and len(v) == 3:
+            at, values, n = v
+            arr = np.full(n, "", dtype=object)
+            if len(values):
+                arr[at] = np.asarray(values, dtype=object)
+            t[k] = arr.reshape(shape)
+        elif isinstance(v, tuple):
             codes, names = v
             arr = np.asarray(names, dtype=object)[codes] if len(names) else np.empty(0, dtype=object)
             t[k] = arr.reshape(shape)

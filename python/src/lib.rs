@@ -22,7 +22,9 @@ use fitbead::models::jan::Jan;
 use fitbead::models::regimes::{
     alpha_of_xi, bulk_friction_law, critical_xi, delta_d_law, delta_m_law,
 };
-use fitbead::models::{regime_of, ForwardModel, JaegerBranch, Model, ModelKind, Outcome};
+use fitbead::models::{
+    regime_of, ForwardModel, JaegerBranch, Model, ModelKind, Outcome, Phases, Regime,
+};
 use fitbead::scene::{CollisionLaw, Scene};
 use numpy::{PyArray1, PyArray3, PyReadonlyArray1};
 use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
@@ -34,9 +36,6 @@ use std::collections::HashMap;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Condvar, Mutex};
 use std::time::Duration;
-
-/// Rows evaluated per parallel block: bounds the memory of the per-row records.
-const BLOCK: usize = 1 << 16;
 
 fn value_error(msg: impl Into<String>) -> PyErr {
     PyValueError::new_err(msg.into())
@@ -83,24 +82,44 @@ fn show(x: f64) -> String {
 }
 
 /// A text column: one code per row into a list of distinct values.
+///
+/// A sparse column (messages: mostly empty, the rest mostly distinct) keeps instead the rows
+/// with a value and their values.
 #[derive(Default)]
 struct TextColumn {
     codes: Vec<u32>,
     names: Vec<String>,
     index: HashMap<String, u32>,
     last: Option<u32>,
+    sparse: bool,
+    rows: usize,
+    at: Vec<u64>,
 }
 
 impl TextColumn {
-    fn push(&mut self, s: &str) {
+    fn named(name: &str) -> Self {
+        TextColumn {
+            sparse: matches!(name, "message" | "reason"),
+            ..TextColumn::default()
+        }
+    }
+
+    fn code(&mut self, s: &str) -> u32 {
         if let Some(c) = self.last {
             if self.names[c as usize] == s {
-                self.codes.push(c);
-                return;
+                return c;
             }
         }
-        let c = match self.index.get(s) {
-            Some(&c) => c,
+        // Most columns hold a handful of values: a scan beats hashing them.
+        // (the first 16 are scanned, the rest looked up).
+        let head = self.names.len().min(16);
+        let found = match self.names[..head].iter().position(|n| n == s) {
+            Some(c) => Some(c as u32),
+            None if self.names.len() > head => self.index.get(s).copied(),
+            None => None,
+        };
+        let c = match found {
+            Some(c) => c,
             None => {
                 let c = self.names.len() as u32;
                 self.names.push(s.to_string());
@@ -109,7 +128,34 @@ impl TextColumn {
             }
         };
         self.last = Some(c);
-        self.codes.push(c);
+        c
+    }
+
+    fn push(&mut self, s: &str) {
+        if self.sparse {
+            if !s.is_empty() {
+                self.at.push(self.rows as u64);
+                self.names.push(s.to_string());
+            }
+        } else {
+            let c = self.code(s);
+            self.codes.push(c);
+        }
+        self.rows += 1;
+    }
+
+    /// Appends `other`'s rows, recoding its values into this column's list.
+    fn append(&mut self, other: TextColumn) {
+        let offset = self.rows as u64;
+        self.rows += other.rows;
+        if self.sparse {
+            self.at.extend(other.at.iter().map(|&r| r + offset));
+            self.names.extend(other.names);
+            return;
+        }
+        let map: Vec<u32> = other.names.iter().map(|s| self.code(s)).collect();
+        self.codes
+            .extend(other.codes.iter().map(|&c| map[c as usize]));
     }
 }
 
@@ -125,9 +171,9 @@ struct Columns {
 
 impl Columns {
     /// Every field of the row records, in order.
-    fn new(num_names: &[&'static str], text_names: &[&'static str], n: usize) -> Self {
+    fn new(num_names: &[&'static str], text_names: &[&'static str]) -> Self {
         let (nn, tn) = (num_names.len(), text_names.len());
-        Columns::pick(num_names, (0..nn).collect(), text_names, (0..tn).collect(), n)
+        Columns::pick(num_names, (0..nn).collect(), text_names, (0..tn).collect())
     }
 
     /// The fields `num_idx` and `text_idx` of the row records (whose fields are named by
@@ -137,14 +183,16 @@ impl Columns {
         num_idx: Vec<usize>,
         text_names: &[&'static str],
         text_idx: Vec<usize>,
-        n: usize,
     ) -> Self {
         Columns {
             num_names: num_idx.iter().map(|&i| num_names[i]).collect(),
-            nums: num_idx.iter().map(|_| Vec::with_capacity(n)).collect(),
+            nums: num_idx.iter().map(|_| Vec::new()).collect(),
             num_idx,
             text_names: text_idx.iter().map(|&i| text_names[i]).collect(),
-            texts: text_idx.iter().map(|_| TextColumn::default()).collect(),
+            texts: text_idx
+                .iter()
+                .map(|&i| TextColumn::named(text_names[i]))
+                .collect(),
             text_idx,
         }
     }
@@ -164,15 +212,24 @@ impl Columns {
             d.set_item(name, PyArray1::from_vec(py, v))?;
         }
         for (name, t) in self.text_names.into_iter().zip(self.texts) {
-            let codes = PyArray1::from_vec(py, t.codes);
-            d.set_item(name, (codes, PyList::new(py, t.names)?))?;
+            if t.sparse {
+                let at = PyArray1::from_vec(py, t.at);
+                d.set_item(name, (at, PyList::new(py, t.names)?, t.rows))?;
+            } else {
+                let codes = PyArray1::from_vec(py, t.codes);
+                d.set_item(name, (codes, PyList::new(py, t.names)?))?;
+            }
         }
         Ok(d)
     }
 }
 
-/// Evaluates `rows` in parallel blocks, each row giving fixed-size number and text records,
-/// and fills `cols` in row order. The first row error (lowest index) is returned.
+/// Rows per parallel task of [`fill`].
+const TASK_ROWS: usize = 2048;
+
+/// Evaluates rows `0..n` in parallel tasks of [`TASK_ROWS`], each row giving fixed-size number
+/// and text records, and fills `cols` in row order: numbers written in place, texts coded per
+/// task and merged. The error of the lowest failing row is returned.
 fn fill<const NF: usize, const NT: usize, F>(
     n: usize,
     cols: &mut Columns,
@@ -181,20 +238,45 @@ fn fill<const NF: usize, const NT: usize, F>(
 where
     F: Fn(usize) -> Result<([f64; NF], [Cow<'static, str>; NT]), String> + Sync,
 {
-    let mut buf = Vec::with_capacity(BLOCK.min(n));
-    let mut start = 0;
-    while start < n {
-        let end = (start + BLOCK).min(n);
-        (start..end)
-            .into_par_iter()
-            .with_min_len(256)
-            .map(&row)
-            .collect_into_vec(&mut buf);
-        for r in buf.drain(..) {
-            let (nums, texts) = r?;
-            cols.push(&nums, &texts);
+    for c in cols.nums.iter_mut() {
+        c.clear();
+        c.resize(n, f64::NAN);
+    }
+    let tasks = n.div_ceil(TASK_ROWS);
+    // Per task: its slice of every numeric column.
+    let mut slices: Vec<Vec<&mut [f64]>> = (0..tasks).map(|_| Vec::new()).collect();
+    for c in cols.nums.iter_mut() {
+        for (t, ch) in c.chunks_mut(TASK_ROWS).enumerate() {
+            slices[t].push(ch);
         }
-        start = end;
+    }
+    let (num_idx, text_idx, text_names) = (&cols.num_idx, &cols.text_idx, &cols.text_names);
+    let done: Vec<Result<Vec<TextColumn>, String>> = slices
+        .into_par_iter()
+        .enumerate()
+        .map(|(t, mut out)| {
+            let start = t * TASK_ROWS;
+            let mut texts: Vec<TextColumn> = text_names
+                .iter()
+                .map(|name| TextColumn::named(name))
+                .collect();
+            let len = out.first().map_or((n - start).min(TASK_ROWS), |s| s.len());
+            for j in 0..len {
+                let (nums, tx) = row(start + j)?;
+                for (o, &i) in out.iter_mut().zip(num_idx) {
+                    o[j] = nums[i];
+                }
+                for (c, &i) in texts.iter_mut().zip(text_idx) {
+                    c.push(&tx[i]);
+                }
+            }
+            Ok(texts)
+        })
+        .collect();
+    for r in done {
+        for (c, part) in cols.texts.iter_mut().zip(r?) {
+            c.append(part);
+        }
     }
     Ok(())
 }
@@ -209,7 +291,10 @@ fn law_of(k: Option<&[f64]>, law: CollisionLaw, i: usize) -> Result<CollisionLaw
         Some(k) => {
             let x = k[i];
             if !x.is_finite() {
-                return Err(format!("K[{i}] = {}: value must be a finite number", show(x)));
+                return Err(format!(
+                    "K[{i}] = {}: value must be a finite number",
+                    show(x)
+                ));
             }
             Ok(CollisionLaw::Value(x))
         }
@@ -325,7 +410,12 @@ fn forward_row(scene: &Scene, model: &Model) -> ForwardRow {
         m => (m.evaluate(scene), None, None),
     };
     let has_k = !matches!(model, Model::Jan(_) | Model::Jaeger(_));
-    texts[0] = Cow::Owned(regime_of(&o).map(|r| r.to_string()).unwrap_or_default());
+    texts[0] = Cow::Borrowed(match regime_of(&o) {
+        Some(Regime::A) => "A",
+        Some(Regime::B) => "B",
+        Some(Regime::C) => "C",
+        None => "",
+    });
     if has_k {
         nums[1] = scene.k();
     }
@@ -341,7 +431,13 @@ fn forward_row(scene: &Scene, model: &Model) -> ForwardRow {
             nums[6] = opt(s.map_slope);
             nums[7] = opt(s.other_fixed_point);
             texts[1] = Cow::Borrowed("ok");
-            texts[2] = Cow::Owned(s.phases.to_string());
+            texts[2] = match s.phases {
+                Phases::Roll => Cow::Borrowed("roll"),
+                Phases::Slip => Cow::Borrowed("slip"),
+                Phases::RollSlip => Cow::Borrowed("roll>slip"),
+                Phases::None => Cow::Borrowed(""),
+                p => Cow::Owned(p.to_string()),
+            };
             if s.other_fixed_point.is_some() {
                 texts[3] = Cow::Borrowed(if has_k {
                     "bistable: another fixed point of the final-velocity map"
@@ -418,9 +514,9 @@ fn forward<'py>(
     check_len("f", f_s.len(), n)?;
     let k_s = opt_slice(&k, "K", n)?;
     let base_law = parse_law(law)?;
-    let spin: SpinRule = spin
-        .parse()
-        .map_err(|e: fitbead::scene::ParameterError| value_error(format!("spin = '{spin}': {e}")))?;
+    let spin: SpinRule = spin.parse().map_err(|e: fitbead::scene::ParameterError| {
+        value_error(format!("spin = '{spin}': {e}"))
+    })?;
     if !(tol > 0.0 && tol < 1.0) {
         return Err(value_error(format!(
             "tol = {}: expected a relative tolerance in (0, 1)",
@@ -463,7 +559,7 @@ fn forward<'py>(
         .chain(&CONTACT_TEXTS)
         .copied()
         .collect();
-    let mut cols = Columns::pick(&all_nums, num_idx, &all_texts, text_idx, n);
+    let mut cols = Columns::pick(&all_nums, num_idx, &all_texts, text_idx);
     let r = py.detach(|| {
         fill(n, &mut cols, |i| {
             let law = law_of(k_s, base_law, i)?;
@@ -563,13 +659,16 @@ fn invert_k<'py>(
     if auto.is_some() {
         texts.extend(AUTO_TEXTS);
     }
-    let mut cols = Columns::new(&nums, &texts, n);
+    let mut cols = Columns::new(&nums, &texts);
     let r = py.detach(|| {
         fill(n, &mut cols, |i| -> Result<KRow, String> {
             let scene = scene_of(i, xi_s, d_s, rho_s, f_s, CollisionLaw::Value(0.5))?;
             let vi = v_s[i];
             if !(vi > 0.0 && vi.is_finite()) {
-                return Err(format!("v[{i}] = {}: must be a finite number > 0", show(vi)));
+                return Err(format!(
+                    "v[{i}] = {}: must be a finite number > 0",
+                    show(vi)
+                ));
             }
             let si = s_s[i];
             let sigma = if si.is_nan() {
@@ -640,7 +739,7 @@ fn k_row(model: &Model, auto: Option<&Auto>, scene: &Scene, vi: f64, sigma: Opti
         texts[5] = Cow::Borrowed(c.choice.name());
         texts[6] = Cow::Owned(c.reason);
     }
-(nums, texts)
+    (nums, texts)
 }
 
 /// δ_m (eq 32), δ_d (eq 31), the bulk friction of eq 79 and the critical ξ of a law.
@@ -657,11 +756,9 @@ fn regimes<'py>(
         return Err(value_error(format!("rho = {}: must be >= 0", show(rho))));
     }
     let xs = slice(&xi, "xi")?;
-    let n = xs.len();
     let mut cols = Columns::new(
         &["alpha_deg", "K", "delta_m_deg", "delta_d_deg", "mu_eq79"],
         &["steady_range"],
-        n,
     );
     for (i, &x) in xs.iter().enumerate() {
         if !(x.is_finite() && x > 0.0) {
@@ -759,7 +856,13 @@ impl PyDataset {
             slice(&rho, "rho")?,
             slice(&f, "f")?,
         );
-        for (name, a) in [("delta_deg", d), ("v", vs), ("sigma_v", ss), ("rho", rs), ("f", fs)] {
+        for (name, a) in [
+            ("delta_deg", d),
+            ("v", vs),
+            ("sigma_v", ss),
+            ("rho", rs),
+            ("f", fs),
+        ] {
             check_len(name, a.len(), n)?;
         }
         let mut rows = Vec::with_capacity(n);
@@ -791,7 +894,12 @@ impl PyDataset {
     /// The K inversion of every point (as `invert_k` over arrays, from the points' own
     /// scenes: no round trip of δ through degrees).
     #[pyo3(signature = (model, tol=1e-10))]
-    fn invert_k<'py>(&self, py: Python<'py>, model: &str, tol: f64) -> PyResult<Bound<'py, PyDict>> {
+    fn invert_k<'py>(
+        &self,
+        py: Python<'py>,
+        model: &str,
+        tol: f64,
+    ) -> PyResult<Bound<'py, PyDict>> {
         let (model, auto) = k_model(model, tol)?;
         let mut texts: Vec<&'static str> = K_TEXTS.to_vec();
         if auto.is_some() {
@@ -799,7 +907,7 @@ impl PyDataset {
         }
         let nums: Vec<&'static str> = K_NUMS.iter().chain(&K_NUMS2).copied().collect();
         let p = &self.inner.points;
-        let mut cols = Columns::new(&nums, &texts, p.len());
+        let mut cols = Columns::new(&nums, &texts);
         let abs = self.has_sigma();
         let r: Result<(), String> = py.detach(|| {
             fill(p.len(), &mut cols, |i| {
@@ -872,7 +980,10 @@ impl PyFitResult {
 
     /// The fit's name (e.g. `stickslip law c`) and series (empty for a global fit).
     fn name(&self) -> (String, String) {
-        (self.inner.stats.fit.clone(), self.inner.stats.series.clone())
+        (
+            self.inner.stats.fit.clone(),
+            self.inner.stats.series.clone(),
+        )
     }
 
     /// One dict per parameter.
@@ -955,10 +1066,7 @@ impl PyFitResult {
         d.set_item("xi", PyArray1::from_vec(py, col(&|q| q.xi)))?;
         d.set_item("delta_deg", PyArray1::from_vec(py, col(&|q| q.delta_deg)))?;
         d.set_item("v", PyArray1::from_vec(py, col(&|q| q.v)))?;
-        d.set_item(
-            "sigma_v",
-            PyArray1::from_vec(py, col(&|q| opt(q.sigma_v))),
-        )?;
+        d.set_item("sigma_v", PyArray1::from_vec(py, col(&|q| opt(q.sigma_v))))?;
         d.set_item("v_fit", PyArray1::from_vec(py, col(&|q| q.v_fit)))?;
         d.set_item("residual", PyArray1::from_vec(py, col(&|q| q.residual)))?;
         d.set_item(
@@ -1086,7 +1194,9 @@ fn interruptible<T: Send>(
             }
             if worker.is_finished() && slot.0.lock().map(|g| g.is_none()).unwrap_or(true) {
                 let _ = worker.join();
-                return Err(PyRuntimeError::new_err("the fit failed unexpectedly (panic)"));
+                return Err(PyRuntimeError::new_err(
+                    "the fit failed unexpectedly (panic)",
+                ));
             }
             if !interrupted && py.check_signals().is_err() {
                 stop.store(true, Ordering::SeqCst);

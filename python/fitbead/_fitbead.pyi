@@ -1,0 +1,94 @@
+"""Type stubs of the compiled core (``fitbead._fitbead``); the documented API is the package's
+(``fitbead/__init__.py``), which broadcasts arrays and wraps these results."""
+
+from typing import Any, Dict, List, Optional, Tuple
+
+import numpy as np
+import numpy.typing as npt
+
+F64 = npt.NDArray[np.float64]
+TextColumn = Tuple[npt.NDArray[np.uint32], List[str]]
+
+def version() -> str: ...
+def threads() -> int: ...
+def forward(
+    model: str,
+    xi: F64,
+    delta_deg: F64,
+    rho: F64,
+    f: F64,
+    k: Optional[F64] = None,
+    law: str = "adjusted",
+    lam: Optional[F64] = None,
+    mu: Optional[F64] = None,
+    a1: Optional[F64] = None,
+    a2: Optional[F64] = None,
+    a3: Optional[F64] = None,
+    branch: str = "upper",
+    spin: str = "roll",
+    tol: float = 1e-14,
+) -> Dict[str, Any]: ...
+def invert_k(
+    model: str, xi: F64, delta_deg: F64, v: F64, sigma_v: F64, rho: F64, f: F64, tol: float = 1e-10
+) -> Dict[str, Any]: ...
+def regimes(xi: F64, law: str = "adjusted", rho: float = 0.4) -> Dict[str, Any]: ...
+
+class _Dataset:
+    @staticmethod
+    def from_csv(path: str, rho: float = 0.4, f: float = 0.1, g: float = 9.81) -> "_Dataset": ...
+    @staticmethod
+    def from_text(text: str, source: str, rho: float = 0.4, f: float = 0.1, g: float = 9.81) -> "_Dataset": ...
+    @staticmethod
+    def default_data() -> "_Dataset": ...
+    @staticmethod
+    def from_arrays(
+        series: List[str], xi: F64, delta_deg: F64, v: F64, sigma_v: F64, rho: F64, f: F64
+    ) -> "_Dataset": ...
+    def invert_k(self, model: str, tol: float = 1e-10) -> Dict[str, Any]: ...
+    def __len__(self) -> int: ...
+    @property
+    def labels(self) -> List[str]: ...
+    @property
+    def has_sigma(self) -> bool: ...
+    def columns(self) -> Dict[str, np.ndarray]: ...
+
+class _FitResult:
+    def report(self) -> str: ...
+    def name(self) -> Tuple[str, str]: ...
+    def params(self) -> List[Dict[str, Any]]: ...
+    def stats(self) -> Dict[str, Any]: ...
+    def correlation(self) -> Optional[List[List[float]]]: ...
+    def points(self) -> Dict[str, Any]: ...
+    def draws(self) -> Optional[Tuple[np.ndarray, np.ndarray, int, int, bool]]: ...
+
+def fit_klaw(
+    data: _Dataset,
+    model: str = "stickslip",
+    law: str = "c",
+    method: str = "lsq",
+    level: float = 0.95,
+    profile: bool = True,
+    seed: int = 1,
+    walkers: Optional[int] = None,
+    max_steps: Optional[int] = None,
+    tol: float = 1e-10,
+) -> _FitResult: ...
+def fit_jan(
+    data: _Dataset,
+    method: str = "lsq",
+    level: float = 0.95,
+    profile: bool = True,
+    seed: int = 1,
+    walkers: Optional[int] = None,
+    max_steps: Optional[int] = None,
+) -> Tuple[List[_FitResult], List[str]]: ...
+def fit_jaeger(
+    data: _Dataset,
+    branch: str = "upper",
+    method: str = "lsq",
+    level: float = 0.95,
+    profile: bool = True,
+    seed: int = 1,
+    walkers: Optional[int] = None,
+    max_steps: Optional[int] = None,
+) -> Tuple[List[_FitResult], List[str]]: ...

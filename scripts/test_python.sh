@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# The Python package's tests, as CI runs them: a fresh virtual environment (target/python-venv),
+# the test dependencies from the package index, `pip install ./python` (which compiles the
+# extension against this checkout), then pytest against the command-line binary
+# target/release/fitbead (built here if `cargo test --release` has not built it).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+venv="${FITBEAD_VENV:-target/python-venv}"
+rm -rf "$venv"
+python3 -m venv "$venv"
+py="$venv/bin/python"
+"$py" -m pip install --quiet --disable-pip-version-check maturin numpy pytest pandas arviz
+start=$(date +%s)
+"$py" -m pip install --quiet --disable-pip-version-check ./python
+echo "pip install ./python: $(($(date +%s) - start)) s"
+"$py" -c "import fitbead; print('import fitbead:', fitbead.__version__, 'on', fitbead.threads(), 'threads')"
+cargo build --release --bin fitbead
+"$py" -m pytest -q -p no:cacheprovider python/tests

@@ -223,7 +223,8 @@ where
     P: RowPlan,
     F: FnOnce(&TableReader<R>) -> Result<P, InputError>,
 {
-    match output {
+    // `--output -` is standard output, as for the fit commands.
+    match output.filter(|p| *p != Path::new("-")) {
         Some(p) => {
             let cannot =
                 |e: std::io::Error| CliError::Other(format!("{}: cannot write: {e}", p.display()));

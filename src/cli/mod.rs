@@ -368,7 +368,8 @@ pub fn read_input(path: Option<&Path>) -> Result<(String, Vec<u8>), CliError> {
 
 /// Writes output bytes to a file atomically, or to stdout.
 pub fn emit(output: Option<&Path>, bytes: &[u8]) -> Result<(), CliError> {
-    match output {
+    // `--output -` is standard output, as for the fit commands.
+    match output.filter(|p| *p != Path::new("-")) {
         Some(p) => write_atomic(p, bytes)
             .map_err(|e| CliError::Other(format!("{}: cannot write: {e}", p.display()))),
         None => print_stdout(bytes),

@@ -249,3 +249,38 @@ fn fit_commands_print_a_fit_report_without_output() {
         assert!(!Path::new("-").exists(), "a file named '-' was written");
     }
 }
+
+#[test]
+fn output_dash_is_standard_output_for_every_table_command() {
+    // Run in a fresh directory: a file named '-' there would be the bug.
+    let tmp = tmpdir();
+    let dir = tmp.path();
+    for args in [
+        vec![
+            "forward",
+            "--model",
+            "stick",
+            "--xi",
+            "1",
+            "--delta-deg",
+            "12",
+        ],
+        vec!["k", "--model", "stick"],
+        vec!["regimes"],
+    ] {
+        let out = bin()
+            .current_dir(dir)
+            .args(&args)
+            .args(["--output", "-"])
+            .output()
+            .unwrap();
+        let text = stdout_ok(&out);
+        let plain = stdout_ok(&bin().current_dir(dir).args(&args).output().unwrap());
+        assert_eq!(text, plain, "{args:?}: --output - differs from no --output");
+        assert!(text.lines().count() > 1, "{args:?}: {text}");
+        assert!(
+            !dir.join("-").exists(),
+            "{args:?}: a file named '-' was written"
+        );
+    }
+}

@@ -11,10 +11,11 @@ use faer::Mat;
 
 use argmin::core::OptimizationResult;
 
-use super::lm::{into_parts, solve, LevenbergMarquardt, LmState, Solution};
+use super::lm::{into_parts, solve, LevenbergMarquardt, Solution};
 use super::lmpar::norm2;
 use super::lsq::{LsqError, LsqOptions, Residuals, SigmaKind, Termination};
 use super::problem::{Evaluator, LeastSquares};
+use super::state::LmState;
 
 /// Covariance of the estimates, from the SVD of the Jacobian at the optimum.
 #[derive(Debug, Clone, PartialEq)]
@@ -784,7 +785,7 @@ mod tests {
                 kv: &KV,
             ) -> Result<(), argmin::core::Error> {
                 let chi2 = kv.get("chi2").and_then(|v| v.get_float()).unwrap();
-                assert_eq!(chi2, state.cost);
+                assert_eq!(chi2, state.get_cost());
                 self.0.lock().unwrap().push(chi2);
                 Ok(())
             }

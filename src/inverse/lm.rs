@@ -54,18 +54,14 @@
 // Index loops mirror the subscripts of the published algorithm (MINPACK-1).
 #![allow(clippy::needless_range_loop)]
 
-use argmin::core::{Error, IterState, Problem, Solver, State, TerminationReason, KV};
+use argmin::core::{Error, Problem, Solver, State, TerminationReason, KV};
 use faer::Mat;
-use nalgebra::{DMatrix, DVector};
 use std::sync::atomic::Ordering;
 
 use super::lmpar::{norm2, Subproblem};
 use super::lsq::{LsqOptions, Residuals, Termination};
 use super::problem::{Evaluator, LeastSquares};
-
-/// The argmin state of [`LevenbergMarquardt`]: `param` is the current estimate, `cost` its χ²;
-/// the gradient, Hessian and residual slots are not used.
-pub type LmState = IterState<DVector<f64>, DVector<f64>, DMatrix<f64>, (), DVector<f64>, f64>;
+use super::state::{LmStage, LmState};
 
 /// The outcome of the iteration proper (no covariance).
 #[derive(Debug, Clone)]
@@ -689,7 +685,7 @@ impl LevenbergMarquardt {
     }
 
     /// Moves the evaluator's counts into argmin's function counts (every iteration when the
-    /// state counts, `IterState::counting`, else once the solver has finished).
+    /// state counts, `LmState::counting`, else once the solver has finished).
     fn count<R>(&self, problem: &mut Problem<LeastSquares<R>>) {
         problem.counts.insert("operator_count", self.ev.nfev as u64);
         problem.counts.insert("jacobian_count", self.ev.njev as u64);
@@ -762,26 +758,34 @@ impl LevenbergMarquardt {
         }
     }
 
-    /// The state after an iteration: the current point and χ², and the termination once done.
-    fn report(&self, state: LmState) -> Result<(LmState, Option<KV>), Error> {
-        let (x, fnorm, par, delta, stage) = match &self.stage {
-            Stage::Run { run, .. } => (&run.x, run.fnorm, run.par, run.delta, "lm"),
-            Stage::Polish { sol, .. } | Stage::Done(sol) => {
-                (&sol.x, sol.fnorm, 0.0, f64::INFINITY, "polish")
+    /// The state after an iteration: the current point and χ², what the solver reports of its
+    /// iteration, and the termination once done.
+    fn report(&self, mut state: LmState) -> Result<(LmState, Option<KV>), Error> {
+        let (x, fnorm) = match &self.stage {
+            Stage::Run { run, previous, .. } => {
+                let steps = run.iterations + previous.as_ref().map_or(0, |p| p.iterations);
+                state.set_lm(LmStage::Lm, run.par, run.delta, steps);
+                if run.outer > 0 {
+                    state.set_scaling(&run.diag, &run.free);
+                }
+                (&run.x, run.fnorm)
+            }
+            Stage::Polish { polisher, sol } => {
+                state.set_lm(LmStage::Polish, 0.0, f64::INFINITY, sol.iterations);
+                if polisher.steps > 0 {
+                    state.set_scaling(&polisher.diag, &polisher.free);
+                }
+                (&sol.x, sol.fnorm)
+            }
+            Stage::Done(sol) => {
+                state.set_lm(LmStage::Done, 0.0, f64::INFINITY, sol.iterations);
+                (&sol.x, sol.fnorm)
             }
             Stage::Idle => return Err(Error::msg("the Levenberg–Marquardt solver has no state")),
         };
         let chi2 = fnorm * fnorm;
-        // The vector of two iterations ago is overwritten, so that a run allocates none.
-        let mut state = state;
-        let p = match state.prev_param.take() {
-            Some(mut p) if p.len() == x.len() => {
-                p.copy_from_slice(x);
-                p
-            }
-            _ => DVector::from_column_slice(x),
-        };
-        let mut state = state.param(p).cost(chi2);
+        state.set_point(x, chi2);
+        state.set_evals(self.ev.nfev, self.ev.njev, self.ev.nfev + self.ev.analytic);
         if let Stage::Done(sol) = &self.stage {
             let reason = if sol.termination.converged() {
                 TerminationReason::SolverConverged
@@ -793,9 +797,9 @@ impl LevenbergMarquardt {
         let kv = self.log.then(|| {
             argmin::kv!(
                 "chi2" => chi2;
-                "lambda" => par;
-                "radius" => delta;
-                "stage" => stage;
+                "lambda" => state.lambda();
+                "radius" => state.radius();
+                "stage" => if state.stage() == LmStage::Lm { "lm" } else { "polish" };
             )
         });
         Ok((state, kv))
@@ -845,7 +849,7 @@ impl<R: Residuals> Solver<LeastSquares<R>, LmState> for LevenbergMarquardt {
             },
             Err(sol) => self.settle(ls, sol, 0, None),
         };
-        if state.counting_enabled || matches!(self.stage, Stage::Done(_)) {
+        if state.is_counting() || matches!(self.stage, Stage::Done(_)) {
             self.count(problem);
         }
         self.report(state)
@@ -857,33 +861,32 @@ impl<R: Residuals> Solver<LeastSquares<R>, LmState> for LevenbergMarquardt {
         state: LmState,
     ) -> Result<(LmState, Option<KV>), Error> {
         let ls = inner(problem)?;
-        self.stage = match std::mem::take(&mut self.stage) {
-            Stage::Run {
-                mut run,
-                restarts,
-                previous,
-            } => match run.iterate(&mut self.ev, ls, &self.opts) {
-                None => Stage::Run {
+        // The stage is replaced only when it ends.
+        let ended = match &mut self.stage {
+            Stage::Run { run, .. } => run.iterate(&mut self.ev, ls, &self.opts),
+            Stage::Polish { polisher, sol } => {
+                if polisher.step(&mut self.ev, ls, &self.opts, sol) {
+                    None
+                } else {
+                    // Any value: the polish ends with the termination of its solution.
+                    Some(Termination::Interrupted)
+                }
+            }
+            Stage::Done(_) => None,
+            Stage::Idle => return Err(Error::msg("the solver was not initialised")),
+        };
+        if let Some(t) = ended {
+            self.stage = match std::mem::take(&mut self.stage) {
+                Stage::Run {
                     run,
                     restarts,
                     previous,
-                },
-                Some(t) => self.settle(ls, run.into_solution(t), restarts, previous),
-            },
-            Stage::Polish {
-                mut polisher,
-                mut sol,
-            } => {
-                if polisher.step(&mut self.ev, ls, &self.opts, &mut sol) {
-                    Stage::Polish { polisher, sol }
-                } else {
-                    Stage::Done(sol)
-                }
-            }
-            done @ Stage::Done(_) => done,
-            Stage::Idle => return Err(Error::msg("the solver was not initialised")),
-        };
-        if state.counting_enabled || matches!(self.stage, Stage::Done(_)) {
+                } => self.settle(ls, run.into_solution(t), restarts, previous),
+                Stage::Polish { sol, .. } => Stage::Done(sol),
+                other => other,
+            };
+        }
+        if state.is_counting() || matches!(self.stage, Stage::Done(_)) {
             self.count(problem);
         }
         self.report(state)

@@ -30,9 +30,10 @@ pub mod mcmc;
 pub mod posterior;
 pub mod problem;
 pub mod profile;
+pub mod state;
 
 pub use estimate::{fit, fit_result, Covariance, Fit};
-pub use lm::{LevenbergMarquardt, LmState};
+pub use lm::LevenbergMarquardt;
 pub use lsq::{
     Infeasible, LsqError, LsqOptions, Model, Residuals, SigmaKind, Termination, WeightedData,
 };
@@ -45,3 +46,4 @@ pub use profile::{
     confidence_intervals, covariance_intervals, profile_interval, ConfidenceIntervals, Interval,
     ProfileEnd, ProfileInterval, DEFAULT_LEVEL,
 };
+pub use state::{LmStage, LmState};

@@ -175,6 +175,8 @@ pub(crate) struct Evaluator {
     pub n: usize,
     pub nfev: usize,
     pub njev: usize,
+    /// Analytic Jacobian evaluations (of `njev`).
+    pub analytic: usize,
     /// Whether the last Jacobian came by finite differences.
     pub differenced: bool,
     /// Where each residual and analytic Jacobian evaluation is counted, if anywhere.
@@ -191,6 +193,7 @@ impl Evaluator {
             n,
             nfev: 0,
             njev: 0,
+            analytic: 0,
             differenced: false,
             tally: None,
             work: vec![0.0; m],
@@ -227,6 +230,9 @@ impl Evaluator {
         self.njev += 1;
         self.differenced = false;
         let analytic = ls.problem.jacobian(x, jac.as_mut());
+        if analytic.is_some() {
+            self.analytic += 1;
+        }
         if let (Some(_), Some(t)) = (&analytic, &self.tally) {
             t.add(1);
         }

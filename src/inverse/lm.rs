@@ -95,8 +95,7 @@ struct LmRun {
     step: Vec<f64>,
     ft: Vec<f64>,
     u: Vec<f64>,
-    /// Work space: a Jacobian column (m), a scaled vector and R·s (n).
-    col: Vec<f64>,
+    /// Work space: a scaled vector and R·s (n).
     scaled: Vec<f64>,
     rs: Vec<f64>,
     /// The Levenberg–Marquardt parameter λ.
@@ -160,7 +159,6 @@ impl LmRun {
             step: vec![0.0; n],
             ft: vec![0.0; m],
             u: vec![0.0; m],
-            col: vec![0.0; m],
             scaled: vec![0.0; n],
             rs: vec![0.0; n],
             par: 0.0,
@@ -191,7 +189,7 @@ impl LmRun {
         ls: &LeastSquares<R>,
         opts: &LsqOptions,
     ) -> Option<Termination> {
-        let (m, n) = (ev.m, ev.n);
+        let n = ev.n;
         let eps = f64::EPSILON;
         let ftol = opts.ftol.max(eps);
         let xtol = opts.xtol.max(eps);
@@ -220,7 +218,6 @@ impl LmRun {
             step,
             ft,
             u,
-            col,
             scaled,
             rs,
             par,
@@ -243,14 +240,15 @@ impl LmRun {
         }
         // Column norms, gradient Jᵀf and the active set.
         for j in 0..n {
-            for (i, c) in col.iter_mut().enumerate() {
-                *c = jac[(i, j)];
-            }
-            acnorm[j] = norm2(col);
-            grad[j] = (0..m).map(|i| jac[(i, j)] * f[i]).sum();
+            let c = jac.col_as_slice(j);
+            acnorm[j] = norm2(c);
+            grad[j] = c.iter().zip(f.iter()).map(|(a, b)| a * b).sum();
             free[j] = !((x[j] <= lo[j] && grad[j] > 0.0) || (x[j] >= hi[j] && grad[j] < 0.0));
-            for i in 0..m {
-                jw[(i, j)] = if free[j] { jac[(i, j)] } else { 0.0 };
+            let w = jw.col_as_slice_mut(j);
+            if free[j] {
+                w.copy_from_slice(c);
+            } else {
+                w.fill(0.0);
             }
         }
         if *first {
@@ -268,7 +266,12 @@ impl LmRun {
         load_r(sp, ipvt, &qr, acnorm);
         let q = qr.compute_thin_Q();
         for (j, q_j) in qtf.iter_mut().enumerate() {
-            *q_j = (0..m).map(|i| q[(i, j)] * f[i]).sum();
+            *q_j = q
+                .col_as_slice(j)
+                .iter()
+                .zip(f.iter())
+                .map(|(a, b)| a * b)
+                .sum();
         }
         // Scaled gradient norm (largest cosine between f and a free column of J).
         let mut gnorm: f64 = 0.0;
@@ -333,6 +336,7 @@ impl LmRun {
                     -(temp1 * temp1 + temp2 * temp2),
                 )
             } else {
+                let jw = jw.as_ref();
                 for (i, ui) in u.iter_mut().enumerate() {
                     *ui = (0..n).map(|j| jw[(i, j)] * step[j]).sum();
                 }
@@ -420,7 +424,6 @@ struct Polisher {
     trial: Vec<f64>,
     step: Vec<f64>,
     ft: Vec<f64>,
-    col: Vec<f64>,
     scaled: Vec<f64>,
     previous: f64,
     steps: usize,
@@ -438,7 +441,6 @@ impl Polisher {
             trial: vec![0.0; n],
             step: vec![0.0; n],
             ft: vec![0.0; m],
-            col: vec![0.0; m],
             scaled: vec![0.0; n],
             previous: f64::INFINITY,
             steps: 0,
@@ -458,7 +460,7 @@ impl Polisher {
             return false;
         }
         self.steps += 1;
-        let (m, n) = (ev.m, ev.n);
+        let n = ev.n;
         let (lo, hi) = (&ls.setup.lower, &ls.setup.upper);
         let xtol = opts.xtol.max(f64::EPSILON);
         let Polisher {
@@ -471,7 +473,6 @@ impl Polisher {
             trial,
             step,
             ft,
-            col,
             scaled,
             previous,
             steps: _,
@@ -480,26 +481,27 @@ impl Polisher {
             return false;
         }
         for j in 0..n {
-            for (i, c) in col.iter_mut().enumerate() {
-                *c = jac[(i, j)];
-            }
-            diag[j] = norm2(col);
+            let c = jac.col_as_slice_mut(j);
+            diag[j] = norm2(c);
             if diag[j] == 0.0 {
                 diag[j] = 1.0;
             }
-            let g: f64 = (0..m).map(|i| jac[(i, j)] * sol.f[i]).sum();
+            let g: f64 = c.iter().zip(sol.f.iter()).map(|(a, b)| a * b).sum();
             free[j] = !((sol.x[j] <= lo[j] && g > 0.0) || (sol.x[j] >= hi[j] && g < 0.0));
             if !free[j] {
-                for i in 0..m {
-                    jac[(i, j)] = 0.0;
-                }
+                c.fill(0.0);
             }
         }
         let qr = jac.col_piv_qr();
         load_r(sp, ipvt, &qr, diag);
         let q = qr.compute_thin_Q();
         for (j, q_j) in qtf.iter_mut().enumerate() {
-            *q_j = (0..m).map(|i| q[(i, j)] * sol.f[i]).sum();
+            *q_j = q
+                .col_as_slice(j)
+                .iter()
+                .zip(sol.f.iter())
+                .map(|(a, b)| a * b)
+                .sum();
         }
         sp.lm_step(ipvt, diag, qtf, f64::INFINITY, 0.0);
         for j in 0..n {

@@ -54,12 +54,14 @@
 // Index loops mirror the subscripts of the published algorithm (MINPACK-1).
 #![allow(clippy::needless_range_loop)]
 
+use argmin::core::observers::ObserverMode;
 use argmin::core::{Error, Problem, Solver, State, TerminationReason, KV};
 use faer::Mat;
 use std::sync::atomic::Ordering;
 
 use super::lmpar::{norm2, Subproblem};
 use super::lsq::{LsqOptions, Residuals, Termination};
+use super::observer::ProgressObserver;
 use super::problem::{Evaluator, LeastSquares};
 use super::state::{LmStage, LmState};
 
@@ -620,7 +622,8 @@ impl LevenbergMarquardt {
                 sigma: opts.sigma,
                 polish: opts.polish,
                 stop: opts.stop.clone(),
-                progress: opts.progress.clone(),
+                // Counted by an observer ([`super::ProgressObserver`]), not by the solver.
+                progress: None,
             },
             ev: Evaluator::new(0, 0),
             stage: Stage::Idle,
@@ -842,7 +845,6 @@ impl<R: Residuals> Solver<LeastSquares<R>, LmState> for LevenbergMarquardt {
             }
         };
         self.ev = Evaluator::new(m, n);
-        self.ev.tally = self.opts.progress.clone();
         self.stage = match LmRun::start(&mut self.ev, ls, start) {
             Ok(run) => Stage::Run {
                 run: Box::new(run),
@@ -931,17 +933,21 @@ fn scaled_norm(d: &[f64], x: &[f64], work: &mut [f64]) -> f64 {
 
 /// Runs [`LevenbergMarquardt`] on `ls` under argmin's `Executor` (argmin's Ctrl-C handling off:
 /// the stop flag of `opts` is the caller's; its timer off: nothing reads the iteration times,
-/// and the profiles' many small fits would pay two clock reads per iteration); returns the
-/// solution, the evaluator (its counts and work space, for the covariance) and the problem.
+/// and the profiles' many small fits would pay two clock reads per iteration), with a
+/// [`ProgressObserver`] over `opts.progress` when there is one; returns the solution, the
+/// evaluator (its counts and work space, for the covariance) and the problem.
 pub(crate) fn solve<R: Residuals>(
     ls: LeastSquares<R>,
     opts: &LsqOptions,
 ) -> Result<(Solution, Evaluator, LeastSquares<R>), Error> {
-    let result = argmin::core::Executor::new(ls, LevenbergMarquardt::new(opts))
+    let mut executor = argmin::core::Executor::new(ls, LevenbergMarquardt::new(opts))
         .ctrlc(false)
-        .timer(false)
-        .run()?;
-    into_parts(result)
+        .timer(false);
+    if let Some(tally) = &opts.progress {
+        executor =
+            executor.add_observer(ProgressObserver::new(tally.clone()), ObserverMode::Always);
+    }
+    into_parts(executor.run()?)
 }
 
 /// The solution, the evaluator and the problem of an executor's result.

@@ -27,6 +27,7 @@ pub mod lm;
 mod lmpar;
 pub mod lsq;
 pub mod mcmc;
+pub mod observer;
 pub mod posterior;
 pub mod problem;
 pub mod profile;
@@ -41,6 +42,7 @@ pub use mcmc::{
     EnsembleSampler, LogDensity, McmcError, McmcOptions, McmcResult, ParameterDiagnostics,
     StopReason,
 };
+pub use observer::ProgressObserver;
 pub use problem::LeastSquares;
 pub use profile::{
     confidence_intervals, covariance_intervals, profile_interval, ConfidenceIntervals, Interval,

@@ -10,7 +10,6 @@
 //! [`CostFunction::cost`], so that derivative-free solvers step back from them; the
 //! Levenberg–Marquardt solver never sees them as errors (they are rejected steps).
 
-use crate::progress::Tally;
 use argmin::core::{CostFunction, Error, Gradient, Jacobian, Operator};
 use faer::Mat;
 use nalgebra::{DMatrix, DVector};
@@ -179,8 +178,6 @@ pub(crate) struct Evaluator {
     pub analytic: usize,
     /// Whether the last Jacobian came by finite differences.
     pub differenced: bool,
-    /// Where each residual and analytic Jacobian evaluation is counted, if anywhere.
-    pub tally: Option<Tally>,
     work: Vec<f64>,
     work2: Vec<f64>,
     xp: Vec<f64>,
@@ -195,7 +192,6 @@ impl Evaluator {
             njev: 0,
             analytic: 0,
             differenced: false,
-            tally: None,
             work: vec![0.0; m],
             work2: vec![0.0; m],
             xp: vec![0.0; n],
@@ -210,9 +206,6 @@ impl Evaluator {
         out: &mut [f64],
     ) -> bool {
         self.nfev += 1;
-        if let Some(t) = &self.tally {
-            t.add(1);
-        }
         match ls.problem.residuals(x, out) {
             Ok(()) => out.iter().all(|v| v.is_finite()),
             Err(Infeasible) => false,
@@ -232,9 +225,6 @@ impl Evaluator {
         let analytic = ls.problem.jacobian(x, jac.as_mut());
         if analytic.is_some() {
             self.analytic += 1;
-        }
-        if let (Some(_), Some(t)) = (&analytic, &self.tally) {
-            t.add(1);
         }
         match analytic {
             Some(Ok(())) => {

@@ -43,7 +43,7 @@ pub use mcmc::{
     StopReason,
 };
 pub use observer::ProgressObserver;
-pub use problem::LeastSquares;
+pub use problem::{ArgminResiduals, LeastSquares};
 pub use profile::{
     confidence_intervals, covariance_intervals, profile_interval, ConfidenceIntervals, Interval,
     ProfileEnd, ProfileInterval, DEFAULT_LEVEL,

@@ -113,9 +113,12 @@ mod tests {
         }
     }
 
-    /// What an observer saw at each iteration: (iteration, steps, stage, model evaluations).
+    /// One iteration as an observer saw it: (iteration, steps, stage, model evaluations).
+    type Row = (u64, usize, LmStage, usize);
+
+    /// What an observer saw at each iteration.
     #[derive(Clone, Default)]
-    struct Seen(Arc<Mutex<Vec<(u64, usize, LmStage, usize)>>>);
+    struct Seen(Arc<Mutex<Vec<Row>>>);
     impl Observe<LmState> for Seen {
         fn observe_iter(&mut self, state: &LmState, _kv: &KV) -> Result<(), Error> {
             self.0.lock().unwrap().push((

@@ -9,6 +9,11 @@
 //!   problem as argmin's `Operator` + `Jacobian` (residuals) and `CostFunction` + `Gradient`
 //!   (χ²) on nalgebra vectors: [`fit`] runs under argmin's `Executor`, argmin's other solvers
 //!   run on fitbead's problems, and observers, timeouts and iteration limits apply to both;
+//!   the solver's state is [`LmState`] (argmin's `State` with λ, the trust radius, the scaling,
+//!   the active set and the stage for observers), and [`ProgressObserver`] is the observer that
+//!   counts a fit's model evaluations for a progress bar;
+//! * [`ArgminResiduals`] — any argmin problem with residuals and their Jacobian
+//!   (`Operator` + `Jacobian` on nalgebra vectors) fitted by fitbead's solver;
 //! * [`confidence_intervals`] — covariance (Student-t / normal) and profile-likelihood
 //!   intervals;
 //! * [`WeightedData`] — a [`Model`] y = f(x; p) with data (x, y, σ) seen as residuals;

@@ -147,11 +147,11 @@ pub fn run(a: Args) -> Result<(), CliError> {
             e
         }
     };
-    // A least-squares fit shows its forward evaluations on a terminal once it has run for a
+    // A least-squares fit shows its model evaluations on a terminal once it has run for a
     // couple of seconds; a posterior run shows the sampler's steps instead.
     let context = KLawContext {
         progress: match choice.method {
-            Method::Lsq { .. } => super::delayed_progress_bar("forward evaluations"),
+            Method::Lsq { .. } => super::delayed_progress_bar("model evaluations"),
             Method::Mcmc(_) => None,
         },
         ..KLawContext::default()

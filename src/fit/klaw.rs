@@ -40,7 +40,7 @@ use crate::inverse::{
     fit, profile_interval, Covariance, Fit, Infeasible, LsqOptions, ProfileInterval, Residuals,
 };
 use crate::models::Model;
-use crate::progress::{Progress, ProgressEvent};
+use crate::progress::{Progress, ProgressEvent, Tally};
 use faer::{Mat, MatMut};
 use rayon::prelude::*;
 use std::fmt;
@@ -689,7 +689,9 @@ pub struct KLawContext {
     /// the caller already has them; computed otherwise.
     pub brackets: Option<Vec<KBracket>>,
     /// Where progress goes: a task labelled with the fit's name, of unknown total, whose
-    /// positions count the forward evaluations done.
+    /// positions count the model evaluations (residual vectors and Jacobians over the data) of
+    /// the least-squares fit and its profiles, from a [`crate::inverse::ProgressObserver`]
+    /// on their iterations.
     pub progress: Option<Progress>,
 }
 
@@ -738,8 +740,7 @@ pub fn fit_law_in(
             KLawProblem::with_brackets(model, data, law, b).with_stop(method.stop().cloned())
         }
         None => KLawProblem::new_until(model, data, law, method.stop().cloned())?,
-    }
-    .with_progress(progress.clone());
+    };
     let (lower, upper) = problem.feasible_box()?;
     let start = problem.start()?;
     let opts = LsqOptions {
@@ -747,6 +748,7 @@ pub fn fit_law_in(
         upper: Some(upper),
         sigma: data.sigma,
         stop: method.stop().cloned(),
+        progress: progress.clone().map(Tally::new),
         ..Default::default()
     };
     let f = fit(&problem, &start, &opts).map_err(|e| KLawError::Solver(e.to_string()))?;

@@ -54,18 +54,16 @@
 // Index loops mirror the subscripts of the published algorithm (MINPACK-1).
 #![allow(clippy::needless_range_loop)]
 
-use argmin::core::{Error, IterState, Problem, Solver, State, TerminationReason, KV};
+use argmin::core::observers::ObserverMode;
+use argmin::core::{Error, Problem, Solver, State, TerminationReason, KV};
 use faer::Mat;
-use nalgebra::{DMatrix, DVector};
 use std::sync::atomic::Ordering;
 
 use super::lmpar::{norm2, Subproblem};
 use super::lsq::{LsqOptions, Residuals, Termination};
+use super::observer::ProgressObserver;
 use super::problem::{Evaluator, LeastSquares};
-
-/// The argmin state of [`LevenbergMarquardt`]: `param` is the current estimate, `cost` its χ²;
-/// the gradient, Hessian and residual slots are not used.
-pub type LmState = IterState<DVector<f64>, DVector<f64>, DMatrix<f64>, (), DVector<f64>, f64>;
+use super::state::{LmStage, LmState};
 
 /// The outcome of the iteration proper (no covariance).
 #[derive(Debug, Clone)]
@@ -99,8 +97,7 @@ struct LmRun {
     step: Vec<f64>,
     ft: Vec<f64>,
     u: Vec<f64>,
-    /// Work space: a Jacobian column (m), a scaled vector and R·s (n).
-    col: Vec<f64>,
+    /// Work space: a scaled vector and R·s (n).
     scaled: Vec<f64>,
     rs: Vec<f64>,
     /// The Levenberg–Marquardt parameter λ.
@@ -164,7 +161,6 @@ impl LmRun {
             step: vec![0.0; n],
             ft: vec![0.0; m],
             u: vec![0.0; m],
-            col: vec![0.0; m],
             scaled: vec![0.0; n],
             rs: vec![0.0; n],
             par: 0.0,
@@ -195,7 +191,7 @@ impl LmRun {
         ls: &LeastSquares<R>,
         opts: &LsqOptions,
     ) -> Option<Termination> {
-        let (m, n) = (ev.m, ev.n);
+        let n = ev.n;
         let eps = f64::EPSILON;
         let ftol = opts.ftol.max(eps);
         let xtol = opts.xtol.max(eps);
@@ -224,7 +220,6 @@ impl LmRun {
             step,
             ft,
             u,
-            col,
             scaled,
             rs,
             par,
@@ -247,14 +242,15 @@ impl LmRun {
         }
         // Column norms, gradient Jᵀf and the active set.
         for j in 0..n {
-            for (i, c) in col.iter_mut().enumerate() {
-                *c = jac[(i, j)];
-            }
-            acnorm[j] = norm2(col);
-            grad[j] = (0..m).map(|i| jac[(i, j)] * f[i]).sum();
+            let c = jac.col_as_slice(j);
+            acnorm[j] = norm2(c);
+            grad[j] = c.iter().zip(f.iter()).map(|(a, b)| a * b).sum();
             free[j] = !((x[j] <= lo[j] && grad[j] > 0.0) || (x[j] >= hi[j] && grad[j] < 0.0));
-            for i in 0..m {
-                jw[(i, j)] = if free[j] { jac[(i, j)] } else { 0.0 };
+            let w = jw.col_as_slice_mut(j);
+            if free[j] {
+                w.copy_from_slice(c);
+            } else {
+                w.fill(0.0);
             }
         }
         if *first {
@@ -272,7 +268,12 @@ impl LmRun {
         load_r(sp, ipvt, &qr, acnorm);
         let q = qr.compute_thin_Q();
         for (j, q_j) in qtf.iter_mut().enumerate() {
-            *q_j = (0..m).map(|i| q[(i, j)] * f[i]).sum();
+            *q_j = q
+                .col_as_slice(j)
+                .iter()
+                .zip(f.iter())
+                .map(|(a, b)| a * b)
+                .sum();
         }
         // Scaled gradient norm (largest cosine between f and a free column of J).
         let mut gnorm: f64 = 0.0;
@@ -337,6 +338,7 @@ impl LmRun {
                     -(temp1 * temp1 + temp2 * temp2),
                 )
             } else {
+                let jw = jw.as_ref();
                 for (i, ui) in u.iter_mut().enumerate() {
                     *ui = (0..n).map(|j| jw[(i, j)] * step[j]).sum();
                 }
@@ -424,7 +426,6 @@ struct Polisher {
     trial: Vec<f64>,
     step: Vec<f64>,
     ft: Vec<f64>,
-    col: Vec<f64>,
     scaled: Vec<f64>,
     previous: f64,
     steps: usize,
@@ -442,7 +443,6 @@ impl Polisher {
             trial: vec![0.0; n],
             step: vec![0.0; n],
             ft: vec![0.0; m],
-            col: vec![0.0; m],
             scaled: vec![0.0; n],
             previous: f64::INFINITY,
             steps: 0,
@@ -462,7 +462,7 @@ impl Polisher {
             return false;
         }
         self.steps += 1;
-        let (m, n) = (ev.m, ev.n);
+        let n = ev.n;
         let (lo, hi) = (&ls.setup.lower, &ls.setup.upper);
         let xtol = opts.xtol.max(f64::EPSILON);
         let Polisher {
@@ -475,7 +475,6 @@ impl Polisher {
             trial,
             step,
             ft,
-            col,
             scaled,
             previous,
             steps: _,
@@ -484,26 +483,27 @@ impl Polisher {
             return false;
         }
         for j in 0..n {
-            for (i, c) in col.iter_mut().enumerate() {
-                *c = jac[(i, j)];
-            }
-            diag[j] = norm2(col);
+            let c = jac.col_as_slice_mut(j);
+            diag[j] = norm2(c);
             if diag[j] == 0.0 {
                 diag[j] = 1.0;
             }
-            let g: f64 = (0..m).map(|i| jac[(i, j)] * sol.f[i]).sum();
+            let g: f64 = c.iter().zip(sol.f.iter()).map(|(a, b)| a * b).sum();
             free[j] = !((sol.x[j] <= lo[j] && g > 0.0) || (sol.x[j] >= hi[j] && g < 0.0));
             if !free[j] {
-                for i in 0..m {
-                    jac[(i, j)] = 0.0;
-                }
+                c.fill(0.0);
             }
         }
         let qr = jac.col_piv_qr();
         load_r(sp, ipvt, &qr, diag);
         let q = qr.compute_thin_Q();
         for (j, q_j) in qtf.iter_mut().enumerate() {
-            *q_j = (0..m).map(|i| q[(i, j)] * sol.f[i]).sum();
+            *q_j = q
+                .col_as_slice(j)
+                .iter()
+                .zip(sol.f.iter())
+                .map(|(a, b)| a * b)
+                .sum();
         }
         sp.lm_step(ipvt, diag, qtf, f64::INFINITY, 0.0);
         for j in 0..n {
@@ -622,7 +622,8 @@ impl LevenbergMarquardt {
                 sigma: opts.sigma,
                 polish: opts.polish,
                 stop: opts.stop.clone(),
-                progress: opts.progress.clone(),
+                // Counted by an observer ([`super::ProgressObserver`]), not by the solver.
+                progress: None,
             },
             ev: Evaluator::new(0, 0),
             stage: Stage::Idle,
@@ -689,7 +690,7 @@ impl LevenbergMarquardt {
     }
 
     /// Moves the evaluator's counts into argmin's function counts (every iteration when the
-    /// state counts, `IterState::counting`, else once the solver has finished).
+    /// state counts, `LmState::counting`, else once the solver has finished).
     fn count<R>(&self, problem: &mut Problem<LeastSquares<R>>) {
         problem.counts.insert("operator_count", self.ev.nfev as u64);
         problem.counts.insert("jacobian_count", self.ev.njev as u64);
@@ -762,26 +763,34 @@ impl LevenbergMarquardt {
         }
     }
 
-    /// The state after an iteration: the current point and χ², and the termination once done.
-    fn report(&self, state: LmState) -> Result<(LmState, Option<KV>), Error> {
-        let (x, fnorm, par, delta, stage) = match &self.stage {
-            Stage::Run { run, .. } => (&run.x, run.fnorm, run.par, run.delta, "lm"),
-            Stage::Polish { sol, .. } | Stage::Done(sol) => {
-                (&sol.x, sol.fnorm, 0.0, f64::INFINITY, "polish")
+    /// The state after an iteration: the current point and χ², what the solver reports of its
+    /// iteration, and the termination once done.
+    fn report(&self, mut state: LmState) -> Result<(LmState, Option<KV>), Error> {
+        let (x, fnorm) = match &self.stage {
+            Stage::Run { run, previous, .. } => {
+                let steps = run.iterations + previous.as_ref().map_or(0, |p| p.iterations);
+                state.set_lm(LmStage::Lm, run.par, run.delta, steps);
+                if run.outer > 0 {
+                    state.set_scaling(&run.diag, &run.free);
+                }
+                (&run.x, run.fnorm)
+            }
+            Stage::Polish { polisher, sol } => {
+                state.set_lm(LmStage::Polish, 0.0, f64::INFINITY, sol.iterations);
+                if polisher.steps > 0 {
+                    state.set_scaling(&polisher.diag, &polisher.free);
+                }
+                (&sol.x, sol.fnorm)
+            }
+            Stage::Done(sol) => {
+                state.set_lm(LmStage::Done, 0.0, f64::INFINITY, sol.iterations);
+                (&sol.x, sol.fnorm)
             }
             Stage::Idle => return Err(Error::msg("the Levenberg–Marquardt solver has no state")),
         };
         let chi2 = fnorm * fnorm;
-        // The vector of two iterations ago is overwritten, so that a run allocates none.
-        let mut state = state;
-        let p = match state.prev_param.take() {
-            Some(mut p) if p.len() == x.len() => {
-                p.copy_from_slice(x);
-                p
-            }
-            _ => DVector::from_column_slice(x),
-        };
-        let mut state = state.param(p).cost(chi2);
+        state.set_point(x, chi2);
+        state.set_evals(self.ev.nfev, self.ev.njev, self.ev.nfev + self.ev.analytic);
         if let Stage::Done(sol) = &self.stage {
             let reason = if sol.termination.converged() {
                 TerminationReason::SolverConverged
@@ -793,9 +802,9 @@ impl LevenbergMarquardt {
         let kv = self.log.then(|| {
             argmin::kv!(
                 "chi2" => chi2;
-                "lambda" => par;
-                "radius" => delta;
-                "stage" => stage;
+                "lambda" => state.lambda();
+                "radius" => state.radius();
+                "stage" => if state.stage() == LmStage::Lm { "lm" } else { "polish" };
             )
         });
         Ok((state, kv))
@@ -836,7 +845,6 @@ impl<R: Residuals> Solver<LeastSquares<R>, LmState> for LevenbergMarquardt {
             }
         };
         self.ev = Evaluator::new(m, n);
-        self.ev.tally = self.opts.progress.clone();
         self.stage = match LmRun::start(&mut self.ev, ls, start) {
             Ok(run) => Stage::Run {
                 run: Box::new(run),
@@ -845,7 +853,7 @@ impl<R: Residuals> Solver<LeastSquares<R>, LmState> for LevenbergMarquardt {
             },
             Err(sol) => self.settle(ls, sol, 0, None),
         };
-        if state.counting_enabled || matches!(self.stage, Stage::Done(_)) {
+        if state.is_counting() || matches!(self.stage, Stage::Done(_)) {
             self.count(problem);
         }
         self.report(state)
@@ -857,33 +865,32 @@ impl<R: Residuals> Solver<LeastSquares<R>, LmState> for LevenbergMarquardt {
         state: LmState,
     ) -> Result<(LmState, Option<KV>), Error> {
         let ls = inner(problem)?;
-        self.stage = match std::mem::take(&mut self.stage) {
-            Stage::Run {
-                mut run,
-                restarts,
-                previous,
-            } => match run.iterate(&mut self.ev, ls, &self.opts) {
-                None => Stage::Run {
+        // The stage is replaced only when it ends.
+        let ended = match &mut self.stage {
+            Stage::Run { run, .. } => run.iterate(&mut self.ev, ls, &self.opts),
+            Stage::Polish { polisher, sol } => {
+                if polisher.step(&mut self.ev, ls, &self.opts, sol) {
+                    None
+                } else {
+                    // Any value: the polish ends with the termination of its solution.
+                    Some(Termination::Interrupted)
+                }
+            }
+            Stage::Done(_) => None,
+            Stage::Idle => return Err(Error::msg("the solver was not initialised")),
+        };
+        if let Some(t) = ended {
+            self.stage = match std::mem::take(&mut self.stage) {
+                Stage::Run {
                     run,
                     restarts,
                     previous,
-                },
-                Some(t) => self.settle(ls, run.into_solution(t), restarts, previous),
-            },
-            Stage::Polish {
-                mut polisher,
-                mut sol,
-            } => {
-                if polisher.step(&mut self.ev, ls, &self.opts, &mut sol) {
-                    Stage::Polish { polisher, sol }
-                } else {
-                    Stage::Done(sol)
-                }
-            }
-            done @ Stage::Done(_) => done,
-            Stage::Idle => return Err(Error::msg("the solver was not initialised")),
-        };
-        if state.counting_enabled || matches!(self.stage, Stage::Done(_)) {
+                } => self.settle(ls, run.into_solution(t), restarts, previous),
+                Stage::Polish { sol, .. } => Stage::Done(sol),
+                other => other,
+            };
+        }
+        if state.is_counting() || matches!(self.stage, Stage::Done(_)) {
             self.count(problem);
         }
         self.report(state)
@@ -926,17 +933,21 @@ fn scaled_norm(d: &[f64], x: &[f64], work: &mut [f64]) -> f64 {
 
 /// Runs [`LevenbergMarquardt`] on `ls` under argmin's `Executor` (argmin's Ctrl-C handling off:
 /// the stop flag of `opts` is the caller's; its timer off: nothing reads the iteration times,
-/// and the profiles' many small fits would pay two clock reads per iteration); returns the
-/// solution, the evaluator (its counts and work space, for the covariance) and the problem.
+/// and the profiles' many small fits would pay two clock reads per iteration), with a
+/// [`ProgressObserver`] over `opts.progress` when there is one; returns the solution, the
+/// evaluator (its counts and work space, for the covariance) and the problem.
 pub(crate) fn solve<R: Residuals>(
     ls: LeastSquares<R>,
     opts: &LsqOptions,
 ) -> Result<(Solution, Evaluator, LeastSquares<R>), Error> {
-    let result = argmin::core::Executor::new(ls, LevenbergMarquardt::new(opts))
+    let mut executor = argmin::core::Executor::new(ls, LevenbergMarquardt::new(opts))
         .ctrlc(false)
-        .timer(false)
-        .run()?;
-    into_parts(result)
+        .timer(false);
+    if let Some(tally) = &opts.progress {
+        executor =
+            executor.add_observer(ProgressObserver::new(tally.clone()), ObserverMode::Always);
+    }
+    into_parts(executor.run()?)
 }
 
 /// The solution, the evaluator and the problem of an executor's result.

@@ -253,9 +253,13 @@ pub struct LsqOptions {
     /// with [`Termination::Interrupted`] (e.g. from a signal handler). Profiles pass it on to
     /// their constrained fits.
     pub stop: Option<Arc<AtomicBool>>,
-    /// Counts every evaluation of the residual vector and of the Jacobian (one each, a
-    /// finite-difference Jacobian by its residual evaluations) as the position of the caller's
-    /// task. Profiles pass it on to their constrained fits.
+    /// Counts the model evaluations of the iterations — every residual vector and every
+    /// analytic Jacobian, one each (a finite-difference Jacobian by its residual evaluations) —
+    /// as the position of the caller's task, through a [`super::ProgressObserver`] that
+    /// [`super::fit`] attaches to its executor (positions move once per iteration; the
+    /// covariance's Jacobian at the end is not counted). Profiles pass it on to their
+    /// constrained fits. The solver itself ignores it: a run built by hand under argmin's
+    /// `Executor` counts by adding the observer.
     pub progress: Option<Tally>,
 }
 

@@ -9,6 +9,11 @@
 //!   problem as argmin's `Operator` + `Jacobian` (residuals) and `CostFunction` + `Gradient`
 //!   (χ²) on nalgebra vectors: [`fit`] runs under argmin's `Executor`, argmin's other solvers
 //!   run on fitbead's problems, and observers, timeouts and iteration limits apply to both;
+//!   the solver's state is [`LmState`] (argmin's `State` with λ, the trust radius, the scaling,
+//!   the active set and the stage for observers), and [`ProgressObserver`] is the observer that
+//!   counts a fit's model evaluations for a progress bar;
+//! * [`ArgminResiduals`] — any argmin problem with residuals and their Jacobian
+//!   (`Operator` + `Jacobian` on nalgebra vectors) fitted by fitbead's solver;
 //! * [`confidence_intervals`] — covariance (Student-t / normal) and profile-likelihood
 //!   intervals;
 //! * [`WeightedData`] — a [`Model`] y = f(x; p) with data (x, y, σ) seen as residuals;
@@ -27,12 +32,14 @@ pub mod lm;
 mod lmpar;
 pub mod lsq;
 pub mod mcmc;
+pub mod observer;
 pub mod posterior;
 pub mod problem;
 pub mod profile;
+pub mod state;
 
 pub use estimate::{fit, fit_result, Covariance, Fit};
-pub use lm::{LevenbergMarquardt, LmState};
+pub use lm::LevenbergMarquardt;
 pub use lsq::{
     Infeasible, LsqError, LsqOptions, Model, Residuals, SigmaKind, Termination, WeightedData,
 };
@@ -40,8 +47,10 @@ pub use mcmc::{
     EnsembleSampler, LogDensity, McmcError, McmcOptions, McmcResult, ParameterDiagnostics,
     StopReason,
 };
-pub use problem::LeastSquares;
+pub use observer::ProgressObserver;
+pub use problem::{ArgminResiduals, LeastSquares};
 pub use profile::{
     confidence_intervals, covariance_intervals, profile_interval, ConfidenceIntervals, Interval,
     ProfileEnd, ProfileInterval, DEFAULT_LEVEL,
 };
+pub use state::{LmStage, LmState};

@@ -10,9 +10,8 @@
 //! [`CostFunction::cost`], so that derivative-free solvers step back from them; the
 //! Levenberg–Marquardt solver never sees them as errors (they are rejected steps).
 
-use crate::progress::Tally;
 use argmin::core::{CostFunction, Error, Gradient, Jacobian, Operator};
-use faer::Mat;
+use faer::{Mat, MatMut};
 use nalgebra::{DMatrix, DVector};
 
 use super::lmpar::norm2;
@@ -166,6 +165,112 @@ impl<R: Residuals> Gradient for LeastSquares<R> {
     }
 }
 
+/// Any argmin problem giving residuals ([`Operator`] from `DVector<f64>` to `DVector<f64>`)
+/// and their Jacobian ([`Jacobian`], a `DMatrix<f64>`) seen as fitbead's [`Residuals`], so
+/// that fitbead's bounded Levenberg–Marquardt ([`super::fit`]) fits it. An error of either
+/// method, a result of the wrong shape, or a non-finite entry is an [`Infeasible`] point (a
+/// rejected step).
+///
+/// ```
+/// use argmin::core::{Error, Jacobian, Operator};
+/// use fitbead::inverse::{fit, ArgminResiduals, LsqOptions};
+/// use nalgebra::{DMatrix, DVector};
+/// /// r_i = y_i − a e^(−b x_i) at x = 0, 1, …, 7.
+/// struct Decay(Vec<f64>);
+/// impl Operator for Decay {
+///     type Param = DVector<f64>;
+///     type Output = DVector<f64>;
+///     fn apply(&self, p: &DVector<f64>) -> Result<DVector<f64>, Error> {
+///         Ok(DVector::from_fn(self.0.len(), |i, _| self.0[i] - p[0] * (-p[1] * i as f64).exp()))
+///     }
+/// }
+/// impl Jacobian for Decay {
+///     type Param = DVector<f64>;
+///     type Jacobian = DMatrix<f64>;
+///     fn jacobian(&self, p: &DVector<f64>) -> Result<DMatrix<f64>, Error> {
+///         Ok(DMatrix::from_fn(self.0.len(), 2, |i, j| {
+///             let (x, e) = (i as f64, (-p[1] * i as f64).exp());
+///             if j == 0 { -e } else { p[0] * x * e }
+///         }))
+///     }
+/// }
+/// let y = (0..8).map(|i| 2.0 * (-0.3 * i as f64).exp()).collect();
+/// let f = fit(&ArgminResiduals::new(Decay(y), 2, 8), &[1.0, 1.0], &LsqOptions::default())
+///     .unwrap();
+/// assert!((f.params[0] - 2.0).abs() < 1e-12 && (f.params[1] - 0.3).abs() < 1e-12);
+/// ```
+#[derive(Debug, Clone)]
+pub struct ArgminResiduals<P> {
+    problem: P,
+    n_params: usize,
+    n_residuals: usize,
+}
+
+impl<P> ArgminResiduals<P> {
+    /// `problem`, of `n_params` parameters and `n_residuals` residuals.
+    pub fn new(problem: P, n_params: usize, n_residuals: usize) -> Self {
+        ArgminResiduals {
+            problem,
+            n_params,
+            n_residuals,
+        }
+    }
+
+    /// The argmin problem.
+    pub fn inner(&self) -> &P {
+        &self.problem
+    }
+
+    /// The argmin problem, given back.
+    pub fn into_inner(self) -> P {
+        self.problem
+    }
+}
+
+impl<P> Residuals for ArgminResiduals<P>
+where
+    P: Operator<Param = DVector<f64>, Output = DVector<f64>>
+        + Jacobian<Param = DVector<f64>, Jacobian = DMatrix<f64>>,
+{
+    fn n_params(&self) -> usize {
+        self.n_params
+    }
+
+    fn n_residuals(&self) -> usize {
+        self.n_residuals
+    }
+
+    /// [`Operator::apply`] at `p`.
+    fn residuals(&self, p: &[f64], out: &mut [f64]) -> Result<(), Infeasible> {
+        let r = self
+            .problem
+            .apply(&DVector::from_column_slice(p))
+            .map_err(|_| Infeasible)?;
+        if r.len() != out.len() {
+            return Err(Infeasible);
+        }
+        out.copy_from_slice(r.as_slice());
+        Ok(())
+    }
+
+    /// [`Jacobian::jacobian`] at `p`.
+    fn jacobian(&self, p: &[f64], mut out: MatMut<'_, f64>) -> Option<Result<(), Infeasible>> {
+        let jac = match self.problem.jacobian(&DVector::from_column_slice(p)) {
+            Ok(j) => j,
+            Err(_) => return Some(Err(Infeasible)),
+        };
+        if jac.nrows() != out.nrows() || jac.ncols() != out.ncols() {
+            return Some(Err(Infeasible));
+        }
+        for j in 0..jac.ncols() {
+            for i in 0..jac.nrows() {
+                out[(i, j)] = jac[(i, j)];
+            }
+        }
+        Some(Ok(()))
+    }
+}
+
 /// Residual and Jacobian evaluation with counting, finiteness checks and finite differences
 /// (central, h = ε^{1/3}·max(|p|, typical); second-order one-sided next to a bound or an
 /// infeasible point). It owns its work space and counts; the problem is passed to each call.
@@ -175,10 +280,10 @@ pub(crate) struct Evaluator {
     pub n: usize,
     pub nfev: usize,
     pub njev: usize,
+    /// Analytic Jacobian evaluations (of `njev`).
+    pub analytic: usize,
     /// Whether the last Jacobian came by finite differences.
     pub differenced: bool,
-    /// Where each residual and analytic Jacobian evaluation is counted, if anywhere.
-    pub tally: Option<Tally>,
     work: Vec<f64>,
     work2: Vec<f64>,
     xp: Vec<f64>,
@@ -191,8 +296,8 @@ impl Evaluator {
             n,
             nfev: 0,
             njev: 0,
+            analytic: 0,
             differenced: false,
-            tally: None,
             work: vec![0.0; m],
             work2: vec![0.0; m],
             xp: vec![0.0; n],
@@ -207,9 +312,6 @@ impl Evaluator {
         out: &mut [f64],
     ) -> bool {
         self.nfev += 1;
-        if let Some(t) = &self.tally {
-            t.add(1);
-        }
         match ls.problem.residuals(x, out) {
             Ok(()) => out.iter().all(|v| v.is_finite()),
             Err(Infeasible) => false,
@@ -227,8 +329,8 @@ impl Evaluator {
         self.njev += 1;
         self.differenced = false;
         let analytic = ls.problem.jacobian(x, jac.as_mut());
-        if let (Some(_), Some(t)) = (&analytic, &self.tally) {
-            t.add(1);
+        if analytic.is_some() {
+            self.analytic += 1;
         }
         match analytic {
             Some(Ok(())) => {

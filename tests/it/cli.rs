@@ -769,3 +769,44 @@ fn jan_and_jaeger_draw_their_progress_bar_on_a_terminal_only() {
         );
     }
 }
+
+/// `klaw`'s least-squares fit shows the same bar (its model evaluations, counted by the
+/// library's progress observer on the fit's iterations) on a terminal only, as
+/// `jan_and_jaeger_draw_their_progress_bar_on_a_terminal_only` checks for those.
+#[test]
+fn klaw_draws_its_progress_bar_on_a_terminal_only() {
+    let d = tmpdir();
+    let o = d.path().join("o.csv");
+    let out = bin()
+        .args(["klaw", "--model", "stick", "--no-profile", "--output"])
+        .arg(&o)
+        .env("FITBEAD_PROGRESS_DELAY_MS", "0")
+        .output()
+        .unwrap();
+    let err = crate::common::stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        !err.contains("model evaluations") && !err.contains('\r'),
+        "a bar on a piped stderr: {err:?}"
+    );
+    let exe = std::env::var("FITBEAD_BIN").unwrap_or(env!("CARGO_BIN_EXE_fitbead").into());
+    let shell = format!(
+        "'{exe}' klaw --model stick --no-profile --output '{}'",
+        o.display()
+    );
+    let Ok(pty) = std::process::Command::new("script")
+        .args(["-qec", &shell, "/dev/null"])
+        .env("FITBEAD_PROGRESS_DELAY_MS", "0")
+        .stdin(std::process::Stdio::null())
+        .output()
+    else {
+        eprintln!("no `script` here: the terminal side of klaw's bar is not checked");
+        return;
+    };
+    let shown = String::from_utf8_lossy(&pty.stdout);
+    assert!(pty.status.success(), "klaw under script: {shown}");
+    assert!(
+        shown.contains("klaw-c") && shown.contains("model evaluations"),
+        "no bar on a terminal: {shown:?}"
+    );
+}

@@ -547,6 +547,7 @@ def main():
     limit = int(sys.argv[3]) if len(sys.argv) > 3 else None
     t0 = time.perf_counter()
     n = 0
+    failed = 0
     w = csv.writer(sys.stdout, lineterminator="\n")
     w.writerow(COLUMNS)
     num = lambda x: "" if x is None else repr(float(x))
@@ -555,15 +556,22 @@ def main():
             if limit is not None and n >= limit:
                 break
             xi, d, v, sg, rho, f = measurement(r)
-            k, k_lo, k_hi, dv, status, br = row(model, Scene(xi, d, rho, f), v, sg)
+            try:
+                k, k_lo, k_hi, dv, status, br = row(model, Scene(xi, d, rho, f), v, sg)
+            except RuntimeError:
+                # scipy's brentq gave up (100 iterations) on this row: counted, written as
+                # invalid, the run goes on.
+                k = k_lo = k_hi = dv = br = None
+                status = "invalid"
+                failed += 1
             ends = ["", "", "", ""] if br is None else [num(br[0]), num(br[1]), br[4], br[5]]
             w.writerow([(r.get("series") or "").strip(), repr(xi), repr(d), repr(v), num(sg),
                         model, num(k), num(k_lo), num(k_hi), num(dv), REGIME[status], status]
                        + ends)
             n += 1
     dt = time.perf_counter() - t0
-    print(f"{model}: {n} rows in {dt:.3f} s: {1e6 * dt / max(n, 1):.1f} us per row",
-          file=sys.stderr)
+    print(f"{model}: {n} rows in {dt:.3f} s: {1e6 * dt / max(n, 1):.1f} us per row"
+          f" ({failed} rows where scipy's brentq did not converge)", file=sys.stderr)
 
 
 if __name__ == "__main__":

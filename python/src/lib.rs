@@ -9,7 +9,7 @@
 
 use fitbead::fit::builder::{JaegerFitter, JanFitter, KLawFitter};
 use fitbead::fit::data::Dataset as RsDataset;
-use fitbead::fit::k::{estimate, KFailure, LowerLimit, UpperLimit};
+use fitbead::fit::k::estimate;
 use fitbead::fit::klaw::KLaw;
 use fitbead::fit::report::FitSet;
 use fitbead::fit::summary::FitResult as RsFitResult;
@@ -588,21 +588,6 @@ const K_NUMS: [&str; 11] = [
 const K_NUMS2: [&str; 1] = ["K_max"];
 const K_TEXTS: [&str; 5] = ["regime", "status", "lower_limit", "upper_limit", "message"];
 
-fn lower_name(l: LowerLimit) -> &'static str {
-    match l {
-        LowerLimit::Crawl => "crawl-over-top",
-        LowerLimit::Zero => "K=0",
-        LowerLimit::Model => "model-limit",
-    }
-}
-
-fn upper_name(u: UpperLimit) -> &'static str {
-    match u {
-        UpperLimit::LiftOff => "lift-off",
-        UpperLimit::Model => "model-limit",
-    }
-}
-
 /// The model of `k`'s `--model` (the five contact models, contact, or auto).
 fn k_model(name: &str, tol: f64) -> PyResult<(Model, Option<Auto>)> {
     if name == "auto" {
@@ -713,19 +698,14 @@ fn k_row(model: &Model, auto: Option<&Auto>, scene: &Scene, vi: f64, sigma: Opti
     nums[8] = CollisionLaw::Impact.k(alpha, rho);
     nums[9] = opt(root.map(|r| r.evals as f64));
     let mut texts: [Cow<'static, str>; 7] = Default::default();
-    let (regime, status) = match &e.root {
-        Ok(_) => ("B", "ok"),
-        Err(KFailure::BelowRange) => ("A", "below-range"),
-        Err(KFailure::AboveRange) => ("C", "above-range"),
-        Err(KFailure::Invalid(_)) => ("", "invalid"),
-    };
+    let (regime, status) = e.regime_status();
     texts[0] = Cow::Borrowed(regime);
     texts[1] = Cow::Borrowed(status);
     if let Some(b) = &e.bracket {
         nums[10] = b.lo;
         nums[11] = b.hi;
-        texts[2] = Cow::Borrowed(lower_name(b.lower));
-        texts[3] = Cow::Borrowed(upper_name(b.upper));
+        texts[2] = Cow::Borrowed(b.lower.name());
+        texts[3] = Cow::Borrowed(b.upper.name());
     }
     let mut message: Vec<String> = Vec::new();
     if let Err(fail) = &e.root {

@@ -14,7 +14,7 @@ use super::scenes::{Header, Row};
 use super::stream::RowPlan;
 use super::InputError;
 use crate::fit::k::auto::{self as kauto, KChoice};
-use crate::fit::k::{estimate, KEstimate, KFailure, LowerLimit, UpperLimit};
+use crate::fit::k::{estimate, KEstimate};
 use crate::models::auto::Auto;
 use crate::models::Model;
 use crate::numfmt::{fmt_f64, push_f64};
@@ -227,21 +227,6 @@ impl KPlan {
     }
 }
 
-fn lower_name(l: LowerLimit) -> &'static str {
-    match l {
-        LowerLimit::Crawl => "crawl-over-top",
-        LowerLimit::Zero => "K=0",
-        LowerLimit::Model => "model-limit",
-    }
-}
-
-fn upper_name(u: UpperLimit) -> &'static str {
-    match u {
-        UpperLimit::LiftOff => "lift-off",
-        UpperLimit::Model => "model-limit",
-    }
-}
-
 impl RowPlan for KPlan {
     type Ready = Measured;
     type Ledger = KLedger;
@@ -289,12 +274,7 @@ impl RowPlan for KPlan {
         w.opt(root.map(|r| r.steady.final_velocity));
         w.opt(e.theta_g.map(f64::to_degrees));
         w.raw(&cache.laws);
-        let (regime, status) = match &e.root {
-            Ok(_) => ("B", "ok"),
-            Err(KFailure::BelowRange) => ("A", "below-range"),
-            Err(KFailure::AboveRange) => ("C", "above-range"),
-            Err(KFailure::Invalid(_)) => ("", "invalid"),
-        };
+        let (regime, status) = e.regime_status();
         w.text(regime);
         w.text(status);
         match root {
@@ -305,8 +285,8 @@ impl RowPlan for KPlan {
             Some(b) => {
                 w.num(b.lo);
                 w.num(b.hi);
-                w.text(lower_name(b.lower));
-                w.text(upper_name(b.upper));
+                w.text(b.lower.name());
+                w.text(b.upper.name());
             }
             None => {
                 for _ in 0..4 {

@@ -15,6 +15,17 @@ pub enum LowerLimit {
     Model,
 }
 
+impl LowerLimit {
+    /// The name in the `k` command's `lower_limit` column.
+    pub fn name(self) -> &'static str {
+        match self {
+            LowerLimit::Crawl => "crawl-over-top",
+            LowerLimit::Zero => "K=0",
+            LowerLimit::Model => "model-limit",
+        }
+    }
+}
+
 /// What sets the upper end of the K bracket.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum UpperLimit {
@@ -23,6 +34,16 @@ pub enum UpperLimit {
     /// The model stops having a steady state before lift-off (found by bisection on its
     /// status): runaway of the stick/slip map, or an approximate model's validity limit.
     Model,
+}
+
+impl UpperLimit {
+    /// The name in the `k` command's `upper_limit` column.
+    pub fn name(self) -> &'static str {
+        match self {
+            UpperLimit::LiftOff => "lift-off",
+            UpperLimit::Model => "model-limit",
+        }
+    }
 }
 
 /// The range of K over which a model has a steady state at one (ξ, δ, ρ, f).
@@ -71,6 +92,17 @@ impl KFailure {
 }
 
 impl KEstimate {
+    /// The `k` command's regime and status words: `B`/`ok` with a K, `A`/`below-range`,
+    /// `C`/`above-range`, and no regime for `invalid`.
+    pub fn regime_status(&self) -> (&'static str, &'static str) {
+        match &self.root {
+            Ok(_) => ("B", "ok"),
+            Err(KFailure::BelowRange) => ("A", "below-range"),
+            Err(KFailure::AboveRange) => ("C", "above-range"),
+            Err(KFailure::Invalid(_)) => ("", "invalid"),
+        }
+    }
+
     /// K at the measured v̄, or why there is none.
     pub fn k(&self) -> Result<f64, KFailure> {
         self.root.as_ref().map(|r| r.k).map_err(Clone::clone)

@@ -570,10 +570,12 @@ class FitSet(list):
         super().__init__(fits)
         self.notes: List[str] = list(notes)
 
-    def get(self, name: str, series: str = "") -> Optional[FitResult]:
-        """The fit named ``name`` for ``series`` (empty for a global fit)."""
+    def get(self, name: str, series: Optional[str] = None) -> Optional[FitResult]:
+        """The fit named ``name`` (``jan-series``, ``jan-global``, ``jaeger``) for ``series``
+        (a series label; ``all`` for a global fit), or the first fit of that name when
+        ``series`` is None."""
         for fr in self:
-            if fr.name == name and fr.series == series:
+            if fr.name == name and (series is None or fr.series == series):
                 return fr
         return None
 

@@ -42,6 +42,8 @@ def test_jan_and_jaeger_reports_equal_cli(cli, data):
     assert len(jan) == 5
     for fr in jan:
         assert str(fr) in report
+    assert jan.get("jan-global") is jan[-1] and jan.get("jan-series", "1.6") is jan[2]
+    assert jan.get("jan-series", "9") is None
     jae = fitbead.fit_jaeger(data)
     _, report, _ = cli("jaeger", "--input", DEFAULT_DATA)
     assert len(jae) == 4

@@ -712,6 +712,8 @@ struct Nd {
     mu_c: f64,
     sin_d: f64,
     cos_d: f64,
+    /// Gravity per unit m g along (downslope, normal): (sin δ, −cos δ).
+    gravity: Vector2<f64>,
     static_overlap: f64,
     tc: f64,
     dt: f64,
@@ -770,6 +772,7 @@ impl Nd {
             mu_c: p.coulomb.unwrap_or(f64::INFINITY),
             sin_d: scene.sc_delta.s,
             cos_d: scene.sc_delta.c,
+            gravity: Vector2::new(scene.sc_delta.s, -scene.sc_delta.c),
             static_overlap,
             tc,
             dt: dt * dt_scale,
@@ -790,7 +793,7 @@ impl Nd {
     #[inline(always)]
     fn eval(&self, cell: i64, pos: Vector2<f64>, v: Vector2<f64>, w: f64) -> Eval {
         let mut e = Eval {
-            a: Vector2::new(self.sin_d, -self.cos_d),
+            a: self.gravity,
             aw: 0.0,
             p_n: 0.0,
             p_t: 0.0,

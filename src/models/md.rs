@@ -792,17 +792,21 @@ impl Nd {
     /// state; the contacts found (absolute row indices, ascending).
     #[inline(always)]
     fn eval(&self, cell: i64, pos: Vector2<f64>, v: Vector2<f64>, w: f64) -> Eval {
-        let mut e = Eval {
-            a: self.gravity,
-            aw: 0.0,
-            p_n: 0.0,
-            p_t: 0.0,
-            u_el: 0.0,
-            n: 0,
-            idx: [0; MAXC],
-        };
+        // Accumulated in locals, the result built once at the end.
+        let mut acc = self.gravity;
+        let (mut aw, mut p_n, mut p_t, mut u_el) = (0.0, 0.0, 0.0, 0.0);
+        let mut found = 0;
+        let mut idx = [0; MAXC];
         if pos.y >= 1.0 {
-            return e;
+            return Eval {
+                a: acc,
+                aw,
+                p_n,
+                p_t,
+                u_el,
+                n: found,
+                idx,
+            };
         }
         let lo = ((pos.x - 1.0) / self.s).ceil() as i64;
         let hi = ((pos.x + 1.0) / self.s).floor() as i64;
@@ -830,17 +834,25 @@ impl Nd {
             if ft.abs() > cap {
                 ft = cap.copysign(ft);
             }
-            e.a += n * fnn + t * ft;
-            e.aw -= ft * self.inv_inertia_r;
-            e.p_n += (fnn - fe) * vapp;
-            e.p_t -= ft * slip;
-            e.u_el += fe * ov / (self.beta + 1.0);
-            if e.n < MAXC {
-                e.idx[e.n] = cell + k;
-                e.n += 1;
+            acc += n * fnn + t * ft;
+            aw -= ft * self.inv_inertia_r;
+            p_n += (fnn - fe) * vapp;
+            p_t -= ft * slip;
+            u_el += fe * ov / (self.beta + 1.0);
+            if found < MAXC {
+                idx[found] = cell + k;
+                found += 1;
             }
         }
-        e
+        Eval {
+            a: acc,
+            aw,
+            p_n,
+            p_t,
+            u_el,
+            n: found,
+            idx,
+        }
     }
 }
 

@@ -712,6 +712,8 @@ struct Nd {
     mu_c: f64,
     sin_d: f64,
     cos_d: f64,
+    /// Gravity per unit m g along (downslope, normal): (sin δ, −cos δ).
+    gravity: Vector2<f64>,
     static_overlap: f64,
     tc: f64,
     dt: f64,
@@ -770,6 +772,7 @@ impl Nd {
             mu_c: p.coulomb.unwrap_or(f64::INFINITY),
             sin_d: scene.sc_delta.s,
             cos_d: scene.sc_delta.c,
+            gravity: Vector2::new(scene.sc_delta.s, -scene.sc_delta.c),
             static_overlap,
             tc,
             dt: dt * dt_scale,
@@ -789,17 +792,21 @@ impl Nd {
     /// state; the contacts found (absolute row indices, ascending).
     #[inline(always)]
     fn eval(&self, cell: i64, pos: Vector2<f64>, v: Vector2<f64>, w: f64) -> Eval {
-        let mut e = Eval {
-            a: Vector2::new(self.sin_d, -self.cos_d),
-            aw: 0.0,
-            p_n: 0.0,
-            p_t: 0.0,
-            u_el: 0.0,
-            n: 0,
-            idx: [0; MAXC],
-        };
+        // Accumulated in locals, the result built once at the end.
+        let mut acc = self.gravity;
+        let (mut aw, mut p_n, mut p_t, mut u_el) = (0.0, 0.0, 0.0, 0.0);
+        let mut found = 0;
+        let mut idx = [0; MAXC];
         if pos.y >= 1.0 {
-            return e;
+            return Eval {
+                a: acc,
+                aw,
+                p_n,
+                p_t,
+                u_el,
+                n: found,
+                idx,
+            };
         }
         let lo = ((pos.x - 1.0) / self.s).ceil() as i64;
         let hi = ((pos.x + 1.0) / self.s).floor() as i64;
@@ -827,17 +834,25 @@ impl Nd {
             if ft.abs() > cap {
                 ft = cap.copysign(ft);
             }
-            e.a += n * fnn + t * ft;
-            e.aw -= ft * self.inv_inertia_r;
-            e.p_n += (fnn - fe) * vapp;
-            e.p_t -= ft * slip;
-            e.u_el += fe * ov / (self.beta + 1.0);
-            if e.n < MAXC {
-                e.idx[e.n] = cell + k;
-                e.n += 1;
+            acc += n * fnn + t * ft;
+            aw -= ft * self.inv_inertia_r;
+            p_n += (fnn - fe) * vapp;
+            p_t -= ft * slip;
+            u_el += fe * ov / (self.beta + 1.0);
+            if found < MAXC {
+                idx[found] = cell + k;
+                found += 1;
             }
         }
-        e
+        Eval {
+            a: acc,
+            aw,
+            p_n,
+            p_t,
+            u_el,
+            n: found,
+            idx,
+        }
     }
 }
 

@@ -381,6 +381,10 @@ pub fn run(a: Args) -> Result<(), CliError> {
     }
     files.push(("report.md".into(), md.into_bytes()));
     let files = format.apply(files).map_err(CliError::Other)?;
+    // A stop that came while the tables and figures were drawn: nothing is written.
+    if super::stop_requested() && !interrupted {
+        return Err(CliError::Interrupted);
+    }
     let created = create_dirs(&out_dir)
         .map_err(|e| CliError::Other(format!("{}: cannot create: {e}", out_dir.display())))?;
     let paths: Vec<PathBuf> = files.iter().map(|f| out_dir.join(&f.0)).collect();

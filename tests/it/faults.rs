@@ -279,7 +279,8 @@ fn signals_stop_every_long_command() {
         (
             "-INT",
             vec![
-                "simulate", "--model", "md", "--series", "1", "--points", "3", "--output", "o.csv",
+                "simulate", "--model", "md", "--series", "1,0.8", "--points", "12", "--output",
+                "o.csv",
             ],
         ),
         ("-TERM", vec!["report", "big.csv", "--out-dir", "."]),

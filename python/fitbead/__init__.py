@@ -608,9 +608,11 @@ _METHOD_DOC = """
         result's value is the posterior median, ``draws`` the kept draws).
     level:
         Confidence level of the intervals, in (0, 1).
-    seed, walkers, max_steps:
+    seed, walkers, max_steps, min_ess:
         MCMC: the seed (the same draws on any machine and thread count), the walkers
-        (default: the library's choice) and the step limit.
+        (default: the library's choice), the step limit, and the bulk and tail ESS every
+        parameter must reach (with rank-normalised split-R̂ ≤ 1.01) before the run stops
+        (default 1000).
 
     Ctrl-C (``KeyboardInterrupt``) stops an MCMC run cleanly and raises.
 """
@@ -627,6 +629,7 @@ def fit_klaw(
     seed: int = 1,
     walkers: Optional[int] = None,
     max_steps: Optional[int] = None,
+    min_ess: Optional[float] = None,
 ) -> FitResult:
     """A law K(α) fitted to every series at once (``fitbead klaw``).
 
@@ -641,7 +644,7 @@ def fit_klaw(
     """
     d = _dataset(data)
     return FitResult(
-        _core.fit_klaw(d._core, model=model, law=law, method=method, level=level, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps)
+        _core.fit_klaw(d._core, model=model, law=law, method=method, level=level, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps, min_ess=min_ess)
     )
 
 
@@ -657,11 +660,12 @@ def fit_jan(
     seed: int = 1,
     walkers: Optional[int] = None,
     max_steps: Optional[int] = None,
+    min_ess: Optional[float] = None,
 ) -> FitSet:
     """Jan's energy balance (eq 74): λ and μ per series (at least 3 points), then the global
     laws of eqs 75–76 (``fitbead jan``)."""
     d = _dataset(data)
-    fits, notes = _core.fit_jan(d._core, method=method, level=level, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps)
+    fits, notes = _core.fit_jan(d._core, method=method, level=level, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps, min_ess=min_ess)
     return FitSet([FitResult(x) for x in fits], notes)
 
 
@@ -678,12 +682,14 @@ def fit_jaeger(
     seed: int = 1,
     walkers: Optional[int] = None,
     max_steps: Optional[int] = None,
+    min_ess: Optional[float] = None,
 ) -> FitSet:
     """Jaeger's heuristic law (eqs 80–84): a1, a2, a3 per series with at least 4 points, on
     the ``upper`` or ``lower`` root of eq 84 (``fitbead jaeger``)."""
     d = _dataset(data)
     fits, notes = _core.fit_jaeger(
-        d._core, branch=branch, method=method, level=level, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps
+        d._core, branch=branch, method=method, level=level, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps,
+        min_ess=min_ess,
     )
     return FitSet([FitResult(x) for x in fits], notes)
 

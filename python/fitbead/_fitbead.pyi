@@ -71,6 +71,7 @@ def fit_klaw(
     seed: int = 1,
     walkers: Optional[int] = None,
     max_steps: Optional[int] = None,
+    min_ess: Optional[float] = None,
     tol: float = 1e-10,
 ) -> _FitResult: ...
 def fit_jan(
@@ -81,6 +82,7 @@ def fit_jan(
     seed: int = 1,
     walkers: Optional[int] = None,
     max_steps: Optional[int] = None,
+    min_ess: Optional[float] = None,
 ) -> Tuple[List[_FitResult], List[str]]: ...
 def fit_jaeger(
     data: _Dataset,
@@ -91,4 +93,5 @@ def fit_jaeger(
     seed: int = 1,
     walkers: Optional[int] = None,
     max_steps: Optional[int] = None,
+    min_ess: Optional[float] = None,
 ) -> Tuple[List[_FitResult], List[str]]: ...

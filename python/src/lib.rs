@@ -1109,6 +1109,7 @@ fn method_args(
     seed: u64,
     walkers: Option<usize>,
     max_steps: Option<usize>,
+    min_ess: Option<f64>,
 ) -> PyResult<MethodArgs> {
     let stop = Arc::new(AtomicBool::new(false));
     let mcmc = match method {
@@ -1120,6 +1121,15 @@ fn method_args(
             }
             if let Some(m) = max_steps {
                 s.options.max_steps = m;
+            }
+            if let Some(e) = min_ess {
+                if !(e > 0.0 && e.is_finite()) {
+                    return Err(value_error(format!(
+                        "min_ess = {}: expected a finite number > 0",
+                        show(e)
+                    )));
+                }
+                s.options.min_ess = e;
             }
             s.options.stop = Some(stop.clone());
             Some(s)
@@ -1192,7 +1202,7 @@ fn fit_error(e: fitbead::fit::error::FitError) -> PyErr {
 
 /// A K(α) law fitted across series (see the Python `fitbead.fit_klaw`).
 #[pyfunction]
-#[pyo3(signature = (data, model="stickslip", law="c", method="lsq", level=0.95, profile=true, seed=1, walkers=None, max_steps=None, tol=1e-10))]
+#[pyo3(signature = (data, model="stickslip", law="c", method="lsq", level=0.95, profile=true, seed=1, walkers=None, max_steps=None, min_ess=None, tol=1e-10))]
 #[allow(clippy::too_many_arguments)]
 fn fit_klaw(
     py: Python<'_>,
@@ -1205,6 +1215,7 @@ fn fit_klaw(
     seed: u64,
     walkers: Option<usize>,
     max_steps: Option<usize>,
+    min_ess: Option<f64>,
     tol: f64,
 ) -> PyResult<PyFitResult> {
     let (m, auto) = k_model(model, tol)?;
@@ -1216,7 +1227,7 @@ fn fit_klaw(
     let l: KLaw = law
         .parse()
         .map_err(|e: String| value_error(format!("law = '{law}': {e}")))?;
-    let a = method_args(method, level, profile, seed, walkers, max_steps)?;
+    let a = method_args(method, level, profile, seed, walkers, max_steps, min_ess)?;
     let mut fitter = KLawFitter::new(m, l).level(a.level);
     fitter = match a.mcmc {
         Some(s) => fitter.mcmc(s),
@@ -1229,7 +1240,7 @@ fn fit_klaw(
 
 /// Jan's λ and μ per series and the global laws (see the Python `fitbead.fit_jan`).
 #[pyfunction]
-#[pyo3(signature = (data, method="lsq", level=0.95, profile=true, seed=1, walkers=None, max_steps=None))]
+#[pyo3(signature = (data, method="lsq", level=0.95, profile=true, seed=1, walkers=None, max_steps=None, min_ess=None))]
 #[allow(clippy::too_many_arguments)]
 fn fit_jan(
     py: Python<'_>,
@@ -1240,8 +1251,9 @@ fn fit_jan(
     seed: u64,
     walkers: Option<usize>,
     max_steps: Option<usize>,
+    min_ess: Option<f64>,
 ) -> PyResult<(Vec<PyFitResult>, Vec<String>)> {
-    let a = method_args(method, level, profile, seed, walkers, max_steps)?;
+    let a = method_args(method, level, profile, seed, walkers, max_steps, min_ess)?;
     let mut fitter = JanFitter::new().level(a.level);
     fitter = match a.mcmc {
         Some(s) => fitter.mcmc(s),
@@ -1254,7 +1266,7 @@ fn fit_jan(
 
 /// Jaeger's a1–a3 per series (see the Python `fitbead.fit_jaeger`).
 #[pyfunction]
-#[pyo3(signature = (data, branch="upper", method="lsq", level=0.95, profile=true, seed=1, walkers=None, max_steps=None))]
+#[pyo3(signature = (data, branch="upper", method="lsq", level=0.95, profile=true, seed=1, walkers=None, max_steps=None, min_ess=None))]
 #[allow(clippy::too_many_arguments)]
 fn fit_jaeger(
     py: Python<'_>,
@@ -1266,11 +1278,12 @@ fn fit_jaeger(
     seed: u64,
     walkers: Option<usize>,
     max_steps: Option<usize>,
+    min_ess: Option<f64>,
 ) -> PyResult<(Vec<PyFitResult>, Vec<String>)> {
     let b: JaegerBranch = branch
         .parse()
         .map_err(|e: String| value_error(format!("branch = '{branch}': {e}")))?;
-    let a = method_args(method, level, profile, seed, walkers, max_steps)?;
+    let a = method_args(method, level, profile, seed, walkers, max_steps, min_ess)?;
     let mut fitter = JaegerFitter::new().branch(b).level(a.level);
     fitter = match a.mcmc {
         Some(s) => fitter.mcmc(s),

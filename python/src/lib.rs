@@ -1196,6 +1196,20 @@ fn interruptible<T: Send>(
     })
 }
 
+/// Sets the level and the method of the [`MethodArgs`] `a` on one of the library's fit
+/// builders (they share these setters) and fits `data` without the GIL, interruptibly.
+macro_rules! run_fit {
+    ($py:expr, $data:expr, $a:expr, $builder:expr) => {{
+        let fitter = $builder.level($a.level);
+        let fitter = match $a.mcmc {
+            Some(s) => fitter.mcmc(s),
+            None => fitter.least_squares($a.profile),
+        };
+        let ds = &$data.inner;
+        interruptible($py, &$a.stop, || fitter.fit(ds))?
+    }};
+}
+
 fn fit_error(e: fitbead::fit::error::FitError) -> PyErr {
     value_error(e.to_string())
 }
@@ -1228,13 +1242,7 @@ fn fit_klaw(
         .parse()
         .map_err(|e: String| value_error(format!("law = '{law}': {e}")))?;
     let a = method_args(method, level, profile, seed, walkers, max_steps, min_ess)?;
-    let mut fitter = KLawFitter::new(m, l).level(a.level);
-    fitter = match a.mcmc {
-        Some(s) => fitter.mcmc(s),
-        None => fitter.least_squares(a.profile),
-    };
-    let ds = &data.inner;
-    let r = interruptible(py, &a.stop, || fitter.fit(ds))?;
+    let r = run_fit!(py, data, a, KLawFitter::new(m, l));
     r.map(|inner| PyFitResult { inner }).map_err(fit_error)
 }
 
@@ -1254,13 +1262,7 @@ fn fit_jan(
     min_ess: Option<f64>,
 ) -> PyResult<(Vec<PyFitResult>, Vec<String>)> {
     let a = method_args(method, level, profile, seed, walkers, max_steps, min_ess)?;
-    let mut fitter = JanFitter::new().level(a.level);
-    fitter = match a.mcmc {
-        Some(s) => fitter.mcmc(s),
-        None => fitter.least_squares(a.profile),
-    };
-    let ds = &data.inner;
-    let r = interruptible(py, &a.stop, || fitter.fit(ds))?;
+    let r = run_fit!(py, data, a, JanFitter::new());
     r.map(fit_set).map_err(fit_error)
 }
 
@@ -1284,13 +1286,7 @@ fn fit_jaeger(
         .parse()
         .map_err(|e: String| value_error(format!("branch = '{branch}': {e}")))?;
     let a = method_args(method, level, profile, seed, walkers, max_steps, min_ess)?;
-    let mut fitter = JaegerFitter::new().branch(b).level(a.level);
-    fitter = match a.mcmc {
-        Some(s) => fitter.mcmc(s),
-        None => fitter.least_squares(a.profile),
-    };
-    let ds = &data.inner;
-    let r = interruptible(py, &a.stop, || fitter.fit(ds))?;
+    let r = run_fit!(py, data, a, JaegerFitter::new().branch(b));
     r.map(fit_set).map_err(fit_error)
 }
 

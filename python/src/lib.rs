@@ -9,7 +9,7 @@
 
 use fitbead::fit::builder::{JaegerFitter, JanFitter, KLawFitter};
 use fitbead::fit::data::Dataset as RsDataset;
-use fitbead::fit::k::estimate;
+use fitbead::fit::k::auto::estimate_with;
 use fitbead::fit::klaw::KLaw;
 use fitbead::fit::report::FitSet;
 use fitbead::fit::summary::FitResult as RsFitResult;
@@ -648,24 +648,7 @@ fn invert_k<'py>(
     let r = py.detach(|| {
         fill(n, &mut cols, |i| -> Result<KRow, String> {
             let scene = scene_of(i, xi_s, d_s, rho_s, f_s, CollisionLaw::Value(0.5))?;
-            let vi = v_s[i];
-            if !(vi > 0.0 && vi.is_finite()) {
-                return Err(format!(
-                    "v[{i}] = {}: must be a finite number > 0",
-                    show(vi)
-                ));
-            }
-            let si = s_s[i];
-            let sigma = if si.is_nan() {
-                None
-            } else if si > 0.0 && si.is_finite() {
-                Some(si)
-            } else {
-                return Err(format!(
-                    "sigma_v[{i}] = {}: must be a finite number > 0 (NaN for none)",
-                    show(si)
-                ));
-            };
+            let (vi, sigma) = measured(i, v_s, s_s)?;
             Ok(k_row(&model, auto.as_ref(), &scene, vi, sigma))
         })
     });
@@ -673,17 +656,34 @@ fn invert_k<'py>(
     cols.into_dict(py)
 }
 
+/// Row `i`'s measured v (finite, > 0) and σ (finite, > 0; NaN for none).
+fn measured(i: usize, v: &[f64], sigma_v: &[f64]) -> Result<(f64, Option<f64>), String> {
+    let vi = v[i];
+    if !(vi > 0.0 && vi.is_finite()) {
+        return Err(format!(
+            "v[{i}] = {}: must be a finite number > 0",
+            show(vi)
+        ));
+    }
+    let si = sigma_v[i];
+    let sigma = if si.is_nan() {
+        None
+    } else if si > 0.0 && si.is_finite() {
+        Some(si)
+    } else {
+        return Err(format!(
+            "sigma_v[{i}] = {}: must be a finite number > 0 (NaN for none)",
+            show(si)
+        ));
+    };
+    Ok((vi, sigma))
+}
+
 type KRow = ([f64; 12], [Cow<'static, str>; 7]);
 
 /// One measurement's K estimate as the `k` command's columns.
 fn k_row(model: &Model, auto: Option<&Auto>, scene: &Scene, vi: f64, sigma: Option<f64>) -> KRow {
-    let (e, choice) = match auto {
-        Some(au) => {
-            let c = fitbead::fit::k::auto::choose(au, scene, vi);
-            (estimate(&c.model, scene, vi, sigma), Some(c))
-        }
-        None => (estimate(model, scene, vi, sigma), None),
-    };
+    let (e, choice) = estimate_with(model, auto, scene, vi, sigma);
     let (alpha, rho) = (scene.alpha_rad(), scene.rho());
     let root = e.root.as_ref().ok();
     let mut nums = [f64::NAN; 12];
@@ -849,23 +849,8 @@ impl PyDataset {
         for (i, label) in series.into_iter().enumerate() {
             let scene =
                 scene_of(i, xs, d, rs, fs, CollisionLaw::Value(0.5)).map_err(value_error)?;
-            if !(vs[i] > 0.0 && vs[i].is_finite()) {
-                return Err(value_error(format!(
-                    "v[{i}] = {}: must be a finite number > 0",
-                    show(vs[i])
-                )));
-            }
-            let s = if ss[i].is_nan() {
-                None
-            } else if ss[i] > 0.0 && ss[i].is_finite() {
-                Some(ss[i])
-            } else {
-                return Err(value_error(format!(
-                    "sigma_v[{i}] = {}: must be a finite number > 0 (NaN for none)",
-                    show(ss[i])
-                )));
-            };
-            rows.push((label, scene, vs[i], s));
+            let (v, s) = measured(i, vs, ss).map_err(value_error)?;
+            rows.push((label, scene, v, s));
         }
         let inner = RsDataset::new(rows).map_err(|e| value_error(e.to_string()))?;
         Ok(PyDataset { inner })

@@ -14,7 +14,7 @@ use super::scenes::{Header, Row};
 use super::stream::RowPlan;
 use super::InputError;
 use crate::fit::k::auto::{self as kauto, KChoice};
-use crate::fit::k::{estimate, KEstimate};
+use crate::fit::k::KEstimate;
 use crate::models::auto::Auto;
 use crate::models::Model;
 use crate::numfmt::{fmt_f64, push_f64};
@@ -214,16 +214,13 @@ impl KPlan {
 
     /// Inverts one measurement with the settings' model, or the one auto chooses for it.
     pub fn invert(&self, m: &Measured) -> (KEstimate, Option<KChoice>) {
-        match &self.settings.auto {
-            Some(au) => {
-                let c = kauto::choose(au, &m.scene, m.v);
-                (estimate(&c.model, &m.scene, m.v, m.sigma_v), Some(c))
-            }
-            None => (
-                estimate(&self.settings.model, &m.scene, m.v, m.sigma_v),
-                None,
-            ),
-        }
+        kauto::estimate_with(
+            &self.settings.model,
+            self.settings.auto.as_ref(),
+            &m.scene,
+            m.v,
+            m.sigma_v,
+        )
     }
 }
 

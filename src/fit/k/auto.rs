@@ -25,6 +25,24 @@ pub struct KChoice {
     pub reason: String,
 }
 
+/// The K estimate of one measurement (eq 69) under `model`, or under the model `auto`
+/// chooses for it ([`choose`]) when `auto` is given, with that choice.
+pub fn estimate_with(
+    model: &Model,
+    auto: Option<&Auto>,
+    scene: &Scene,
+    v: f64,
+    sigma_v: Option<f64>,
+) -> (super::KEstimate, Option<KChoice>) {
+    match auto {
+        Some(au) => {
+            let c = choose(au, scene, v);
+            (estimate(&c.model, scene, v, sigma_v), Some(c))
+        }
+        None => (estimate(model, scene, v, sigma_v), None),
+    }
+}
+
 /// Chooses the model for inverting one point (ξ, δ, ρ, f of `scene`, measured `v`).
 pub fn choose(auto: &Auto, scene: &Scene, v: f64) -> KChoice {
     let model_of = |c: Choice| match c {

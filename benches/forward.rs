@@ -37,6 +37,27 @@ fn bench(c: &mut Criterion) {
                 .sum::<f64>()
         })
     });
+    // The stick model with its scene built from (ξ, δ°, ρ, f, K) as the forward command and the
+    // Python binding build it per row (K a number): the exact per-scene work without any I/O.
+    let inputs: Vec<(f64, f64, f64)> = s.iter().map(|x| (x.xi(), x.delta_deg(), x.k())).collect();
+    g.bench_function("stick with its scene", |b| {
+        b.iter(|| {
+            inputs
+                .iter()
+                .map(|&(xi, d, k)| {
+                    let x = Scene::new(
+                        black_box(xi),
+                        black_box(d),
+                        0.4,
+                        0.1,
+                        CollisionLaw::Value(k),
+                    )
+                    .unwrap();
+                    stick::steady(&x).map(|r| r.mean_velocity).unwrap_or(0.0)
+                })
+                .sum::<f64>()
+        })
+    });
     g.bench_function("stick-approx", |b| {
         b.iter(|| {
             s.iter()

@@ -64,16 +64,26 @@ pub enum CollisionLaw {
 
 impl CollisionLaw {
     /// Evaluates K at the contact angle α (radians) and gyration parameter ρ.
+    ///
+    /// Each law evaluates only the functions of α it needs (a number needs none).
     pub fn k(&self, alpha: f64, rho: f64) -> f64 {
-        let c2 = (2.0 * alpha).cos();
-        let s = alpha.sin();
-        let s2 = (2.0 * alpha).sin();
+        let c2 = || (2.0 * alpha).cos();
+        let s_s2 = || {
+            let s = alpha.sin();
+            (s, (2.0 * alpha).sin())
+        };
         match *self {
             CollisionLaw::Value(k) => k,
-            CollisionLaw::Cos2a => c2,
-            CollisionLaw::Adjusted => c2 + 0.5 * s * s * s2,
-            CollisionLaw::Impact => (c2 + rho) / (1.0 + rho),
-            CollisionLaw::C(c) => c2 + c * s * s * s2,
+            CollisionLaw::Cos2a => c2(),
+            CollisionLaw::Adjusted => {
+                let (s, s2) = s_s2();
+                c2() + 0.5 * s * s * s2
+            }
+            CollisionLaw::Impact => (c2() + rho) / (1.0 + rho),
+            CollisionLaw::C(c) => {
+                let (s, s2) = s_s2();
+                c2() + c * s * s * s2
+            }
         }
     }
 

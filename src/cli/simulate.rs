@@ -4,6 +4,7 @@
 use super::args::{ContactArgs, OutputArgs};
 use super::{emit, parse_list, CliError};
 use fitbead::io::fmt_f64;
+use fitbead::models::contact::{Contact, SpinRule};
 use fitbead::models::jaeger::Jaeger;
 use fitbead::models::jan::Jan;
 use fitbead::models::md::{
@@ -86,9 +87,14 @@ pub const MAX_ROWS: usize = 10_000_000;
 pub const MAX_SERIES: usize = 10_000;
 
 /// `simulate --model contact --v0 V --beads N`: the bead-by-bead transient from a launch.
-fn trace(a: &Args, law: CollisionLaw, series: &[f64], v0: f64) -> Result<(), CliError> {
+fn trace(
+    a: &Args,
+    law: CollisionLaw,
+    series: &[f64],
+    v0: f64,
+    spin: SpinRule,
+) -> Result<(), CliError> {
     use fitbead::io::reports::transient_csv;
-    use fitbead::models::contact::{Contact, SpinRule};
     if !(v0.is_finite() && v0 >= 0.0) {
         return Err(super::flag_error(
             "--v0",
@@ -112,12 +118,6 @@ fn trace(a: &Args, law: CollisionLaw, series: &[f64], v0: f64) -> Result<(), Cli
             "--v0 needs the slope of the scene (--delta-deg)",
         ));
     };
-    let spin: SpinRule = a
-        .spin
-        .parse()
-        .map_err(|e: fitbead::scene::ParameterError| {
-            super::flag_error("--spin", &a.spin, e.to_string())
-        })?;
     let model = Contact {
         spin,
         ..Contact::default()
@@ -132,6 +132,25 @@ fn trace(a: &Args, law: CollisionLaw, series: &[f64], v0: f64) -> Result<(), Cli
         .collect::<Result<Vec<_>, _>>()?;
     let bytes = transient_csv(&model, &scenes, d, v0, beads)?;
     emit(a.out.output.as_deref(), &bytes)
+}
+
+/// `--spin`: the contact model's spin rule. A rule other than the default `roll` is refused
+/// for the other models, which have no spin rule.
+fn spin_rule(a: &Args, kind: ModelKind) -> Result<SpinRule, CliError> {
+    let spin: SpinRule = a
+        .spin
+        .parse()
+        .map_err(|e: fitbead::scene::ParameterError| {
+            super::flag_error("--spin", &a.spin, e.to_string())
+        })?;
+    if kind != ModelKind::Contact && spin != SpinRule::Roll {
+        return Err(super::flag_error(
+            "--spin",
+            &a.spin,
+            "a spin rule applies to --model contact only",
+        ));
+    }
+    Ok(spin)
 }
 
 /// `--delta-range LO,HI` (degrees, LO < HI), when given.
@@ -159,6 +178,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let law: CollisionLaw = a.law.parse().map_err(|e: fitbead::scene::ParameterError| {
         super::flag_error("--law", &a.law, e.to_string())
     })?;
+    let spin = spin_rule(&a, kind)?;
     let series = parse_list("--series", &a.series)?;
     if series.len() > MAX_SERIES {
         return Err(super::flag_error(
@@ -176,7 +196,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
                 "the bead-by-bead transient needs --model contact",
             ));
         }
-        return trace(&a, law, &series, v0);
+        return trace(&a, law, &series, v0, spin);
     }
     if a.points == 0 || a.points > MAX_POINTS {
         return Err(super::flag_error(
@@ -242,6 +262,10 @@ pub fn run(a: Args) -> Result<(), CliError> {
             .map_err(|e| super::flag_error("--series", &xi.to_string(), e.to_string()))?
             .alpha_rad();
         let model = match (kind, kind.contact_model()) {
+            (ModelKind::Contact, _) => Model::Contact(Contact {
+                spin,
+                ..Contact::default()
+            }),
             (_, Some(m)) => m,
             (ModelKind::Jan, None) => match &jan {
                 None => Model::Jan(Jan::paper_fit(alpha)),

@@ -485,3 +485,71 @@ fn cli_forward_and_transient() {
         .unwrap()
         .starts_with("xi,delta_deg,bead,initial_velocity"));
 }
+
+/// `simulate --model contact --spin RULE` makes its synthetic data under that rule: each row's
+/// v_true equals the library's contact model with the same rule at the row's scene (and differs
+/// from the default rule's); an unknown rule, or a rule other than `roll` for a model without
+/// spin rules, exits 2 naming `--spin`.
+#[test]
+fn simulate_uses_the_spin_rule_and_refuses_one_it_cannot_use() {
+    let run = |spin: &str| {
+        let out = bin()
+            .args([
+                "simulate", "--model", "contact", "--series", "1", "--points", "3", "--spin", spin,
+            ])
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let text = String::from_utf8(out.stdout).unwrap();
+        let mut r = csv::Reader::from_reader(text.as_bytes());
+        let rows: Vec<(f64, f64)> = r
+            .records()
+            .map(|x| {
+                let x = x.unwrap();
+                (x[2].parse().unwrap(), x[5].parse().unwrap())
+            })
+            .collect();
+        rows
+    };
+    for (name, rule) in [
+        ("keep", SpinRule::Keep),
+        ("factor=0.5", SpinRule::Factor(0.5)),
+    ] {
+        let model = Model::Contact(Contact {
+            spin: rule,
+            ..Contact::default()
+        });
+        let roll = run("roll");
+        let rows = run(name);
+        assert_eq!(rows.len(), 3);
+        for ((d, v_true), (d_roll, v_roll)) in rows.iter().zip(&roll) {
+            let sc = Scene::new(1.0, *d, 0.4, 0.1, CollisionLaw::Adjusted).unwrap();
+            assert_eq!(
+                *v_true,
+                model.evaluate(&sc).unwrap().mean_velocity,
+                "{name} at {d}"
+            );
+            let sc_roll = Scene::new(1.0, *d_roll, 0.4, 0.1, CollisionLaw::Adjusted).unwrap();
+            let roll_model = Model::Contact(Contact::default());
+            assert_eq!(
+                *v_roll,
+                roll_model.evaluate(&sc_roll).unwrap().mean_velocity
+            );
+            assert_ne!(v_true, v_roll, "{name}: the rule must change the data");
+        }
+    }
+    for args in [
+        ["--model", "contact", "--spin", "reset"],
+        ["--model", "stickslip", "--spin", "keep"],
+    ] {
+        let out = bin().arg("simulate").args(args).output().unwrap();
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("'--spin'"), "{args:?}: {err}");
+        assert!(out.stdout.is_empty());
+    }
+}

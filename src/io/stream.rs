@@ -10,6 +10,10 @@
 //! reading the whole table first: a malformed row anywhere in the input (or an input with no
 //! rows) is reported before any bad value, then the first bad row in input order; a failed
 //! write is reported only once the whole input proved good, writing stopping at the failure.
+//! Nothing is written before the first chunk has been checked (the header goes out with its
+//! rows), so an input whose first [`CHUNK_ROWS`] rows hold the bad one leaves even a stream
+//! such as standard output empty; a bad row further on follows the rows before it there (a
+//! file given as `--output` is written atomically and stays untouched).
 //! It reports its progress in input bytes to a [`Progress`] sink and stops between tasks when
 //! the caller's stop flag is raised.
 
@@ -205,9 +209,12 @@ where
     if n_cur == 0 {
         return Err(reader.no_rows().into());
     }
+    // The header goes out with the first chunk's rows, once they have all been checked: an
+    // input whose first chunk holds a bad row writes nothing, even to a stream.
     let mut header = Vec::new();
     plan.header(&mut header);
-    let mut pending = vec![header];
+    let mut header = Some(header);
+    let mut pending: Vec<Vec<u8>> = Vec::new();
     // Output buffers come back here once written, and serve the chunk after next; the notes'
     // vectors come back once recorded, and serve the next chunk.
     let mut spare: Vec<Vec<u8>> = Vec::new();
@@ -239,13 +246,16 @@ where
             },
         );
         let n_next = read?;
-        let parts = match done {
+        let mut parts = match done {
             Ok(parts) => parts,
             Err(StreamError::Input(e)) => return Err(first_error(&mut reader, e, opts)),
             Err(e) => return Err(e),
         };
         let bytes: usize = parts.iter().map(Vec::len).sum();
         row_bytes = row_bytes.max(bytes.div_ceil(n_cur) + 16);
+        if let Some(h) = header.take() {
+            parts.insert(0, h);
+        }
         spare = std::mem::replace(&mut pending, parts);
         rows += n_cur as u64;
         if let Some(p) = &opts.progress {

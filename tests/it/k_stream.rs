@@ -94,3 +94,43 @@ fn a_series_that_changes_xi_late_is_caught_across_chunks() {
         );
     }
 }
+
+/// What reaches the sink (standard output, for `k` without --output) before a bad row's error:
+/// nothing when the bad row is in the first chunk; otherwise the header and the rows of the
+/// chunks before the bad row's, the good output's first lines.
+#[test]
+fn a_bad_row_leaves_only_the_chunks_before_it_written() {
+    let text = table();
+    let want = run(&text, 10_000, 10_000).unwrap();
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    // Data row 250 (0-based) is line 252 of the file.
+    lines[251] = "b,1,abc,0.3,0.01,bad".into();
+    let bad = lines.join("\n") + "\n";
+    for (chunk, task, written_rows) in [(10_000, 10_000, None), (300, 7, None), (64, 5, Some(192))]
+    {
+        let reader = TableReader::new("in.csv", bad.as_bytes()).unwrap();
+        let opts = StreamOptions {
+            chunk_rows: chunk,
+            task_rows: task,
+            ..StreamOptions::default()
+        };
+        let settings = KSettings {
+            model: Model::Stick,
+            auto: None,
+            model_name: "stick".into(),
+            plot: false,
+        };
+        let make =
+            |r: &TableReader<&[u8]>| KPlan::new(r, &MeasurementDefaults::default(), settings);
+        let mut out = Vec::new();
+        let r = stream(reader, make, KLedger::default(), &mut out, &opts);
+        assert!(matches!(r, Err(StreamError::Input(_))), "chunks of {chunk}");
+        match written_rows {
+            None => assert!(out.is_empty(), "chunks of {chunk}: {} bytes", out.len()),
+            Some(n) => {
+                assert_eq!(out.iter().filter(|&&b| b == b'\n').count(), 1 + n);
+                assert!(want.starts_with(&out), "chunks of {chunk}");
+            }
+        }
+    }
+}

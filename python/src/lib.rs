@@ -22,9 +22,7 @@ use fitbead::models::jan::Jan;
 use fitbead::models::regimes::{
     alpha_of_xi, bulk_friction_law, critical_xi, delta_d_law, delta_m_law,
 };
-use fitbead::models::{
-    regime_of, ForwardModel, JaegerBranch, Model, ModelKind, Outcome, Phases, Regime,
-};
+use fitbead::models::{regime_of, Evaluation, JaegerBranch, Model, ModelKind, Phases, Regime};
 use fitbead::scene::{CollisionLaw, Scene};
 use numpy::{PyArray1, PyArray3, PyReadonlyArray1};
 use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
@@ -398,17 +396,12 @@ type ForwardRow = ([f64; 15], [Cow<'static, str>; 9]);
 fn forward_row(scene: &Scene, model: &Model) -> ForwardRow {
     let mut nums = [f64::NAN; 15];
     let mut texts: [Cow<'static, str>; 9] = Default::default();
-    let (o, contact, auto): (Outcome, _, _) = match model {
-        Model::Contact(c) => {
-            let r = c.steady_state(scene);
-            (Contact::outcome(scene, &r), Some((c.spin, r.ok())), None)
-        }
-        Model::Auto(au) => {
-            let r = au.choose(scene);
-            (r.outcome, None, Some((r.choice, r.reason)))
-        }
-        m => (m.evaluate(scene), None, None),
-    };
+    let Evaluation {
+        outcome: o,
+        contact,
+        auto,
+    } = model.evaluate_detailed(scene);
+    let auto = auto.map(|r| (r.choice, r.reason));
     let has_k = !matches!(model, Model::Jan(_) | Model::Jaeger(_));
     texts[0] = Cow::Borrowed(match regime_of(&o) {
         Some(Regime::A) => "A",

@@ -16,11 +16,11 @@ use super::cells::Cells;
 use super::scenes::{Row, TableReader};
 use super::stream::RowPlan;
 use super::InputError;
-use crate::models::auto::{Auto, AutoOutcome};
+use crate::models::auto::Auto;
 use crate::models::contact::{Contact, SpinRule, SteadyContact};
 use crate::models::jaeger::Jaeger;
 use crate::models::jan::Jan;
-use crate::models::{regime_of, ForwardModel, JaegerBranch, Model, ModelKind, Outcome};
+use crate::models::{regime_of, Evaluation, JaegerBranch, Model, ModelKind};
 use crate::scene::ParameterError;
 use crate::scene::{CollisionLaw, Scene};
 use std::io::Read;
@@ -467,7 +467,11 @@ impl RowPlan for ForwardPlan {
     }
 
     fn write(&self, row: &Row<'_>, job: Job, _: &mut (), out: &mut Vec<u8>) {
-        let (o, d, au) = evaluate(&job);
+        let Evaluation {
+            outcome: o,
+            contact: d,
+            auto: au,
+        } = job.model.evaluate_detailed(&job.scene);
         let kind = self.settings.kind;
         let general = kind == ModelKind::Contact;
         let contact = !matches!(kind, ModelKind::Jan | ModelKind::Jaeger);
@@ -521,7 +525,7 @@ impl RowPlan for ForwardPlan {
             }
         }
         if let (true, Some(d)) = (general, &d) {
-            contact_cells(&mut w, &job, d);
+            contact_cells(&mut w, &job, d.0, &d.1);
         }
         if kind == ModelKind::Auto {
             match au {
@@ -539,41 +543,12 @@ impl RowPlan for ForwardPlan {
     }
 }
 
-/// One row's outcome, with what the contact model and `auto` add.
-fn evaluate(j: &Job) -> (Outcome, Option<ContactDetail>, Option<AutoOutcome>) {
-    match j.model {
-        Model::Contact(c) => {
-            let r = c.steady_state(&j.scene);
-            (
-                Contact::outcome(&j.scene, &r),
-                Some(ContactDetail {
-                    rule: c.spin,
-                    steady: r.ok(),
-                }),
-                None,
-            )
-        }
-        // The auto choice travels with each outcome.
-        Model::Auto(au) => {
-            let r = au.choose(&j.scene);
-            (r.outcome, None, Some(r))
-        }
-        m => (m.evaluate(&j.scene), None, None),
-    }
-}
-
-/// What the contact model adds to a row.
-struct ContactDetail {
-    rule: SpinRule,
-    steady: Option<SteadyContact>,
-}
-
-fn contact_cells(w: &mut Cells, job: &Job, d: &ContactDetail) {
-    let Some(s) = &d.steady else {
+fn contact_cells(w: &mut Cells, job: &Job, rule: SpinRule, steady: &Option<SteadyContact>) {
+    let Some(s) = steady else {
         for _ in 0..CONTACT_COLUMNS.len() - 1 {
             w.empty();
         }
-        w.show(d.rule);
+        w.show(rule);
         return;
     };
     let e = s.energy(&job.scene);
@@ -587,5 +562,5 @@ fn contact_cells(w: &mut Cells, job: &Job, d: &ContactDetail) {
     w.num(e.collision_spin / p);
     w.num(e.friction_work / p);
     w.num(e.closure());
-    w.show(d.rule);
+    w.show(rule);
 }

@@ -276,6 +276,49 @@ impl Model {
     ];
 }
 
+/// A forward evaluation with what the general contact model and `auto` tell beyond the
+/// outcome (the `forward` command's extra columns).
+#[derive(Debug, Clone)]
+pub struct Evaluation {
+    /// The steady state, or why there is none.
+    pub outcome: Outcome,
+    /// The general contact model: its spin rule and its steady state (`None` where there is
+    /// none).
+    pub contact: Option<(contact::SpinRule, Option<contact::SteadyContact>)>,
+    /// `auto`: the model it chose and why.
+    pub auto: Option<auto::AutoOutcome>,
+}
+
+impl Model {
+    /// [`ForwardModel::evaluate`] with the contact model's steady state and `auto`'s choice
+    /// kept (the same outcome).
+    pub fn evaluate_detailed(&self, scene: &Scene) -> Evaluation {
+        match self {
+            Model::Contact(c) => {
+                let r = c.steady_state(scene);
+                Evaluation {
+                    outcome: contact::Contact::outcome(scene, &r),
+                    contact: Some((c.spin, r.ok())),
+                    auto: None,
+                }
+            }
+            Model::Auto(au) => {
+                let r = au.choose(scene);
+                Evaluation {
+                    outcome: r.outcome,
+                    contact: None,
+                    auto: Some(r),
+                }
+            }
+            m => Evaluation {
+                outcome: m.evaluate(scene),
+                contact: None,
+                auto: None,
+            },
+        }
+    }
+}
+
 impl ForwardModel for Model {
     fn name(&self) -> &'static str {
         match self {

@@ -4,6 +4,8 @@ use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use fitbead::models::{slip, stick, stickslip};
 use fitbead::special::elliptic::rf;
 use fitbead::{CollisionLaw, Scene};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 
 fn scenes() -> Vec<Scene> {
     let mut v = Vec::new();
@@ -21,9 +23,58 @@ fn scenes() -> Vec<Scene> {
     v
 }
 
+/// `n` random scenes as python/bench/bench_forward.py draws them (ξ in [0.8, 3], the adjusted
+/// law's K as a number, ρ = 0.4 on half of them and in [0.2, 0.7] on the others, f = 0.1; δ 90 %
+/// in (δ_m, δ_d), 5 % below δ_m, 5 % above δ_d): (ξ, δ in degrees, K, ρ).
+fn random_scenes(n: usize) -> Vec<(f64, f64, f64, f64)> {
+    let mut rng = ChaCha8Rng::seed_from_u64(20251125);
+    (0..n)
+        .map(|_| {
+            let xi: f64 = rng.random_range(0.8..3.0);
+            let rho = if rng.random::<f64>() < 0.5 {
+                0.4
+            } else {
+                rng.random_range(0.2..0.7f64)
+            };
+            let a = (1.0 / (1.0 + xi)).asin();
+            let k = (2.0 * a).cos() + 0.5 * a.sin().powi(2) * (2.0 * a).sin();
+            let dm = 2.0 * ((a / 2.0).tan() * (1.0 - k) / (1.0 + k)).atan();
+            let c = (1.0 + rho) * (1.0 - k * k);
+            let dd = (c / (a.tan() * (4.0 + c))).atan();
+            let (u, class) = (rng.random::<f64>(), rng.random::<f64>());
+            let d = if class < 0.9 {
+                dm + u * (dd - dm)
+            } else if class < 0.95 {
+                dm * (0.5 + 0.5 * u)
+            } else {
+                dd + u * ((1.5 * dd).min(89f64.to_radians()) - dd)
+            };
+            (xi, d.to_degrees(), k, rho)
+        })
+        .collect()
+}
+
 fn bench(c: &mut Criterion) {
     let s = scenes();
     let n = s.len() as u64;
+    // The stick model with its scene built per row from (ξ, δ°, K, ρ, f) as `forward` and the
+    // Python binding build it: the exact per-scene work without reading or writing anything.
+    let random = random_scenes(100_000);
+    let mut g = c.benchmark_group("random scenes");
+    g.throughput(criterion::Throughput::Elements(random.len() as u64));
+    g.sample_size(20);
+    g.bench_function("stick with its scene", |b| {
+        b.iter(|| {
+            random
+                .iter()
+                .map(|&(xi, d, k, rho)| {
+                    let x = Scene::new(black_box(xi), d, rho, 0.1, CollisionLaw::Value(k)).unwrap();
+                    stick::steady(&x).map(|r| r.mean_velocity).unwrap_or(0.0)
+                })
+                .sum::<f64>()
+        })
+    });
+    g.finish();
     let mut g = c.benchmark_group("per-scene");
     g.throughput(criterion::Throughput::Elements(n));
     g.bench_function("stick", |b| {
@@ -33,27 +84,6 @@ fn bench(c: &mut Criterion) {
                     stick::steady(black_box(x))
                         .map(|r| r.mean_velocity)
                         .unwrap_or(0.0)
-                })
-                .sum::<f64>()
-        })
-    });
-    // The stick model with its scene built from (ξ, δ°, ρ, f, K) as the forward command and the
-    // Python binding build it per row (K a number): the exact per-scene work without any I/O.
-    let inputs: Vec<(f64, f64, f64)> = s.iter().map(|x| (x.xi(), x.delta_deg(), x.k())).collect();
-    g.bench_function("stick with its scene", |b| {
-        b.iter(|| {
-            inputs
-                .iter()
-                .map(|&(xi, d, k)| {
-                    let x = Scene::new(
-                        black_box(xi),
-                        black_box(d),
-                        0.4,
-                        0.1,
-                        CollisionLaw::Value(k),
-                    )
-                    .unwrap();
-                    stick::steady(&x).map(|r| r.mean_velocity).unwrap_or(0.0)
                 })
                 .sum::<f64>()
         })

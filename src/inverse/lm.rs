@@ -57,12 +57,13 @@
 use argmin::core::observers::ObserverMode;
 use argmin::core::{Error, Problem, Solver, State, TerminationReason, KV};
 use faer::Mat;
+use std::collections::HashMap;
 use std::sync::atomic::Ordering;
 
 use super::lmpar::{norm2, Subproblem};
 use super::lsq::{LsqOptions, Residuals, Termination};
 use super::observer::ProgressObserver;
-use super::problem::{Evaluator, LeastSquares};
+use super::problem::{Evaluator, LeastSquares, View};
 use super::state::{LmStage, LmState};
 
 /// The outcome of the iteration proper (no covariance).
@@ -116,11 +117,7 @@ struct LmRun {
 impl LmRun {
     /// Starts a run at `x0`, or returns the solution when the start already ends it (an
     /// infeasible start, or χ² = 0).
-    fn start<R: Residuals>(
-        ev: &mut Evaluator,
-        ls: &LeastSquares<R>,
-        x0: Vec<f64>,
-    ) -> Result<LmRun, Solution> {
+    fn start(ev: &mut Evaluator, ls: View<'_>, x0: Vec<f64>) -> Result<LmRun, Solution> {
         let (m, n) = (ev.m, ev.n);
         let mut f = vec![0.0; m];
         if !ev.residuals(ls, &x0, &mut f) {
@@ -185,10 +182,10 @@ impl LmRun {
 
     /// One outer iteration: a Jacobian, then trial steps until one is accepted. Returns the
     /// reason when the run ends.
-    fn iterate<R: Residuals>(
+    fn iterate(
         &mut self,
         ev: &mut Evaluator,
-        ls: &LeastSquares<R>,
+        ls: View<'_>,
         opts: &LsqOptions,
     ) -> Option<Termination> {
         let n = ev.n;
@@ -451,10 +448,10 @@ impl Polisher {
 
     /// Tries one polish step from `sol`; true when it was taken (and `sol` moved), false when
     /// the polish is over.
-    fn step<R: Residuals>(
+    fn step(
         &mut self,
         ev: &mut Evaluator,
-        ls: &LeastSquares<R>,
+        ls: View<'_>,
         opts: &LsqOptions,
         sol: &mut Solution,
     ) -> bool {
@@ -601,6 +598,9 @@ pub struct LevenbergMarquardt {
     ev: Evaluator,
     stage: Stage,
     log: bool,
+    /// Whether argmin's function counts are kept (off only for [`solve`], which discards
+    /// them).
+    counts: bool,
 }
 
 impl LevenbergMarquardt {
@@ -628,6 +628,7 @@ impl LevenbergMarquardt {
             ev: Evaluator::new(0, 0),
             stage: Stage::Idle,
             log: false,
+            counts: true,
         }
     }
 
@@ -689,19 +690,12 @@ impl LevenbergMarquardt {
         }
     }
 
-    /// Moves the evaluator's counts into argmin's function counts (every iteration when the
-    /// state counts, `LmState::counting`, else once the solver has finished).
-    fn count<R>(&self, problem: &mut Problem<LeastSquares<R>>) {
-        problem.counts.insert("operator_count", self.ev.nfev as u64);
-        problem.counts.insert("jacobian_count", self.ev.njev as u64);
-    }
-
     /// After a run ended with `sol`: restarts (from `sol`, if it converged and restarts are
     /// left), keeps the better of a restart and the run before it, then polishes a converged
     /// solution.
-    fn settle<R: Residuals>(
+    fn settle(
         &mut self,
-        ls: &LeastSquares<R>,
+        ls: View<'_>,
         mut sol: Solution,
         mut restarts: usize,
         mut previous: Option<Solution>,
@@ -811,31 +805,48 @@ impl LevenbergMarquardt {
     }
 }
 
-/// The least-squares problem inside argmin's wrapper.
-fn inner<R>(problem: &Problem<LeastSquares<R>>) -> Result<&LeastSquares<R>, Error> {
-    problem
-        .problem
-        .as_ref()
-        .ok_or_else(|| Error::msg("no least-squares problem"))
+/// The least-squares problem inside argmin's wrapper, as the iteration sees it, and argmin's
+/// function counts.
+fn parts<R: Residuals>(
+    problem: &mut Problem<LeastSquares<R>>,
+) -> Result<(View<'_>, &mut Counts), Error> {
+    match &problem.problem {
+        Some(ls) => Ok((ls.view(), &mut problem.counts)),
+        None => Err(Error::msg("no least-squares problem")),
+    }
 }
 
-impl<R: Residuals> Solver<LeastSquares<R>, LmState> for LevenbergMarquardt {
-    fn name(&self) -> &str {
-        "Levenberg-Marquardt (Moré 1978, bounded)"
+/// argmin's function counts of a problem.
+type Counts = HashMap<&'static str, u64>;
+
+/// The solver proper, compiled once for every problem type: the [`Solver`] implementation only
+/// unwraps argmin's problem and calls these.
+impl LevenbergMarquardt {
+    /// Moves the evaluator's counts into argmin's function counts (every iteration when the
+    /// state counts, `LmState::counting`, else once the solver has finished).
+    fn count(&self, state: &LmState, counts: &mut Counts) {
+        if self.counts && (state.is_counting() || matches!(self.stage, Stage::Done(_))) {
+            counts.insert("operator_count", self.ev.nfev as u64);
+            counts.insert("jacobian_count", self.ev.njev as u64);
+        }
     }
 
-    fn init(
+    /// [`Solver::init`]: the start (the state's `param` projected onto the box, else the
+    /// problem's), the first run's residuals, and the state reporting them.
+    #[inline(never)]
+    fn init_view(
         &mut self,
-        problem: &mut Problem<LeastSquares<R>>,
+        ls: View<'_>,
+        counts: &mut Counts,
         state: LmState,
     ) -> Result<(LmState, Option<KV>), Error> {
-        let ls = inner(problem)?;
-        let (m, n) = (ls.n_residuals(), ls.n_params());
+        let (m, n) = (ls.problem.n_residuals(), ls.problem.n_params());
+        let (lo, hi) = (&ls.setup.lower, &ls.setup.upper);
         let start = match state.get_param() {
             None => ls.setup.start.clone(),
-            Some(p) if p.len() == n && p.iter().all(|v| v.is_finite()) => (0..n)
-                .map(|j| p[j].clamp(ls.setup.lower[j], ls.setup.upper[j]))
-                .collect(),
+            Some(p) if p.len() == n && p.iter().all(|v| v.is_finite()) => {
+                (0..n).map(|j| p[j].clamp(lo[j], hi[j])).collect()
+            }
             Some(p) => {
                 return Err(Error::msg(format!(
                     "the initial parameter vector has length {} (expected {n}) or a \
@@ -853,18 +864,19 @@ impl<R: Residuals> Solver<LeastSquares<R>, LmState> for LevenbergMarquardt {
             },
             Err(sol) => self.settle(ls, sol, 0, None),
         };
-        if state.is_counting() || matches!(self.stage, Stage::Done(_)) {
-            self.count(problem);
-        }
+        self.count(&state, counts);
         self.report(state)
     }
 
-    fn next_iter(
+    /// [`Solver::next_iter`]: one outer Levenberg–Marquardt iteration or one polish step, the
+    /// next stage when this one ends, and the state reporting it.
+    #[inline(never)]
+    fn next_iter_view(
         &mut self,
-        problem: &mut Problem<LeastSquares<R>>,
+        ls: View<'_>,
+        counts: &mut Counts,
         state: LmState,
     ) -> Result<(LmState, Option<KV>), Error> {
-        let ls = inner(problem)?;
         // The stage is replaced only when it ends.
         let ended = match &mut self.stage {
             Stage::Run { run, .. } => run.iterate(&mut self.ev, ls, &self.opts),
@@ -890,10 +902,32 @@ impl<R: Residuals> Solver<LeastSquares<R>, LmState> for LevenbergMarquardt {
                 other => other,
             };
         }
-        if state.is_counting() || matches!(self.stage, Stage::Done(_)) {
-            self.count(problem);
-        }
+        self.count(&state, counts);
         self.report(state)
+    }
+}
+
+impl<R: Residuals> Solver<LeastSquares<R>, LmState> for LevenbergMarquardt {
+    fn name(&self) -> &str {
+        "Levenberg-Marquardt (Moré 1978, bounded)"
+    }
+
+    fn init(
+        &mut self,
+        problem: &mut Problem<LeastSquares<R>>,
+        state: LmState,
+    ) -> Result<(LmState, Option<KV>), Error> {
+        let (ls, counts) = parts(problem)?;
+        self.init_view(ls, counts, state)
+    }
+
+    fn next_iter(
+        &mut self,
+        problem: &mut Problem<LeastSquares<R>>,
+        state: LmState,
+    ) -> Result<(LmState, Option<KV>), Error> {
+        let (ls, counts) = parts(problem)?;
+        self.next_iter_view(ls, counts, state)
     }
 }
 
@@ -931,16 +965,25 @@ fn scaled_norm(d: &[f64], x: &[f64], work: &mut [f64]) -> f64 {
     norm2(work)
 }
 
+/// A problem of any type behind a trait object: the one problem type of the fits that
+/// [`solve`] runs, so that argmin's `Executor` and the solver are compiled once for all of them.
+pub(crate) type DynLeastSquares<'a> = LeastSquares<&'a dyn Residuals>;
+
 /// Runs [`LevenbergMarquardt`] on `ls` under argmin's `Executor` (argmin's Ctrl-C handling off:
 /// the stop flag of `opts` is the caller's; its timer off: nothing reads the iteration times,
-/// and the profiles' many small fits would pay two clock reads per iteration), with a
+/// and the profiles' many small fits would pay two clock reads per iteration; argmin's
+/// function counts off: the evaluator counts, and the problem's counts are dropped), with a
 /// [`ProgressObserver`] over `opts.progress` when there is one; returns the solution, the
 /// evaluator (its counts and work space, for the covariance) and the problem.
-pub(crate) fn solve<R: Residuals>(
-    ls: LeastSquares<R>,
+pub(crate) fn solve<'a>(
+    ls: DynLeastSquares<'a>,
     opts: &LsqOptions,
-) -> Result<(Solution, Evaluator, LeastSquares<R>), Error> {
-    let mut executor = argmin::core::Executor::new(ls, LevenbergMarquardt::new(opts))
+) -> Result<(Solution, Evaluator, DynLeastSquares<'a>), Error> {
+    let solver = LevenbergMarquardt {
+        counts: false,
+        ..LevenbergMarquardt::new(opts)
+    };
+    let mut executor = argmin::core::Executor::new(ls, solver)
         .ctrlc(false)
         .timer(false);
     if let Some(tally) = &opts.progress {

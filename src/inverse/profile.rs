@@ -26,9 +26,8 @@ use faer::{Mat, MatMut};
 use statrs::distribution::{ContinuousCDF, Normal, StudentsT};
 
 use super::estimate::Fit;
-use super::lm::solve;
+use super::lm::{solve, DynLeastSquares};
 use super::lsq::{validate, Infeasible, LsqError, LsqOptions, Residuals, SigmaKind};
-use super::problem::LeastSquares;
 use crate::special::root::brent;
 
 /// The customary confidence level, 0.95.
@@ -373,7 +372,7 @@ impl<R: Residuals + ?Sized> Profiler<'_, R> {
             typical: subset(&self.opts.typical, self.index),
             ..self.opts.clone()
         };
-        let ls = LeastSquares::new(fixed, warm, &sub).ok()?;
+        let ls = DynLeastSquares::new(&fixed, warm, &sub).ok()?;
         let (sol, ev, _) = solve(ls, &sub).ok()?;
         self.evals += ev.nfev;
         if !sol.termination.converged() {

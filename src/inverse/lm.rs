@@ -56,7 +56,7 @@
 
 use argmin::core::observers::ObserverMode;
 use argmin::core::{Error, Problem, Solver, State, TerminationReason, KV};
-use faer::Mat;
+use faer::{Mat, MatRef};
 use std::collections::HashMap;
 use std::sync::atomic::Ordering;
 
@@ -64,6 +64,7 @@ use super::lmpar::{norm2, Subproblem};
 use super::lsq::{LsqOptions, Residuals, Termination};
 use super::observer::ProgressObserver;
 use super::problem::{Evaluator, LeastSquares, View};
+use super::qr::PivotedQr;
 use super::state::{LmStage, LmState};
 
 /// The outcome of the iteration proper (no covariance).
@@ -76,17 +77,14 @@ pub(crate) struct Solution {
     pub iterations: usize,
 }
 
-/// One Levenberg–Marquardt run (MINPACK `lmder` with projection on the box): the point reached,
-/// the trust region, the scaling and the work space, advanced one outer iteration (one
-/// Jacobian) at a time by [`LmRun::iterate`].
+/// The work space of a fit (m residuals, n parameters): the Jacobian, its factorisation, the
+/// subproblem and the trial point. A run hands it to the restart or the polish after it
+/// ([`Work::reuse`]).
 #[derive(Debug, Clone)]
-struct LmRun {
-    x: Vec<f64>,
-    f: Vec<f64>,
-    fnorm: f64,
-    iterations: usize,
+struct Work {
     jac: Mat<f64>,
     jw: Mat<f64>,
+    qr: PivotedQr,
     diag: Vec<f64>,
     acnorm: Vec<f64>,
     qtf: Vec<f64>,
@@ -101,6 +99,55 @@ struct LmRun {
     /// Work space: a scaled vector and R·s (n).
     scaled: Vec<f64>,
     rs: Vec<f64>,
+}
+
+impl Work {
+    fn new(m: usize, n: usize) -> Self {
+        Work {
+            jac: Mat::<f64>::zeros(m, n),
+            jw: Mat::<f64>::zeros(m, n),
+            qr: PivotedQr::new(m, n),
+            diag: vec![0.0; n],
+            acnorm: vec![0.0; n],
+            qtf: vec![0.0; n],
+            grad: vec![0.0; n],
+            free: vec![true; n],
+            sp: Subproblem::new(n),
+            ipvt: vec![0usize; n],
+            trial: vec![0.0; n],
+            step: vec![0.0; n],
+            ft: vec![0.0; m],
+            u: vec![0.0; m],
+            scaled: vec![0.0; n],
+            rs: vec![0.0; n],
+        }
+    }
+
+    /// `work` made ready for the next stage, or new work space. Every buffer is written before
+    /// it is read, except those the problem writes (the Jacobian and the trial residuals),
+    /// which are zeroed as when new.
+    fn reuse(work: Option<Work>, m: usize, n: usize) -> Work {
+        match work {
+            Some(mut w) => {
+                w.jac.fill(0.0);
+                w.ft.fill(0.0);
+                w
+            }
+            None => Work::new(m, n),
+        }
+    }
+}
+
+/// One Levenberg–Marquardt run (MINPACK `lmder` with projection on the box): the point reached,
+/// the trust region, the scaling and the work space, advanced one outer iteration (one
+/// Jacobian) at a time by [`LmRun::iterate`].
+#[derive(Debug, Clone)]
+struct LmRun {
+    x: Vec<f64>,
+    f: Vec<f64>,
+    fnorm: f64,
+    iterations: usize,
+    w: Work,
     /// The Levenberg–Marquardt parameter λ.
     par: f64,
     /// The trust radius Δ.
@@ -115,9 +162,14 @@ struct LmRun {
 }
 
 impl LmRun {
-    /// Starts a run at `x0`, or returns the solution when the start already ends it (an
-    /// infeasible start, or χ² = 0).
-    fn start(ev: &mut Evaluator, ls: View<'_>, x0: Vec<f64>) -> Result<LmRun, Solution> {
+    /// Starts a run at `x0` (in the work space of `work`, taken when the run starts), or
+    /// returns the solution when the start already ends it (an infeasible start, or χ² = 0).
+    fn start(
+        ev: &mut Evaluator,
+        ls: View<'_>,
+        x0: Vec<f64>,
+        work: &mut Option<Work>,
+    ) -> Result<LmRun, Solution> {
         let (m, n) = (ev.m, ev.n);
         let mut f = vec![0.0; m];
         if !ev.residuals(ls, &x0, &mut f) {
@@ -145,21 +197,7 @@ impl LmRun {
             f,
             fnorm,
             iterations: 0,
-            jac: Mat::<f64>::zeros(m, n),
-            jw: Mat::<f64>::zeros(m, n),
-            diag: vec![0.0; n],
-            acnorm: vec![0.0; n],
-            qtf: vec![0.0; n],
-            grad: vec![0.0; n],
-            free: vec![true; n],
-            sp: Subproblem::new(n),
-            ipvt: vec![0usize; n],
-            trial: vec![0.0; n],
-            step: vec![0.0; n],
-            ft: vec![0.0; m],
-            u: vec![0.0; m],
-            scaled: vec![0.0; n],
-            rs: vec![0.0; n],
+            w: Work::reuse(work.take(), m, n),
             par: 0.0,
             delta: 0.0,
             xnorm: 0.0,
@@ -169,15 +207,16 @@ impl LmRun {
         })
     }
 
-    /// The run's result, ended by `termination`.
-    fn into_solution(self, termination: Termination) -> Solution {
-        Solution {
+    /// The run's result, ended by `termination`, and its work space.
+    fn end(self, termination: Termination) -> (Solution, Work) {
+        let sol = Solution {
             x: self.x,
             f: self.f,
             fnorm: self.fnorm,
             termination,
             iterations: self.iterations,
-        }
+        };
+        (sol, self.w)
     }
 
     /// One outer iteration: a Jacobian, then trial steps until one is accepted. Returns the
@@ -204,8 +243,18 @@ impl LmRun {
             f,
             fnorm,
             iterations,
+            w,
+            par,
+            delta,
+            xnorm,
+            first,
+            outer,
+            edge,
+        } = self;
+        let Work {
             jac,
             jw,
+            qr,
             diag,
             acnorm,
             qtf,
@@ -219,13 +268,7 @@ impl LmRun {
             u,
             scaled,
             rs,
-            par,
-            delta,
-            xnorm,
-            first,
-            outer,
-            edge,
-        } = self;
+        } = w;
 
         if *outer >= opts.max_iterations {
             return Some(Termination::MaxIterations);
@@ -261,16 +304,9 @@ impl LmRun {
             }
         }
         // QR with column pivoting of the (active-set) Jacobian; Qᵀf.
-        let qr = jw.col_piv_qr();
-        load_r(sp, ipvt, &qr, acnorm);
-        let q = qr.compute_thin_Q();
+        qr.factor(jw.as_ref(), |r, perm| load_r(sp, ipvt, r, perm, acnorm));
         for (j, q_j) in qtf.iter_mut().enumerate() {
-            *q_j = q
-                .col_as_slice(j)
-                .iter()
-                .zip(f.iter())
-                .map(|(a, b)| a * b)
-                .sum();
+            *q_j = qr.q_col(j).iter().zip(f.iter()).map(|(a, b)| a * b).sum();
         }
         // Scaled gradient norm (largest cosine between f and a free column of J).
         let mut gnorm: f64 = 0.0;
@@ -414,33 +450,17 @@ const POLISH_CONTRACTION: f64 = 0.9;
 /// Gauss–Newton step, computed from the gradient Jᵀf, still knows where the minimum is.
 #[derive(Debug, Clone)]
 struct Polisher {
-    jac: Mat<f64>,
-    sp: Subproblem,
-    ipvt: Vec<usize>,
-    qtf: Vec<f64>,
-    diag: Vec<f64>,
-    free: Vec<bool>,
-    trial: Vec<f64>,
-    step: Vec<f64>,
-    ft: Vec<f64>,
-    scaled: Vec<f64>,
+    /// The work space (of the run before, when there was one): the Jacobian is masked in
+    /// place, `diag` holds its column norms.
+    w: Work,
     previous: f64,
     steps: usize,
 }
 
 impl Polisher {
-    fn new(m: usize, n: usize) -> Self {
+    fn new(w: Work) -> Self {
         Polisher {
-            jac: Mat::<f64>::zeros(m, n),
-            sp: Subproblem::new(n),
-            ipvt: vec![0usize; n],
-            qtf: vec![0.0; n],
-            diag: vec![0.0; n],
-            free: vec![true; n],
-            trial: vec![0.0; n],
-            step: vec![0.0; n],
-            ft: vec![0.0; m],
-            scaled: vec![0.0; n],
+            w,
             previous: f64::INFINITY,
             steps: 0,
         }
@@ -463,7 +483,13 @@ impl Polisher {
         let (lo, hi) = (&ls.setup.lower, &ls.setup.upper);
         let xtol = opts.xtol.max(f64::EPSILON);
         let Polisher {
+            w,
+            previous,
+            steps: _,
+        } = self;
+        let Work {
             jac,
+            qr,
             sp,
             ipvt,
             qtf,
@@ -473,9 +499,8 @@ impl Polisher {
             step,
             ft,
             scaled,
-            previous,
-            steps: _,
-        } = self;
+            ..
+        } = w;
         if ev.nfev >= opts.max_residual_evals || !ev.jacobian(ls, &sol.x, &sol.f, jac) {
             return false;
         }
@@ -491,12 +516,10 @@ impl Polisher {
                 c.fill(0.0);
             }
         }
-        let qr = jac.col_piv_qr();
-        load_r(sp, ipvt, &qr, diag);
-        let q = qr.compute_thin_Q();
+        qr.factor(jac.as_ref(), |r, perm| load_r(sp, ipvt, r, perm, diag));
         for (j, q_j) in qtf.iter_mut().enumerate() {
-            *q_j = q
-                .col_as_slice(j)
+            *q_j = qr
+                .q_col(j)
                 .iter()
                 .zip(sol.f.iter())
                 .map(|(a, b)| a * b)
@@ -673,7 +696,7 @@ impl LevenbergMarquardt {
             Stage::Idle => None,
             Stage::Done(sol) | Stage::Polish { sol, .. } => Some(sol),
             Stage::Run { run, previous, .. } => {
-                let current = run.into_solution(mapped);
+                let (current, _) = run.end(mapped);
                 Some(match previous {
                     Some(p) if p.fnorm <= current.fnorm => Solution {
                         iterations: p.iterations + current.iterations,
@@ -692,13 +715,14 @@ impl LevenbergMarquardt {
 
     /// After a run ended with `sol`: restarts (from `sol`, if it converged and restarts are
     /// left), keeps the better of a restart and the run before it, then polishes a converged
-    /// solution.
+    /// solution. `work` is the work space of the run, if it started.
     fn settle(
         &mut self,
         ls: View<'_>,
         mut sol: Solution,
         mut restarts: usize,
         mut previous: Option<Solution>,
+        mut work: Option<Work>,
     ) -> Stage {
         loop {
             let current = match previous.take() {
@@ -709,12 +733,12 @@ impl LevenbergMarquardt {
                     if sol.termination.converged() || improved {
                         let s = Solution { iterations, ..sol };
                         if !improved {
-                            return self.finalise(s);
+                            return self.finalise(s, work);
                         }
                         s
                     } else {
                         prev.iterations = iterations;
-                        return self.finalise(prev);
+                        return self.finalise(prev, work);
                     }
                 }
             };
@@ -723,7 +747,7 @@ impl LevenbergMarquardt {
                 && current.termination != Termination::ExactFit
             {
                 restarts += 1;
-                match LmRun::start(&mut self.ev, ls, current.x.clone()) {
+                match LmRun::start(&mut self.ev, ls, current.x.clone(), &mut work) {
                     Ok(run) => {
                         return Stage::Run {
                             run: Box::new(run),
@@ -738,18 +762,18 @@ impl LevenbergMarquardt {
                     }
                 }
             }
-            return self.finalise(current);
+            return self.finalise(current, work);
         }
     }
 
-    /// Polish a converged solution (if asked), else finish.
-    fn finalise(&self, sol: Solution) -> Stage {
+    /// Polish a converged solution (if asked; in `work`, if there is one), else finish.
+    fn finalise(&self, sol: Solution, work: Option<Work>) -> Stage {
         if self.opts.polish
             && sol.termination.converged()
             && sol.termination != Termination::ExactFit
         {
             Stage::Polish {
-                polisher: Box::new(Polisher::new(self.ev.m, self.ev.n)),
+                polisher: Box::new(Polisher::new(Work::reuse(work, self.ev.m, self.ev.n))),
                 sol,
             }
         } else {
@@ -765,14 +789,14 @@ impl LevenbergMarquardt {
                 let steps = run.iterations + previous.as_ref().map_or(0, |p| p.iterations);
                 state.set_lm(LmStage::Lm, run.par, run.delta, steps);
                 if run.outer > 0 {
-                    state.set_scaling(&run.diag, &run.free);
+                    state.set_scaling(&run.w.diag, &run.w.free);
                 }
                 (&run.x, run.fnorm)
             }
             Stage::Polish { polisher, sol } => {
                 state.set_lm(LmStage::Polish, 0.0, f64::INFINITY, sol.iterations);
                 if polisher.steps > 0 {
-                    state.set_scaling(&polisher.diag, &polisher.free);
+                    state.set_scaling(&polisher.w.diag, &polisher.w.free);
                 }
                 (&sol.x, sol.fnorm)
             }
@@ -856,13 +880,13 @@ impl LevenbergMarquardt {
             }
         };
         self.ev = Evaluator::new(m, n);
-        self.stage = match LmRun::start(&mut self.ev, ls, start) {
+        self.stage = match LmRun::start(&mut self.ev, ls, start, &mut None) {
             Ok(run) => Stage::Run {
                 run: Box::new(run),
                 restarts: 0,
                 previous: None,
             },
-            Err(sol) => self.settle(ls, sol, 0, None),
+            Err(sol) => self.settle(ls, sol, 0, None, None),
         };
         self.count(&state, counts);
         self.report(state)
@@ -897,7 +921,10 @@ impl LevenbergMarquardt {
                     run,
                     restarts,
                     previous,
-                } => self.settle(ls, run.into_solution(t), restarts, previous),
+                } => {
+                    let (sol, work) = run.end(t);
+                    self.settle(ls, sol, restarts, previous, Some(work))
+                }
                 Stage::Polish { sol, .. } => Stage::Done(sol),
                 other => other,
             };
@@ -940,13 +967,12 @@ impl<R: Residuals> Solver<LeastSquares<R>, LmState> for LevenbergMarquardt {
 fn load_r(
     sp: &mut Subproblem,
     ipvt: &mut [usize],
-    qr: &faer::linalg::solvers::ColPivQr<f64>,
+    r: MatRef<'_, f64>,
+    perm: &[usize],
     colnorm: &[f64],
 ) {
     let n = ipvt.len();
-    let r = qr.thin_R();
-    let (fwd, _) = qr.P().arrays();
-    ipvt.copy_from_slice(fwd);
+    ipvt.copy_from_slice(perm);
     for j in 0..n {
         for i in 0..n {
             sp.r[i + j * n] = if i <= j { r[(i, j)] } else { 0.0 };

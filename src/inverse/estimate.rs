@@ -11,7 +11,7 @@ use faer::Mat;
 
 use argmin::core::OptimizationResult;
 
-use super::lm::{into_parts, solve, DynLeastSquares, LevenbergMarquardt, Solution};
+use super::lm::{into_parts, solve, DynLeastSquares, LevenbergMarquardt, Solution, Spare};
 use super::lmpar::norm2;
 use super::lsq::{LsqError, LsqOptions, Residuals, SigmaKind, Termination};
 use super::problem::{Evaluator, LeastSquares, View};
@@ -113,7 +113,8 @@ pub fn fit<R: Residuals + ?Sized>(
     opts: &LsqOptions,
 ) -> Result<Fit, LsqError> {
     let ls = DynLeastSquares::new(&problem, start, opts)?;
-    let (sol, mut ev, ls) = solve(ls, opts).map_err(|e| LsqError::Solver(e.to_string()))?;
+    let (sol, mut ev, ls) =
+        solve(ls, opts, &mut Spare::new()).map_err(|e| LsqError::Solver(e.to_string()))?;
     Ok(finish(&mut ev, ls.view(), sol, opts.sigma))
 }
 
@@ -127,8 +128,8 @@ pub fn fit_result<R: Residuals>(
     result: OptimizationResult<LeastSquares<R>, LevenbergMarquardt, LmState>,
     sigma: SigmaKind,
 ) -> Result<Fit, LsqError> {
-    let (sol, mut ev, ls) = into_parts(result).map_err(|e| LsqError::Solver(e.to_string()))?;
-    Ok(finish(&mut ev, ls.view(), sol, sigma))
+    let (sol, solver, ls) = into_parts(result).map_err(|e| LsqError::Solver(e.to_string()))?;
+    Ok(finish(&mut solver.into_evaluator(), ls.view(), sol, sigma))
 }
 
 /// The [`Fit`] of a solution: statistics, and the covariance from the Jacobian at the estimate.

@@ -123,18 +123,30 @@ impl Work {
         }
     }
 
-    /// `work` made ready for the next stage, or new work space. Every buffer is written before
-    /// it is read, except those the problem writes (the Jacobian and the trial residuals),
-    /// which are zeroed as when new.
+    /// `work` made ready for the next stage, or new work space when there is none of this
+    /// shape. Every buffer is written before it is read, except those the problem writes (the
+    /// Jacobian and the trial residuals), which are zeroed as when new.
     fn reuse(work: Option<Work>, m: usize, n: usize) -> Work {
         match work {
-            Some(mut w) => {
+            Some(mut w) if w.jac.nrows() == m && w.jac.ncols() == n => {
                 w.jac.fill(0.0);
                 w.ft.fill(0.0);
                 w
             }
-            None => Work::new(m, n),
+            _ => Work::new(m, n),
         }
+    }
+}
+
+/// Work space passed from one fit to the next ([`solve`]): a caller that runs many fits of the
+/// same shape (the profiles' constrained fits) allocates it once.
+#[derive(Debug, Default)]
+pub(crate) struct Spare(Option<Work>);
+
+impl Spare {
+    /// No work space yet.
+    pub fn new() -> Self {
+        Spare(None)
     }
 }
 
@@ -304,7 +316,7 @@ impl LmRun {
             }
         }
         // QR with column pivoting of the (active-set) Jacobian; Qᵀf.
-        qr.factor(jw.as_ref(), |r, perm| load_r(sp, ipvt, r, perm, acnorm));
+        qr.factor(jw, |r, perm| load_r(sp, ipvt, r, perm, acnorm));
         for (j, q_j) in qtf.iter_mut().enumerate() {
             *q_j = qr.q_col(j).iter().zip(f.iter()).map(|(a, b)| a * b).sum();
         }
@@ -516,7 +528,7 @@ impl Polisher {
                 c.fill(0.0);
             }
         }
-        qr.factor(jac.as_ref(), |r, perm| load_r(sp, ipvt, r, perm, diag));
+        qr.factor(jac, |r, perm| load_r(sp, ipvt, r, perm, diag));
         for (j, q_j) in qtf.iter_mut().enumerate() {
             *q_j = qr
                 .q_col(j)
@@ -624,6 +636,8 @@ pub struct LevenbergMarquardt {
     /// Whether argmin's function counts are kept (off only for [`solve`], which discards
     /// them).
     counts: bool,
+    /// Work space for the next run, and the last run's once the solver has finished.
+    spare: Option<Work>,
 }
 
 impl LevenbergMarquardt {
@@ -652,6 +666,7 @@ impl LevenbergMarquardt {
             stage: Stage::Idle,
             log: false,
             counts: true,
+            spare: None,
         }
     }
 
@@ -679,6 +694,11 @@ impl LevenbergMarquardt {
     /// Jacobian evaluations so far.
     pub fn jacobian_evals(&self) -> usize {
         self.ev.njev
+    }
+
+    /// The evaluator: its counts and work space.
+    pub(crate) fn into_evaluator(self) -> Evaluator {
+        self.ev
     }
 
     /// The solution reached: the finished one, or, when argmin stopped the run
@@ -767,7 +787,7 @@ impl LevenbergMarquardt {
     }
 
     /// Polish a converged solution (if asked; in `work`, if there is one), else finish.
-    fn finalise(&self, sol: Solution, work: Option<Work>) -> Stage {
+    fn finalise(&mut self, sol: Solution, work: Option<Work>) -> Stage {
         if self.opts.polish
             && sol.termination.converged()
             && sol.termination != Termination::ExactFit
@@ -777,6 +797,9 @@ impl LevenbergMarquardt {
                 sol,
             }
         } else {
+            if work.is_some() {
+                self.spare = work;
+            }
             Stage::Done(sol)
         }
     }
@@ -880,13 +903,14 @@ impl LevenbergMarquardt {
             }
         };
         self.ev = Evaluator::new(m, n);
-        self.stage = match LmRun::start(&mut self.ev, ls, start, &mut None) {
+        let mut spare = self.spare.take();
+        self.stage = match LmRun::start(&mut self.ev, ls, start, &mut spare) {
             Ok(run) => Stage::Run {
                 run: Box::new(run),
                 restarts: 0,
                 previous: None,
             },
-            Err(sol) => self.settle(ls, sol, 0, None, None),
+            Err(sol) => self.settle(ls, sol, 0, None, spare),
         };
         self.count(&state, counts);
         self.report(state)
@@ -925,7 +949,10 @@ impl LevenbergMarquardt {
                     let (sol, work) = run.end(t);
                     self.settle(ls, sol, restarts, previous, Some(work))
                 }
-                Stage::Polish { sol, .. } => Stage::Done(sol),
+                Stage::Polish { sol, polisher } => {
+                    self.spare = Some(polisher.w);
+                    Stage::Done(sol)
+                }
                 other => other,
             };
         }
@@ -1004,9 +1031,11 @@ pub(crate) type DynLeastSquares<'a> = LeastSquares<&'a dyn Residuals>;
 pub(crate) fn solve<'a>(
     ls: DynLeastSquares<'a>,
     opts: &LsqOptions,
+    spare: &mut Spare,
 ) -> Result<(Solution, Evaluator, DynLeastSquares<'a>), Error> {
     let solver = LevenbergMarquardt {
         counts: false,
+        spare: spare.0.take(),
         ..LevenbergMarquardt::new(opts)
     };
     let mut executor = argmin::core::Executor::new(ls, solver)
@@ -1016,13 +1045,15 @@ pub(crate) fn solve<'a>(
         executor =
             executor.add_observer(ProgressObserver::new(tally.clone()), ObserverMode::Always);
     }
-    into_parts(executor.run()?)
+    let (sol, solver, ls) = into_parts(executor.run()?)?;
+    spare.0 = solver.spare;
+    Ok((sol, solver.ev, ls))
 }
 
-/// The solution, the evaluator and the problem of an executor's result.
+/// The solution, the solver and the problem of an executor's result.
 pub(crate) fn into_parts<R: Residuals>(
     result: argmin::core::OptimizationResult<LeastSquares<R>, LevenbergMarquardt, LmState>,
-) -> Result<(Solution, Evaluator, LeastSquares<R>), Error> {
+) -> Result<(Solution, LevenbergMarquardt, LeastSquares<R>), Error> {
     let mut result = result;
     let reason = result.state.get_termination_reason();
     let sol = result
@@ -1033,5 +1064,5 @@ pub(crate) fn into_parts<R: Residuals>(
         .problem
         .problem
         .ok_or_else(|| Error::msg("the executor lost the problem"))?;
-    Ok((sol, result.solver.ev, ls))
+    Ok((sol, result.solver, ls))
 }

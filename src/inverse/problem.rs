@@ -302,6 +302,7 @@ pub(crate) struct Evaluator {
     pub analytic: usize,
     /// Whether the last Jacobian came by finite differences.
     pub differenced: bool,
+    /// Work space of the finite differences (m, m and n), allocated by the first of them.
     work: Vec<f64>,
     work2: Vec<f64>,
     xp: Vec<f64>,
@@ -316,9 +317,9 @@ impl Evaluator {
             njev: 0,
             analytic: 0,
             differenced: false,
-            work: vec![0.0; m],
-            work2: vec![0.0; m],
-            xp: vec![0.0; n],
+            work: Vec::new(),
+            work2: Vec::new(),
+            xp: Vec::new(),
         }
     }
 
@@ -384,6 +385,11 @@ impl Evaluator {
     }
 
     fn differences(&mut self, ls: View<'_>, x: &[f64], f: &[f64], jac: &mut Mat<f64>) -> bool {
+        if self.xp.len() != self.n {
+            self.work = vec![0.0; self.m];
+            self.work2 = vec![0.0; self.m];
+            self.xp = vec![0.0; self.n];
+        }
         let eta = f64::EPSILON.cbrt();
         for j in 0..self.n {
             let xj = x[j];

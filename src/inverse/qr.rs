@@ -70,10 +70,14 @@ impl PivotedQr {
 
     /// Factors `j` (m × n), then calls `with` with R (n × n, upper triangle; the strict lower
     /// triangle holds no part of it) and the permutation, then forms Q's first n columns.
-    pub fn factor(&mut self, j: MatRef<'_, f64>, with: impl FnOnce(MatRef<'_, f64>, &[usize])) {
+    pub fn factor(&mut self, j: &Mat<f64>, with: impl FnOnce(MatRef<'_, f64>, &[usize])) {
         let (m, n) = (self.a.nrows(), self.a.ncols());
         let par = get_global_parallelism();
-        self.a.copy_from(j);
+        for c in 0..n {
+            self.a
+                .col_as_slice_mut(c)
+                .copy_from_slice(j.col_as_slice(c));
+        }
         self.coeff.fill(0.0);
         qr_in_place(
             self.a.as_mut(),
@@ -152,7 +156,7 @@ mod tests {
                     let r = qr.thin_R();
                     let q = qr.compute_thin_Q();
                     let (fwd, _) = qr.P().arrays();
-                    work.factor(j.as_ref(), |rr, p| {
+                    work.factor(&j, |rr, p| {
                         assert_eq!(p, fwd);
                         for c in 0..n {
                             for i in 0..=c {

@@ -50,6 +50,15 @@
 //! Each argmin iteration is one outer iteration (one Jacobian, then trial steps until one is
 //! accepted) or one polish step; the solver's reasons for stopping are [`Termination`]s, and the
 //! estimate with its covariance is [`super::fit`]'s [`super::Fit`].
+//!
+//! The iteration is compiled once, whatever the problem: it sees the residuals through a trait
+//! object (`&dyn Residuals`, with the box), and the [`Solver`] implementation, generic over the
+//! problem, only unwraps argmin's problem and calls it. [`super::fit`] and the profiles run
+//! argmin's `Executor` on that trait object too (`DynLeastSquares`), so one copy of the
+//! executor loop and of the iteration serves every fit. The work space (the Jacobian, its
+//! pivoted QR factors, the subproblem, the trial point) is allocated when a fit starts and
+//! passed on to its restarts and its polish; the profiles' constrained fits, all of one shape,
+//! share it (`Spare`).
 
 // Index loops mirror the subscripts of the published algorithm (MINPACK-1).
 #![allow(clippy::needless_range_loop)]

@@ -11,10 +11,10 @@ use faer::Mat;
 
 use argmin::core::OptimizationResult;
 
-use super::lm::{into_parts, solve, LevenbergMarquardt, Solution};
+use super::lm::{into_parts, solve, DynLeastSquares, LevenbergMarquardt, Solution, Spare};
 use super::lmpar::norm2;
 use super::lsq::{LsqError, LsqOptions, Residuals, SigmaKind, Termination};
-use super::problem::{Evaluator, LeastSquares};
+use super::problem::{Evaluator, LeastSquares, View};
 use super::state::LmState;
 
 /// Covariance of the estimates, from the SVD of the Jacobian at the optimum.
@@ -112,9 +112,10 @@ pub fn fit<R: Residuals + ?Sized>(
     start: &[f64],
     opts: &LsqOptions,
 ) -> Result<Fit, LsqError> {
-    let ls = LeastSquares::new(problem, start, opts)?;
-    let (sol, mut ev, ls) = solve(ls, opts).map_err(|e| LsqError::Solver(e.to_string()))?;
-    Ok(finish(&mut ev, &ls, sol, opts.sigma))
+    let ls = DynLeastSquares::new(&problem, start, opts)?;
+    let (sol, mut ev, ls) =
+        solve(ls, opts, &mut Spare::new()).map_err(|e| LsqError::Solver(e.to_string()))?;
+    Ok(finish(&mut ev, ls.view(), sol, opts.sigma))
 }
 
 /// The [`Fit`] (estimate, statistics and covariance) of a run of
@@ -127,16 +128,12 @@ pub fn fit_result<R: Residuals>(
     result: OptimizationResult<LeastSquares<R>, LevenbergMarquardt, LmState>,
     sigma: SigmaKind,
 ) -> Result<Fit, LsqError> {
-    let (sol, mut ev, ls) = into_parts(result).map_err(|e| LsqError::Solver(e.to_string()))?;
-    Ok(finish(&mut ev, &ls, sol, sigma))
+    let (sol, solver, ls) = into_parts(result).map_err(|e| LsqError::Solver(e.to_string()))?;
+    Ok(finish(&mut solver.into_evaluator(), ls.view(), sol, sigma))
 }
 
-fn finish<R: Residuals>(
-    ev: &mut Evaluator,
-    ls: &LeastSquares<R>,
-    sol: Solution,
-    sigma: SigmaKind,
-) -> Fit {
+/// The [`Fit`] of a solution: statistics, and the covariance from the Jacobian at the estimate.
+fn finish(ev: &mut Evaluator, ls: View<'_>, sol: Solution, sigma: SigmaKind) -> Fit {
     let (m, n) = (ev.m, ev.n);
     let dof = m - n;
     let chi2 = if sol.fnorm.is_finite() {

@@ -50,19 +50,30 @@
 //! Each argmin iteration is one outer iteration (one Jacobian, then trial steps until one is
 //! accepted) or one polish step; the solver's reasons for stopping are [`Termination`]s, and the
 //! estimate with its covariance is [`super::fit`]'s [`super::Fit`].
+//!
+//! The iteration is compiled once, whatever the problem: it sees the residuals through a trait
+//! object (`&dyn Residuals`, with the box), and the [`Solver`] implementation, generic over the
+//! problem, only unwraps argmin's problem and calls it. [`super::fit`] and the profiles run
+//! argmin's `Executor` on that trait object too (`DynLeastSquares`), so one copy of the
+//! executor loop and of the iteration serves every fit. The work space (the Jacobian, its
+//! pivoted QR factors, the subproblem, the trial point) is allocated when a fit starts and
+//! passed on to its restarts and its polish; the profiles' constrained fits, all of one shape,
+//! share it (`Spare`).
 
 // Index loops mirror the subscripts of the published algorithm (MINPACK-1).
 #![allow(clippy::needless_range_loop)]
 
 use argmin::core::observers::ObserverMode;
 use argmin::core::{Error, Problem, Solver, State, TerminationReason, KV};
-use faer::Mat;
+use faer::{Mat, MatRef};
+use std::collections::HashMap;
 use std::sync::atomic::Ordering;
 
 use super::lmpar::{norm2, Subproblem};
 use super::lsq::{LsqOptions, Residuals, Termination};
 use super::observer::ProgressObserver;
-use super::problem::{Evaluator, LeastSquares};
+use super::problem::{Evaluator, LeastSquares, View};
+use super::qr::PivotedQr;
 use super::state::{LmStage, LmState};
 
 /// The outcome of the iteration proper (no covariance).
@@ -75,17 +86,14 @@ pub(crate) struct Solution {
     pub iterations: usize,
 }
 
-/// One Levenberg–Marquardt run (MINPACK `lmder` with projection on the box): the point reached,
-/// the trust region, the scaling and the work space, advanced one outer iteration (one
-/// Jacobian) at a time by [`LmRun::iterate`].
+/// The work space of a fit (m residuals, n parameters): the Jacobian, its factorisation, the
+/// subproblem and the trial point. A run hands it to the restart or the polish after it
+/// ([`Work::reuse`]).
 #[derive(Debug, Clone)]
-struct LmRun {
-    x: Vec<f64>,
-    f: Vec<f64>,
-    fnorm: f64,
-    iterations: usize,
+struct Work {
     jac: Mat<f64>,
     jw: Mat<f64>,
+    qr: PivotedQr,
     diag: Vec<f64>,
     acnorm: Vec<f64>,
     qtf: Vec<f64>,
@@ -100,6 +108,67 @@ struct LmRun {
     /// Work space: a scaled vector and R·s (n).
     scaled: Vec<f64>,
     rs: Vec<f64>,
+}
+
+impl Work {
+    fn new(m: usize, n: usize) -> Self {
+        Work {
+            jac: Mat::<f64>::zeros(m, n),
+            jw: Mat::<f64>::zeros(m, n),
+            qr: PivotedQr::new(m, n),
+            diag: vec![0.0; n],
+            acnorm: vec![0.0; n],
+            qtf: vec![0.0; n],
+            grad: vec![0.0; n],
+            free: vec![true; n],
+            sp: Subproblem::new(n),
+            ipvt: vec![0usize; n],
+            trial: vec![0.0; n],
+            step: vec![0.0; n],
+            ft: vec![0.0; m],
+            u: vec![0.0; m],
+            scaled: vec![0.0; n],
+            rs: vec![0.0; n],
+        }
+    }
+
+    /// `work` made ready for the next stage, or new work space when there is none of this
+    /// shape. Every buffer is written before it is read, except those the problem writes (the
+    /// Jacobian and the trial residuals), which are zeroed as when new.
+    fn reuse(work: Option<Work>, m: usize, n: usize) -> Work {
+        match work {
+            Some(mut w) if w.jac.nrows() == m && w.jac.ncols() == n => {
+                w.jac.fill(0.0);
+                w.ft.fill(0.0);
+                w
+            }
+            _ => Work::new(m, n),
+        }
+    }
+}
+
+/// Work space passed from one fit to the next ([`solve`]): a caller that runs many fits of the
+/// same shape (the profiles' constrained fits) allocates it once.
+#[derive(Debug, Default)]
+pub(crate) struct Spare(Option<Work>);
+
+impl Spare {
+    /// No work space yet.
+    pub fn new() -> Self {
+        Spare(None)
+    }
+}
+
+/// One Levenberg–Marquardt run (MINPACK `lmder` with projection on the box): the point reached,
+/// the trust region, the scaling and the work space, advanced one outer iteration (one
+/// Jacobian) at a time by [`LmRun::iterate`].
+#[derive(Debug, Clone)]
+struct LmRun {
+    x: Vec<f64>,
+    f: Vec<f64>,
+    fnorm: f64,
+    iterations: usize,
+    w: Work,
     /// The Levenberg–Marquardt parameter λ.
     par: f64,
     /// The trust radius Δ.
@@ -114,12 +183,13 @@ struct LmRun {
 }
 
 impl LmRun {
-    /// Starts a run at `x0`, or returns the solution when the start already ends it (an
-    /// infeasible start, or χ² = 0).
-    fn start<R: Residuals>(
+    /// Starts a run at `x0` (in the work space of `work`, taken when the run starts), or
+    /// returns the solution when the start already ends it (an infeasible start, or χ² = 0).
+    fn start(
         ev: &mut Evaluator,
-        ls: &LeastSquares<R>,
+        ls: View<'_>,
         x0: Vec<f64>,
+        work: &mut Option<Work>,
     ) -> Result<LmRun, Solution> {
         let (m, n) = (ev.m, ev.n);
         let mut f = vec![0.0; m];
@@ -148,21 +218,7 @@ impl LmRun {
             f,
             fnorm,
             iterations: 0,
-            jac: Mat::<f64>::zeros(m, n),
-            jw: Mat::<f64>::zeros(m, n),
-            diag: vec![0.0; n],
-            acnorm: vec![0.0; n],
-            qtf: vec![0.0; n],
-            grad: vec![0.0; n],
-            free: vec![true; n],
-            sp: Subproblem::new(n),
-            ipvt: vec![0usize; n],
-            trial: vec![0.0; n],
-            step: vec![0.0; n],
-            ft: vec![0.0; m],
-            u: vec![0.0; m],
-            scaled: vec![0.0; n],
-            rs: vec![0.0; n],
+            w: Work::reuse(work.take(), m, n),
             par: 0.0,
             delta: 0.0,
             xnorm: 0.0,
@@ -172,23 +228,24 @@ impl LmRun {
         })
     }
 
-    /// The run's result, ended by `termination`.
-    fn into_solution(self, termination: Termination) -> Solution {
-        Solution {
+    /// The run's result, ended by `termination`, and its work space.
+    fn end(self, termination: Termination) -> (Solution, Work) {
+        let sol = Solution {
             x: self.x,
             f: self.f,
             fnorm: self.fnorm,
             termination,
             iterations: self.iterations,
-        }
+        };
+        (sol, self.w)
     }
 
     /// One outer iteration: a Jacobian, then trial steps until one is accepted. Returns the
     /// reason when the run ends.
-    fn iterate<R: Residuals>(
+    fn iterate(
         &mut self,
         ev: &mut Evaluator,
-        ls: &LeastSquares<R>,
+        ls: View<'_>,
         opts: &LsqOptions,
     ) -> Option<Termination> {
         let n = ev.n;
@@ -207,8 +264,18 @@ impl LmRun {
             f,
             fnorm,
             iterations,
+            w,
+            par,
+            delta,
+            xnorm,
+            first,
+            outer,
+            edge,
+        } = self;
+        let Work {
             jac,
             jw,
+            qr,
             diag,
             acnorm,
             qtf,
@@ -222,13 +289,7 @@ impl LmRun {
             u,
             scaled,
             rs,
-            par,
-            delta,
-            xnorm,
-            first,
-            outer,
-            edge,
-        } = self;
+        } = w;
 
         if *outer >= opts.max_iterations {
             return Some(Termination::MaxIterations);
@@ -264,16 +325,9 @@ impl LmRun {
             }
         }
         // QR with column pivoting of the (active-set) Jacobian; Qᵀf.
-        let qr = jw.col_piv_qr();
-        load_r(sp, ipvt, &qr, acnorm);
-        let q = qr.compute_thin_Q();
+        qr.factor(jw, |r, perm| load_r(sp, ipvt, r, perm, acnorm));
         for (j, q_j) in qtf.iter_mut().enumerate() {
-            *q_j = q
-                .col_as_slice(j)
-                .iter()
-                .zip(f.iter())
-                .map(|(a, b)| a * b)
-                .sum();
+            *q_j = qr.q_col(j).iter().zip(f.iter()).map(|(a, b)| a * b).sum();
         }
         // Scaled gradient norm (largest cosine between f and a free column of J).
         let mut gnorm: f64 = 0.0;
@@ -417,33 +471,17 @@ const POLISH_CONTRACTION: f64 = 0.9;
 /// Gauss–Newton step, computed from the gradient Jᵀf, still knows where the minimum is.
 #[derive(Debug, Clone)]
 struct Polisher {
-    jac: Mat<f64>,
-    sp: Subproblem,
-    ipvt: Vec<usize>,
-    qtf: Vec<f64>,
-    diag: Vec<f64>,
-    free: Vec<bool>,
-    trial: Vec<f64>,
-    step: Vec<f64>,
-    ft: Vec<f64>,
-    scaled: Vec<f64>,
+    /// The work space (of the run before, when there was one): the Jacobian is masked in
+    /// place, `diag` holds its column norms.
+    w: Work,
     previous: f64,
     steps: usize,
 }
 
 impl Polisher {
-    fn new(m: usize, n: usize) -> Self {
+    fn new(w: Work) -> Self {
         Polisher {
-            jac: Mat::<f64>::zeros(m, n),
-            sp: Subproblem::new(n),
-            ipvt: vec![0usize; n],
-            qtf: vec![0.0; n],
-            diag: vec![0.0; n],
-            free: vec![true; n],
-            trial: vec![0.0; n],
-            step: vec![0.0; n],
-            ft: vec![0.0; m],
-            scaled: vec![0.0; n],
+            w,
             previous: f64::INFINITY,
             steps: 0,
         }
@@ -451,10 +489,10 @@ impl Polisher {
 
     /// Tries one polish step from `sol`; true when it was taken (and `sol` moved), false when
     /// the polish is over.
-    fn step<R: Residuals>(
+    fn step(
         &mut self,
         ev: &mut Evaluator,
-        ls: &LeastSquares<R>,
+        ls: View<'_>,
         opts: &LsqOptions,
         sol: &mut Solution,
     ) -> bool {
@@ -466,7 +504,13 @@ impl Polisher {
         let (lo, hi) = (&ls.setup.lower, &ls.setup.upper);
         let xtol = opts.xtol.max(f64::EPSILON);
         let Polisher {
+            w,
+            previous,
+            steps: _,
+        } = self;
+        let Work {
             jac,
+            qr,
             sp,
             ipvt,
             qtf,
@@ -476,9 +520,8 @@ impl Polisher {
             step,
             ft,
             scaled,
-            previous,
-            steps: _,
-        } = self;
+            ..
+        } = w;
         if ev.nfev >= opts.max_residual_evals || !ev.jacobian(ls, &sol.x, &sol.f, jac) {
             return false;
         }
@@ -494,12 +537,10 @@ impl Polisher {
                 c.fill(0.0);
             }
         }
-        let qr = jac.col_piv_qr();
-        load_r(sp, ipvt, &qr, diag);
-        let q = qr.compute_thin_Q();
+        qr.factor(jac, |r, perm| load_r(sp, ipvt, r, perm, diag));
         for (j, q_j) in qtf.iter_mut().enumerate() {
-            *q_j = q
-                .col_as_slice(j)
+            *q_j = qr
+                .q_col(j)
                 .iter()
                 .zip(sol.f.iter())
                 .map(|(a, b)| a * b)
@@ -601,6 +642,11 @@ pub struct LevenbergMarquardt {
     ev: Evaluator,
     stage: Stage,
     log: bool,
+    /// Whether argmin's function counts are kept (off only for [`solve`], which discards
+    /// them).
+    counts: bool,
+    /// Work space for the next run, and the last run's once the solver has finished.
+    spare: Option<Work>,
 }
 
 impl LevenbergMarquardt {
@@ -628,6 +674,8 @@ impl LevenbergMarquardt {
             ev: Evaluator::new(0, 0),
             stage: Stage::Idle,
             log: false,
+            counts: true,
+            spare: None,
         }
     }
 
@@ -657,6 +705,11 @@ impl LevenbergMarquardt {
         self.ev.njev
     }
 
+    /// The evaluator: its counts and work space.
+    pub(crate) fn into_evaluator(self) -> Evaluator {
+        self.ev
+    }
+
     /// The solution reached: the finished one, or, when argmin stopped the run
     /// (`reason`, from the final state), the current point with `reason` mapped onto
     /// [`Termination`] (an interrupt or a timeout is [`Termination::Interrupted`], the
@@ -672,7 +725,7 @@ impl LevenbergMarquardt {
             Stage::Idle => None,
             Stage::Done(sol) | Stage::Polish { sol, .. } => Some(sol),
             Stage::Run { run, previous, .. } => {
-                let current = run.into_solution(mapped);
+                let (current, _) = run.end(mapped);
                 Some(match previous {
                     Some(p) if p.fnorm <= current.fnorm => Solution {
                         iterations: p.iterations + current.iterations,
@@ -689,22 +742,16 @@ impl LevenbergMarquardt {
         }
     }
 
-    /// Moves the evaluator's counts into argmin's function counts (every iteration when the
-    /// state counts, `LmState::counting`, else once the solver has finished).
-    fn count<R>(&self, problem: &mut Problem<LeastSquares<R>>) {
-        problem.counts.insert("operator_count", self.ev.nfev as u64);
-        problem.counts.insert("jacobian_count", self.ev.njev as u64);
-    }
-
     /// After a run ended with `sol`: restarts (from `sol`, if it converged and restarts are
     /// left), keeps the better of a restart and the run before it, then polishes a converged
-    /// solution.
-    fn settle<R: Residuals>(
+    /// solution. `work` is the work space of the run, if it started.
+    fn settle(
         &mut self,
-        ls: &LeastSquares<R>,
+        ls: View<'_>,
         mut sol: Solution,
         mut restarts: usize,
         mut previous: Option<Solution>,
+        mut work: Option<Work>,
     ) -> Stage {
         loop {
             let current = match previous.take() {
@@ -715,12 +762,12 @@ impl LevenbergMarquardt {
                     if sol.termination.converged() || improved {
                         let s = Solution { iterations, ..sol };
                         if !improved {
-                            return self.finalise(s);
+                            return self.finalise(s, work);
                         }
                         s
                     } else {
                         prev.iterations = iterations;
-                        return self.finalise(prev);
+                        return self.finalise(prev, work);
                     }
                 }
             };
@@ -729,7 +776,7 @@ impl LevenbergMarquardt {
                 && current.termination != Termination::ExactFit
             {
                 restarts += 1;
-                match LmRun::start(&mut self.ev, ls, current.x.clone()) {
+                match LmRun::start(&mut self.ev, ls, current.x.clone(), &mut work) {
                     Ok(run) => {
                         return Stage::Run {
                             run: Box::new(run),
@@ -744,21 +791,24 @@ impl LevenbergMarquardt {
                     }
                 }
             }
-            return self.finalise(current);
+            return self.finalise(current, work);
         }
     }
 
-    /// Polish a converged solution (if asked), else finish.
-    fn finalise(&self, sol: Solution) -> Stage {
+    /// Polish a converged solution (if asked; in `work`, if there is one), else finish.
+    fn finalise(&mut self, sol: Solution, work: Option<Work>) -> Stage {
         if self.opts.polish
             && sol.termination.converged()
             && sol.termination != Termination::ExactFit
         {
             Stage::Polish {
-                polisher: Box::new(Polisher::new(self.ev.m, self.ev.n)),
+                polisher: Box::new(Polisher::new(Work::reuse(work, self.ev.m, self.ev.n))),
                 sol,
             }
         } else {
+            if work.is_some() {
+                self.spare = work;
+            }
             Stage::Done(sol)
         }
     }
@@ -771,14 +821,14 @@ impl LevenbergMarquardt {
                 let steps = run.iterations + previous.as_ref().map_or(0, |p| p.iterations);
                 state.set_lm(LmStage::Lm, run.par, run.delta, steps);
                 if run.outer > 0 {
-                    state.set_scaling(&run.diag, &run.free);
+                    state.set_scaling(&run.w.diag, &run.w.free);
                 }
                 (&run.x, run.fnorm)
             }
             Stage::Polish { polisher, sol } => {
                 state.set_lm(LmStage::Polish, 0.0, f64::INFINITY, sol.iterations);
                 if polisher.steps > 0 {
-                    state.set_scaling(&polisher.diag, &polisher.free);
+                    state.set_scaling(&polisher.w.diag, &polisher.w.free);
                 }
                 (&sol.x, sol.fnorm)
             }
@@ -811,31 +861,48 @@ impl LevenbergMarquardt {
     }
 }
 
-/// The least-squares problem inside argmin's wrapper.
-fn inner<R>(problem: &Problem<LeastSquares<R>>) -> Result<&LeastSquares<R>, Error> {
-    problem
-        .problem
-        .as_ref()
-        .ok_or_else(|| Error::msg("no least-squares problem"))
+/// The least-squares problem inside argmin's wrapper, as the iteration sees it, and argmin's
+/// function counts.
+fn parts<R: Residuals>(
+    problem: &mut Problem<LeastSquares<R>>,
+) -> Result<(View<'_>, &mut Counts), Error> {
+    match &problem.problem {
+        Some(ls) => Ok((ls.view(), &mut problem.counts)),
+        None => Err(Error::msg("no least-squares problem")),
+    }
 }
 
-impl<R: Residuals> Solver<LeastSquares<R>, LmState> for LevenbergMarquardt {
-    fn name(&self) -> &str {
-        "Levenberg-Marquardt (Moré 1978, bounded)"
+/// argmin's function counts of a problem.
+type Counts = HashMap<&'static str, u64>;
+
+/// The solver proper, compiled once for every problem type: the [`Solver`] implementation only
+/// unwraps argmin's problem and calls these.
+impl LevenbergMarquardt {
+    /// Moves the evaluator's counts into argmin's function counts (every iteration when the
+    /// state counts, `LmState::counting`, else once the solver has finished).
+    fn count(&self, state: &LmState, counts: &mut Counts) {
+        if self.counts && (state.is_counting() || matches!(self.stage, Stage::Done(_))) {
+            counts.insert("operator_count", self.ev.nfev as u64);
+            counts.insert("jacobian_count", self.ev.njev as u64);
+        }
     }
 
-    fn init(
+    /// [`Solver::init`]: the start (the state's `param` projected onto the box, else the
+    /// problem's), the first run's residuals, and the state reporting them.
+    #[inline(never)]
+    fn init_view(
         &mut self,
-        problem: &mut Problem<LeastSquares<R>>,
+        ls: View<'_>,
+        counts: &mut Counts,
         state: LmState,
     ) -> Result<(LmState, Option<KV>), Error> {
-        let ls = inner(problem)?;
-        let (m, n) = (ls.n_residuals(), ls.n_params());
+        let (m, n) = (ls.problem.n_residuals(), ls.problem.n_params());
+        let (lo, hi) = (&ls.setup.lower, &ls.setup.upper);
         let start = match state.get_param() {
             None => ls.setup.start.clone(),
-            Some(p) if p.len() == n && p.iter().all(|v| v.is_finite()) => (0..n)
-                .map(|j| p[j].clamp(ls.setup.lower[j], ls.setup.upper[j]))
-                .collect(),
+            Some(p) if p.len() == n && p.iter().all(|v| v.is_finite()) => {
+                (0..n).map(|j| p[j].clamp(lo[j], hi[j])).collect()
+            }
             Some(p) => {
                 return Err(Error::msg(format!(
                     "the initial parameter vector has length {} (expected {n}) or a \
@@ -845,26 +912,28 @@ impl<R: Residuals> Solver<LeastSquares<R>, LmState> for LevenbergMarquardt {
             }
         };
         self.ev = Evaluator::new(m, n);
-        self.stage = match LmRun::start(&mut self.ev, ls, start) {
+        let mut spare = self.spare.take();
+        self.stage = match LmRun::start(&mut self.ev, ls, start, &mut spare) {
             Ok(run) => Stage::Run {
                 run: Box::new(run),
                 restarts: 0,
                 previous: None,
             },
-            Err(sol) => self.settle(ls, sol, 0, None),
+            Err(sol) => self.settle(ls, sol, 0, None, spare),
         };
-        if state.is_counting() || matches!(self.stage, Stage::Done(_)) {
-            self.count(problem);
-        }
+        self.count(&state, counts);
         self.report(state)
     }
 
-    fn next_iter(
+    /// [`Solver::next_iter`]: one outer Levenberg–Marquardt iteration or one polish step, the
+    /// next stage when this one ends, and the state reporting it.
+    #[inline(never)]
+    fn next_iter_view(
         &mut self,
-        problem: &mut Problem<LeastSquares<R>>,
+        ls: View<'_>,
+        counts: &mut Counts,
         state: LmState,
     ) -> Result<(LmState, Option<KV>), Error> {
-        let ls = inner(problem)?;
         // The stage is replaced only when it ends.
         let ended = match &mut self.stage {
             Stage::Run { run, .. } => run.iterate(&mut self.ev, ls, &self.opts),
@@ -885,15 +954,43 @@ impl<R: Residuals> Solver<LeastSquares<R>, LmState> for LevenbergMarquardt {
                     run,
                     restarts,
                     previous,
-                } => self.settle(ls, run.into_solution(t), restarts, previous),
-                Stage::Polish { sol, .. } => Stage::Done(sol),
+                } => {
+                    let (sol, work) = run.end(t);
+                    self.settle(ls, sol, restarts, previous, Some(work))
+                }
+                Stage::Polish { sol, polisher } => {
+                    self.spare = Some(polisher.w);
+                    Stage::Done(sol)
+                }
                 other => other,
             };
         }
-        if state.is_counting() || matches!(self.stage, Stage::Done(_)) {
-            self.count(problem);
-        }
+        self.count(&state, counts);
         self.report(state)
+    }
+}
+
+impl<R: Residuals> Solver<LeastSquares<R>, LmState> for LevenbergMarquardt {
+    fn name(&self) -> &str {
+        "Levenberg-Marquardt (Moré 1978, bounded)"
+    }
+
+    fn init(
+        &mut self,
+        problem: &mut Problem<LeastSquares<R>>,
+        state: LmState,
+    ) -> Result<(LmState, Option<KV>), Error> {
+        let (ls, counts) = parts(problem)?;
+        self.init_view(ls, counts, state)
+    }
+
+    fn next_iter(
+        &mut self,
+        problem: &mut Problem<LeastSquares<R>>,
+        state: LmState,
+    ) -> Result<(LmState, Option<KV>), Error> {
+        let (ls, counts) = parts(problem)?;
+        self.next_iter_view(ls, counts, state)
     }
 }
 
@@ -906,13 +1003,12 @@ impl<R: Residuals> Solver<LeastSquares<R>, LmState> for LevenbergMarquardt {
 fn load_r(
     sp: &mut Subproblem,
     ipvt: &mut [usize],
-    qr: &faer::linalg::solvers::ColPivQr<f64>,
+    r: MatRef<'_, f64>,
+    perm: &[usize],
     colnorm: &[f64],
 ) {
     let n = ipvt.len();
-    let r = qr.thin_R();
-    let (fwd, _) = qr.P().arrays();
-    ipvt.copy_from_slice(fwd);
+    ipvt.copy_from_slice(perm);
     for j in 0..n {
         for i in 0..n {
             sp.r[i + j * n] = if i <= j { r[(i, j)] } else { 0.0 };
@@ -931,29 +1027,42 @@ fn scaled_norm(d: &[f64], x: &[f64], work: &mut [f64]) -> f64 {
     norm2(work)
 }
 
+/// A problem of any type behind a trait object: the one problem type of the fits that
+/// [`solve`] runs, so that argmin's `Executor` and the solver are compiled once for all of them.
+pub(crate) type DynLeastSquares<'a> = LeastSquares<&'a dyn Residuals>;
+
 /// Runs [`LevenbergMarquardt`] on `ls` under argmin's `Executor` (argmin's Ctrl-C handling off:
 /// the stop flag of `opts` is the caller's; its timer off: nothing reads the iteration times,
-/// and the profiles' many small fits would pay two clock reads per iteration), with a
+/// and the profiles' many small fits would pay two clock reads per iteration; argmin's
+/// function counts off: the evaluator counts, and the problem's counts are dropped), with a
 /// [`ProgressObserver`] over `opts.progress` when there is one; returns the solution, the
 /// evaluator (its counts and work space, for the covariance) and the problem.
-pub(crate) fn solve<R: Residuals>(
-    ls: LeastSquares<R>,
+pub(crate) fn solve<'a>(
+    ls: DynLeastSquares<'a>,
     opts: &LsqOptions,
-) -> Result<(Solution, Evaluator, LeastSquares<R>), Error> {
-    let mut executor = argmin::core::Executor::new(ls, LevenbergMarquardt::new(opts))
+    spare: &mut Spare,
+) -> Result<(Solution, Evaluator, DynLeastSquares<'a>), Error> {
+    let solver = LevenbergMarquardt {
+        counts: false,
+        spare: spare.0.take(),
+        ..LevenbergMarquardt::new(opts)
+    };
+    let mut executor = argmin::core::Executor::new(ls, solver)
         .ctrlc(false)
         .timer(false);
     if let Some(tally) = &opts.progress {
         executor =
             executor.add_observer(ProgressObserver::new(tally.clone()), ObserverMode::Always);
     }
-    into_parts(executor.run()?)
+    let (sol, solver, ls) = into_parts(executor.run()?)?;
+    spare.0 = solver.spare;
+    Ok((sol, solver.ev, ls))
 }
 
-/// The solution, the evaluator and the problem of an executor's result.
+/// The solution, the solver and the problem of an executor's result.
 pub(crate) fn into_parts<R: Residuals>(
     result: argmin::core::OptimizationResult<LeastSquares<R>, LevenbergMarquardt, LmState>,
-) -> Result<(Solution, Evaluator, LeastSquares<R>), Error> {
+) -> Result<(Solution, LevenbergMarquardt, LeastSquares<R>), Error> {
     let mut result = result;
     let reason = result.state.get_termination_reason();
     let sol = result
@@ -964,5 +1073,5 @@ pub(crate) fn into_parts<R: Residuals>(
         .problem
         .problem
         .ok_or_else(|| Error::msg("the executor lost the problem"))?;
-    Ok((sol, result.solver.ev, ls))
+    Ok((sol, result.solver, ls))
 }

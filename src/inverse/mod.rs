@@ -36,6 +36,7 @@ pub mod observer;
 pub mod posterior;
 pub mod problem;
 pub mod profile;
+mod qr;
 pub mod state;
 
 pub use estimate::{fit, fit_result, Covariance, Fit};

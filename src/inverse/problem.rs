@@ -42,7 +42,25 @@ pub struct LeastSquares<R> {
     pub(crate) setup: Setup,
 }
 
+/// A least-squares problem as the solver's iteration sees it: the residuals behind a trait
+/// object, with the box and typical magnitudes. The iteration ([`super::lm`]), the finite
+/// differences ([`Evaluator`]) and the covariance are compiled once for every problem type;
+/// only the residual and Jacobian evaluations are the problem's own code.
+#[derive(Clone, Copy)]
+pub(crate) struct View<'a> {
+    pub problem: &'a dyn Residuals,
+    pub setup: &'a Setup,
+}
+
 impl<R: Residuals> LeastSquares<R> {
+    /// The problem as the solver's iteration sees it.
+    pub(crate) fn view(&self) -> View<'_> {
+        View {
+            problem: &self.problem,
+            setup: &self.setup,
+        }
+    }
+
     /// Checks `start` and the bounds and typical magnitudes of `opts` against `problem` (the
     /// same checks as [`super::fit`]); the start is projected onto the box.
     pub fn new(problem: R, start: &[f64], opts: &LsqOptions) -> Result<Self, LsqError> {
@@ -108,7 +126,7 @@ impl<R: Residuals> LeastSquares<R> {
         let f = self.residual_vector(p)?;
         let mut ev = Evaluator::new(self.n_residuals(), self.n_params());
         let mut jac = Mat::<f64>::zeros(ev.m, ev.n);
-        if ev.jacobian(self, p, &f, &mut jac) {
+        if ev.jacobian(self.view(), p, &f, &mut jac) {
             Ok((f, jac))
         } else {
             Err(Infeasible)
@@ -284,6 +302,7 @@ pub(crate) struct Evaluator {
     pub analytic: usize,
     /// Whether the last Jacobian came by finite differences.
     pub differenced: bool,
+    /// Work space of the finite differences (m, m and n), allocated by the first of them.
     work: Vec<f64>,
     work2: Vec<f64>,
     xp: Vec<f64>,
@@ -298,19 +317,14 @@ impl Evaluator {
             njev: 0,
             analytic: 0,
             differenced: false,
-            work: vec![0.0; m],
-            work2: vec![0.0; m],
-            xp: vec![0.0; n],
+            work: Vec::new(),
+            work2: Vec::new(),
+            xp: Vec::new(),
         }
     }
 
     /// Residuals at `x`; false if infeasible or not finite.
-    pub fn residuals<R: Residuals>(
-        &mut self,
-        ls: &LeastSquares<R>,
-        x: &[f64],
-        out: &mut [f64],
-    ) -> bool {
+    pub fn residuals(&mut self, ls: View<'_>, x: &[f64], out: &mut [f64]) -> bool {
         self.nfev += 1;
         match ls.problem.residuals(x, out) {
             Ok(()) => out.iter().all(|v| v.is_finite()),
@@ -319,13 +333,7 @@ impl Evaluator {
     }
 
     /// Jacobian at `x` (where the residuals are `f`); false if it cannot be formed.
-    pub fn jacobian<R: Residuals>(
-        &mut self,
-        ls: &LeastSquares<R>,
-        x: &[f64],
-        f: &[f64],
-        jac: &mut Mat<f64>,
-    ) -> bool {
+    pub fn jacobian(&mut self, ls: View<'_>, x: &[f64], f: &[f64], jac: &mut Mat<f64>) -> bool {
         self.njev += 1;
         self.differenced = false;
         let analytic = ls.problem.jacobian(x, jac.as_mut());
@@ -354,14 +362,7 @@ impl Evaluator {
 
     /// Evaluates at x with component j replaced by v (within bounds); the residuals go to
     /// `work` (`second = false`) or `work2`.
-    fn probe<R: Residuals>(
-        &mut self,
-        ls: &LeastSquares<R>,
-        x: &[f64],
-        j: usize,
-        v: f64,
-        second: bool,
-    ) -> bool {
+    fn probe(&mut self, ls: View<'_>, x: &[f64], j: usize, v: f64, second: bool) -> bool {
         if !(v >= ls.setup.lower[j] && v <= ls.setup.upper[j]) {
             return false;
         }
@@ -383,13 +384,12 @@ impl Evaluator {
         ok
     }
 
-    fn differences<R: Residuals>(
-        &mut self,
-        ls: &LeastSquares<R>,
-        x: &[f64],
-        f: &[f64],
-        jac: &mut Mat<f64>,
-    ) -> bool {
+    fn differences(&mut self, ls: View<'_>, x: &[f64], f: &[f64], jac: &mut Mat<f64>) -> bool {
+        if self.xp.len() != self.n {
+            self.work = vec![0.0; self.m];
+            self.work2 = vec![0.0; self.m];
+            self.xp = vec![0.0; self.n];
+        }
         let eta = f64::EPSILON.cbrt();
         for j in 0..self.n {
             let xj = x[j];

@@ -24,11 +24,11 @@
 
 use faer::{Mat, MatMut};
 use statrs::distribution::{ContinuousCDF, Normal, StudentsT};
+use std::cell::RefCell;
 
 use super::estimate::Fit;
-use super::lm::solve;
+use super::lm::{solve, DynLeastSquares, Spare};
 use super::lsq::{validate, Infeasible, LsqError, LsqOptions, Residuals, SigmaKind};
-use super::problem::LeastSquares;
 use crate::special::root::brent;
 
 /// The customary confidence level, 0.95.
@@ -103,21 +103,37 @@ struct Fixed<'a, R: ?Sized> {
     inner: &'a R,
     k: usize,
     value: f64,
+    /// The point whose other parameters stand in for those `p` does not give.
     full: Vec<f64>,
+    /// Work space: the full point, and the full Jacobian.
+    point: RefCell<Vec<f64>>,
+    jac: RefCell<Mat<f64>>,
 }
 
-impl<R: Residuals + ?Sized> Fixed<'_, R> {
-    fn expand(&self, p: &[f64]) -> Vec<f64> {
-        let mut full = self.full.clone();
+impl<'a, R: Residuals + ?Sized> Fixed<'a, R> {
+    /// `inner` with parameter `k` held (at `full[k]` until [`Fixed::value`] is set).
+    fn new(inner: &'a R, k: usize, full: Vec<f64>) -> Self {
+        Fixed {
+            inner,
+            k,
+            value: full[k],
+            point: RefCell::new(full.clone()),
+            jac: RefCell::new(Mat::zeros(inner.n_residuals(), inner.n_params())),
+            full,
+        }
+    }
+
+    /// The full point of `p` (the other parameters) into `point`.
+    fn expand(&self, p: &[f64], point: &mut [f64]) {
+        point.copy_from_slice(&self.full);
         let mut it = p.iter();
-        for (j, v) in full.iter_mut().enumerate() {
+        for (j, v) in point.iter_mut().enumerate() {
             if j == self.k {
                 *v = self.value;
             } else if let Some(x) = it.next() {
                 *v = *x;
             }
         }
-        full
     }
 }
 
@@ -129,13 +145,19 @@ impl<R: Residuals + ?Sized> Residuals for Fixed<'_, R> {
         self.inner.n_residuals()
     }
     fn residuals(&self, p: &[f64], out: &mut [f64]) -> Result<(), Infeasible> {
-        self.inner.residuals(&self.expand(p), out)
+        let mut point = self.point.borrow_mut();
+        self.expand(p, &mut point);
+        self.inner.residuals(&point, out)
     }
     fn jacobian(&self, p: &[f64], mut out: MatMut<'_, f64>) -> Option<Result<(), Infeasible>> {
         let n = self.inner.n_params();
         let m = self.inner.n_residuals();
-        let mut jac = Mat::<f64>::zeros(m, n);
-        match self.inner.jacobian(&self.expand(p), jac.as_mut())? {
+        let mut point = self.point.borrow_mut();
+        self.expand(p, &mut point);
+        let mut jac = self.jac.borrow_mut();
+        // As new: the problem may leave entries unwritten.
+        jac.fill(0.0);
+        match self.inner.jacobian(&point, jac.as_mut())? {
             Ok(()) => {}
             Err(e) => return Some(Err(e)),
         }
@@ -257,7 +279,13 @@ pub fn profile_interval<R: Residuals + ?Sized>(
     let mut prof = Profiler {
         problem,
         opts,
-        index,
+        sub: LsqOptions {
+            lower: subset(&opts.lower, index),
+            upper: subset(&opts.upper, index),
+            typical: subset(&opts.typical, index),
+            ..opts.clone()
+        },
+        spare: Spare::new(),
         chi2_min: fit.chi2,
         threshold,
         others: fit
@@ -269,7 +297,7 @@ pub fn profile_interval<R: Residuals + ?Sized>(
             .collect(),
         fits: 0,
         evals: 0,
-        full: fit.params.clone(),
+        fixed: Fixed::new(problem, index, fit.params.clone()),
     };
     let lower = prof.end(p_hat, -width, setup.lower[index]);
     let upper = prof.end(p_hat, width, setup.upper[index]);
@@ -323,15 +351,19 @@ pub fn confidence_intervals<R: Residuals + ?Sized>(
 
 struct Profiler<'a, R: ?Sized> {
     problem: &'a R,
+    /// The problem with the profiled parameter held.
+    fixed: Fixed<'a, R>,
     opts: &'a LsqOptions,
-    index: usize,
+    /// The options of the constrained fits: those of the fit without the profiled parameter.
+    sub: LsqOptions,
+    /// Work space of the constrained fits, all of the same shape.
+    spare: Spare,
     chi2_min: f64,
     threshold: f64,
     /// Optimum of the other parameters at p̂.
     others: Vec<f64>,
     fits: usize,
     evals: usize,
-    full: Vec<f64>,
 }
 
 impl<R: Residuals + ?Sized> Profiler<'_, R> {
@@ -347,12 +379,7 @@ impl<R: Residuals + ?Sized> Profiler<'_, R> {
         {
             return None;
         }
-        let fixed = Fixed {
-            inner: self.problem,
-            k: self.index,
-            value: v,
-            full: self.full.clone(),
-        };
+        self.fixed.value = v;
         self.fits += 1;
         if warm.is_empty() {
             // One parameter: nothing to re-minimise.
@@ -367,14 +394,8 @@ impl<R: Residuals + ?Sized> Profiler<'_, R> {
                 .is_finite()
                 .then(|| (chi2 - self.chi2_min - self.threshold, Vec::new()));
         }
-        let sub = LsqOptions {
-            lower: subset(&self.opts.lower, self.index),
-            upper: subset(&self.opts.upper, self.index),
-            typical: subset(&self.opts.typical, self.index),
-            ..self.opts.clone()
-        };
-        let ls = LeastSquares::new(fixed, warm, &sub).ok()?;
-        let (sol, ev, _) = solve(ls, &sub).ok()?;
+        let ls = DynLeastSquares::new(&self.fixed, warm, &self.sub).ok()?;
+        let (sol, ev, _) = solve(ls, &self.sub, &mut self.spare).ok()?;
         self.evals += ev.nfev;
         if !sol.termination.converged() {
             return None;

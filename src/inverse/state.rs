@@ -113,6 +113,32 @@ impl Default for Inner {
     }
 }
 
+impl Inner {
+    /// Makes the current point the best one.
+    fn new_best(&mut self) {
+        if let Some(p) = &self.param {
+            match &mut self.best_param {
+                Some(b) if b.len() == p.len() => b.copy_from(p),
+                b => *b = Some(p.clone()),
+            }
+        }
+        self.best_cost = self.cost;
+        self.last_best_iter = self.iter;
+    }
+
+    /// Copies argmin's function counts of a problem.
+    fn copy_counts(&mut self, counts: &HashMap<&'static str, u64>) {
+        for (k, &v) in counts.iter() {
+            match self.counts.get_mut(*k) {
+                Some(c) => *c = v,
+                None => {
+                    self.counts.insert(k.to_string(), v);
+                }
+            }
+        }
+    }
+}
+
 /// Copies `src` into `dst`, reusing its allocation when the lengths agree.
 fn copy_into<T: Copy>(dst: &mut Vec<T>, src: &[T]) {
     if dst.len() == src.len() {
@@ -209,6 +235,7 @@ impl LmState {
     }
 
     /// Sets the current point and χ² (the point's buffer is reused).
+    #[inline]
     pub(crate) fn set_point(&mut self, x: &[f64], cost: f64) {
         let s = &mut *self.0;
         match &mut s.param {
@@ -219,6 +246,7 @@ impl LmState {
     }
 
     /// Sets what the solver reports of its iteration.
+    #[inline]
     pub(crate) fn set_lm(&mut self, stage: LmStage, lambda: f64, radius: f64, steps: usize) {
         let s = &mut *self.0;
         s.stage = stage;
@@ -228,6 +256,7 @@ impl LmState {
     }
 
     /// Sets the scaling D and the active set from the solver's `free` flags.
+    #[inline]
     pub(crate) fn set_scaling(&mut self, diag: &[f64], free: &[bool]) {
         let s = &mut *self.0;
         copy_into(&mut s.scaling, diag);
@@ -240,6 +269,7 @@ impl LmState {
     }
 
     /// Sets the evaluation counts.
+    #[inline]
     pub(crate) fn set_evals(&mut self, residual: usize, jacobian: usize, model: usize) {
         let s = &mut *self.0;
         s.residual_evals = residual;
@@ -257,6 +287,7 @@ impl State for LmState {
     }
 
     /// A lower χ² makes the current point the best one.
+    #[inline]
     fn update(&mut self) {
         let s = &mut *self.0;
         if s.cost < s.best_cost
@@ -264,14 +295,7 @@ impl State for LmState {
                 && s.best_cost.is_infinite()
                 && s.cost.is_sign_positive() == s.best_cost.is_sign_positive())
         {
-            if let Some(p) = &s.param {
-                match &mut s.best_param {
-                    Some(b) if b.len() == p.len() => b.copy_from(p),
-                    b => *b = Some(p.clone()),
-                }
-            }
-            s.best_cost = s.cost;
-            s.last_best_iter = s.iter;
+            s.new_best();
         }
     }
 
@@ -308,17 +332,10 @@ impl State for LmState {
     }
 
     /// Copies the problem's counts when counting is on ([`LmState::counting`]).
+    #[inline]
     fn func_counts<O>(&mut self, problem: &Problem<O>) {
-        let s = &mut *self.0;
-        if s.counting {
-            for (k, &v) in problem.counts.iter() {
-                match s.counts.get_mut(*k) {
-                    Some(c) => *c = v,
-                    None => {
-                        s.counts.insert(k.to_string(), v);
-                    }
-                }
-            }
+        if self.0.counting {
+            self.0.copy_counts(&problem.counts);
         }
     }
 

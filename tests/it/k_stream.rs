@@ -29,7 +29,9 @@ fn table() -> String {
     s
 }
 
-fn run(text: &str, chunk: usize, task: usize) -> Result<Vec<u8>, String> {
+/// Streams `text` through `k --model stick` in chunks of `chunk` rows and tasks of `task`,
+/// writing to `out`; the input error's message when there is one.
+fn run_into(text: &str, chunk: usize, task: usize, out: &mut Vec<u8>) -> Result<(), String> {
     let reader = TableReader::new("in.csv", text.as_bytes()).map_err(|e| e.to_string())?;
     let opts = StreamOptions {
         chunk_rows: chunk,
@@ -43,12 +45,16 @@ fn run(text: &str, chunk: usize, task: usize) -> Result<Vec<u8>, String> {
         plot: false,
     };
     let make = |r: &TableReader<&[u8]>| KPlan::new(r, &MeasurementDefaults::default(), settings);
-    let mut out = Vec::new();
-    match stream(reader, make, KLedger::default(), &mut out, &opts) {
-        Ok(_) => Ok(out),
+    match stream(reader, make, KLedger::default(), out, &opts) {
+        Ok(_) => Ok(()),
         Err(StreamError::Input(e)) => Err(e.to_string()),
         Err(e) => panic!("writing to a Vec failed: {e:?}"),
     }
+}
+
+fn run(text: &str, chunk: usize, task: usize) -> Result<Vec<u8>, String> {
+    let mut out = Vec::new();
+    run_into(text, chunk, task, &mut out).map(|()| out)
 }
 
 #[test]
@@ -108,23 +114,9 @@ fn a_bad_row_leaves_only_the_chunks_before_it_written() {
     let bad = lines.join("\n") + "\n";
     for (chunk, task, written_rows) in [(10_000, 10_000, None), (300, 7, None), (64, 5, Some(192))]
     {
-        let reader = TableReader::new("in.csv", bad.as_bytes()).unwrap();
-        let opts = StreamOptions {
-            chunk_rows: chunk,
-            task_rows: task,
-            ..StreamOptions::default()
-        };
-        let settings = KSettings {
-            model: Model::Stick,
-            auto: None,
-            model_name: "stick".into(),
-            plot: false,
-        };
-        let make =
-            |r: &TableReader<&[u8]>| KPlan::new(r, &MeasurementDefaults::default(), settings);
         let mut out = Vec::new();
-        let r = stream(reader, make, KLedger::default(), &mut out, &opts);
-        assert!(matches!(r, Err(StreamError::Input(_))), "chunks of {chunk}");
+        let r = run_into(&bad, chunk, task, &mut out);
+        assert!(r.is_err(), "chunks of {chunk}");
         match written_rows {
             None => assert!(out.is_empty(), "chunks of {chunk}: {} bytes", out.len()),
             Some(n) => {

@@ -45,6 +45,22 @@ fn slice<'a>(a: &'a PyReadonlyArray1<'_, f64>, name: &str) -> PyResult<&'a [f64]
         .map_err(|_| value_error(format!("{name}: expected a contiguous float64 array")))
 }
 
+/// The arrays as slices, every one as long as the first (xi): an array that is not contiguous
+/// float64 or has another length is an error naming it, checked in the order given.
+fn slices_of<'a, const N: usize>(
+    arrays: [(&'a PyReadonlyArray1<'_, f64>, &str); N],
+) -> PyResult<[&'a [f64]; N]> {
+    let mut out: [&[f64]; N] = [&[]; N];
+    for (i, (a, name)) in arrays.into_iter().enumerate() {
+        let s = slice(a, name)?;
+        if i > 0 {
+            check_len(name, s.len(), out[0].len())?;
+        }
+        out[i] = s;
+    }
+    Ok(out)
+}
+
 fn opt_slice<'a>(
     a: &'a Option<PyReadonlyArray1<'_, f64>>,
     name: &str,
@@ -497,14 +513,13 @@ fn forward<'py>(
             "model md is not vectorised (it integrates each scene's bead row); use the command line's `forward --model md`",
         ));
     }
-    let xi_s = slice(&xi, "xi")?;
+    let [xi_s, d_s, rho_s, f_s] = slices_of([
+        (&xi, "xi"),
+        (&delta_deg, "delta_deg"),
+        (&rho, "rho"),
+        (&f, "f"),
+    ])?;
     let n = xi_s.len();
-    let d_s = slice(&delta_deg, "delta_deg")?;
-    check_len("delta_deg", d_s.len(), n)?;
-    let rho_s = slice(&rho, "rho")?;
-    check_len("rho", rho_s.len(), n)?;
-    let f_s = slice(&f, "f")?;
-    check_len("f", f_s.len(), n)?;
     let k_s = opt_slice(&k, "K", n)?;
     let base_law = parse_law(law)?;
     let spin: SpinRule = spin.parse().map_err(|e: fitbead::scene::ParameterError| {
@@ -620,18 +635,15 @@ fn invert_k<'py>(
     tol: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (model, auto) = k_model(model, tol)?;
-    let xi_s = slice(&xi, "xi")?;
+    let [xi_s, d_s, v_s, s_s, rho_s, f_s] = slices_of([
+        (&xi, "xi"),
+        (&delta_deg, "delta_deg"),
+        (&v, "v"),
+        (&sigma_v, "sigma_v"),
+        (&rho, "rho"),
+        (&f, "f"),
+    ])?;
     let n = xi_s.len();
-    let d_s = slice(&delta_deg, "delta_deg")?;
-    check_len("delta_deg", d_s.len(), n)?;
-    let v_s = slice(&v, "v")?;
-    check_len("v", v_s.len(), n)?;
-    let s_s = slice(&sigma_v, "sigma_v")?;
-    check_len("sigma_v", s_s.len(), n)?;
-    let rho_s = slice(&rho, "rho")?;
-    check_len("rho", rho_s.len(), n)?;
-    let f_s = slice(&f, "f")?;
-    check_len("f", f_s.len(), n)?;
     let nums: Vec<&'static str> = K_NUMS.iter().chain(&K_NUMS2).copied().collect();
     let mut texts: Vec<&'static str> = K_TEXTS.to_vec();
     if auto.is_some() {
@@ -819,25 +831,16 @@ impl PyDataset {
         rho: PyReadonlyArray1<'_, f64>,
         f: PyReadonlyArray1<'_, f64>,
     ) -> PyResult<Self> {
-        let xs = slice(&xi, "xi")?;
-        let n = xs.len();
+        let n = slice(&xi, "xi")?.len();
         check_len("series", series.len(), n)?;
-        let (d, vs, ss, rs, fs) = (
-            slice(&delta_deg, "delta_deg")?,
-            slice(&v, "v")?,
-            slice(&sigma_v, "sigma_v")?,
-            slice(&rho, "rho")?,
-            slice(&f, "f")?,
-        );
-        for (name, a) in [
-            ("delta_deg", d),
-            ("v", vs),
-            ("sigma_v", ss),
-            ("rho", rs),
-            ("f", fs),
-        ] {
-            check_len(name, a.len(), n)?;
-        }
+        let [xs, d, vs, ss, rs, fs] = slices_of([
+            (&xi, "xi"),
+            (&delta_deg, "delta_deg"),
+            (&v, "v"),
+            (&sigma_v, "sigma_v"),
+            (&rho, "rho"),
+            (&f, "f"),
+        ])?;
         let mut rows = Vec::with_capacity(n);
         for (i, label) in series.into_iter().enumerate() {
             let scene =

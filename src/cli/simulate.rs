@@ -92,7 +92,7 @@ fn trace(
     law: CollisionLaw,
     series: &[f64],
     v0: f64,
-    spin: SpinRule,
+    model: Contact,
 ) -> Result<(), CliError> {
     use fitbead::io::reports::transient_csv;
     if !(v0.is_finite() && v0 >= 0.0) {
@@ -117,10 +117,6 @@ fn trace(
             "",
             "--v0 needs the slope of the scene (--delta-deg)",
         ));
-    };
-    let model = Contact {
-        spin,
-        ..Contact::default()
     };
     let scenes = series
         .iter()
@@ -178,7 +174,11 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let law: CollisionLaw = a.law.parse().map_err(|e: fitbead::scene::ParameterError| {
         super::flag_error("--law", &a.law, e.to_string())
     })?;
-    let spin = spin_rule(&a, kind)?;
+    // The contact model under the --spin rule (other models have none).
+    let contact = Contact {
+        spin: spin_rule(&a, kind)?,
+        ..Contact::default()
+    };
     let series = parse_list("--series", &a.series)?;
     if series.len() > MAX_SERIES {
         return Err(super::flag_error(
@@ -196,7 +196,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
                 "the bead-by-bead transient needs --model contact",
             ));
         }
-        return trace(&a, law, &series, v0, spin);
+        return trace(&a, law, &series, v0, contact);
     }
     if a.points == 0 || a.points > MAX_POINTS {
         return Err(super::flag_error(
@@ -262,10 +262,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
             .map_err(|e| super::flag_error("--series", &xi.to_string(), e.to_string()))?
             .alpha_rad();
         let model = match (kind, kind.contact_model()) {
-            (ModelKind::Contact, _) => Model::Contact(Contact {
-                spin,
-                ..Contact::default()
-            }),
+            (ModelKind::Contact, _) => Model::Contact(contact),
             (_, Some(m)) => m,
             (ModelKind::Jan, None) => match &jan {
                 None => Model::Jan(Jan::paper_fit(alpha)),

@@ -14,6 +14,7 @@ mod figures;
 mod fits;
 mod forward_stream;
 mod jaeger_posterior;
+mod k_edges;
 mod k_inversion;
 mod k_stream;
 mod mcmc;

@@ -45,6 +45,22 @@ pub(crate) fn eval(
     }
 }
 
+/// The lowest K above `lo` (and not above `limit`) at which `model` is steady, among the K that
+/// double precision resolves there: lo + 2ⁿ lo ε, n = 0, 1, …, each at least one ulp above lo.
+pub(crate) fn lowest_steady(
+    model: &Model,
+    scene: &Scene,
+    lo: f64,
+    limit: f64,
+    evals: &mut usize,
+) -> Option<(f64, Steady)> {
+    let step = (lo * f64::EPSILON).max(f64::MIN_POSITIVE);
+    (0..64)
+        .map(|n| lo + step * 2f64.powi(n))
+        .take_while(|&k| k <= limit)
+        .find_map(|k| eval(model, scene, k, evals).ok().map(|s| (k, s)))
+}
+
 /// Squared speed at Θf of one slip contact launched at Θ0 with squared speed `w0sq` (eq 38
 /// from Θ0; no stop check: the caller's bracket logic handles stopping).
 fn slip_contact_sq(scene: &Scene, w0sq: f64) -> f64 {
@@ -287,8 +303,13 @@ pub fn bracket(model: &Model, scene: &Scene) -> Result<KBracket, KFailure> {
         (Ok(s), LowerLimit::Zero) => (0.0, s.mean_velocity),
         (Ok(_), LowerLimit::Model) => {
             // An approximate model's own limit (the analytic candidate is its exact boundary):
-            // the slowest motion is its limit at lo.
-            let s = eval(model, scene, lo + (hi - lo) * 1e-13, &mut evals);
+            // the slowest motion is its value at the lowest steady K above lo that double
+            // precision resolves (steps of 2ⁿ lo ε, at least one ulp each).
+            let first = lowest_steady(model, scene, lo, lo + (hi - lo) * 1e-13, &mut evals);
+            let s = first.map_or_else(
+                || eval(model, scene, lo + (hi - lo) * 1e-13, &mut evals),
+                |(_, s)| Ok(s),
+            );
             (lo, s.map(|s| s.mean_velocity).unwrap_or(0.0))
         }
         (Err(_), _) => {

@@ -25,7 +25,7 @@
 //! are left to the general search, where the forward model's own fixed-point search gives out.
 //! Elsewhere [`super::estimate()`](super::estimate::estimate) uses its general bracketing search in K.
 
-use super::types::{KBracket, KEstimate, KFailure, KRoot, LowerLimit, UpperLimit};
+use super::types::{KBracket, KEstimate, KRoot, LowerLimit, UpperLimit};
 use crate::models::regimes::theta_g;
 use crate::models::stickslip::{self, Branch};
 use crate::models::{Model, NotSteady, Phases, Steady};
@@ -632,16 +632,10 @@ pub fn estimate(model: &Model, scene: &Scene, v: f64, sigma_v: Option<f64>) -> O
     if l.saddle && v + sigma_v.unwrap_or(0.0) > br.v_hi * (1.0 - 1e-6) {
         return None;
     }
+    // Above the range: the general search reports it, with K_lo and K_hi at v ∓ σ by the
+    // same rule as every other row (module docs of [`super`]).
     if v > br.v_hi {
-        return Some(KEstimate {
-            bracket: Some(br),
-            root: Err(KFailure::AboveRange),
-            k_lo: None,
-            k_hi: None,
-            dv_dk: None,
-            theta_g: None,
-            notes,
-        });
+        return None;
     }
     // The root.
     let mut n_root = 0;

@@ -1,8 +1,8 @@
 //! Eq 69 solved in K by Brent's method in s = ln(K − K_min) (module docs of [`super`]), K_lo
 //! and K_hi at v ∓ σ, and dv̄/dK over the evaluated K values.
 
-use super::bracket::{bracket, eval};
-use super::types::{KBracket, KEstimate, KFailure, KRoot, LowerLimit};
+use super::bracket::{bracket, eval, lowest_steady};
+use super::types::{KBracket, KEstimate, KFailure, KRoot};
 use crate::models::regimes::theta_g;
 use crate::models::{Model, NotSteady, Steady};
 use crate::scene::Scene;
@@ -19,20 +19,27 @@ pub fn solve(model: &Model, scene: &Scene, br: &KBracket, v: f64) -> Result<KRoo
             "v must be > 0 and finite, got {v}"
         )));
     }
+    let mut evals = 0;
+    // Within ROUNDING (relative) of the slowest or fastest steady motion, v is that motion to
+    // the rounding of v̄ itself: K is the bracket's bottom (its lowest steady K) or top.
     if v < br.v_lo {
+        if v >= br.v_lo * (1.0 - ROUNDING) {
+            if let Some((k, steady)) = lowest_steady(model, scene, br.lo, br.hi, &mut evals) {
+                return Ok(KRoot { k, steady, evals });
+            }
+        }
         return Err(KFailure::BelowRange);
     }
-    if v > br.v_hi {
+    if v > br.v_hi * (1.0 + ROUNDING) {
         return Err(KFailure::AboveRange);
     }
-    let mut evals = 0;
     let tau_star = 2.0 * scene.sin_alpha / v;
     let width = br.hi - br.lo;
     let k_of = |s: f64| br.lo + s.exp();
     let s_hi = width.ln();
     let g_hi = tau_star - br.tau_hi;
     if g_hi <= 0.0 {
-        // v = v_hi to the last ulp (τ* and τ_hi may differ by rounding of 2 sin α / v).
+        // v = v_hi to rounding (of v̄, and of τ* = 2 sin α / v).
         let steady =
             eval(model, scene, br.hi, &mut evals).map_err(|e| KFailure::Invalid(e.to_string()))?;
         return Ok(KRoot {
@@ -72,22 +79,21 @@ pub fn solve(model: &Model, scene: &Scene, br: &KBracket, v: f64) -> Result<KRoo
         s_lo -= step;
         step *= 2.0;
         if s_lo.exp() < ulp_floor {
-            // The root lies within rounding of K_min (v far below the crawl speed scale):
-            // return the first K above K_min, a few ulp up, where the model is steady.
-            let mut d = 2.0 * ulp_floor;
-            for _ in 0..64 {
-                if let Ok(steady) = eval(model, scene, br.lo + d, &mut evals) {
-                    return Ok(KRoot {
-                        k: br.lo + d,
-                        steady,
-                        evals,
-                    });
-                }
-                d *= 2.0;
+            // The lowest K above K_min that double precision resolves (K_min + K_min ε is at
+            // least one ulp above it).
+            s_lo = ulp_floor.ln();
+            g_lo = g(s_lo, &mut evals, &mut last);
+            if g_lo > 0.0 {
+                // v is slower than the motion at every K that double precision distinguishes
+                // from K_min.
+                return match last {
+                    Some((s, st)) if s == s_lo => {
+                        below_resolution(model, scene, br, tau_star, k_of(s), st, evals)
+                    }
+                    _ => Err(KFailure::BelowRange),
+                };
             }
-            return Err(KFailure::Invalid(
-                "no steady state found within rounding of K_min".into(),
-            ));
+            break;
         }
         g_lo = g(s_lo, &mut evals, &mut last);
     }
@@ -115,32 +121,188 @@ pub fn solve(model: &Model, scene: &Scene, br: &KBracket, v: f64) -> Result<KRoo
     };
     let k = k_of(r.x).min(br.hi);
     if (tau_star - steady.contact_time).abs() > 1e-9 * tau_star {
-        // Either K is resolved to its last bits where τ is steep (the crawl end: one ulp of K
-        // moves ln(K − K_min) by a visible step), or v̄(K) jumps over v. The neighbours two
-        // ulp away tell: a resolved root has τ* between them and a small step across.
-        let u = 2.0 * f64::EPSILON * k;
-        let tm = eval(model, scene, k - u, &mut evals).map(|s| s.contact_time);
-        let tp = eval(model, scene, (k + u).min(br.hi), &mut evals).map(|s| s.contact_time);
-        let resolved = match (tm, tp) {
-            (Ok(a), Ok(b)) => {
-                (a - tau_star) * (b - tau_star) <= 0.0 && (a - b).abs() <= 1e-3 * tau_star
-            }
-            // At the crawl end the steady state ends within rounding of K_min: v is slower
-            // than any K distinguishable from K_min, which is then the answer to 1e-12.
-            (Err(NotSteady::Stops { .. }), Ok(_)) => {
-                br.lower == LowerLimit::Crawl
-                    && k - br.lo <= 1e-12
-                    && steady.contact_time < tau_star
-            }
-            _ => false,
-        };
-        if !resolved {
-            return Err(KFailure::Invalid(format!(
-                "v(K) jumps at K = {k}: no K gives this velocity"
-            )));
-        }
+        resolved(model, scene, br, tau_star, k, &steady, &mut evals)?;
     }
     Ok(KRoot { k, steady, evals })
+}
+
+/// Relative tolerance on v at the ends of the steady range: the rounding of v̄ by the
+/// forward models there (measured up to 49 ε for stick-approx near its limit A = B,
+/// tests/it/k_edges.rs).
+const ROUNDING: f64 = 128.0 * f64::EPSILON;
+
+/// v is slower than the motion at `k`, the lowest steady K that double precision resolves
+/// above K_min. Either by rounding only, and then `k` is the root; or near a crawl end, where
+/// the contact time grows as a − b ln(K − K_min) (module docs of [`super`]): a and b from the
+/// model at 2⁶ and 2¹² steps of K_min ε above K_min give the distance d* at which τ = τ*.
+/// Where d* is at least half a step, the root is resolved to within a few ulp by `k` itself;
+/// below that it rounds to K_min, where the bead stops: v is below the range (regime A).
+fn below_resolution(
+    model: &Model,
+    scene: &Scene,
+    br: &KBracket,
+    tau_star: f64,
+    k: f64,
+    steady: Steady,
+    evals: usize,
+) -> Result<KRoot, KFailure> {
+    let mut evals = evals;
+    if tau_star - steady.contact_time <= ROUNDING * tau_star {
+        // v is the motion at `k` to rounding (v̄ flat near K_min, as where K² w_f² is below
+        // the rounding of the squared speed it adds to).
+        return Ok(KRoot { k, steady, evals });
+    }
+    let step = (br.lo * f64::EPSILON).max(f64::MIN_POSITIVE);
+    let (d1, d2) = (64.0 * step, 4096.0 * step);
+    let t1 = eval(model, scene, br.lo + d1, &mut evals).map(|s| s.contact_time);
+    let t2 = eval(model, scene, br.lo + d2, &mut evals).map(|s| s.contact_time);
+    if let (Ok(t1), Ok(t2)) = (t1, t2) {
+        let b = (t1 - t2) / (d2 / d1).ln();
+        let d_star = d1 * (-(tau_star - t1) / b).exp();
+        if b > 0.0 && d_star >= 0.5 * step {
+            return Ok(KRoot { k, steady, evals });
+        }
+    }
+    Err(KFailure::BelowRange)
+}
+
+/// Whether v̄(K) is continuous in K inside its bracket. The rolling models are: the contact
+/// time is an integral of (w0² + g(θ))^{-1/2} with w0 = K Θ̇f (eqs 11–27, eq 29 for the
+/// approximation), continuous in K while the speed stays positive, which is what the bracket
+/// holds. So are the slip models: the same with the factor e^{2fθ} (§4.3), or the elliptic
+/// integral of a′ + p cos(θ − θ*) with coefficients continuous in K (eqs 53–59). Stick/slip and
+/// the general contact model can jump where the fixed point of the collision map changes branch
+/// or a phase appears.
+fn continuous_in_k(model: &Model) -> bool {
+    matches!(
+        model,
+        Model::Stick | Model::StickApprox | Model::Slip | Model::SlipApprox
+    )
+}
+
+/// Accepts a root `k` of τ(K) = τ* whose residual is above 1e-9 τ*: either K is resolved to
+/// its last bits where τ is steep (near the crawl end one ulp of K moves τ by a visible
+/// step), or v̄(K) jumps over v, or v is slower than the slowest motion at any K that double
+/// precision distinguishes from K_min.
+///
+/// Within a few u = 2ε K of K_min, K is the lowest steady K resolved above K_min: v slower than the motion there is decided by
+/// [`below_resolution`]. A model
+/// continuous in K ([`continuous_in_k`]) otherwise has its root where Brent's method put it
+/// (its bracket held a sign change). Elsewhere τ* must lie between τ at K ∓ w for w = u, 4u or
+/// 16u (the wider pairs where rounding makes τ uneven at the scale of an ulp), and the step
+/// between them must be one a continuous function makes ([`steady_step`]).
+fn resolved(
+    model: &Model,
+    scene: &Scene,
+    br: &KBracket,
+    tau_star: f64,
+    k: f64,
+    steady: &Steady,
+    evals: &mut usize,
+) -> Result<(), KFailure> {
+    let u = 2.0 * f64::EPSILON * k;
+    let jump = || KFailure::Invalid(format!("v(K) jumps at K = {k}: no K gives this velocity"));
+    let mut tau_at = |k: f64| eval(model, scene, k, evals).map(|s| s.contact_time);
+    let below = tau_at(k - u);
+    let above = tau_at((k + u).min(br.hi));
+    if k - u <= br.lo + 4.0 * u {
+        // The bottom of the steady range, within rounding of K_min, where every model rolls
+        // over the top and so is continuous in K.
+        return if steady.contact_time < tau_star {
+            below_resolution(model, scene, br, tau_star, k, *steady, 0).map(|_| ())
+        } else {
+            Ok(())
+        };
+    }
+    if continuous_in_k(model) {
+        return Ok(());
+    }
+    let mut pair = (below, above);
+    for w in [u, 4.0 * u, 16.0 * u] {
+        let (km, kp) = (k - w, (k + w).min(br.hi));
+        if w > u {
+            pair = (tau_at(km), tau_at(kp));
+        }
+        if let (Ok(a), Ok(b)) = pair {
+            if (a - tau_star) * (b - tau_star) <= 0.0 {
+                let continuous = (a - b).abs() <= 1e-3 * tau_star
+                    || steady_step(model, scene, br, (km, a), (kp, b), evals);
+                return if continuous { Ok(()) } else { Err(jump()) };
+            }
+        }
+    }
+    Err(jump())
+}
+
+/// Whether the step of τ from K = `m.0` to `p.0` (values `m.1`, `p.1`) is what a continuous
+/// τ(K) makes there, by two tests; a jump of size J fails both.
+///
+/// 1. Slope in s = ln(K − K_min), where τ is close to linear near the crawl end (module docs
+///    of [`super`]): over a stencil 16 times wider than the step in s (never under 0.05; at
+///    least 8 times where the top of the bracket clips it), the slope predicts the step; a
+///    jump gives the stencil a slope of at most J over its width, so its step is more than
+///    four times the prediction.
+/// 2. Growth with the width: the step across 8 times the distance is at least 3 times the
+///    step (a continuous function's grows about 8-fold unless it bends sharply; a jump's stays
+///    J). This one serves near the top end, where s is not the natural variable.
+fn steady_step(
+    model: &Model,
+    scene: &Scene,
+    br: &KBracket,
+    m: (f64, f64),
+    p: (f64, f64),
+    evals: &mut usize,
+) -> bool {
+    let step = (p.1 - m.1).abs();
+    let tau_at = |k: f64, evals: &mut usize| {
+        (k > br.lo && k <= br.hi)
+            .then(|| eval(model, scene, k, evals).ok())
+            .flatten()
+            .map(|st| st.contact_time)
+    };
+    // 1. The slope in s.
+    let s_of = |x: f64| (x - br.lo).ln();
+    let step_s = s_of(p.0) - s_of(m.0);
+    if step_s > 0.0 {
+        let half = (8.0 * step_s).max(0.025);
+        let s0 = 0.5 * (s_of(p.0) + s_of(m.0));
+        let s_top = s_of(br.hi);
+        let stencils = [
+            (s0 - half, s0 + half),
+            (s0 - 2.0 * half, s0),
+            (s0, s0 + 2.0 * half),
+        ];
+        for (sa, sb) in stencils {
+            // Clipped to the top of the bracket, if still eight steps wide.
+            let sb = sb.min(s_top);
+            if sb - sa < 8.0 * step_s {
+                continue;
+            }
+            let ka = br.lo + sa.exp();
+            let kb = br.lo + sb.exp();
+            if let (Some(ta), Some(tb)) = (tau_at(ka, evals), tau_at(kb, evals)) {
+                let predicted = (tb - ta).abs() / (sb - sa) * step_s;
+                if step <= 4.0 * predicted {
+                    return true;
+                }
+                break;
+            }
+        }
+    }
+    // 2. Growth with the width.
+    let w = p.0 - m.0;
+    let mid = 0.5 * (p.0 + m.0);
+    let wide = [
+        (mid - 4.0 * w, mid + 4.0 * w),
+        (mid - 8.0 * w, mid),
+        (mid, mid + 8.0 * w),
+    ];
+    for (ka, kb) in wide {
+        if let (Some(ta), Some(tb)) = (tau_at(ka, evals), tau_at(kb, evals)) {
+            return (tb - ta).abs() >= 3.0 * step;
+        }
+    }
+    false
 }
 
 fn clamp_end(
@@ -199,6 +361,14 @@ pub fn estimate_in_k(model: &Model, scene: &Scene, v: f64, sigma_v: Option<f64>)
     };
     let root = solve(model, scene, &br, v);
     let mut notes = Vec::new();
+    if root == Err(KFailure::BelowRange) && v >= br.v_lo {
+        notes.push(format!(
+            "v = {} is slower than the motion at any K that double precision distinguishes \
+             from K_min = {} (v̄ → 0 only as K → K_min, where the bead stops)",
+            crate::numfmt::fmt_sig(v, 4),
+            br.lo
+        ));
+    }
     let (k_lo, k_hi) = match sigma_v {
         Some(s) => (
             clamp_end(model, scene, &br, v - s, "K_lo", &mut notes),
@@ -284,6 +454,7 @@ pub fn dv_dk(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fit::k::types::LowerLimit;
     use crate::fit::k::types::UpperLimit;
     use crate::models::ForwardModel;
     use crate::scene::CollisionLaw;

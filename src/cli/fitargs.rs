@@ -24,7 +24,10 @@ pub struct FitOutputArgs {
     /// The parameter report CSV (fit,series,parameter,value,stderr,ci_low,ci_high,ci_method,
     /// unit, then extra columns), written atomically; `-` writes it to stdout. Without it, a
     /// one-screen fit report per fit goes to stdout (values ± standard errors, intervals,
-    /// correlations, χ², AIC, BIC, convergence, warnings)
+    /// correlations, χ², AIC, BIC, convergence, warnings). Every output flag takes `-` for
+    /// stdout, and a standard stream or descriptor (/dev/stdout, /proc/self/fd/N) is written
+    /// through in place; only one output may go to stdout (without --output the fit report
+    /// takes it)
     #[arg(long)]
     pub output: Option<PathBuf>,
 }
@@ -53,8 +56,9 @@ pub struct FitArgs {
     /// The parameter report CSV.
     #[command(flatten)]
     pub out: FitOutputArgs,
-    /// Fit statistics CSV (written atomically): χ², dof, AIC, BIC, termination per fit.
-    /// Printed to stderr as a table when absent.
+    /// Fit statistics CSV (written atomically): χ², dof, AIC, BIC, termination per fit; `-`
+    /// writes it to stdout (then --output must name a file). Printed to stderr as a table
+    /// when absent.
     #[arg(long)]
     pub output_stats: Option<PathBuf>,
     /// Estimation method: lsq (least squares) or mcmc (posterior sampling by an affine-invariant
@@ -93,7 +97,7 @@ pub struct FitArgs {
     #[arg(long)]
     pub fit_scatter: bool,
     /// MCMC: write the kept draws (after burn-in and thinning) to this CSV: fit,series,walker,
-    /// step, one column per parameter, log_posterior.
+    /// step, one column per parameter, log_posterior; `-` writes it to stdout.
     #[arg(long)]
     pub draws: Option<PathBuf>,
     /// MCMC: with --plot, a corner plot of every posterior (marginal histograms and pairwise

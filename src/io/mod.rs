@@ -14,7 +14,8 @@ pub mod scenes;
 pub mod stream;
 
 pub use atomic::{
-    distinct_paths, same_file, write_atomic, write_atomic_all, write_atomic_all_then, AtomicFile,
+    distinct_paths, remove_stale_temporaries, same_file, stream_of, write_atomic, write_atomic_all,
+    write_atomic_all_then, AtomicFile, STALE_UNOWNED_SECS,
 };
 
 pub use crate::numfmt::{clip, fmt_f64, fmt_sig, push_f64, ECHO_CHARS};

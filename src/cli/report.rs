@@ -8,7 +8,6 @@ use super::CliError;
 use fitbead::fit::k::unsteady_points;
 use fitbead::io::measurements::locate_point;
 use fitbead::io::measurements::{is_shipped_data, si_conversion};
-use fitbead::io::write_atomic_all;
 use fitbead::report::analysis::analyse;
 use fitbead::report::figures::FigureFormat;
 use fitbead::report::text::{markdown, terminal_summary, ReportContext};
@@ -26,7 +25,10 @@ pub struct Args {
     /// The measurements (as for `klaw`) and the defaults of the columns they may leave out.
     #[command(flatten)]
     pub data: DataArgs,
-    /// Directory for the tables, figures and report.md, created if missing [default: report]
+    /// Directory for the tables, figures and report.md, created if missing [default: report].
+    /// Written as one unit: locked while written (concurrent runs wait, never mix), every
+    /// file or none, the run recorded in .fitbead.manifest; files of the previous run that
+    /// this one does not write are removed, other files (yours) are never touched
     #[arg(long)]
     pub out_dir: Option<PathBuf>,
     /// lsq or mcmc (posteriors for every fit; adds one corner_<fit>_<series>.svg per
@@ -387,13 +389,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
     }
     let created = create_dirs(&out_dir)
         .map_err(|e| CliError::Other(format!("{}: cannot create: {e}", out_dir.display())))?;
-    let paths: Vec<PathBuf> = files.iter().map(|f| out_dir.join(&f.0)).collect();
-    let staged: Vec<(&Path, &[u8])> = paths
-        .iter()
-        .zip(&files)
-        .map(|(p, f)| (p.as_path(), f.1.as_slice()))
-        .collect();
-    if let Err(e) = write_atomic_all(&staged) {
+    if let Err(e) = fitbead::io::outdir::write_dir(&out_dir, &files) {
         // All or nothing: directories made for this report go as well.
         for d in created.iter().rev() {
             let _ = std::fs::remove_dir(d);

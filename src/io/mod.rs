@@ -1,5 +1,6 @@
 //! Files: CSV reading with errors that name file, line, column and value; atomic writing
-//! ([`AtomicFile`], [`write_atomic_all`]: whole files or none, modes kept, links followed);
+//! ([`AtomicFile`], [`write_atomic_all`]: whole files or none, modes kept, links followed;
+//! directories of outputs written as one unit: [`outdir`]);
 //! tables streamed through a per-row computation in bounded memory ([`stream`]), with the
 //! row plans of `fitbead forward` ([`forward`]) and `fitbead k` ([`kstream`]).
 
@@ -9,6 +10,7 @@ pub mod forward;
 pub mod kstream;
 pub mod md;
 pub mod measurements;
+pub mod outdir;
 pub mod reports;
 pub mod scenes;
 pub mod stream;

@@ -10,7 +10,7 @@ use fitbead::io::measurements::locate_point;
 use fitbead::io::measurements::{is_shipped_data, si_conversion};
 use fitbead::report::analysis::analyse;
 use fitbead::report::figures::FigureFormat;
-use fitbead::report::text::{markdown, terminal_summary, ReportContext};
+use fitbead::report::text::{markdown, one_line, terminal_summary, ReportContext};
 use std::path::{Path, PathBuf};
 
 /// The contact models the report fits (a point must be steady under one of them).
@@ -364,10 +364,10 @@ pub fn run(a: Args) -> Result<(), CliError> {
              \"Plausibility checks\"):\n\n",
         );
         for w in &implausible {
-            md.push_str(&format!("- {w}\n"));
+            md.push_str(&format!("- {}\n", one_line(&w.to_string())));
         }
         for w in &absurd {
-            md.push_str(&format!("- {w}\n"));
+            md.push_str(&format!("- {}\n", one_line(w)));
         }
     }
     if !warnings.is_empty() {
@@ -378,7 +378,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
 ",
         );
         for w in &warnings {
-            md.push_str(&format!("- {w}\n"));
+            md.push_str(&format!("- {}\n", one_line(w)));
         }
     }
     files.push(("report.md".into(), md.into_bytes()));

@@ -14,10 +14,6 @@ use fitbead::report::figures::{corner_svg, CornerBlock};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
-/// Most walkers of a posterior run (`--walkers`): each step keeps one draw per walker in
-/// memory.
-pub const MAX_WALKERS: usize = 10_000;
-
 /// `--output` of the fit commands: the parameter CSV, or the fit report on stdout.
 #[derive(Debug, Clone, Default, clap::Args)]
 pub struct FitOutputArgs {
@@ -153,40 +149,22 @@ impl FitArgs {
             options.seed = 1;
         }
         options.walkers = self.walkers;
-        if let Some(w) = self.walkers {
-            if w < 4 || w % 2 == 1 || w > MAX_WALKERS {
-                return Err(super::flag_error(
-                    "--walkers",
-                    &w.to_string(),
-                    format!(
-                        "must be even, at least 4 (and more than the parameters) and at most \
-                         {MAX_WALKERS}"
-                    ),
-                ));
-            }
-        }
         if let Some(e) = self.min_ess {
-            if !(e >= 0.0 && e.is_finite()) {
-                return Err(super::flag_error(
-                    "--min-ess",
-                    &e.to_string(),
-                    "must be a finite number >= 0",
-                ));
-            }
             options.min_ess = e;
         }
         if let Some(m) = self.max_steps {
-            if m == 0 {
-                return Err(super::flag_error("--max-steps", "0", "must be >= 1"));
-            }
             options.max_steps = m;
         }
         if let Some(t) = self.thin {
-            if t == 0 {
-                return Err(super::flag_error("--thin", "0", "must be >= 1"));
-            }
             options.thin = t;
         }
+        options.check().map_err(|e| {
+            super::flag_error(
+                &format!("--{}", e.option.replace('_', "-")),
+                &e.value,
+                e.expected,
+            )
+        })?;
         let mut priors = Vec::new();
         for p in &self.priors {
             let Some((name, dist)) = p.split_once('=') else {

@@ -13,16 +13,11 @@ const IDENTICAL: &str = "series,xi,delta_deg,v\nA,1,3,0.5\nA,1,3,0.5\nA,1,3,0.5\
 const TWO_SLOPES: &str =
     "series,xi,delta_deg,v\nA,1,10,0.50\nA,1,10,0.52\nA,1,20,0.80\nA,1,20,0.83\n";
 
+/// Rows of a CSV, each keyed by column name.
+type Rows = Vec<HashMap<String, String>>;
+
 /// Runs `cmd` on `data`: the fit report, the parameter rows and the statistics rows.
-fn run(
-    dir: &Path,
-    cmd: &[&str],
-    data: &str,
-) -> (
-    String,
-    Vec<HashMap<String, String>>,
-    Vec<HashMap<String, String>>,
-) {
+fn run(dir: &Path, cmd: &[&str], data: &str) -> (String, Rows, Rows) {
     let input = write(dir, "data.csv", data);
     let report = stdout_ok(&bin().args(cmd).arg(&input).output().unwrap());
     let stats = dir.join("stats.csv");

@@ -91,11 +91,29 @@ class Table(dict):
 
 
 def _as_f64(name: str, x: Any) -> np.ndarray:
+    """``x`` as float64; a masked array with masked entries and complex numbers are refused
+    (their mask or imaginary part would otherwise be dropped silently)."""
+    if isinstance(x, np.ma.MaskedArray) and np.ma.getmaskarray(x).any():
+        raise ValueError(
+            f"{name}: a masked array with {int(np.ma.count_masked(x))} masked entries; "
+            "fill them (e.g. .filled(np.nan)) or leave those points out"
+        )
+    try:
+        complex_input = np.iscomplexobj(x)
+    except (TypeError, ValueError):
+        complex_input = False
+    if complex_input:
+        raise ValueError(f"{name}: complex numbers are not accepted; pass real numbers (e.g. .real)")
     try:
         a = np.asarray(x, dtype=np.float64)
     except (TypeError, ValueError) as e:
         raise ValueError(f"{name}: expected numbers ({e})") from None
     return a
+
+
+def _model_name(model: Any) -> Any:
+    """A model name in any case, as the command line takes it."""
+    return model.strip().lower() if isinstance(model, str) else model
 
 
 def _broadcast(named: Mapping[str, Any]) -> Tuple[Tuple[int, ...], Dict[str, Optional[np.ndarray]]]:
@@ -194,6 +212,7 @@ def forward(
     ValueError
         A bad value, naming the argument, the row and the value.
     """
+    model = _model_name(model)
     if model not in MODELS:
         if model == "md":
             raise ValueError("model md is not vectorised; use the command line's `fitbead forward --model md`")
@@ -262,6 +281,7 @@ def invert_k(
         ``below-range``, ``above-range``, ``invalid``) and ``message``; ``auto`` adds
         ``model_used`` and ``reason``.
     """
+    model = _model_name(model)
     if model not in K_MODELS:
         raise ValueError(f"model = {model!r}: expected one of {', '.join(K_MODELS)}")
     if isinstance(xi, Dataset):
@@ -644,7 +664,7 @@ def fit_klaw(
     """
     d = _dataset(data)
     return FitResult(
-        _core.fit_klaw(d._core, model=model, law=law, method=method, level=level, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps, min_ess=min_ess)
+        _core.fit_klaw(d._core, model=_model_name(model), law=law, method=method, level=level, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps, min_ess=min_ess)
     )
 
 

@@ -598,7 +598,7 @@ const K_TEXTS: [&str; 5] = ["regime", "status", "lower_limit", "upper_limit", "m
 
 /// The model of `k`'s `--model` (the five contact models, contact, or auto).
 fn k_model(name: &str, tol: f64) -> PyResult<(Model, Option<Auto>)> {
-    if name == "auto" {
+    if name.trim().eq_ignore_ascii_case("auto") {
         if !(tol > 0.0 && tol < 1.0) {
             return Err(value_error(format!(
                 "tol = {}: expected a relative tolerance in (0, 1)",
@@ -1093,7 +1093,7 @@ fn method_args(
     min_ess: Option<f64>,
 ) -> PyResult<MethodArgs> {
     let stop = Arc::new(AtomicBool::new(false));
-    let mcmc = match method {
+    let mcmc = match method.to_ascii_lowercase().as_str() {
         "lsq" => None,
         "mcmc" => {
             let mut s = McmcSettings::seeded(seed);
@@ -1104,14 +1104,9 @@ fn method_args(
                 s.options.max_steps = m;
             }
             if let Some(e) = min_ess {
-                if !(e > 0.0 && e.is_finite()) {
-                    return Err(value_error(format!(
-                        "min_ess = {}: expected a finite number > 0",
-                        show(e)
-                    )));
-                }
                 s.options.min_ess = e;
             }
+            s.options.check().map_err(|e| value_error(e.to_string()))?;
             s.options.stop = Some(stop.clone());
             Some(s)
         }

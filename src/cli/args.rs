@@ -76,7 +76,9 @@ impl DataArgs {
 #[derive(Debug, Clone, Default, clap::Args)]
 pub struct OutputArgs {
     /// Output CSV, written atomically (a temporary file renamed over the target only when the
-    /// whole run succeeded); stdout when absent.
+    /// whole run succeeded); stdout when absent or `-`. A standard stream or open descriptor
+    /// (/dev/stdout, /dev/stderr, /proc/self/fd/N) is written through in place, appending when
+    /// it was opened to append (`>>`).
     #[arg(long)]
     pub output: Option<PathBuf>,
 }
@@ -85,7 +87,8 @@ pub struct OutputArgs {
 #[derive(Debug, Clone, Default, clap::Args)]
 pub struct PlotArgs {
     /// SVG figure of the result (the command's description says what it shows), written
-    /// atomically.
+    /// atomically; `-` writes it to stdout (only one output may go there: without --output
+    /// the result takes it).
     #[arg(long)]
     pub plot: Option<PathBuf>,
 }

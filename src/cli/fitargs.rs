@@ -14,17 +14,16 @@ use fitbead::report::figures::{corner_svg, CornerBlock};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
-/// Most walkers of a posterior run (`--walkers`): each step keeps one draw per walker in
-/// memory.
-pub const MAX_WALKERS: usize = 10_000;
-
 /// `--output` of the fit commands: the parameter CSV, or the fit report on stdout.
 #[derive(Debug, Clone, Default, clap::Args)]
 pub struct FitOutputArgs {
     /// The parameter report CSV (fit,series,parameter,value,stderr,ci_low,ci_high,ci_method,
     /// unit, then extra columns), written atomically; `-` writes it to stdout. Without it, a
     /// one-screen fit report per fit goes to stdout (values ± standard errors, intervals,
-    /// correlations, χ², AIC, BIC, convergence, warnings)
+    /// correlations, χ², AIC, BIC, convergence, warnings). Every output flag takes `-` for
+    /// stdout, and a standard stream or descriptor (/dev/stdout, /proc/self/fd/N) is written
+    /// through in place; only one output may go to stdout (without --output the fit report
+    /// takes it)
     #[arg(long)]
     pub output: Option<PathBuf>,
 }
@@ -53,8 +52,9 @@ pub struct FitArgs {
     /// The parameter report CSV.
     #[command(flatten)]
     pub out: FitOutputArgs,
-    /// Fit statistics CSV (written atomically): χ², dof, AIC, BIC, termination per fit.
-    /// Printed to stderr as a table when absent.
+    /// Fit statistics CSV (written atomically): χ², dof, AIC, BIC, termination per fit; `-`
+    /// writes it to stdout (then --output must name a file). Printed to stderr as a table
+    /// when absent.
     #[arg(long)]
     pub output_stats: Option<PathBuf>,
     /// Estimation method: lsq (least squares) or mcmc (posterior sampling by an affine-invariant
@@ -93,7 +93,7 @@ pub struct FitArgs {
     #[arg(long)]
     pub fit_scatter: bool,
     /// MCMC: write the kept draws (after burn-in and thinning) to this CSV: fit,series,walker,
-    /// step, one column per parameter, log_posterior.
+    /// step, one column per parameter, log_posterior; `-` writes it to stdout.
     #[arg(long)]
     pub draws: Option<PathBuf>,
     /// MCMC: with --plot, a corner plot of every posterior (marginal histograms and pairwise
@@ -149,40 +149,22 @@ impl FitArgs {
             options.seed = 1;
         }
         options.walkers = self.walkers;
-        if let Some(w) = self.walkers {
-            if w < 4 || w % 2 == 1 || w > MAX_WALKERS {
-                return Err(super::flag_error(
-                    "--walkers",
-                    &w.to_string(),
-                    format!(
-                        "must be even, at least 4 (and more than the parameters) and at most \
-                         {MAX_WALKERS}"
-                    ),
-                ));
-            }
-        }
         if let Some(e) = self.min_ess {
-            if !(e >= 0.0 && e.is_finite()) {
-                return Err(super::flag_error(
-                    "--min-ess",
-                    &e.to_string(),
-                    "must be a finite number >= 0",
-                ));
-            }
             options.min_ess = e;
         }
         if let Some(m) = self.max_steps {
-            if m == 0 {
-                return Err(super::flag_error("--max-steps", "0", "must be >= 1"));
-            }
             options.max_steps = m;
         }
         if let Some(t) = self.thin {
-            if t == 0 {
-                return Err(super::flag_error("--thin", "0", "must be >= 1"));
-            }
             options.thin = t;
         }
+        options.check().map_err(|e| {
+            super::flag_error(
+                &format!("--{}", e.option.replace('_', "-")),
+                &e.value,
+                e.expected,
+            )
+        })?;
         let mut priors = Vec::new();
         for p in &self.priors {
             let Some((name, dist)) = p.split_once('=') else {

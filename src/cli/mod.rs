@@ -277,7 +277,8 @@ fn check_stdout(c: &Command) -> Result<(), CliError> {
 pub type NamedPaths<'a> = Vec<(&'static str, Option<&'a Path>)>;
 
 /// Refuses, before any work, an output that is also an input or another output of the same
-/// run (after following symbolic links), and an output that is a directory.
+/// run (after following symbolic links), an output that is a directory, and two outputs to
+/// standard output (`-`, `/dev/stdout`; without `--output` the result takes it).
 fn check_paths(c: &Command) -> Result<(), CliError> {
     fn opt(p: &Option<PathBuf>) -> Option<&Path> {
         p.as_deref()
@@ -311,7 +312,23 @@ fn check_paths(c: &Command) -> Result<(), CliError> {
             ],
         ),
     };
-    Ok(distinct_paths(&inputs, &outputs)?)
+    distinct_paths(&inputs, &outputs)?;
+    // Without --output the result goes to standard output, which no other output may take.
+    let result_on_stdout =
+        matches!(outputs.first(), Some(("--output", None))) && !matches!(c, Command::Report(_));
+    if result_on_stdout {
+        for (flag, p) in outputs.iter().skip(1) {
+            if let Some(p) = p.filter(|p| fitbead::io::stream_of(p) == Some(1)) {
+                return Err(flag_error(
+                    flag,
+                    &p.display().to_string(),
+                    "goes to standard output, which takes the result when --output is not \
+                     given: give --output FILE, or a file here",
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The stop flag raised by SIGINT (Ctrl-C), SIGTERM or SIGHUP: the handler is installed on the

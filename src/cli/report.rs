@@ -8,10 +8,9 @@ use super::CliError;
 use fitbead::fit::k::unsteady_points;
 use fitbead::io::measurements::locate_point;
 use fitbead::io::measurements::{is_shipped_data, si_conversion};
-use fitbead::io::write_atomic_all;
 use fitbead::report::analysis::analyse;
 use fitbead::report::figures::FigureFormat;
-use fitbead::report::text::{markdown, terminal_summary, ReportContext};
+use fitbead::report::text::{markdown, one_line, terminal_summary, ReportContext};
 use std::path::{Path, PathBuf};
 
 /// The contact models the report fits (a point must be steady under one of them).
@@ -26,7 +25,10 @@ pub struct Args {
     /// The measurements (as for `klaw`) and the defaults of the columns they may leave out.
     #[command(flatten)]
     pub data: DataArgs,
-    /// Directory for the tables, figures and report.md, created if missing [default: report]
+    /// Directory for the tables, figures and report.md, created if missing [default: report].
+    /// Written as one unit: locked while written (concurrent runs wait, never mix), every
+    /// file or none, the run recorded in .fitbead.manifest; files of the previous run that
+    /// this one does not write are removed, other files (yours) are never touched
     #[arg(long)]
     pub out_dir: Option<PathBuf>,
     /// lsq or mcmc (posteriors for every fit; adds one corner_<fit>_<series>.svg per
@@ -53,8 +55,9 @@ pub struct Args {
     #[arg(long)]
     pub max_steps: Option<usize>,
     /// A TOML recipe with any of the keys input, out_dir, method, format, units, rho, f, g,
-    /// level, seed, min_ess, max_steps (paths relative to the recipe's directory); flags given on the
-    /// command line win.
+    /// level, seed, min_ess, max_steps (paths relative to the recipe's directory, never
+    /// empty); flags given on the command line win. seed, min_ess and max_steps apply to mcmc
+    /// and are ignored under lsq. A bad value is reported with the recipe file, line and key
     #[arg(long)]
     pub recipe: Option<PathBuf>,
 }
@@ -93,7 +96,55 @@ pub struct Recipe {
     pub shown_input: Option<String>,
 }
 
-fn read_recipe(path: &Path) -> Result<Recipe, CliError> {
+/// The recipe's keys that a flag of the same meaning overrides, with that flag.
+const RECIPE_FLAGS: [(&str, &str); 12] = [
+    ("input", "--input"),
+    ("out_dir", "--out-dir"),
+    ("method", "--method"),
+    ("format", "--format"),
+    ("units", "--units"),
+    ("rho", "--rho"),
+    ("f", "--f"),
+    ("g", "--g"),
+    ("level", "--level"),
+    ("seed", "--seed"),
+    ("min_ess", "--min-ess"),
+    ("max_steps", "--max-steps"),
+];
+
+/// A recipe as read: its keys, its file's name and text (to blame a bad value on its line).
+struct RecipeFile {
+    recipe: Recipe,
+    name: String,
+    text: String,
+}
+
+impl RecipeFile {
+    /// The 1-based line of `key = …` in the recipe, when it is written that way.
+    fn line_of(&self, key: &str) -> Option<u64> {
+        self.text
+            .lines()
+            .position(|l| {
+                l.trim_start()
+                    .strip_prefix(key)
+                    .is_some_and(|rest| rest.trim_start().starts_with('='))
+            })
+            .map(|i| i as u64 + 1)
+    }
+
+    /// An error about the recipe's `key`, located on its line.
+    fn error(&self, key: &str, value: &str, message: impl Into<String>) -> CliError {
+        CliError::Input(fitbead::io::InputError {
+            file: self.name.clone(),
+            line: self.line_of(key),
+            column: Some(key.to_string()),
+            value: Some(value.to_string()),
+            message: message.into(),
+        })
+    }
+}
+
+fn read_recipe(path: &Path) -> Result<RecipeFile, CliError> {
     let name = path.display().to_string();
     let text = std::fs::read_to_string(path).map_err(|e| {
         CliError::Input(fitbead::io::InputError::file(
@@ -107,11 +158,68 @@ fn read_recipe(path: &Path) -> Result<Recipe, CliError> {
             format!("not a valid recipe: {e}"),
         ))
     })?;
+    let file = RecipeFile {
+        recipe: Recipe::default(),
+        name,
+        text,
+    };
+    // An empty path would be the recipe's own directory; the flags refuse it too.
+    for (key, p) in [("input", &r.input), ("out_dir", &r.out_dir)] {
+        if p.as_ref().is_some_and(|p| p.as_os_str().is_empty()) {
+            return Err(file.error(
+                key,
+                "",
+                "an empty path: name a file or directory (\".\" for the recipe's own directory)",
+            ));
+        }
+    }
     let dir = path.parent().unwrap_or(Path::new(""));
     r.shown_input = r.input.as_ref().map(|p| p.display().to_string());
     r.input = r.input.map(|p| dir.join(p));
     r.out_dir = r.out_dir.map(|p| dir.join(p));
-    Ok(r)
+    Ok(RecipeFile { recipe: r, ..file })
+}
+
+/// Whether the recipe's `key` is the value used: set in the recipe and not given as a flag.
+fn from_recipe(a: &Args, r: &Recipe, key: &str) -> bool {
+    match key {
+        "input" => a.data.path().is_none() && r.input.is_some(),
+        "out_dir" => a.out_dir.is_none() && r.out_dir.is_some(),
+        "method" => a.method.is_none() && r.method.is_some(),
+        "format" => a.format.is_none() && r.format.is_some(),
+        "units" => a.units.is_none() && r.units.is_some(),
+        "rho" => a.data.contact.rho.is_none() && r.rho.is_some(),
+        "f" => a.data.contact.f.is_none() && r.f.is_some(),
+        "g" => a.data.g.is_none() && r.g.is_some(),
+        "level" => a.level.level.is_none() && r.level.is_some(),
+        "seed" => a.seed.is_none() && r.seed.is_some(),
+        "min_ess" => a.min_ess.is_none() && r.min_ess.is_some(),
+        "max_steps" => a.max_steps.is_none() && r.max_steps.is_some(),
+        _ => false,
+    }
+}
+
+/// `e` blamed on the recipe when it is about a setting whose value came from the recipe: the
+/// recipe file, the key's line, the key.
+fn blame_recipe(e: CliError, file: &RecipeFile, keys: &[&str]) -> CliError {
+    let CliError::Input(ie) = e else { return e };
+    if ie.file != fitbead::io::SETTINGS_ORIGIN {
+        return CliError::Input(ie);
+    }
+    let flag = ie.column.clone().unwrap_or_default();
+    let key = RECIPE_FLAGS
+        .iter()
+        .find(|(_, f)| *f == flag)
+        .map(|(k, _)| *k);
+    match key.filter(|k| keys.contains(k)) {
+        Some(k) => CliError::Input(fitbead::io::InputError {
+            file: file.name.clone(),
+            line: file.line_of(k),
+            column: Some(k.to_string()),
+            ..ie
+        }),
+        None => CliError::Input(ie),
+    }
 }
 
 /// The unit of the velocities on the report's figures (`--units`).
@@ -123,12 +231,31 @@ enum Units {
     Si,
 }
 
-/// Runs `fitbead report`.
+/// Runs `fitbead report`. An error about a setting taken from the recipe names the recipe
+/// file, the key's line and the key.
 pub fn run(a: Args) -> Result<(), CliError> {
-    let r = match &a.recipe {
-        Some(p) => read_recipe(p)?,
-        None => Recipe::default(),
+    let Some(path) = a.recipe.clone() else {
+        return run_with(a, Recipe::default());
     };
+    let mut file = read_recipe(&path)?;
+    let mut r = std::mem::take(&mut file.recipe);
+    // The MCMC keys of a recipe apply to a posterior run only; under least squares (the
+    // recipe's method or --method lsq, which wins) they are ignored, not an error.
+    let method = a.method.clone().or(r.method.clone()).unwrap_or_default();
+    if !method.eq_ignore_ascii_case("mcmc") {
+        r.seed = None;
+        r.min_ess = None;
+        r.max_steps = None;
+    }
+    let keys: Vec<&str> = RECIPE_FLAGS
+        .iter()
+        .map(|(k, _)| *k)
+        .filter(|k| from_recipe(&a, &r, k))
+        .collect();
+    run_with(a, r).map_err(|e| blame_recipe(e, &file, &keys))
+}
+
+fn run_with(a: Args, r: Recipe) -> Result<(), CliError> {
     let from_flags = a.data.path().map(Path::to_path_buf);
     let shown = match (&from_flags, &r.shown_input) {
         (None, Some(s)) => Some(s.clone()),
@@ -362,10 +489,10 @@ pub fn run(a: Args) -> Result<(), CliError> {
              \"Plausibility checks\"):\n\n",
         );
         for w in &implausible {
-            md.push_str(&format!("- {w}\n"));
+            md.push_str(&format!("- {}\n", one_line(&w.to_string())));
         }
         for w in &absurd {
-            md.push_str(&format!("- {w}\n"));
+            md.push_str(&format!("- {}\n", one_line(w)));
         }
     }
     if !warnings.is_empty() {
@@ -376,7 +503,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
 ",
         );
         for w in &warnings {
-            md.push_str(&format!("- {w}\n"));
+            md.push_str(&format!("- {}\n", one_line(w)));
         }
     }
     files.push(("report.md".into(), md.into_bytes()));
@@ -387,13 +514,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
     }
     let created = create_dirs(&out_dir)
         .map_err(|e| CliError::Other(format!("{}: cannot create: {e}", out_dir.display())))?;
-    let paths: Vec<PathBuf> = files.iter().map(|f| out_dir.join(&f.0)).collect();
-    let staged: Vec<(&Path, &[u8])> = paths
-        .iter()
-        .zip(&files)
-        .map(|(p, f)| (p.as_path(), f.1.as_slice()))
-        .collect();
-    if let Err(e) = write_atomic_all(&staged) {
+    if let Err(e) = fitbead::io::outdir::write_dir(&out_dir, &files) {
         // All or nothing: directories made for this report go as well.
         for d in created.iter().rev() {
             let _ = std::fs::remove_dir(d);

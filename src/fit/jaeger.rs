@@ -24,7 +24,7 @@
 use super::data::Dataset;
 use super::jaeger_coordinates::JaegerCoordinates;
 use super::posterior::{summarise_reparameterised, summarise_with, Method, Prior};
-use super::summary::{FitResult, ParamSpec, Solved};
+use super::summary::{distinct_points, FitResult, ParamSpec, Solved};
 use crate::inverse::{fit, Infeasible, LsqOptions, Model, WeightedData};
 use crate::models::jaeger::Jaeger;
 use crate::models::JaegerBranch;
@@ -264,6 +264,7 @@ pub fn fit_jaeger_with(
             fit: &f,
             level,
             options: &opts,
+            distinct: Some(distinct_points(x.iter().map(|q| [q.0, q.1, q.2]))),
         };
         let mut summary = match JaegerCoordinates::for_series(&x, branch) {
             Some(c) => summarise_reparameterised(method, solved, &c),

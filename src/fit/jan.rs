@@ -13,7 +13,7 @@
 
 use super::data::Dataset;
 use super::posterior::{summarise_with, Method};
-use super::summary::{FitResult, ParamSpec, Solved};
+use super::summary::{distinct_points, FitResult, ParamSpec, Solved};
 use crate::inverse::{fit, Infeasible, LsqOptions, Model, WeightedData};
 
 /// The paper's global values (λ0, λ1, μ0, μ1), eqs 75–76.
@@ -164,6 +164,7 @@ pub fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFits {
             Some((a, b)) if b > 0.0 => (2.0 * sa / b, (-a / b).clamp(0.0, 0.999 * tmin)),
             _ => (crate::models::jan::Jan::paper_fit(sa.asin()).lambda, 0.0),
         };
+        let distinct = distinct_points(x.iter().map(|p| [p.1, p.2]));
         let problem = match WeightedData::new(JanSeries, x, y, Some(sg)) {
             Ok(p) => p,
             Err(e) => {
@@ -215,6 +216,7 @@ pub fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFits {
                 fit: &f,
                 level,
                 options: &opts,
+                distinct: Some(distinct),
             },
         );
         sum.attach_points(data, &data.series_index(s));
@@ -328,6 +330,7 @@ pub fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFits {
                     fit: &f,
                     level,
                     options: &opts,
+                    distinct: Some(distinct_points(x.iter().map(|p| [p.0, p.1, p.2]))),
                 },
             );
             sum.attach_points(data, &(0..data.points.len()).collect::<Vec<_>>());

@@ -773,6 +773,7 @@ pub fn fit_law_in(
         fit: &f,
         level,
         options: &opts,
+        distinct: None,
     };
     let mut summary = match method {
         // Independent parameters: each profiled on its own series.

@@ -96,6 +96,7 @@ fn sample<R: Residuals + Sync + ?Sized>(
         fit: f,
         level,
         options: _,
+        distinct: _,
     } = solved;
     let mut out = summarise(solved, false);
     let n = specs.len();

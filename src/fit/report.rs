@@ -41,6 +41,15 @@ fn num(x: f64) -> String {
     fmt_sig(x, 6)
 }
 
+/// An information criterion, `undefined` where it is NaN (see [`StatsRow::aic`]).
+fn criterion(x: f64) -> String {
+    if x.is_nan() {
+        "undefined".into()
+    } else {
+        num(x)
+    }
+}
+
 fn method_name(r: &FitResult) -> &'static str {
     if r.stats.mcmc.is_some() {
         "posterior sampling (affine-invariant ensemble)"
@@ -96,8 +105,8 @@ impl fmt::Display for FitResult {
         writeln!(f, "    variables          = {}", s.n_params)?;
         writeln!(f, "    chi-square         = {}", num(s.chi2))?;
         writeln!(f, "    reduced chi-square = {}", num(s.reduced_chi2))?;
-        writeln!(f, "    AIC                = {}", num(s.aic))?;
-        writeln!(f, "    BIC                = {}", num(s.bic))?;
+        writeln!(f, "    AIC                = {}", criterion(s.aic))?;
+        writeln!(f, "    BIC                = {}", criterion(s.bic))?;
         writeln!(
             f,
             "    sigma              = {}",

@@ -94,9 +94,9 @@ pub struct StatsRow {
     pub dof: usize,
     /// χ²/dof.
     pub reduced_chi2: f64,
-    /// AIC (see [`Fit::aic`]).
+    /// AIC (see [`Fit::aic`]); NaN where undefined (χ² = 0 with no σ given, the note says so).
     pub aic: f64,
-    /// BIC (see [`Fit::bic`]).
+    /// BIC (see [`Fit::bic`]); NaN where AIC is.
     pub bic: f64,
     /// Termination reason (`scored` for a parameter-free law).
     pub termination: String,
@@ -441,6 +441,50 @@ pub struct Solved<'a, R: ?Sized> {
     pub level: f64,
     /// The solver's options (bounds, σ convention).
     pub options: &'a LsqOptions,
+    /// How many distinct points the fit sees (points at the same abscissae count once; see
+    /// [`distinct_points`]), when the fit counts them: with fewer than the parameters the
+    /// data cannot determine them all.
+    pub distinct: Option<usize>,
+}
+
+/// The number of distinct abscissae among `keys` (compared bit for bit).
+pub fn distinct_points<const N: usize>(keys: impl IntoIterator<Item = [f64; N]>) -> usize {
+    let set: std::collections::HashSet<[u64; N]> =
+        keys.into_iter().map(|k| k.map(f64::to_bits)).collect();
+    set.len()
+}
+
+/// Why the data of a converged least-squares fit do not determine its parameters, if they do
+/// not: fewer distinct points than parameters; a Jacobian rank deficient at the estimate with
+/// no parameter on a bound of its box (a direction along which χ² does not change); or, with
+/// no σ given, χ² = 0 (a scatter estimated as 0 leaves intervals of zero width). Such a fit
+/// reports no standard errors, correlations or intervals.
+fn undetermined(f: &Fit, n_params: usize, distinct: Option<usize>) -> Option<String> {
+    if !f.converged() {
+        return None;
+    }
+    if let Some(d) = distinct.filter(|&d| d < n_params) {
+        return Some(format!(
+            "{d} distinct point(s) for {n_params} parameters: the data do not determine the \
+             parameters; no standard errors or intervals"
+        ));
+    }
+    let no_dof = f.sigma == SigmaKind::Relative && f.dof == 0;
+    if f.covariance.is_none() && !no_dof && !f.at_bound.iter().any(|b| *b) {
+        return Some(
+            "Jacobian rank deficient at the estimate: the data do not determine the \
+             parameters; no standard errors or intervals"
+                .into(),
+        );
+    }
+    if f.sigma == SigmaKind::Relative && f.chi2 == 0.0 {
+        return Some(
+            "chi2 = 0 with no sigma given: the scatter is estimated as 0; no standard errors \
+             or intervals"
+                .into(),
+        );
+    }
+    None
 }
 
 impl<R: ?Sized> Clone for Solved<'_, R> {
@@ -480,9 +524,13 @@ pub fn summarise_with_profiles<R: Residuals + ?Sized>(
         fit: f,
         level,
         options: opts,
+        distinct,
     } = s;
     let mut note = String::new();
-    let ci = if f.converged() && f.chi2.is_finite() {
+    let unknown = undetermined(f, specs.len(), distinct);
+    let ci = if unknown.is_some() {
+        None
+    } else if f.converged() && f.chi2.is_finite() {
         profiles(&s).filter(|p| p.len() == specs.len())
     } else {
         note = format!(
@@ -491,14 +539,16 @@ pub fn summarise_with_profiles<R: Residuals + ?Sized>(
         );
         None
     };
-    let wald = if f.converged() {
+    let wald = if f.converged() && unknown.is_none() {
         crate::inverse::covariance_intervals(f, level)
             .ok()
             .flatten()
     } else {
         None
     };
-    if f.converged() && f.covariance.is_none() {
+    if let Some(why) = &unknown {
+        note = why.clone();
+    } else if f.converged() && f.covariance.is_none() {
         note = if f.sigma == SigmaKind::Relative && f.dof == 0 {
             "no degree of freedom left to estimate the scatter (no sigma given): no covariance"
                 .into()
@@ -506,6 +556,19 @@ pub fn summarise_with_profiles<R: Residuals + ?Sized>(
             "Jacobian rank deficient at the estimate: no covariance".into()
         };
     }
+    // With no σ given, −2 ln L = m ln(2π χ²/m) + m is unbounded below at χ² = 0.
+    let (aic, bic) = if f.aic == f64::NEG_INFINITY || f.bic == f64::NEG_INFINITY {
+        let why = "chi2 = 0: AIC and BIC undefined (the likelihood with the scatter estimated is \
+                   unbounded)";
+        note = if note.is_empty() {
+            why.into()
+        } else {
+            format!("{note}; {why}")
+        };
+        (f64::NAN, f64::NAN)
+    } else {
+        (f.aic, f.bic)
+    };
     let mut evals = f.residual_evals;
     let params = specs
         .iter()
@@ -531,6 +594,9 @@ pub fn summarise_with_profiles<R: Residuals + ?Sized>(
             if f.at_bound.get(j).copied().unwrap_or(false) {
                 pnote.push_str("on a bound of its box; the covariance ignores the bound. ");
             }
+            if unknown.is_some() {
+                pnote.push_str("not determined by the data: no standard error or interval. ");
+            }
             if let Some((lo, hi)) = prof {
                 for (end, which) in [(lo, "lower"), (hi, "upper")] {
                     match end {
@@ -555,7 +621,7 @@ pub fn summarise_with_profiles<R: Residuals + ?Sized>(
                 series: series.to_string(),
                 parameter: s.name.to_string(),
                 value: f.params[j],
-                stderr: if f.converged() {
+                stderr: if f.converged() && unknown.is_none() {
                     f.std_errors().map(|se| se[j])
                 } else {
                     None
@@ -584,8 +650,8 @@ pub fn summarise_with_profiles<R: Residuals + ?Sized>(
             chi2: f.chi2,
             dof: f.dof,
             reduced_chi2: f.reduced_chi2,
-            aic: f.aic,
-            bic: f.bic,
+            aic,
+            bic,
             termination: termination_name(f.termination).to_string(),
             converged: f.converged(),
             iterations: f.iterations,
@@ -596,15 +662,19 @@ pub fn summarise_with_profiles<R: Residuals + ?Sized>(
             mcmc: None,
         },
         draws: None,
-        correlation: f.covariance.as_ref().map(|c| {
-            (0..c.correlation.nrows())
-                .map(|i| {
-                    (0..c.correlation.ncols())
-                        .map(|j| c.correlation[(i, j)])
-                        .collect()
-                })
-                .collect()
-        }),
+        correlation: f
+            .covariance
+            .as_ref()
+            .filter(|_| unknown.is_none())
+            .map(|c| {
+                (0..c.correlation.nrows())
+                    .map(|i| {
+                        (0..c.correlation.ncols())
+                            .map(|j| c.correlation[(i, j)])
+                            .collect()
+                    })
+                    .collect()
+            }),
         residuals: f.residuals.clone(),
         points: Vec::new(),
     }

@@ -129,6 +129,63 @@ impl Default for McmcOptions {
     }
 }
 
+/// Most walkers a run may have: each step keeps one draw per walker in memory.
+pub const MAX_WALKERS: usize = 10_000;
+
+/// A user-given sampler setting out of its range: the option (`walkers`, `min_ess`,
+/// `max_steps` or `thin`), the value given, and what it must be.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error("{option} = {value}: {expected}")]
+pub struct OptionError {
+    /// The option's name.
+    pub option: &'static str,
+    /// The value given, as text.
+    pub value: String,
+    /// What the option must be.
+    pub expected: String,
+}
+
+impl McmcOptions {
+    /// Checks the settings a user chooses (walkers, min_ess, max_steps, thin) against their
+    /// ranges: walkers even, at least 4 and at most [`MAX_WALKERS`]; min_ess finite and ≥ 0;
+    /// max_steps and thin ≥ 1. The command line and the Python binding refuse the same values.
+    pub fn check(&self) -> Result<(), OptionError> {
+        let bad = |option, value: String, expected: String| {
+            Err(OptionError {
+                option,
+                value,
+                expected,
+            })
+        };
+        if let Some(w) = self.walkers {
+            if w < 4 || w % 2 == 1 || w > MAX_WALKERS {
+                return bad(
+                    "walkers",
+                    w.to_string(),
+                    format!(
+                        "must be even, at least 4 (and more than the parameters) and at most \
+                         {MAX_WALKERS}"
+                    ),
+                );
+            }
+        }
+        if !(self.min_ess >= 0.0 && self.min_ess.is_finite()) {
+            return bad(
+                "min_ess",
+                self.min_ess.to_string(),
+                "must be a finite number >= 0".into(),
+            );
+        }
+        if self.max_steps == 0 {
+            return bad("max_steps", "0".into(), "must be >= 1".into());
+        }
+        if self.thin == 0 {
+            return bad("thin", "0".into(), "must be >= 1".into());
+        }
+        Ok(())
+    }
+}
+
 /// Errors of the ensemble sampler (all detected before sampling starts).
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum McmcError {

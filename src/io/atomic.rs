@@ -8,6 +8,12 @@
 //!   link stays;
 //! - a **device, FIFO or socket** cannot be replaced: it is opened and written in place (so
 //!   `/dev/null` stays a device and a FIFO's reader gets the bytes);
+//! - a **standard stream or open descriptor** of this process (`-`, which is standard output,
+//!   `/dev/stdout`, `/dev/stderr`, `/dev/fd/N`, `/proc/self/fd/N`, or a link to one) is written
+//!   through the descriptor itself, at its offset and in append mode when it was opened so: a
+//!   file redirected with `>>` keeps its earlier content, and a pipe gets the bytes; a
+//!   descriptor of another process (`/proc/PID/fd/N`) is opened in place, in append mode when
+//!   that descriptor is;
 //! - a **directory** is an error before anything is written;
 //! - a **new file** gets mode 0666 less the process umask (0644 under umask 022), as a file
 //!   made by `>` in a shell would; an **existing file** keeps its mode.
@@ -16,6 +22,14 @@
 //! target resolved, none a directory, no two the same file), then renamed one after the other;
 //! if a rename fails, the files already renamed are put back as they were (the previous
 //! contents of a replaced file are kept under a hard link until the group succeeds).
+//!
+//! A target that became a symbolic link after it was resolved (swapped in during the run) is
+//! resolved again just before the rename: the link stays a link and its final target is
+//! replaced.
+//!
+//! Temporary files and backups are named `.fitbead-PID-XXXXXX.tmp` and `.fitbead-PID-XXXXXX.bak`
+//! (PID the writing process): [`remove_stale_temporaries`] removes those of a process that is
+//! gone (a run killed by SIGKILL leaves them behind).
 
 use super::{setting_error, InputError};
 use std::fs::{File, OpenOptions};
@@ -34,14 +48,8 @@ enum Target {
     Regular(PathBuf, std::fs::Permissions),
     /// A device, FIFO or socket: written in place.
     Special(PathBuf),
-}
-
-impl Target {
-    fn path(&self) -> &Path {
-        match self {
-            Target::New(p) | Target::Regular(p, _) | Target::Special(p) => p,
-        }
-    }
+    /// An open descriptor of this process (a standard stream): written through it.
+    Descriptor(i32),
 }
 
 fn with_path(path: &Path, e: std::io::Error) -> std::io::Error {
@@ -58,8 +66,16 @@ fn is_a_directory(path: &Path) -> std::io::Error {
 /// Follows the symbolic links of `path` (the last component only, repeatedly) and says what
 /// the final target is.
 fn resolve(path: &Path) -> std::io::Result<Target> {
+    if path == Path::new("-") {
+        return Ok(Target::Descriptor(1));
+    }
     let mut p = path.to_path_buf();
     for _ in 0..MAX_LINKS {
+        match descriptor_of(&p) {
+            Some(Fd::Own(fd)) => return Ok(Target::Descriptor(fd)),
+            Some(Fd::Foreign) => return Ok(Target::Special(p)),
+            None => {}
+        }
         let meta = match std::fs::symlink_metadata(&p) {
             Ok(m) => m,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Target::New(p)),
@@ -88,6 +104,81 @@ fn resolve(path: &Path) -> std::io::Result<Target> {
     )))
 }
 
+/// A path in a directory of open descriptors.
+enum Fd {
+    /// Descriptor N of this process.
+    Own(i32),
+    /// A descriptor of another process.
+    Foreign,
+}
+
+/// Whether `p` names an open descriptor: `N` in this process's descriptor directory
+/// (`/proc/self/fd`, `/dev/fd`, `/proc/thread-self/fd`, `/proc/PID/fd` with this PID), or in
+/// another process's (`/proc/PID/fd`). Only on Linux; elsewhere `/dev/fd/N` is a device.
+fn descriptor_of(p: &Path) -> Option<Fd> {
+    if !cfg!(target_os = "linux") {
+        return None;
+    }
+    let n: i32 = p.file_name()?.to_str()?.parse().ok()?;
+    let dir = std::fs::canonicalize(p.parent()?).ok()?;
+    let parts: Vec<&str> = dir.iter().filter_map(|c| c.to_str()).collect();
+    let pid = match parts.as_slice() {
+        ["/", "proc", pid, "fd"] | ["/", "proc", pid, "task", _, "fd"] => {
+            pid.parse::<u32>().ok()?
+        }
+        _ => return None,
+    };
+    Some(if pid == std::process::id() {
+        Fd::Own(n)
+    } else {
+        Fd::Foreign
+    })
+}
+
+/// Whether descriptor `fd` of this process is open in append mode (Linux, from /proc; false
+/// elsewhere or when unknown).
+fn descriptor_appends(path: &Path) -> bool {
+    // /proc/PID/fdinfo/N beside /proc/PID/fd/N; O_APPEND is 0o2000.
+    let (Some(dir), Some(n)) = (path.parent().and_then(Path::parent), path.file_name()) else {
+        return false;
+    };
+    std::fs::read_to_string(dir.join("fdinfo").join(n))
+        .ok()
+        .and_then(|info| {
+            info.lines()
+                .find_map(|l| l.strip_prefix("flags:"))
+                .and_then(|f| u32::from_str_radix(f.trim(), 8).ok())
+        })
+        .is_some_and(|f| f & 0o2000 != 0)
+}
+
+/// A new handle on descriptor `fd` of this process (a duplicate: same offset, same flags).
+#[cfg(unix)]
+fn duplicate(fd: i32, path: &Path) -> std::io::Result<File> {
+    use std::os::fd::BorrowedFd;
+    if fd < 0 {
+        return Err(bad_descriptor(fd, path));
+    }
+    // SAFETY: the descriptor is only duplicated (F_DUPFD_CLOEXEC), never closed; one that is
+    // not open makes the duplication fail with EBADF.
+    let b = unsafe { BorrowedFd::borrow_raw(fd) };
+    b.try_clone_to_owned()
+        .map(File::from)
+        .map_err(|_| bad_descriptor(fd, path))
+}
+
+#[cfg(not(unix))]
+fn duplicate(fd: i32, path: &Path) -> std::io::Result<File> {
+    Err(bad_descriptor(fd, path))
+}
+
+fn bad_descriptor(fd: i32, path: &Path) -> std::io::Error {
+    std::io::Error::new(
+        std::io::ErrorKind::NotFound,
+        format!("{}: descriptor {fd} is not open", path.display()),
+    )
+}
+
 /// The directory a temporary file for `target` goes in.
 fn dir_of(target: &Path) -> PathBuf {
     match target.parent() {
@@ -98,26 +189,68 @@ fn dir_of(target: &Path) -> PathBuf {
 
 /// Whether `a` and `b` name the same file once symbolic links are followed: the same device
 /// and inode when both exist, else the same path (its directory made absolute). A path that
-/// cannot be resolved is not the same as any other.
+/// cannot be resolved is not the same as any other. Two standard streams (`-`,
+/// `/dev/stdout`, `/proc/self/fd/N`) are the same when they are the same descriptor; a stream
+/// is the same as a path only when it is redirected to that regular file.
 pub fn same_file(a: &Path, b: &Path) -> bool {
     let (Ok(ta), Ok(tb)) = (resolve_any(a), resolve_any(b)) else {
         return false;
     };
+    let meta = |t: &Resolved| match t {
+        Resolved::Path(p) => std::fs::metadata(p),
+        Resolved::Fd(fd) => duplicate(*fd, Path::new("-"))
+            .and_then(|f| f.metadata())
+            .and_then(|m| {
+                if m.is_file() {
+                    Ok(m)
+                } else {
+                    Err(std::io::Error::other("not a regular file"))
+                }
+            }),
+    };
+    match (&ta, &tb) {
+        (Resolved::Fd(x), Resolved::Fd(y)) => return x == y,
+        (Resolved::Path(x), Resolved::Path(y)) if !x.exists() || !y.exists() => {
+            return absolute(x) == absolute(y)
+        }
+        _ => {}
+    }
     #[cfg(unix)]
     {
         use std::os::unix::fs::MetadataExt;
-        if let (Ok(ma), Ok(mb)) = (std::fs::metadata(&ta), std::fs::metadata(&tb)) {
+        if let (Ok(ma), Ok(mb)) = (meta(&ta), meta(&tb)) {
             return ma.dev() == mb.dev() && ma.ino() == mb.ino();
         }
     }
-    absolute(&ta) == absolute(&tb)
+    match (&ta, &tb) {
+        (Resolved::Path(x), Resolved::Path(y)) => absolute(x) == absolute(y),
+        _ => false,
+    }
+}
+
+/// Whether `path` resolves to an open descriptor of this process (`-` is standard output):
+/// descriptor N, or `None` for a path.
+pub fn stream_of(path: &Path) -> Option<i32> {
+    match resolve(path) {
+        Ok(Target::Descriptor(fd)) => Some(fd),
+        _ => None,
+    }
+}
+
+/// What a path names, directories included.
+enum Resolved {
+    Path(PathBuf),
+    Fd(i32),
 }
 
 /// The final target of `path`'s symbolic links, directories included.
-fn resolve_any(path: &Path) -> std::io::Result<PathBuf> {
+fn resolve_any(path: &Path) -> std::io::Result<Resolved> {
     match resolve(path) {
-        Ok(t) => Ok(t.path().to_path_buf()),
-        Err(e) if e.kind() == std::io::ErrorKind::IsADirectory => Ok(path.to_path_buf()),
+        Ok(Target::Descriptor(fd)) => Ok(Resolved::Fd(fd)),
+        Ok(Target::New(p) | Target::Regular(p, _) | Target::Special(p)) => Ok(Resolved::Path(p)),
+        Err(e) if e.kind() == std::io::ErrorKind::IsADirectory => {
+            Ok(Resolved::Path(path.to_path_buf()))
+        }
         Err(e) => Err(e),
     }
 }
@@ -162,12 +295,23 @@ impl AtomicFile {
 
     fn create_for(path: &Path, target: Target) -> std::io::Result<AtomicFile> {
         let sink = match target {
-            Target::Special(p) => Sink::Direct(
-                OpenOptions::new()
-                    .write(true)
-                    .open(&p)
-                    .map_err(|e| with_path(path, e))?,
-            ),
+            Target::Descriptor(fd) => Sink::Direct(duplicate(fd, path)?),
+            Target::Special(p) => {
+                // A descriptor of another process: in append mode when it is; a regular file
+                // behind it is rewritten from the start.
+                let foreign = matches!(descriptor_of(&p), Some(Fd::Foreign));
+                let append = foreign && descriptor_appends(&p);
+                let truncate =
+                    foreign && !append && std::fs::metadata(&p).is_ok_and(|m| m.is_file());
+                Sink::Direct(
+                    OpenOptions::new()
+                        .write(true)
+                        .append(append)
+                        .truncate(truncate)
+                        .open(&p)
+                        .map_err(|e| with_path(path, e))?,
+                )
+            }
             Target::New(p) => Sink::Temp {
                 tmp: temp_in(&p, None).map_err(|e| with_path(path, e))?,
                 target: p,
@@ -187,7 +331,7 @@ impl AtomicFile {
     /// only flushed).
     pub fn commit(mut self) -> std::io::Result<()> {
         self.sync()?;
-        self.persist().map(|_| ())
+        self.persist(false).map(|_| ())
     }
 
     fn sync(&mut self) -> std::io::Result<()> {
@@ -202,8 +346,11 @@ impl AtomicFile {
         matches!(self.sink, Sink::Direct(_))
     }
 
-    /// Renames the temporary file over the target; returns what [`undo`] needs.
-    fn persist(self) -> std::io::Result<Done> {
+    /// Renames the temporary file over the target; returns what [`Done::undo`] needs (with
+    /// `keep_backup`, a hard link to the previous contents, for a group's roll-back). A target
+    /// that became a symbolic link since it was resolved is resolved again: the link stays
+    /// and its final target is replaced.
+    fn persist(self, keep_backup: bool) -> std::io::Result<Done> {
         let path = self.path;
         match self.sink {
             Sink::Direct(_) => Ok(Done {
@@ -212,7 +359,12 @@ impl AtomicFile {
                 existed: true,
             }),
             Sink::Temp { tmp, target } => {
-                let backup = backup_of(&target);
+                let (tmp, target) = retarget(tmp, target).map_err(|e| with_path(&path, e))?;
+                let backup = if keep_backup {
+                    backup_of(&target)
+                } else {
+                    None
+                };
                 let existed = backup.is_some() || target.exists();
                 match tmp.persist(&target) {
                     Ok(_) => Ok(Done {
@@ -230,6 +382,43 @@ impl AtomicFile {
             }
         }
     }
+}
+
+/// The temporary file and the target it is renamed over, once `target` is resolved again: a
+/// symbolic link put there since is followed (the bytes are moved to a temporary file in the
+/// link's final directory when that differs); a directory, device or stream put there is an
+/// error.
+fn retarget(
+    tmp: tempfile::NamedTempFile,
+    target: PathBuf,
+) -> std::io::Result<(tempfile::NamedTempFile, PathBuf)> {
+    let is_link = std::fs::symlink_metadata(&target).is_ok_and(|m| m.file_type().is_symlink());
+    if !is_link {
+        return Ok((tmp, target));
+    }
+    let (p, perm) = match resolve(&target)? {
+        Target::New(p) => (p, None),
+        Target::Regular(p, perm) => (p, Some(perm)),
+        Target::Special(_) | Target::Descriptor(_) => {
+            return Err(std::io::Error::other(format!(
+                "{}: became a link to a device or stream during the run",
+                target.display()
+            )))
+        }
+    };
+    let same_dir =
+        std::fs::canonicalize(dir_of(&p)).ok() == std::fs::canonicalize(dir_of(tmp.path())).ok();
+    if same_dir {
+        if let Some(perm) = perm {
+            tmp.as_file().set_permissions(perm)?;
+        }
+        return Ok((tmp, p));
+    }
+    let mut moved = temp_in(&p, perm)?;
+    let mut from = tmp.reopen()?;
+    std::io::copy(&mut from, &mut moved)?;
+    moved.as_file().sync_all()?;
+    Ok((moved, p))
 }
 
 /// A rename done within a group, and how to undo it.
@@ -274,7 +463,7 @@ fn backup_of(target: &Path) -> Option<PathBuf> {
     for _ in 0..16 {
         // A fresh unique name: create and remove an empty temporary file, then link to it.
         let name = tempfile::Builder::new()
-            .prefix(".fitbead-")
+            .prefix(&temp_prefix())
             .suffix(".bak")
             .tempfile_in(&dir)
             .ok()?
@@ -291,6 +480,74 @@ fn backup_of(target: &Path) -> Option<PathBuf> {
     None
 }
 
+/// The prefix of this process's temporary files and backups: `.fitbead-PID-`.
+fn temp_prefix() -> String {
+    format!(".fitbead-{}-", std::process::id())
+}
+
+/// How old a temporary file or backup named without a process id (`.fitbead-XXXXXX.tmp`, as
+/// fitbead named them before) must be for [`remove_stale_temporaries`] to take it as stale.
+pub const STALE_UNOWNED_SECS: u64 = 3600;
+
+/// Removes the stale temporary files and backups of fitbead's own naming in `dir`: a regular
+/// file named `.fitbead-PID-XXXXXX.tmp` or `.fitbead-PID-XXXXXX.bak` whose process PID is no
+/// longer running (on Linux; elsewhere only the age rule applies), or one named
+/// `.fitbead-XXXXXX.tmp` / `.bak` without a process id that was last modified more than
+/// [`STALE_UNOWNED_SECS`] ago. A live run's files, other names, links and directories are
+/// never touched. Returns the names removed.
+pub fn remove_stale_temporaries(dir: &Path) -> std::io::Result<Vec<String>> {
+    let mut removed = Vec::new();
+    for e in std::fs::read_dir(dir)? {
+        let Ok(e) = e else { continue };
+        let name = e.file_name();
+        let Some(name) = name.to_str() else { continue };
+        let Some(stem) = name
+            .strip_prefix(".fitbead-")
+            .and_then(|n| n.strip_suffix(".tmp").or_else(|| n.strip_suffix(".bak")))
+        else {
+            continue;
+        };
+        let Ok(meta) = std::fs::symlink_metadata(e.path()) else {
+            continue;
+        };
+        if !meta.file_type().is_file() {
+            continue;
+        }
+        let stale = match stem.split_once('-') {
+            Some((pid, rest))
+                if !pid.is_empty()
+                    && !rest.is_empty()
+                    && pid.bytes().all(|b| b.is_ascii_digit()) =>
+            {
+                let pid: u64 = pid.parse().unwrap_or(0);
+                pid != u64::from(std::process::id()) && process_gone(pid, &meta)
+            }
+            _ => meta
+                .modified()
+                .ok()
+                .and_then(|m| m.elapsed().ok())
+                .is_some_and(|age| age.as_secs() > STALE_UNOWNED_SECS),
+        };
+        if stale && std::fs::remove_file(e.path()).is_ok() {
+            removed.push(name.to_string());
+        }
+    }
+    removed.sort();
+    Ok(removed)
+}
+
+/// Whether process `pid`, which wrote a file whose metadata is `meta`, is gone: on Linux, no
+/// /proc/PID; elsewhere, when the file is older than [`STALE_UNOWNED_SECS`].
+fn process_gone(pid: u64, meta: &std::fs::Metadata) -> bool {
+    if cfg!(target_os = "linux") && Path::new("/proc/self").exists() {
+        return !Path::new("/proc").join(pid.to_string()).exists();
+    }
+    meta.modified()
+        .ok()
+        .and_then(|m| m.elapsed().ok())
+        .is_some_and(|age| age.as_secs() > STALE_UNOWNED_SECS)
+}
+
 /// A temporary file in `target`'s directory: mode `perm` (an existing target's), or 0666 less
 /// the umask for a new file.
 fn temp_in(
@@ -298,7 +555,8 @@ fn temp_in(
     perm: Option<std::fs::Permissions>,
 ) -> std::io::Result<tempfile::NamedTempFile> {
     let mut b = tempfile::Builder::new();
-    b.prefix(".fitbead-").suffix(".tmp");
+    let prefix = temp_prefix();
+    b.prefix(&prefix).suffix(".tmp");
     #[cfg(unix)]
     {
         use std::os::unix::fs::PermissionsExt;
@@ -366,7 +624,8 @@ pub fn write_atomic_all_then(
     }
     for i in 0..files.len() {
         for j in 0..i {
-            if !matches!(targets[i], Target::Special(_)) && same_file(files[i].0, files[j].0) {
+            let streams = matches!(targets[i], Target::Special(_) | Target::Descriptor(_));
+            if !streams && same_file(files[i].0, files[j].0) {
                 return Err(std::io::Error::new(
                     std::io::ErrorKind::InvalidInput,
                     format!(
@@ -381,7 +640,7 @@ pub fn write_atomic_all_then(
     let mut staged = Vec::with_capacity(files.len());
     let mut direct = Vec::new();
     for ((path, bytes), target) in files.iter().zip(targets) {
-        if matches!(target, Target::Special(_)) {
+        if matches!(target, Target::Special(_) | Target::Descriptor(_)) {
             direct.push((*path, *bytes));
             continue;
         }
@@ -399,7 +658,7 @@ pub fn write_atomic_all_then(
     };
     for f in staged {
         debug_assert!(!f.is_direct());
-        match f.persist() {
+        match f.persist(true) {
             Ok(d) => done.push(d),
             Err(e) => {
                 rollback(&done);
@@ -425,8 +684,10 @@ pub fn write_atomic_all_then(
 
 /// Refuses, before any work, an output that is a directory, that is one of the `inputs`
 /// (after following symbolic links; `-`, standard input, is none) or that is another of the
-/// `outputs`. Paths are named by the flag that gives them (absent ones skipped); the error
-/// names the flag.
+/// `outputs`. An output `-` is standard output; two outputs to the same standard stream or
+/// descriptor (`-` and `/dev/stdout`, say) are refused as well: their bytes would be mixed.
+/// Paths are named by the flag that gives them (absent ones skipped); the error names the
+/// flag.
 pub fn distinct_paths(
     inputs: &[(&str, Option<&Path>)],
     outputs: &[(&str, Option<&Path>)],
@@ -436,7 +697,8 @@ pub fn distinct_paths(
         .filter_map(|(n, p)| p.map(|p| (*n, p)))
         .collect();
     for (i, (flag, p)) in outs.iter().enumerate() {
-        if p.is_dir() {
+        let stream = stream_of(p);
+        if stream.is_none() && p.is_dir() {
             return Err(setting_error(
                 flag.trim_start_matches("--"),
                 &p.display().to_string(),
@@ -453,6 +715,21 @@ pub fn distinct_paths(
             }
         }
         for (oflag, q) in &outs[..i] {
+            if let Some(fd) = stream.filter(|fd| stream_of(q) == Some(*fd)) {
+                let name = match fd {
+                    1 => "standard output".to_string(),
+                    2 => "standard error".to_string(),
+                    n => format!("descriptor {n}"),
+                };
+                return Err(setting_error(
+                    flag.trim_start_matches("--"),
+                    &p.display().to_string(),
+                    format!(
+                        "goes to {name}, as {oflag} does: only one output may go to a stream \
+                         (give one of them a file)"
+                    ),
+                ));
+            }
             if same_file(p, q) {
                 return Err(setting_error(
                     flag.trim_start_matches("--"),

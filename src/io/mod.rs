@@ -1,5 +1,6 @@
 //! Files: CSV reading with errors that name file, line, column and value; atomic writing
-//! ([`AtomicFile`], [`write_atomic_all`]: whole files or none, modes kept, links followed);
+//! ([`AtomicFile`], [`write_atomic_all`]: whole files or none, modes kept, links followed;
+//! directories of outputs written as one unit: [`outdir`]);
 //! tables streamed through a per-row computation in bounded memory ([`stream`]), with the
 //! row plans of `fitbead forward` ([`forward`]) and `fitbead k` ([`kstream`]).
 
@@ -9,12 +10,14 @@ pub mod forward;
 pub mod kstream;
 pub mod md;
 pub mod measurements;
+pub mod outdir;
 pub mod reports;
 pub mod scenes;
 pub mod stream;
 
 pub use atomic::{
-    distinct_paths, same_file, write_atomic, write_atomic_all, write_atomic_all_then, AtomicFile,
+    distinct_paths, remove_stale_temporaries, same_file, stream_of, write_atomic, write_atomic_all,
+    write_atomic_all_then, AtomicFile, STALE_UNOWNED_SECS,
 };
 
 pub use crate::numfmt::{clip, fmt_f64, fmt_sig, push_f64, ECHO_CHARS};

@@ -11,10 +11,59 @@ pub mod plots;
 pub mod text;
 pub mod workprecision;
 
+/// Longest file-name part made of a series label ([`file_stems`]), in bytes.
+pub const STEM_BYTES: usize = 64;
+
+/// File-name parts for series `labels` (in order): a label is data, never a path, so every
+/// character outside `[A-Za-z0-9._-]` becomes `_` and the result is cut at [`STEM_BYTES`]; a
+/// label that had to change and now shares its name with another label gets `-` and eight
+/// hexadecimal digits of a hash of the label appended (stable: the same label gets the same
+/// name whatever the other labels). A label already safe keeps its name.
+pub fn file_stems(labels: &[String]) -> Vec<String> {
+    let safe = |l: &str| -> String {
+        let mut s: String = l
+            .chars()
+            .map(|c| {
+                if c.is_ascii_alphanumeric() || matches!(c, '.' | '_' | '-') {
+                    c
+                } else {
+                    '_'
+                }
+            })
+            .collect();
+        s.truncate(STEM_BYTES);
+        if s.is_empty() || s.chars().all(|c| c == '.') {
+            s = s.replace('.', "_");
+            s.push('_');
+        }
+        s
+    };
+    let stems: Vec<String> = labels.iter().map(|l| safe(l)).collect();
+    let mut out = stems.clone();
+    for (i, l) in labels.iter().enumerate() {
+        let shared = stems.iter().filter(|s| **s == stems[i]).count() > 1;
+        if shared && *l != stems[i] {
+            // FNV-1a, 32 bits.
+            let h = l.bytes().fold(0x811c_9dc5_u32, |h, b| {
+                (h ^ u32::from(b)).wrapping_mul(0x0100_0193)
+            });
+            out[i] = format!("{}-{h:08x}", stems[i]);
+        }
+    }
+    // Two changed labels of one hash (or one changed label equal to another's hashed name)
+    // are told apart by their position.
+    for i in 0..out.len() {
+        if out[..i].contains(&out[i]) {
+            out[i] = format!("{}-{}", out[i], i + 1);
+        }
+    }
+    out
+}
+
 /// Every file of fixed name `fitbead report` may write in its directory (with `--format png`
 /// or `both`, each figure `NAME.svg` also, or instead, as `NAME.png`; with `--method mcmc`, one
 /// corner plot per posterior, `corner_<fit>_<series>.svg` with the fit named as in
-/// `params.csv`).
+/// `params.csv` and the series label made a safe file name by [`file_stems`]).
 pub const REPORT_FILES: [&str; 19] = [
     "bulk_friction.csv",
     "energy.csv",

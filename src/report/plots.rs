@@ -862,8 +862,16 @@ impl Analysis {
     }
 
     /// One corner plot per posterior: (file name `corner_<fit>_<series>.svg` with the fit
-    /// named as in `params.csv`, SVG). Empty without posteriors.
+    /// named as in `params.csv` and the series label made a safe, unique file name by
+    /// [`super::file_stems`], SVG). Empty without posteriors.
     pub fn corner_figures(&self) -> Vec<(String, String)> {
+        let stems = super::file_stems(&self.data.labels);
+        let stem = |series: &str| -> String {
+            match self.data.labels.iter().position(|l| l == series) {
+                Some(i) => stems[i].clone(),
+                None => super::file_stems(&[series.to_string()]).remove(0),
+            }
+        };
         let mut out = Vec::new();
         for (name, fits) in self.named_fits() {
             for f in fits {
@@ -876,7 +884,7 @@ impl Analysis {
                         b.title.push_str(" (interrupted)");
                     }
                     out.push((
-                        format!("corner_{name}_{}.svg", f.stats.series),
+                        format!("corner_{name}_{}.svg", stem(&f.stats.series)),
                         corner_figure(&b).to_svg(),
                     ));
                 }

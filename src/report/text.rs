@@ -24,6 +24,18 @@ pub struct ReportContext {
     pub corner_files: Vec<String>,
 }
 
+/// `s` as a Markdown table cell: `|` escaped (`\|`), every line break a space. Series labels
+/// are data: one with `|` or a newline must not split or end a row.
+pub fn table_cell(s: &str) -> String {
+    one_line(s).replace('|', "\\|")
+}
+
+/// `s` on one Markdown line (a list item, a paragraph): every line break (CR, LF or both) a
+/// space.
+pub fn one_line(s: &str) -> String {
+    s.replace("\r\n", " ").replace(['\r', '\n'], " ")
+}
+
 /// A parameter's name in the report's tables: qualified by series where a fit across series
 /// has one per series (`K[1.6]`).
 fn param_name(r: &ParamRow, fit_series: &str) -> String {
@@ -86,12 +98,14 @@ fn parameter_table(an: &Analysis) -> String {
                 String::new()
             };
             m.push_str(&format!(
-                "| {} | {series} | {} | {} | {} | {} | {note} |\n",
-                f.stats.fit,
-                param_name(r, &f.stats.series),
+                "| {} | {} | {} | {} | {} | {} | {} |\n",
+                table_cell(&f.stats.fit),
+                table_cell(&series),
+                table_cell(&param_name(r, &f.stats.series)),
                 value_pm(r),
                 interval_cell(r),
                 r.paper_value.map_or("—".into(), |v| fmt_sig(v, 4)),
+                table_cell(&note),
             ));
         }
     }
@@ -100,7 +114,7 @@ fn parameter_table(an: &Analysis) -> String {
     let bad: Vec<String> = fits
         .iter()
         .filter(|f| !f.converged())
-        .map(|f| format!("{} [{}]", f.stats.fit, f.stats.series))
+        .map(|f| one_line(&format!("{} [{}]", f.stats.fit, f.stats.series)))
         .collect();
     if !bad.is_empty() {
         m.push_str(&format!(
@@ -151,7 +165,7 @@ fn jaeger_section(an: &Analysis) -> String {
             .collect();
         m.push_str(&format!(
             "| {} | {} | {} | {} | {} | {}/{} | {} | {} | {} | {} |\n",
-            an.data.labels[s],
+            table_cell(&an.data.labels[s]),
             fmt_f64(an.data.points[an.data.series_index(s)[0]].scene.xi),
             cell(0),
             cell(1),
@@ -184,7 +198,7 @@ fn jaeger_section(an: &Analysis) -> String {
         ));
     }
     for n in &an.jaeger.notes {
-        m.push_str(&format!("- {n}\n"));
+        m.push_str(&format!("- {}\n", one_line(n)));
     }
     if !an.jaeger.notes.is_empty() {
         m.push('\n');
@@ -272,7 +286,7 @@ fn si_units(p: &ReportContext) -> String {
         for s in si {
             m.push_str(&format!(
                 "| {} | {} | {} | {} | {} |\n",
-                s.series,
+                table_cell(&s.series),
                 fmt_f64(s.xi),
                 range(s.r_m),
                 range(s.g),
@@ -503,7 +517,7 @@ pub fn markdown(an: &Analysis, ctx: &ReportContext, method: &str) -> String {
             sig3(c.delta_aic),
             sig3(c.delta_bic),
             c.delta_waic.map_or("—".to_string(), sig3),
-            c.note
+            table_cell(&c.note)
         ));
     }
     if an.mcmc {
@@ -520,7 +534,7 @@ pub fn markdown(an: &Analysis, ctx: &ReportContext, method: &str) -> String {
         fmt_f64(crate::report::analysis::SUPPORT_THRESHOLD)
     ));
     for s in an.support_statements() {
-        m.push_str(&format!("- {s}\n"));
+        m.push_str(&format!("- {}\n", one_line(&s)));
     }
     let notes: Vec<&String> = an
         .contact
@@ -532,7 +546,7 @@ pub fn markdown(an: &Analysis, ctx: &ReportContext, method: &str) -> String {
     if !notes.is_empty() {
         m.push_str("\nNotes from the fits:\n\n");
         for n in notes {
-            m.push_str(&format!("- {n}\n"));
+            m.push_str(&format!("- {}\n", one_line(n)));
         }
     }
     m.push_str("\n## Figures\n\n");

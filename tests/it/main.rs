@@ -9,6 +9,8 @@ mod cli;
 mod cli_mcmc;
 mod contact;
 mod cross_solvers;
+mod edges_files;
+mod edges_fits;
 mod faults;
 mod figures;
 mod fits;

@@ -87,6 +87,15 @@ pub fn run(a: Args) -> Result<(), CliError> {
         )
     })?;
     let branch = super::jaeger_branch(&a.branch)?;
+    for (flag, x) in [("--xi", a.xi), ("--delta-deg", a.delta_deg)] {
+        if let Some(x) = x.filter(|x| !x.is_finite()) {
+            return Err(super::flag_error(
+                flag,
+                &fitbead::numfmt::echo_f64(x),
+                "not a finite number",
+            ));
+        }
+    }
     let single = if let (Some(xi), Some(d)) = (a.xi, a.delta_deg) {
         Some(format!("xi,delta_deg\n{},{}\n", fmt_f64(xi), fmt_f64(d)).into_bytes())
     } else if a.xi.is_some() || a.delta_deg.is_some() {

@@ -528,7 +528,10 @@ fn md_error(a: &Args, xi: f64, e: fitbead::scene::ParameterError) -> CliError {
     };
     let flag = match flag {
         "--rho" | "--series" => flag.to_string(),
-        f => format!("--{}", f.replace('_', "-")),
+        f => match fitbead::models::md::MdSetting::from_column(f) {
+            Some(s) => format!("--{}", s.flag()),
+            None => format!("--{}", f.replace('_', "-")),
+        },
     };
     super::flag_error(&flag, &value, e.to_string())
 }

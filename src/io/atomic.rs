@@ -423,9 +423,22 @@ pub fn write_atomic_all_then(
     Ok(())
 }
 
+/// Whether `p` is a character device (`/dev/null`, a terminal), after following links.
+fn is_char_device(p: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        std::fs::metadata(p).is_ok_and(|m| m.file_type().is_char_device())
+    }
+    #[cfg(not(unix))]
+    {
+        p == Path::new("NUL")
+    }
+}
+
 /// Refuses, before any work, an output that is a directory, that is one of the `inputs`
 /// (after following symbolic links; `-`, standard input, is none) or that is another of the
-/// `outputs`. Paths are named by the flag that gives them (absent ones skipped); the error
+/// `outputs` (a character device such as `/dev/null` excepted). Paths are named by the flag that gives them (absent ones skipped); the error
 /// names the flag.
 pub fn distinct_paths(
     inputs: &[(&str, Option<&Path>)],
@@ -453,7 +466,8 @@ pub fn distinct_paths(
             }
         }
         for (oflag, q) in &outs[..i] {
-            if same_file(p, q) {
+            // A character device (/dev/null, a terminal) takes any number of writers.
+            if same_file(p, q) && !is_char_device(p) {
                 return Err(setting_error(
                     flag.trim_start_matches("--"),
                     &p.display().to_string(),

@@ -9,6 +9,7 @@ mod cli;
 mod cli_mcmc;
 mod contact;
 mod cross_solvers;
+mod edges_cli;
 mod faults;
 mod figures;
 mod fits;

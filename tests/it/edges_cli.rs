@@ -173,15 +173,15 @@ fn md_settings_beyond_the_step_cap_are_refused_at_once() {
     let cases: Vec<(Vec<&str>, Vec<&str>)> = vec![
         (
             vec!["--xi", "1", "--delta-deg", "12", "--young-pa", "1e300"],
-            vec!["--young-pa", "'1e300'", "1e10 time steps"],
+            vec!["--young-pa", "'1e300'", "1e12 time steps"],
         ),
         (
             vec!["--xi", "1", "--delta-deg", "12", "--density", "1e-300"],
-            vec!["--density", "'1e-300'", "1e10 time steps"],
+            vec!["--density", "'1e-300'", "1e12 time steps"],
         ),
         (
             vec!["--input", s(&scenes)],
-            vec!["line 2", "young_pa", "1e10 time steps"],
+            vec!["line 2", "young_pa", "1e12 time steps"],
         ),
     ];
     for (extra, must) in cases {
@@ -205,7 +205,7 @@ fn md_settings_beyond_the_step_cap_are_refused_at_once() {
         ],
         Duration::from_secs(20),
     );
-    expect(&out, 2, &["--young-pa", "1e10 time steps"], "simulate");
+    expect(&out, 2, &["--young-pa", "1e12 time steps"], "simulate");
 }
 
 #[test]

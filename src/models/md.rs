@@ -629,13 +629,13 @@ pub const MIN_RHO: f64 = 0.01;
 /// ρ → 0 or γ → ∞, and the scene is refused ([`Md::check_scene`]).
 pub const MAX_STEP_SHRINK: f64 = 100.0;
 
-/// Most time steps one md run may take: a run gives up after `max_time_per_bead` × (`beads`
-/// + 1) time units, so the step (`step_fraction` of the Hertz contact time, which shrinks as
-/// (m/k_n)^{1/(β+1)}: as E^{-0.4} and as the bead's mass^{0.4} for β = 3/2) bounds its steps;
-/// settings whose bound exceeds this are refused ([`Md::check_scene`]) instead of running for
-/// ever. Ristow's set with the default run is bounded by about 1.3·10⁸ steps (10⁵ beads: 3·10¹⁰),
-/// the steel set by about 7·10⁹; a run that moves on takes some 200 times fewer steps than its
-/// bound.
+/// Most time steps one md run may take. A run gives up after `max_time_per_bead` times
+/// (`beads` plus one) time units, so its step bounds its steps: `step_fraction` of the Hertz
+/// contact time, which shrinks as (m/k_n)^{1/(β+1)}, as E^{-0.4} and as the bead's mass^{0.4}
+/// for β = 3/2. Settings whose bound exceeds this are refused ([`Md::check_scene`]) instead of
+/// running for ever. Ristow's set with the default run is bounded by about 1.3·10⁸ steps
+/// (3·10¹⁰ for 10⁵ beads), the steel set by about 7·10⁹; a run that moves on takes some 200
+/// times fewer steps than its bound.
 pub const MAX_MD_STEPS: f64 = 1e12;
 
 /// Why settings over [`MAX_MD_STEPS`] are refused (the field named is the setting whose

@@ -168,6 +168,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
                 f: a.data.contact.f.or(r.f),
             },
             g: a.data.g.or(r.g),
+            strict_columns: a.data.strict_columns,
         },
         level: LevelArgs {
             level: a.level.level.or(r.level),

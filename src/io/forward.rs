@@ -25,6 +25,29 @@ use crate::scene::ParameterError;
 use crate::scene::{CollisionLaw, Scene};
 use std::io::Read;
 
+/// Every column a scenes table may have: the scene's, [`SCENE_CELL_COLUMNS`] and md's
+/// settings; any other passes through ([`super::scenes::check_columns`]).
+pub fn scene_columns() -> Vec<&'static str> {
+    let mut v = vec![
+        "xi",
+        "delta_deg",
+        "K",
+        "rho",
+        "f",
+        "lambda",
+        "mu",
+        "a1",
+        "a2",
+        "a3",
+        "spin",
+    ];
+    v.extend(SCENE_CELL_COLUMNS);
+    v.extend(crate::models::md::MdSetting::ALL.map(|s| s.column()));
+    v.sort_unstable();
+    v.dedup();
+    v
+}
+
 /// Columns added after [`OUTPUT_COLUMNS`] by the contact model.
 pub const CONTACT_COLUMNS: [&str; 10] = [
     "phase_sequence",

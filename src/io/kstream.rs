@@ -189,7 +189,7 @@ impl KPlan {
         let cols = MeasurementColumns::new(header, defaults)?;
         let headers = header.headers().to_vec();
         let pass = (0..headers.len())
-            .filter(|&i| !INPUT_OWN.contains(&headers[i].as_str()))
+            .filter(|&i| !INPUT_OWN.iter().any(|n| header.col(n) == Some(i)))
             .collect();
         Ok(KPlan {
             settings,

@@ -1,5 +1,6 @@
 //! Edges of the command line: stopping long fits at once, md settings that would run for
-//! ever, values echoed as the user wrote them, and outputs that may coincide.
+//! ever, values echoed as the user wrote them, outputs that may coincide, and files as people
+//! write them (misspelt, differently cased or differently separated columns).
 
 use crate::common::{bin, stderr, tmpdir, write};
 use std::path::Path;
@@ -260,4 +261,112 @@ fn dev_null_may_take_several_outputs() {
         "/dev/null",
     ]);
     expect(&out, 0, &[], "two outputs on /dev/null");
+}
+
+const DATA: &str = "series,xi,delta_deg,v,sigma_v\n\
+                    a,0.8,10.9354,0.2766,0.0057\n\
+                    a,0.8,11.2709,0.2977,0.0060\n\
+                    a,0.8,11.6064,0.3143,0.0062\n";
+
+#[test]
+fn a_misspelt_column_is_warned_about_and_refused_when_strict() {
+    let dir = tmpdir();
+    let p = write(&dir, "d.csv", &DATA.replacen("sigma_v", "sigma_vs", 1));
+    for cmd in ["klaw", "k"] {
+        let out = fb(&[cmd, "--model", "stick", s(&p)]);
+        expect(
+            &out,
+            0,
+            &["d.csv", "'sigma_vs'", "did you mean 'sigma_v'?"],
+            cmd,
+        );
+        let out = fb(&[cmd, "--model", "stick", "--strict-columns", s(&p)]);
+        expect(
+            &out,
+            2,
+            &["d.csv", "line 1", "'sigma_vs'", "did you mean 'sigma_v'?"],
+            cmd,
+        );
+    }
+    // A column far from every known name passes through in silence, unless strict.
+    let p = write(&dir, "id.csv", "xi,delta_deg,id\n1,12,a\n");
+    let out = fb(&["forward", "--model", "stick", "--input", s(&p)]);
+    expect(&out, 0, &[], "id");
+    assert_eq!(stderr(&out), "");
+    let out = fb(&[
+        "forward",
+        "--model",
+        "stick",
+        "--strict-columns",
+        "--input",
+        s(&p),
+    ]);
+    expect(&out, 2, &["id.csv", "line 1", "'id'"], "strict id");
+    let p = write(&dir, "rh0.csv", "xi,delta_deg,rh0\n1,12,0.5\n");
+    let out = fb(&["forward", "--model", "stick", "--input", s(&p)]);
+    expect(&out, 0, &["'rh0'", "did you mean 'rho'?"], "rh0");
+}
+
+#[test]
+fn header_names_match_in_any_case_and_outputs_keep_canonical_names() {
+    let dir = tmpdir();
+    let p = write(&dir, "d.csv", &DATA.replacen("xi", "Xi", 1));
+    let out = fb(&["k", "--model", "stick", "--strict-columns", s(&p)]);
+    expect(&out, 0, &[], "Xi");
+    let text = String::from_utf8(out.stdout).unwrap();
+    let header = text.lines().next().unwrap();
+    assert!(header.starts_with("series,xi,delta_deg,"), "{header}");
+    assert!(!header.contains("Xi"), "{header}");
+}
+
+#[test]
+fn a_missing_column_suggests_the_nearest_present_name() {
+    let dir = tmpdir();
+    let p = write(&dir, "d.csv", &DATA.replacen("delta_deg", "dleta_deg", 1));
+    let out = fb(&["klaw", "--model", "stick", s(&p)]);
+    expect(
+        &out,
+        2,
+        &[
+            "'delta_deg'",
+            "missing required column",
+            "did you mean 'dleta_deg'?",
+        ],
+        "dleta_deg",
+    );
+}
+
+#[test]
+fn semicolon_tab_and_decimal_comma_files_are_named_as_such() {
+    let dir = tmpdir();
+    let p = write(&dir, "semi.csv", &DATA.replace(',', ";"));
+    let out = fb(&["klaw", "--model", "stick", s(&p)]);
+    expect(&out, 2, &["semi.csv", "line 1", "semicolon-separated"], ";");
+    let p = write(&dir, "tab.csv", &DATA.replace(',', "\t"));
+    let out = fb(&["k", "--model", "stick", s(&p)]);
+    expect(&out, 2, &["tab.csv", "line 1", "tab-separated"], "tab");
+    let p = write(&dir, "comma.csv", "xi,delta_deg,v\n0,8,10,9,0,27\n");
+    let out = fb(&["k", "--model", "stick", s(&p)]);
+    expect(
+        &out,
+        2,
+        &[
+            "comma.csv",
+            "line 2 has 6 fields, the header 3",
+            "decimal separator",
+        ],
+        "decimal comma",
+    );
+}
+
+#[test]
+fn an_unterminated_quote_is_refused_naming_its_line() {
+    let dir = tmpdir();
+    let p = write(&dir, "q.csv", "xi,delta_deg\n1,12\n1,\"12\n");
+    let out = fb(&["forward", "--model", "stick", "--input", s(&p)]);
+    expect(&out, 2, &["q.csv", "line 3", "unterminated quote"], "quote");
+    // A quoted cell that is closed reads as before.
+    let p = write(&dir, "ok.csv", "xi,delta_deg,note\n1,12,\"a, b\"\n");
+    let out = fb(&["forward", "--model", "stick", "--input", s(&p)]);
+    expect(&out, 0, &[], "closed quote");
 }

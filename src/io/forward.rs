@@ -6,7 +6,7 @@
 //! Input columns `xi`, `delta_deg` (required), `K` (a number or a law name), `rho`, `f`,
 //! `lambda`, `mu` (Jan), `a1`, `a2`, `a3` (Jaeger) and `spin` (contact); an empty cell or an
 //! absent column takes the setting. Every input cell passes through (trimmed), an input column
-//! whose name is also an output column renamed `in_NAME`; then [`OUTPUT_COLUMNS`], then
+//! whose name is also an output column renamed `in_NAME` (see [`super::pass_through_names`]); then [`OUTPUT_COLUMNS`], then
 //! [`CONTACT_COLUMNS`] (contact model) or [`AUTO_COLUMNS`] (auto).
 //!
 //! Settings are named in messages as the command line's flags (`--rho` of
@@ -459,14 +459,16 @@ impl RowPlan for ForwardPlan {
         let kind = self.settings.kind;
         let general = kind == ModelKind::Contact;
         let mut w = Cells::new(out);
-        for h in &self.headers {
-            if OUTPUT_COLUMNS.contains(&h.as_str())
-                || general && CONTACT_COLUMNS.contains(&h.as_str())
-            {
-                w.text(&format!("in_{h}"));
-            } else {
-                w.text(h);
-            }
+        let mut outputs = OUTPUT_COLUMNS.to_vec();
+        if general {
+            outputs.extend(CONTACT_COLUMNS);
+        }
+        if kind == ModelKind::Auto {
+            outputs.extend(AUTO_COLUMNS);
+        }
+        let inputs = self.headers.iter().map(String::as_str);
+        for name in super::pass_through_names(inputs, &outputs) {
+            w.text(&name);
         }
         for c in OUTPUT_COLUMNS {
             w.text(c);

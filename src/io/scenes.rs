@@ -455,11 +455,11 @@ pub fn edit_distance(a: &str, b: &str) -> usize {
 }
 
 /// Whether `name` looks like a misspelling of `known`: at most 2 edits apart (ignoring case),
-/// and at most a third of `known`'s length (at least 1), so that short names such as `id`
-/// are not taken for `g` or `f`.
+/// and at most a third of `known`'s length, so that names of one or two letters (`v`, `K`,
+/// `id`) are never taken for one another.
 pub fn is_close(name: &str, known: &str) -> bool {
     let d = edit_distance(name, known);
-    d > 0 && d <= 2 && d <= (known.chars().count() / 3).max(1)
+    d > 0 && d <= 2 && d <= known.chars().count() / 3
 }
 
 /// The name among `candidates` that `name` most likely misspells ([`is_close`]), if any.

@@ -370,3 +370,54 @@ fn an_unterminated_quote_is_refused_naming_its_line() {
     let out = fb(&["forward", "--model", "stick", "--input", s(&p)]);
     expect(&out, 0, &[], "closed quote");
 }
+
+#[test]
+fn noise_free_simulations_read_back_and_repeated_series_are_refused() {
+    let dir = tmpdir();
+    let out = fb(&["simulate", "--noise", "0", "--points", "3", "--series", "1"]);
+    expect(&out, 0, &[], "noise 0");
+    let p = write(&dir, "n0.csv", &String::from_utf8(out.stdout).unwrap());
+    for cmd in ["k", "klaw"] {
+        expect(&fb(&[cmd, "--model", "stick", s(&p)]), 0, &[], cmd);
+    }
+    let out = fb(&["simulate", "--series", "1,2,1.0"]);
+    expect(
+        &out,
+        2,
+        &["--series", "'1.0'", "given twice"],
+        "duplicate series",
+    );
+}
+
+#[test]
+fn pass_through_columns_named_like_outputs_get_unique_names() {
+    let dir = tmpdir();
+    let p = write(
+        &dir,
+        "o.csv",
+        "xi,delta_deg,v,in_v,model_used\n1,12,1,2,x\n",
+    );
+    let out = fb(&["forward", "--model", "auto", "--input", s(&p)]);
+    expect(&out, 0, &[], "forward");
+    let text = String::from_utf8(out.stdout).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let mut unique = header.clone();
+    unique.sort_unstable();
+    unique.dedup();
+    assert_eq!(unique.len(), header.len(), "{header:?}");
+    let again = write(&dir, "again.csv", &text);
+    expect(
+        &fb(&["forward", "--model", "stick", "--input", s(&again)]),
+        0,
+        &[],
+        "output read back",
+    );
+    let p = write(&dir, "k.csv", "xi,delta_deg,v,K,in_K\n1,12,0.3,1,2\n");
+    let out = fb(&["k", "--model", "stick", s(&p)]);
+    let text = String::from_utf8(out.stdout.clone()).unwrap();
+    expect(&out, 0, &[], "k");
+    assert!(
+        text.lines().next().unwrap().ends_with(",in_in_K,in_K"),
+        "{text}"
+    );
+}

@@ -18,6 +18,16 @@ pub fn fmt_f64(x: f64) -> String {
     f64_str(&mut b, x).to_string()
 }
 
+/// `x` as a message echoes it: the shortest decimal that reads back as the same double
+/// (`1e300`, never its 301 digits), `NaN`, `inf` or `-inf`.
+pub fn echo_f64(x: f64) -> String {
+    if x.is_finite() {
+        fmt_f64(x)
+    } else {
+        x.to_string()
+    }
+}
+
 /// [`fmt_f64`] appended to `out`, without allocating.
 pub fn push_f64(out: &mut Vec<u8>, x: f64) {
     let mut b = ryu::Buffer::new();

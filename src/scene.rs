@@ -206,7 +206,7 @@ fn check(field: &'static str, value: f64, ok: bool, reason: &'static str) -> Res
     } else {
         Err(ParameterError::InvalidParameter {
             field,
-            value: value.to_string(),
+            value: crate::numfmt::echo_f64(value),
             reason,
         })
     }
@@ -303,7 +303,30 @@ impl Scene {
         };
         let alpha = of_xi.alpha;
         let k = law.k(alpha, rho);
+        if !law.is_value() && !(k > 0.0) {
+            // The law, not a number the user gave, is at fault: its K vanishes at this ξ.
+            return Err(ParameterError::InvalidParameter {
+                field: "xi",
+                value: crate::numfmt::echo_f64(xi),
+                reason: "the collision law gives no K > 0 at this xi (its contact angle alpha \
+                         is too close to 90 degrees): use a larger xi, or give K as a number",
+            });
+        }
         check("K", k, k > 0.0, "collisional parameter must be > 0")?;
+        if !law.is_value() && !(k < 1.0) {
+            // A law such as c = 10 can exceed 1 at small ξ (eq 1 bounds K by 1).
+            return Err(ParameterError::InvalidParameter {
+                field: "K",
+                value: format!(
+                    "{} (law {law} at xi = {})",
+                    crate::numfmt::echo_f64(k),
+                    crate::numfmt::echo_f64(xi)
+                ),
+                reason: "the collision law gives K >= 1 here (a collision cannot return more \
+                         velocity than it receives): choose a law or coefficient with K < 1 \
+                         at this xi",
+            });
+        }
         if law.is_value() {
             // A collision returns at most the tangential velocity it receives (eq 1).
             check(

@@ -3,7 +3,9 @@
 //! f, the output file, the figure and the interval level.
 
 use super::CliError;
-use fitbead::io::measurements::MeasurementDefaults;
+use fitbead::io::measurements::{MeasurementDefaults, MEASUREMENT_COLUMNS};
+use fitbead::io::scenes::{check_columns, Header};
+use fitbead::io::InputError;
 use std::path::{Path, PathBuf};
 
 /// `--rho` and `--f`: the defaults of rows without a `rho` or `f` column.
@@ -48,6 +50,10 @@ pub struct DataArgs {
     /// Gravity g in m/s² of dimensional rows without a g column [default: 9.81]
     #[arg(long)]
     pub g: Option<f64>,
+    /// Refuse a column the measurements file has and fitbead does not read (without it, a
+    /// column close to a known name gets a warning, others pass through)
+    #[arg(long = "strict-columns")]
+    pub strict_columns: bool,
 }
 
 impl DataArgs {
@@ -59,6 +65,19 @@ impl DataArgs {
     /// g given, or 9.81 m/s².
     pub fn g(&self) -> f64 {
         self.g.unwrap_or(MeasurementDefaults::default().g)
+    }
+
+    /// Checks the columns of a measurements file given: an error for an unknown one with
+    /// `--strict-columns`, else a warning on stderr for each close to a known name (the
+    /// embedded data set is not checked).
+    pub fn check_columns(&self, t: &impl Header) -> Result<(), InputError> {
+        if self.path().is_none() {
+            return Ok(());
+        }
+        for w in check_columns(t, &MEASUREMENT_COLUMNS, self.strict_columns)? {
+            eprintln!("fitbead: warning: {w}");
+        }
+        Ok(())
     }
 
     /// The defaults, checked (ρ ≥ 0, f ≥ 0, g > 0).

@@ -229,6 +229,7 @@ impl FitArgs {
         let input = self.data.path();
         let (source, text) = read_input(input)?;
         let t = Table::parse(&source, &text)?;
+        self.data.check_columns(&t)?;
         let defaults = self.data.defaults()?;
         let rows = read_measurements(&t, &defaults)?;
         let ds = dataset_of(&t, &rows)?;

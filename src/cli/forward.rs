@@ -4,9 +4,9 @@
 
 use super::args::{ContactArgs, OutputArgs};
 use super::{emit, read_input, CliError};
-use fitbead::io::forward::{ForwardPlan, ForwardSettings, ForwardText};
+use fitbead::io::forward::{scene_columns, ForwardPlan, ForwardSettings, ForwardText};
 use fitbead::io::md::{md_csv, md_jobs, MdTable};
-use fitbead::io::scenes::{Table, TableReader};
+use fitbead::io::scenes::{check_columns, Header, Table, TableReader};
 use fitbead::io::stream::{stream, RowPlan, StreamError, StreamOptions, Streamed};
 use fitbead::io::{fmt_f64, AtomicFile, InputError};
 use fitbead::models::md::{
@@ -75,6 +75,19 @@ pub struct Args {
     /// Molecular-dynamics settings (`--model md`).
     #[command(flatten)]
     pub md: MdArgs,
+    /// Refuse a column the scenes file has and fitbead does not read (without it, a column
+    /// close to a known name gets a warning, others pass through)
+    #[arg(long = "strict-columns")]
+    pub strict_columns: bool,
+}
+
+/// Checks the columns of a scenes table: an error for an unknown one with `--strict-columns`,
+/// else a warning on stderr for each close to a known name.
+fn check_scene_columns(a: &Args, t: &impl Header) -> Result<(), CliError> {
+    for w in check_columns(t, &scene_columns(), a.strict_columns)? {
+        eprintln!("fitbead: warning: {w}");
+    }
+    Ok(())
 }
 
 /// Runs `fitbead forward`.
@@ -87,6 +100,15 @@ pub fn run(a: Args) -> Result<(), CliError> {
         )
     })?;
     let branch = super::jaeger_branch(&a.branch)?;
+    for (flag, x) in [("--xi", a.xi), ("--delta-deg", a.delta_deg)] {
+        if let Some(x) = x.filter(|x| !x.is_finite()) {
+            return Err(super::flag_error(
+                flag,
+                &fitbead::numfmt::echo_f64(x),
+                "not a finite number",
+            ));
+        }
+    }
     let single = if let (Some(xi), Some(d)) = (a.xi, a.delta_deg) {
         Some(format!("xi,delta_deg\n{},{}\n", fmt_f64(xi), fmt_f64(d)).into_bytes())
     } else if a.xi.is_some() || a.delta_deg.is_some() {
@@ -104,6 +126,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
             None => read_input(a.input.as_deref())?,
         };
         let t = Table::parse(&source, &text)?;
+        check_scene_columns(&a, &t)?;
         return run_md(&a, &t);
     }
     let (source, input, size) = match single {
@@ -118,6 +141,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         None => open_input(a.input.as_deref())?,
     };
     let reader = TableReader::new(&source, input)?;
+    check_scene_columns(&a, &reader)?;
     let opts = stream_options("forward", size);
     let make = |r: &TableReader<Input>| plan(&a, kind, branch, r);
     stream_to(reader, make, (), a.out.output.as_deref(), &opts, |_| Ok(())).map(|_| ())

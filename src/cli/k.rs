@@ -88,6 +88,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let input = a.data.path();
     let (source, input, size) = open_input(input)?;
     let reader = TableReader::new(&source, input)?;
+    a.data.check_columns(&reader)?;
     let ledger = KLedger::checking(&reader);
     // Checked here, reported after the table's own errors (as when it was read whole).
     let defaults = a.data.defaults();

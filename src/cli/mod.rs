@@ -153,7 +153,8 @@ fn clip_message(message: &str) -> String {
 
 /// Parses the command line as [`Cli::parse`] does, with negative numbers allowed as the
 /// values of every flag (`--xi -1` is the value −1 given to `--xi`, refused by its check, not
-/// an unknown flag `-1`).
+/// an unknown flag `-1`), and any value starting with `-` taken by a flag that reads a number
+/// (`--delta-deg -inf` is the value −∞, refused by the flag's check, not a flag `-i`).
 pub fn parse() -> Cli {
     use clap::{CommandFactory, FromArgMatches};
     let mut cmd = Cli::command();
@@ -161,8 +162,17 @@ pub fn parse() -> Cli {
         .get_subcommands()
         .map(|s| s.get_name().to_string())
         .collect();
+    let number = std::any::TypeId::of::<f64>();
     for n in names {
-        cmd = cmd.mut_subcommand(n, |s| s.allow_negative_numbers(true));
+        cmd = cmd.mut_subcommand(n, |s| {
+            s.allow_negative_numbers(true).mut_args(|a| {
+                if a.get_value_parser().type_id() == number {
+                    a.allow_hyphen_values(true)
+                } else {
+                    a
+                }
+            })
+        });
     }
     let m = cmd.get_matches();
     Cli::from_arg_matches(&m).unwrap_or_else(|e| e.exit())

@@ -62,11 +62,16 @@ pub fn run(a: Args) -> Result<(), CliError> {
         }
         let al = alpha_of_xi(xi);
         let k = law.k(al, a.rho);
-        if !(k.is_finite() && k > 0.0) {
+        if !(k.is_finite() && k > 0.0 && k < 1.0) {
             return Err(super::flag_error(
                 "--law",
                 &a.law,
-                format!("K = {k} at xi = {xi}: must be > 0"),
+                format!(
+                    "K = {} at xi = {}: a law's K must be in (0, 1) (a collision cannot return \
+                     more velocity than it receives)",
+                    fitbead::numfmt::echo_f64(k),
+                    fitbead::numfmt::echo_f64(xi)
+                ),
             ));
         }
         let (dm, dd) = (delta_m_law(al, law, a.rho), delta_d_law(al, law, a.rho));

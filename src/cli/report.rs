@@ -295,6 +295,7 @@ fn run_with(a: Args, r: Recipe) -> Result<(), CliError> {
                 f: a.data.contact.f.or(r.f),
             },
             g: a.data.g.or(r.g),
+            strict_columns: a.data.strict_columns,
         },
         level: LevelArgs {
             level: a.level.level.or(r.level),

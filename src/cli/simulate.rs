@@ -180,6 +180,22 @@ pub fn run(a: Args) -> Result<(), CliError> {
         ..Contact::default()
     };
     let series = parse_list("--series", &a.series)?;
+    // Rows of a series are labelled by its ξ: two equal values would make one series.
+    for (j, x) in series.iter().enumerate() {
+        if let Some(i) = series[..j].iter().position(|y| y == x) {
+            let text: Vec<&str> = a.series.split(',').map(str::trim).collect();
+            return Err(super::flag_error(
+                "--series",
+                text[j],
+                format!(
+                    "xi {} is given twice (values {} and {}): each series needs its own xi",
+                    fmt_f64(*x),
+                    i + 1,
+                    j + 1
+                ),
+            ));
+        }
+    }
     if series.len() > MAX_SERIES {
         return Err(super::flag_error(
             "--series",
@@ -345,7 +361,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
                 fmt_f64(xi),
                 fmt_f64(d_deg),
                 fmt_f64(v),
-                fmt_f64(a.noise * v_true),
+                sigma_cell(a.noise * v_true),
                 fmt_f64(v_true),
             ])
             .map_err(io)?;
@@ -353,6 +369,16 @@ pub fn run(a: Args) -> Result<(), CliError> {
     }
     let bytes = w.into_inner().map_err(|e| CliError::Other(e.to_string()))?;
     emit(a.out.output.as_deref(), &bytes)
+}
+
+/// The `sigma_v` cell of a synthetic point: empty when σ is 0 (`--noise 0`), so that the file
+/// reads as noise-free data (unit weights) rather than as a refused σ = 0.
+fn sigma_cell(sigma: f64) -> String {
+    if sigma > 0.0 {
+        fmt_f64(sigma)
+    } else {
+        String::new()
+    }
 }
 
 fn run_md(a: &Args, series: &[f64], stop: &AtomicBool) -> Result<(), CliError> {
@@ -501,7 +527,7 @@ fn run_md(a: &Args, series: &[f64], stop: &AtomicBool) -> Result<(), CliError> {
                 fmt_f64(xi),
                 fmt_f64(d),
                 fmt_f64(v),
-                fmt_f64(sigma),
+                sigma_cell(sigma),
                 fmt_f64(v_true),
                 fmt_f64(se),
                 r.mean_velocity_si.map(fmt_f64).unwrap_or_default(),
@@ -528,7 +554,10 @@ fn md_error(a: &Args, xi: f64, e: fitbead::scene::ParameterError) -> CliError {
     };
     let flag = match flag {
         "--rho" | "--series" => flag.to_string(),
-        f => format!("--{}", f.replace('_', "-")),
+        f => match fitbead::models::md::MdSetting::from_column(f) {
+            Some(s) => format!("--{}", s.flag()),
+            None => format!("--{}", f.replace('_', "-")),
+        },
     };
     super::flag_error(&flag, &value, e.to_string())
 }

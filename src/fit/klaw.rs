@@ -36,8 +36,10 @@ use super::posterior::{summarise_with, Method};
 use super::summary::{
     information_criteria, summarise_with_profiles, FitResult, ParamSpec, Solved, StatsRow,
 };
+use crate::inverse::estimate::information_criteria as fit_criteria;
 use crate::inverse::{
     fit, profile_interval, Covariance, Fit, Infeasible, LsqOptions, ProfileInterval, Residuals,
+    SigmaKind, Termination,
 };
 use crate::models::Model;
 use crate::progress::{Progress, ProgressEvent, Tally};
@@ -395,7 +397,7 @@ impl<'a> KLawProblem<'a> {
         if self.stopped() {
             return Err(KLawError::Interrupted);
         }
-        Ok((0..self.n)
+        let start: Vec<f64> = (0..self.n)
             .map(|j| {
                 let pts = &self.members[j];
                 let step = pts.len().div_ceil(START_POINTS).max(1);
@@ -403,6 +405,9 @@ impl<'a> KLawProblem<'a> {
                     .par_iter()
                     .step_by(step)
                     .filter_map(|&i| {
+                        if self.stopped() {
+                            return None;
+                        }
                         let p = &self.data.points[i];
                         let e = estimate(&self.model, &p.scene, p.v, None);
                         e.root.ok().map(|r| (r.k - self.a[i]) / self.b[i])
@@ -421,7 +426,11 @@ impl<'a> KLawProblem<'a> {
                 // keep a NaN end from panicking.
                 mid.max(l).min(h)
             })
-            .collect())
+            .collect();
+        if self.stopped() {
+            return Err(KLawError::Interrupted);
+        }
+        Ok(start)
     }
 
     /// Counts `n` forward evaluations (more or less: inversions count one each) and reports
@@ -450,14 +459,11 @@ impl<'a> KLawProblem<'a> {
         Ok(-d * self.b[i] / pt.sigma)
     }
 
-    /// The points of parameter `j`'s group as a problem of its own, the other parameters held
-    /// at `p` (module docs: the parameters are independent with one per series).
-    fn group(&self, j: usize, p: &[f64]) -> GroupProblem<'_, 'a> {
-        GroupProblem {
-            parent: self,
-            j,
-            p: p.to_vec(),
-        }
+    /// The points of parameter `j`'s group as a problem of its own in that parameter alone
+    /// (module docs: the parameters are independent with one per series, so the others do
+    /// not enter its residuals).
+    fn group(&self, j: usize) -> GroupProblem<'_, 'a> {
+        GroupProblem { parent: self, j }
     }
 }
 
@@ -540,19 +546,17 @@ impl Residuals for KLawProblem<'_> {
     }
 }
 
-/// The points of one group as a one-parameter problem (the group's own parameter), the
-/// others held where they are.
+/// The points of one group as a one-parameter problem (the group's own parameter, on which
+/// alone their residuals depend).
 struct GroupProblem<'p, 'a> {
     parent: &'p KLawProblem<'a>,
     j: usize,
-    p: Vec<f64>,
 }
 
 impl GroupProblem<'_, '_> {
-    fn at(&self, x: &[f64]) -> Vec<f64> {
-        let mut p = self.p.clone();
-        p[self.j] = x[0];
-        p
+    /// K of point `i` (of this group) at the group's parameter `x`.
+    fn k_at(&self, i: usize, x: f64) -> f64 {
+        self.parent.a[i] + self.parent.b[i] * x
     }
 }
 
@@ -564,26 +568,29 @@ impl Residuals for GroupProblem<'_, '_> {
         self.parent.members[self.j].len()
     }
     fn residuals(&self, x: &[f64], out: &mut [f64]) -> Result<(), Infeasible> {
-        let (q, pts) = (self.at(x), &self.parent.members[self.j]);
+        let pts = &self.parent.members[self.j];
         let r = out
             .par_iter_mut()
             .zip(pts.par_iter())
             .with_min_len(MIN_CHUNK)
             .try_for_each(|(o, &i)| {
                 let pt = &self.parent.data.points[i];
-                *o = (pt.v - self.parent.eval_v(i, self.parent.k_of(i, &q))?) / pt.sigma;
+                *o = (pt.v - self.parent.eval_v(i, self.k_at(i, x[0]))?) / pt.sigma;
                 Ok(())
             });
         self.parent.tick(pts.len() as u64);
         r
     }
     fn jacobian(&self, x: &[f64], mut out: MatMut<'_, f64>) -> Option<Result<(), Infeasible>> {
-        let (q, pts) = (self.at(x), &self.parent.members[self.j]);
+        let pts = &self.parent.members[self.j];
         let d: Result<Vec<f64>, Infeasible> = pts
             .par_iter()
             .with_min_len(MIN_CHUNK)
             .map(|&i| {
-                let k = self.parent.k_of(i, &q);
+                if self.parent.stopped() {
+                    return Err(Infeasible);
+                }
+                let k = self.k_at(i, x[0]);
                 self.parent.slope(i, k, self.parent.eval_v(i, k)?)
             })
             .collect();
@@ -600,6 +607,39 @@ impl Residuals for GroupProblem<'_, '_> {
     }
 }
 
+/// The options of parameter `j` of `opts` alone, as a one-parameter problem's (its bounds
+/// and typical size; the tolerances, stop flag and progress as `opts`), σ taken as `sigma`.
+fn one_param_options(opts: &LsqOptions, j: usize, sigma: SigmaKind) -> LsqOptions {
+    let one = |v: &Option<Vec<f64>>| v.as_ref().map(|v| vec![v[j]]);
+    LsqOptions {
+        ftol: opts.ftol,
+        xtol: opts.xtol,
+        gtol: opts.gtol,
+        max_iterations: opts.max_iterations,
+        max_residual_evals: opts.max_residual_evals,
+        initial_radius_factor: opts.initial_radius_factor,
+        lower: one(&opts.lower),
+        upper: one(&opts.upper),
+        typical: one(&opts.typical),
+        restarts: opts.restarts,
+        sigma,
+        polish: opts.polish,
+        stop: opts.stop.clone(),
+        progress: opts.progress.clone(),
+    }
+}
+
+/// A 1 × 1 covariance of standard error `se` with the factor `scale`.
+fn covariance_1(se: f64, scale: f64) -> Covariance {
+    Covariance {
+        matrix: Mat::from_fn(1, 1, |_, _| se * se),
+        correlation: Mat::from_fn(1, 1, |_, _| 1.0),
+        std_errors: vec![se],
+        scale,
+        condition: 1.0,
+    }
+}
+
 /// Profile intervals of a law with one parameter per series, each on its series' points
 /// alone (module docs): the same Δχ² threshold and covariance half-width as the full fit's,
 /// the constrained χ² of the others being their optimum's. `None` when one cannot be formed.
@@ -612,7 +652,7 @@ fn separable_profiles(
     (0..problem.n)
         .into_par_iter()
         .map(|j| {
-            let group = problem.group(j, &fit.params);
+            let group = problem.group(j);
             let pts = &problem.members[j];
             let residuals: Vec<f64> = pts.iter().map(|&i| fit.residuals[i]).collect();
             let chi2 = residuals.iter().map(|r| r * r).sum();
@@ -620,29 +660,128 @@ fn separable_profiles(
                 params: vec![fit.params[j]],
                 residuals,
                 chi2,
-                covariance: fit.covariance.as_ref().map(|c| {
-                    let se = c.std_errors[j];
-                    Covariance {
-                        matrix: Mat::from_fn(1, 1, |_, _| se * se),
-                        correlation: Mat::from_fn(1, 1, |_, _| 1.0),
-                        std_errors: vec![se],
-                        scale: c.scale,
-                        condition: 1.0,
-                    }
-                }),
+                dof: fit.dof,
+                reduced_chi2: fit.reduced_chi2,
+                covariance: fit
+                    .covariance
+                    .as_ref()
+                    .map(|c| covariance_1(c.std_errors[j], c.scale)),
+                sigma: fit.sigma,
+                aic: fit.aic,
+                bic: fit.bic,
+                iterations: fit.iterations,
+                residual_evals: fit.residual_evals,
+                jacobian_evals: fit.jacobian_evals,
+                termination: fit.termination,
                 at_bound: vec![fit.at_bound.get(j).copied().unwrap_or(false)],
-                ..fit.clone()
             };
-            let one = |v: &Option<Vec<f64>>| v.as_ref().map(|v| vec![v[j]]);
-            let sub_opts = LsqOptions {
-                lower: one(&opts.lower),
-                upper: one(&opts.upper),
-                typical: one(&opts.typical),
-                ..opts.clone()
-            };
+            let sub_opts = one_param_options(opts, j, opts.sigma);
             profile_interval(&group, &sub, 0, level, &sub_opts).ok()
         })
         .collect()
+}
+
+/// The least-squares fit of a law with one parameter per series, made series by series
+/// (module docs: each parameter moves its own series' residuals only, so the joint optimum is
+/// the optimum of every series on its own), in time linear in the number of series.
+///
+/// The result is the joint fit's: the parameters and residuals of every series in the order
+/// of the parameters and points; χ², the degrees of freedom m − n, AIC and BIC over all m
+/// points and n parameters; the covariance block-diagonal (JᵀJ is diagonal), each variance
+/// 1/Σᵢ ∂rᵢ/∂p_j² of its series times the joint scale (1 with σ given, χ²/(m − n) with unit
+/// weights), the correlations 0 and the condition number of the column-equilibrated
+/// Jacobian 1 (orthogonal columns). It has a covariance only when every series has one. The
+/// termination is the first series' (in parameter order) that did not converge, else that of
+/// the series that took the most iterations; iterations and evaluations are the most any
+/// series took (the series run side by side).
+fn fit_per_series(
+    problem: &KLawProblem<'_>,
+    start: &[f64],
+    opts: &LsqOptions,
+) -> Result<Fit, KLawError> {
+    let (n, m) = (problem.n, problem.data.points.len());
+    let fits = (0..n)
+        .into_par_iter()
+        .map(|j| {
+            // σ is taken as given in each series' fit: the scale of unit weights is the
+            // joint χ²/(m − n), applied below.
+            let sub_opts = one_param_options(opts, j, SigmaKind::Absolute);
+            fit(&problem.group(j), &start[j..=j], &sub_opts)
+        })
+        .collect::<Result<Vec<Fit>, _>>()
+        .map_err(|e| KLawError::Solver(e.to_string()))?;
+    let mut residuals = vec![f64::NAN; m];
+    let mut feasible = true;
+    for (j, f) in fits.iter().enumerate() {
+        let pts = &problem.members[j];
+        if f.residuals.len() == pts.len() {
+            for (&i, &r) in pts.iter().zip(&f.residuals) {
+                residuals[i] = r;
+            }
+        } else {
+            feasible = false;
+        }
+    }
+    let chi2 = if feasible && fits.iter().all(|f| f.chi2.is_finite()) {
+        residuals.iter().map(|r| r * r).sum()
+    } else {
+        f64::INFINITY
+    };
+    if !feasible {
+        residuals.clear();
+    }
+    let dof = m - n;
+    let reduced_chi2 = if dof > 0 {
+        chi2 / dof as f64
+    } else {
+        f64::INFINITY
+    };
+    let scale = match opts.sigma {
+        SigmaKind::Absolute => Some(1.0),
+        SigmaKind::Relative if dof > 0 => Some(reduced_chi2),
+        SigmaKind::Relative => None,
+    };
+    let covariance = match scale {
+        Some(s) if chi2.is_finite() => fits
+            .iter()
+            .map(|f| f.covariance.as_ref().map(|c| c.std_errors[0] * s.sqrt()))
+            .collect::<Option<Vec<f64>>>()
+            .map(|se| Covariance {
+                matrix: Mat::from_fn(n, n, |i, j| if i == j { se[i] * se[i] } else { 0.0 }),
+                correlation: Mat::from_fn(n, n, |i, j| if i == j { 1.0 } else { 0.0 }),
+                std_errors: se,
+                scale: s,
+                condition: 1.0,
+            }),
+        _ => None,
+    };
+    let (aic, bic) = fit_criteria(chi2, m, n, opts.sigma);
+    let slowest = fits.iter().max_by_key(|f| f.iterations);
+    let termination = fits
+        .iter()
+        .find(|f| !f.converged())
+        .or(slowest)
+        .map_or(Termination::InfeasibleStart, |f| f.termination);
+    let most = |g: fn(&Fit) -> usize| fits.iter().map(g).max().unwrap_or(0);
+    Ok(Fit {
+        params: fits.iter().map(|f| f.params[0]).collect(),
+        residuals,
+        chi2,
+        dof,
+        reduced_chi2,
+        covariance,
+        sigma: opts.sigma,
+        aic,
+        bic,
+        iterations: most(|f| f.iterations),
+        residual_evals: most(|f| f.residual_evals),
+        jacobian_evals: most(|f| f.jacobian_evals),
+        termination,
+        at_bound: fits
+            .iter()
+            .map(|f| f.at_bound.first().copied().unwrap_or(false))
+            .collect(),
+    })
 }
 
 /// The fitted law with its reports.
@@ -751,7 +890,13 @@ pub fn fit_law_in(
         progress: progress.clone().map(Tally::new),
         ..Default::default()
     };
-    let f = fit(&problem, &start, &opts).map_err(|e| KLawError::Solver(e.to_string()))?;
+    let f = match method {
+        // Independent parameters: each series fitted on its own.
+        Method::Lsq { .. } if law == KLaw::FreePerSeries => {
+            fit_per_series(&problem, &start, &opts)?
+        }
+        _ => fit(&problem, &start, &opts).map_err(|e| KLawError::Solver(e.to_string()))?,
+    };
     let specs: Vec<ParamSpec> = (0..problem.n)
         .map(|_| ParamSpec {
             name: problem.param_name(),

@@ -169,14 +169,7 @@ fn finish(ev: &mut Evaluator, ls: View<'_>, sol: Solution, sigma: SigmaKind) -> 
     } else {
         None
     };
-    let (k, mf) = (n as f64, m as f64);
-    let (aic, bic) = match sigma {
-        SigmaKind::Absolute => (chi2 + 2.0 * k, chi2 + k * mf.ln()),
-        SigmaKind::Relative => {
-            let m2ll = mf * ((2.0 * std::f64::consts::PI * chi2 / mf).ln() + 1.0);
-            (m2ll + 2.0 * (k + 1.0), m2ll + (k + 1.0) * mf.ln())
-        }
-    };
+    let (aic, bic) = information_criteria(chi2, m, n, sigma);
     let at_bound = (0..n)
         .map(|j| sol.x[j] <= ls.setup.lower[j] || sol.x[j] >= ls.setup.upper[j])
         .collect();
@@ -195,6 +188,19 @@ fn finish(ev: &mut Evaluator, ls: View<'_>, sol: Solution, sigma: SigmaKind) -> 
         jacobian_evals: ev.njev,
         termination: sol.termination,
         at_bound,
+    }
+}
+
+/// AIC and BIC of a fit of `n` parameters to `m` residuals with χ² = `chi2` (the conventions
+/// of [`Fit::aic`] and [`Fit::bic`]).
+pub(crate) fn information_criteria(chi2: f64, m: usize, n: usize, sigma: SigmaKind) -> (f64, f64) {
+    let (k, mf) = (n as f64, m as f64);
+    match sigma {
+        SigmaKind::Absolute => (chi2 + 2.0 * k, chi2 + k * mf.ln()),
+        SigmaKind::Relative => {
+            let m2ll = mf * ((2.0 * std::f64::consts::PI * chi2 / mf).ln() + 1.0);
+            (m2ll + 2.0 * (k + 1.0), m2ll + (k + 1.0) * mf.ln())
+        }
     }
 }
 

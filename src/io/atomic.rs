@@ -682,12 +682,25 @@ pub fn write_atomic_all_then(
     Ok(())
 }
 
+/// Whether `p` is a character device (`/dev/null`, a terminal), after following links.
+fn is_char_device(p: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        std::fs::metadata(p).is_ok_and(|m| m.file_type().is_char_device())
+    }
+    #[cfg(not(unix))]
+    {
+        p == Path::new("NUL")
+    }
+}
+
 /// Refuses, before any work, an output that is a directory, that is one of the `inputs`
 /// (after following symbolic links; `-`, standard input, is none) or that is another of the
-/// `outputs`. An output `-` is standard output; two outputs to the same standard stream or
-/// descriptor (`-` and `/dev/stdout`, say) are refused as well: their bytes would be mixed.
-/// Paths are named by the flag that gives them (absent ones skipped); the error names the
-/// flag.
+/// `outputs` (a character device such as `/dev/null` excepted). An output `-` is standard
+/// output; two outputs to the same standard stream or descriptor (`-` and `/dev/stdout`, say)
+/// are refused as well: their bytes would be mixed. Paths are named by the flag that gives
+/// them (absent ones skipped); the error names the flag.
 pub fn distinct_paths(
     inputs: &[(&str, Option<&Path>)],
     outputs: &[(&str, Option<&Path>)],
@@ -730,7 +743,8 @@ pub fn distinct_paths(
                     ),
                 ));
             }
-            if same_file(p, q) {
+            // A character device (/dev/null, a terminal) takes any number of writers.
+            if same_file(p, q) && !is_char_device(p) {
                 return Err(setting_error(
                     flag.trim_start_matches("--"),
                     &p.display().to_string(),

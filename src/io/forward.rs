@@ -6,7 +6,7 @@
 //! Input columns `xi`, `delta_deg` (required), `K` (a number or a law name), `rho`, `f`,
 //! `lambda`, `mu` (Jan), `a1`, `a2`, `a3` (Jaeger) and `spin` (contact); an empty cell or an
 //! absent column takes the setting. Every input cell passes through (trimmed), an input column
-//! whose name is also an output column renamed `in_NAME`; then [`OUTPUT_COLUMNS`], then
+//! whose name is also an output column renamed `in_NAME` (see [`super::pass_through_names`]); then [`OUTPUT_COLUMNS`], then
 //! [`CONTACT_COLUMNS`] (contact model) or [`AUTO_COLUMNS`] (auto).
 //!
 //! Settings are named in messages as the command line's flags (`--rho` of
@@ -24,6 +24,29 @@ use crate::models::{regime_of, Evaluation, JaegerBranch, Model, ModelKind};
 use crate::scene::ParameterError;
 use crate::scene::{CollisionLaw, Scene};
 use std::io::Read;
+
+/// Every column a scenes table may have: the scene's, [`SCENE_CELL_COLUMNS`] and md's
+/// settings; any other passes through ([`super::scenes::check_columns`]).
+pub fn scene_columns() -> Vec<&'static str> {
+    let mut v = vec![
+        "xi",
+        "delta_deg",
+        "K",
+        "rho",
+        "f",
+        "lambda",
+        "mu",
+        "a1",
+        "a2",
+        "a3",
+        "spin",
+    ];
+    v.extend(SCENE_CELL_COLUMNS);
+    v.extend(crate::models::md::MdSetting::ALL.map(|s| s.column()));
+    v.sort_unstable();
+    v.dedup();
+    v
+}
 
 /// Columns added after [`OUTPUT_COLUMNS`] by the contact model.
 pub const CONTACT_COLUMNS: [&str; 10] = [
@@ -436,14 +459,16 @@ impl RowPlan for ForwardPlan {
         let kind = self.settings.kind;
         let general = kind == ModelKind::Contact;
         let mut w = Cells::new(out);
-        for h in &self.headers {
-            if OUTPUT_COLUMNS.contains(&h.as_str())
-                || general && CONTACT_COLUMNS.contains(&h.as_str())
-            {
-                w.text(&format!("in_{h}"));
-            } else {
-                w.text(h);
-            }
+        let mut outputs = OUTPUT_COLUMNS.to_vec();
+        if general {
+            outputs.extend(CONTACT_COLUMNS);
+        }
+        if kind == ModelKind::Auto {
+            outputs.extend(AUTO_COLUMNS);
+        }
+        let inputs = self.headers.iter().map(String::as_str);
+        for name in super::pass_through_names(inputs, &outputs) {
+            w.text(&name);
         }
         for c in OUTPUT_COLUMNS {
             w.text(c);

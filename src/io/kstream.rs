@@ -189,7 +189,7 @@ impl KPlan {
         let cols = MeasurementColumns::new(header, defaults)?;
         let headers = header.headers().to_vec();
         let pass = (0..headers.len())
-            .filter(|&i| !INPUT_OWN.contains(&headers[i].as_str()))
+            .filter(|&i| !INPUT_OWN.iter().any(|n| header.col(n) == Some(i)))
             .collect();
         Ok(KPlan {
             settings,
@@ -235,13 +235,10 @@ impl RowPlan for KPlan {
         for c in self.own_columns() {
             w.text(c);
         }
-        for &i in &self.pass {
-            let h = self.headers[i].as_str();
-            if self.own_columns().any(|c| c == h) {
-                w.text(&format!("in_{h}"));
-            } else {
-                w.text(h);
-            }
+        let own: Vec<&str> = self.own_columns().collect();
+        let pass = self.pass.iter().map(|&i| self.headers[i].as_str());
+        for name in super::pass_through_names(pass, &own) {
+            w.text(&name);
         }
         w.end();
     }

@@ -137,17 +137,8 @@ pub fn md_csv(
     results: &[(MdResult, Option<f64>)],
 ) -> csv::Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::with_capacity(t.rows.len() * 400));
-    let mut header: Vec<String> = t
-        .headers
-        .iter()
-        .map(|h| {
-            if MD_OUTPUT_COLUMNS.contains(&h.as_str()) {
-                format!("in_{h}")
-            } else {
-                h.clone()
-            }
-        })
-        .collect();
+    let mut header =
+        super::pass_through_names(t.headers.iter().map(String::as_str), &MD_OUTPUT_COLUMNS);
     header.extend(MD_OUTPUT_COLUMNS.iter().map(|s| s.to_string()));
     w.write_record(&header)?;
     let opt = |x: Option<f64>| x.map(fmt_f64).unwrap_or_default();

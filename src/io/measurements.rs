@@ -25,6 +25,22 @@ pub const DEFAULT_DATA: &str = include_str!("../../data/default.csv");
 /// The name the default data set goes by in messages.
 pub const DEFAULT_DATA_NAME: &str = "<embedded default data: data/default.csv>";
 
+/// Every column a measurement file may have (module docs); any other passes through `fitbead
+/// k` and is otherwise unused ([`super::scenes::check_columns`]).
+pub const MEASUREMENT_COLUMNS: [&str; 11] = [
+    "xi",
+    "delta_deg",
+    "series",
+    "v",
+    "v_m_s",
+    "sigma_v",
+    "sigma_v_m_s",
+    "R_m",
+    "g",
+    "rho",
+    "f",
+];
+
 /// Values for the columns a measurement file may leave out.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MeasurementDefaults {

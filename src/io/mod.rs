@@ -108,6 +108,34 @@ impl fmt::Display for InputError {
 
 impl std::error::Error for InputError {}
 
+/// The output names of input columns passed through beside `outputs`, in order: each name as
+/// written, unless it is one of `outputs`; then `in_NAME`, prefixed with `in_` again while it
+/// is still an output, an input or an output name given before (`v` beside an input `in_v`
+/// becomes `in_in_v`). The names returned and `outputs` are all distinct.
+pub fn pass_through_names<'a>(
+    inputs: impl IntoIterator<Item = &'a str> + Clone,
+    outputs: &[&str],
+) -> Vec<String> {
+    let given: std::collections::HashSet<&str> = inputs.clone().into_iter().collect();
+    let mut chosen: std::collections::HashSet<String> = std::collections::HashSet::new();
+    let mut names = Vec::new();
+    for h in inputs {
+        let mut name = h.to_string();
+        if outputs.contains(&h) {
+            name = format!("in_{h}");
+            while outputs.contains(&name.as_str())
+                || given.contains(name.as_str())
+                || chosen.contains(&name)
+            {
+                name.insert_str(0, "in_");
+            }
+        }
+        chosen.insert(name.clone());
+        names.push(name);
+    }
+    names
+}
+
 /// Appends one CSV field to `out` as the `csv` crate's default writer does: quoted (with
 /// quotes doubled) when it holds a comma, a quote, a carriage return or a newline.
 pub fn push_csv_field(out: &mut Vec<u8>, field: &[u8]) {

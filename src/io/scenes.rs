@@ -28,7 +28,7 @@ pub struct TableReader<R: Read> {
     source: String,
     headers: Vec<String>,
     index: HashMap<String, usize>,
-    rdr: csv::Reader<Chain<Cursor<Vec<u8>>, R>>,
+    rdr: csv::Reader<QuoteWatch<Chain<Cursor<Vec<u8>>, R>>>,
     rows_seen: u64,
     done: bool,
     /// A record swapped with the caller's while one is read (so that reading allocates
@@ -36,6 +36,63 @@ pub struct TableReader<R: Read> {
     spare: Option<csv::StringRecord>,
     /// Bytes of the longest row so far, to size new records.
     row_bytes: usize,
+}
+
+/// Where the CSV quoting of the bytes read through it stands: whether a quoted cell is open,
+/// and on which line it opened. A quote opens a cell only at the start of a field, as the
+/// `csv` reader reads it (elsewhere it is a literal character).
+struct QuoteWatch<R> {
+    inner: R,
+    state: Quoting,
+    line: u64,
+    opened: u64,
+}
+
+#[derive(Clone, Copy, PartialEq)]
+enum Quoting {
+    FieldStart,
+    Unquoted,
+    Quoted,
+    QuoteInQuoted,
+}
+
+impl<R> QuoteWatch<R> {
+    fn new(inner: R) -> Self {
+        QuoteWatch {
+            inner,
+            state: Quoting::FieldStart,
+            line: 1,
+            opened: 0,
+        }
+    }
+
+    /// The line of a quoted cell still open (the input ended inside it), if any.
+    fn open_quote(&self) -> Option<u64> {
+        (self.state == Quoting::Quoted).then_some(self.opened)
+    }
+}
+
+impl<R: Read> Read for QuoteWatch<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        for &b in &buf[..n] {
+            if b == b'\n' {
+                self.line += 1;
+            }
+            self.state = match (self.state, b) {
+                (Quoting::Quoted, b'"') => Quoting::QuoteInQuoted,
+                (Quoting::Quoted, _) => Quoting::Quoted,
+                (Quoting::QuoteInQuoted, b'"') => Quoting::Quoted,
+                (Quoting::FieldStart, b'"') => {
+                    self.opened = self.line;
+                    Quoting::Quoted
+                }
+                (_, b',' | b'\n' | b'\r') => Quoting::FieldStart,
+                _ => Quoting::Unquoted,
+            };
+        }
+        Ok(n)
+    }
 }
 
 /// 1-based line number where a record read by [`TableReader`] starts (0 when unknown).
@@ -72,13 +129,29 @@ impl<R: Read> TableReader<R> {
             .has_headers(true)
             .trim(csv::Trim::Headers)
             .buffer_capacity(1 << 16)
-            .from_reader(Cursor::new(prefix).chain(input));
+            .from_reader(QuoteWatch::new(Cursor::new(prefix).chain(input)));
         let headers: Vec<String> = rdr
             .headers()
             .map_err(|e| InputError::file(source, format!("cannot read header: {e}")))?
             .iter()
             .map(|s| s.to_string())
             .collect();
+        if let [h] = headers.as_slice() {
+            for (sep, name) in [(';', "semicolon"), ('\t', "tab")] {
+                if h.contains(sep) {
+                    return Err(InputError {
+                        file: source.to_string(),
+                        line: Some(1),
+                        column: None,
+                        value: Some(h.clone()),
+                        message: format!(
+                            "the header looks {name}-separated; fitbead reads comma-separated \
+                             files (with '.' as the decimal point)"
+                        ),
+                    });
+                }
+            }
+        }
         let mut index = HashMap::new();
         for (i, h) in headers.iter().enumerate() {
             if h.is_empty() {
@@ -116,9 +189,9 @@ impl<R: Read> TableReader<R> {
         &self.headers
     }
 
-    /// Index of a column, if present.
+    /// Index of a column, if present ([`find_column`]).
     pub fn col(&self, name: &str) -> Option<usize> {
-        self.index.get(name).copied()
+        find_column(&self.index, &self.headers, name)
     }
 
     /// Index of a required column.
@@ -213,6 +286,18 @@ impl<R: Read> TableReader<R> {
         self.row_bytes = self.row_bytes.max(rec.as_byte_record().as_slice().len());
         if !more {
             self.done = true;
+            if let Some(line) = self.rdr.get_ref().open_quote() {
+                return Err(InputError {
+                    file: self.source.clone(),
+                    line: Some(line),
+                    column: None,
+                    value: None,
+                    message: format!(
+                        "malformed CSV: unterminated quote: the quoted cell opened on line \
+                         {line} runs to the end of the input"
+                    ),
+                });
+            }
             return Ok(false);
         }
         if rec.len() == 1 && rec.get(0).map(str::trim) == Some("") {
@@ -230,6 +315,31 @@ impl<R: Read> TableReader<R> {
     fn csv_error(&self, e: csv::Error) -> InputError {
         if let csv::ErrorKind::Io(io) = e.kind() {
             return InputError::file(&self.source, format!("cannot read: {io}"));
+        }
+        if let csv::ErrorKind::UnequalLengths {
+            pos,
+            expected_len,
+            len,
+        } = e.kind()
+        {
+            let line = pos.as_ref().map(|p| p.line());
+            let mut message = format!(
+                "malformed CSV: line {} has {len} fields, the header {expected_len}",
+                line.unwrap_or(0)
+            );
+            if len > expected_len {
+                message.push_str(
+                    ": is ',' used as the decimal separator? fitbead reads '.' as the \
+                     decimal point and ',' between fields (quote a cell that holds a comma)",
+                );
+            }
+            return InputError {
+                file: self.source.clone(),
+                line,
+                column: None,
+                value: None,
+                message,
+            };
         }
         InputError {
             file: self.source.clone(),
@@ -265,7 +375,7 @@ impl<R: Read> Header for TableReader<R> {
         &self.headers
     }
     fn col(&self, name: &str) -> Option<usize> {
-        self.index.get(name).copied()
+        find_column(&self.index, &self.headers, name)
     }
 }
 
@@ -277,20 +387,24 @@ impl Header for Table {
         &self.headers
     }
     fn col(&self, name: &str) -> Option<usize> {
-        self.index.get(name).copied()
+        find_column(&self.index, &self.headers, name)
     }
 }
 
 fn missing_column(source: &str, headers: &[String], name: &str) -> InputError {
+    let mut message = format!(
+        "missing required column (header has: {})",
+        headers.join(",")
+    );
+    if let Some(h) = nearest(name, headers.iter().map(String::as_str)) {
+        message.push_str(&format!("; did you mean '{h}'?"));
+    }
     InputError {
         file: source.to_string(),
         line: Some(1),
         column: Some(name.to_string()),
         value: None,
-        message: format!(
-            "missing required column (header has: {})",
-            headers.join(",")
-        ),
+        message,
     }
 }
 
@@ -300,10 +414,127 @@ fn require(
     index: &HashMap<String, usize>,
     name: &str,
 ) -> Result<usize, InputError> {
-    index
-        .get(name)
-        .copied()
-        .ok_or_else(|| missing_column(source, headers, name))
+    find_column(index, headers, name).ok_or_else(|| missing_column(source, headers, name))
+}
+
+/// Where column `name` is: the column of that exact name, else the one column whose name
+/// differs from it only in case (`Xi` for `xi`); `None` when there is none, or several that
+/// differ only in case. Every lookup of a column by name goes through here.
+pub fn find_column(
+    index: &HashMap<String, usize>,
+    headers: &[String],
+    name: &str,
+) -> Option<usize> {
+    if let Some(&i) = index.get(name) {
+        return Some(i);
+    }
+    let mut found = headers
+        .iter()
+        .enumerate()
+        .filter(|(_, h)| h.eq_ignore_ascii_case(name))
+        .map(|(i, _)| i);
+    let first = found.next()?;
+    found.next().is_none().then_some(first)
+}
+
+/// Levenshtein distance between `a` and `b`, ignoring ASCII case.
+pub fn edit_distance(a: &str, b: &str) -> usize {
+    let a: Vec<char> = a.chars().map(|c| c.to_ascii_lowercase()).collect();
+    let b: Vec<char> = b.chars().map(|c| c.to_ascii_lowercase()).collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    let mut cur = vec![0; b.len() + 1];
+    for (i, ca) in a.iter().enumerate() {
+        cur[0] = i + 1;
+        for (j, cb) in b.iter().enumerate() {
+            let sub = prev[j] + usize::from(ca != cb);
+            cur[j + 1] = sub.min(prev[j + 1] + 1).min(cur[j] + 1);
+        }
+        std::mem::swap(&mut prev, &mut cur);
+    }
+    prev[b.len()]
+}
+
+/// Whether `name` looks like a misspelling of `known`: at most 2 edits apart (ignoring case),
+/// and at most a third of `known`'s length, so that names of one or two letters (`v`, `K`,
+/// `id`) are never taken for one another.
+pub fn is_close(name: &str, known: &str) -> bool {
+    let d = edit_distance(name, known);
+    d > 0 && d <= 2 && d <= known.chars().count() / 3
+}
+
+/// The name among `candidates` that `name` most likely misspells ([`is_close`]), if any.
+pub fn nearest<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+    candidates
+        .into_iter()
+        .filter(|c| is_close(name, c))
+        .min_by_key(|c| edit_distance(name, c))
+}
+
+/// A column of a table that no reader of it uses, with the known name it most likely
+/// misspells.
+#[derive(Debug, Clone, PartialEq)]
+pub struct UnknownColumn {
+    /// Where the table came from.
+    pub source: String,
+    /// The column's name as written.
+    pub column: String,
+    /// The known column it is close to ([`is_close`]), if any.
+    pub nearest: Option<String>,
+}
+
+impl std::fmt::Display for UnknownColumn {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{}: column '{}' is not one fitbead reads",
+            self.source, self.column
+        )?;
+        if let Some(n) = &self.nearest {
+            write!(f, "; did you mean '{n}'?")?;
+        }
+        Ok(())
+    }
+}
+
+/// The columns of `t` that none of `known` resolves to ([`find_column`]). With `strict`, the
+/// first of them is an error (line 1, naming the column and the nearest known name);
+/// otherwise those close to a known name are returned, for the caller to warn about (other
+/// columns pass through on purpose, e.g. an `id`).
+pub fn check_columns(
+    t: &impl Header,
+    known: &[&str],
+    strict: bool,
+) -> Result<Vec<UnknownColumn>, InputError> {
+    let used: Vec<usize> = known.iter().filter_map(|k| t.col(k)).collect();
+    let mut out = Vec::new();
+    for (i, h) in t.headers().iter().enumerate() {
+        if used.contains(&i) {
+            continue;
+        }
+        let near = nearest(h, known.iter().copied()).map(str::to_string);
+        if strict {
+            let mut message =
+                String::from("not a column fitbead reads (refused by --strict-columns)");
+            if let Some(n) = &near {
+                message.push_str(&format!("; did you mean '{n}'?"));
+            }
+            return Err(InputError {
+                file: t.source().to_string(),
+                line: Some(1),
+                column: Some(h.clone()),
+                value: None,
+                message,
+            });
+        }
+        if near.is_some() {
+            out.push(UnknownColumn {
+                source: t.source().to_string(),
+                column: h.clone(),
+                nearest: near,
+            });
+        }
+    }
+    Ok(out)
 }
 
 /// One row of a table with what its messages need: the source, the column names and the
@@ -385,9 +616,9 @@ impl Table {
         })
     }
 
-    /// Index of a column, if present.
+    /// Index of a column, if present ([`find_column`]).
     pub fn col(&self, name: &str) -> Option<usize> {
-        self.index.get(name).copied()
+        find_column(&self.index, &self.headers, name)
     }
 
     /// Index of a required column.

@@ -95,7 +95,7 @@ impl Default for MdParams {
 fn invalid(field: &'static str, value: f64, reason: &'static str) -> Error {
     Error::InvalidParameter {
         field,
-        value: value.to_string(),
+        value: crate::numfmt::echo_f64(value),
         reason,
     }
 }
@@ -549,7 +549,7 @@ impl MdSettings {
                         Some(s),
                         Error::InvalidParameter {
                             field: s.column(),
-                            value: x.to_string(),
+                            value: crate::numfmt::echo_f64(x),
                             reason: "must be a whole number",
                         },
                     ))
@@ -628,6 +628,22 @@ pub const MIN_RHO: f64 = 0.01;
 /// step (`step_fraction` × contact time): beyond it the run's cost grows without bound as
 /// ρ → 0 or γ → ∞, and the scene is refused ([`Md::check_scene`]).
 pub const MAX_STEP_SHRINK: f64 = 100.0;
+
+/// Most time steps one md run may take. A run gives up after `max_time_per_bead` times
+/// (`beads` plus one) time units, so its step bounds its steps: `step_fraction` of the Hertz
+/// contact time, which shrinks as (m/k_n)^{1/(β+1)}, as E^{-0.4} and as the bead's mass^{0.4}
+/// for β = 3/2. Settings whose bound exceeds this are refused ([`Md::check_scene`]) instead of
+/// running for ever. Ristow's set with the default run is bounded by about 1.3·10⁸ steps
+/// (3·10¹⁰ for 10⁵ beads), the steel set by about 7·10⁹; a run that moves on takes some 200
+/// times fewer steps than its bound.
+pub const MAX_MD_STEPS: f64 = 1e12;
+
+/// Why settings over [`MAX_MD_STEPS`] are refused (the field named is the setting whose
+/// default value would lower the bound most).
+const TOO_MANY_STEPS: &str = "md: these settings allow a run of more than 1e12 time steps \
+    (the step is step_fraction of the Hertz contact time, which shrinks with a stiffer, \
+    smaller or lighter bead; the run lasts at most 200 time units per row bead): bring this \
+    setting closer to its default";
 
 /// Everything one simulation measures. Velocities in units sqrt(g (R+r)), lengths in units
 /// R + r unless named otherwise, times in sqrt((R+r)/g); dissipation as fractions of the
@@ -933,7 +949,58 @@ impl Md {
                  raise rho",
             ));
         }
+        if !(self.step_bound(scene) <= MAX_MD_STEPS) {
+            let (field, value) = self.costliest_setting(scene);
+            return Err(invalid(field.column(), value, TOO_MANY_STEPS));
+        }
         Ok(())
+    }
+
+    /// Most time steps a run of `scene` may take ([`MAX_MD_STEPS`]): its longest simulated
+    /// time, `max_time_per_bead` × (`beads` + 1), over the step.
+    pub fn step_bound(&self, scene: &Scene) -> f64 {
+        let nd = Nd::new(&self.params, &self.config, scene, 1.0);
+        self.config.max_time_per_bead * (self.config.beads as f64 + 1.0) / nd.dt
+    }
+
+    /// The setting that, put back to its value in [`Md::default`], lowers
+    /// [`Md::step_bound`] most, with its value here.
+    fn costliest_setting(&self, scene: &Scene) -> (MdSetting, f64) {
+        let (d, p, c) = (Md::default(), &self.params, &self.config);
+        let candidates = [
+            (MdSetting::Young, p.young),
+            (MdSetting::Density, p.density),
+            (MdSetting::RowRadius, p.row_radius),
+            (MdSetting::Gravity, p.g),
+            (MdSetting::Poisson, p.poisson),
+            (MdSetting::Beta, p.beta),
+            (MdSetting::StepFraction, c.step_fraction),
+            (MdSetting::Beads, c.beads as f64),
+        ];
+        let bound_without = |s: MdSetting| {
+            let mut m = *self;
+            match s {
+                MdSetting::Young => m.params.young = d.params.young,
+                MdSetting::Density => m.params.density = d.params.density,
+                MdSetting::RowRadius => m.params.row_radius = d.params.row_radius,
+                MdSetting::Gravity => m.params.g = d.params.g,
+                MdSetting::Poisson => m.params.poisson = d.params.poisson,
+                MdSetting::Beta => m.params.beta = d.params.beta,
+                MdSetting::StepFraction => m.config.step_fraction = d.config.step_fraction,
+                _ => m.config.beads = d.config.beads,
+            }
+            let b = m.step_bound(scene);
+            if b.is_nan() {
+                f64::INFINITY
+            } else {
+                b
+            }
+        };
+        candidates
+            .into_iter()
+            .map(|(s, x)| (bound_without(s), s, x))
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .map_or((MdSetting::Young, p.young), |(_, s, x)| (s, x))
     }
 
     /// Simulates one scene (ξ, δ, ρ; K and f of the scene are not used). `dt_scale`

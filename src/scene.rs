@@ -318,8 +318,12 @@ impl Scene {
             return Err(ParameterError::InvalidParameter {
                 field: "K",
                 value: format!(
-                    "{} (law {law} at xi = {})",
+                    "{} (law {} at xi = {})",
                     crate::numfmt::echo_f64(k),
+                    match law {
+                        CollisionLaw::C(c) => format!("c={}", crate::numfmt::echo_f64(c)),
+                        _ => law.to_string(),
+                    },
                     crate::numfmt::echo_f64(xi)
                 ),
                 reason: "the collision law gives K >= 1 here (a collision cannot return more \

@@ -3,7 +3,7 @@
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::{Child, Command, Output};
 
 /// A command that runs the fitbead binary cargo built for these tests, or the one named by
 /// the environment variable `FITBEAD_BIN` (to run the tests against another build, e.g. to
@@ -83,4 +83,36 @@ pub fn col(h: &[String], name: &str) -> usize {
 /// A table of tests/reference/ (docs/ACCURACY.md#reference-tables says how each was made).
 pub fn reference_table(name: &str) -> (Vec<String>, Vec<Vec<String>>) {
     read_table(&root().join("tests").join("reference").join(name))
+}
+
+/// Asserts exit code `code` and that stderr holds every one of `must`.
+pub fn expect(out: &Output, code: i32, must: &[&str], what: &str) {
+    let e = stderr(out);
+    assert_eq!(out.status.code(), Some(code), "{what}: {e}");
+    assert!(!e.contains("panicked"), "{what}: {e}");
+    for m in must {
+        assert!(e.contains(m), "{what}: '{m}' not in: {e}");
+    }
+}
+
+pub fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// Names in `dir` that start with `.fitbead-` (temporary or backup files).
+pub fn leftovers(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with(".fitbead-"))
+        .collect()
+}
+
+pub fn signal(child: &Child, sig: &str) {
+    let ok = Command::new("kill")
+        .args([sig, &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(ok.success());
 }

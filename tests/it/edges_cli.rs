@@ -2,9 +2,9 @@
 //! ever, values echoed as the user wrote them, outputs that may coincide, and files as people
 //! write them (misspelt, differently cased or differently separated columns).
 
-use crate::common::{bin, stderr, tmpdir, write};
+use crate::common::{bin, expect, s, signal, stderr, tmpdir, write};
 use std::path::Path;
-use std::process::{Child, Command, ExitStatus, Output, Stdio};
+use std::process::{ExitStatus, Output, Stdio};
 use std::time::{Duration, Instant};
 
 /// Runs fitbead with `args`, killed after `limit`; the output and whether it ended in time.
@@ -38,28 +38,6 @@ fn fb(args: &[&str]) -> Output {
         "{args:?} did not end in 60 s"
     );
     out
-}
-
-/// Asserts exit code `code` and that stderr holds every one of `must`.
-fn expect(out: &Output, code: i32, must: &[&str], what: &str) {
-    let e = stderr(out);
-    assert_eq!(out.status.code(), Some(code), "{what}: {e}");
-    assert!(!e.contains("panicked"), "{what}: {e}");
-    for m in must {
-        assert!(e.contains(m), "{what}: '{m}' not in: {e}");
-    }
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-fn signal(child: &Child, sig: &str) {
-    let ok = Command::new("kill")
-        .args([sig, &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(ok.success());
 }
 
 /// Starts `args` in `dir`, sends `sig` after `after`, and returns the exit status and how

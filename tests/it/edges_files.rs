@@ -3,7 +3,7 @@
 //! previous run's files and stale temporaries removed, foreign files kept), series labels that
 //! are data and not paths or markup, and recipes whose values are blamed on the recipe.
 
-use crate::common::{bin, stderr, tmpdir, write};
+use crate::common::{bin, expect, leftovers, s, stderr, tmpdir, write};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -16,30 +16,6 @@ fn fb_in(dir: &Path, args: &[&str]) -> Output {
         .stdin(Stdio::null())
         .output()
         .unwrap()
-}
-
-/// Asserts exit code `code` and that stderr holds every one of `must`.
-fn expect(out: &Output, code: i32, must: &[&str], what: &str) {
-    let e = stderr(out);
-    assert_eq!(out.status.code(), Some(code), "{what}: {e}");
-    assert!(!e.contains("panicked"), "{what}: {e}");
-    for m in must {
-        assert!(e.contains(m), "{what}: '{m}' not in: {e}");
-    }
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-/// Names in `dir` that start with `.fitbead-` (temporary or backup files).
-fn leftovers(dir: &Path) -> Vec<String> {
-    std::fs::read_dir(dir)
-        .unwrap()
-        .filter_map(|e| e.ok())
-        .map(|e| e.file_name().to_string_lossy().into_owned())
-        .filter(|n| n.starts_with(".fitbead-"))
-        .collect()
 }
 
 fn bin_path() -> PathBuf {

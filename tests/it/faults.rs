@@ -3,9 +3,9 @@
 //! panic, a hang, a clobbered file or a silent wrong fit. The fuzz harness that looks for the
 //! next such fault is the ignored test [`fuzz_mutated_inputs`] (docs/GUIDE.md, "Exit codes").
 
-use crate::common::{bin, col, stderr, table, tmpdir, write};
+use crate::common::{bin, col, expect, leftovers, s, signal, stderr, table, tmpdir, write};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, ExitStatus, Output, Stdio};
+use std::process::{Command, ExitStatus, Output, Stdio};
 use std::time::{Duration, Instant};
 
 /// Runs `cmd` to its end or until `limit`, then kills it; the output and whether it ended in
@@ -54,30 +54,6 @@ fn fb(args: &[&str]) -> Output {
     let (out, in_time) = run_for(bin().args(args), Duration::from_secs(60));
     assert!(in_time, "{args:?} did not end within 60 s");
     out
-}
-
-/// Asserts exit code `code` and that stderr holds every one of `must`.
-fn expect(out: &Output, code: i32, must: &[&str], what: &str) {
-    let e = stderr(out);
-    assert_eq!(out.status.code(), Some(code), "{what}: {e}");
-    assert!(!e.contains("panicked"), "{what}: {e}");
-    for m in must {
-        assert!(e.contains(m), "{what}: '{m}' not in: {e}");
-    }
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-/// Names in `dir` that start with `.fitbead-` (temporary or backup files).
-fn leftovers(dir: &Path) -> Vec<String> {
-    std::fs::read_dir(dir)
-        .unwrap()
-        .filter_map(|e| e.ok())
-        .map(|e| e.file_name().to_string_lossy().into_owned())
-        .filter(|n| n.starts_with(".fitbead-"))
-        .collect()
 }
 
 // Panics and hangs.
@@ -223,14 +199,6 @@ fn huge_counts_are_refused_before_any_work() {
 }
 
 // Signals.
-
-fn signal(child: &Child, sig: &str) {
-    let ok = Command::new("kill")
-        .args([sig, &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(ok.success());
-}
 
 /// Starts `args` in `dir`, sends `sig` after `after`, and returns the exit status and how
 /// long the command took to stop after the signal.

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The scipy peer of `fitbead k` for the speed comparison (docs/PERFORMANCE.md): per measured
 row the same work as `fitbead k --model stick|stickslip`, by scipy's brentq, ellipkinc and quad
-(rolling time: corrected eqs 12-15 of MODEL.md; slip phase of stick/slip: eqs 64-68).
+(rolling time: corrected eqs 12-15 as docs/PHYSICS.md corrects them; slip phase of stick/slip: eqs 64-68).
 
 Per row, as src/fit/k/ does it:
 - the row's xi, delta_deg, v, sigma_v, rho and f (an empty rho or f cell takes --rho 0.4 /

@@ -162,3 +162,26 @@ impl Dataset {
         )
     }
 }
+
+/// How one series' velocities were made dimensionless (input in m/s): the ranges over its rows
+/// of the row beads' radius, of g and of the velocity unit sqrt(g R (1 + ξ)).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SiSeries {
+    /// Series label.
+    pub series: String,
+    /// Radius ratio ξ.
+    pub xi: f64,
+    /// Smallest and largest R over the series' rows, metres.
+    pub r_m: (f64, f64),
+    /// Smallest and largest g, m/s².
+    pub g: (f64, f64),
+    /// Smallest and largest velocity unit sqrt(g R (1 + ξ)), m/s.
+    pub unit_m_s: (f64, f64),
+}
+
+impl SiSeries {
+    /// The series' velocity unit in m/s when it is the same on every row.
+    pub fn unit(&self) -> Option<f64> {
+        (self.unit_m_s.0 == self.unit_m_s.1).then_some(self.unit_m_s.0)
+    }
+}

@@ -23,6 +23,7 @@
 
 use super::data::Dataset;
 use super::jaeger_coordinates::JaegerCoordinates;
+pub use super::jaeger_coordinates::JaegerX;
 use super::posterior::{summarise_reparameterised, summarise_with, Method, Prior};
 use super::summary::{distinct_points, FitResult, ParamSpec, Solved};
 use crate::inverse::{fit, Infeasible, LsqOptions, Model, WeightedData};
@@ -44,9 +45,6 @@ pub fn paper_values(xi: f64) -> Option<[f64; 3]> {
         .find(|r| (r.0 - xi).abs() < 1e-9)
         .map(|r| [r.1, r.2, r.3])
 }
-
-/// What Jaeger's formula needs of a point: (tan δ, cos δ, ε).
-pub type JaegerX = (f64, f64, f64);
 
 /// Jaeger's model on one branch, p = (a1, a2, a3).
 #[derive(Debug, Clone, Copy)]

@@ -65,10 +65,12 @@
 //! (J1) against its inverse, (J2) against finite differences, and the posterior quantiles
 //! against those sampled in (ln a1, ln a2, ln a3).
 
-use super::jaeger::JaegerX;
 use crate::inverse::posterior::Reparameterisation;
 use crate::models::jaeger::Jaeger;
 use crate::models::JaegerBranch;
+
+/// What Jaeger's formula needs of a point: (tan δ, cos δ, ε).
+pub type JaegerX = (f64, f64, f64);
 
 /// The shape w = a2 X₀ a sampling run starts from at least: a least-squares optimum on the
 /// bound a2 = 0 has ln w = −∞, and the posterior density in ln w falls as w towards it (the

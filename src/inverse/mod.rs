@@ -38,6 +38,8 @@ pub mod problem;
 pub mod profile;
 mod qr;
 pub mod state;
+#[cfg(test)]
+mod tests;
 
 pub use estimate::{fit, fit_result, Covariance, Fit};
 pub use lm::LevenbergMarquardt;

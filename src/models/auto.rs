@@ -284,7 +284,7 @@ mod tests {
         // The shortcut changes nothing but the reason, on the bench's scenes (hard ones
         // included).
         let mut fired = 0;
-        for (s, _) in crate::report::workprecision::draw_scenes(400, 3) {
+        for (s, _) in crate::models::sample::draw_scenes(400, 3) {
             for tol in [1e-4, 1e-10] {
                 let a = Auto { tol };
                 let (x, y) = (a.choose_with(&s, true), a.choose_with(&s, false));

@@ -11,6 +11,7 @@ pub mod jaeger;
 pub mod jan;
 pub mod md;
 pub mod regimes;
+pub mod sample;
 pub mod slip;
 pub mod stick;
 pub mod stickquad;

@@ -10,10 +10,10 @@ use crate::fit::klaw::{fit_law_with, KLaw, KLawFit, KLawProblem};
 use crate::fit::posterior::Method;
 use crate::fit::summary::{FitResult, ParamRow};
 use crate::inverse::{Model as _, Residuals, SigmaKind};
-use crate::io::fmt_f64;
 use crate::models::energy;
 use crate::models::regimes::{bulk_friction, critical_xi, delta_d_law, delta_m_law};
 use crate::models::{regime_of, ForwardModel, JaegerBranch, Model, Regime};
+use crate::numfmt::fmt_f64;
 use crate::progress::{Progress, ProgressEvent};
 use crate::scene::CollisionLaw;
 use rayon::prelude::*;
@@ -1212,5 +1212,5 @@ fn waic_sum<'a>(fits: impl IntoIterator<Item = &'a FitResult>) -> Option<f64> {
 
 /// Three significant digits (report tables and messages).
 pub fn sig3(x: f64) -> String {
-    crate::io::fmt_sig(x, 3)
+    crate::numfmt::fmt_sig(x, 3)
 }

@@ -15,11 +15,11 @@ use crate::fit::jan::velocity as jan_velocity;
 use crate::fit::k::estimate;
 use crate::fit::summary::FitResult;
 use crate::inverse::{Model as _, SigmaKind};
-use crate::io::fmt_sig;
 use crate::models::regimes::{
     alpha_of_xi, critical_xi, delta_d_law, delta_m_law, regime_b_interval,
 };
 use crate::models::{ForwardModel, JaegerBranch, Model};
+use crate::numfmt::fmt_sig;
 use crate::scene::CollisionLaw;
 use rayon::prelude::*;
 

@@ -2,8 +2,8 @@
 
 use super::analysis::{sig3, Analysis};
 use super::figures::FigureFormat;
+use crate::fit::data::SiSeries;
 use crate::fit::summary::ParamRow;
-use crate::io::measurements::SiSeries;
 use crate::models::JaegerBranch;
 use crate::numfmt::{fmt_f64, fmt_interval, fmt_sig, fmt_value_pm};
 

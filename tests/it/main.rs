@@ -20,6 +20,7 @@ mod jaeger_posterior;
 mod k_edges;
 mod k_inversion;
 mod k_stream;
+mod layers;
 mod mcmc;
 mod md;
 mod nist;

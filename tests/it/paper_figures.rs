@@ -72,7 +72,7 @@ fn fig7_stickslip_over_rolling_ratios() {
 /// the stable fixed point to 1.2e-13 and the unstable one to 4.5e-15 (measured 7.6e-14 and
 /// 2.2e-15).
 #[test]
-fn bistable_stickslip_scene_of_model_md() {
+fn bistable_stickslip_scene_of_physics_md() {
     // ξ = 10, ρ = 1, f = 0.2, K = 0.9842, δ = 5.767° (docs/PHYSICS.md#stickslip). The design
     // notes quoted the stable fixed point as "≈ 0.770 (v̄ = 0.76955…)" and an unstable one
     // "near 0.92". The reference gives 0.77783298050220538 (v̄ = 0.76864621159332382) and

@@ -372,6 +372,40 @@ fn carlson_rf_matches_mpmath_at_hard_points() {
     assert_eq!(n, 85);
 }
 
+/// Legendre's F(φ | m) = sin φ · R_F(cos² φ, cos² φ + (1 − m) sin² φ, 1)
+/// (src/special/elliptic.rs `legendre_f`) at the 576 `ellipf` rows of
+/// tests/reference/elliptic_refs.csv (mpmath's `ellipf` at 80 digits on the double φ and m,
+/// cross-checked by a quadrature at 50 digits in the `check` column): φ from 0 to the double
+/// nearest π/2 (16 steps of 10⁻ʲ below it), m from −10 to 1 − 10⁻¹⁶ and 1. sin φ and cos φ are
+/// taken of the double φ, as the reference is, and 1 − m is exact for m ≥ ½ (Sterbenz), so the
+/// error is that of R_F (≤ 4.6e-16 above) plus a few roundings: the bound is 8u. F(π/2 | 1)
+/// is infinite in both.
+#[test]
+fn legendre_f_matches_mpmath_from_zero_to_the_double_nearest_half_pi() {
+    use fitbead::special::elliptic::legendre_f;
+    use fitbead::special::SinCos;
+    let (_, records) = reference_table("elliptic_refs.csv");
+    let (mut n, mut worst) = (0, 0.0f64);
+    for rec in records {
+        if rec[0] != "ellipf" {
+            continue;
+        }
+        let (phi, m): (f64, f64) = (rec[4].parse().unwrap(), rec[5].parse().unwrap());
+        let reference: f64 = rec[6].parse().unwrap();
+        let got = legendre_f(SinCos::of(phi), 1.0 - m);
+        if reference == 0.0 || reference.is_infinite() {
+            assert_eq!(got, reference, "F({phi} | {m})");
+        } else {
+            let e = (got - reference).abs() / reference.abs();
+            assert!(e <= 8.0 * U, "F({phi} | {m}) = {got} vs {reference}: {e:e}");
+            worst = worst.max(e);
+        }
+        n += 1;
+    }
+    println!("F(phi | m) at {n} points: largest relative error {worst:.3e}");
+    assert_eq!(n, 576);
+}
+
 /// u = 2⁻⁵³, the unit roundoff of f64.
 const U: f64 = f64::EPSILON / 2.0;
 

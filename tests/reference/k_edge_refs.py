@@ -46,7 +46,7 @@ the speed at the crawl point never comes from a cancelling difference:
           tau = int_{Theta0}^{Thetaf} dtheta / sqrt(m + 2B sin^2(theta/2))   (eqs 9, 11)
           by make_refs.inv_sqrt_integral(method 'ts'): tanh-sinh, maxdegree 10, split at the
           top and at geometric break points 0 +- w 4^j, w = sqrt(m/B) the peak width.
-  stick-approx (eq 29 corrected, MODEL.md section 2): A - B = m (as above), A = B cos Theta0
+  stick-approx (eq 29 corrected, docs/PHYSICS.md, Pure rolling): A - B = m (as above), A = B cos Theta0
           + K^2 L^2; tau = gamma [asinh(tan Om(Thetaf))
           + asinh(tan Om(|Theta0|))], gamma = 2/sqrt(A+B), tan Om(T) = tan(T/2) sqrt((A+B)/(A-B)).
   slip:   least squared speed / E over the contact m = K^2 Lp2 - wc^2

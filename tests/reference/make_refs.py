@@ -17,11 +17,11 @@ What it writes (next to this file; see README.md for the columns):
                               slip-approx, stickslip) on a grid of scenes and on
                               named hard cases.
   stickslip_map_bistable.csv  the stick/slip final-velocity map H(x) on a fine grid
-                              for the bistable scene of MODEL.md section 3.
+                              for the bistable scene of docs/PHYSICS.md (Stick/slip).
   derived_refs.csv            regime limits delta_m (eq 32) and delta_d (eq 31),
                               each checked by root finding, bulk friction mu (eq 79)
                               against tan(delta_m), Theta_G at stick steady states,
-                              xi_c, and the MODEL.md section 7 figures.
+                              xi_c, and the figures of docs/PHYSICS.md (Reference figures).
   elliptic_refs.csv           Carlson R_F(x,y,z) and Legendre F(phi|m) at hard
                               points, each checked by an independent quadrature.
 
@@ -37,7 +37,7 @@ Conventions
   relative change of v when alpha is multiplied by (1 + 2^-52): a f64 code
   cannot be expected to agree better than a few times that.
 * Outputs are printed with 25 significant digits (mpmath.nstr(x, 25)).
-* Dimensionless units of MODEL.md: B = 2/(1+rho), v = 2 sin(alpha)/tau.
+* Dimensionless units (docs/PHYSICS.md, Geometry and units): B = 2/(1+rho), v = 2 sin(alpha)/tau.
 
 Method, per model (primary at mp.dps = 40; check at mp.dps = 50)
 ----------------------------------------------------------------
@@ -65,7 +65,7 @@ b) stick-approx (eq 29 corrected): tau~ = gamma [asinh(tan Om(Thetaf))
    sin^2 Om(T) = (A+B) sin^2(T/2)/(A - B cos T).  A formula: primary evaluates
    it through sin^2 Om as written; check through the equivalent
    tan Om = tan(T/2) sqrt((A+B)/(A-B)) at dps 50.  Only where A > B.
-c) slip (MODEL.md section 3, eqs 46-53 corrected): b = -6f/(1+4f^2),
+c) slip (docs/PHYSICS.md Slip, eqs 46-53 corrected): b = -6f/(1+4f^2),
    c = (4f^2-2)/(1+4f^2), Lp2 = (b sin Tf + c cos Tf - (b sin T0 + c cos T0) e^{4f alpha})
    / (1 - K^2 e^{4 f alpha}), a_inf = K^2 Lp2 - b sin T0 - c cos T0,
    G^2 = a_inf e^{2f(theta-T0)} + b sin theta + c cos theta.  'none' if
@@ -75,7 +75,7 @@ d) slip-approx (eqs 54-59): G^2 ~ a' + b' sin + c' cos with e^{2f theta} ->
    1 + 4f^2 + 2f sin - 4f^2 cos; time by quadrature of the approximate integrand.
    A if that integrand is not positive on the contact.  final_velocity is the
    exact slip model's sqrt(Lp2) (the approximation only changes the time).
-e) stickslip (section 4.4, eqs 64-68): final-velocity map H(x) of MODEL.md
+e) stickslip (section 4.4, eqs 64-68): final-velocity map H(x) of docs/PHYSICS.md
    (rationalised eq 36 for Theta_G; branches noslip / slip / slipfromstart /
    noreal = no real Theta_G, treated as no slip).  All fixed points are found
    by scanning H(x)-x on a grid (double precision) and bisecting every sign
@@ -867,9 +867,9 @@ def build_hard_tasks():
         # slip from the start: Theta0 > 0 (delta > alpha), small f
         add('slip from start (Theta_G<=Theta0)', 10.0, math.radians(7.0), 0.9, 0.4, 0.01, ('stick', 'stickslip'))
         add('slip from start (Theta_G<=Theta0)', 4.0, math.radians(13.0), 0.8, 0.4, 0.01, ('stick', 'stickslip'))
-        # bistable scene, with K = 0.9842 as MODEL.md states it, and with the
+        # bistable scene, with K = 0.9842 as docs/PHYSICS.md states it, and with the
         # fitted law at xi = 10 (0.98421927813...) that 0.9842 rounds
-        add('bistable (MODEL.md 3)', 10.0, math.radians(5.767), 0.9842, 1.0, 0.2, ('stick', 'stickslip'))
+        add('bistable (PHYSICS.md stick/slip)', 10.0, math.radians(5.767), 0.9842, 1.0, 0.2, ('stick', 'stickslip'))
         add('bistable with K=Kfit(xi=10) unrounded', 10.0, math.radians(5.767), K_law_double('Kfit', 10.0), 1.0, 0.2,
             ('stick', 'stickslip'))
         # slip and stick/slip with K e^{2 f alpha} = 1 - 1e-6 in regime B: the
@@ -885,8 +885,8 @@ def build_hard_tasks():
         for xi, deg in ((2.0, 5.73), (1.0, 11.53)):
             K = K_law_double('Kfit', xi)
             add('Fig7 xi=%r delta=%rdeg' % (xi, deg), xi, math.radians(deg), K, 0.4, 0.1)
-        # MODEL.md section 2 check scene
-        add('MODEL.md 2 check (v=0.39120827...)', 1.0, math.radians(12.0), K_law_double('Kfit', 1.0), 0.4, 0.1, ('stick', 'stick-approx'))
+        # the rolling check scene of docs/PHYSICS.md (Reference figures)
+        add('rolling check (v=0.39120827...)', 1.0, math.radians(12.0), K_law_double('Kfit', 1.0), 0.4, 0.1, ('stick', 'stick-approx'))
         # slip model near its own stop limit: delta where min G^2 = 0, times (1+1e-6)
         for xi in (1.0, 2.0):
             K = K_law_double('Kfit', xi)
@@ -1064,8 +1064,8 @@ def derived_rows(log):
             add('theta_G_deg_stick_steady', tg * 180 / mpmath.pi, tgp * 180 / mpmath.pi, xi, K, 0.4, 0.1, d,
                 note='rationalised eq 36 | check: eq 36 as printed; delta frac %s of [delta_m;delta_d]; Theta0=%s deg'
                 % (fr, mpmath.nstr(sc.th0 * 180 / mpmath.pi, 6)))
-    add('theta_G_deg_min_over_above', min(tgs), None, note='MODEL.md 7: 14.7')
-    add('theta_G_deg_max_over_above', max(tgs), None, note='MODEL.md 7: 16.8')
+    add('theta_G_deg_min_over_above', min(tgs), None, note='expected: 14.7')
+    add('theta_G_deg_max_over_above', max(tgs), None, note='expected: 16.8')
     # xi_c: delta_m(xi) = delta_d(xi), fitted law (K not rounded: function of xi), rho = 0.4
     def h(xi):
         a = alpha_of(xi)
@@ -1085,7 +1085,7 @@ def derived_rows(log):
     K1 = K_law_double('Kfit', 1.0)
     dm1 = delta_m_eq32(alpha_of(1.0), mpf(K1))
     add('S7_delta_m_deg_xi1_Kfit', dm1 * 180 / mpmath.pi, delta_m_root(alpha_of(1.0), mpf(K1), mpf(0.4)) * 180 / mpmath.pi,
-        1.0, K1, note='MODEL.md 7: 7.469')
+        1.0, K1, note='expected: 7.469')
     for xi, deg, paper in ((2.0, 5.73, '1.061'), (1.0, 11.53, '1.159')):
         K = K_law_double('Kfit', xi)
         d = math.radians(deg)
@@ -1098,7 +1098,7 @@ def derived_rows(log):
         ratio = att[0]['v'] / vs['v']
         ratio2 = mpf(att2[0]['v']) / mpf(vs2['v'])
         add('S7_v_stickslip_over_v_stick', ratio, ratio2, xi, K, 0.4, 0.1, d,
-            note='MODEL.md 7: %s; %d fixed point(s); theta_G at fixed point %s deg' % (
+            note='expected: %s; %d fixed point(s); theta_G at fixed point %s deg' % (
                 paper, len(vss), mpmath.nstr(att[0]['extra'], 6)))
     # eq 79 vs eq 76 (Jan's fitted mu = 0.0025 e^{7.46 sin alpha})
     for xi in (0.8, 1.0, 1.6, 2.0):
@@ -1106,10 +1106,10 @@ def derived_rows(log):
         K = K_law_double('Kfit', xi)
         mu79 = mu_eq79(a, mpf(K))
         mu76 = mpf('0.0025') * mpmath.exp(mpf('7.46') * mpmath.sin(a))
-        add('S7_mu79_over_mu76_minus_1', mu79 / mu76 - 1, None, xi, K, note='MODEL.md 7: +18..+26 %%; mu79=%s mu76=%s' % (
+        add('S7_mu79_over_mu76_minus_1', mu79 / mu76 - 1, None, xi, K, note='expected: +18..+26 %%; mu79=%s mu76=%s' % (
             mpmath.nstr(mu79, 8), mpmath.nstr(mu76, 8)))
         add('tan_delta_m_Kfit', mpmath.tan(delta_m_eq32(a, mpf(K))), mu79, xi, K,
-            note='MODEL.md 5: 0.1905 0.1311 0.0555 0.0355 for xi = 0.8 1 1.6 2 | check: eq 79')
+            note='expected: 0.1905 0.1311 0.0555 0.0355 for xi = 0.8 1 1.6 2 | check: eq 79')
     return rows
 
 
@@ -1233,7 +1233,7 @@ def ode_spot_check(log):
     rows = list(csv.DictReader(open(os.path.join(HERE, 'forward_refs.csv'))))
     picks = [('Fig7 xi=2.0 delta=5.73deg', 'stickslip'), ('Fig7 xi=1.0 delta=11.53deg', 'stickslip'),
              ('f=1e-06', 'slip'), ('Theta0=0 (delta=double(alpha))', 'slip'),
-             ('MODEL.md 2 check (v=0.39120827...)', 'stick'), ('slip from start (Theta_G<=Theta0)', 'stickslip')]
+             ('rolling check (v=0.39120827...)', 'stick'), ('slip from start (Theta_G<=Theta0)', 'stickslip')]
     worst = mpf(0)
     with mp.workdps(20):
         for case, model in picks:

@@ -5,7 +5,7 @@ large radius ratios: tests/reference/named_law_refs.csv.
 For a law given by name fitbead receives xi (and rho), not K: K is a function of
 alpha = asin(1/(1+xi)), evaluated here at working precision from the exact double xi and never
 rounded.  As xi grows, 1 - K ~ 2 sin^2(alpha) ~ 2/xi^2, so these rows test that 1 - K is
-carried without cancellation.  Laws (MODEL.md sections 2 and 4, README): cos2a = cos 2 alpha;
+carried without cancellation.  Laws (docs/PHYSICS.md, Collision laws): cos2a = cos 2 alpha;
 adjusted = cos 2 alpha + 1/2 sin^2 alpha sin 2 alpha; impact = (cos 2 alpha + rho)/(1 + rho);
 c=0.3 = cos 2 alpha + 0.3 sin^2 alpha sin 2 alpha.  xi in {10, 100, 1000}, rho in {0, 0.4, 1}.
 

@@ -115,7 +115,7 @@ pub fn quantile(sorted: &[f64], q: f64) -> f64 {
 /// decimal place.
 pub fn value_pm(value: f64, err: f64) -> String {
     if !(err.is_finite() && err > 0.0) {
-        return crate::io::fmt_sig(value, 4);
+        return crate::numfmt::fmt_sig(value, 4);
     }
     let dec = (1 - err.log10().floor() as i32).max(0) as usize;
     let s = format!("{value:.dec$} ± {err:.dec$}");

@@ -1,6 +1,6 @@
 //! The figures: SVG documents written by the crate's own engine ([`svg`] for the document
 //! and its text, [`plot`] for axes, legends and grids of panels), the corner plots of
-//! posteriors ([`corner`]), and the scatter figure of `fitbead k`. [`png`] (feature `png`)
+//! posteriors ([`corner`]), and the scatter figure of `fitbead k`. `png` (feature `png`)
 //! renders any of them to PNG with resvg and the embedded font.
 //!
 //! Labels are markup: `_{…}` sets a subscript and `^{…}` a superscript (written as `tspan`s
@@ -113,7 +113,7 @@ impl FigureFormat {
     }
 
     /// `files` (name, bytes) with every `*.svg` written in this format: kept, replaced by its
-    /// PNG rendering ([`png::svg_to_png`] at [`png::REPORT_SCALE`]), or both. Without the
+    /// PNG rendering (`png::svg_to_png` at `png::REPORT_SCALE`), or both. Without the
     /// `png` feature a PNG format is an error.
     pub fn apply(self, files: Vec<(String, Vec<u8>)>) -> Result<Vec<(String, Vec<u8>)>, String> {
         if self == FigureFormat::Svg {

@@ -445,6 +445,30 @@ class Param:
     ess_tail: Optional[float] = None
 
 
+def _param(r: Dict[str, Any], bounds: Tuple[float, float]) -> Param:
+    """A :class:`Param` from one row of the parameter report (the keys of params.csv)."""
+    return Param(
+        name=r["parameter"],
+        series=r["series"],
+        value=r["value"],
+        stderr=r["stderr"],
+        low=r["ci_low"],
+        high=r["ci_high"],
+        method=r["ci_method"],
+        level=r["level"],
+        unit=r["unit"],
+        at_bound=r["at_bound"],
+        bounds=tuple(bounds),
+        paper_value=r["paper_value"],
+        paper_source=r["paper_source"],
+        lsq_value=r["lsq_value"],
+        note=r["note"],
+        rhat=r["rhat"],
+        ess_bulk=r["ess_bulk"],
+        ess_tail=r["ess_tail"],
+    )
+
+
 class FitResult:
     """One fit: parameters with errors and intervals, correlations, residuals, statistics.
 
@@ -456,10 +480,10 @@ class FitResult:
     def __init__(self, core: Any) -> None:
         self._core = core
         self.name, self.series = core.name()
-        rows = core.params()
-        names = [r["name"] for r in rows]
+        rows = [_param(r, b) for r, b in zip(core.params(), core.param_bounds())]
+        names = [p.name for p in rows]
         unique = len(set(names)) == len(names)
-        self.params: Dict[str, Param] = {(r["name"] if unique else f"{r['name']}[{r['series']}]"): Param(**r) for r in rows}
+        self.params: Dict[str, Param] = {(p.name if unique else f"{p.name}[{p.series}]"): p for p in rows}
         """The parameters in the fit's order, by name; where a name repeats (one K per
         series), by ``name[series]``."""
         self.stats: Dict[str, Any] = dict(core.stats())

@@ -15,6 +15,7 @@ use fitbead::fit::report::FitSet;
 use fitbead::fit::summary::FitResult as RsFitResult;
 use fitbead::inverse::posterior::McmcSettings;
 use fitbead::io::measurements::{MeasurementDefaults, MeasurementFile};
+use fitbead::io::records::{cells, Cell, ParamRecord, StatsRecord};
 use fitbead::models::auto::Auto;
 use fitbead::models::contact::{Contact, SpinRule};
 use fitbead::models::jaeger::Jaeger;
@@ -297,6 +298,22 @@ where
 
 fn opt(x: Option<f64>) -> f64 {
     x.unwrap_or(f64::NAN)
+}
+
+/// A report record as a dict keyed by its CSV columns: text, float, int, bool, or None for an
+/// empty cell.
+fn record_dict<'py, R: serde::Serialize>(py: Python<'py>, r: &R) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    for (k, c) in cells(r) {
+        match c {
+            Cell::Text(s) => d.set_item(k, s)?,
+            Cell::Number(x) => d.set_item(k, x)?,
+            Cell::Count(n) => d.set_item(k, n)?,
+            Cell::Flag(b) => d.set_item(k, b)?,
+            Cell::Empty => d.set_item(k, py.None())?,
+        }
+    }
+    Ok(d)
 }
 
 /// The collision law of row `i`: a number from `k`, else the named law.
@@ -947,65 +964,25 @@ impl PyFitResult {
         )
     }
 
-    /// One dict per parameter.
+    /// One dict per parameter, keyed by the columns of the parameter report (params.csv):
+    /// the same record the command line writes; an empty cell is None.
     fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
         let l = PyList::empty(py);
         for p in &self.inner.params {
-            let d = PyDict::new(py);
-            let (iv, method) = p.interval();
-            d.set_item("name", &p.parameter)?;
-            d.set_item("series", &p.series)?;
-            d.set_item("value", p.value)?;
-            d.set_item("stderr", p.stderr)?;
-            d.set_item("low", iv.map(|x| x.0))?;
-            d.set_item("high", iv.map(|x| x.1))?;
-            d.set_item("method", method)?;
-            d.set_item("level", p.level)?;
-            d.set_item("unit", p.unit)?;
-            d.set_item("at_bound", p.at_bound)?;
-            d.set_item("bounds", p.bounds)?;
-            d.set_item("paper_value", p.paper_value)?;
-            d.set_item("paper_source", p.paper_source)?;
-            d.set_item("lsq_value", p.lsq_value)?;
-            d.set_item("note", &p.note)?;
-            if let Some(pd) = &p.posterior {
-                d.set_item("rhat", pd.rhat)?;
-                d.set_item("ess_bulk", pd.ess_bulk)?;
-                d.set_item("ess_tail", pd.ess_tail)?;
-            }
-            l.append(d)?;
+            l.append(record_dict(py, &ParamRecord::from(p))?)?;
         }
         Ok(l)
     }
 
-    /// Fit statistics.
+    /// Each parameter's box (lower, upper), in the order of `params`.
+    fn param_bounds(&self) -> Vec<(f64, f64)> {
+        self.inner.params.iter().map(|p| p.bounds).collect()
+    }
+
+    /// Fit statistics, keyed by the columns of the statistics report (stats.csv): the same
+    /// record the command line writes; an empty cell is None.
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let s = &self.inner.stats;
-        let d = PyDict::new(py);
-        d.set_item("n_points", s.n_points)?;
-        d.set_item("n_params", s.n_params)?;
-        d.set_item("dof", s.dof)?;
-        d.set_item("chi2", self.inner.chi2())?;
-        d.set_item("reduced_chi2", self.inner.reduced_chi2())?;
-        d.set_item("aic", s.aic)?;
-        d.set_item("bic", s.bic)?;
-        d.set_item("termination", &s.termination)?;
-        d.set_item("converged", self.inner.converged())?;
-        d.set_item("iterations", s.iterations)?;
-        d.set_item("residual_evals", s.residual_evals)?;
-        d.set_item("condition", s.condition)?;
-        d.set_item("note", &s.note)?;
-        if let Some(m) = &s.mcmc {
-            d.set_item("mcmc_status", &m.status)?;
-            d.set_item("walkers", m.walkers)?;
-            d.set_item("steps", m.steps)?;
-            d.set_item("burn_in", m.burn_in)?;
-            d.set_item("draws", m.draws)?;
-            d.set_item("acceptance", m.acceptance)?;
-            d.set_item("ess_min", m.ess_min)?;
-            d.set_item("rhat_max", m.rhat_max)?;
-        }
-        Ok(d)
+        record_dict(py, &StatsRecord::from(&self.inner.stats))
     }
 
     /// The correlation matrix of the parameters (rows in the order of `params`), or None.

@@ -152,3 +152,30 @@ def test_regimes_equal_cli(cli):
         assert_bits_equal(c, t[c], cols[c])
     assert list(t["steady_range"]) == cols["steady_range"]
     assert_bits_equal("critical_xi", [t.critical_xi] * 4, cols["critical_xi"])
+
+
+def test_parameter_and_statistics_records_are_the_cli_columns_and_cells(cli, data, tmp_path):
+    """The binding's parameter and statistics dicts are the records the command line writes
+    to params.csv and stats.csv: the same keys in the same order, and every cell equal (an
+    empty cell is None), for a least-squares and a posterior fit."""
+    for method in ["lsq", "mcmc"]:
+        extra = ["--method", "mcmc", "--min-ess", "100", "--seed", "3"] if method == "mcmc" else []
+        p, s = tmp_path / f"p_{method}.csv", tmp_path / f"s_{method}.csv"
+        cli("klaw", "--model", "stick", "--input", DEFAULT_DATA, *extra, "--output", p, "--output-stats", s)
+        kw = dict(method="mcmc", min_ess=100, seed=3) if method == "mcmc" else {}
+        fit = fitbead.fit_klaw(data, model="stick", **kw)
+        for rows, path in [(fit._core.params(), p), (fit._core.stats(), s)]:
+            rows = rows if isinstance(rows, list) else [rows]
+            cols = read_csv_text(path.read_text())
+            for i, r in enumerate(rows):
+                assert list(r) == list(cols), (method, path.name)
+                for k, v in r.items():
+                    cell = cols[k][i]
+                    if v is None:
+                        assert cell == "", (method, k, cell)
+                    elif isinstance(v, bool):
+                        assert cell == str(v).lower(), (method, k)
+                    elif isinstance(v, float):
+                        assert float(cell) == v, (method, k, cell, v)
+                    else:
+                        assert cell == str(v), (method, k, cell, v)

@@ -11,6 +11,7 @@ pub mod kstream;
 pub mod md;
 pub mod measurements;
 pub mod outdir;
+pub mod records;
 pub mod reports;
 pub mod scenes;
 pub mod stream;

@@ -2,9 +2,15 @@
 //! K = cos 2α + c sin²α sin 2α fitted to a data set by least squares and by MCMC.
 use fitbead::prelude::*;
 
-fn main() -> std::result::Result<(), Box<dyn std::error::Error>> {
+fn main() -> Result<(), Box<dyn std::error::Error>> {
     // ξ = r/R = 1, slope δ = 12°, sphere (ρ = 0.4), friction f = 0.1, the paper's fitted K law.
-    let scene = Scene::new(1.0, 12.0, 0.4, 0.1, CollisionLaw::Adjusted)?;
+    let scene = Scene::builder()
+        .xi(1.0)
+        .delta_deg(12.0)
+        .rho(0.4)
+        .friction(0.1)
+        .law(CollisionLaw::Adjusted)
+        .build()?;
     let steady = Model::Stick.evaluate(&scene)?;
     println!("stick model: mean velocity v = {}", steady.mean_velocity);
 

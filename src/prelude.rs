@@ -1,6 +1,6 @@
 //! The names a typical program needs, in one import: `use fitbead::prelude::*;`.
 
-pub use crate::error::{Error, Result};
+pub use crate::error::Error;
 pub use crate::fit::builder::{JaegerFitter, JanFitter, KLawFitter};
 pub use crate::fit::data::Dataset;
 pub use crate::fit::error::FitError;
@@ -11,4 +11,4 @@ pub use crate::fit::summary::{FitResult, ParamRow, PointFit};
 pub use crate::inverse::posterior::{McmcSettings, Prior};
 pub use crate::io::measurements::MeasurementDefaults;
 pub use crate::models::{ForwardModel, JaegerBranch, Model, NotSteady, Outcome, Regime, Steady};
-pub use crate::scene::{CollisionLaw, Scene};
+pub use crate::scene::{CollisionLaw, Scene, SceneBuilder};

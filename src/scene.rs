@@ -235,6 +235,103 @@ impl OfXi {
     }
 }
 
+/// A [`Scene`] built from named values whose names carry their units: ξ and the slope are
+/// required; ρ defaults to 2/5 (a sphere), f to 0.1 and the collision law to the paper's
+/// fitted one, K = cos 2α + ½ sin²α sin 2α (§3.6.1).
+///
+/// ```
+/// use fitbead::{CollisionLaw, Scene};
+/// let s = Scene::builder().xi(1.0).delta_deg(12.0).rho(0.4).friction(0.1)
+///     .law(CollisionLaw::Adjusted).build()?;
+/// assert_eq!(s, Scene::new(1.0, 12.0, 0.4, 0.1, CollisionLaw::Adjusted)?);
+/// # Ok::<(), fitbead::scene::ParameterError>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SceneBuilder {
+    xi: Option<f64>,
+    slope: Option<Slope>,
+    rho: f64,
+    f: f64,
+    law: CollisionLaw,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Slope {
+    Degrees(f64),
+    Radians(f64),
+}
+
+impl SceneBuilder {
+    /// Radius ratio ξ = r/R of the mobile bead to the row beads.
+    pub fn xi(mut self, xi: f64) -> Self {
+        self.xi = Some(xi);
+        self
+    }
+
+    /// Slope δ of the row, in degrees.
+    pub fn delta_deg(mut self, delta: f64) -> Self {
+        self.slope = Some(Slope::Degrees(delta));
+        self
+    }
+
+    /// Slope δ of the row, in radians.
+    pub fn delta_rad(mut self, delta: f64) -> Self {
+        self.slope = Some(Slope::Radians(delta));
+        self
+    }
+
+    /// Gyration parameter ρ (2/5 for a sphere, 1/2 for a cylinder).
+    pub fn rho(mut self, rho: f64) -> Self {
+        self.rho = rho;
+        self
+    }
+
+    /// Coulomb friction coefficient f between the beads.
+    pub fn friction(mut self, f: f64) -> Self {
+        self.f = f;
+        self
+    }
+
+    /// The collision law: a number K or a law K(α).
+    pub fn law(mut self, law: CollisionLaw) -> Self {
+        self.law = law;
+        self
+    }
+
+    /// The scene, validated as [`Scene::new`] validates it; ξ or the slope not given is an
+    /// error naming it.
+    pub fn build(self) -> Result<Scene> {
+        let missing = |field| ParameterError::InvalidParameter {
+            field,
+            value: String::new(),
+            reason: "not given",
+        };
+        let xi = self.xi.ok_or_else(|| missing("xi"))?;
+        match self.slope.ok_or_else(|| missing("delta_deg"))? {
+            Slope::Degrees(d) => Scene::new(xi, d, self.rho, self.f, self.law),
+            Slope::Radians(d) => Scene::from_radians(xi, d, self.rho, self.f, self.law),
+        }
+    }
+}
+
+impl Scene {
+    /// A [`SceneBuilder`]: named, unit-suffixed setters.
+    pub fn builder() -> SceneBuilder {
+        SceneBuilder {
+            xi: None,
+            slope: None,
+            rho: 0.4,
+            f: 0.1,
+            law: CollisionLaw::Adjusted,
+        }
+    }
+
+    /// The same scene at another slope δ, in degrees.
+    pub fn with_delta_deg(&self, delta_deg: f64) -> Result<Self> {
+        self.with_delta(delta_deg.to_radians())
+    }
+}
+
 impl Scene {
     /// Builds a scene from δ in degrees (the unit of the command line and of the CSV files).
     pub fn new(xi: f64, delta_deg: f64, rho: f64, f: f64, law: CollisionLaw) -> Result<Self> {

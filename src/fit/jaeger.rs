@@ -26,7 +26,7 @@ use super::jaeger_coordinates::JaegerCoordinates;
 pub use super::jaeger_coordinates::JaegerX;
 use super::posterior::{summarise_reparameterised, summarise_with, Method, Prior};
 use super::summary::{distinct_points, FitResult, ParamSpec, Solved};
-use crate::inverse::{fit, Infeasible, LsqOptions, Model, WeightedData};
+use crate::inverse::{fit, CurveModel, Infeasible, LsqOptions, WeightedData};
 use crate::models::jaeger::Jaeger;
 use crate::models::JaegerBranch;
 
@@ -71,7 +71,7 @@ impl JaegerModel {
     }
 }
 
-impl Model<JaegerX> for JaegerModel {
+impl CurveModel<JaegerX> for JaegerModel {
     fn n_params(&self) -> usize {
         3
     }

@@ -14,7 +14,7 @@
 use super::data::Dataset;
 use super::posterior::{summarise_with, Method};
 use super::summary::{distinct_points, FitResult, ParamSpec, Solved};
-use crate::inverse::{fit, Infeasible, LsqOptions, Model, WeightedData};
+use crate::inverse::{fit, CurveModel, Infeasible, LsqOptions, WeightedData};
 
 /// The paper's global values (λ0, λ1, μ0, μ1), eqs 75–76.
 pub const PAPER_GLOBAL: [f64; 4] = [0.063, 4.96, 0.0025, 7.46];
@@ -37,7 +37,7 @@ pub fn velocity(x: &JanX, lambda: f64, mu: f64) -> Result<(f64, f64, f64), Infea
 #[derive(Debug, Clone, Copy)]
 pub struct JanSeries;
 
-impl Model<JanX> for JanSeries {
+impl CurveModel<JanX> for JanSeries {
     fn n_params(&self) -> usize {
         2
     }
@@ -56,7 +56,7 @@ impl Model<JanX> for JanSeries {
 #[derive(Debug, Clone, Copy)]
 pub struct JanGlobal;
 
-impl Model<JanX> for JanGlobal {
+impl CurveModel<JanX> for JanGlobal {
     fn n_params(&self) -> usize {
         4
     }

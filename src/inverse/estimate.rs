@@ -95,9 +95,9 @@ impl Fit {
 /// [`Fit::termination`] (check [`Fit::converged`]).
 ///
 /// ```
-/// use fitbead::inverse::{fit, LsqOptions, Model, SigmaKind, WeightedData, Infeasible};
+/// use fitbead::inverse::{fit, LsqOptions, CurveModel, SigmaKind, WeightedData, Infeasible};
 /// struct Line;
-/// impl Model<f64> for Line {
+/// impl CurveModel<f64> for Line {
 ///     fn n_params(&self) -> usize { 2 }
 ///     fn value(&self, x: &f64, p: &[f64]) -> Result<f64, Infeasible> { Ok(p[0] + p[1] * x) }
 /// }

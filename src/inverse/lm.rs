@@ -614,10 +614,10 @@ enum Stage {
 ///
 /// ```
 /// use argmin::core::{Executor, State};
-/// use fitbead::inverse::{Infeasible, LeastSquares, LevenbergMarquardt, LsqOptions, Model,
+/// use fitbead::inverse::{Infeasible, LeastSquares, LevenbergMarquardt, LsqOptions, CurveModel,
 ///     WeightedData};
 /// struct Decay;
-/// impl Model<f64> for Decay {
+/// impl CurveModel<f64> for Decay {
 ///     fn n_params(&self) -> usize { 2 }
 ///     fn value(&self, x: &f64, p: &[f64]) -> Result<f64, Infeasible> {
 ///         Ok(p[0] * (-p[1] * x).exp())

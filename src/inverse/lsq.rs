@@ -1,5 +1,5 @@
 //! Least-squares problems and the solver's settings: [`Residuals`] (weighted residuals of n
-//! parameters, analytic Jacobian optional), [`Model`] with [`WeightedData`] (y = f(x; p) with data
+//! parameters, analytic Jacobian optional), [`CurveModel`] with [`WeightedData`] (y = f(x; p) with data
 //! (x, y, σ)), [`Infeasible`] points, [`LsqOptions`], the reasons a fit stops
 //! ([`Termination`]) and malformed input ([`LsqError`]).
 //!
@@ -56,7 +56,7 @@ impl<R: Residuals + ?Sized> Residuals for &R {
 }
 
 /// A model function y = f(x; p) for [`WeightedData`].
-pub trait Model<X: ?Sized> {
+pub trait CurveModel<X: ?Sized> {
     /// Number of parameters.
     fn n_params(&self) -> usize;
     /// f(x; p), or [`Infeasible`].
@@ -68,7 +68,7 @@ pub trait Model<X: ?Sized> {
     }
 }
 
-/// Data (xᵢ, yᵢ, σᵢ) and a [`Model`], seen as the residuals rᵢ = (yᵢ − f(xᵢ; p)) / σᵢ.
+/// Data (xᵢ, yᵢ, σᵢ) and a [`CurveModel`], seen as the residuals rᵢ = (yᵢ − f(xᵢ; p)) / σᵢ.
 #[derive(Debug, Clone)]
 pub struct WeightedData<X, M> {
     model: M,
@@ -77,7 +77,7 @@ pub struct WeightedData<X, M> {
     inv_sigma: Vec<f64>,
 }
 
-impl<X, M: Model<X>> WeightedData<X, M> {
+impl<X, M: CurveModel<X>> WeightedData<X, M> {
     /// Data with standard deviations `sigma` (each finite and > 0), or unit weights if `None`.
     pub fn new(
         model: M,
@@ -131,7 +131,7 @@ impl<X, M: Model<X>> WeightedData<X, M> {
     }
 }
 
-impl<X, M: Model<X>> Residuals for WeightedData<X, M> {
+impl<X, M: CurveModel<X>> Residuals for WeightedData<X, M> {
     fn n_params(&self) -> usize {
         self.model.n_params()
     }

@@ -16,7 +16,7 @@
 //!   (`Operator` + `Jacobian` on nalgebra vectors) fitted by fitbead's solver;
 //! * [`confidence_intervals`] — covariance (Student-t / normal) and profile-likelihood
 //!   intervals;
-//! * [`WeightedData`] — a [`Model`] y = f(x; p) with data (x, y, σ) seen as residuals;
+//! * [`WeightedData`] — a [`CurveModel`] y = f(x; p) with data (x, y, σ) seen as residuals;
 //! * [`EnsembleSampler`] — Bayesian sampling of any [`LogDensity`] with the affine-invariant
 //!   stretch move (J. Goodman & J. Weare, "Ensemble samplers with affine invariance", Comm.
 //!   App. Math. Comp. Sci. 5, 2010; emcee's split-half parallel form, Foreman-Mackey et al.
@@ -44,7 +44,7 @@ mod tests;
 pub use estimate::{fit, fit_result, Covariance, Fit};
 pub use lm::LevenbergMarquardt;
 pub use lsq::{
-    Infeasible, LsqError, LsqOptions, Model, Residuals, SigmaKind, Termination, WeightedData,
+    CurveModel, Infeasible, LsqError, LsqOptions, Residuals, SigmaKind, Termination, WeightedData,
 };
 pub use mcmc::{
     EnsembleSampler, LogDensity, McmcError, McmcOptions, McmcResult, ParameterDiagnostics,

@@ -18,11 +18,11 @@ use crate::progress::Tally;
 /// ```
 /// use argmin::core::observers::ObserverMode;
 /// use argmin::core::{Executor, State};
-/// use fitbead::inverse::{Infeasible, LeastSquares, LevenbergMarquardt, LsqOptions, Model,
+/// use fitbead::inverse::{Infeasible, LeastSquares, LevenbergMarquardt, LsqOptions, CurveModel,
 ///     ProgressObserver, WeightedData};
 /// use fitbead::progress::{Progress, Tally};
 /// struct Decay;
-/// impl Model<f64> for Decay {
+/// impl CurveModel<f64> for Decay {
 ///     fn n_params(&self) -> usize { 2 }
 ///     fn value(&self, x: &f64, p: &[f64]) -> Result<f64, Infeasible> {
 ///         Ok(p[0] * (-p[1] * x).exp())
@@ -83,8 +83,8 @@ impl Observe<LmState> for ProgressObserver {
 mod tests {
     use super::*;
     use crate::inverse::{
-        fit, fit_result, Infeasible, LeastSquares, LevenbergMarquardt, LmStage, LsqOptions, Model,
-        WeightedData,
+        fit, fit_result, CurveModel, Infeasible, LeastSquares, LevenbergMarquardt, LmStage,
+        LsqOptions, WeightedData,
     };
     use crate::progress::{Progress, ProgressEvent};
     use argmin::core::observers::ObserverMode;
@@ -95,7 +95,7 @@ mod tests {
     struct Decay {
         analytic: bool,
     }
-    impl Model<f64> for Decay {
+    impl CurveModel<f64> for Decay {
         fn n_params(&self) -> usize {
             2
         }

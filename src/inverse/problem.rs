@@ -23,10 +23,10 @@ use super::lsq::{validate, Infeasible, LsqError, LsqOptions, Residuals, Setup};
 ///
 /// ```
 /// use argmin::core::{CostFunction, Operator};
-/// use fitbead::inverse::{Infeasible, LeastSquares, LsqOptions, Model, WeightedData};
+/// use fitbead::inverse::{Infeasible, LeastSquares, LsqOptions, CurveModel, WeightedData};
 /// use nalgebra::DVector;
 /// struct Line;
-/// impl Model<f64> for Line {
+/// impl CurveModel<f64> for Line {
 ///     fn n_params(&self) -> usize { 2 }
 ///     fn value(&self, x: &f64, p: &[f64]) -> Result<f64, Infeasible> { Ok(p[0] + p[1] * x) }
 /// }

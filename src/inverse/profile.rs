@@ -313,9 +313,9 @@ pub fn profile_interval<R: Residuals + ?Sized>(
 /// ([`DEFAULT_LEVEL`] = 0.95 is the usual choice).
 ///
 /// ```
-/// use fitbead::inverse::{confidence_intervals, fit, Infeasible, LsqOptions, Model, WeightedData};
+/// use fitbead::inverse::{confidence_intervals, fit, Infeasible, LsqOptions, CurveModel, WeightedData};
 /// struct Decay;
-/// impl Model<f64> for Decay {
+/// impl CurveModel<f64> for Decay {
 ///     fn n_params(&self) -> usize { 2 }
 ///     fn value(&self, x: &f64, p: &[f64]) -> Result<f64, Infeasible> { Ok(p[0] * (-p[1] * x).exp()) }
 /// }

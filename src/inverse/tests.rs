@@ -6,13 +6,13 @@ use super::lm::LevenbergMarquardt;
 use super::lsq::{LsqError, LsqOptions, Residuals, SigmaKind, Termination};
 use super::problem::LeastSquares;
 use super::state::LmState;
-use crate::inverse::lsq::{Infeasible, Model, WeightedData};
+use crate::inverse::lsq::{CurveModel, Infeasible, WeightedData};
 use crate::inverse::profile::{confidence_intervals, ProfileEnd};
 use std::cell::Cell;
 
 /// y = a + b·x.
 struct Line;
-impl Model<f64> for Line {
+impl CurveModel<f64> for Line {
     fn n_params(&self) -> usize {
         2
     }
@@ -28,7 +28,7 @@ impl Model<f64> for Line {
 
 /// y = a·exp(b·x), gradient by the solver's differences.
 struct Decay;
-impl Model<f64> for Decay {
+impl CurveModel<f64> for Decay {
     fn n_params(&self) -> usize {
         2
     }
@@ -39,7 +39,7 @@ impl Model<f64> for Decay {
 
 /// y = exp(b·x): one parameter.
 struct Exp1;
-impl Model<f64> for Exp1 {
+impl CurveModel<f64> for Exp1 {
     fn n_params(&self) -> usize {
         1
     }
@@ -352,7 +352,7 @@ fn bounds_are_respected() {
 /// y = √(c − x)·d, infeasible for c ≤ max x; the optimum is feasible but the first
 /// trust-region steps from far away cross into the infeasible region.
 struct Root;
-impl Model<f64> for Root {
+impl CurveModel<f64> for Root {
     fn n_params(&self) -> usize {
         2
     }
@@ -451,7 +451,7 @@ fn optimum_beyond_the_feasible_edge_is_not_convergence() {
 #[test]
 fn differences_agree_with_analytic_jacobian() {
     struct LineNoGrad;
-    impl Model<f64> for LineNoGrad {
+    impl CurveModel<f64> for LineNoGrad {
         fn n_params(&self) -> usize {
             2
         }
@@ -488,7 +488,7 @@ fn limits_and_rank_deficiency_are_reported() {
     assert!(!f.converged());
     // y = a + b (two names for one constant): J has rank 1, no covariance.
     struct Twice;
-    impl Model<f64> for Twice {
+    impl CurveModel<f64> for Twice {
         fn n_params(&self) -> usize {
             2
         }

@@ -9,7 +9,7 @@ use crate::fit::k::bracket;
 use crate::fit::klaw::{fit_law_with, KLaw, KLawFit, KLawProblem};
 use crate::fit::posterior::Method;
 use crate::fit::summary::{FitResult, ParamRow};
-use crate::inverse::{Model as _, Residuals, SigmaKind};
+use crate::inverse::{CurveModel as _, Residuals, SigmaKind};
 use crate::models::energy;
 use crate::models::regimes::{bulk_friction, critical_xi, delta_d_law, delta_m_law};
 use crate::models::{regime_of, ForwardModel, JaegerBranch, Model, Regime};

@@ -21,7 +21,7 @@ use crate::fit::jaeger::JaegerModel;
 use crate::fit::jan::{JanGlobal, JanSeries};
 use crate::fit::summary::FitResult;
 use crate::inverse::mcmc::diagnostics::quantile_sorted;
-use crate::inverse::Model as _;
+use crate::inverse::CurveModel as _;
 use crate::models::{ForwardModel, Model};
 use crate::scene::{CollisionLaw, Scene};
 use rayon::prelude::*;

@@ -14,7 +14,7 @@ use crate::fit::jaeger::{paper_values, JaegerModel};
 use crate::fit::jan::velocity as jan_velocity;
 use crate::fit::k::estimate;
 use crate::fit::summary::FitResult;
-use crate::inverse::{Model as _, SigmaKind};
+use crate::inverse::{CurveModel as _, SigmaKind};
 use crate::models::regimes::{
     alpha_of_xi, critical_xi, delta_d_law, delta_m_law, regime_b_interval,
 };

@@ -331,8 +331,8 @@ fn jaeger_coverage_over_200_replicates() {
 fn analytic_gradients_match_central_differences() {
     use fitbead::fit::jaeger::JaegerModel;
     use fitbead::fit::jan::{JanGlobal, JanSeries};
-    use fitbead::inverse::Model as LsqModel;
-    fn check<X, M: LsqModel<X>>(m: &M, x: &X, p: &[f64]) {
+    use fitbead::inverse::CurveModel;
+    fn check<X, M: CurveModel<X>>(m: &M, x: &X, p: &[f64]) {
         let mut g = vec![0.0; p.len()];
         m.gradient(x, p, &mut g).unwrap().unwrap();
         for k in 0..p.len() {

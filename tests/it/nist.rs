@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 
 use faer::MatMut;
 use fitbead::inverse::{
-    fit, Fit, Infeasible, LsqOptions, Model, Residuals, SigmaKind, WeightedData,
+    fit, Fit, Infeasible, LsqOptions, CurveModel, Residuals, SigmaKind, WeightedData,
 };
 use fitbead::special::dd::Dd;
 
@@ -665,7 +665,7 @@ impl Nist {
     }
 }
 
-impl Model<[f64; 2]> for Nist {
+impl CurveModel<[f64; 2]> for Nist {
     fn n_params(&self) -> usize {
         use Nist::*;
         match self {

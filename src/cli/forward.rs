@@ -122,7 +122,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
     };
     if kind == ModelKind::Md {
         let (source, text) = match single {
-            Some(text) => ("<command line>".to_string(), text),
+            Some(text) => (fitbead::io::SETTINGS_ORIGIN.to_string(), text),
             None => read_input(a.input.as_deref())?,
         };
         let t = Table::parse(&source, &text)?;
@@ -133,7 +133,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         Some(text) => {
             let n = text.len() as u64;
             (
-                "<command line>".to_string(),
+                fitbead::io::SETTINGS_ORIGIN.to_string(),
                 Input::Text(Cursor::new(text)),
                 n,
             )

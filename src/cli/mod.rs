@@ -590,7 +590,7 @@ pub fn parse_list(flag: &str, s: &str) -> Result<Vec<f64>, CliError> {
                 .filter(|v| v.is_finite())
                 .ok_or_else(|| {
                     CliError::Input(InputError {
-                        file: "<command line>".into(),
+                        file: fitbead::io::SETTINGS_ORIGIN.into(),
                         line: None,
                         column: Some(flag.to_string()),
                         value: Some(t.to_string()),
@@ -611,7 +611,7 @@ pub fn jaeger_branch(value: &str) -> Result<fitbead::models::JaegerBranch, CliEr
 /// An error about a command-line flag value.
 pub fn flag_error(flag: &str, value: &str, message: impl Into<String>) -> CliError {
     CliError::Input(InputError {
-        file: "<command line>".into(),
+        file: fitbead::io::SETTINGS_ORIGIN.into(),
         line: None,
         column: Some(flag.to_string()),
         value: Some(value.to_string()),

@@ -89,7 +89,9 @@ impl InputError {
 pub const MESSAGE_CHARS: usize = 1000;
 
 impl fmt::Display for InputError {
-    /// `file, line L, column 'C', value 'V': message`, with the file name, the column name and
+    /// `file, line L, column 'C', value 'V': message` (for a flag of the command line,
+    /// `<command line>, flag '--NAME', value 'V': message`, without an empty value), with the
+    /// file name, the column name and
     /// the value each cut at [`ECHO_CHARS`] characters and the message at [`MESSAGE_CHARS`]
     /// ([`clip`]).
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -97,11 +99,17 @@ impl fmt::Display for InputError {
         if let Some(l) = self.line {
             write!(f, ", line {l}")?;
         }
+        // A setting is named as the flag it came from; an empty value says nothing.
+        let setting =
+            self.file == SETTINGS_ORIGIN && self.column.as_ref().is_some_and(|c| c.starts_with("--"));
         if let Some(c) = &self.column {
-            write!(f, ", column '{}'", clip(c, ECHO_CHARS))?;
+            let what = if setting { "flag" } else { "column" };
+            write!(f, ", {what} '{}'", clip(c, ECHO_CHARS))?;
         }
-        if let Some(v) = &self.value {
-            write!(f, ", value '{}'", clip(v, ECHO_CHARS))?;
+        match &self.value {
+            Some(v) if setting && v.is_empty() => {}
+            Some(v) => write!(f, ", value '{}'", clip(v, ECHO_CHARS))?,
+            None => {}
         }
         write!(f, ": {}", clip(&self.message, MESSAGE_CHARS))
     }

@@ -153,14 +153,14 @@ fn unknown_spin_rule_is_reported_as_a_spin_rule() {
     assert_eq!(code, Some(2));
     assert_eq!(
         err,
-        "fitbead: error: <command line>, column '--spin', value 'reset': unknown spin rule \
+        "fitbead: error: <command line>, flag '--spin', value 'reset': unknown spin rule \
          'reset' (expected roll, keep, impact or factor=L)\n"
     );
     let (code, err) = run(&[&["forward", "--model", "stick", "--K", "bogus"][..], &scene].concat());
     assert_eq!(code, Some(2));
     assert_eq!(
         err,
-        "fitbead: error: <command line>, column '--K', value 'bogus': unknown collision law \
+        "fitbead: error: <command line>, flag '--K', value 'bogus': unknown collision law \
          'bogus' (expected a number, cos2a, adjusted, impact or c=VALUE)\n"
     );
     expect_error(

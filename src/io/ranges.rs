@@ -10,8 +10,8 @@
 //! boundaries follows the quoting as the `csv` reader does (a quote opens a cell only at the
 //! start of a field; `""` inside one is a quote), so a newline inside a quoted cell never
 //! cuts a record; it runs byte by byte only over bytes holding a quote, and otherwise looks
-//! only at line ends. No range starts with the bytes of a UTF-8 byte order mark (a fresh
-//! reader would drop them).
+//! only at line ends. A range's reader gets its first byte alone, so that it keeps the bytes
+//! of a UTF-8 byte order mark at the range's start, as the one reader does after the header.
 //!
 //! Errors keep their order: a range stops at its first malformed row (a row whose field count
 //! differs from the header's, or with invalid UTF-8), and that row is reported only after
@@ -159,15 +159,6 @@ impl Csv {
 
 fn is_end(b: u8) -> bool {
     b == b'\n' || b == b'\r'
-}
-
-/// Whether a range may start at `p` of `buf`, a position right after a record's end: the
-/// next byte is known (or the input ended there) and does not begin a byte order mark.
-fn may_start(buf: &[u8], p: usize, eof: bool) -> bool {
-    match buf.get(p) {
-        Some(&c) => c != 0xEF,
-        None => eof,
-    }
 }
 
 /// In a block that starts before a record and holds no quote: whether the line end at `i`
@@ -404,7 +395,7 @@ impl<R: Read> Ranges<R> {
                 q = q.step(b, line, &mut op);
                 let (next, ended) = csv.step(b);
                 csv = next;
-                if ended && may_start(buf, i + 1, eof) && i + 1 < buf.len() {
+                if ended {
                     last = Some((i + 1, q, op));
                     if i + 1 - cuts[cuts.len() - 1] >= step {
                         cuts.push(i + 1);
@@ -426,7 +417,7 @@ impl<R: Read> Ranges<R> {
                     let Some(i) = buf[..hi].iter().rposition(|&b| is_end(b)) else {
                         break None;
                     };
-                    if ends_record(buf, i) && may_start(buf, i + 1, false) {
+                    if ends_record(buf, i) {
                         break Some(i + 1);
                     }
                     hi = i;
@@ -449,7 +440,7 @@ impl<R: Read> Ranges<R> {
                     .enumerate()
                     .filter(|&(_, &b)| is_end(b))
                     .map(|(k, _)| at + k)
-                    .find(|&i| ends_record(buf, i) && may_start(buf, i + 1, eof));
+                    .find(|&i| ends_record(buf, i));
                 match next {
                     Some(i) if i + 1 < end => {
                         cuts.push(i + 1);
@@ -499,6 +490,21 @@ impl<R: Read> Ranges<R> {
     }
 }
 
+/// A range's bytes read with the first byte alone: the `csv` reader drops a byte order mark
+/// only when its first read holds one whole, which a range's first read then never does.
+struct FirstByteAlone<'a>(&'a [u8], bool);
+
+impl Read for FirstByteAlone<'_> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = if std::mem::take(&mut self.1) {
+            buf.len().min(1)
+        } else {
+            buf.len()
+        };
+        self.0.read(&mut buf[..n])
+    }
+}
+
 /// Parses one range (`bytes`, at `at`'s offset and line of the input `source`) under a
 /// header of `width` fields, reusing the records of `spare`.
 fn parse(
@@ -513,7 +519,7 @@ fn parse(
         .has_headers(false)
         .flexible(true)
         .buffer_capacity(1 << 16)
-        .from_reader(bytes);
+        .from_reader(FirstByteAlone(bytes, true));
     let mut rows = Vec::with_capacity(spare.len());
     let mut rec = spare.pop().unwrap_or_default();
     let mut failure = None;

@@ -8,6 +8,7 @@ mod bench_cli;
 mod cli;
 mod cli_mcmc;
 mod contact;
+mod csv_ranges;
 mod cross_solvers;
 mod edges_cli;
 mod edges_files;

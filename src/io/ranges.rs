@@ -271,7 +271,9 @@ impl<R: Read> Ranges<R> {
             n => (self.parsed_bytes / n).max(1),
         };
         let rows = rows as u64;
-        let want = rows.saturating_mul(per_row).saturating_add(rows * per_row / 8);
+        let want = rows
+            .saturating_mul(per_row)
+            .saturating_add(rows * per_row / 8);
         let mut want = usize::try_from(want).unwrap_or(usize::MAX).max(MIN_BLOCK);
         let Cut {
             spans,

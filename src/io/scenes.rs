@@ -321,13 +321,15 @@ impl<R: Read> TableReader<R> {
         csv_error(&self.source, &e)
     }
 
+    /// Whether [`into_ranges`](Self::into_ranges) can take over: no row has been read yet,
+    /// and the bytes after the header are still at hand.
+    pub(crate) fn hands_over(&self) -> bool {
+        self.rows_seen == 0 && !self.done && self.rdr.get_ref().keep.is_some()
+    }
+
     /// The reader's rows from here on as [`super::ranges::Ranges`], which parses them in
-    /// parallel; the reader itself when it has read rows already (the bytes after its header
-    /// are then no longer at hand).
-    pub(crate) fn into_ranges(self) -> Result<super::ranges::Ranges<R>, Self> {
-        if self.rows_seen > 0 || self.done || self.rdr.get_ref().keep.is_none() {
-            return Err(self);
-        }
+    /// parallel; only when [`hands_over`](Self::hands_over) (otherwise it has no rows).
+    pub(crate) fn into_ranges(self) -> super::ranges::Ranges<R> {
         let pos = self.rdr.position().clone();
         let TableReader {
             source,
@@ -350,7 +352,7 @@ impl<R: Read> TableReader<R> {
             }
             state = state.step(b, line, &mut opened);
         }
-        Ok(super::ranges::Ranges::new(super::ranges::Rest {
+        super::ranges::Ranges::new(super::ranges::Rest {
             source,
             width: headers.len(),
             bytes,
@@ -360,7 +362,7 @@ impl<R: Read> TableReader<R> {
             records: pos.record(),
             quoting: state,
             opened,
-        }))
+        })
     }
 }
 
@@ -400,11 +402,7 @@ pub(crate) fn ragged_row(source: &str, line: Option<u64>, len: u64, expected: u6
 }
 
 /// A record at `pos` with invalid UTF-8 (the byte index counted from the trimmed cell).
-pub(crate) fn utf8_error(
-    source: &str,
-    pos: &csv::Position,
-    e: csv::FromUtf8Error,
-) -> InputError {
+pub(crate) fn utf8_error(source: &str, pos: &csv::Position, e: csv::FromUtf8Error) -> InputError {
     let (field, up_to) = (e.utf8_error().field(), e.utf8_error().valid_up_to());
     let b = e.into_byte_record();
     let cell = b.get(field).unwrap_or(b"");

@@ -310,9 +310,10 @@ enum Source<R: Read> {
 
 impl<R: Read> Source<R> {
     fn new(reader: TableReader<R>) -> Self {
-        match reader.into_ranges() {
-            Ok(r) => Source::Ranges(r),
-            Err(r) => Source::Serial(r),
+        if reader.hands_over() {
+            Source::Ranges(reader.into_ranges())
+        } else {
+            Source::Serial(reader)
         }
     }
 

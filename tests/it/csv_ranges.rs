@@ -100,7 +100,11 @@ fn check(name: &str, text: &[u8]) {
 
 fn summary(r: &Result<Vec<u8>, String>) -> String {
     match r {
-        Ok(b) => format!("{} bytes, {} lines", b.len(), b.split(|&c| c == b'\n').count()),
+        Ok(b) => format!(
+            "{} bytes, {} lines",
+            b.len(),
+            b.split(|&c| c == b'\n').count()
+        ),
         Err(e) => format!("error: {e}"),
     }
 }
@@ -194,18 +198,36 @@ fn errors_keep_their_order() {
     // A malformed row anywhere comes first, then the first bad value in input order.
     check("ragged late", &with_row(&plain, 19_000, b"1,2"));
     check("ragged early", &with_row(&plain, 3, b"1,2,3,4"));
-    check("bad early, ragged late", &with_row(&with_row(&plain, 10, b"bad,1,2"), 18_000, b"1"));
-    check("bad late", &with_row(&with_row(&plain, 17_000, b"bad,1,2"), 19_000, b"bad,3,4"));
+    check(
+        "bad early, ragged late",
+        &with_row(&with_row(&plain, 10, b"bad,1,2"), 18_000, b"1"),
+    );
+    check(
+        "bad late",
+        &with_row(&with_row(&plain, 17_000, b"bad,1,2"), 19_000, b"bad,3,4"),
+    );
     check("bad first", &with_row(&plain, 0, b"bad,1,2"));
     check("utf-8 late", &with_row(&plain, 15_000, b"1,\xff,2"));
     check("utf-8, padded", &with_row(&plain, 15_000, b"1,  a\xc3,2"));
-    check("ragged after quoted newlines", &with_row(&t, 12_000, b"1,2"));
-    check("bad after quoted newlines", &with_row(&t, 12_000, b"bad,2,3"));
+    check(
+        "ragged after quoted newlines",
+        &with_row(&t, 12_000, b"1,2"),
+    );
+    check(
+        "bad after quoted newlines",
+        &with_row(&t, 12_000, b"bad,2,3"),
+    );
     check("spaces only", &with_row(&plain, 9_000, b"   "));
     // A quote left open runs to the end of the input.
     check("unterminated", &with_row(&plain, 16_000, b"1,\"open,2"));
-    check("unterminated, last row", &[&plain[..], b"1,2,\"open\n"].concat());
-    check("unterminated, ragged", &[&plain[..], b"1,\"open\n"].concat());
+    check(
+        "unterminated, last row",
+        &[&plain[..], b"1,2,\"open\n"].concat(),
+    );
+    check(
+        "unterminated, ragged",
+        &[&plain[..], b"1,\"open\n"].concat(),
+    );
     // No rows.
     check("header only", b"a,b,c\n");
     check("header without newline", b"a,b,c");

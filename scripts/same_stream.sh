@@ -77,7 +77,7 @@ w("semicolon.csv", meas.replace(b",", b";"))
 w("only_blank_rows.csv", head + b"\n\n\n")
 EOF
 if [ $big = 1 ]; then
-  [ -f "$in/k5m.csv" ] || "$old" simulate --model stick --series 0.6,0.7,0.8,0.9,1,1.1,1.2,1.3,1.4,1.5,1.6,1.7,1.8,1.9,2,2.2,2.4,2.6,2.8,3 --points 250000 --seed 5 > "$in/k5m.csv"
+  [ -f "$in/k5m.csv" ] || "$old" simulate --model stick --series "$(python3 -c "print(','.join(f'{0.8 + 0.11 * k:.2f}' for k in range(20)))")" --points 250000 --seed 5 --output "$in/k5m.csv"
   [ -f "$in/f1m.csv" ] || "$old" simulate --model stick --series 0.8,1,1.6,2 --points 250000 --seed 6 > "$in/f1m.csv"
   [ -f "$in/k5m_bad.csv" ] || python3 - "$in" <<'EOF'
 import sys, os

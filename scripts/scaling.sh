@@ -28,7 +28,7 @@ fi
 cd "$work" || exit 2
 
 # --- inputs (the same for every binary: fixed seeds) ----------------------------------
-series20=0.6,0.7,0.8,0.9,1,1.1,1.2,1.3,1.4,1.5,1.6,1.7,1.8,1.9,2,2.2,2.4,2.6,2.8,3
+series20=$(python3 -c "print(','.join(f'{0.8 + 0.11 * k:.2f}' for k in range(20)))")
 "$bin" simulate --model stick --series "$series20" --points $((250000 / div)) --seed 1 \
   --output k_stick.csv || exit 2
 "$bin" simulate --model stick --series 0.8,1,1.6,2 --points $((250000 / div)) --seed 2 \

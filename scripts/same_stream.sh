@@ -4,7 +4,7 @@
 # inputs, each run at 1 thread and at the machine's default.
 #
 # Usage: scripts/same_stream.sh OLD_BINARY NEW_BINARY [WORKDIR] [--big]
-#   REUSE_OLD=1 keeps the old binary's outputs from an earlier run in WORKDIR.
+#   REUSE=1 keeps the outputs of an earlier run in WORKDIR (of binaries of the same names).
 #   --big adds the large inputs (k stick on 5,000,000 simulated rows, forward stick on
 #   1,000,000), minutes of work.
 # Prints one line per differing case and a count; exits 1 when any case differs.
@@ -112,9 +112,10 @@ case_() { # name args... (a literal OUT is replaced by an --output path)
       if [ "$x" = OUT ]; then a+=(--output "$work/out/$name.$t.file"); else a+=("$x"); fi
     done
     for bin in "$old" "$new"; do
-      # With REUSE_OLD=1, the old binary's outputs of an earlier run in WORKDIR are kept.
-      if [ "$bin" = "$old" ] && [ "${REUSE_OLD:-0}" = 1 ] &&
-        [ -f "$work/out/$name.$t.$(basename "$old").rc" ]; then continue; fi
+      # With REUSE=1, the outputs of an earlier run in WORKDIR are kept.
+      if [ "${REUSE:-0}" = 1 ] && [ -f "$work/out/$name.$t.$(basename "$bin").rc" ]; then
+        continue
+      fi
       # An existing target must stay as it is on error.
       [ -n "$(printf '%s\n' "$@" | grep -x OUT)" ] && echo previous > "$work/out/$name.$t.file"
       run "$name" $t "$bin" "${a[@]}"
@@ -143,7 +144,7 @@ for f in "$in"/*.csv; do
     case_ "k_stickslip_$b" k --model stickslip --input "$f" OUT
     case_ "fwd_stick_out_$b" forward --model stick --input "$f" OUT ;;
   esac
-  case $b in default|md_ristow|quoted_newlines)
+  case $b in default|md_ristow)
     case_ "k_auto_$b" k --model auto --input "$f" OUT
     case_ "fwd_contact_$b" forward --model contact --input "$f" OUT ;;
   esac

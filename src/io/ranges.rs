@@ -9,8 +9,8 @@
 //! it, and its positions are the whole input's less the range's start. The scan that finds
 //! boundaries follows the quoting as the `csv` reader does (a quote opens a cell only at the
 //! start of a field; `""` inside one is a quote), so a newline inside a quoted cell never
-//! cuts a record; it runs byte by byte only over bytes holding a quote, and otherwise looks
-//! only at line ends. A range's reader gets its first byte alone, so that it keeps the bytes
+//! cuts a record; it runs byte by byte only over a block of input that holds a quote, and
+//! otherwise looks only at line ends. A range's reader gets its first byte alone, so that it keeps the bytes
 //! of a UTF-8 byte order mark at the range's start, as the one reader does after the header.
 //!
 //! Errors keep their order: a range stops at its first malformed row (a row whose field count

@@ -11,6 +11,7 @@ pub mod kstream;
 pub mod md;
 pub mod measurements;
 pub mod outdir;
+mod ranges;
 pub mod records;
 pub mod reports;
 pub mod scenes;

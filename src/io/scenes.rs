@@ -40,20 +40,44 @@ pub struct TableReader<R: Read> {
 
 /// Where the CSV quoting of the bytes read through it stands: whether a quoted cell is open,
 /// and on which line it opened. A quote opens a cell only at the start of a field, as the
-/// `csv` reader reads it (elsewhere it is a literal character).
+/// `csv` reader reads it (elsewhere it is a literal character). Until `keep` is dropped it
+/// also keeps every byte it passes on, so that the rows after the header can be handed to
+/// [`super::ranges::Ranges`] without reading the input twice.
 struct QuoteWatch<R> {
     inner: R,
     state: Quoting,
     line: u64,
     opened: u64,
+    keep: Option<Vec<u8>>,
 }
 
-#[derive(Clone, Copy, PartialEq)]
-enum Quoting {
+/// The state of [`QuoteWatch`]: at the start of a field, in an unquoted field, in a quoted
+/// cell, or just after a quote in a quoted cell.
+#[derive(Clone, Copy, PartialEq, Debug)]
+pub(crate) enum Quoting {
     FieldStart,
     Unquoted,
     Quoted,
     QuoteInQuoted,
+}
+
+impl Quoting {
+    /// The state after byte `b` of line `line` (counted with `b`); a quote that opens a cell
+    /// sets `opened` to `line`.
+    #[inline]
+    pub(crate) fn step(self, b: u8, line: u64, opened: &mut u64) -> Quoting {
+        match (self, b) {
+            (Quoting::Quoted, b'"') => Quoting::QuoteInQuoted,
+            (Quoting::Quoted, _) => Quoting::Quoted,
+            (Quoting::QuoteInQuoted, b'"') => Quoting::Quoted,
+            (Quoting::FieldStart, b'"') => {
+                *opened = line;
+                Quoting::Quoted
+            }
+            (_, b',' | b'\n' | b'\r') => Quoting::FieldStart,
+            _ => Quoting::Unquoted,
+        }
+    }
 }
 
 impl<R> QuoteWatch<R> {
@@ -63,6 +87,7 @@ impl<R> QuoteWatch<R> {
             state: Quoting::FieldStart,
             line: 1,
             opened: 0,
+            keep: Some(Vec::new()),
         }
     }
 
@@ -79,17 +104,10 @@ impl<R: Read> Read for QuoteWatch<R> {
             if b == b'\n' {
                 self.line += 1;
             }
-            self.state = match (self.state, b) {
-                (Quoting::Quoted, b'"') => Quoting::QuoteInQuoted,
-                (Quoting::Quoted, _) => Quoting::Quoted,
-                (Quoting::QuoteInQuoted, b'"') => Quoting::Quoted,
-                (Quoting::FieldStart, b'"') => {
-                    self.opened = self.line;
-                    Quoting::Quoted
-                }
-                (_, b',' | b'\n' | b'\r') => Quoting::FieldStart,
-                _ => Quoting::Unquoted,
-            };
+            self.state = self.state.step(b, self.line, &mut self.opened);
+        }
+        if let Some(k) = &mut self.keep {
+            k.extend_from_slice(&buf[..n]);
         }
         Ok(n)
     }
@@ -214,6 +232,7 @@ impl<R: Read> TableReader<R> {
         recs: &mut Vec<csv::StringRecord>,
         max: usize,
     ) -> Result<usize, InputError> {
+        self.rdr.get_mut().keep = None;
         let mut n = 0;
         while n < max && !self.done {
             if n == recs.len() {
@@ -232,6 +251,7 @@ impl<R: Read> TableReader<R> {
     /// Reads the rest of the input only to find what [`Table::parse`] would have reported
     /// before any check of the values: a malformed row, or no data rows at all.
     pub fn drain(&mut self) -> Option<InputError> {
+        self.rdr.get_mut().keep = None;
         let mut rec = csv::StringRecord::new();
         while !self.done {
             if let Err(e) = self.read_one(&mut rec) {
@@ -261,25 +281,7 @@ impl<R: Read> TableReader<R> {
             Ok(r) => r,
             Err(e) => {
                 self.done = true;
-                let (field, up_to) = (e.utf8_error().field(), e.utf8_error().valid_up_to());
-                let b = e.into_byte_record();
-                let cell = b.get(field).unwrap_or(b"");
-                let lead = cell.iter().take_while(|c| c.is_ascii_whitespace()).count();
-                return Err(InputError {
-                    file: self.source.clone(),
-                    line: Some(pos.line()),
-                    column: None,
-                    value: None,
-                    message: format!(
-                        "malformed CSV: CSV parse error: record {} (line {}, field: {field}, \
-                         byte: {}): invalid utf-8: invalid UTF-8 in field {field} near byte \
-                         index {}",
-                        pos.record(),
-                        pos.line(),
-                        pos.byte(),
-                        up_to.saturating_sub(lead)
-                    ),
-                });
+                return Err(utf8_error(&self.source, &pos, e));
             }
         };
         self.spare = Some(std::mem::replace(rec, read));
@@ -287,16 +289,7 @@ impl<R: Read> TableReader<R> {
         if !more {
             self.done = true;
             if let Some(line) = self.rdr.get_ref().open_quote() {
-                return Err(InputError {
-                    file: self.source.clone(),
-                    line: Some(line),
-                    column: None,
-                    value: None,
-                    message: format!(
-                        "malformed CSV: unterminated quote: the quoted cell opened on line \
-                         {line} runs to the end of the input"
-                    ),
-                });
+                return Err(unterminated_quote(&self.source, line));
             }
             return Ok(false);
         }
@@ -323,31 +316,125 @@ impl<R: Read> TableReader<R> {
         } = e.kind()
         {
             let line = pos.as_ref().map(|p| p.line());
-            let mut message = format!(
-                "malformed CSV: line {} has {len} fields, the header {expected_len}",
-                line.unwrap_or(0)
-            );
-            if len > expected_len {
-                message.push_str(
-                    ": is ',' used as the decimal separator? fitbead reads '.' as the \
-                     decimal point and ',' between fields (quote a cell that holds a comma)",
-                );
+            return ragged_row(&self.source, line, *len, *expected_len);
+        }
+        csv_error(&self.source, &e)
+    }
+
+    /// Whether [`into_ranges`](Self::into_ranges) can take over: no row has been read yet,
+    /// and the bytes after the header are still at hand.
+    pub(crate) fn hands_over(&self) -> bool {
+        self.rows_seen == 0 && !self.done && self.rdr.get_ref().keep.is_some()
+    }
+
+    /// The reader's rows from here on as [`super::ranges::Ranges`], which parses them in
+    /// parallel; only when [`hands_over`](Self::hands_over) (otherwise it has no rows).
+    pub(crate) fn into_ranges(self) -> super::ranges::Ranges<R> {
+        let pos = self.rdr.position().clone();
+        let TableReader {
+            source,
+            headers,
+            rdr,
+            ..
+        } = self;
+        let watch = rdr.into_inner();
+        let kept = watch.keep.unwrap_or_default();
+        let (prefix, input) = watch.inner.into_inner();
+        let start = usize::try_from(pos.byte()).map_or(kept.len(), |h| h.min(kept.len()));
+        let mut bytes = kept[start..].to_vec();
+        let at = usize::try_from(prefix.position()).unwrap_or(usize::MAX);
+        bytes.extend_from_slice(prefix.get_ref().get(at..).unwrap_or(&[]));
+        // Where the quoting stands at the end of the header, as the watch saw it.
+        let (mut state, mut line, mut opened) = (Quoting::FieldStart, 1, 0);
+        for &b in &kept[..start] {
+            if b == b'\n' {
+                line += 1;
             }
-            return InputError {
-                file: self.source.clone(),
-                line,
-                column: None,
-                value: None,
-                message,
-            };
+            state = state.step(b, line, &mut opened);
         }
-        InputError {
-            file: self.source.clone(),
-            line: e.position().map(|p| p.line()),
-            column: None,
-            value: None,
-            message: format!("malformed CSV: {e}"),
-        }
+        super::ranges::Ranges::new(super::ranges::Rest {
+            source,
+            width: headers.len(),
+            bytes,
+            input,
+            byte: pos.byte(),
+            line: pos.line(),
+            records: pos.record(),
+            quoting: state,
+            opened,
+        })
+    }
+}
+
+/// A `csv` error other than a ragged row, as [`TableReader`] reports it.
+pub(crate) fn csv_error(source: &str, e: &csv::Error) -> InputError {
+    if let csv::ErrorKind::Io(io) = e.kind() {
+        return InputError::file(source, format!("cannot read: {io}"));
+    }
+    InputError {
+        file: source.to_string(),
+        line: e.position().map(|p| p.line()),
+        column: None,
+        value: None,
+        message: format!("malformed CSV: {e}"),
+    }
+}
+
+/// A row of `len` fields under a header of `expected`, starting on `line`.
+pub(crate) fn ragged_row(source: &str, line: Option<u64>, len: u64, expected: u64) -> InputError {
+    let mut message = format!(
+        "malformed CSV: line {} has {len} fields, the header {expected}",
+        line.unwrap_or(0)
+    );
+    if len > expected {
+        message.push_str(
+            ": is ',' used as the decimal separator? fitbead reads '.' as the \
+             decimal point and ',' between fields (quote a cell that holds a comma)",
+        );
+    }
+    InputError {
+        file: source.to_string(),
+        line,
+        column: None,
+        value: None,
+        message,
+    }
+}
+
+/// A record at `pos` with invalid UTF-8 (the byte index counted from the trimmed cell).
+pub(crate) fn utf8_error(source: &str, pos: &csv::Position, e: csv::FromUtf8Error) -> InputError {
+    let (field, up_to) = (e.utf8_error().field(), e.utf8_error().valid_up_to());
+    let b = e.into_byte_record();
+    let cell = b.get(field).unwrap_or(b"");
+    let lead = cell.iter().take_while(|c| c.is_ascii_whitespace()).count();
+    InputError {
+        file: source.to_string(),
+        line: Some(pos.line()),
+        column: None,
+        value: None,
+        message: format!(
+            "malformed CSV: CSV parse error: record {} (line {}, field: {field}, \
+             byte: {}): invalid utf-8: invalid UTF-8 in field {field} near byte \
+             index {}",
+            pos.record(),
+            pos.line(),
+            pos.byte(),
+            up_to.saturating_sub(lead)
+        ),
+    }
+}
+
+/// A quoted cell opened on `line` that runs to the end of the input.
+pub(crate) fn unterminated_quote(source: &str, line: u64) -> InputError {
+    InputError {
+        file: source.to_string(),
+        line: Some(line),
+        column: None,
+        value: None,
+        message: format!(
+            "malformed CSV: unterminated quote: the quoted cell opened on line \
+             {line} runs to the end of the input"
+        ),
     }
 }
 

@@ -1,8 +1,13 @@
 //! Streaming a CSV table through a per-row computation in bounded memory: rows are read
 //! [`CHUNK_ROWS`] at a time; each chunk is checked, computed and formatted in parallel (rayon
 //! tasks of [`TASK_ROWS`] rows writing straight into byte buffers) while the previous chunk's
-//! bytes are written and the next chunk is read. Memory stays at two chunks of input records
-//! and one of output bytes, whatever the number of rows; the output is in input order.
+//! bytes are written and the next chunk is read. Reading is parallel too: one thread reads
+//! the raw bytes and cuts them into ranges at record boundaries (a scan that follows the CSV
+//! quoting, so a quoted cell may hold newlines), and rayon tasks parse the ranges, each with
+//! its own `csv` reader, alongside the tasks of the chunk being computed; the rows keep the
+//! line numbers, checks and messages of one reader reading the whole input. Memory stays at
+//! about two chunks of input records and raw bytes and one of output bytes, whatever the
+//! number of rows; the output is in input order.
 //!
 //! What a row means is a [`RowPlan`]'s business: `fitbead forward`'s scenes
 //! ([`super::forward::ForwardPlan`]) and `fitbead k`'s measurements
@@ -17,6 +22,7 @@
 //! It reports its progress in input bytes to a [`Progress`] sink and stops between tasks when
 //! the caller's stop flag is raised.
 
+use super::ranges::Ranges;
 use super::scenes::{line_of, Row, TableReader};
 use super::InputError;
 use crate::progress::{Progress, ProgressEvent};
@@ -174,7 +180,7 @@ impl Drop for Finish<'_> {
 /// what the plan keeps across rows. See the module docs for the order in which errors are
 /// reported.
 pub fn stream<R, P, F>(
-    mut reader: TableReader<R>,
+    reader: TableReader<R>,
     make: F,
     ledger: P::Ledger,
     out: &mut (dyn Write + Send),
@@ -188,13 +194,14 @@ where
     let mut ledger = ledger;
     let plan = match make(&reader) {
         Ok(p) => p,
-        Err(e) => return Err(first_error(&mut reader, e, opts)),
+        Err(e) => return Err(first_error(&mut Source::new(reader), e, opts)),
     };
     let chunk_rows = opts.chunk_rows.max(1);
     let ctx = Context {
         source: reader.source().to_string(),
         headers: reader.headers().to_vec(),
     };
+    let mut reader = Source::new(reader);
     let _finish = Finish(opts.progress.as_ref());
     if let Some(p) = &opts.progress {
         p.report(ProgressEvent::Start {
@@ -284,7 +291,7 @@ fn stopped(opts: &StreamOptions) -> bool {
 /// or an input without rows, is reported first (as when the whole table was read before any
 /// check); a stop raised meanwhile ends the stream instead.
 fn first_error<R: Read>(
-    reader: &mut TableReader<R>,
+    reader: &mut Source<R>,
     e: InputError,
     opts: &StreamOptions,
 ) -> StreamError {
@@ -292,6 +299,55 @@ fn first_error<R: Read>(
         return StreamError::Stopped;
     }
     StreamError::Input(reader.drain().unwrap_or(e))
+}
+
+/// Where the rows come from: ranges parsed in parallel, or (for a reader that has read rows
+/// already) the reader itself.
+enum Source<R: Read> {
+    Ranges(Ranges<R>),
+    Serial(TableReader<R>),
+}
+
+impl<R: Read> Source<R> {
+    fn new(reader: TableReader<R>) -> Self {
+        if reader.hands_over() {
+            Source::Ranges(reader.into_ranges())
+        } else {
+            Source::Serial(reader)
+        }
+    }
+
+    fn read_chunk(
+        &mut self,
+        recs: &mut Vec<csv::StringRecord>,
+        max: usize,
+    ) -> Result<usize, InputError> {
+        match self {
+            Source::Ranges(r) => r.read_chunk(recs, max),
+            Source::Serial(r) => r.read_chunk(recs, max),
+        }
+    }
+
+    fn drain(&mut self) -> Option<InputError> {
+        match self {
+            Source::Ranges(r) => r.drain(),
+            Source::Serial(r) => r.drain(),
+        }
+    }
+
+    fn no_rows(&self) -> InputError {
+        match self {
+            Source::Ranges(r) => r.no_rows(),
+            Source::Serial(r) => r.no_rows(),
+        }
+    }
+
+    fn bytes_read(&self) -> u64 {
+        match self {
+            Source::Ranges(r) => r.bytes_read(),
+            Source::Serial(r) => r.bytes_read(),
+        }
+    }
 }
 
 fn write_parts(out: &mut dyn Write, parts: &[Vec<u8>], failed: &mut Option<std::io::Error>) {

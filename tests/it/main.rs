@@ -9,6 +9,7 @@ mod cli;
 mod cli_mcmc;
 mod contact;
 mod cross_solvers;
+mod csv_ranges;
 mod edges_cli;
 mod edges_files;
 mod edges_fits;

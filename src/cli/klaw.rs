@@ -49,6 +49,10 @@ pub fn run(a: Args) -> Result<(), CliError> {
         .law
         .parse()
         .map_err(|e: String| super::flag_error("--law", &a.law, e))?;
+    // The handler goes in before the data are read: a signal while a large file is read and
+    // checked raises the flag (polled from the first bracket on) instead of killing the
+    // process with no exit code.
+    super::stop_flag();
     let (t, _rows, ds) = a.io.read()?;
     let names: &[&str] = match law {
         KLaw::C => &["c"],

@@ -380,9 +380,16 @@ fn run_with(a: Args, r: Recipe) -> Result<(), CliError> {
         an.models_by_series_csv().map_err(csv_err)?,
     ));
     // Under a posterior run: the bands of v̄(δ) and the posterior median at every point.
-    let bands = an
-        .mcmc
-        .then(|| fitbead::report::bands::posterior_bands(&an));
+    // A run whose sampling was interrupted has none (the bands of every fit's draws cost
+    // model evaluations by the million); a stop while they are drawn writes nothing.
+    let bands = if an.mcmc && !interrupted {
+        match fitbead::report::bands::posterior_bands_until(&an, &super::stop_flag()) {
+            Some(b) => Some(b),
+            None => return Err(CliError::Interrupted),
+        }
+    } else {
+        None
+    };
     let fits = an.fit_results_at(bands.as_ref());
     let params = an.params();
     let stats: Vec<_> = fits.iter().map(|f| f.stats.clone()).collect();

@@ -25,7 +25,7 @@ use super::data::Dataset;
 use super::jaeger_coordinates::JaegerCoordinates;
 pub use super::jaeger_coordinates::JaegerX;
 use super::posterior::{summarise_reparameterised, summarise_with, Method, Prior};
-use super::summary::{distinct_points, FitResult, ParamSpec, Solved};
+use super::summary::{distinct_points, observed_norm, FitResult, ParamSpec, Solved};
 use crate::inverse::{fit, CurveModel, Infeasible, LsqOptions, WeightedData};
 use crate::models::jaeger::Jaeger;
 use crate::models::JaegerBranch;
@@ -208,6 +208,7 @@ pub fn fit_jaeger_with(
             .collect();
         let y: Vec<f64> = pts.iter().map(|p| p.v).collect();
         let sg: Vec<f64> = pts.iter().map(|p| p.sigma).collect();
+        let norm = observed_norm(y.iter().zip(&sg));
         let Some(p0) = start(&model, &x, &y, &sg) else {
             notes.push(format!(
                 "series '{label}': no start with every point on the {} branch",
@@ -263,6 +264,7 @@ pub fn fit_jaeger_with(
             level,
             options: &opts,
             distinct: Some(distinct_points(x.iter().map(|q| [q.0, q.1, q.2]))),
+            observed_norm: Some(norm),
         };
         let mut summary = match JaegerCoordinates::for_series(&x, branch) {
             Some(c) => summarise_reparameterised(method, solved, &c),

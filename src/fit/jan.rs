@@ -13,7 +13,7 @@
 
 use super::data::Dataset;
 use super::posterior::{summarise_with, Method};
-use super::summary::{distinct_points, FitResult, ParamSpec, Solved};
+use super::summary::{distinct_points, observed_norm, FitResult, ParamSpec, Solved};
 use crate::inverse::{fit, CurveModel, Infeasible, LsqOptions, WeightedData};
 
 /// The paper's global values (λ0, λ1, μ0, μ1), eqs 75–76.
@@ -165,6 +165,7 @@ pub fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFits {
             _ => (crate::models::jan::Jan::paper_fit(sa.asin()).lambda, 0.0),
         };
         let distinct = distinct_points(x.iter().map(|p| [p.1, p.2]));
+        let norm = observed_norm(y.iter().zip(&sg));
         let problem = match WeightedData::new(JanSeries, x, y, Some(sg)) {
             Ok(p) => p,
             Err(e) => {
@@ -217,6 +218,7 @@ pub fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFits {
                 level,
                 options: &opts,
                 distinct: Some(distinct),
+                observed_norm: Some(norm),
             },
         );
         sum.attach_points(data, &data.series_index(s));
@@ -260,6 +262,7 @@ pub fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFits {
         let (l0, l1) = fit_line(&lam_pts, (PAPER_GLOBAL[0], PAPER_GLOBAL[1]));
         let (m0, m1) = fit_line(&mu_pts, (PAPER_GLOBAL[2], PAPER_GLOBAL[3]));
         let (x, y, sg) = xs(data, None);
+        let norm = observed_norm(y.iter().zip(&sg));
         let problem = WeightedData::new(JanGlobal, x.clone(), y, Some(sg)).ok();
         let opts = LsqOptions {
             lower: Some(vec![0.0, f64::NEG_INFINITY, 0.0, f64::NEG_INFINITY]),
@@ -331,6 +334,7 @@ pub fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFits {
                     level,
                     options: &opts,
                     distinct: Some(distinct_points(x.iter().map(|p| [p.0, p.1, p.2]))),
+                    observed_norm: Some(norm),
                 },
             );
             sum.attach_points(data, &(0..data.points.len()).collect::<Vec<_>>());

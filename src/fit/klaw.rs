@@ -34,7 +34,8 @@ use super::k::bracket::eval;
 use super::k::{bracket, dv_dk, estimate, KBracket, KFailure};
 use super::posterior::{summarise_with, Method};
 use super::summary::{
-    information_criteria, summarise_with_profiles, FitResult, ParamSpec, Solved, StatsRow,
+    information_criteria, observed_norm, summarise_with_profiles, FitResult, ParamSpec, Solved,
+    StatsRow,
 };
 use crate::inverse::estimate::information_criteria as fit_criteria;
 use crate::inverse::{
@@ -487,6 +488,11 @@ impl Residuals for KLawProblem<'_> {
             .with_min_len(MIN_CHUNK)
             .enumerate()
             .try_for_each(|(i, (o, vi))| {
+                // A stop makes the residuals unavailable at once (a rejected step, a rejected
+                // proposal of the sampler, which then stops at its next check).
+                if self.stopped() {
+                    return Err(Infeasible);
+                }
                 let pt = &self.data.points[i];
                 *vi = self.eval_v(i, self.k_of(i, p))?;
                 *o = (pt.v - *vi) / pt.sigma;
@@ -919,6 +925,7 @@ pub fn fit_law_in(
         level,
         options: &opts,
         distinct: None,
+        observed_norm: Some(observed_norm(data.points.iter().map(|p| (&p.v, &p.sigma)))),
     };
     let mut summary = match method {
         // Independent parameters: each profiled on its own series.

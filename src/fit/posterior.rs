@@ -32,7 +32,9 @@
 //! the level asked (`ci_method = posterior`); the covariance interval of the least-squares
 //! optimum stays in `cov_low`/`cov_high` and the optimum in `lsq_value`.
 
-use super::summary::{summarise, FitResult, McmcFailure, McmcStats, ParamRow, Solved};
+use super::summary::{
+    chi2_vanishes, summarise, FitResult, McmcFailure, McmcStats, ParamRow, Solved,
+};
 use crate::inverse::mcmc::{EnsembleSampler, StopReason};
 use crate::inverse::posterior::Posterior;
 pub use crate::inverse::posterior::Reparameterisation;
@@ -97,6 +99,7 @@ fn sample<R: Residuals + Sync + ?Sized>(
         level,
         options: _,
         distinct: _,
+        observed_norm,
     } = solved;
     let mut out = summarise(solved, false);
     let n = specs.len();
@@ -113,6 +116,16 @@ fn sample<R: Residuals + Sync + ?Sized>(
         })
         .collect();
     let with_scale = f.sigma == SigmaKind::Relative || settings.fit_scatter;
+    // With χ² = 0 (or rounding) the likelihood grows without bound as the scale goes to 0:
+    // the posterior of the scale is improper and there is nothing to sample.
+    if with_scale && f.converged() && chi2_vanishes(f.chi2, observed_norm) {
+        let failure = McmcFailure::NotStarted(format!(
+            "chi2 = {} at the optimum leaves the posterior of the scatter's scale improper (it \
+             piles up at 0); give sigma (and leave the scatter unfitted) to sample the parameters",
+            fmt_sig(f.chi2, 3)
+        ));
+        return failed(out, failure);
+    }
     let scale_prior = with_scale.then(|| {
         settings
             .prior(SCALE_NAME)
@@ -420,10 +433,12 @@ fn failed(mut out: FitResult, failure: McmcFailure) -> FitResult {
     out.stats.note = join(&out.stats.note, &failure.to_string());
     out.stats.converged = false;
     for row in out.params.iter_mut() {
-        row.note = join(
-            "MCMC did not run: least-squares value and interval",
-            &row.note,
-        );
+        let what = if row.cov.is_some() || row.profile.is_some() {
+            "MCMC did not run: least-squares value and interval"
+        } else {
+            "MCMC did not run: least-squares value"
+        };
+        row.note = join(what, &row.note);
     }
     out.stats.mcmc = Some(McmcStats {
         status: "failed".into(),

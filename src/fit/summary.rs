@@ -445,6 +445,34 @@ pub struct Solved<'a, R: ?Sized> {
     /// [`distinct_points`]), when the fit counts them: with fewer than the parameters the
     /// data cannot determine them all.
     pub distinct: Option<usize>,
+    /// The size ‖y/σ‖ of the weighted observations, when the fit gives it: with no σ given, a
+    /// χ² within the rounding of the data ([`ROUNDING`] · ‖y/σ‖, squared) estimates the
+    /// scatter as 0 as χ² = 0 does.
+    pub observed_norm: Option<f64>,
+}
+
+/// The relative size of residuals that are rounding, not scatter: 256 ε (5.7e-14) of the
+/// observations' size. A model evaluated in double precision matches data it can reproduce
+/// to a few ulp; no measured scatter is that small.
+pub const ROUNDING: f64 = 256.0 * f64::EPSILON;
+
+/// ‖y/σ‖ of observations `y` with σ `s` (see [`Solved::observed_norm`]).
+pub fn observed_norm<'a>(y: impl IntoIterator<Item = (&'a f64, &'a f64)>) -> f64 {
+    y.into_iter()
+        .map(|(y, s)| (y / s) * (y / s))
+        .sum::<f64>()
+        .sqrt()
+}
+
+/// Whether `chi2` is 0 or within the rounding of observations of size `norm` (see
+/// [`Solved::observed_norm`]): a scale of the scatter fitted to it is 0.
+pub(crate) fn chi2_vanishes(chi2: f64, norm: Option<f64>) -> bool {
+    chi2 == 0.0 || norm.is_some_and(|n| chi2 <= (ROUNDING * n) * (ROUNDING * n))
+}
+
+/// Whether a fit with no σ given estimates the scatter as 0 ([`chi2_vanishes`]).
+fn scatter_vanishes(f: &Fit, norm: Option<f64>) -> bool {
+    f.sigma == SigmaKind::Relative && chi2_vanishes(f.chi2, norm)
 }
 
 /// The number of distinct abscissae among `keys` (compared bit for bit).
@@ -457,9 +485,15 @@ pub fn distinct_points<const N: usize>(keys: impl IntoIterator<Item = [f64; N]>)
 /// Why the data of a converged least-squares fit do not determine its parameters, if they do
 /// not: fewer distinct points than parameters; a Jacobian rank deficient at the estimate with
 /// no parameter on a bound of its box (a direction along which χ² does not change); or, with
-/// no σ given, χ² = 0 (a scatter estimated as 0 leaves intervals of zero width). Such a fit
-/// reports no standard errors, correlations or intervals.
-fn undetermined(f: &Fit, n_params: usize, distinct: Option<usize>) -> Option<String> {
+/// no σ given, χ² = 0 or within the rounding of observations of size `norm` (a scatter
+/// estimated as 0 leaves intervals of zero width). Such a fit reports no standard errors,
+/// correlations or intervals.
+fn undetermined(
+    f: &Fit,
+    n_params: usize,
+    distinct: Option<usize>,
+    norm: Option<f64>,
+) -> Option<String> {
     if !f.converged() {
         return None;
     }
@@ -483,6 +517,14 @@ fn undetermined(f: &Fit, n_params: usize, distinct: Option<usize>) -> Option<Str
              or intervals"
                 .into(),
         );
+    }
+    if scatter_vanishes(f, norm) {
+        return Some(format!(
+            "chi2 = {} is rounding (the residuals are within {} of the data) with no sigma \
+             given: the scatter is estimated as 0; no standard errors or intervals",
+            fmt_sig(f.chi2, 3),
+            fmt_sig(ROUNDING, 2)
+        ));
     }
     None
 }
@@ -525,9 +567,10 @@ pub fn summarise_with_profiles<R: Residuals + ?Sized>(
         level,
         options: opts,
         distinct,
+        observed_norm,
     } = s;
     let mut note = String::new();
-    let unknown = undetermined(f, specs.len(), distinct);
+    let unknown = undetermined(f, specs.len(), distinct, observed_norm);
     let ci = if unknown.is_some() {
         None
     } else if f.converged() && f.chi2.is_finite() {
@@ -557,9 +600,18 @@ pub fn summarise_with_profiles<R: Residuals + ?Sized>(
         };
     }
     // With no σ given, −2 ln L = m ln(2π χ²/m) + m is unbounded below at χ² = 0.
-    let (aic, bic) = if f.aic == f64::NEG_INFINITY || f.bic == f64::NEG_INFINITY {
-        let why = "chi2 = 0: AIC and BIC undefined (the likelihood with the scatter estimated is \
-                   unbounded)";
+    // Within the rounding of the data χ² is 0 in all but its noise, and so are AIC and BIC.
+    let (aic, bic) = if f.aic == f64::NEG_INFINITY
+        || f.bic == f64::NEG_INFINITY
+        || scatter_vanishes(f, observed_norm)
+    {
+        let why = if f.chi2 == 0.0 {
+            "chi2 = 0: AIC and BIC undefined (the likelihood with the scatter estimated is \
+             unbounded)"
+        } else {
+            "chi2 is rounding: AIC and BIC undefined (the likelihood with the scatter estimated \
+             is unbounded)"
+        };
         note = if note.is_empty() {
             why.into()
         } else {

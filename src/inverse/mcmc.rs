@@ -508,12 +508,14 @@ impl<'a, D: LogDensity + ?Sized> EnsembleSampler<'a, D> {
         let mut reason = StopReason::MaxSteps;
         let mut last: Option<Assessment> = None;
         let mut next_check = o.check_every;
-        while steps < o.max_steps {
-            if o.stop.as_ref().is_some_and(|s| s.load(Ordering::Relaxed)) {
+        let stopped = || o.stop.as_ref().is_some_and(|s| s.load(Ordering::Relaxed));
+        'steps: while steps < o.max_steps {
+            if stopped() {
                 reason = StopReason::Interrupted;
                 break;
             }
             let step = steps as u128;
+            let accepted_before = accepted.clone();
             for h in 0..2 {
                 let (moving, other) = if h == 0 {
                     (0..half, half..nw)
@@ -565,6 +567,14 @@ impl<'a, D: LogDensity + ?Sized> EnsembleSampler<'a, D> {
                         (r.ln() < log_ratio).then_some((y, lpy))
                     })
                     .collect();
+                // A stop during the half-step may have cut evaluations short (a target may
+                // refuse to evaluate once it sees the flag): the step is left out of the
+                // chains, which hold whole steps only.
+                if stopped() {
+                    accepted = accepted_before;
+                    reason = StopReason::Interrupted;
+                    break 'steps;
+                }
                 for (w, up) in moving.zip(updates) {
                     if let Some((y, lpy)) = up {
                         pos[w] = y;

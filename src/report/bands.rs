@@ -25,6 +25,7 @@ use crate::inverse::CurveModel as _;
 use crate::models::{ForwardModel, Model};
 use crate::scene::{CollisionLaw, Scene};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Draws used per fit at most.
 pub const BAND_DRAWS: usize = 1000;
@@ -118,6 +119,13 @@ impl Curve {
 /// The posterior bands and point medians of every fit of `an` that kept draws (none under
 /// least squares). See the module docs.
 pub fn posterior_bands(an: &Analysis) -> PosteriorBands {
+    let never = AtomicBool::new(false);
+    posterior_bands_until(an, &never).unwrap_or_default()
+}
+
+/// As [`posterior_bands`], giving up once `stop` is raised (polled before every draw's v̄):
+/// `None` then. A run that is not stopped gives the same bands.
+pub fn posterior_bands_until(an: &Analysis, stop: &AtomicBool) -> Option<PosteriorBands> {
     let mut out = PosteriorBands::default();
     let all: Vec<usize> = (0..an.data.points.len()).collect();
     for c in &an.contact {
@@ -128,7 +136,9 @@ pub fn posterior_bands(an: &Analysis) -> PosteriorBands {
         for (fit, curve) in laws {
             if let Some(f) = fit {
                 let name = format!("{}-{}", c.name, f.summary.stats.fit);
-                add(&mut out, &name, &f.summary, curve, &c.data, &c.used, None);
+                add(
+                    &mut out, &name, &f.summary, curve, &c.data, &c.used, None, stop,
+                )?;
             }
         }
     }
@@ -142,7 +152,8 @@ pub fn posterior_bands(an: &Analysis) -> PosteriorBands {
                 &an.data,
                 &all,
                 Some(s),
-            );
+                stop,
+            )?;
         }
     }
     if let Some(f) = &an.jan.global {
@@ -154,7 +165,8 @@ pub fn posterior_bands(an: &Analysis) -> PosteriorBands {
             &an.data,
             &all,
             None,
-        );
+            stop,
+        )?;
     }
     for (s, f) in an.jaeger.series.iter().enumerate() {
         if let Some(f) = f {
@@ -167,15 +179,17 @@ pub fn posterior_bands(an: &Analysis) -> PosteriorBands {
                 &an.data,
                 &all,
                 Some(s),
-            );
+                stop,
+            )?;
         }
     }
-    out
+    Some(out)
 }
 
 /// Adds the bands and point medians of one fit: `data` is the data set it was fitted on,
 /// `index` maps its points to the analysis' data set, `only` restricts it to one series (a
-/// per-series fit).
+/// per-series fit). `None` once `stop` is raised.
+#[allow(clippy::too_many_arguments)]
 fn add(
     out: &mut PosteriorBands,
     name: &str,
@@ -184,11 +198,14 @@ fn add(
     data: &Dataset,
     index: &[usize],
     only: Option<usize>,
-) {
-    let Some(d) = &fit.draws else { return };
+    stop: &AtomicBool,
+) -> Option<()> {
+    let Some(d) = &fit.draws else {
+        return Some(());
+    };
     let draws = subset(&d.chains);
     if draws.is_empty() {
-        return;
+        return Some(());
     }
     for (s, label) in data.labels.iter().enumerate() {
         if only.is_some_and(|o| o != s) {
@@ -230,14 +247,17 @@ fn add(
         let q: Vec<[f64; 3]> = at
             .par_iter()
             .map(|&(p, delta)| {
-                let mut v: Vec<f64> = draws
-                    .iter()
-                    .filter_map(|x| curve.velocity(x, column, p, delta))
-                    .collect();
+                let mut v = Vec::with_capacity(draws.len());
+                for x in &draws {
+                    if stop.load(Ordering::Relaxed) {
+                        return None;
+                    }
+                    v.extend(curve.velocity(x, column, p, delta));
+                }
                 v.sort_by(f64::total_cmp);
-                [0.05, 0.5, 0.95].map(|pr| quantile_sorted(&v, pr))
+                Some([0.05, 0.5, 0.95].map(|pr| quantile_sorted(&v, pr)))
             })
-            .collect();
+            .collect::<Option<_>>()?;
         let (qg, qp) = q.split_at(grid.len());
         out.bands.push(Band {
             fit: name.to_string(),
@@ -259,6 +279,7 @@ fn add(
             });
         }
     }
+    Some(())
 }
 
 /// At most [`BAND_DRAWS`] draws, evenly spaced through the kept draws taken step by step

@@ -872,25 +872,29 @@ impl Analysis {
                 None => super::file_stems(&[series.to_string()]).remove(0),
             }
         };
-        let mut out = Vec::new();
-        for (name, fits) in self.named_fits() {
-            for f in fits {
-                if let Some(mut b) = CornerBlock::from_posterior(f) {
-                    b.title = fit_title(&name).replace(", per series", "");
-                    if f.stats.series != "all" {
-                        b.title.push_str(&format!(", series {}", f.stats.series));
-                    }
-                    if f.draws.as_ref().is_some_and(|d| d.interrupted) {
-                        b.title.push_str(" (interrupted)");
-                    }
-                    out.push((
-                        format!("corner_{name}_{}.svg", stem(&f.stats.series)),
-                        corner_figure(&b).to_svg(),
-                    ));
+        // Drawn side by side (a corner of one K per series has hundreds of panels), in the
+        // order of the fits.
+        let named = self.named_fits();
+        let all: Vec<(&str, &FitResult)> = named
+            .iter()
+            .flat_map(|(name, fits)| fits.iter().map(move |f| (name.as_str(), *f)))
+            .collect();
+        all.par_iter()
+            .filter_map(|&(name, f)| {
+                let mut b = CornerBlock::from_posterior(f)?;
+                b.title = fit_title(name).replace(", per series", "");
+                if f.stats.series != "all" {
+                    b.title.push_str(&format!(", series {}", f.stats.series));
                 }
-            }
-        }
-        out
+                if f.draws.as_ref().is_some_and(|d| d.interrupted) {
+                    b.title.push_str(" (interrupted)");
+                }
+                Some((
+                    format!("corner_{name}_{}.svg", stem(&f.stats.series)),
+                    corner_figure(&b).to_svg(),
+                ))
+            })
+            .collect()
     }
 }
 

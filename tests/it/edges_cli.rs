@@ -145,6 +145,57 @@ fn free_per_series_fit_stops_within_a_second_of_sigint_or_sigterm() {
     }
 }
 
+/// A posterior report on 20 series of 50 points stops within a second of SIGINT while it
+/// samples, writing the draws so far (the posterior bands, millions of model evaluations
+/// over the draws, are left out of an interrupted report).
+#[cfg(unix)]
+#[test]
+fn posterior_report_on_twenty_series_stops_within_a_second_of_sigint() {
+    let dir = tmpdir();
+    let data = dir.path().join("big.csv");
+    let series = "0.8,0.85,0.9,0.95,1,1.05,1.1,1.15,1.2,1.25,1.3,1.35,1.4,1.45,1.5,1.6,1.7,1.8,\
+                  1.9,2";
+    let out = fb(&[
+        "simulate",
+        "--series",
+        series,
+        "--points",
+        "50",
+        "--output",
+        s(&data),
+    ]);
+    expect(&out, 0, &[], "simulate");
+    // The least-squares report times the fits that come before the sampling: the signal
+    // comes 3 s after that, well inside the sampling (minutes), however loaded the machine.
+    let (out, lsq) = fb_within(
+        &["report", s(&data), "--out-dir", s(&dir.path().join("lsq"))],
+        Duration::from_secs(120),
+    );
+    expect(&out, 0, &[], "least-squares report");
+    let args = [
+        "report",
+        "big.csv",
+        "--method",
+        "mcmc",
+        "--seed",
+        "1",
+        "--out-dir",
+        "out",
+    ];
+    let (st, took) = interrupt(dir.path(), &args, "-INT", lsq + Duration::from_secs(3));
+    eprintln!("stopped {took:?} after SIGINT (least-squares report: {lsq:?})");
+    assert_eq!(st.code(), Some(130));
+    assert!(took < Duration::from_secs(1), "stopped after {took:?}");
+    // The signal came while sampling: the report holds the draws so far, marked.
+    let stats = std::fs::read_to_string(dir.path().join("out/stats.csv")).unwrap();
+    let (h, rows) = crate::common::table(&stats);
+    let c = crate::common::col(&h, "mcmc_status");
+    assert!(
+        rows.iter().any(|r| r[c] == "interrupted"),
+        "no interrupted run: {stats}"
+    );
+}
+
 #[test]
 fn md_settings_beyond_the_step_cap_are_refused_at_once() {
     let dir = tmpdir();

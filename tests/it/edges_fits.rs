@@ -106,3 +106,77 @@ fn as_many_distinct_slopes_as_parameters_still_give_jan_intervals() {
         assert!(!r["note"].contains("not determined"), "{r:?}");
     }
 }
+
+#[test]
+fn identical_points_give_klaw_no_interval_though_chi2_is_rounding_not_zero() {
+    let dir = tmpdir();
+    for (law, fit) in [("c", "klaw-c"), ("free-per-series", "klaw-free-per-series")] {
+        let cmd = ["klaw", "--model", "stick", "--law", law];
+        let (report, params, stats) = run(dir.path(), &cmd, IDENTICAL);
+        assert!(
+            report.contains("the scatter is estimated as 0"),
+            "{fit}: {report}"
+        );
+        assert!(!report.contains("95% interval ["), "{fit}: {report}");
+        assert!(
+            report.contains("AIC                = undefined"),
+            "{report}"
+        );
+        assert_no_interval(&params, fit);
+        let s = stats.iter().find(|r| r["fit"] == fit).unwrap();
+        let chi2: f64 = s["chi2"].parse().unwrap();
+        assert!(chi2 < 1e-25, "{s:?}");
+        assert_eq!((s["aic"].as_str(), s["bic"].as_str()), ("", ""), "{s:?}");
+        assert!(s["note"].contains("the scatter is estimated as 0"), "{s:?}");
+        assert!(s["note"].contains("AIC and BIC undefined"), "{s:?}");
+    }
+}
+
+#[test]
+fn identical_points_with_sigma_keep_klaw_intervals() {
+    let dir = tmpdir();
+    let data = "series,xi,delta_deg,v,sigma_v\nA,1,3,0.5,0.01\nA,1,3,0.5,0.01\nA,1,3,0.5,0.01\n";
+    let (_, params, _) = run(dir.path(), &["klaw", "--model", "stick"], data);
+    let r = params.iter().find(|r| r["fit"] == "klaw-c").unwrap();
+    let (lo, hi): (f64, f64) = (r["ci_low"].parse().unwrap(), r["ci_high"].parse().unwrap());
+    assert!(lo < hi, "{r:?}");
+    assert!(!r["note"].contains("not determined"), "{r:?}");
+}
+
+#[test]
+fn identical_points_leave_the_posterior_of_the_scale_improper_and_unsampled() {
+    let dir = tmpdir();
+    let input = write(dir.path(), "data.csv", IDENTICAL);
+    for cmd in [&["klaw", "--model", "stick"][..], &["jan"][..]] {
+        let t0 = std::time::Instant::now();
+        let out = bin()
+            .args(cmd)
+            .arg(&input)
+            .args(["--method", "mcmc", "--seed", "1", "--output", "-"])
+            .output()
+            .unwrap();
+        let took = t0.elapsed();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{cmd:?}: {err}");
+        assert!(
+            err.contains("posterior of the scatter's scale improper"),
+            "{err}"
+        );
+        // Refused before sampling: no 100,000 steps towards a scale of 0.
+        assert!(took.as_secs_f64() < 10.0, "{cmd:?} took {took:?}");
+        let (_, params) = records(&String::from_utf8_lossy(&out.stdout));
+        let fit = if cmd[0] == "klaw" {
+            "klaw-c"
+        } else {
+            "jan-series"
+        };
+        let rows: Vec<_> = params.iter().filter(|r| r["fit"] == fit).collect();
+        assert!(!rows.is_empty(), "{params:?}");
+        for r in rows {
+            for c in ["stderr", "ci_low", "ci_high", "mean", "sd"] {
+                assert_eq!(r[c], "", "{fit} {}: {c}", r["parameter"]);
+            }
+            assert!(r["note"].contains("MCMC did not run"), "{r:?}");
+        }
+    }
+}

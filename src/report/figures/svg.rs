@@ -18,6 +18,25 @@ pub const FONT_FAMILY: &str = "DejaVu Sans, Bitstream Vera Sans, Verdana, Arial,
 /// A coordinate or length as written to the document: at most two decimals, no trailing
 /// zeros.
 pub fn num(x: f64) -> String {
+    let h = (x * 100.0).round();
+    // Hundredths below 2^50 in magnitude: r = h/100 is within far less than 0.005 of h/100,
+    // so its two-decimal form is the digits of the integer h (written without the general
+    // float formatter, which figures call hundreds of thousands of times).
+    if h.abs() < (1u64 << 50) as f64 {
+        let n = h as i64;
+        let (q, m) = (n.unsigned_abs() / 100, n.unsigned_abs() % 100);
+        let sign = if n < 0 { "-" } else { "" };
+        return match m {
+            0 => format!("{sign}{q}"),
+            _ if m % 10 == 0 => format!("{sign}{q}.{}", m / 10),
+            _ => format!("{sign}{q}.{m:02}"),
+        };
+    }
+    num_formatted(x)
+}
+
+/// [`num`] through the float formatter (any `x`, NaN and infinities included).
+fn num_formatted(x: f64) -> String {
     let r = (x * 100.0).round() / 100.0;
     let r = if r == 0.0 { 0.0 } else { r };
     let s = format!("{r:.2}");
@@ -504,6 +523,50 @@ fn points_attr(pts: &[(f64, f64)]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn numbers_are_written_as_the_float_formatter_writes_them() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let mut xs = vec![
+            0.0,
+            -0.0,
+            0.004,
+            -0.004,
+            0.005,
+            -0.005,
+            0.015,
+            0.125,
+            -0.125,
+            1e-300,
+            99.995,
+            -99.995,
+            1e12,
+            -1e12,
+            1.1259e13,
+            1.1259e13 + 0.005,
+            2e15,
+            -3e17,
+            1e300,
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::MAX,
+            f64::MIN,
+        ];
+        for _ in 0..200_000 {
+            let e = rng.random_range(-6.0..16.0);
+            let x = rng.random_range(-1.0..1.0) * 10f64.powf(e);
+            xs.push(x);
+            // Values at and beside the halfway points of the hundredths.
+            let h = (x * 100.0).trunc() + 0.5;
+            xs.push(h / 100.0);
+            xs.push(f64::from_bits((h / 100.0).to_bits() + 1));
+        }
+        for x in xs {
+            assert_eq!(num(x), num_formatted(x), "{x:e}");
+        }
+    }
 
     #[test]
     fn numbers_keep_hundredths() {

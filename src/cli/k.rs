@@ -102,7 +102,12 @@ pub fn run(a: Args) -> Result<(), CliError> {
         let d = match defaults {
             Ok(d) => d,
             Err(CliError::Input(e)) => return Err(e),
-            Err(e) => return Err(InputError::file(fitbead::io::SETTINGS_ORIGIN, e.to_string())),
+            Err(e) => {
+                return Err(InputError::file(
+                    fitbead::io::SETTINGS_ORIGIN,
+                    e.to_string(),
+                ))
+            }
         };
         KPlan::new(r, &d, settings)
     };

@@ -101,8 +101,8 @@ impl fmt::Display for InputError {
             write!(f, ", line {l}")?;
         }
         // A setting is named as the flag it came from; an empty value says nothing.
-        let setting =
-            self.file == SETTINGS_ORIGIN && self.column.as_ref().is_some_and(|c| c.starts_with("--"));
+        let setting = self.file == SETTINGS_ORIGIN
+            && self.column.as_ref().is_some_and(|c| c.starts_with("--"));
         if let Some(c) = &self.column {
             let what = if setting { "flag" } else { "column" };
             write!(f, ", {what} '{}'", clip(c, ECHO_CHARS))?;

@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 
 use faer::MatMut;
 use fitbead::inverse::{
-    fit, Fit, Infeasible, LsqOptions, CurveModel, Residuals, SigmaKind, WeightedData,
+    fit, CurveModel, Fit, Infeasible, LsqOptions, Residuals, SigmaKind, WeightedData,
 };
 use fitbead::special::dd::Dd;
 

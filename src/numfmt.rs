@@ -75,7 +75,7 @@ fn pm_places(stderr: f64) -> Option<usize> {
 /// `value ± stderr` as a reader quotes it: the standard error to two significant digits and
 /// the value to the same decimal place (0.493057 ± 0.00396831 → `0.4931 ± 0.0040`); the value
 /// to four significant digits when there is no standard error.
-pub fn fmt_value_pm(value: f64, stderr: Option<f64>) -> String {
+pub(crate) fn fmt_value_pm(value: f64, stderr: Option<f64>) -> String {
     match stderr.and_then(|se| pm_places(se).map(|d| (se, d))) {
         Some((se, d)) if value.is_finite() => format!("{value:.d$} ± {se:.d$}"),
         _ => fmt_sig(value, 4),
@@ -84,7 +84,7 @@ pub fn fmt_value_pm(value: f64, stderr: Option<f64>) -> String {
 
 /// An interval's ends at the precision [`fmt_value_pm`] gives the value (one more place), or
 /// to four significant digits when there is no standard error.
-pub fn fmt_interval(lo: f64, hi: f64, stderr: Option<f64>) -> String {
+pub(crate) fn fmt_interval(lo: f64, hi: f64, stderr: Option<f64>) -> String {
     match stderr.and_then(pm_places) {
         Some(d) if lo.is_finite() && hi.is_finite() => {
             let d = d + 1;

@@ -31,7 +31,7 @@ use crate::models::jaeger::Jaeger;
 use crate::models::JaegerBranch;
 
 /// The paper's Fig. 9 values (ξ, a1, a2, a3), Jaeger units.
-pub const PAPER_FIG9: [(f64, f64, f64, f64); 4] = [
+pub(crate) const PAPER_FIG9: [(f64, f64, f64, f64); 4] = [
     (0.8, 0.19, 3.83, 1.28),
     (1.0, 0.131, 18.57, 1.41),
     (1.6, 0.06, 20.71, 0.8987),
@@ -311,7 +311,7 @@ pub fn fit_jaeger_with(
 }
 
 /// `upper` or `lower`.
-pub fn branch_name(b: JaegerBranch) -> &'static str {
+pub(crate) fn branch_name(b: JaegerBranch) -> &'static str {
     match b {
         JaegerBranch::Upper => "upper",
         JaegerBranch::Lower => "lower",

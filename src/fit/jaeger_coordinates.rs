@@ -77,7 +77,7 @@ pub type JaegerX = (f64, f64, f64);
 /// factor w of (J2)). At w = e⁻³ ≈ 0.05 the resistance term a1/(1 + a2 X) is within 1 % of
 /// the straight a1 (1 − a2 X) wherever X < 2X₀; on the shipped data ln w = −3 lies between the
 /// 2.5 % quantile and the median of ln w in the three posteriors whose optimum has a2 = 0.
-pub const START_MIN_LN_SHAPE: f64 = -3.0;
+pub(crate) const START_MIN_LN_SHAPE: f64 = -3.0;
 
 /// Relative agreement required between X₀ and the lower root of eq 84 at t₀ on the lower
 /// branch (the two differ by rounding only when y is in the domain).
@@ -190,7 +190,7 @@ impl Reparameterisation for JaegerCoordinates {
         self.to_coordinates(x).map(|y| y.to_vec())
     }
 
-    /// The coordinates of (a1, a2, a3) with ln w raised to at least [`START_MIN_LN_SHAPE`]:
+    /// The coordinates of (a1, a2, a3) with ln w raised to at least `START_MIN_LN_SHAPE`:
     /// the same level u₀ and slope s at the mean slope, a little curvature where the optimum
     /// had none.
     fn start(&self, x: &[f64]) -> Option<Vec<f64>> {

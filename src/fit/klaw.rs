@@ -11,7 +11,7 @@
 //!   intersection means no value of the law keeps every point steady, and the fit says so
 //!   instead of searching;
 //! - the start is derived: the median over the group of the per-point inversions of eq 69
-//!   (at most [`START_POINTS`] per group, evenly spread over its points), mapped to p, clamped
+//!   (at most `START_POINTS` per group, evenly spread over its points), mapped to p, clamped
 //!   into the box;
 //! - the Jacobian costs two forward evaluations per point whatever the number of parameters:
 //!   ∂r_i/∂p_j = −(dv̄/dK)_i b_i/σ_i for j = g(i), else 0, with dv̄/dK from
@@ -31,7 +31,7 @@
 
 use super::data::Dataset;
 use super::k::bracket::eval;
-use super::k::{bracket, dv_dk, estimate, KBracket, KFailure};
+use super::k::{bracket, dv_dk, estimate, KBracket};
 use super::posterior::{summarise_with, Method};
 use super::summary::{
     information_criteria, observed_norm, summarise_with_profiles, FitResult, ParamSpec, Solved,
@@ -190,17 +190,7 @@ pub struct KLawProblem<'a> {
 const MIN_CHUNK: usize = 4;
 
 /// Points per group whose inversions give the start (evenly spread over the group).
-pub const START_POINTS: usize = 255;
-
-/// The brackets of K of every point of `data` under `model` (in parallel), or why a point has
-/// none: what [`KLawProblem::with_brackets`] needs, and what tells which points no K makes
-/// steady.
-pub fn brackets(model: &Model, data: &Dataset) -> Vec<Result<KBracket, KFailure>> {
-    data.points
-        .par_iter()
-        .map(|p| bracket(model, &p.scene))
-        .collect()
-}
+pub(crate) const START_POINTS: usize = 255;
 
 impl<'a> KLawProblem<'a> {
     /// The problem for `law` under `model` (a contact model whose K can be inverted).
@@ -234,8 +224,8 @@ impl<'a> KLawProblem<'a> {
         Ok(Self::with_brackets(model, data, law, brackets).with_stop(stop))
     }
 
-    /// The problem with the brackets of every point already known (from [`brackets`], in the
-    /// order of `data.points`).
+    /// The problem with the brackets of every point already known (one bracket of K per point,
+    /// in the order of `data.points`).
     ///
     /// # Panics
     /// When there are not as many brackets as points.
@@ -390,7 +380,7 @@ impl<'a> KLawProblem<'a> {
     }
 
     /// The start: per group, the median of the per-point inversions of eq 69 (at most
-    /// [`START_POINTS`] points, evenly spread over the group) mapped to the parameter, clamped
+    /// `START_POINTS` points, evenly spread over the group) mapped to the parameter, clamped
     /// into the open box (ends pulled in by 1e-6 of its width); the box's middle when no point
     /// of the group inverts.
     pub fn start(&self) -> Result<Vec<f64>, KLawError> {
@@ -830,7 +820,7 @@ pub fn fit_law_with(
 /// What a K-law fit may be given besides its model, data, law, level and method.
 #[derive(Debug, Clone, Default)]
 pub struct KLawContext {
-    /// The brackets of K of every point (from [`brackets`], in the order of the points), when
+    /// The brackets of K of every point (one per point, in the order of the points), when
     /// the caller already has them; computed otherwise.
     pub brackets: Option<Vec<KBracket>>,
     /// Where progress goes: a task labelled with the fit's name, of unknown total, whose

@@ -23,7 +23,7 @@
 //! Coordinates: a parameter whose box is [0, ∞), and the scale, is sampled as ln x; Jaeger's
 //! a1, a2, a3 in the coordinates of [`super::jaeger_coordinates`] (the velocity at the
 //! series' mean slope, the slope of the law there and a shape), through
-//! [`summarise_reparameterised`]. Either way the log density carries the Jacobian, so the
+//! `summarise_reparameterised`. Either way the log density carries the Jacobian, so the
 //! priors are those of the parameters, and the sampler records the parameters: the draws and
 //! the R̂, ESS and τ that decide convergence are theirs.
 //!
@@ -46,7 +46,7 @@ use rayon::prelude::*;
 
 /// The column naming a parameter in the draws file: its name, with the series appended where
 /// a fit across series has one parameter per series (`K[series]`).
-pub fn draws_column(fit: &FitResult, row: &ParamRow) -> String {
+pub(crate) fn draws_column(fit: &FitResult, row: &ParamRow) -> String {
     if row.series == fit.stats.series {
         row.parameter.clone()
     } else {
@@ -56,7 +56,7 @@ pub fn draws_column(fit: &FitResult, row: &ParamRow) -> String {
 
 /// Summarises a finished least-squares fit by `method`: [`summarise`] for least squares, or
 /// a posterior run started from the optimum (module docs) for MCMC.
-pub fn summarise_with<R: Residuals + Sync + ?Sized>(
+pub(crate) fn summarise_with<R: Residuals + Sync + ?Sized>(
     method: &Method,
     solved: Solved<'_, R>,
 ) -> FitResult {
@@ -69,7 +69,7 @@ pub fn summarise_with<R: Residuals + Sync + ?Sized>(
 /// As [`summarise_with`], with a posterior run sampling the parameters in the coordinates of
 /// `transform` (the priors, draws and reported values stay those of the parameters; see
 /// [`Reparameterisation`]). Least squares ignores `transform`.
-pub fn summarise_reparameterised<R: Residuals + Sync + ?Sized>(
+pub(crate) fn summarise_reparameterised<R: Residuals + Sync + ?Sized>(
     method: &Method,
     solved: Solved<'_, R>,
     transform: &dyn Reparameterisation,
@@ -424,7 +424,8 @@ fn sample<R: Residuals + Sync + ?Sized>(
 }
 
 /// The note every parameter row of an interrupted posterior run starts with.
-pub const INTERRUPTED_NOTE: &str = "interrupted: posterior from the draws so far, not converged";
+pub(crate) const INTERRUPTED_NOTE: &str =
+    "interrupted: posterior from the draws so far, not converged";
 
 /// The least-squares summary `out` marked as a posterior run that could not sample: status
 /// `failed`, the failure in the note and in [`McmcStats::failure`]; the rows keep the

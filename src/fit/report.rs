@@ -10,7 +10,7 @@ use crate::numfmt::fmt_sig;
 use std::fmt;
 
 /// Correlations at or below this magnitude are left out of the report.
-pub const CORRELATION_SHOWN: f64 = 0.1;
+pub(crate) const CORRELATION_SHOWN: f64 = 0.1;
 
 /// Several fits made together (Jan's per-series and global laws, Jaeger's per-series fits), with
 /// the reasons any fit was not made.

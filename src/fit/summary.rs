@@ -120,11 +120,11 @@ pub struct StatsRow {
 /// over 30 σ per point on average. The paper's models leave misfits of up to about 40 % of v̄
 /// (§5.3), some 20 σ at the usual 2 % errors (reduced χ² near 400); far beyond that the
 /// velocities or their σ are more likely in the wrong unit than the model wrong.
-pub const ABSURD_REDUCED_CHI2: f64 = 1000.0;
+pub(crate) const ABSURD_REDUCED_CHI2: f64 = 1000.0;
 
 impl StatsRow {
     /// Why this fit's misfit is implausible for the σ given, if it is: reduced χ² above
-    /// [`ABSURD_REDUCED_CHI2`] with σ given (with unit weights χ² is in the units of v̄ and
+    /// `ABSURD_REDUCED_CHI2` with σ given (with unit weights χ² is in the units of v̄ and
     /// says nothing of units); `None` for a law scored without fitting.
     pub fn absurd_misfit(&self) -> Option<String> {
         (self.sigma == SigmaKind::Absolute
@@ -442,11 +442,11 @@ pub struct Solved<'a, R: ?Sized> {
     /// The solver's options (bounds, σ convention).
     pub options: &'a LsqOptions,
     /// How many distinct points the fit sees (points at the same abscissae count once; see
-    /// [`distinct_points`]), when the fit counts them: with fewer than the parameters the
+    /// `distinct_points`), when the fit counts them: with fewer than the parameters the
     /// data cannot determine them all.
     pub distinct: Option<usize>,
     /// The size ‖y/σ‖ of the weighted observations, when the fit gives it: with no σ given, a
-    /// χ² within the rounding of the data ([`ROUNDING`] · ‖y/σ‖, squared) estimates the
+    /// χ² within the rounding of the data (`ROUNDING` · ‖y/σ‖, squared) estimates the
     /// scatter as 0 as χ² = 0 does.
     pub observed_norm: Option<f64>,
 }
@@ -454,10 +454,10 @@ pub struct Solved<'a, R: ?Sized> {
 /// The relative size of residuals that are rounding, not scatter: 256 ε (5.7e-14) of the
 /// observations' size. A model evaluated in double precision matches data it can reproduce
 /// to a few ulp; no measured scatter is that small.
-pub const ROUNDING: f64 = 256.0 * f64::EPSILON;
+pub(crate) const ROUNDING: f64 = 256.0 * f64::EPSILON;
 
 /// ‖y/σ‖ of observations `y` with σ `s` (see [`Solved::observed_norm`]).
-pub fn observed_norm<'a>(y: impl IntoIterator<Item = (&'a f64, &'a f64)>) -> f64 {
+pub(crate) fn observed_norm<'a>(y: impl IntoIterator<Item = (&'a f64, &'a f64)>) -> f64 {
     y.into_iter()
         .map(|(y, s)| (y / s) * (y / s))
         .sum::<f64>()
@@ -476,7 +476,7 @@ fn scatter_vanishes(f: &Fit, norm: Option<f64>) -> bool {
 }
 
 /// The number of distinct abscissae among `keys` (compared bit for bit).
-pub fn distinct_points<const N: usize>(keys: impl IntoIterator<Item = [f64; N]>) -> usize {
+pub(crate) fn distinct_points<const N: usize>(keys: impl IntoIterator<Item = [f64; N]>) -> usize {
     let set: std::collections::HashSet<[u64; N]> =
         keys.into_iter().map(|k| k.map(f64::to_bits)).collect();
     set.len()
@@ -539,7 +539,7 @@ impl<R: ?Sized> Copy for Solved<'_, R> {}
 
 /// Builds the summary of a finished fit: covariance intervals, and profile intervals when
 /// `profile` is set and the fit converged.
-pub fn summarise<R: Residuals + ?Sized>(s: Solved<'_, R>, profile: bool) -> FitResult {
+pub(crate) fn summarise<R: Residuals + ?Sized>(s: Solved<'_, R>, profile: bool) -> FitResult {
     summarise_with_profiles(s, |s| {
         if profile {
             confidence_intervals(s.problem, s.fit, s.level, s.options)
@@ -554,7 +554,7 @@ pub fn summarise<R: Residuals + ?Sized>(s: Solved<'_, R>, profile: bool) -> FitR
 /// As [`summarise`], with the profile intervals (one per parameter) from `profiles`, called
 /// only when the fit converged (a problem whose parameters are independent of one another
 /// can profile each on its own residuals).
-pub fn summarise_with_profiles<R: Residuals + ?Sized>(
+pub(crate) fn summarise_with_profiles<R: Residuals + ?Sized>(
     s: Solved<'_, R>,
     profiles: impl FnOnce(&Solved<'_, R>) -> Option<Vec<ProfileInterval>>,
 ) -> FitResult {
@@ -733,7 +733,7 @@ pub fn summarise_with_profiles<R: Residuals + ?Sized>(
 }
 
 /// AIC and BIC of a parameter-free model with residuals `r` (conventions of [`Fit::aic`]).
-pub fn information_criteria(r: &[f64], sigma: SigmaKind) -> (f64, f64) {
+pub(crate) fn information_criteria(r: &[f64], sigma: SigmaKind) -> (f64, f64) {
     let m = r.len() as f64;
     let chi2: f64 = r.iter().map(|x| x * x).sum();
     match sigma {

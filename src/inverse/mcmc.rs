@@ -130,7 +130,7 @@ impl Default for McmcOptions {
 }
 
 /// Most walkers a run may have: each step keeps one draw per walker in memory.
-pub const MAX_WALKERS: usize = 10_000;
+pub(crate) const MAX_WALKERS: usize = 10_000;
 
 /// A user-given sampler setting out of its range: the option (`walkers`, `min_ess`,
 /// `max_steps` or `thin`), the value given, and what it must be.
@@ -147,7 +147,7 @@ pub struct OptionError {
 
 impl McmcOptions {
     /// Checks the settings a user chooses (walkers, min_ess, max_steps, thin) against their
-    /// ranges: walkers even, at least 4 and at most [`MAX_WALKERS`]; min_ess finite and ≥ 0;
+    /// ranges: walkers even, at least 4 and at most `MAX_WALKERS`; min_ess finite and ≥ 0;
     /// max_steps and thin ≥ 1. The command line and the Python binding refuse the same values.
     pub fn check(&self) -> Result<(), OptionError> {
         let bad = |option, value: String, expected: String| {

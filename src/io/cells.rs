@@ -1,6 +1,6 @@
 //! Writing CSV records straight into a byte buffer, cell by cell, with the bytes of the `csv`
 //! crate's default writer (comma separators, quotes only where needed, `\n` after a record)
-//! and without allocating: numbers by [`push_f64`], text quoted by [`push_csv_field`].
+//! and without allocating: numbers by [`push_f64`], text quoted by `push_csv_field`.
 
 use super::push_csv_field;
 use crate::numfmt::push_f64;

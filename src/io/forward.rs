@@ -6,8 +6,8 @@
 //! Input columns `xi`, `delta_deg` (required), `K` (a number or a law name), `rho`, `f`,
 //! `lambda`, `mu` (Jan), `a1`, `a2`, `a3` (Jaeger) and `spin` (contact); an empty cell or an
 //! absent column takes the setting. Every input cell passes through (trimmed), an input column
-//! whose name is also an output column renamed `in_NAME` (see [`super::pass_through_names`]); then [`OUTPUT_COLUMNS`], then
-//! [`CONTACT_COLUMNS`] (contact model) or [`AUTO_COLUMNS`] (auto).
+//! whose name is also an output column renamed `in_NAME` (see `pass_through_names`); then `OUTPUT_COLUMNS`, then
+//! `CONTACT_COLUMNS` (contact model) or `AUTO_COLUMNS` (auto).
 //!
 //! Settings are named in messages as the command line's flags (`--rho` of
 //! [`SETTINGS_ORIGIN`]), since that is where they come from.
@@ -25,7 +25,7 @@ use crate::scene::ParameterError;
 use crate::scene::{CollisionLaw, Scene};
 use std::io::Read;
 
-/// Every column a scenes table may have: the scene's, [`SCENE_CELL_COLUMNS`] and md's
+/// Every column a scenes table may have: the scene's, `SCENE_CELL_COLUMNS` and md's
 /// settings; any other passes through ([`super::scenes::check_columns`]).
 pub fn scene_columns() -> Vec<&'static str> {
     let mut v = vec![
@@ -49,7 +49,7 @@ pub fn scene_columns() -> Vec<&'static str> {
 }
 
 /// Columns added after [`OUTPUT_COLUMNS`] by the contact model.
-pub const CONTACT_COLUMNS: [&str; 10] = [
+pub(crate) const CONTACT_COLUMNS: [&str; 10] = [
     "phase_sequence",
     "phase_change_deg",
     "initial_spin",
@@ -63,10 +63,10 @@ pub const CONTACT_COLUMNS: [&str; 10] = [
 ];
 
 /// Columns added after [`OUTPUT_COLUMNS`] by `auto`: the model used and why.
-pub const AUTO_COLUMNS: [&str; 2] = ["model_used", "reason"];
+pub(crate) const AUTO_COLUMNS: [&str; 2] = ["model_used", "reason"];
 
 /// Output columns added to each row.
-pub const OUTPUT_COLUMNS: [&str; 12] = [
+pub(crate) const OUTPUT_COLUMNS: [&str; 12] = [
     "v",
     "regime",
     "status",
@@ -149,7 +149,7 @@ pub struct SceneColumns {
     pub a: [Option<usize>; 3],
     /// `spin`.
     pub spin: Option<usize>,
-    /// The columns of [`SCENE_CELL_COLUMNS`], in its order (checked on every row).
+    /// The columns of `SCENE_CELL_COLUMNS`, in its order (checked on every row).
     pub cells: [Option<usize>; 23],
 }
 
@@ -255,7 +255,7 @@ impl SceneColumns {
 
 /// The scene columns every `forward` row may carry, whatever the model: each present cell of
 /// them is checked ([`check_scene_cells`]), used by the model or not.
-pub const SCENE_CELL_COLUMNS: [&str; 23] = [
+pub(crate) const SCENE_CELL_COLUMNS: [&str; 23] = [
     "K",
     "rho",
     "f",
@@ -285,7 +285,7 @@ pub const SCENE_CELL_COLUMNS: [&str; 23] = [
 /// table has, as the model that uses it would (K a law name or a number in (0, 1), ρ, f ≥ 0,
 /// λ > 0, μ ≥ 0, a1, a2 ≥ 0, a3 > 0, a spin rule, finite md settings, whole counts): a bad
 /// cell is an error even when the chosen model does not read it. `col` finds a column.
-pub fn check_scene_cells(
+pub(crate) fn check_scene_cells(
     r: &Row<'_>,
     col: &dyn Fn(&str) -> Option<usize>,
 ) -> Result<(), InputError> {
@@ -353,7 +353,11 @@ fn field_column(field: &str) -> &str {
 /// The error of a scene or model that `Scene::new` (or a model's constructor) refused for row
 /// `r`: located at the offending cell when its column is among `cols` (name, index), else
 /// about the setting it came from.
-pub fn scene_error(r: &Row<'_>, e: ParameterError, cols: &[(&str, Option<usize>)]) -> InputError {
+pub(crate) fn scene_error(
+    r: &Row<'_>,
+    e: ParameterError,
+    cols: &[(&str, Option<usize>)],
+) -> InputError {
     let field = match &e {
         ParameterError::InvalidParameter { field, .. } => field_column(field).to_string(),
         ParameterError::UnknownLaw(_) => "K".into(),

@@ -2,7 +2,7 @@
 //! [`super::stream::stream`] runs over a table of any size. Each row is read and checked as
 //! [`super::measurements`] reads a whole file (the series check in input order, keeping one
 //! entry per series), inverted (eq 69: [`crate::fit::k::estimate()`]) and written as one
-//! record of [`COLUMNS`], [`EXTRA_COLUMNS`], [`AUTO_COLUMNS`] (auto only), then the input's
+//! record of `COLUMNS`, `EXTRA_COLUMNS`, `AUTO_COLUMNS` (auto only), then the input's
 //! other columns (trimmed; a name clashing with an output column renamed `in_NAME`).
 
 use super::cells::Cells;
@@ -24,7 +24,7 @@ use std::collections::HashMap;
 use std::fmt::Display;
 
 /// The contract columns, in order.
-pub const COLUMNS: [&str; 18] = [
+pub(crate) const COLUMNS: [&str; 18] = [
     "series",
     "xi",
     "delta_deg",
@@ -47,11 +47,12 @@ pub const COLUMNS: [&str; 18] = [
 
 /// Columns added after the contract ones: the bracket of K, what sets its ends, and why a
 /// row has no K or how its interval was cut.
-pub const EXTRA_COLUMNS: [&str; 5] = ["K_min", "K_max", "lower_limit", "upper_limit", "message"];
+pub(crate) const EXTRA_COLUMNS: [&str; 5] =
+    ["K_min", "K_max", "lower_limit", "upper_limit", "message"];
 
 /// Columns added after [`EXTRA_COLUMNS`] by auto: the model each row was inverted with, and
 /// why.
-pub const AUTO_COLUMNS: [&str; 2] = ["model_used", "reason"];
+pub(crate) const AUTO_COLUMNS: [&str; 2] = ["model_used", "reason"];
 
 /// Rows per chunk of a K stream ([`super::stream::StreamOptions::chunk_rows`]), a quarter of
 /// the engine's [`super::stream::CHUNK_ROWS`]: a K row costs microseconds, so smaller chunks

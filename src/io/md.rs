@@ -14,7 +14,7 @@ use crate::scene::ParameterError as Error;
 use crate::scene::{CollisionLaw, Scene};
 
 /// md output columns added to each row.
-pub const MD_OUTPUT_COLUMNS: [&str; 29] = [
+pub(crate) const MD_OUTPUT_COLUMNS: [&str; 29] = [
     "v",
     "regime",
     "status",
@@ -62,7 +62,7 @@ pub struct MdTable {
 
 /// The scene and md model of every row of `t`, or the first bad value: a cell located by line
 /// and column, a flag (`--NAME`, [`MdSetting::flag`]) by its value. Every cell of the scene
-/// columns is checked, whether md reads it or not ([`check_scene_cells`]).
+/// columns is checked, whether md reads it or not (`check_scene_cells`).
 pub fn md_jobs(t: &Table, base: &MdTable) -> Result<Vec<(Scene, Md)>, InputError> {
     let c_xi = t.require("xi")?;
     let c_d = t.require("delta_deg")?;
@@ -129,7 +129,7 @@ pub fn md_jobs(t: &Table, base: &MdTable) -> Result<Vec<(Scene, Md)>, InputError
 }
 
 /// The table of md runs: `t`'s columns (an input name that clashes with an output column
-/// gets `in_`), then [`MD_OUTPUT_COLUMNS`] per row, from each row's run and, with a step
+/// gets `in_`), then `MD_OUTPUT_COLUMNS` per row, from each row's run and, with a step
 /// check, the relative change of v̄ at half the step.
 pub fn md_csv(
     t: &Table,

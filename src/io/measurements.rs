@@ -551,7 +551,7 @@ pub fn locate_point(t: &Table, ds: &Dataset, i: usize) -> String {
 }
 
 /// The lines of `t` that hold the points of series `s` of `ds`, as `2, 3, 5`.
-pub fn series_lines(t: &Table, ds: &Dataset, s: usize) -> String {
+pub(crate) fn series_lines(t: &Table, ds: &Dataset, s: usize) -> String {
     ds.series_index(s)
         .iter()
         .map(|&i| t.lines[i].to_string())
@@ -594,29 +594,29 @@ impl std::fmt::Display for Implausible {
 /// Slopes are doubted when every one is below this fraction of the stop slope δ_m (eq 32) of
 /// its ξ under the paper's fitted law: no K near the paper's moves a bead there, while the
 /// same numbers read as radians usually fall in the steady range.
-pub const SLOPE_FRACTION: f64 = 0.5;
+pub(crate) const SLOPE_FRACTION: f64 = 0.5;
 
 /// Velocities are doubted when their median ratio to the rolling model at the paper's fitted
 /// law (over the points inside its steady range) is below 1/`VELOCITY_FACTOR` or above
 /// `VELOCITY_FACTOR`. The paper's models agree with measurements within about 40 % (§5.3), and
 /// the factor sqrt(g (R + r)) between m/s and the dimensionless unit is below 0.5 for every
 /// bead row with R + r < 2.5 cm.
-pub const VELOCITY_FACTOR: f64 = 2.0;
+pub(crate) const VELOCITY_FACTOR: f64 = 2.0;
 
 /// Row-bead radii above this (metres) are doubted: beads over 20 cm across; the experiments
 /// the paper discusses use millimetre beads (Ristow's R = 2.5 mm).
-pub const MAX_ROW_RADIUS_M: f64 = 0.1;
+pub(crate) const MAX_ROW_RADIUS_M: f64 = 0.1;
 
 /// Velocity ratios kept by a [`Plausibility`] at most (the first ones in file order): the
 /// median of 10,000 ratios is as telling as that of millions (its standard error is about
 /// 1.25/sqrt(10,000) = 1.3 % of the spread), and memory and time stay bounded on streamed
 /// files (each ratio costs one rolling-model evaluation).
-pub const MAX_RATIOS: usize = 10_000;
+pub(crate) const MAX_RATIOS: usize = 10_000;
 
 /// Looks for unit mistakes in measurements read from `t`: slopes in radians, velocities in
 /// m/s in the dimensionless column, row-bead radii in millimetres. The thresholds come from
 /// the rolling model with the paper's fitted law K = cos 2α + ½ sin²α sin 2α
-/// ([`SLOPE_FRACTION`], [`VELOCITY_FACTOR`], [`MAX_ROW_RADIUS_M`]). Nothing is refused: the
+/// (`SLOPE_FRACTION`, `VELOCITY_FACTOR`, `MAX_ROW_RADIUS_M`). Nothing is refused: the
 /// caller shows the warnings. A table streamed row by row gets the same checks from a
 /// [`Plausibility`].
 pub fn plausibility(t: &Table, rows: &[Measurement]) -> Vec<Implausible> {
@@ -665,7 +665,7 @@ impl From<&Measured> for PlausiblePoint {
 }
 
 /// The checks of [`plausibility`], fed one validated row at a time in file order; its memory
-/// is bounded (at most [`MAX_RATIOS`] velocity ratios). [`Plausibility::warnings`] says what it found.
+/// is bounded (at most `MAX_RATIOS` velocity ratios). [`Plausibility::warnings`] says what it found.
 #[derive(Debug, Clone)]
 pub struct Plausibility {
     /// The velocities are `v_m_s` (no column `v`).

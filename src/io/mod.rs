@@ -122,7 +122,7 @@ impl std::error::Error for InputError {}
 /// written, unless it is one of `outputs`; then `in_NAME`, prefixed with `in_` again while it
 /// is still an output, an input or an output name given before (`v` beside an input `in_v`
 /// becomes `in_in_v`). The names returned and `outputs` are all distinct.
-pub fn pass_through_names<'a>(
+pub(crate) fn pass_through_names<'a>(
     inputs: impl IntoIterator<Item = &'a str> + Clone,
     outputs: &[&str],
 ) -> Vec<String> {
@@ -148,7 +148,7 @@ pub fn pass_through_names<'a>(
 
 /// Appends one CSV field to `out` as the `csv` crate's default writer does: quoted (with
 /// quotes doubled) when it holds a comma, a quote, a carriage return or a newline.
-pub fn push_csv_field(out: &mut Vec<u8>, field: &[u8]) {
+pub(crate) fn push_csv_field(out: &mut Vec<u8>, field: &[u8]) {
     if field
         .iter()
         .any(|&b| matches!(b, b',' | b'"' | b'\r' | b'\n'))

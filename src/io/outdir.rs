@@ -8,7 +8,7 @@
 //!    and the files of two runs are never mixed;
 //! 2. removes the stale temporary files and backups of fitbead's own naming
 //!    ([`super::remove_stale_temporaries`]: those of runs that are gone, never a live run's);
-//! 3. records in the manifest [`MANIFEST`] that this run is writing (naming the run, and
+//! 3. records in the manifest `MANIFEST` that this run is writing (naming the run, and
 //!    every file of the previous run and of this one);
 //! 4. writes every file as one group ([`super::write_atomic_all`]: all of them or, on an
 //!    error, none changed);
@@ -24,7 +24,7 @@ use std::path::Path;
 
 /// The manifest's name in the directory. It does not start with `.fitbead-`, the prefix of
 /// temporary files.
-pub const MANIFEST: &str = ".fitbead.manifest";
+pub(crate) const MANIFEST: &str = ".fitbead.manifest";
 
 /// What a manifest says: the run's state and its files.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -79,7 +79,7 @@ fn plain_name(name: &str) -> bool {
 
 /// Writes `files` (name in `dir`, bytes) into the existing directory `dir` as one unit (module
 /// docs): locked, stale temporaries removed, all files or none, the previous run's files that
-/// are not written again removed, the run recorded in [`MANIFEST`]. A name that is not a plain
+/// are not written again removed, the run recorded in `MANIFEST`. A name that is not a plain
 /// file name is an error before anything is written.
 pub fn write_dir(dir: &Path, files: &[(String, Vec<u8>)]) -> std::io::Result<()> {
     if let Some((bad, _)) = files.iter().find(|(n, _)| !plain_name(n)) {

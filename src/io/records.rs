@@ -4,7 +4,7 @@
 //! ([`CorrelationRecord`], correlations.csv).
 //!
 //! Each record derives `serde::Serialize`; its columns are its fields, in order, with their
-//! serde names ([`columns`]). Every writer reads the record: the CSV files ([`to_csv`]) and the
+//! serde names ([`columns`]). Every writer reads the record: the CSV files (`to_csv`) and the
 //! Python binding's dicts (through [`cells`]). A number is written as the shortest decimal
 //! that reads back as the same double ([`crate::numfmt::fmt_f64`]), an absent or non-finite
 //! number as an empty cell.
@@ -77,7 +77,7 @@ pub fn columns<R: Serialize + Default>() -> Vec<String> {
 }
 
 /// The records as CSV: the header from [`columns`], one row per record.
-pub fn to_csv<R: Serialize + Default>(
+pub(crate) fn to_csv<R: Serialize + Default>(
     records: impl IntoIterator<Item = R>,
 ) -> csv::Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());

@@ -105,7 +105,7 @@ pub fn correlations_csv(fits: &[&FitResult]) -> csv::Result<Vec<u8>> {
 }
 
 /// Columns of the `simulate --model contact --v0` transient.
-pub const TRACE_COLUMNS: [&str; 15] = [
+pub(crate) const TRACE_COLUMNS: [&str; 15] = [
     "xi",
     "delta_deg",
     "bead",
@@ -125,7 +125,7 @@ pub const TRACE_COLUMNS: [&str; 15] = [
 
 /// The bead-by-bead transient of the general contact model from the launch speed `v0` (and
 /// spin `v0`), over `beads` row beads for each scene (all at the slope `delta_deg`, degrees, as
-/// printed), as CSV ([`TRACE_COLUMNS`]), with each
+/// printed), as CSV (`TRACE_COLUMNS`), with each
 /// scene's steady mean velocity beside it.
 pub fn transient_csv(
     model: &Contact,

@@ -207,7 +207,7 @@ impl<R: Read> TableReader<R> {
         &self.headers
     }
 
-    /// Index of a column, if present ([`find_column`]).
+    /// Index of a column, if present (`find_column`).
     pub fn col(&self, name: &str) -> Option<usize> {
         find_column(&self.index, &self.headers, name)
     }
@@ -507,7 +507,7 @@ fn require(
 /// Where column `name` is: the column of that exact name, else the one column whose name
 /// differs from it only in case (`Xi` for `xi`); `None` when there is none, or several that
 /// differ only in case. Every lookup of a column by name goes through here.
-pub fn find_column(
+pub(crate) fn find_column(
     index: &HashMap<String, usize>,
     headers: &[String],
     name: &str,
@@ -525,7 +525,7 @@ pub fn find_column(
 }
 
 /// Levenshtein distance between `a` and `b`, ignoring ASCII case.
-pub fn edit_distance(a: &str, b: &str) -> usize {
+pub(crate) fn edit_distance(a: &str, b: &str) -> usize {
     let a: Vec<char> = a.chars().map(|c| c.to_ascii_lowercase()).collect();
     let b: Vec<char> = b.chars().map(|c| c.to_ascii_lowercase()).collect();
     let mut prev: Vec<usize> = (0..=b.len()).collect();
@@ -544,12 +544,12 @@ pub fn edit_distance(a: &str, b: &str) -> usize {
 /// Whether `name` looks like a misspelling of `known`: at most 2 edits apart (ignoring case),
 /// and at most a third of `known`'s length, so that names of one or two letters (`v`, `K`,
 /// `id`) are never taken for one another.
-pub fn is_close(name: &str, known: &str) -> bool {
+pub(crate) fn is_close(name: &str, known: &str) -> bool {
     let d = edit_distance(name, known);
     d > 0 && d <= 2 && d <= known.chars().count() / 3
 }
 
-/// The name among `candidates` that `name` most likely misspells ([`is_close`]), if any.
+/// The name among `candidates` that `name` most likely misspells (`is_close`), if any.
 pub fn nearest<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
     candidates
         .into_iter()
@@ -565,7 +565,7 @@ pub struct UnknownColumn {
     pub source: String,
     /// The column's name as written.
     pub column: String,
-    /// The known column it is close to ([`is_close`]), if any.
+    /// The known column it is close to (`is_close`), if any.
     pub nearest: Option<String>,
 }
 
@@ -583,7 +583,7 @@ impl std::fmt::Display for UnknownColumn {
     }
 }
 
-/// The columns of `t` that none of `known` resolves to ([`find_column`]). With `strict`, the
+/// The columns of `t` that none of `known` resolves to (`find_column`). With `strict`, the
 /// first of them is an error (line 1, naming the column and the nearest known name);
 /// otherwise those close to a known name are returned, for the caller to warn about (other
 /// columns pass through on purpose, e.g. an `id`).
@@ -703,7 +703,7 @@ impl Table {
         })
     }
 
-    /// Index of a column, if present ([`find_column`]).
+    /// Index of a column, if present (`find_column`).
     pub fn col(&self, name: &str) -> Option<usize> {
         find_column(&self.index, &self.headers, name)
     }

@@ -107,7 +107,7 @@ impl PhaseKind {
 }
 
 /// Most phases one contact may go through before the model gives up (chattering).
-pub const MAX_PHASES: usize = 8;
+pub(crate) const MAX_PHASES: usize = 8;
 
 /// The phase sequence of one contact and the angles where the phases change.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

@@ -622,7 +622,7 @@ pub enum MdFailure {
 /// with ρ = 2/5 for a homogeneous sphere, 1/2 for a cylinder, 2/3 for a thin shell; ρ → 0 is
 /// a point mass, whose spin relaxes at the rate γ_s (1 + 1/ρ) and would need an ever smaller
 /// time step.
-pub const MIN_RHO: f64 = 0.01;
+pub(crate) const MIN_RHO: f64 = 0.01;
 
 /// Largest factor by which the damping rates may shrink the time step below the contact-time
 /// step (`step_fraction` × contact time): beyond it the run's cost grows without bound as
@@ -636,7 +636,7 @@ pub const MAX_STEP_SHRINK: f64 = 100.0;
 /// running for ever. Ristow's set with the default run is bounded by about 1.3·10⁸ steps
 /// (3·10¹⁰ for 10⁵ beads), the steel set by about 7·10⁹; a run that moves on takes some 200
 /// times fewer steps than its bound.
-pub const MAX_MD_STEPS: f64 = 1e12;
+pub(crate) const MAX_MD_STEPS: f64 = 1e12;
 
 /// Why settings over [`MAX_MD_STEPS`] are refused (the field named is the setting whose
 /// default value would lower the bound most).
@@ -903,7 +903,7 @@ impl Md {
     }
 
     /// Checks that `scene` is inside the model's domain with these parameters: ρ ≥
-    /// [`MIN_RHO`], and damping rates that shrink the time step by at most
+    /// `MIN_RHO`, and damping rates that shrink the time step by at most
     /// [`MAX_STEP_SHRINK`] below the contact-time step (the normal rate γ_n m_eff/m and the
     /// spin relaxation rate γ_s m_eff/m (1 + 1/ρ), in units sqrt(g/(R+r)), each times the
     /// step, at most 0.1). The error names the field to change.
@@ -956,7 +956,7 @@ impl Md {
         Ok(())
     }
 
-    /// Most time steps a run of `scene` may take ([`MAX_MD_STEPS`]): its longest simulated
+    /// Most time steps a run of `scene` may take (`MAX_MD_STEPS`): its longest simulated
     /// time, `max_time_per_bead` × (`beads` + 1), over the step.
     pub fn step_bound(&self, scene: &Scene) -> f64 {
         let nd = Nd::new(&self.params, &self.config, scene, 1.0);
@@ -1456,7 +1456,7 @@ fn run(
 }
 
 /// The md scan of slopes for regime B: every 0.5° from 0.5° to 45°.
-pub const MD_SCAN_STEP_DEG: f64 = 0.5;
+pub(crate) const MD_SCAN_STEP_DEG: f64 = 0.5;
 pub const MD_SCAN_POINTS: usize = 90;
 /// Bisection steps refining each end of the md regime B range (0.5°/2⁷ ≈ 0.004°).
 pub const MD_REFINE: usize = 7;

@@ -58,7 +58,7 @@ fn bulk_friction_of(alpha: f64, k: f64, omk: f64) -> f64 {
 /// The K whose stop limit δ_m is `delta` at contact angle `alpha` (eq 32 solved for K):
 /// K = (1 − t)/(1 + t) with t = tan(δ/2)/tan(α/2). Negative when δ > α (no K > 0 stops the
 /// bead there). Radians.
-pub fn k_at_delta_m(alpha: f64, delta: f64) -> f64 {
+pub(crate) fn k_at_delta_m(alpha: f64, delta: f64) -> f64 {
     let t = (0.5 * delta).tan() / (0.5 * alpha).tan();
     (1.0 - t) / (1.0 + t)
 }
@@ -66,7 +66,7 @@ pub fn k_at_delta_m(alpha: f64, delta: f64) -> f64 {
 /// The K whose lift-off limit δ_d is `delta` (eq 31 solved for K):
 /// K² = 1 − 4u/((1 − u)(1 + ρ)) with u = tan δ tan α; `None` when no K > 0 has δ_d = δ
 /// (the bead lifts off at this slope whatever K). Radians.
-pub fn k_at_delta_d(alpha: f64, delta: f64, rho: f64) -> Option<f64> {
+pub(crate) fn k_at_delta_d(alpha: f64, delta: f64, rho: f64) -> Option<f64> {
     let u = delta.tan() * alpha.tan();
     if u >= 1.0 {
         return None;
@@ -115,7 +115,7 @@ pub fn critical_xi(law: CollisionLaw, rho: f64) -> Option<f64> {
 
 /// ϑ = 2 cos Θ0 + (1+ρ) Θ̇0² (eq 36).
 #[inline]
-pub fn vartheta(scene: &Scene, w0sq: f64) -> f64 {
+pub(crate) fn vartheta(scene: &Scene, w0sq: f64) -> f64 {
     2.0 * scene.sc_0.c + (1.0 + scene.rho) * w0sq
 }
 
@@ -137,7 +137,7 @@ pub fn theta_g(scene: &Scene, w0sq: f64) -> Option<f64> {
 /// Θ_G of a rolling phase with energy invariant ϑ = 2 cos Θa + (1+ρ) Θ̇a² (eq 36, rationalised
 /// as in [`theta_g`]): the angle > 0 where H = T/N reaches f; `None` when N < 0 on the whole
 /// bead.
-pub fn theta_g_of(rho: f64, f: f64, th: f64) -> Option<f64> {
+pub(crate) fn theta_g_of(rho: f64, f: f64, th: f64) -> Option<f64> {
     let p = 3.0 + rho;
     let disc = rho * rho + f * f * (p - th) * (p + th);
     if disc < 0.0 || p - th < 0.0 {

@@ -12,7 +12,7 @@ use crate::special::SinCos;
 /// Coefficients of the slip first integral Θ̇² = a e^{2fΘ} + b sin Θ + c cos Θ (eq 39):
 /// b = −6f/(1+4f²), c = (4f² − 2)/(1+4f²).
 #[inline]
-pub fn slip_coefficients(f: f64) -> (f64, f64) {
+pub(crate) fn slip_coefficients(f: f64) -> (f64, f64) {
     let d = 1.0 + 4.0 * f * f;
     (-6.0 * f / d, (4.0 * f * f - 2.0) / d)
 }
@@ -159,7 +159,7 @@ fn slip_time_panel(ph: &SlipPhase, a: f64, b: f64, ga: f64, tol: f64) -> Option<
 /// Θ̇² and each side is integrated after θ = θm ± h sinh t with h = sqrt(Θ̇²(θm)/q),
 /// q = ½ d²Θ̇²/dθ² at θm, which turns the near-singular peak (a bead crawling over the top)
 /// into an almost constant integrand.
-pub fn slip_time(ph: &SlipPhase, a: f64, b: f64, tol: f64) -> Result<f64, NotSteady> {
+pub(crate) fn slip_time(ph: &SlipPhase, a: f64, b: f64, tol: f64) -> Result<f64, NotSteady> {
     slip_time_in(ph, a, b, tol, None)
 }
 
@@ -566,7 +566,7 @@ const DD_DENOMINATOR_ABOVE: f64 = -1e-13;
 /// L'² = (b sin Θf + c cos Θf − (b sin Θ0 + c cos Θ0) e^{4fα}) / (1 − K² e^{4fα}), with the
 /// differences in product form (e^{4fα} − 1 by expm1), and from [`SlipDd`] where the
 /// denominator is below `DD_DENOMINATOR_BELOW` (1e-2). `Err(Runaway)` when K² e^{4fα} ≥ 1.
-pub fn final_velocity_sq(scene: &Scene) -> Result<f64, NotSteady> {
+pub(crate) fn final_velocity_sq(scene: &Scene) -> Result<f64, NotSteady> {
     let (b, c) = slip_coefficients(scene.f);
     let em1 = (4.0 * scene.f * scene.alpha).exp_m1();
     let k2 = scene.k * scene.k;

@@ -7,7 +7,7 @@ use crate::special::elliptic::cos_integral;
 
 /// Steady final velocity squared L² = 4 sin δ sin α / ((1+ρ)(1−K²)) (eq 19).
 #[inline]
-pub fn final_velocity_sq(scene: &Scene) -> f64 {
+pub(crate) fn final_velocity_sq(scene: &Scene) -> f64 {
     scene.b * 2.0 * scene.sin_delta_sin_alpha() / scene.one_minus_k2()
 }
 
@@ -16,7 +16,7 @@ pub fn final_velocity_sq(scene: &Scene) -> f64 {
 /// recomputed in double-double when it cancels, so P keeps its relative accuracy for δ as close
 /// to δ_m as the double inputs allow; 1 − K comes from [`Scene::one_minus_k`] (exact for a
 /// number K, from sin²α for a named law).
-pub fn lower_limit_factor(scene: &Scene) -> f64 {
+pub(crate) fn lower_limit_factor(scene: &Scene) -> f64 {
     let k = scene.k;
     let omk = scene.one_minus_k();
     let (sd, cd) = (scene.sc_half_delta.s, scene.sc_half_delta.c);
@@ -57,7 +57,7 @@ pub fn top_velocity_sq(scene: &Scene) -> f64 {
 
 /// Angle where a bead rolling up from Θ0 with squared speed `w0sq` stops (Θ̇ = 0), from
 /// sin²(Θ/2) = sin²(Θ0/2) − Θ̇0²/(2B) (eq 9).
-pub fn stop_angle(scene: &Scene, w0sq: f64) -> f64 {
+pub(crate) fn stop_angle(scene: &Scene, w0sq: f64) -> f64 {
     let s0 = scene.sc_half_0.s;
     let r = (s0 * s0 - w0sq / (2.0 * scene.b)).max(0.0).sqrt();
     -2.0 * r.min(1.0).asin()
@@ -91,7 +91,7 @@ fn rolling_state(scene: &Scene) -> Result<RollingState, NotSteady> {
 
 /// The steady rolling velocities (L = Θ̇f, K L = Θ̇0; eq 19) when the rolling steady state
 /// exists (the same checks as [`steady`], without its contact time).
-pub fn rolling_velocities(scene: &Scene) -> Result<(f64, f64), NotSteady> {
+pub(crate) fn rolling_velocities(scene: &Scene) -> Result<(f64, f64), NotSteady> {
     let st = rolling_state(scene)?;
     Ok((st.l2.sqrt(), st.w0sq.sqrt()))
 }
@@ -154,20 +154,26 @@ pub fn steady_approx(scene: &Scene) -> Outcome {
 /// Θ̇² = Θ̇a² + B (cos Θa − cos θ) (eq 9), with the difference in product form
 /// 2B sin((θ+Θa)/2) sin((θ−Θa)/2) so that θ near Θa keeps its digits.
 #[inline]
-pub fn rolling_speed_sq(b: f64, theta_a: f64, wa_sq: f64, theta: f64) -> f64 {
+pub(crate) fn rolling_speed_sq(b: f64, theta_a: f64, wa_sq: f64, theta: f64) -> f64 {
     wa_sq + 2.0 * b * (0.5 * (theta + theta_a)).sin() * (0.5 * (theta - theta_a)).sin()
 }
 
 /// Time to roll from Θa to Θb (Θa ≤ Θb, both on the row bead) starting with squared speed
 /// `wa_sq` at Θa; `None` if the bead stops before Θb. Used by the stick/slip model.
-pub fn rolling_time(b: f64, theta_a: f64, theta_b: f64, wa_sq: f64) -> Option<f64> {
+pub(crate) fn rolling_time(b: f64, theta_a: f64, theta_b: f64, wa_sq: f64) -> Option<f64> {
     let sa = (0.5 * theta_a).sin();
     rolling_time_top(b, theta_a, theta_b, wa_sq, wa_sq - 2.0 * b * sa * sa)
 }
 
 /// [`rolling_time`] with the squared speed at the top, `wt_sq` = Θ̇a² − 2B sin²(Θa/2), given by
 /// the caller (who may know it without the cancellation of that difference).
-pub fn rolling_time_top(b: f64, theta_a: f64, theta_b: f64, wa_sq: f64, wt_sq: f64) -> Option<f64> {
+pub(crate) fn rolling_time_top(
+    b: f64,
+    theta_a: f64,
+    theta_b: f64,
+    wa_sq: f64,
+    wt_sq: f64,
+) -> Option<f64> {
     use crate::special::SinCos;
     let ha = SinCos::of(0.5 * theta_a);
     let hb = SinCos::of(0.5 * theta_b);

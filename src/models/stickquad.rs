@@ -17,7 +17,7 @@ use crate::special::quad::{integrate, QuadOptions};
 /// Contact time of eq 11 from Θ0 to Θf at launch velocity² `w0sq` and top velocity² `wtsq`
 /// (= w0sq − 2B sin²(Θ0/2)), by adaptive Gauss–Kronrod quadrature at relative tolerance
 /// `tol` (at most 256 panels per side). `None` when the integrand is not positive.
-pub fn rolling_time_quad(scene: &Scene, w0sq: f64, wtsq: f64, tol: f64) -> Option<f64> {
+pub(crate) fn rolling_time_quad(scene: &Scene, w0sq: f64, wtsq: f64, tol: f64) -> Option<f64> {
     let b = scene.b;
     let (t0, tf) = (scene.theta_0, scene.theta_f);
     let opts = QuadOptions {

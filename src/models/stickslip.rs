@@ -97,7 +97,7 @@ pub fn launch(scene: &Scene, w0sq: f64, top_sq: f64) -> Result<MapStep, NotStead
 
 /// Contact time of a launch (eqs 64–65): rolling to Θ_G by Carlson's form, slip to Θf by
 /// quadrature to `tol`; `w0sq`, `top_sq` and `step` as given to and returned by [`launch`].
-pub fn launch_time(
+pub(crate) fn launch_time(
     scene: &Scene,
     w0sq: f64,
     top_sq: f64,
@@ -494,7 +494,7 @@ pub fn steady_tol(scene: &Scene, tol: f64) -> Outcome {
 /// [`steady`] without the diagnostics that cost more map evaluations than the steady state
 /// itself: the map's slope at the fixed point and the search for a second fixed point (64
 /// maps where K e^{2fα} ≥ 0.95). For root finders that need only v̄ and the final velocity.
-pub fn steady_lean(scene: &Scene) -> Outcome {
+pub(crate) fn steady_lean(scene: &Scene) -> Outcome {
     steady_with(scene, 1e-14, false)
 }
 

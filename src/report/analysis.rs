@@ -21,7 +21,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
 /// The contract columns of the bulk-friction table, in order.
-pub const MU_COLUMNS: [&str; 12] = [
+pub(crate) const MU_COLUMNS: [&str; 12] = [
     "series",
     "xi",
     "mu_jan",
@@ -42,7 +42,7 @@ const CONTACT: [(Model, &str); 2] = [(Model::Stick, "rolling"), (Model::StickSli
 
 /// ΔAIC (and ΔBIC) above which extra parameters count as supported by the data (the usual
 /// rule of thumb: a difference below 2 is not worth a parameter).
-pub const SUPPORT_THRESHOLD: f64 = 2.0;
+pub(crate) const SUPPORT_THRESHOLD: f64 = 2.0;
 
 /// The laws fitted under one contact model, on the points that model can make steady.
 pub struct ContactFits {
@@ -394,7 +394,7 @@ impl Analysis {
         out
     }
 
-    /// The bulk-friction table as CSV ([`MU_COLUMNS`], then `alpha_deg,K_lo,K_hi,mu_eq76,
+    /// The bulk-friction table as CSV (`MU_COLUMNS`, then `alpha_deg,K_lo,K_hi,mu_eq76,
     /// rel_diff_eq76,level`).
     pub fn mu_csv(&self) -> csv::Result<Vec<u8>> {
         let mut w = csv::Writer::from_writer(Vec::new());
@@ -1040,7 +1040,7 @@ impl Analysis {
     }
 
     /// Sentences on which extra parameters the data support (ΔAIC and ΔBIC both beyond
-    /// [`SUPPORT_THRESHOLD`]).
+    /// `SUPPORT_THRESHOLD`).
     pub fn support_statements(&self) -> Vec<String> {
         let cands = self.candidates();
         let get = |name: &str| cands.iter().find(|c| c.name == name);
@@ -1211,6 +1211,6 @@ fn waic_sum<'a>(fits: impl IntoIterator<Item = &'a FitResult>) -> Option<f64> {
 }
 
 /// Three significant digits (report tables and messages).
-pub fn sig3(x: f64) -> String {
+pub(crate) fn sig3(x: f64) -> String {
     crate::numfmt::fmt_sig(x, 3)
 }

@@ -12,10 +12,10 @@ pub mod text;
 pub mod workprecision;
 
 /// Longest file-name part made of a series label ([`file_stems`]), in bytes.
-pub const STEM_BYTES: usize = 64;
+pub(crate) const STEM_BYTES: usize = 64;
 
 /// File-name parts for series `labels` (in order): a label is data, never a path, so every
-/// character outside `[A-Za-z0-9._-]` becomes `_` and the result is cut at [`STEM_BYTES`]; a
+/// character outside `[A-Za-z0-9._-]` becomes `_` and the result is cut at `STEM_BYTES`; a
 /// label that had to change and now shares its name with another label gets `-` and eight
 /// hexadecimal digits of a hash of the label appended (stable: the same label gets the same
 /// name whatever the other labels). A label already safe keeps its name.

@@ -26,7 +26,7 @@ pub struct ReportContext {
 
 /// `s` as a Markdown table cell: `|` escaped (`\|`), every line break a space. Series labels
 /// are data: one with `|` or a newline must not split or end a row.
-pub fn table_cell(s: &str) -> String {
+pub(crate) fn table_cell(s: &str) -> String {
     one_line(s).replace('|', "\\|")
 }
 

@@ -19,7 +19,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 /// The contract columns of the CSV.
-pub const COLUMNS: [&str; 9] = [
+pub(crate) const COLUMNS: [&str; 9] = [
     "model",
     "method",
     "tolerance",
@@ -32,13 +32,13 @@ pub const COLUMNS: [&str; 9] = [
 ];
 
 /// Tolerances of the quadrature variants.
-pub const TOLS: [f64; 6] = [1e-4, 1e-6, 1e-8, 1e-10, 1e-12, 1e-14];
+pub(crate) const TOLS: [f64; 6] = [1e-4, 1e-6, 1e-8, 1e-10, 1e-12, 1e-14];
 /// Tolerances tried for auto.
-pub const AUTO_TOLS: [f64; 5] = [1e-4, 1e-6, 1e-8, 1e-10, 1e-12];
+pub(crate) const AUTO_TOLS: [f64; 5] = [1e-4, 1e-6, 1e-8, 1e-10, 1e-12];
 /// Tolerances of the contact model in the K inversion rows.
 const K_CONTACT_TOLS: [f64; 3] = [1e-6, 1e-10, 1e-14];
 /// Scenes used for the K inversion rows (each inversion costs tens of forward evaluations).
-pub const K_SCENES: usize = 100;
+pub(crate) const K_SCENES: usize = 100;
 
 /// Bounds the references' cross-checks must meet (maximum relative disagreement of v̄).
 pub const XCHECK_BOUNDS: [(&str, f64); 4] = [
@@ -406,15 +406,7 @@ pub struct BenchResult {
     pub auto_mix: (usize, usize, usize),
 }
 
-/// Runs the whole bench on `scenes` (single thread).
-pub fn run_bench(scenes: &[(Scene, Draw)]) -> BenchResult {
-    match run_bench_until(scenes, &AtomicBool::new(false)) {
-        Ok(r) => r,
-        Err(Interrupted) => unreachable!("the stop flag is never raised"),
-    }
-}
-
-/// As [`run_bench`], stopping with [`Interrupted`] once `stop` is raised (polled before every
+/// Runs the whole bench on `scenes` (single thread), stopping with [`Interrupted`] once `stop` is raised (polled before every
 /// scene of every variant: a few milliseconds apart at most).
 pub fn run_bench_until(
     scenes: &[(Scene, Draw)],

@@ -154,7 +154,7 @@ fn across_top(h0: SinCos, h1: SinCos, [w0sq, w1sq, wt2]: [f64; 3]) -> [[f64; 3];
 
 /// [`cos_integral`] of two motions between the same angles (`h0`, `h1`, `den`) with the squared
 /// speeds `a` and `b` (each `[w0sq, w1sq, wtsq]`), each to the last bit; across the top their
-/// four R_F run side by side ([`rf_lanes`]).
+/// four R_F run side by side (`rf_lanes`).
 #[inline]
 pub fn cos_integral_pair(h0: SinCos, h1: SinCos, a: [f64; 3], b: [f64; 3], den: f64) -> [f64; 2] {
     if !(h1.s > 0.0 && h0.s < 0.0) {
@@ -176,7 +176,7 @@ pub fn cos_integral_pair(h0: SinCos, h1: SinCos, a: [f64; 3], b: [f64; 3], den: 
 /// 1.3 times one, four about 1.4 times two; docs/PERFORMANCE.md); elsewhere `N` calls of
 /// [`rf`].
 #[inline]
-pub fn rf_lanes<const N: usize>(a: [[f64; 3]; N]) -> [f64; N] {
+pub(crate) fn rf_lanes<const N: usize>(a: [[f64; 3]; N]) -> [f64; N] {
     if !a.iter().all(|t| in_range(*t)) {
         return a.map(|[x, y, z]| rf(x, y, z));
     }

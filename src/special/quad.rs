@@ -37,7 +37,7 @@ const WG: [f64; 4] = [
     0.417_959_183_673_469_4,
 ];
 
-/// Tolerances and limits of [`integrate`].
+/// Tolerances and limits of `integrate`.
 #[derive(Debug, Clone, Copy)]
 pub struct QuadOptions {
     /// Relative tolerance on the integral.
@@ -94,7 +94,12 @@ fn gk15<F: FnMut(f64) -> f64>(f: &mut F, a: f64, b: f64) -> (f64, f64) {
 }
 
 /// ∫_a^b f(x) dx by adaptive Gauss–Kronrod (a ≤ b or a > b).
-pub fn integrate<F: FnMut(f64) -> f64>(mut f: F, a: f64, b: f64, opts: QuadOptions) -> QuadResult {
+pub(crate) fn integrate<F: FnMut(f64) -> f64>(
+    mut f: F,
+    a: f64,
+    b: f64,
+    opts: QuadOptions,
+) -> QuadResult {
     const CAP: usize = 256;
     let max_panels = opts.max_panels.clamp(1, CAP);
     let mut lo = [0.0f64; CAP];
@@ -245,7 +250,7 @@ const WG10: [f64; 5] = [
 /// Piessens et al. 1983): resasc·min(1, (200 |K21 − G10| / resasc)^{3/2}), resasc = ∫|f − mean|.
 /// With 21 points the rule is exact to degree 31: on the analytic slip integrands of a steady
 /// stick/slip contact one panel reaches 1e-15 where the 15-point rule needs three.
-pub fn gk21_pairs<F: FnMut(f64) -> (f64, f64)>(mut pair: F, fc: f64, h: f64) -> (f64, f64) {
+pub(crate) fn gk21_pairs<F: FnMut(f64) -> (f64, f64)>(mut pair: F, fc: f64, h: f64) -> (f64, f64) {
     let mut fv = [(0.0f64, 0.0f64); 10];
     let mut rk = WK21[10] * fc;
     let mut rg = 0.0;
@@ -283,13 +288,18 @@ fn quadpack_error(k_minus_g: f64, resasc: f64) -> f64 {
 /// |K15 − G7| test would subdivide a smooth integrand far past double precision: on the contact
 /// model's spin integral it needs one panel where [`integrate`] needs about ten for 1e-14,
 /// with the same result to round-off (tests/it/contact.rs holds it against an RK4 reference).
-pub fn integrate_smooth<F: FnMut(f64) -> f64>(mut f: F, a: f64, b: f64, rel_tol: f64) -> f64 {
+pub(crate) fn integrate_smooth<F: FnMut(f64) -> f64>(
+    mut f: F,
+    a: f64,
+    b: f64,
+    rel_tol: f64,
+) -> f64 {
     integrate_smooth_n(|x| [f(x)], a, b, rel_tol)[0]
 }
 
 /// [`integrate_smooth`] of N integrands sharing their abscissae (one evaluation of `f` gives
 /// all N values): each component to `rel_tol` of its own magnitude.
-pub fn integrate_smooth_n<const N: usize, F: FnMut(f64) -> [f64; N]>(
+pub(crate) fn integrate_smooth_n<const N: usize, F: FnMut(f64) -> [f64; N]>(
     mut f: F,
     a: f64,
     b: f64,

@@ -122,7 +122,7 @@ pub fn brent<F: FnMut(f64) -> f64>(
 /// The maximum of a unimodal f on [a, b] by golden-section search, to a bracket of width
 /// ≤ `xtol` (at most `max_iter` steps); returns the lower end of the final bracket. Used on
 /// K(launch speed) of the stick/slip model, whose maximum is the saddle-node of its map.
-pub fn golden_max<F: FnMut(f64) -> f64>(
+pub(crate) fn golden_max<F: FnMut(f64) -> f64>(
     mut f: F,
     mut a: f64,
     mut b: f64,

@@ -159,7 +159,7 @@ pub fn split_chains(chains: &[Vec<f64>]) -> Vec<Vec<f64>> {
 /// Rank-normalises draws pooled over all chains: each draw is replaced by
 /// Φ⁻¹((r − 3/8)/(S + 1/4)), r its rank among the S pooled draws (ties get their average
 /// rank), Φ the standard normal CDF (Vehtari et al. 2021, eq. 14).
-pub fn rank_normalise(chains: &[Vec<f64>]) -> Vec<Vec<f64>> {
+pub(crate) fn rank_normalise(chains: &[Vec<f64>]) -> Vec<Vec<f64>> {
     // Values with their pooled index, sorted by value (ties in any order: they share their
     // average rank).
     let mut order: Vec<(f64, usize)> = chains.iter().flatten().copied().zip(0..).collect();

@@ -16,7 +16,7 @@ use crate::fit::summary::FitResult;
 pub struct CornerBlock {
     /// Heading (fit and series).
     pub title: String,
-    /// Parameter names (as in the draws file, [`draws_column`]).
+    /// Parameter names (as in the draws file, `draws_column`).
     pub names: Vec<String>,
     /// Draws per parameter (same length for every parameter).
     pub draws: Vec<Vec<f64>>,
@@ -70,14 +70,14 @@ pub const MAX_POINTS: usize = 400;
 const SHADES: usize = 8;
 /// Probability mass inside the 1σ and 2σ contours of a two-dimensional normal,
 /// 1 − e^{−k²/2} for k = 1, 2.
-pub const CONTOUR_MASS: [f64; 2] = [0.393_469_340_287_366_6, 0.864_664_716_763_387_3];
+pub(crate) const CONTOUR_MASS: [f64; 2] = [0.393_469_340_287_366_6, 0.864_664_716_763_387_3];
 
 const DRAWS: &str = PALETTE[0];
 const OPTIMUM: &str = PALETTE[1];
 
 /// A parameter name as a label: Greek letters for λ and μ, trailing digits as subscripts
 /// (`a1` → a₁, `lambda0` → λ₀), a series in brackets kept.
-pub fn param_label(name: &str) -> String {
+pub(crate) fn param_label(name: &str) -> String {
     let (base, tail) = match name.find('[') {
         Some(i) => (&name[..i], &name[i..]),
         None => (name, ""),
@@ -113,7 +113,7 @@ pub fn quantile(sorted: &[f64], q: f64) -> f64 {
 
 /// "value ± error" with the error to two significant digits and the value to the same
 /// decimal place.
-pub fn value_pm(value: f64, err: f64) -> String {
+pub(crate) fn value_pm(value: f64, err: f64) -> String {
     if !(err.is_finite() && err > 0.0) {
         return crate::numfmt::fmt_sig(value, 4);
     }

@@ -5,7 +5,7 @@
 //!
 //! Labels are markup: `_{…}` sets a subscript and `^{…}` a superscript (written as `tspan`s
 //! shifted with `dy`, which every SVG viewer supports); Greek letters and symbols are Unicode.
-//! Every document names the font family list [`svg::FONT_FAMILY`], whose first member is the
+//! Every document names the font family list `FONT_FAMILY`, whose first member is the
 //! embedded DejaVu Sans (`assets/fonts/`), whose advance widths the layout measures text with.
 
 pub mod corner;
@@ -48,13 +48,13 @@ pub struct Scatter {
 }
 
 /// Series `i`'s colour and marker.
-pub fn series_style(i: usize) -> (&'static str, Mark) {
+pub(crate) fn series_style(i: usize) -> (&'static str, Mark) {
     (PALETTE[i % PALETTE.len()], MARKS[i % MARKS.len()])
 }
 
 /// The scatter figure as a panel: series `i` in [`series_style`]`(i)`, its reference line
 /// dashed in the same colour.
-pub fn scatter_panel(fig: &Scatter) -> Panel {
+pub(crate) fn scatter_panel(fig: &Scatter) -> Panel {
     let mut p = Panel::new("", Axis::new(&fig.x_label), Axis::new(&fig.y_label));
     for (i, s) in fig.series.iter().enumerate() {
         let (colour, mark) = series_style(i);
@@ -73,7 +73,7 @@ pub fn scatter_panel(fig: &Scatter) -> Panel {
 }
 
 /// Renders a scatter figure to an SVG document.
-pub fn scatter_svg(fig: &Scatter) -> Result<String, String> {
+pub(crate) fn scatter_svg(fig: &Scatter) -> Result<String, String> {
     Ok(Figure::new(&fig.title, 1, (720.0, 460.0), vec![scatter_panel(fig)]).to_svg())
 }
 

@@ -4,7 +4,7 @@
 //! diagonal) under a title, with an optional legend shared by the panels to the right of the
 //! grid. A panel holds [`Item`]s in data coordinates on linear or log₁₀ axes, a light major
 //! grid, and its own legend, set in the first empty corner of the plot area or, when the data
-//! leave none, outside to the right. Every text is measured ([`super::svg::text_width`]) so
+//! leave none, outside to the right. Every text is measured (`text_width`) so
 //! that margins fit their labels and no two texts overlap.
 
 use super::svg::{ascent, descent, line_height, text_width, Anchor, Mark, Stroke, Svg};
@@ -16,15 +16,15 @@ pub const PALETTE: [&str; 8] = [
 ];
 
 /// Text sizes, px.
-pub const TICK_SIZE: f64 = 14.0;
+pub(crate) const TICK_SIZE: f64 = 14.0;
 /// Axis labels and legend entries.
-pub const LABEL_SIZE: f64 = 16.0;
+pub(crate) const LABEL_SIZE: f64 = 16.0;
 /// Panel titles.
-pub const PANEL_TITLE_SIZE: f64 = 17.0;
+pub(crate) const PANEL_TITLE_SIZE: f64 = 17.0;
 /// Figure titles.
-pub const TITLE_SIZE: f64 = 20.0;
+pub(crate) const TITLE_SIZE: f64 = 20.0;
 /// Legend entries.
-pub const LEGEND_SIZE: f64 = 14.0;
+pub(crate) const LEGEND_SIZE: f64 = 14.0;
 
 const GRID: &str = "#e3e3e3";
 const FRAME: &str = "#404040";

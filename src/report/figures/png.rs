@@ -6,12 +6,12 @@ use resvg::{tiny_skia, usvg};
 
 /// The embedded font: a subset of DejaVu Sans 2.37 (Latin, Greek, combining marks, punctuation,
 /// scripts and mathematical operators; licence in `assets/fonts/LICENSE-DejaVu.txt`).
-pub const FONT: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSans-subset.ttf");
+pub(crate) const FONT: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSans-subset.ttf");
 
 /// The family name of [`FONT`].
-pub const FONT_NAME: &str = "DejaVu Sans";
+pub(crate) const FONT_NAME: &str = "DejaVu Sans";
 
-/// Parsing options whose font database holds [`FONT`] alone, with every generic family
+/// Parsing options whose font database holds `FONT` alone, with every generic family
 /// mapped to it.
 pub fn options() -> usvg::Options<'static> {
     let mut opt = usvg::Options::default();
@@ -50,7 +50,7 @@ pub fn render_pixmap(svg: &str, scale: f32) -> Result<tiny_skia::Pixmap, String>
 }
 
 /// Renders an SVG document to PNG bytes at `scale`.
-pub fn svg_to_png(svg: &str, scale: f32) -> Result<Vec<u8>, String> {
+pub(crate) fn svg_to_png(svg: &str, scale: f32) -> Result<Vec<u8>, String> {
     render_pixmap(svg, scale)?
         .encode_png()
         .map_err(|e| format!("cannot encode PNG: {e}"))
@@ -58,7 +58,7 @@ pub fn svg_to_png(svg: &str, scale: f32) -> Result<Vec<u8>, String> {
 
 /// The pixel scale of the PNG files `fitbead report --format png` writes (2: sharp on a
 /// high-density screen and in print at the figure's size).
-pub const REPORT_SCALE: f32 = 2.0;
+pub(crate) const REPORT_SCALE: f32 = 2.0;
 
 #[cfg(test)]
 mod tests {

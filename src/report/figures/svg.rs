@@ -13,7 +13,7 @@ use std::fmt::Write as _;
 
 /// The font family list of every figure: the embedded font first, then look-alikes a viewer
 /// may have.
-pub const FONT_FAMILY: &str = "DejaVu Sans, Bitstream Vera Sans, Verdana, Arial, sans-serif";
+pub(crate) const FONT_FAMILY: &str = "DejaVu Sans, Bitstream Vera Sans, Verdana, Arial, sans-serif";
 
 /// A coordinate or length as written to the document: at most two decimals, no trailing
 /// zeros.
@@ -44,7 +44,7 @@ fn num_formatted(x: f64) -> String {
 }
 
 /// Escapes text for an SVG text node or attribute.
-pub fn escape(s: &str) -> String {
+pub(crate) fn escape(s: &str) -> String {
     let mut o = String::with_capacity(s.len());
     for c in s.chars() {
         match c {
@@ -137,7 +137,7 @@ fn advance(c: char) -> f64 {
 
 /// Width in px of `markup` set at `size` px in the embedded font (kerning ignored: it only
 /// narrows the text).
-pub fn text_width(markup: &str, size: f64) -> f64 {
+pub(crate) fn text_width(markup: &str, size: f64) -> f64 {
     runs(markup)
         .iter()
         .map(|(s, t)| t.chars().map(advance).sum::<f64>() * size * s.scale())
@@ -146,18 +146,18 @@ pub fn text_width(markup: &str, size: f64) -> f64 {
 
 /// Height in px above the baseline of text at `size` (the font's ascender; a superscript
 /// reaches no higher).
-pub fn ascent(size: f64) -> f64 {
+pub(crate) fn ascent(size: f64) -> f64 {
     ASCENT / UNITS_PER_EM * size
 }
 
 /// Depth in px below the baseline of text at `size` (the font's descender, plus room for a
 /// subscript).
-pub fn descent(size: f64) -> f64 {
+pub(crate) fn descent(size: f64) -> f64 {
     -DESCENT / UNITS_PER_EM * size + 0.1 * size
 }
 
 /// Height in px of one line of text at `size`.
-pub fn line_height(size: f64) -> f64 {
+pub(crate) fn line_height(size: f64) -> f64 {
     ascent(size) + descent(size)
 }
 
@@ -438,7 +438,7 @@ impl Svg {
         self.body.push('\n');
     }
 
-    /// Text: `markup` ([`text_width`]'s sub- and superscripts) at `size` px with its
+    /// Text: `markup` (`text_width`'s sub- and superscripts) at `size` px with its
     /// baseline at (x, y), anchored by `anchor`, rotated by −90° about (x, y) when
     /// `vertical`.
     #[allow(clippy::too_many_arguments)]

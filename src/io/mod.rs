@@ -6,6 +6,7 @@
 
 mod atomic;
 pub mod cells;
+mod csvsyntax;
 pub mod forward;
 pub mod kstream;
 pub mod md;

@@ -18,7 +18,7 @@
 //! every row before it has been handed out; a quoted cell still open at the end of the input
 //! is reported after the last row.
 
-use super::scenes::{ragged_row, unterminated_quote, utf8_error, Quoting};
+use super::csvsyntax::{csv_error, ragged_row, unterminated_quote, utf8_error, Quoting};
 use super::InputError;
 use rayon::prelude::*;
 use std::collections::VecDeque;
@@ -531,7 +531,7 @@ fn parse(
             Ok(true) => {}
             Ok(false) => break,
             Err(e) => {
-                failure = Some(Failure::Other(super::scenes::csv_error(source, &e)));
+                failure = Some(Failure::Other(csv_error(source, &e)));
                 break;
             }
         }

@@ -1,22 +1,48 @@
 #!/usr/bin/env bash
-# The Python package's tests, as CI runs them: a fresh virtual environment (target/python-venv),
-# the test dependencies from the package index, `pip install ./python` (which compiles the
-# extension against this checkout), then pytest against the command-line binary
-# target/release/fitbead (built here unless FITBEAD_BIN_BUILT=1 says it is built).
+# The Python package's tests, as CI runs them:
+# 1. a build environment (target/python-build-venv) with maturin, which builds one abi3 wheel
+#    (CPython >= 3.9, manylinux tag checked by maturin) into python/target/wheels; the
+#    extension compiles in its own target directory, python/target (python/.cargo/config.toml);
+# 2. a fresh test environment (target/python-venv) where the wheel is installed with cargo
+#    off PATH, as on a machine without Rust, with the test dependencies;
+# 3. pytest against the command-line binary target/release/fitbead (built here unless
+#    FITBEAD_BIN_BUILT=1 says it is built), with cargo still off PATH.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+root=$(pwd)
+pipq=(--quiet --disable-pip-version-check)
+build_venv="${FITBEAD_BUILD_VENV:-target/python-build-venv}"
 venv="${FITBEAD_VENV:-target/python-venv}"
-rm -rf "$venv"
-python3 -m venv "$venv"
-py="$venv/bin/python"
-"$py" -m pip install --quiet --disable-pip-version-check maturin numpy pytest pandas arviz
+
+if [ ! -x "$build_venv/bin/maturin" ]; then
+  python3 -m venv "$build_venv"
+  "$build_venv/bin/python" -m pip install "${pipq[@]}" "maturin>=1.7,<2"
+fi
+rm -f python/target/wheels/fitbead-*.whl
 start=$(date +%s)
-"$py" -m pip install --quiet --disable-pip-version-check ./python
-echo "pip install ./python: $(($(date +%s) - start)) s"
-"$py" -c "import fitbead; print('import fitbead:', fitbead.__version__, 'on', fitbead.threads(), 'threads')"
-# .ci/run sets FITBEAD_BIN_BUILT=1 after `cargo test --release` has built the binary (a plain
-# `cargo build` would build it again: tests build with the dev-dependencies' features).
+(cd python && "$root/$build_venv/bin/maturin" build --release --quiet \
+  --interpreter "$root/$build_venv/bin/python" --out target/wheels)
+wheel=$(ls python/target/wheels/fitbead-*.whl)
+echo "wheel: $(basename "$wheel"), $(stat -c %s "$wheel") bytes, built in $(($(date +%s) - start)) s"
+case "$(basename "$wheel")" in
+  *-abi3-manylinux*) ;;
+  *) echo "the wheel is not an abi3 manylinux wheel: $(basename "$wheel")" >&2; exit 1 ;;
+esac
+
 if [ "${FITBEAD_BIN_BUILT:-0}" != 1 ]; then
   cargo build --release --bin fitbead
 fi
-"$py" -m pytest -q -p no:cacheprovider python/tests
+
+# PATH without any directory that holds cargo or rustc.
+nocargo=$(printf '%s' "$PATH" | tr ':' '\n' | while read -r d; do
+  [ -n "$d" ] && [ ! -x "$d/cargo" ] && [ ! -x "$d/rustc" ] && printf '%s:' "$d"; done)
+nocargo=${nocargo%:}
+
+rm -rf "$venv"
+python3 -m venv "$venv"
+py="$root/$venv/bin/python"
+"$py" -m pip install "${pipq[@]}" -r python/tests/requirements.txt
+PATH="$nocargo" "$py" -m pip install "${pipq[@]}" "$wheel"
+PATH="$nocargo" "$py" -c "import fitbead, shutil; assert shutil.which('cargo') is None; print('import fitbead:', fitbead.__version__, 'on', fitbead.threads(), 'threads, cargo not on PATH')"
+PATH="$nocargo" FITBEAD_BIN="$root/target/release/fitbead" MPLBACKEND=Agg \
+  "$py" -m pytest -q -p no:cacheprovider python/tests

@@ -14,8 +14,10 @@ use fitbead::fit::klaw::KLaw;
 use fitbead::fit::report::FitSet;
 use fitbead::fit::summary::FitResult as RsFitResult;
 use fitbead::inverse::posterior::McmcSettings;
-use fitbead::io::measurements::{MeasurementDefaults, MeasurementFile};
-use fitbead::io::records::{cells, Cell, ParamRecord, StatsRecord};
+use fitbead::io::measurements::{plausibility, MeasurementDefaults, MeasurementFile};
+use fitbead::io::records::{
+    cells, columns, Cell, CorrelationRecord, ParamRecord, ResidualRecord, StatsRecord,
+};
 use fitbead::models::auto::Auto;
 use fitbead::models::contact::{Contact, SpinRule};
 use fitbead::models::jaeger::Jaeger;
@@ -36,8 +38,16 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Condvar, Mutex};
 use std::time::Duration;
 
+pyo3::create_exception!(
+    _fitbead,
+    FitbeadError,
+    PyValueError,
+    "Bad input or a computation that cannot be done: the command line's message (file, line, \
+     column, value where it has them)."
+);
+
 fn value_error(msg: impl Into<String>) -> PyErr {
-    PyValueError::new_err(msg.into())
+    FitbeadError::new_err(msg.into())
 }
 
 /// A contiguous view of a 1-D float64 array.
@@ -799,6 +809,22 @@ fn regimes<'py>(
 #[pyclass(module = "fitbead._fitbead", name = "_Dataset", frozen)]
 struct PyDataset {
     inner: RsDataset,
+    /// The command line's plausibility warnings on the data (unit mistakes), each prefixed
+    /// with the data's source as the command line prints it.
+    warnings: Vec<String>,
+}
+
+impl PyDataset {
+    fn of_file(m: MeasurementFile) -> Self {
+        let warnings = plausibility(&m.table, &m.rows)
+            .iter()
+            .map(|w| format!("{}: {w}", m.table.source))
+            .collect();
+        PyDataset {
+            inner: m.dataset,
+            warnings,
+        }
+    }
 }
 
 #[pymethods]
@@ -813,7 +839,7 @@ impl PyDataset {
             .map_err(|e| value_error(e.to_string()))?;
         let m = MeasurementFile::read(std::path::Path::new(path), &d)
             .map_err(|e| value_error(e.to_string()))?;
-        Ok(PyDataset { inner: m.dataset })
+        Ok(PyDataset::of_file(m))
     }
 
     /// Parses CSV text (named `source` in errors), as `from_csv` reads a file.
@@ -825,7 +851,7 @@ impl PyDataset {
             .map_err(|e| value_error(e.to_string()))?;
         let m = MeasurementFile::parse(source, text.as_bytes(), &d)
             .map_err(|e| value_error(e.to_string()))?;
-        Ok(PyDataset { inner: m.dataset })
+        Ok(PyDataset::of_file(m))
     }
 
     /// The shipped synthetic data set (data/default.csv).
@@ -833,6 +859,7 @@ impl PyDataset {
     fn default_data() -> Self {
         PyDataset {
             inner: RsDataset::default_data(),
+            warnings: Vec::new(),
         }
     }
 
@@ -866,7 +893,10 @@ impl PyDataset {
             rows.push((label, scene, v, s));
         }
         let inner = RsDataset::new(rows).map_err(|e| value_error(e.to_string()))?;
-        Ok(PyDataset { inner })
+        Ok(PyDataset {
+            inner,
+            warnings: Vec::new(),
+        })
     }
 
     /// The K inversion of every point (as `invert_k` over arrays, from the points' own
@@ -901,6 +931,13 @@ impl PyDataset {
     /// Number of points.
     fn __len__(&self) -> usize {
         self.inner.points.len()
+    }
+
+    /// The command line's plausibility warnings on the data read (unit mistakes: slopes in
+    /// radians, velocities in m/s or mm/s, radii in millimetres).
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.warnings.clone()
     }
 
     /// The series labels, in order of first appearance.
@@ -983,6 +1020,32 @@ impl PyFitResult {
     /// record the command line writes; an empty cell is None.
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         record_dict(py, &StatsRecord::from(&self.inner.stats))
+    }
+
+    /// One dict per fitted point, keyed by the columns of residuals.csv (the command line's
+    /// record).
+    fn residual_records<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        let l = PyList::empty(py);
+        for r in ResidualRecord::of(&[&self.inner]) {
+            l.append(record_dict(py, &r)?)?;
+        }
+        Ok(l)
+    }
+
+    /// One dict per pair of parameters, keyed by the columns of correlations.csv (the command
+    /// line's record).
+    fn correlation_records<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        let l = PyList::empty(py);
+        for r in CorrelationRecord::of(&[&self.inner]) {
+            l.append(record_dict(py, &r)?)?;
+        }
+        Ok(l)
+    }
+
+    /// The warning the command line prints when the misfit is implausible for the σ given
+    /// (reduced χ² far above 1: a unit mistake), or None.
+    fn absurd_misfit(&self) -> Option<String> {
+        self.inner.stats.absurd_misfit()
     }
 
     /// The correlation matrix of the parameters (rows in the order of `params`), or None.
@@ -1244,6 +1307,41 @@ fn fit_jaeger(
 }
 
 /// The version of the Rust library.
+/// The column names of the command line's CSV report `kind`: `params`, `stats`,
+/// `residuals` or `correlations` (the records both write).
+#[pyfunction]
+fn record_columns(kind: &str) -> PyResult<Vec<String>> {
+    match kind {
+        "params" => Ok(columns::<ParamRecord>()),
+        "stats" => Ok(columns::<StatsRecord>()),
+        "residuals" => Ok(columns::<ResidualRecord>()),
+        "correlations" => Ok(columns::<CorrelationRecord>()),
+        _ => Err(value_error(format!(
+            "kind = {kind:?}: expected params, stats, residuals or correlations"
+        ))),
+    }
+}
+
+/// The column names of the command line's `forward` output under `model` (after the input's
+/// own columns), or of its `k` output (the input columns with an output of their own first;
+/// auto's two when `model` is auto): `command` is `forward` or `k`.
+#[pyfunction]
+fn output_columns(command: &str, model: &str) -> PyResult<Vec<String>> {
+    let kind = model
+        .parse::<ModelKind>()
+        .map_err(|e| value_error(e.to_string()))?;
+    let names = match command {
+        "forward" => fitbead::io::forward::output_columns(kind),
+        "k" => fitbead::io::kstream::output_columns(kind == ModelKind::Auto),
+        _ => {
+            return Err(value_error(format!(
+                "command = {command:?}: expected forward or k"
+            )))
+        }
+    };
+    Ok(names.into_iter().map(String::from).collect())
+}
+
 #[pyfunction]
 fn version() -> &'static str {
     env!("CARGO_PKG_VERSION")
@@ -1264,6 +1362,9 @@ fn _fitbead(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fit_jan, m)?)?;
     m.add_function(wrap_pyfunction!(fit_jaeger, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
+    m.add_function(wrap_pyfunction!(record_columns, m)?)?;
+    m.add_function(wrap_pyfunction!(output_columns, m)?)?;
+    m.add("FitbeadError", m.py().get_type::<FitbeadError>())?;
     m.add_function(wrap_pyfunction!(threads, m)?)?;
     m.add_class::<PyDataset>()?;
     m.add_class::<PyFitResult>()?;

@@ -75,7 +75,7 @@ def test_to_pandas(data):
     pd = pytest.importorskip("pandas")
     fit = fitbead.fit_klaw(data, model="stick", law="c")
     df = fit.to_pandas()
-    assert list(df.index) == ["c"] and df.loc["c", "value"] == fit["c"].value
+    assert list(df["parameter"]) == ["c"] and df.loc[0, "value"] == fit["c"].value
     res = fit.to_pandas("residuals")
     assert len(res) == 36 and set(res.columns) >= {"v", "v_fit", "residual"}
     # A DataFrame in: the same data set, the same fit, bit for bit.

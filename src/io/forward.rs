@@ -81,6 +81,19 @@ pub(crate) const OUTPUT_COLUMNS: [&str; 12] = [
     "message",
 ];
 
+/// The columns `forward` adds after the input's own under a model of `kind`, in order:
+/// [`OUTPUT_COLUMNS`], then the contact model's or auto's own.
+pub fn output_columns(kind: ModelKind) -> Vec<&'static str> {
+    let mut outputs = OUTPUT_COLUMNS.to_vec();
+    if kind == ModelKind::Contact {
+        outputs.extend(CONTACT_COLUMNS);
+    }
+    if kind == ModelKind::Auto {
+        outputs.extend(AUTO_COLUMNS);
+    }
+    outputs
+}
+
 pub use super::{setting_error, SETTINGS_ORIGIN};
 
 /// The values rows fall back on where their column is absent or their cell empty, and the
@@ -460,32 +473,14 @@ impl RowPlan for ForwardPlan {
     type Scratch = ();
 
     fn header(&self, out: &mut Vec<u8>) {
-        let kind = self.settings.kind;
-        let general = kind == ModelKind::Contact;
         let mut w = Cells::new(out);
-        let mut outputs = OUTPUT_COLUMNS.to_vec();
-        if general {
-            outputs.extend(CONTACT_COLUMNS);
-        }
-        if kind == ModelKind::Auto {
-            outputs.extend(AUTO_COLUMNS);
-        }
+        let outputs = output_columns(self.settings.kind);
         let inputs = self.headers.iter().map(String::as_str);
         for name in super::pass_through_names(inputs, &outputs) {
             w.text(&name);
         }
-        for c in OUTPUT_COLUMNS {
+        for c in outputs {
             w.text(c);
-        }
-        if general {
-            for c in CONTACT_COLUMNS {
-                w.text(c);
-            }
-        }
-        if kind == ModelKind::Auto {
-            for c in AUTO_COLUMNS {
-                w.text(c);
-            }
         }
         w.end();
     }

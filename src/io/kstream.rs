@@ -54,6 +54,20 @@ pub(crate) const EXTRA_COLUMNS: [&str; 5] =
 /// why.
 pub(crate) const AUTO_COLUMNS: [&str; 2] = ["model_used", "reason"];
 
+/// The columns of a K row in order (input columns with their own output column included),
+/// with auto's two when `auto`: the input's other columns follow them.
+pub fn output_columns(auto: bool) -> Vec<&'static str> {
+    let mut v: Vec<&'static str> = COLUMNS
+        .iter()
+        .chain(EXTRA_COLUMNS.iter())
+        .copied()
+        .collect();
+    if auto {
+        v.extend(AUTO_COLUMNS);
+    }
+    v
+}
+
 /// Rows per chunk of a K stream ([`super::stream::StreamOptions::chunk_rows`]), a quarter of
 /// the engine's [`super::stream::CHUNK_ROWS`]: a K row costs microseconds, so smaller chunks
 /// lose nothing to the pauses between them, while the memory the stream touches (two chunks
@@ -201,16 +215,7 @@ impl KPlan {
     }
 
     fn own_columns(&self) -> impl Iterator<Item = &'static str> + '_ {
-        let auto: &[&str] = if self.settings.auto.is_some() {
-            &AUTO_COLUMNS
-        } else {
-            &[]
-        };
-        COLUMNS
-            .iter()
-            .chain(EXTRA_COLUMNS.iter())
-            .chain(auto.iter())
-            .copied()
+        output_columns(self.settings.auto.is_some()).into_iter()
     }
 
     /// Inverts one measurement with the settings' model, or the one auto chooses for it.

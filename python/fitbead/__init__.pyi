@@ -1,0 +1,4 @@
+# Type stubs of the package's public names (stubgen, as fitbead/_api.pyi).
+from ._api import BoundWarning as BoundWarning, ConvergenceWarning as ConvergenceWarning, Dataset as Dataset, FitResult as FitResult, FitSet as FitSet, FitbeadError as FitbeadError, FitbeadWarning as FitbeadWarning, K_MODELS as K_MODELS, MODELS as MODELS, Param as Param, Table as Table, UnitWarning as UnitWarning, __version__ as __version__, fit_jaeger as fit_jaeger, fit_jan as fit_jan, fit_klaw as fit_klaw, forward as forward, invert_k as invert_k, regimes as regimes, threads as threads
+
+__all__ = ['K_MODELS', 'MODELS', 'BoundWarning', 'ConvergenceWarning', 'Dataset', 'FitbeadError', 'FitbeadWarning', 'FitResult', 'FitSet', 'Param', 'Table', 'UnitWarning', '__version__', 'fit_jaeger', 'fit_jan', 'fit_klaw', 'forward', 'invert_k', 'regimes', 'threads']

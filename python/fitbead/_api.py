@@ -1,0 +1,1231 @@
+"""The implementation of the ``fitbead`` package (its public names are re-exported by
+``fitbead/__init__.py``, which lists them in ``__all__``)."""
+
+from __future__ import annotations
+
+import html as _html
+import math
+import warnings
+from dataclasses import dataclass, field
+from statistics import NormalDist
+from typing import Any, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _fitbead as _core
+
+__version__: str = _core.version()
+
+ArrayLike = Union[float, Sequence[float], np.ndarray]
+
+MODELS = ("stick", "stick-approx", "slip", "slip-approx", "stickslip", "contact", "jan", "jaeger", "auto")
+"""The models :func:`forward` evaluates (the command line's names)."""
+
+K_MODELS = ("stick", "stick-approx", "slip", "slip-approx", "stickslip", "contact", "auto")
+"""The models :func:`invert_k` inverts."""
+
+
+FitbeadError = _core.FitbeadError
+FitbeadError.__module__ = "fitbead"
+"""Raised on bad input or a computation that cannot be done (a ``ValueError``): the command
+line's message, naming the file, line, column and value where it has them."""
+
+
+class FitbeadWarning(UserWarning):
+    """Base class of every warning fitbead gives (the command line prints the same text on
+    stderr)."""
+
+
+class UnitWarning(FitbeadWarning):
+    """The data look like a unit mistake: slopes in radians, velocities in m/s, mm/s or cm/s
+    in the dimensionless column, radii in millimetres, or a reduced χ² far above 1 with σ
+    given."""
+
+
+class ConvergenceWarning(FitbeadWarning):
+    """A fit stopped without converging (least squares: its termination; MCMC: R̂ or ESS
+    short of the target, or the run cut short)."""
+
+
+class BoundWarning(FitbeadWarning):
+    """A fitted parameter sits on a bound of its box (its interval is one-sided)."""
+
+
+_PACKAGE_DIR = __file__.rsplit("/", 1)[0] if "/" in __file__ else ""
+
+
+def _warn(message: str, category: type) -> None:
+    """``warnings.warn`` attributed to the first caller outside this package (the user's
+    line, not fitbead's)."""
+    import sys
+
+    level, frame = 2, sys._getframe(1)
+    while frame is not None and frame.f_code.co_filename.startswith(_PACKAGE_DIR):
+        frame = frame.f_back
+        level += 1
+    warnings.warn(message, category, stacklevel=level)
+
+
+def threads() -> int:
+    """Number of threads the vectorised functions use (rayon's pool)."""
+    return _core.threads()
+
+
+class Table(dict):
+    """The columns of a vectorised result: a dict of numpy arrays of one shape.
+
+    Numeric columns are float64 with NaN where the command line leaves a cell empty; text
+    columns (``status``, ``regime``, ``message``, ...) are object arrays of ``str``. The column
+    names are the command line's CSV columns.
+    """
+
+    shape: Tuple[int, ...] = ()
+
+    def to_pandas(self):
+        """The columns as a pandas DataFrame (flattened; needs pandas)."""
+        import pandas as pd
+
+        return pd.DataFrame({k: np.ravel(v) for k, v in self.items()})
+
+    def __repr__(self) -> str:
+        cols = ", ".join(self.keys())
+        return f"Table(shape={self.shape}, columns=[{cols}])"
+
+
+def _as_f64(name: str, x: Any) -> np.ndarray:
+    """``x`` as float64; a masked array with masked entries and complex numbers are refused
+    (their mask or imaginary part would otherwise be dropped silently)."""
+    if isinstance(x, np.ma.MaskedArray) and np.ma.getmaskarray(x).any():
+        raise FitbeadError(
+            f"{name}: a masked array with {int(np.ma.count_masked(x))} masked entries; "
+            "fill them (e.g. .filled(np.nan)) or leave those points out"
+        )
+    try:
+        complex_input = np.iscomplexobj(x)
+    except (TypeError, ValueError):
+        complex_input = False
+    if complex_input:
+        raise FitbeadError(f"{name}: complex numbers are not accepted; pass real numbers (e.g. .real)")
+    try:
+        a = np.asarray(x, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise FitbeadError(f"{name}: expected numbers ({e})") from None
+    return a
+
+
+def _model_name(model: Any) -> Any:
+    """A model name in any case, as the command line takes it."""
+    return model.strip().lower() if isinstance(model, str) else model
+
+
+def _flat(a: np.ndarray) -> np.ndarray:
+    """``a`` flattened to a C-contiguous, aligned float64 array (arrays unpickled from
+    out-of-band buffers, as Dask's workers receive them, may be unaligned)."""
+    return np.require(np.ascontiguousarray(a, dtype=np.float64).reshape(-1), requirements=["C", "A"])
+
+
+def _broadcast(named: Mapping[str, Any]) -> Tuple[Tuple[int, ...], Dict[str, Optional[np.ndarray]]]:
+    """Broadcasts the non-None arrays together; returns the shape and flat contiguous arrays."""
+    keys = [k for k, v in named.items() if v is not None]
+    arrays = [_as_f64(k, named[k]) for k in keys]
+    try:
+        b = np.broadcast_arrays(*arrays)
+    except ValueError as e:
+        shapes = ", ".join(f"{k} {a.shape}" for k, a in zip(keys, arrays))
+        raise FitbeadError(f"arguments do not broadcast together: {shapes}") from e
+    shape = b[0].shape if b else ()
+    flat: Dict[str, Optional[np.ndarray]] = {k: None for k in named}
+    for k, a in zip(keys, b):
+        flat[k] = _flat(a)
+    return shape, flat
+
+
+def _table(raw: Mapping[str, Any], shape: Tuple[int, ...]) -> Table:
+    t = Table()
+    for k, v in raw.items():
+        if isinstance(v, tuple) and len(v) == 3:
+            at, values, n = v
+            arr = np.full(n, "", dtype=object)
+            if len(values):
+                arr[at] = np.asarray(values, dtype=object)
+            t[k] = arr.reshape(shape)
+        elif isinstance(v, tuple):
+            codes, names = v
+            arr = np.asarray(names, dtype=object)[codes] if len(names) else np.empty(0, dtype=object)
+            t[k] = arr.reshape(shape)
+        else:
+            t[k] = np.asarray(v).reshape(shape)
+    t.shape = shape
+    return t
+
+
+def _ordered(t: Table, names: Sequence[str]) -> Table:
+    """``t`` with its columns in the command line's order ``names`` (every name must be a
+    column of ``t`` and every column a name: the binding and the command line share the list)."""
+    missing = [n for n in names if n not in t]
+    extra = [k for k in t if k not in names]
+    if missing or extra:
+        raise RuntimeError(f"fitbead: columns differ from the command line's: missing {missing}, extra {extra}")
+    out = Table((n, t[n]) for n in names)
+    out.shape = t.shape
+    return out
+
+
+def forward(
+    model: str,
+    xi: ArrayLike,
+    delta_deg: ArrayLike,
+    K: Union[str, ArrayLike] = "adjusted",
+    rho: ArrayLike = 0.4,
+    f: ArrayLike = 0.1,
+    *,
+    mu: Optional[ArrayLike] = None,
+    a1: Optional[ArrayLike] = None,
+    a2: Optional[ArrayLike] = None,
+    a3: Optional[ArrayLike] = None,
+    c: Optional[float] = None,
+    branch: str = "upper",
+    spin: str = "roll",
+    tol: float = 1e-14,
+    **params: Any,
+) -> Table:
+    """The steady state of every scene under one model (``fitbead forward``).
+
+    Parameters
+    ----------
+    model : str
+        ``stick`` (pure rolling), ``stick-approx``, ``slip``, ``slip-approx``, ``stickslip``,
+        ``contact`` (the general contact model), ``jan`` (eq 74), ``jaeger`` (eqs 80–84) or
+        ``auto`` (the simplest model meeting ``tol``).
+    xi, delta_deg : array_like
+        Radius ratio ξ = r/R (> 0) and slope δ in degrees; arrays broadcast together with
+        every other array argument.
+    K : str or array_like, default "adjusted"
+        The collision law: numbers (K per scene) or a law name — ``adjusted`` (the paper's
+        fitted law), ``cos2a``, ``impact`` or ``c=VALUE``.
+    rho, f : array_like
+        Gyration parameter ρ (0.4 a sphere) and Coulomb friction f.
+    mu : array_like, optional
+        Jan's μ (eq 74); with ``lambda`` (a keyword Python reserves: pass it as
+        ``**{"lambda": x}`` or through ``**fit.values``). Default: the paper's eqs 75–76 at
+        each scene's α; NaN entries take the default too.
+    a1, a2, a3 : array_like, optional
+        Jaeger's coefficients (required for ``jaeger``).
+    c : float, optional
+        The K(α) law's c (eq 69's law K = cos 2α + c sin²α sin 2α): the same as
+        ``K=f"c={c}"``.
+    branch : str, default "upper"
+        Jaeger's root of eq 84 when there are two: ``upper`` or ``lower``.
+    spin : str, default "roll"
+        The contact model's spin rule at a collision: ``roll``, ``keep``, ``impact`` or
+        ``factor=L``.
+    tol : float, default 1e-14
+        The contact model's quadrature tolerance; the target tolerance of ``auto``.
+    **params
+        ``lambda`` (Jan's λ), under the name the command line and the fit reports use.
+
+    Returns
+    -------
+    Table
+        The command line's columns, in its order: ``xi``, ``delta_deg`` (broadcast), ``v``
+        (mean velocity v̄, NaN without a steady state), ``regime`` (A, B, C), ``status``
+        (``ok``, ``stops``, ``lift-off``, ``no-steady-state``, ``invalid``,
+        ``no-fixed-point``), ``K_used``, ``final_velocity``, ``initial_velocity``,
+        ``contact_time``, ``theta_G_deg`` (Θ_G, eq 36), ``map_slope``,
+        ``other_fixed_point``, ``phases``, ``message``; the contact model adds its energy
+        budget and phase columns, ``auto`` adds ``model_used`` and ``reason``.
+
+    Raises
+    ------
+    FitbeadError
+        A bad value, naming the argument, the row and the value.
+
+    Examples
+    --------
+    >>> import numpy as np, fitbead
+    >>> out = fitbead.forward("stick", xi=1.0, delta_deg=np.linspace(5, 25, 5))
+    >>> list(out["status"])
+    ['stops', 'ok', 'ok', 'ok', 'lift-off']
+    """
+    lam = params.pop("lambda", None)
+    if "lam" in params:
+        if lam is not None:
+            raise TypeError("forward: give lambda once (lam is its old name)")
+        warnings.warn("forward: lam is now lambda (the command line's name)", DeprecationWarning, stacklevel=2)
+        lam = params.pop("lam")
+    params.pop("sigma_scale", None)
+    if params:
+        raise TypeError(f"forward: unexpected arguments {sorted(params)}")
+    model = _model_name(model)
+    if model not in MODELS:
+        if model == "md":
+            raise FitbeadError("model md is not vectorised; use the command line's `fitbead forward --model md`")
+        raise FitbeadError(f"model = {model!r}: expected one of {', '.join(MODELS)}")
+    k_arr = None
+    law = "adjusted"
+    if c is not None:
+        if not (isinstance(K, str) and K == "adjusted"):
+            raise TypeError("forward: give K or c, not both")
+        K = f"c={float(c)!r}"
+    if isinstance(K, str):
+        law = K
+    else:
+        k_arr = K
+    shape, a = _broadcast(
+        {"xi": xi, "delta_deg": delta_deg, "rho": rho, "f": f, "K": k_arr, "lam": lam, "mu": mu, "a1": a1, "a2": a2, "a3": a3}
+    )
+    raw = _core.forward(
+        model,
+        a["xi"],
+        a["delta_deg"],
+        a["rho"],
+        a["f"],
+        k=a["K"],
+        law=law,
+        lam=a["lam"],
+        mu=a["mu"],
+        a1=a["a1"],
+        a2=a["a2"],
+        a3=a["a3"],
+        branch=branch,
+        spin=spin,
+        tol=tol,
+    )
+    t = _table(raw, shape)
+    t["xi"] = a["xi"].reshape(shape).copy()  # type: ignore[union-attr]
+    t["delta_deg"] = a["delta_deg"].reshape(shape).copy()  # type: ignore[union-attr]
+    return _ordered(t, ["xi", "delta_deg", *_core.output_columns("forward", model)])
+
+
+def invert_k(
+    model: str,
+    xi: Union[ArrayLike, "Dataset"],
+    delta_deg: Optional[ArrayLike] = None,
+    v: Optional[ArrayLike] = None,
+    sigma_v: Optional[ArrayLike] = None,
+    rho: ArrayLike = 0.4,
+    f: ArrayLike = 0.1,
+    *,
+    tol: float = 1e-10,
+) -> Table:
+    """The collisional parameter K of every measured point (eq 69; ``fitbead k``).
+
+    Either arrays (``xi``, ``delta_deg``, ``v`` and optionally ``sigma_v``, ``rho``, ``f``,
+    broadcast together) or a :class:`Dataset` as the second argument.
+
+    Parameters
+    ----------
+    model:
+        ``stick``, ``stick-approx``, ``slip``, ``slip-approx``, ``stickslip``, ``contact`` or
+        ``auto`` (per row the model chosen at the stick K, to the tolerance ``tol``).
+    v, sigma_v:
+        Measured mean velocity (> 0, units sqrt(g (R + r))) and its standard error (> 0, or
+        NaN / None for none).
+
+    Returns
+    -------
+    Table
+        The command line's columns in its order: the inputs ``series`` (a Dataset's labels;
+        not for arrays), ``xi``, ``delta_deg``, ``v``, ``sigma_v``, then ``model``, ``K`` (at v), ``K_lo`` (at v − σ), ``K_hi`` (at v + σ), ``dv_dK``,
+        ``final_velocity``, ``theta_G_deg``, the named laws' ``K_cos2a``, ``K_adjusted``,
+        ``K_impact``, ``iterations``, the bracket ``K_min``/``K_max`` and what sets its ends
+        (``lower_limit``, ``upper_limit``), ``regime``, ``status`` (``ok``,
+        ``below-range``, ``above-range``, ``invalid``) and ``message``; ``auto`` adds
+        ``model_used`` and ``reason``.
+    """
+    model = _model_name(model)
+    if model not in K_MODELS:
+        raise FitbeadError(f"model = {model!r}: expected one of {', '.join(K_MODELS)}")
+    if isinstance(xi, Dataset):
+        t = _table(xi._core.invert_k(model, tol=tol), (len(xi),))
+        cols = xi.columns()
+        for k in ("series", "xi", "delta_deg", "v", "sigma_v"):
+            t[k] = cols[k]
+        t["model"] = np.full(len(xi), model, dtype=object)
+        return _ordered(t, _core.output_columns("k", model))
+    if delta_deg is None or v is None:
+        raise FitbeadError("invert_k needs xi, delta_deg and v (or a Dataset)")
+    if sigma_v is None:
+        sigma_v = np.nan
+    shape, a = _broadcast({"xi": xi, "delta_deg": delta_deg, "v": v, "sigma_v": sigma_v, "rho": rho, "f": f})
+    raw = _core.invert_k(model, a["xi"], a["delta_deg"], a["v"], a["sigma_v"], a["rho"], a["f"], tol=tol)
+    t = _table(raw, shape)
+    for k in ("xi", "delta_deg", "v", "sigma_v"):
+        t[k] = a[k].reshape(shape).copy()  # type: ignore[union-attr]
+    t["model"] = np.full(shape, model, dtype=object)
+    names = [n for n in _core.output_columns("k", model) if n != "series"]
+    return _ordered(t, names)
+
+
+def regimes(xi: ArrayLike = (0.8, 1.0, 1.6, 2.0), law: str = "adjusted", rho: float = 0.4) -> Table:
+    """The regime limits of a collision law (``fitbead regimes``).
+
+    Returns ``xi``, ``alpha_deg``, ``K``, ``delta_m_deg`` (δ_m, eq 32: below it the bead
+    stops), ``delta_d_deg`` (δ_d, eq 31: above it the bead lifts off), ``mu_eq79`` (the bulk
+    friction of eq 79), ``steady_range`` (``yes`` where δ_m < δ_d); the table's attribute
+    ``critical_xi`` is the ξ below which no steady regime exists (None if there is none).
+    """
+    x = _flat(np.atleast_1d(_as_f64("xi", xi)))
+    raw = dict(_core.regimes(x, law=law, rho=float(rho)))
+    crit = raw.pop("critical_xi")
+    t = _table(raw, x.shape)
+    t = Table({"xi": x.copy(), **t})
+    t.shape = x.shape
+    t.critical_xi = crit  # type: ignore[attr-defined]
+    return t
+
+
+class Dataset:
+    """Measured mean velocities grouped in series (the command line's measurement CSV).
+
+    Build one with :meth:`read_csv` (same columns, units and error messages as the command
+    line: ``series,xi,delta_deg,v[,sigma_v][,rho][,f]`` or dimensional ``v_m_s`` with
+    ``R_m``), :meth:`from_arrays`, :meth:`from_pandas` or :meth:`default`.
+    """
+
+    def __init__(self, core: Any) -> None:
+        self._core = core
+        for w in core.warnings:
+            _warn(w, UnitWarning)
+
+    @classmethod
+    def read_csv(cls, path: str, *, rho: float = 0.4, f: float = 0.1, g: float = 9.81) -> "Dataset":
+        """Reads a measurement CSV as the command line does.
+
+        Parameters
+        ----------
+        path : str or path-like
+            The file: columns ``series,xi,delta_deg,v[,sigma_v][,rho][,f]`` (dimensionless
+            velocities) or ``v_m_s`` with ``R_m`` (SI).
+        rho, f, g : float
+            Values for the columns the file leaves out; ``g`` in m/s² for SI files.
+
+        Returns
+        -------
+        Dataset
+
+        Raises
+        ------
+        FitbeadError
+            The command line's text: file, line, column, value, message.
+
+        Warns
+        -----
+        UnitWarning
+            Each of the command line's plausibility warnings (slopes in radians, velocities
+            in m/s or mm/s in the dimensionless column, radii in millimetres).
+        """
+        return cls(_core._Dataset.from_csv(str(path), rho=rho, f=f, g=g))
+
+    @classmethod
+    def default(cls) -> "Dataset":
+        """The shipped synthetic data set (36 points in 4 series; data/default.csv)."""
+        return cls(_core._Dataset.default_data())
+
+    @classmethod
+    def from_arrays(
+        cls,
+        xi: ArrayLike,
+        delta_deg: ArrayLike,
+        v: ArrayLike,
+        sigma_v: Optional[ArrayLike] = None,
+        *,
+        series: Optional[Iterable[Any]] = None,
+        rho: ArrayLike = 0.4,
+        f: ArrayLike = 0.1,
+    ) -> "Dataset":
+        """From arrays (broadcast together). ``series`` labels group the points (default:
+        grouped by ξ); without ``sigma_v`` the fits weight relatively."""
+        shape, a = _broadcast(
+            {"xi": xi, "delta_deg": delta_deg, "v": v, "sigma_v": np.nan if sigma_v is None else sigma_v, "rho": rho, "f": f}
+        )
+        n = a["xi"].size  # type: ignore[union-attr]
+        labels = [""] * n if series is None else [str(s) for s in np.ravel(np.asarray(list(series), dtype=object))]
+        return cls(_core._Dataset.from_arrays(labels, a["xi"], a["delta_deg"], a["v"], a["sigma_v"], a["rho"], a["f"]))
+
+    @classmethod
+    def from_pandas(cls, df: Any, *, rho: float = 0.4, f: float = 0.1, g: float = 9.81) -> "Dataset":
+        """From a DataFrame with the CSV's columns, checked as the command line checks a file
+        (errors name the DataFrame's line as the CSV would have it: header on line 1)."""
+        text = df.to_csv(index=False)
+        return cls(_core._Dataset.from_text(text, "<DataFrame>", rho=rho, f=f, g=g))
+
+    @property
+    def warnings(self) -> List[str]:
+        """The plausibility warnings given when the data were read (also given as
+        :class:`UnitWarning`)."""
+        return list(self._core.warnings)
+
+    def __len__(self) -> int:
+        return len(self._core)
+
+    @property
+    def labels(self) -> List[str]:
+        """The series labels, in order of first appearance."""
+        return self._core.labels
+
+    @property
+    def has_sigma(self) -> bool:
+        """Whether the points carry σ (absolute weights) or not (relative weights)."""
+        return self._core.has_sigma
+
+    def columns(self) -> Dict[str, np.ndarray]:
+        """The points as arrays: series (labels), series_index, xi, delta_deg, v, sigma_v
+        (NaN without), rho, f; velocities dimensionless.
+
+        The data set holds δ in radians: ``delta_deg`` is converted back and may differ from
+        the file's degrees in the last bit (:func:`invert_k` on a Dataset uses the radians
+        themselves)."""
+        c = dict(self._core.columns())
+        labels = np.asarray(self.labels, dtype=object)
+        c["series"] = labels[c["series_index"]]
+        return c
+
+    def to_pandas(self):
+        """The points as a DataFrame (needs pandas)."""
+        import pandas as pd
+
+        c = self.columns()
+        cols = ["series", "xi", "delta_deg", "v", "sigma_v", "rho", "f"]
+        return pd.DataFrame({k: c[k] for k in cols})
+
+    def __repr__(self) -> str:
+        return f"Dataset({len(self)} points, series {self.labels})"
+
+
+def _dataset(data: Any) -> Dataset:
+    if isinstance(data, Dataset):
+        return data
+    if data is None:
+        return Dataset.default()
+    if isinstance(data, str) or hasattr(data, "__fspath__"):
+        return Dataset.read_csv(str(data))
+    if hasattr(data, "to_csv") and hasattr(data, "columns"):
+        return Dataset.from_pandas(data)
+    raise FitbeadError("data: expected a Dataset, a CSV path or a pandas DataFrame")
+
+
+def _nan(x: Any) -> float:
+    """A record's number as a float: NaN for an empty cell (None)."""
+    return math.nan if x is None else float(x)
+
+
+@dataclass(frozen=True)
+class Param:
+    """One fitted parameter: a row of the command line's params.csv.
+
+    Numbers the report leaves empty are NaN (never None), so that arrays and DataFrames built
+    from parameters stay numeric.
+    """
+
+    name: str
+    series: str
+    """The series the parameter belongs to (``all`` for a parameter of every series)."""
+    value: float
+    """Least-squares optimum, or the posterior median."""
+    stderr: float
+    """Standard error (covariance), or the posterior standard deviation; NaN where none."""
+    low: float
+    high: float
+    """The interval at ``level`` (NaN where none was found: see ``note``)."""
+    method: str
+    """How the interval was obtained (``profile``, ``covariance``, ``posterior``, ``none``)."""
+    level: float
+    unit: str
+    at_bound: bool
+    """The optimum sits on a bound of the parameter (see the report's warning)."""
+    bounds: Tuple[float, float]
+    paper_value: float
+    paper_source: str
+    lsq_value: float
+    note: str
+    rhat: float = math.nan
+    ess_bulk: float = math.nan
+    ess_tail: float = math.nan
+    cov_low: float = math.nan
+    cov_high: float = math.nan
+    """The covariance (Wald) interval, beside the profile one."""
+    profile_low: float = math.nan
+    profile_high: float = math.nan
+    profile_low_status: str = ""
+    profile_high_status: str = ""
+    """Whether each end of the profile interval was found, and if not why."""
+    mean: float = math.nan
+    sd: float = math.nan
+    q2_5: float = math.nan
+    q50: float = math.nan
+    q97_5: float = math.nan
+    """Posterior mean, standard deviation and quantiles (MCMC; NaN under least squares)."""
+    tau: float = math.nan
+    """Integrated autocorrelation time of the posterior draws (MCMC)."""
+    record: Dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
+    """The whole row as the command line writes it (keys: params.csv's columns)."""
+
+
+def _param(r: Dict[str, Any], bounds: Tuple[float, float]) -> Param:
+    """A :class:`Param` from one row of the parameter report (the keys of params.csv)."""
+    return Param(
+        name=r["parameter"],
+        series=r["series"],
+        value=_nan(r["value"]),
+        stderr=_nan(r["stderr"]),
+        low=_nan(r["ci_low"]),
+        high=_nan(r["ci_high"]),
+        method=r["ci_method"],
+        level=_nan(r["level"]),
+        unit=r["unit"],
+        at_bound=r["at_bound"],
+        bounds=(float(bounds[0]), float(bounds[1])),
+        paper_value=_nan(r["paper_value"]),
+        paper_source=r["paper_source"],
+        lsq_value=_nan(r["lsq_value"]),
+        note=r["note"],
+        rhat=_nan(r["rhat"]),
+        ess_bulk=_nan(r["ess_bulk"]),
+        ess_tail=_nan(r["ess_tail"]),
+        cov_low=_nan(r["cov_low"]),
+        cov_high=_nan(r["cov_high"]),
+        profile_low=_nan(r["profile_low"]),
+        profile_high=_nan(r["profile_high"]),
+        profile_low_status=r["profile_low_status"] or "",
+        profile_high_status=r["profile_high_status"] or "",
+        mean=_nan(r["mean"]),
+        sd=_nan(r["sd"]),
+        q2_5=_nan(r["q2.5"]),
+        q50=_nan(r["q50"]),
+        q97_5=_nan(r["q97.5"]),
+        tau=_nan(r["tau"]),
+        record=dict(r),
+    )
+
+
+def _frame(records: Sequence[Mapping[str, Any]], columns: Sequence[str]):
+    """A DataFrame of report records with the command line's columns: a column of numbers
+    and empty cells is float64 with NaN (never object with None)."""
+    import pandas as pd
+
+    df = pd.DataFrame(list(records), columns=list(columns))
+    for c in df.columns:
+        vals = [x for x in df[c] if x is not None and not (isinstance(x, float) and math.isnan(x))]
+        numeric = all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in vals)
+        if numeric and (vals or df[c].isna().all()) and c not in _TEXT_COLUMNS:
+            df[c] = pd.to_numeric(df[c].astype(object).where(df[c].notna(), np.nan), errors="coerce").astype("float64")
+    return df
+
+
+# Text columns of the reports that may be empty in every row of a table (kept as text).
+_TEXT_COLUMNS = frozenset(
+    ["note", "paper_source", "profile_low_status", "profile_high_status", "mcmc_status", "method", "ci_method", "unit"]
+)
+
+# What each fit evaluates: fit name -> how its parameters make a curve.
+_JAEGER = "jaeger"
+
+
+class FitResult:
+    """One fit: parameters with errors and intervals, correlations, residuals, statistics.
+
+    ``print(result)`` shows the fit report the command line prints; in a notebook the report
+    renders as HTML. The lmfit habits hold: :attr:`params` by name, :attr:`covar`,
+    :attr:`residual`, :meth:`eval`, :meth:`eval_band`, :meth:`fit_report`, :meth:`plot`. For
+    an MCMC fit, :attr:`draws` holds the posterior draws and :meth:`to_arviz` makes an
+    ``arviz.InferenceData`` with a pointwise log likelihood (so ``az.loo`` and
+    ``az.compare`` work).
+    """
+
+    def __init__(self, core: Any, context: Optional[Dict[str, Any]] = None) -> None:
+        self._core = core
+        self._context: Dict[str, Any] = dict(context or {})
+        self.name, self.series = core.name()
+        rows = [_param(r, b) for r, b in zip(core.params(), core.param_bounds())]
+        names = [p.name for p in rows]
+        unique = len(set(names)) == len(names)
+        self.params: Dict[str, Param] = {(p.name if unique else f"{p.name}[{p.series}]"): p for p in rows}
+        """The parameters in the fit's order, by name; where a name repeats (one K per
+        series), by ``name[series]``."""
+        self.stats: Dict[str, Any] = dict(core.stats())
+        """χ², reduced χ², AIC, BIC, termination, iterations, ... (and MCMC diagnostics):
+        the keys and cells of the command line's stats.csv (an empty cell is None)."""
+        corr = core.correlation()
+        self.correlation: Optional[np.ndarray] = None if corr is None else np.asarray(corr, dtype=float)
+        """Correlation matrix of the parameters (order of :attr:`params`), or None."""
+        pts = dict(core.points())
+        pts["series"] = np.asarray(pts["series"], dtype=object)
+        self.residuals: Dict[str, np.ndarray] = pts
+        """The fitted points: series, xi, delta_deg, v, sigma_v, v_fit, residual,
+        normalised_residual (the columns of the report's residuals.csv)."""
+        d = core.draws()
+        self.draws: Optional[np.ndarray] = None
+        """Posterior draws ``[walker, kept step, parameter]`` (MCMC), else None."""
+        self.log_posterior: Optional[np.ndarray] = None
+        self.burn_in = self.thin = 0
+        self.interrupted = False
+        if d is not None:
+            self.draws, self.log_posterior, self.burn_in, self.thin, self.interrupted = d
+
+    def _warn(self) -> None:
+        """Gives the command line's warnings on this fit as Python warnings."""
+        absurd = self._core.absurd_misfit()
+        label = f"{self.name} [{self.series}]"
+        if absurd:
+            _warn(f"{label}: {absurd}", UnitWarning)
+        if not self.stats.get("converged", True):
+            why = self.stats.get("note") or self.stats.get("termination")
+            _warn(f"{label}: not converged: {why}", ConvergenceWarning)
+        for key, p in self.params.items():
+            if p.at_bound:
+                _warn(f"{label}: {key} = {p.value:.6g} is on a bound of {p.bounds}: {p.note}", BoundWarning)
+
+    @property
+    def param_names(self) -> List[str]:
+        """The parameters' keys in the fit's order (the order of :attr:`covar`)."""
+        return list(self.params)
+
+    @property
+    def values(self) -> Dict[str, float]:
+        """``{name: value}`` of the parameters that set the curve (not the scatter's scale),
+        with the names :func:`forward` takes: ``fitbead.forward(model, xi, d, **fit.values)``
+        evaluates a Jan, Jaeger or K-law ``c`` fit."""
+        return {p.name: p.value for p in self.params.values() if p.name != "sigma_scale" and p.name != "K"}
+
+    @property
+    def covar(self) -> Optional[np.ndarray]:
+        """Covariance matrix of the parameters (order of :attr:`param_names`): from the
+        least-squares covariance, or of the posterior draws (MCMC); None where a standard
+        error is missing (an undetermined fit)."""
+        se = np.array([p.stderr for p in self.params.values()], dtype=float)
+        if se.size == 0 or np.isnan(se).any():
+            return None
+        r = self.correlation if self.correlation is not None else (np.eye(1) if se.size == 1 else None)
+        if r is None:
+            return None
+        return r * np.outer(se, se)
+
+    @property
+    def residual(self) -> np.ndarray:
+        """The normalised residuals (v − v̄_fit)/σ of the fitted points (lmfit's
+        ``residual``; divided by the relative weight where no σ is given)."""
+        return np.asarray(self.residuals["normalised_residual"], dtype=float)
+
+    @property
+    def correlations(self) -> Dict[Tuple[str, str], float]:
+        """Correlation of each pair of parameters ``{(a, b): r}`` with a before b."""
+        if self.correlation is None:
+            return {}
+        n = self.param_names
+        return {(n[i], n[j]): float(self.correlation[i, j]) for i in range(len(n)) for j in range(i + 1, len(n))}
+
+    @property
+    def chi2(self) -> float:
+        return self.stats["chi2"]
+
+    @property
+    def reduced_chi2(self) -> float:
+        return self.stats["reduced_chi2"]
+
+    @property
+    def aic(self) -> float:
+        return _nan(self.stats["aic"])
+
+    @property
+    def bic(self) -> float:
+        return _nan(self.stats["bic"])
+
+    @property
+    def converged(self) -> bool:
+        return self.stats["converged"]
+
+    def __getitem__(self, name: str) -> Param:
+        return self.params[name]
+
+    # ---- evaluating the fitted model -------------------------------------------------------
+
+    def _series_xi(self, series: Optional[str]) -> float:
+        r = self.residuals
+        labels = [series] if series is not None else ([self.series] if self.series not in ("", "all") else [])
+        for lab in labels:
+            m = r["series"] == lab
+            if m.any():
+                return float(np.asarray(r["xi"])[m][0])
+        xs = np.unique(np.asarray(r["xi"], dtype=float))
+        if xs.size == 1:
+            return float(xs[0])
+        raise FitbeadError(f"{self.name}: give xi (the fit covers several: {', '.join(f'{x:g}' for x in xs)})")
+
+    def _curve(self, theta: np.ndarray, xi: np.ndarray, delta_deg: np.ndarray, series: Optional[np.ndarray] = None) -> np.ndarray:
+        """The fitted model's v̄ at parameter rows ``theta[draw, parameter]`` (fit order) and
+        points ``xi``, ``delta_deg`` (1-D, same length): an array ``[draw, point]``."""
+        names = [p.name for p in self.params.values()]
+        th = np.atleast_2d(np.asarray(theta, dtype=float))
+        col = {n: th[:, i : i + 1] for i, n in enumerate(names)}
+        xi2, d2 = xi[None, :], delta_deg[None, :]
+        ctx = self._context
+        rho, f = ctx.get("rho", 0.4), ctx.get("f", 0.1)
+        if self.name.startswith("klaw-"):
+            model = ctx["model"]
+            if self.name == "klaw-impact":
+                v = np.asarray(forward(model, xi2, d2, K="impact", rho=rho, f=f)["v"])
+                return np.broadcast_to(v, (th.shape[0], v.shape[1])).copy()
+            if self.name == "klaw-c":
+                alpha = np.radians(np.asarray(regimes(xi)["alpha_deg"], dtype=float))[None, :]
+                a, b = np.cos(2 * alpha), np.sin(alpha) ** 2 * np.sin(2 * alpha)
+                return np.asarray(forward(model, xi2, d2, K=a + b * col["c"], rho=rho, f=f)["v"])
+            # One K per series: the series of each point picks its K.
+            keys = self.param_names
+            if series is None:
+                raise FitbeadError(f"{self.name}: give series (one K per series: {', '.join(keys)})")
+            idx = np.array([keys.index(f"K[{s}]") if f"K[{s}]" in keys else -1 for s in series])
+            if (idx < 0).any():
+                raise FitbeadError(f"{self.name}: series {series[idx < 0][0]!r} is not one of the fit's ({', '.join(keys)})")
+            return np.asarray(forward(model, xi2, d2, K=th[:, idx], rho=rho, f=f)["v"])
+        if self.name == "jan-series":
+            return np.asarray(forward("jan", xi2, d2, **{"lambda": col["lambda"]}, mu=col["mu"])["v"])
+        if self.name == "jan-global":
+            s = np.sin(np.radians(np.asarray(regimes(xi)["alpha_deg"], dtype=float)))[None, :]
+            lam = col["lambda0"] * np.exp(col["lambda1"] * s)
+            mu = col["mu0"] * np.exp(col["mu1"] * s)
+            return np.asarray(forward("jan", xi2, d2, **{"lambda": lam}, mu=mu)["v"])
+        if self.name == _JAEGER:
+            return np.asarray(
+                forward("jaeger", xi2, d2, a1=col["a1"], a2=col["a2"], a3=col["a3"], branch=ctx.get("branch", "upper"))["v"]
+            )
+        raise FitbeadError(f"{self.name}: no curve to evaluate")
+
+    def _points(self, delta_deg: ArrayLike, xi: Optional[ArrayLike], series: Optional[str]):
+        d = np.atleast_1d(_as_f64("delta_deg", delta_deg))
+        x = self._series_xi(series) if xi is None else xi
+        shape, a = _broadcast({"xi": x, "delta_deg": d})
+        lab = None
+        if series is not None:
+            lab = np.full(a["xi"].size, str(series), dtype=object)  # type: ignore[union-attr]
+        elif self.name == "klaw-free-per-series" and xi is None and self.series not in ("", "all"):
+            lab = np.full(a["xi"].size, self.series, dtype=object)  # type: ignore[union-attr]
+        return shape, a["xi"], a["delta_deg"], lab
+
+    def eval(self, delta_deg: ArrayLike, xi: Optional[ArrayLike] = None, *, series: Optional[str] = None) -> np.ndarray:
+        """The fitted model's mean velocity v̄ at new slopes (lmfit's ``eval``).
+
+        Parameters
+        ----------
+        delta_deg : array_like
+            Slopes in degrees.
+        xi : array_like, optional
+            Radius ratios (broadcast with ``delta_deg``); default: the ξ of the fit's series
+            (or of ``series``).
+        series : str, optional
+            For a fit with one K per series, the series whose K to use.
+
+        Returns
+        -------
+        numpy.ndarray
+            v̄ (NaN where the model has no steady state), shaped as the broadcast arguments.
+        """
+        shape, x, d, lab = self._points(delta_deg, xi, series)
+        theta = np.array([[p.value for p in self.params.values()]])
+        return self._curve(theta, x, d, lab)[0].reshape(shape)
+
+    def eval_band(
+        self, delta_deg: ArrayLike, xi: Optional[ArrayLike] = None, *, level: float = 0.95, series: Optional[str] = None, draws: int = 400
+    ) -> Table:
+        """A confidence (least squares) or credible (MCMC) band of the fitted curve.
+
+        Under least squares: the delta method, v̄ ± z σ_v̄ with σ_v̄² = J C Jᵀ, J the
+        derivatives of v̄ in the parameters (central differences, step 10⁻⁴ standard
+        errors) and C :attr:`covar`. Under MCMC: the quantiles (1 ∓ level)/2 of v̄ over up to
+        ``draws`` posterior draws evenly spaced through the kept ones.
+
+        Returns
+        -------
+        Table
+            ``xi``, ``delta_deg``, ``v`` (the fit's curve), ``v_low``, ``v_high``.
+        """
+        if not (0.0 < level < 1.0):
+            raise FitbeadError(f"level = {level}: expected a value in (0, 1)")
+        shape, x, d, lab = self._points(delta_deg, xi, series)
+        theta0 = np.array([p.value for p in self.params.values()])
+        v = self._curve(theta0[None, :], x, d, lab)[0]
+        if self.draws is not None:
+            flat = self.draws.reshape(-1, self.draws.shape[-1])
+            pick = flat[np.unique(np.linspace(0, len(flat) - 1, min(draws, len(flat))).astype(int))]
+            curves = self._curve(pick, x, d, lab)
+            lo = np.nanquantile(curves, (1 - level) / 2, axis=0)
+            hi = np.nanquantile(curves, (1 + level) / 2, axis=0)
+        else:
+            cov = self.covar
+            if cov is None:
+                raise FitbeadError(f"{self.name}: no covariance (an undetermined fit): no band")
+            keep = [i for i, p in enumerate(self.params.values()) if p.name != "sigma_scale"]
+            jac = np.zeros((len(keep), v.size))
+            for row, i in enumerate(keep):
+                h = 1e-4 * cov[i, i] ** 0.5 if cov[i, i] > 0 else 1e-8 * max(abs(theta0[i]), 1.0)
+                up, dn = theta0.copy(), theta0.copy()
+                up[i] += h
+                dn[i] -= h
+                jac[row] = (self._curve(up[None, :], x, d, lab)[0] - self._curve(dn[None, :], x, d, lab)[0]) / (2 * h)
+            c = cov[np.ix_(keep, keep)]
+            sd = np.sqrt(np.einsum("ip,ij,jp->p", jac, c, jac))
+            z = NormalDist().inv_cdf((1 + level) / 2)
+            lo, hi = v - z * sd, v + z * sd
+        t = Table(xi=x.reshape(shape), delta_deg=d.reshape(shape), v=v.reshape(shape), v_low=lo.reshape(shape), v_high=hi.reshape(shape))
+        t.shape = shape
+        return t
+
+    # ---- reports --------------------------------------------------------------------------
+
+    def report(self) -> str:
+        """The fit report (the command line's text)."""
+        return self._core.report()
+
+    def fit_report(self) -> str:
+        """The fit report (lmfit's name for :meth:`report`)."""
+        return self.report()
+
+    def __str__(self) -> str:
+        return self.report()
+
+    def __repr__(self) -> str:
+        ps = ", ".join(f"{p.name}={p.value:.6g}" for p in self.params.values())
+        s = f" [{self.series}]" if self.series else ""
+        return f"FitResult({self.name}{s}: {ps})"
+
+    def _repr_html_(self) -> str:
+        rows = []
+        for p in self.params.values():
+            err = "" if math.isnan(p.stderr) else f"{p.stderr:.3g}"
+            iv = "" if math.isnan(p.low) else f"[{p.low:.6g}, {p.high:.6g}] ({p.method})"
+            paper = "" if math.isnan(p.paper_value) else f"{p.paper_value:.6g}"
+            rows.append(
+                f"<tr><td>{_html.escape(p.name)}</td><td>{p.value:.6g}</td><td>{err}</td><td>{_html.escape(iv)}</td>"
+                f"<td>{paper}</td></tr>"
+            )
+        table = (
+            "<table><thead><tr><th>parameter</th><th>value</th><th>stderr</th><th>interval</th><th>paper</th></tr></thead>"
+            f"<tbody>{''.join(rows)}</tbody></table>"
+        )
+        return f"<div>{table}<details><summary>fit report</summary><pre>{_html.escape(self.report())}</pre></details></div>"
+
+    def to_pandas(self, what: str = "params"):
+        """A DataFrame (needs pandas) with the command line's columns and numeric dtypes
+        (NaN for an empty cell).
+
+        Parameters
+        ----------
+        what : {"params", "stats", "residuals", "correlations", "draws"}
+            ``params`` (params.csv: one row per parameter), ``stats`` (stats.csv: one row),
+            ``residuals`` (residuals.csv: one row per point), ``correlations``
+            (correlations.csv: one row per pair), ``draws`` (one row per kept draw, with
+            walker and step).
+        """
+        import pandas as pd
+
+        if what == "params":
+            return _frame(self._core.params(), _core.record_columns("params"))
+        if what == "stats":
+            return _frame([self._core.stats()], _core.record_columns("stats"))
+        if what == "residuals":
+            return _frame(self._core.residual_records(), _core.record_columns("residuals"))
+        if what == "correlations":
+            return _frame(self._core.correlation_records(), _core.record_columns("correlations"))
+        if what == "draws":
+            if self.draws is None:
+                raise FitbeadError("no draws: a least-squares fit")
+            w, s, k = self.draws.shape
+            df = pd.DataFrame(self.draws.reshape(w * s, k), columns=self.param_names)
+            df.insert(0, "step", np.tile(np.arange(s) * max(self.thin, 1) + self.burn_in + 1, w))
+            df.insert(0, "walker", np.repeat(np.arange(w), s))
+            return df
+        raise FitbeadError(f"what = {what!r}: expected params, stats, residuals, correlations or draws")
+
+    def log_likelihood(self) -> np.ndarray:
+        """The pointwise log likelihood ``[walker, kept step, point]`` of the posterior draws
+        (MCMC): ln N(v_i | v̄_i(θ), (s σ_i)²), with σ_i the point's σ (1 without) and s the
+        scatter's scale where it is sampled (``sigma_scale``), constants included."""
+        if self.draws is None:
+            raise FitbeadError("no draws: the log likelihood per draw needs an MCMC fit (method='mcmc')")
+        r = self.residuals
+        w, s, k = self.draws.shape
+        flat = self.draws.reshape(w * s, k)
+        x = np.asarray(r["xi"], dtype=float)
+        d = np.asarray(r["delta_deg"], dtype=float)
+        lab = np.asarray(r["series"], dtype=object) if self.name == "klaw-free-per-series" else None
+        vfit = np.concatenate([self._curve(flat[i : i + 4096], x, d, lab) for i in range(0, len(flat), 4096)])
+        sig = np.asarray(r["sigma_v"], dtype=float)
+        sig = np.where(np.isnan(sig), 1.0, sig)[None, :]
+        names = [p.name for p in self.params.values()]
+        scale = flat[:, names.index("sigma_scale")][:, None] if "sigma_scale" in names else 1.0
+        sd = scale * sig
+        z = (np.asarray(r["v"], dtype=float)[None, :] - vfit) / sd
+        ll = -0.5 * z * z - np.log(sd) - 0.5 * math.log(2 * math.pi)
+        return ll.reshape(w, s, -1)
+
+    def to_arviz(self):
+        """The posterior as an ``arviz.InferenceData`` (needs ArviZ): ``posterior`` (one
+        chain per walker), ``log_likelihood`` (``v``, per point: :meth:`log_likelihood`, so
+        ``az.loo``, ``az.waic`` and ``az.compare`` work), ``sample_stats`` (``lp``: the log
+        posterior), ``observed_data`` (``v``) and ``constant_data`` (``xi``, ``delta_deg``,
+        ``sigma_v``)."""
+        import arviz as az
+
+        if self.draws is None:
+            raise FitbeadError("no draws: to_arviz needs an MCMC fit (method='mcmc')")
+        post = {n: self.draws[:, :, i] for i, n in enumerate(self.param_names)}
+        r = self.residuals
+        return az.from_dict(
+            posterior=post,
+            log_likelihood={"v": self.log_likelihood()},
+            sample_stats={"lp": self.log_posterior},
+            observed_data={"v": r["v"]},
+            constant_data={"xi": r["xi"], "delta_deg": r["delta_deg"], "sigma_v": r["sigma_v"]},
+            dims={"v": ["point"], "xi": ["point"], "delta_deg": ["point"], "sigma_v": ["point"]},
+            attrs={"fit": self.name, "series": self.series, "burn_in": self.burn_in, "thin": self.thin},
+        )
+
+    def plot(self, ax: Any = None, *, level: float = 0.95, units: str = "dimensionless"):
+        """Data with error bars, the fitted curve and its band (:meth:`eval_band`) per
+        series, and the normalised residuals below (needs matplotlib).
+
+        Parameters
+        ----------
+        ax : sequence of two matplotlib Axes, optional
+            Where to draw (curve, residuals); default: a new figure.
+        level : float
+            Level of the band.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        import matplotlib.pyplot as plt
+
+        if ax is None:
+            fig, ax = plt.subplots(2, 1, sharex=True, height_ratios=[3, 1], figsize=(6.4, 5.6))
+        else:
+            fig = ax[0].figure
+        r = self.residuals
+        labels = list(dict.fromkeys(r["series"]))
+        for lab in labels:
+            m = r["series"] == lab
+            d, v, s = np.asarray(r["delta_deg"])[m], np.asarray(r["v"])[m], np.asarray(r["sigma_v"])[m]
+            xi = float(np.asarray(r["xi"])[m][0])
+            pts = ax[0].errorbar(d, v, yerr=None if np.isnan(s).all() else s, fmt="o", ms=4, capsize=2, label=f"ξ = {xi:g}")
+            grid = np.linspace(d.min(), d.max(), 120)
+            try:
+                band = self.eval_band(grid, xi, level=level, series=lab if self.name == "klaw-free-per-series" else None)
+            except FitbeadError:
+                band = None
+            color = pts[0].get_color()
+            if band is not None:
+                ax[0].plot(grid, band["v"], color=color, lw=1.2)
+                ax[0].fill_between(grid, band["v_low"], band["v_high"], color=color, alpha=0.2, lw=0)
+            ax[1].plot(d, np.asarray(r["normalised_residual"])[m], "o", ms=4, color=color)
+        ax[1].axhline(0, color="0.5", lw=0.8)
+        ax[0].set_ylabel("mean velocity v̄ / √(g(R+r))")
+        ax[1].set_ylabel("residual / σ")
+        ax[1].set_xlabel("slope δ (degrees)")
+        ax[0].set_title(f"{self.name}" + (f" [{self.series}]" if self.series not in ("", "all") else "") + f", band {level:.0%}")
+        ax[0].legend(fontsize="small")
+        return fig
+
+
+class FitSet(list):
+    """The fits of one run (Jan's per-series fits and global laws; Jaeger's per series), with
+    the run's notes. A list of :class:`FitResult`."""
+
+    def __init__(self, fits: Iterable[FitResult], notes: Iterable[str]) -> None:
+        super().__init__(fits)
+        self.notes: List[str] = list(notes)
+
+    def get(self, name: str, series: Optional[str] = None) -> Optional[FitResult]:
+        """The fit named ``name`` (``jan-series``, ``jan-global``, ``jaeger``) for ``series``
+        (a series label; ``all`` for a global fit), or the first fit of that name when
+        ``series`` is None."""
+        for fr in self:
+            if fr.name == name and (series is None or fr.series == series):
+                return fr
+        return None
+
+    def __str__(self) -> str:
+        parts = [str(fr) for fr in self]
+        if self.notes:
+            parts.append("notes:\n" + "\n".join(f"  {n}" for n in self.notes))
+        return "\n\n".join(parts)
+
+    def _repr_html_(self) -> str:
+        return "".join(fr._repr_html_() for fr in self)
+
+    def to_pandas(self, what: str = "params"):
+        """Every fit's table in one DataFrame (needs pandas): ``params``, ``stats``,
+        ``residuals`` or ``correlations``, with the command line's columns (its CSV of the
+        whole run), numeric dtypes and NaN for empty cells."""
+        import pandas as pd
+
+        if what == "draws":
+            raise FitbeadError("draws: take them from each fit (fits[i].to_pandas('draws'))")
+        frames = [fr.to_pandas(what) for fr in self]
+        if not frames:
+            return _frame([], _core.record_columns(what))
+        return pd.concat(frames, ignore_index=True)
+
+
+def _fitted(core: Any, context: Dict[str, Any]) -> FitResult:
+    fr = FitResult(core, context)
+    fr._warn()
+    return fr
+
+
+def fit_klaw(
+    data: Any = None,
+    *,
+    model: str = "stickslip",
+    law: str = "c",
+    method: str = "lsq",
+    level: float = 0.95,
+    profile: bool = True,
+    seed: int = 1,
+    walkers: Optional[int] = None,
+    max_steps: Optional[int] = None,
+    min_ess: Optional[float] = None,
+) -> FitResult:
+    """A law K(α) fitted to every series at once (``fitbead klaw``).
+
+    Parameters
+    ----------
+    data : Dataset, str, path or DataFrame, optional
+        The measurements (default: the shipped data).
+    model : str, default "stickslip"
+        The contact model: ``stick``, ``stick-approx``, ``slip``, ``slip-approx``,
+        ``stickslip`` or ``contact``.
+    law : str, default "c"
+        ``c`` (K = cos 2α + c sin²α sin 2α), ``free-per-series`` (one K per series) or
+        ``impact`` (nothing fitted: scored).
+    method : {"lsq", "mcmc"}, default "lsq"
+        ``lsq`` (least squares; intervals from profile likelihood when ``profile``, else
+        the covariance) or ``mcmc`` (a posterior run from the least-squares optimum: the
+        result's value is the posterior median, ``draws`` the kept draws).
+    level : float, default 0.95
+        Confidence level of the intervals, in (0, 1).
+    profile : bool, default True
+        Least squares: profile-likelihood intervals (else the covariance's).
+    seed : int, default 1
+        MCMC: the seed (the same draws on any machine and thread count).
+    walkers, max_steps : int, optional
+        MCMC: the walkers (default: the library's choice) and the step limit.
+    min_ess : float, optional
+        MCMC: the bulk and tail ESS every parameter must reach (with rank-normalised split-R̂
+        ≤ 1.01) before the run stops (default 1000).
+
+    Returns
+    -------
+    FitResult
+
+    Raises
+    ------
+    FitbeadError
+        Bad data or settings (the command line's message).
+    KeyboardInterrupt
+        Ctrl-C stops an MCMC run cleanly and raises.
+
+    Warns
+    -----
+    UnitWarning, ConvergenceWarning, BoundWarning
+        The command line's warnings on the data and the fit.
+    """
+    d = _dataset(data)
+    core = _core.fit_klaw(
+        d._core, model=_model_name(model), law=law, method=method, level=level, profile=profile, seed=seed, walkers=walkers,
+        max_steps=max_steps, min_ess=min_ess,
+    )
+    return _fitted(core, {"model": _model_name(model)})
+
+
+def fit_jan(
+    data: Any = None,
+    *,
+    method: str = "lsq",
+    level: float = 0.95,
+    profile: bool = True,
+    seed: int = 1,
+    walkers: Optional[int] = None,
+    max_steps: Optional[int] = None,
+    min_ess: Optional[float] = None,
+) -> FitSet:
+    """Jan's energy balance (eq 74): λ and μ per series (at least 3 points), then the global
+    laws of eqs 75–76 (``fitbead jan``).
+
+    Parameters
+    ----------
+    data : Dataset, str, path or DataFrame, optional
+        The measurements (default: the shipped data).
+    method : {"lsq", "mcmc"}, default "lsq"
+        ``lsq`` (least squares; intervals from profile likelihood when ``profile``, else
+        the covariance) or ``mcmc`` (a posterior run from the least-squares optimum).
+    level : float, default 0.95
+        Confidence level of the intervals, in (0, 1).
+    profile : bool, default True
+        Least squares: profile-likelihood intervals (else the covariance's).
+    seed, walkers, max_steps, min_ess
+        MCMC settings, as in :func:`fit_klaw`.
+
+    Returns
+    -------
+    FitSet
+        ``jan-series`` fits (λ, μ) per series, then ``jan-global`` (λ0, λ1, μ0, μ1 of
+        λ = λ0 e^{λ1 sin α}, μ = μ0 e^{μ1 sin α}).
+
+    Warns
+    -----
+    UnitWarning, ConvergenceWarning, BoundWarning
+        The command line's warnings on the data and the fits.
+    """
+    d = _dataset(data)
+    fits, notes = _core.fit_jan(d._core, method=method, level=level, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps, min_ess=min_ess)
+    return FitSet([_fitted(x, {}) for x in fits], notes)
+
+
+def fit_jaeger(
+    data: Any = None,
+    *,
+    branch: str = "upper",
+    method: str = "lsq",
+    level: float = 0.95,
+    profile: bool = True,
+    seed: int = 1,
+    walkers: Optional[int] = None,
+    max_steps: Optional[int] = None,
+    min_ess: Optional[float] = None,
+) -> FitSet:
+    """Jaeger's heuristic law (eqs 80–84): a1, a2, a3 per series with at least 4 points
+    (``fitbead jaeger``).
+
+    Parameters
+    ----------
+    data : Dataset, str, path or DataFrame, optional
+        The measurements (default: the shipped data).
+    branch : {"upper", "lower"}, default "upper"
+        The root of eq 84 when there are two.
+    method : {"lsq", "mcmc"}, default "lsq"
+        ``lsq`` (least squares; intervals from profile likelihood when ``profile``, else
+        the covariance) or ``mcmc`` (a posterior run from the least-squares optimum).
+    level : float, default 0.95
+        Confidence level of the intervals, in (0, 1).
+    profile : bool, default True
+        Least squares: profile-likelihood intervals (else the covariance's).
+    seed, walkers, max_steps, min_ess
+        MCMC settings, as in :func:`fit_klaw`.
+
+    Returns
+    -------
+    FitSet
+        One ``jaeger`` fit per series.
+
+    Warns
+    -----
+    UnitWarning, ConvergenceWarning, BoundWarning
+        The command line's warnings on the data and the fits.
+    """
+    d = _dataset(data)
+    fits, notes = _core.fit_jaeger(
+        d._core, branch=branch, method=method, level=level, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps,
+        min_ess=min_ess,
+    )
+    return FitSet([_fitted(x, {"branch": branch}) for x in fits], notes)

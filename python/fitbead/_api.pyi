@@ -1,0 +1,483 @@
+# Type stubs of the package's implementation, made by `stubgen -p fitbead --include-docstrings`
+# (mypy) from the installed package; python/tests/test_habits.py checks them against it.
+import numpy as np
+from dataclasses import dataclass, field
+from typing import Any, Iterable, Sequence
+
+__version__: str
+ArrayLike = float | Sequence[float] | np.ndarray
+MODELS: tuple[str, ...]
+K_MODELS: tuple[str, ...]
+
+class FitbeadError(ValueError):
+    """Raised on bad input or a computation that cannot be done: the command line's message,
+    naming the file, line, column and value where it has them."""
+
+class FitbeadWarning(UserWarning):
+    """Base class of every warning fitbead gives (the command line prints the same text on
+    stderr)."""
+class UnitWarning(FitbeadWarning):
+    """The data look like a unit mistake: slopes in radians, velocities in m/s, mm/s or cm/s
+    in the dimensionless column, radii in millimetres, or a reduced χ² far above 1 with σ
+    given."""
+class ConvergenceWarning(FitbeadWarning):
+    """A fit stopped without converging (least squares: its termination; MCMC: R̂ or ESS
+    short of the target, or the run cut short)."""
+class BoundWarning(FitbeadWarning):
+    """A fitted parameter sits on a bound of its box (its interval is one-sided)."""
+
+def threads() -> int:
+    """Number of threads the vectorised functions use (rayon's pool)."""
+
+class Table(dict):
+    """The columns of a vectorised result: a dict of numpy arrays of one shape.
+
+    Numeric columns are float64 with NaN where the command line leaves a cell empty; text
+    columns (``status``, ``regime``, ``message``, ...) are object arrays of ``str``. The column
+    names are the command line's CSV columns.
+    """
+    shape: tuple[int, ...]
+    def to_pandas(self):
+        """The columns as a pandas DataFrame (flattened; needs pandas)."""
+
+def forward(model: str, xi: ArrayLike, delta_deg: ArrayLike, K: str | ArrayLike = 'adjusted', rho: ArrayLike = 0.4, f: ArrayLike = 0.1, *, mu: ArrayLike | None = None, a1: ArrayLike | None = None, a2: ArrayLike | None = None, a3: ArrayLike | None = None, c: float | None = None, branch: str = 'upper', spin: str = 'roll', tol: float = 1e-14, **params: Any) -> Table:
+    '''The steady state of every scene under one model (``fitbead forward``).
+
+    Parameters
+    ----------
+    model : str
+        ``stick`` (pure rolling), ``stick-approx``, ``slip``, ``slip-approx``, ``stickslip``,
+        ``contact`` (the general contact model), ``jan`` (eq 74), ``jaeger`` (eqs 80–84) or
+        ``auto`` (the simplest model meeting ``tol``).
+    xi, delta_deg : array_like
+        Radius ratio ξ = r/R (> 0) and slope δ in degrees; arrays broadcast together with
+        every other array argument.
+    K : str or array_like, default "adjusted"
+        The collision law: numbers (K per scene) or a law name — ``adjusted`` (the paper\'s
+        fitted law), ``cos2a``, ``impact`` or ``c=VALUE``.
+    rho, f : array_like
+        Gyration parameter ρ (0.4 a sphere) and Coulomb friction f.
+    mu : array_like, optional
+        Jan\'s μ (eq 74); with ``lambda`` (a keyword Python reserves: pass it as
+        ``**{"lambda": x}`` or through ``**fit.values``). Default: the paper\'s eqs 75–76 at
+        each scene\'s α; NaN entries take the default too.
+    a1, a2, a3 : array_like, optional
+        Jaeger\'s coefficients (required for ``jaeger``).
+    c : float, optional
+        The K(α) law\'s c (eq 69\'s law K = cos 2α + c sin²α sin 2α): the same as
+        ``K=f"c={c}"``.
+    branch : str, default "upper"
+        Jaeger\'s root of eq 84 when there are two: ``upper`` or ``lower``.
+    spin : str, default "roll"
+        The contact model\'s spin rule at a collision: ``roll``, ``keep``, ``impact`` or
+        ``factor=L``.
+    tol : float, default 1e-14
+        The contact model\'s quadrature tolerance; the target tolerance of ``auto``.
+    **params
+        ``lambda`` (Jan\'s λ), under the name the command line and the fit reports use.
+
+    Returns
+    -------
+    Table
+        The command line\'s columns, in its order: ``xi``, ``delta_deg`` (broadcast), ``v``
+        (mean velocity v̄, NaN without a steady state), ``regime`` (A, B, C), ``status``
+        (``ok``, ``stops``, ``lift-off``, ``no-steady-state``, ``invalid``,
+        ``no-fixed-point``), ``K_used``, ``final_velocity``, ``initial_velocity``,
+        ``contact_time``, ``theta_G_deg`` (Θ_G, eq 36), ``map_slope``,
+        ``other_fixed_point``, ``phases``, ``message``; the contact model adds its energy
+        budget and phase columns, ``auto`` adds ``model_used`` and ``reason``.
+
+    Raises
+    ------
+    FitbeadError
+        A bad value, naming the argument, the row and the value.
+
+    Examples
+    --------
+    >>> import numpy as np, fitbead
+    >>> out = fitbead.forward("stick", xi=1.0, delta_deg=np.linspace(5, 25, 5))
+    >>> list(out["status"])
+    [\'stops\', \'ok\', \'ok\', \'ok\', \'lift-off\']
+    '''
+def invert_k(model: str, xi: ArrayLike | Dataset, delta_deg: ArrayLike | None = None, v: ArrayLike | None = None, sigma_v: ArrayLike | None = None, rho: ArrayLike = 0.4, f: ArrayLike = 0.1, *, tol: float = 1e-10) -> Table:
+    """The collisional parameter K of every measured point (eq 69; ``fitbead k``).
+
+    Either arrays (``xi``, ``delta_deg``, ``v`` and optionally ``sigma_v``, ``rho``, ``f``,
+    broadcast together) or a :class:`Dataset` as the second argument.
+
+    Parameters
+    ----------
+    model:
+        ``stick``, ``stick-approx``, ``slip``, ``slip-approx``, ``stickslip``, ``contact`` or
+        ``auto`` (per row the model chosen at the stick K, to the tolerance ``tol``).
+    v, sigma_v:
+        Measured mean velocity (> 0, units sqrt(g (R + r))) and its standard error (> 0, or
+        NaN / None for none).
+
+    Returns
+    -------
+    Table
+        The command line's columns in its order: the inputs ``series`` (a Dataset's labels;
+        not for arrays), ``xi``, ``delta_deg``, ``v``, ``sigma_v``, then ``model``, ``K`` (at v), ``K_lo`` (at v − σ), ``K_hi`` (at v + σ), ``dv_dK``,
+        ``final_velocity``, ``theta_G_deg``, the named laws' ``K_cos2a``, ``K_adjusted``,
+        ``K_impact``, ``iterations``, the bracket ``K_min``/``K_max`` and what sets its ends
+        (``lower_limit``, ``upper_limit``), ``regime``, ``status`` (``ok``,
+        ``below-range``, ``above-range``, ``invalid``) and ``message``; ``auto`` adds
+        ``model_used`` and ``reason``.
+    """
+def regimes(xi: ArrayLike = (0.8, 1.0, 1.6, 2.0), law: str = 'adjusted', rho: float = 0.4) -> Table:
+    """The regime limits of a collision law (``fitbead regimes``).
+
+    Returns ``xi``, ``alpha_deg``, ``K``, ``delta_m_deg`` (δ_m, eq 32: below it the bead
+    stops), ``delta_d_deg`` (δ_d, eq 31: above it the bead lifts off), ``mu_eq79`` (the bulk
+    friction of eq 79), ``steady_range`` (``yes`` where δ_m < δ_d); the table's attribute
+    ``critical_xi`` is the ξ below which no steady regime exists (None if there is none).
+    """
+
+class Dataset:
+    """Measured mean velocities grouped in series (the command line's measurement CSV).
+
+    Build one with :meth:`read_csv` (same columns, units and error messages as the command
+    line: ``series,xi,delta_deg,v[,sigma_v][,rho][,f]`` or dimensional ``v_m_s`` with
+    ``R_m``), :meth:`from_arrays`, :meth:`from_pandas` or :meth:`default`.
+    """
+    def __init__(self, core: Any) -> None: ...
+    @classmethod
+    def read_csv(cls, path: str, *, rho: float = 0.4, f: float = 0.1, g: float = 9.81) -> Dataset:
+        """Reads a measurement CSV as the command line does.
+
+        Parameters
+        ----------
+        path : str or path-like
+            The file: columns ``series,xi,delta_deg,v[,sigma_v][,rho][,f]`` (dimensionless
+            velocities) or ``v_m_s`` with ``R_m`` (SI).
+        rho, f, g : float
+            Values for the columns the file leaves out; ``g`` in m/s² for SI files.
+
+        Returns
+        -------
+        Dataset
+
+        Raises
+        ------
+        FitbeadError
+            The command line's text: file, line, column, value, message.
+
+        Warns
+        -----
+        UnitWarning
+            Each of the command line's plausibility warnings (slopes in radians, velocities
+            in m/s or mm/s in the dimensionless column, radii in millimetres).
+        """
+    @classmethod
+    def default(cls) -> Dataset:
+        """The shipped synthetic data set (36 points in 4 series; data/default.csv)."""
+    @classmethod
+    def from_arrays(cls, xi: ArrayLike, delta_deg: ArrayLike, v: ArrayLike, sigma_v: ArrayLike | None = None, *, series: Iterable[Any] | None = None, rho: ArrayLike = 0.4, f: ArrayLike = 0.1) -> Dataset:
+        """From arrays (broadcast together). ``series`` labels group the points (default:
+        grouped by ξ); without ``sigma_v`` the fits weight relatively."""
+    @classmethod
+    def from_pandas(cls, df: Any, *, rho: float = 0.4, f: float = 0.1, g: float = 9.81) -> Dataset:
+        """From a DataFrame with the CSV's columns, checked as the command line checks a file
+        (errors name the DataFrame's line as the CSV would have it: header on line 1)."""
+    @property
+    def warnings(self) -> list[str]:
+        """The plausibility warnings given when the data were read (also given as
+        :class:`UnitWarning`)."""
+    def __len__(self) -> int: ...
+    @property
+    def labels(self) -> list[str]:
+        """The series labels, in order of first appearance."""
+    @property
+    def has_sigma(self) -> bool:
+        """Whether the points carry σ (absolute weights) or not (relative weights)."""
+    def columns(self) -> dict[str, np.ndarray]:
+        """The points as arrays: series (labels), series_index, xi, delta_deg, v, sigma_v
+        (NaN without), rho, f; velocities dimensionless.
+
+        The data set holds δ in radians: ``delta_deg`` is converted back and may differ from
+        the file's degrees in the last bit (:func:`invert_k` on a Dataset uses the radians
+        themselves)."""
+    def to_pandas(self):
+        """The points as a DataFrame (needs pandas)."""
+
+@dataclass(frozen=True)
+class Param:
+    """One fitted parameter: a row of the command line's params.csv.
+
+    Numbers the report leaves empty are NaN (never None), so that arrays and DataFrames built
+    from parameters stay numeric.
+    """
+    name: str
+    series: str
+    value: float
+    stderr: float
+    low: float
+    high: float
+    method: str
+    level: float
+    unit: str
+    at_bound: bool
+    bounds: tuple[float, float]
+    paper_value: float
+    paper_source: str
+    lsq_value: float
+    note: str
+    rhat: float = ...
+    ess_bulk: float = ...
+    ess_tail: float = ...
+    cov_low: float = ...
+    cov_high: float = ...
+    profile_low: float = ...
+    profile_high: float = ...
+    profile_low_status: str = ...
+    profile_high_status: str = ...
+    mean: float = ...
+    sd: float = ...
+    q2_5: float = ...
+    q50: float = ...
+    q97_5: float = ...
+    tau: float = ...
+    record: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
+
+class FitResult:
+    """One fit: parameters with errors and intervals, correlations, residuals, statistics.
+
+    ``print(result)`` shows the fit report the command line prints; in a notebook the report
+    renders as HTML. The lmfit habits hold: :attr:`params` by name, :attr:`covar`,
+    :attr:`residual`, :meth:`eval`, :meth:`eval_band`, :meth:`fit_report`, :meth:`plot`. For
+    an MCMC fit, :attr:`draws` holds the posterior draws and :meth:`to_arviz` makes an
+    ``arviz.InferenceData`` with a pointwise log likelihood (so ``az.loo`` and
+    ``az.compare`` work).
+    """
+    params: dict[str, Param]
+    stats: dict[str, Any]
+    correlation: np.ndarray | None
+    residuals: dict[str, np.ndarray]
+    draws: np.ndarray | None
+    log_posterior: np.ndarray | None
+    burn_in: int
+    interrupted: bool
+    def __init__(self, core: Any, context: dict[str, Any] | None = None) -> None: ...
+    @property
+    def param_names(self) -> list[str]:
+        """The parameters' keys in the fit's order (the order of :attr:`covar`)."""
+    @property
+    def values(self) -> dict[str, float]:
+        """``{name: value}`` of the parameters that set the curve (not the scatter's scale),
+        with the names :func:`forward` takes: ``fitbead.forward(model, xi, d, **fit.values)``
+        evaluates a Jan, Jaeger or K-law ``c`` fit."""
+    @property
+    def covar(self) -> np.ndarray | None:
+        """Covariance matrix of the parameters (order of :attr:`param_names`): from the
+        least-squares covariance, or of the posterior draws (MCMC); None where a standard
+        error is missing (an undetermined fit)."""
+    @property
+    def residual(self) -> np.ndarray:
+        """The normalised residuals (v − v̄_fit)/σ of the fitted points (lmfit's
+        ``residual``; divided by the relative weight where no σ is given)."""
+    @property
+    def correlations(self) -> dict[tuple[str, str], float]:
+        """Correlation of each pair of parameters ``{(a, b): r}`` with a before b."""
+    @property
+    def chi2(self) -> float: ...
+    @property
+    def reduced_chi2(self) -> float: ...
+    @property
+    def aic(self) -> float: ...
+    @property
+    def bic(self) -> float: ...
+    @property
+    def converged(self) -> bool: ...
+    def __getitem__(self, name: str) -> Param: ...
+    def eval(self, delta_deg: ArrayLike, xi: ArrayLike | None = None, *, series: str | None = None) -> np.ndarray:
+        """The fitted model's mean velocity v̄ at new slopes (lmfit's ``eval``).
+
+        Parameters
+        ----------
+        delta_deg : array_like
+            Slopes in degrees.
+        xi : array_like, optional
+            Radius ratios (broadcast with ``delta_deg``); default: the ξ of the fit's series
+            (or of ``series``).
+        series : str, optional
+            For a fit with one K per series, the series whose K to use.
+
+        Returns
+        -------
+        numpy.ndarray
+            v̄ (NaN where the model has no steady state), shaped as the broadcast arguments.
+        """
+    def eval_band(self, delta_deg: ArrayLike, xi: ArrayLike | None = None, *, level: float = 0.95, series: str | None = None, draws: int = 400) -> Table:
+        """A confidence (least squares) or credible (MCMC) band of the fitted curve.
+
+        Under least squares: the delta method, v̄ ± z σ_v̄ with σ_v̄² = J C Jᵀ, J the
+        derivatives of v̄ in the parameters (central differences, step 10⁻⁴ standard
+        errors) and C :attr:`covar`. Under MCMC: the quantiles (1 ∓ level)/2 of v̄ over up to
+        ``draws`` posterior draws evenly spaced through the kept ones.
+
+        Returns
+        -------
+        Table
+            ``xi``, ``delta_deg``, ``v`` (the fit's curve), ``v_low``, ``v_high``.
+        """
+    def report(self) -> str:
+        """The fit report (the command line's text)."""
+    def fit_report(self) -> str:
+        """The fit report (lmfit's name for :meth:`report`)."""
+    def to_pandas(self, what: str = 'params'):
+        '''A DataFrame (needs pandas) with the command line\'s columns and numeric dtypes
+        (NaN for an empty cell).
+
+        Parameters
+        ----------
+        what : {"params", "stats", "residuals", "correlations", "draws"}
+            ``params`` (params.csv: one row per parameter), ``stats`` (stats.csv: one row),
+            ``residuals`` (residuals.csv: one row per point), ``correlations``
+            (correlations.csv: one row per pair), ``draws`` (one row per kept draw, with
+            walker and step).
+        '''
+    def log_likelihood(self) -> np.ndarray:
+        """The pointwise log likelihood ``[walker, kept step, point]`` of the posterior draws
+        (MCMC): ln N(v_i | v̄_i(θ), (s σ_i)²), with σ_i the point's σ (1 without) and s the
+        scatter's scale where it is sampled (``sigma_scale``), constants included."""
+    def to_arviz(self):
+        """The posterior as an ``arviz.InferenceData`` (needs ArviZ): ``posterior`` (one
+        chain per walker), ``log_likelihood`` (``v``, per point: :meth:`log_likelihood`, so
+        ``az.loo``, ``az.waic`` and ``az.compare`` work), ``sample_stats`` (``lp``: the log
+        posterior), ``observed_data`` (``v``) and ``constant_data`` (``xi``, ``delta_deg``,
+        ``sigma_v``)."""
+    def plot(self, ax: Any = None, *, level: float = 0.95, units: str = 'dimensionless'):
+        """Data with error bars, the fitted curve and its band (:meth:`eval_band`) per
+        series, and the normalised residuals below (needs matplotlib).
+
+        Parameters
+        ----------
+        ax : sequence of two matplotlib Axes, optional
+            Where to draw (curve, residuals); default: a new figure.
+        level : float
+            Level of the band.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+
+class FitSet(list):
+    """The fits of one run (Jan's per-series fits and global laws; Jaeger's per series), with
+    the run's notes. A list of :class:`FitResult`."""
+    notes: list[str]
+    def __init__(self, fits: Iterable[FitResult], notes: Iterable[str]) -> None: ...
+    def get(self, name: str, series: str | None = None) -> FitResult | None:
+        """The fit named ``name`` (``jan-series``, ``jan-global``, ``jaeger``) for ``series``
+        (a series label; ``all`` for a global fit), or the first fit of that name when
+        ``series`` is None."""
+    def to_pandas(self, what: str = 'params'):
+        """Every fit's table in one DataFrame (needs pandas): ``params``, ``stats``,
+        ``residuals`` or ``correlations``, with the command line's columns (its CSV of the
+        whole run), numeric dtypes and NaN for empty cells."""
+
+def fit_klaw(data: Any = None, *, model: str = 'stickslip', law: str = 'c', method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None) -> FitResult:
+    '''A law K(α) fitted to every series at once (``fitbead klaw``).
+
+    Parameters
+    ----------
+    data : Dataset, str, path or DataFrame, optional
+        The measurements (default: the shipped data).
+    model : str, default "stickslip"
+        The contact model: ``stick``, ``stick-approx``, ``slip``, ``slip-approx``,
+        ``stickslip`` or ``contact``.
+    law : str, default "c"
+        ``c`` (K = cos 2α + c sin²α sin 2α), ``free-per-series`` (one K per series) or
+        ``impact`` (nothing fitted: scored).
+    method : {"lsq", "mcmc"}, default "lsq"
+        ``lsq`` (least squares; intervals from profile likelihood when ``profile``, else
+        the covariance) or ``mcmc`` (a posterior run from the least-squares optimum: the
+        result\'s value is the posterior median, ``draws`` the kept draws).
+    level : float, default 0.95
+        Confidence level of the intervals, in (0, 1).
+    profile : bool, default True
+        Least squares: profile-likelihood intervals (else the covariance\'s).
+    seed : int, default 1
+        MCMC: the seed (the same draws on any machine and thread count).
+    walkers, max_steps : int, optional
+        MCMC: the walkers (default: the library\'s choice) and the step limit.
+    min_ess : float, optional
+        MCMC: the bulk and tail ESS every parameter must reach (with rank-normalised split-R̂
+        ≤ 1.01) before the run stops (default 1000).
+
+    Returns
+    -------
+    FitResult
+
+    Raises
+    ------
+    FitbeadError
+        Bad data or settings (the command line\'s message).
+    KeyboardInterrupt
+        Ctrl-C stops an MCMC run cleanly and raises.
+
+    Warns
+    -----
+    UnitWarning, ConvergenceWarning, BoundWarning
+        The command line\'s warnings on the data and the fit.
+    '''
+def fit_jan(data: Any = None, *, method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None) -> FitSet:
+    '''Jan\'s energy balance (eq 74): λ and μ per series (at least 3 points), then the global
+    laws of eqs 75–76 (``fitbead jan``).
+
+    Parameters
+    ----------
+    data : Dataset, str, path or DataFrame, optional
+        The measurements (default: the shipped data).
+    method : {"lsq", "mcmc"}, default "lsq"
+        ``lsq`` (least squares; intervals from profile likelihood when ``profile``, else
+        the covariance) or ``mcmc`` (a posterior run from the least-squares optimum).
+    level : float, default 0.95
+        Confidence level of the intervals, in (0, 1).
+    profile : bool, default True
+        Least squares: profile-likelihood intervals (else the covariance\'s).
+    seed, walkers, max_steps, min_ess
+        MCMC settings, as in :func:`fit_klaw`.
+
+    Returns
+    -------
+    FitSet
+        ``jan-series`` fits (λ, μ) per series, then ``jan-global`` (λ0, λ1, μ0, μ1 of
+        λ = λ0 e^{λ1 sin α}, μ = μ0 e^{μ1 sin α}).
+
+    Warns
+    -----
+    UnitWarning, ConvergenceWarning, BoundWarning
+        The command line\'s warnings on the data and the fits.
+    '''
+def fit_jaeger(data: Any = None, *, branch: str = 'upper', method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None) -> FitSet:
+    '''Jaeger\'s heuristic law (eqs 80–84): a1, a2, a3 per series with at least 4 points
+    (``fitbead jaeger``).
+
+    Parameters
+    ----------
+    data : Dataset, str, path or DataFrame, optional
+        The measurements (default: the shipped data).
+    branch : {"upper", "lower"}, default "upper"
+        The root of eq 84 when there are two.
+    method : {"lsq", "mcmc"}, default "lsq"
+        ``lsq`` (least squares; intervals from profile likelihood when ``profile``, else
+        the covariance) or ``mcmc`` (a posterior run from the least-squares optimum).
+    level : float, default 0.95
+        Confidence level of the intervals, in (0, 1).
+    profile : bool, default True
+        Least squares: profile-likelihood intervals (else the covariance\'s).
+    seed, walkers, max_steps, min_ess
+        MCMC settings, as in :func:`fit_klaw`.
+
+    Returns
+    -------
+    FitSet
+        One ``jaeger`` fit per series.
+
+    Warns
+    -----
+    UnitWarning, ConvergenceWarning, BoundWarning
+        The command line\'s warnings on the data and the fits.
+    '''

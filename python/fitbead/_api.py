@@ -558,6 +558,11 @@ class Param:
     """Posterior mean, standard deviation and quantiles (MCMC; NaN under least squares)."""
     tau: float = math.nan
     """Integrated autocorrelation time of the posterior draws (MCMC)."""
+    prior_sensitivity: float = math.nan
+    likelihood_sensitivity: float = math.nan
+    prior_diagnosis: str = ""
+    """Power-scaling sensitivity of the posterior to the prior and to the likelihood, and
+    ``prior-driven`` or ``prior-data conflict`` where it is flagged (MCMC)."""
     record: Dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
     """The whole row as the command line writes it (keys: params.csv's columns)."""
 
@@ -595,6 +600,9 @@ def _param(r: Dict[str, Any], bounds: Tuple[float, float]) -> Param:
         q50=_nan(r["q50"]),
         q97_5=_nan(r["q97.5"]),
         tau=_nan(r["tau"]),
+        prior_sensitivity=_nan(r["prior_sensitivity"]),
+        likelihood_sensitivity=_nan(r["likelihood_sensitivity"]),
+        prior_diagnosis=r["prior_diagnosis"] or "",
         record=dict(r),
     )
 
@@ -615,7 +623,7 @@ def _frame(records: Sequence[Mapping[str, Any]], columns: Sequence[str]):
 
 # Text columns of the reports that may be empty in every row of a table (kept as text).
 _TEXT_COLUMNS = frozenset(
-    ["note", "paper_source", "profile_low_status", "profile_high_status", "mcmc_status", "method", "ci_method", "unit"]
+    ["prior_diagnosis", "note", "paper_source", "profile_low_status", "profile_high_status", "mcmc_status", "method", "ci_method", "unit"]
 )
 
 # What each fit evaluates: fit name -> how its parameters make a curve.

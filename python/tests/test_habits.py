@@ -258,3 +258,13 @@ def test_stubs_name_every_public_item_with_its_parameters():
             assert stub == real, name
         elif inspect.isclass(obj):
             assert name in classes, name
+
+
+def test_prior_sensitivity_reaches_the_parameters(data):
+    """The posterior's power-scaling check arrives in Param and to_pandas: Jaeger's a2 at
+    ξ = 0.8 is flagged (tests/it/prior_sensitivity.rs checks the library's side)."""
+    set_ = fitbead.fit_jaeger(data, method="mcmc", seed=1, min_ess=400)
+    a2 = set_.get("jaeger", "0.8").params["a2"]
+    assert a2.prior_sensitivity >= 0.05 and a2.prior_diagnosis in ("prior-driven", "prior-data conflict")
+    p = set_.to_pandas()
+    assert p["prior_sensitivity"].dtype == np.float64 and (p["prior_sensitivity"] >= 0).all()

@@ -271,10 +271,12 @@ pub fn fit_jaeger_with(
             None => summarise_with(method, solved),
         };
         summary.attach_points(data, &data.series_index(s));
+        // The notes describe the values reported: the optimum, or the posterior medians.
+        let value = |k: usize| summary.params.get(k).map_or(f.params[k], |r| r.value);
         let m = Jaeger {
-            a1: f.params[0],
-            a2: f.params[1],
-            a3: f.params[2],
+            a1: value(0),
+            a2: value(1),
+            a3: value(2),
             branch,
         };
         let bistable_points = x.iter().filter(|q| m.bistable(q.0)).count();

@@ -33,8 +33,9 @@
 //! optimum stays in `cov_low`/`cov_high` and the optimum in `lsq_value`.
 
 use super::summary::{
-    chi2_vanishes, summarise, FitResult, McmcFailure, McmcStats, ParamRow, Solved,
+    chi2_vanishes, summarise, FitResult, McmcFailure, McmcStats, ParamRow, PowerScaling, Solved,
 };
+use crate::inverse::mcmc::sensitivity::sensitivity;
 use crate::inverse::mcmc::{EnsembleSampler, StopReason};
 use crate::inverse::posterior::Posterior;
 pub use crate::inverse::posterior::Reparameterisation;
@@ -287,25 +288,59 @@ fn sample<R: Residuals + Sync + ?Sized>(
             bounds: (0.0, f64::INFINITY),
             lsq_value: Some(s0),
             posterior: None,
+            sensitivity: None,
         });
     }
     let all_priors: Vec<&Prior> = priors.iter().chain(scale_prior.iter()).collect();
+    // What the least-squares run noted is about the optimum the chains start from.
+    if !out.stats.note.is_empty() {
+        out.stats.note = format!("least-squares start: {}", out.stats.note);
+    }
+    let ll = pointwise_log_likelihood(problem, n, &res.chains);
+    let scaling = power_scaling(&ll, &all_priors);
+    // The rows report the posterior: their notes are the posterior's (the least-squares
+    // notes describe the optimum, kept in `lsq_value`, and are not repeated here).
     for (j, row) in out.params.iter_mut().enumerate() {
         row.lsq_value = Some(row.value);
         row.profile = None;
+        row.at_bound = false;
         let prior_note = format!("prior {}", all_priors[j]);
         match res.diagnostics.get(j) {
             Some(d) => {
                 row.value = d.median;
                 row.stderr = Some(d.sd);
                 row.posterior = Some(d.clone());
-                row.note = join(&prior_note, &row.note);
+                row.at_bound = d.median <= row.bounds.0 || d.median >= row.bounds.1;
+                row.note = prior_note;
+                if let Some(ps) = scaling.as_ref().and_then(|v| v.get(j)).copied() {
+                    row.sensitivity = Some(ps);
+                    let what = match ps.diagnosis() {
+                        "prior-driven" => Some(format!(
+                            "prior-driven: the data say little about {}, so its posterior and \
+                             interval reflect the prior",
+                            row.parameter
+                        )),
+                        "prior-data conflict" => Some(format!(
+                            "prior-data conflict: the prior and the data pull {} apart",
+                            row.parameter
+                        )),
+                        _ => None,
+                    };
+                    if let Some(what) = what {
+                        row.note = join(
+                            &row.note,
+                            &format!(
+                                "{what} (power-scaling sensitivity to the prior {}, to the \
+                                 likelihood {}; flagged from 0.05)",
+                                fmt_sig(ps.prior, 2),
+                                fmt_sig(ps.likelihood, 2)
+                            ),
+                        );
+                    }
+                }
             }
             None => {
-                row.note = join(
-                    &format!("{prior_note}; no draw kept: least-squares values"),
-                    &row.note,
-                );
+                row.note = format!("{prior_note}; no draw kept: least-squares values");
             }
         }
     }
@@ -410,7 +445,7 @@ fn sample<R: Residuals + Sync + ?Sized>(
         acceptance: res.acceptance_overall,
         ess_min,
         rhat_max,
-        waic: waic(problem, n, &res.chains),
+        waic: waic(&ll),
         failure: None,
     });
     out.draws = Some(Draws {
@@ -459,42 +494,16 @@ const WAIC_DRAWS: usize = 1000;
 /// (with the scale), dropping the constant −ln σᵢ − ½ ln 2π, which is the same for every model
 /// of the same data, so WAIC differences between models are exact. Returns (WAIC, p_waic,
 /// standard error of WAIC), or `None` without draws.
-fn waic<R: Residuals + Sync + ?Sized>(
-    problem: &R,
-    n: usize,
-    chains: &[Vec<Vec<f64>>],
-) -> Option<(f64, f64, f64)> {
-    let pooled: Vec<&Vec<f64>> = chains.iter().flatten().collect();
-    if pooled.len() < 2 {
-        return None;
-    }
-    let stride = pooled.len().div_ceil(WAIC_DRAWS).max(1);
-    let m = problem.n_residuals();
-    let ll: Vec<Vec<f64>> = pooled
-        .par_iter()
-        .step_by(stride)
-        .filter_map(|x| {
-            let mut r = vec![0.0; m];
-            problem.residuals(&x[..n], &mut r).ok()?;
-            let s = x.get(n).copied();
-            Some(
-                r.iter()
-                    .map(|ri| match s {
-                        None => -0.5 * ri * ri,
-                        Some(s) => -s.ln() - 0.5 * ri * ri / (s * s),
-                    })
-                    .collect(),
-            )
-        })
-        .collect();
+fn waic(ll: &[(&[f64], Vec<f64>)]) -> Option<(f64, f64, f64)> {
     let ns = ll.len();
     if ns < 2 {
         return None;
     }
+    let m = ll[0].1.len();
     let mut elpd_i = Vec::with_capacity(m);
     let mut p_total = 0.0;
     for i in 0..m {
-        let col: Vec<f64> = ll.iter().map(|d| d[i]).collect();
+        let col: Vec<f64> = ll.iter().map(|d| d.1[i]).collect();
         let mx = col.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         let lppd = mx + (col.iter().map(|v| (v - mx).exp()).sum::<f64>() / ns as f64).ln();
         let mean = col.iter().sum::<f64>() / ns as f64;
@@ -509,6 +518,63 @@ fn waic<R: Residuals + Sync + ?Sized>(
         / (m as f64 - 1.0).max(1.0))
     .sqrt();
     Some((total, p_total, se))
+}
+
+/// Up to [`WAIC_DRAWS`] draws evenly spaced through the pooled kept draws, each with its
+/// pointwise log likelihood ln p(yᵢ | θ) (the constant −ln σᵢ − ½ ln 2π dropped, as in
+/// [`waic`]); draws whose residuals cannot be evaluated are left out. Empty with fewer than
+/// two draws.
+fn pointwise_log_likelihood<'a, R: Residuals + Sync + ?Sized>(
+    problem: &R,
+    n: usize,
+    chains: &'a [Vec<Vec<f64>>],
+) -> Vec<(&'a [f64], Vec<f64>)> {
+    let pooled: Vec<&Vec<f64>> = chains.iter().flatten().collect();
+    if pooled.len() < 2 {
+        return Vec::new();
+    }
+    let stride = pooled.len().div_ceil(WAIC_DRAWS).max(1);
+    let m = problem.n_residuals();
+    pooled
+        .par_iter()
+        .step_by(stride)
+        .filter_map(|x| {
+            let mut r = vec![0.0; m];
+            problem.residuals(&x[..n], &mut r).ok()?;
+            let s = x.get(n).copied();
+            Some((
+                x.as_slice(),
+                r.iter()
+                    .map(|ri| match s {
+                        None => -0.5 * ri * ri,
+                        Some(s) => -s.ln() - 0.5 * ri * ri / (s * s),
+                    })
+                    .collect(),
+            ))
+        })
+        .collect()
+}
+
+/// The power-scaling sensitivity of every sampled parameter (the scale included) to the
+/// prior and to the likelihood ([`crate::inverse::mcmc::sensitivity`]), from the draws of
+/// [`pointwise_log_likelihood`]; the log prior of a draw is the sum of its parameters'
+/// log prior densities.
+fn power_scaling(ll: &[(&[f64], Vec<f64>)], priors: &[&Prior]) -> Option<Vec<PowerScaling>> {
+    let draws: Vec<&[f64]> = ll.iter().map(|d| d.0).collect();
+    let log_prior: Vec<f64> = draws
+        .iter()
+        .map(|x| x.iter().zip(priors).map(|(v, p)| p.ln_pdf(*v)).sum())
+        .collect();
+    let log_lik: Vec<f64> = ll.iter().map(|d| d.1.iter().sum()).collect();
+    let prior = sensitivity(&draws, &log_prior)?;
+    let likelihood = sensitivity(&draws, &log_lik)?;
+    Some(
+        prior
+            .into_iter()
+            .zip(likelihood)
+            .map(|(prior, likelihood)| PowerScaling { prior, likelihood })
+            .collect(),
+    )
 }
 
 /// Pearson correlation matrix of the draws, all walkers pooled; `None` without draws.

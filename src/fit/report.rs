@@ -182,6 +182,18 @@ impl fmt::Display for FitResult {
                 ));
             }
         }
+        for p in &self.params {
+            if let Some(x) = p.sensitivity.filter(|x| !x.diagnosis().is_empty()) {
+                warnings.push(format!(
+                    "{}: {} (power-scaling sensitivity to the prior {}, to the likelihood {}; \
+                     flagged from 0.05): its posterior and interval depend on the prior",
+                    p.parameter,
+                    x.diagnosis(),
+                    num(x.prior),
+                    num(x.likelihood)
+                ));
+            }
+        }
         if !s.converged && (s.n_params > 0 || s.mcmc.is_some()) {
             warnings.push("the fit did not converge: the values are not an optimum".into());
         }

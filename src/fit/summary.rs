@@ -53,6 +53,35 @@ pub struct ParamRow {
     pub lsq_value: Option<f64>,
     /// Posterior summary (MCMC only): `value` is then its median, `stderr` its sd.
     pub posterior: Option<ParameterDiagnostics>,
+    /// How much the posterior of this parameter moves when the prior or the likelihood is
+    /// power-scaled (MCMC only).
+    pub sensitivity: Option<PowerScaling>,
+}
+
+/// Power-scaling sensitivity of one parameter's posterior (`priorsense`'s diagnostic: the
+/// derivative, in log₂ of the power, of the cumulative Jensen–Shannon distance between the
+/// posterior and the posterior with that component raised to the power).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PowerScaling {
+    /// Sensitivity to power-scaling the prior.
+    pub prior: f64,
+    /// Sensitivity to power-scaling the likelihood.
+    pub likelihood: f64,
+}
+
+impl PowerScaling {
+    /// `prior-driven` (sensitive to the prior, not to the likelihood: the data say little and
+    /// the interval reflects the prior), `prior-data conflict` (sensitive to both), or empty.
+    pub fn diagnosis(&self) -> &'static str {
+        let t = crate::inverse::mcmc::sensitivity::SENSITIVITY_THRESHOLD;
+        if self.prior >= t && self.likelihood >= t {
+            "prior-data conflict"
+        } else if self.prior >= t {
+            "prior-driven"
+        } else {
+            ""
+        }
+    }
 }
 
 impl ParamRow {
@@ -662,9 +691,13 @@ pub(crate) fn summarise_with_profiles<R: Residuals + ?Sized>(
                              there do not converge inside the model's feasible region. ",
                             fmt_f64(e)
                         )),
-                        ProfileEnd::NotFound => {
-                            pnote.push_str(&format!("profile {which} end not found. "))
-                        }
+                        ProfileEnd::NotFound => pnote.push_str(&format!(
+                            "profile {which} end not found: the likelihood does not fall by the \
+                             {} % threshold on that side within the search, so the data do not \
+                             bound {} there. ",
+                            fmt_sig(100.0 * level, 6),
+                            s.name
+                        )),
                     }
                 }
             }
@@ -689,6 +722,7 @@ pub(crate) fn summarise_with_profiles<R: Residuals + ?Sized>(
                 bounds,
                 lsq_value: Some(f.params[j]),
                 posterior: None,
+                sensitivity: None,
             }
         })
         .collect();

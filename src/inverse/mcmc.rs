@@ -28,6 +28,7 @@
 //! [`diagnostics`] and work on any chains.
 
 pub mod diagnostics;
+pub(crate) mod sensitivity;
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Arc;

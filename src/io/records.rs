@@ -154,6 +154,12 @@ pub struct ParamRecord {
     pub tau: Option<f64>,
     /// The least-squares optimum (the start of the chains for a posterior run).
     pub lsq_value: Option<f64>,
+    /// Power-scaling sensitivity of the posterior to the prior (posterior runs).
+    pub prior_sensitivity: Option<f64>,
+    /// Power-scaling sensitivity of the posterior to the likelihood (posterior runs).
+    pub likelihood_sensitivity: Option<f64>,
+    /// `prior-driven`, `prior-data conflict` or empty (posterior runs; threshold 0.05).
+    pub prior_diagnosis: String,
 }
 
 fn end_value(e: ProfileEnd) -> Option<f64> {
@@ -211,6 +217,9 @@ impl From<&ParamRow> for ParamRecord {
             rhat: post.map(|d| d.rhat),
             tau: post.map(|d| d.tau),
             lsq_value: r.lsq_value,
+            prior_sensitivity: r.sensitivity.map(|x| x.prior),
+            likelihood_sensitivity: r.sensitivity.map(|x| x.likelihood),
+            prior_diagnosis: r.sensitivity.map_or("", |x| x.diagnosis()).into(),
         }
     }
 }

@@ -86,7 +86,15 @@ fn parameter_table(an: &Analysis) -> String {
             } else {
                 f.stats.series.clone()
             };
-            let note = if r.at_bound {
+            let flagged = r.sensitivity.filter(|x| !x.diagnosis().is_empty());
+            let note = if let Some(x) = flagged {
+                format!(
+                    "{} (power-scaling sensitivity to the prior {}, to the likelihood {})",
+                    x.diagnosis(),
+                    fmt_sig(x.prior, 2),
+                    fmt_sig(x.likelihood, 2)
+                )
+            } else if r.at_bound {
                 format!("on the bound {}", fmt_sig(bound_of(r), 4))
             } else if r.stderr.is_none() && !an.mcmc {
                 if f.stats.note.contains("rank deficient") {

@@ -26,6 +26,7 @@ mod mcmc;
 mod md;
 mod nist;
 mod paper_figures;
+mod prior_sensitivity;
 mod properties;
 mod recipes;
 mod reference_models;

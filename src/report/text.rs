@@ -96,6 +96,14 @@ fn parameter_table(an: &Analysis) -> String {
                 )
             } else if r.at_bound {
                 format!("on the bound {}", fmt_sig(bound_of(r), 4))
+            } else if r.interval().0.is_none() {
+                // Why there is no interval, in the words of the row's note.
+                r.note
+                    .split(". ")
+                    .find(|s| s.contains("profile") || s.contains("not determined"))
+                    .map_or("no interval".to_string(), |s| {
+                        format!("no interval: {}", s.trim_end_matches('.'))
+                    })
             } else if r.stderr.is_none() && !an.mcmc {
                 if f.stats.note.contains("rank deficient") {
                     "no standard error (rank-deficient Jacobian)".to_string()

@@ -291,9 +291,19 @@ fn summary(s: &DesignSettings, r: &DesignResult) -> String {
                     fmt_sig(td, 4),
                     fmt_sig(te, 4)
                 );
+                let n = |x: f64| {
+                    if x.is_finite() {
+                        format!("{x}")
+                    } else {
+                        "never".to_string()
+                    }
+                };
                 let _ = writeln!(
                     o,
-                    "points for power 0.8 at significance 0.05: design {nd} / evenly spaced {ne}"
+                    "points in all for power 0.8 at significance 0.05: design {} / evenly \
+                     spaced {}",
+                    n(nd),
+                    n(ne)
                 );
             }
         }

@@ -56,7 +56,8 @@ pub enum Command {
     /// Synthetic measurements inside regime B, reproducible from a seed.
     Simulate(simulate::Args),
     /// The slopes to measure, per series, for a fit's parameters (D, c criteria) or to tell
-    /// two models apart (T), with the predicted standard errors.
+    /// two models apart (T), with the predicted standard errors. With --plot: the sensitivity
+    /// of every candidate slope per series, the chosen slopes marked.
     Design(design::Args),
     /// Work-precision report: error against time of every model and method variant, and of
     /// `--model auto`, against cross-checked references (CSV and SVG).

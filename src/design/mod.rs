@@ -205,9 +205,10 @@ pub struct DesignResult {
     /// T: the criterion min_θ Σ (v̄_A − v̄_B(θ))²/σ² at the design and at evenly spaced
     /// slopes (the noncentrality of the test of B).
     pub discrimination: Option<(f64, f64)>,
-    /// T: the points needed for the test of B to reach power 0.8 at significance 0.05, at the
-    /// design's proportions and at evenly spaced slopes.
-    pub points_needed: Option<(usize, usize)>,
+    /// T: the points needed, in all, for the test of B to reach power 0.8 at significance
+    /// 0.05, at the design's proportions and at evenly spaced slopes (+∞ where the two models
+    /// agree at every slope of the design).
+    pub points_needed: Option<(f64, f64)>,
     /// What each candidate slope contributes, per series: (slope in degrees, sensitivity
     /// ψ/λ of the approximate design; 1 on its support at the optimum).
     pub sensitivity: Vec<Vec<(f64, f64)>>,
@@ -282,10 +283,14 @@ pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
     };
     let prob = problem::problem(s.fit, model, s.law, &s.series, s.rho, s.f, s.branch)?;
     let p = prob.names.len();
-    let ranges = ranges(s, &prob)?;
+    let rival_prob = match s.criterion {
+        Criterion::T => Some(rival(s, &prob)?),
+        _ => None,
+    };
+    let ranges = ranges(s, &prob, rival_prob.as_ref())?;
     // Candidates, stratum by stratum.
     let mut cands = Vec::new();
-    let mut strata = Vec::new();
+    let mut strata: Vec<Vec<usize>> = Vec::new();
     for (k, &(lo, hi)) in ranges.iter().enumerate() {
         let mut st = Vec::new();
         for i in 0..s.grid {
@@ -341,7 +346,8 @@ pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
             )
         }
         Criterion::T => {
-            let (a, rival) = t_design(s, &prob, &cands, &strata, &budgets)?;
+            let (a, rival, st) = t_design(s, &prob, &cands, &strata, &budgets)?;
+            strata = st;
             (
                 a,
                 "squared distance to the rival (T)".to_string(),
@@ -406,12 +412,11 @@ pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
             discrimination = Some((t_design, t_even));
             let total = (s.points * s.series.len()) as f64;
             let need = |t: f64| {
-                let lambda = noncentrality(0.05, 0.8);
                 let per_point = t / total;
                 if per_point > 0.0 {
-                    (lambda / per_point).ceil().min(usize::MAX as f64 / 2.0) as usize
+                    (noncentrality(0.05, 0.8) / per_point).ceil()
                 } else {
-                    usize::MAX
+                    f64::INFINITY
                 }
             };
             points_needed = Some((need(t_design), need(t_even)));
@@ -540,7 +545,11 @@ fn no_range(xi: f64, why: &str) -> DesignError {
 
 /// The slope range of each series (radians): regime B of the guess, cut to the caller's
 /// range, kept 5 % of its width from each end.
-fn ranges(s: &DesignSettings, prob: &Problem) -> Result<Vec<(f64, f64)>, DesignError> {
+fn ranges(
+    s: &DesignSettings,
+    prob: &Problem,
+    rival: Option<&Problem>,
+) -> Result<Vec<(f64, f64)>, DesignError> {
     (0..s.series.len())
         .map(|k| {
             let xi = s.series[k];
@@ -558,6 +567,22 @@ fn ranges(s: &DesignSettings, prob: &Problem) -> Result<Vec<(f64, f64)>, DesignE
                 return Err(no_range(
                     xi,
                     "the slope range given lies outside regime B of the guess",
+                ));
+            }
+            // The T criterion compares the two models where both are steady at the guess.
+            let (lo, hi) = match rival {
+                Some(r) => {
+                    let (l, h) = r.regime_b(k).ok_or_else(|| {
+                        no_range(xi, "the rival model at the guess has no steady state")
+                    })?;
+                    (lo.max(l), hi.min(h))
+                }
+                None => (lo, hi),
+            };
+            if !(lo < hi) {
+                return Err(no_range(
+                    xi,
+                    "the model and its rival at the guess have no steady slope in common",
                 ));
             }
             let m = 0.05 * (hi - lo);
@@ -702,14 +727,35 @@ fn t_value(
 
 /// The T-optimal approximate design (Atkinson–Fedorov), started from equal weights on every
 /// fifth candidate.
+/// Only the candidates where the rival at its guess is steady take part (the rival is
+/// fitted there); these strata are returned with the design.
 fn t_design(
     s: &DesignSettings,
     prob: &Problem,
     cands: &[Cand],
     strata: &[Vec<usize>],
     budgets: &[f64],
-) -> Result<(Approx, Problem), DesignError> {
+) -> Result<(Approx, Problem, Vec<Vec<usize>>), DesignError> {
     let rival = rival(s, prob)?;
+    let strata: Vec<Vec<usize>> = strata
+        .iter()
+        .map(|st| {
+            st.iter()
+                .copied()
+                .filter(|&j| {
+                    let c = &cands[j];
+                    rival.velocity(c.series, c.delta, &rival.guess).is_some()
+                })
+                .collect()
+        })
+        .collect();
+    if let Some(k) = strata.iter().position(Vec::is_empty) {
+        return Err(no_range(
+            s.series[k],
+            "the rival model at the guess has no steady state in its range",
+        ));
+    }
+    let strata = &strata[..];
     let truth: Vec<Option<f64>> = cands
         .iter()
         .map(|c| prob.velocity(c.series, c.delta, &prob.guess))
@@ -752,7 +798,7 @@ fn t_design(
             "the rival model could not be fitted to the true curve",
         )
     })?;
-    Ok((a, rival))
+    Ok((a, rival, strata.to_vec()))
 }
 
 /// The noncentrality at which a one-degree-of-freedom χ² test at significance `alpha` has

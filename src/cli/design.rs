@@ -347,6 +347,10 @@ fn figure(s: &DesignSettings, r: &DesignResult) -> Figure {
                 stroke: Stroke::solid("#808080", 1.0).dashed("4 3"),
             });
         }
+        p.items.push(fitbead::report::figures::plot::Item::HLine {
+            y: 1.0,
+            stroke: Stroke::solid("#404040", 1.0).dashed("2 3"),
+        });
         p.points(chosen, colour, Mark::Circle);
         let even: Vec<(f64, f64, f64, f64)> = r
             .even
@@ -378,18 +382,22 @@ fn figure(s: &DesignSettings, r: &DesignResult) -> Figure {
         LegendEntry::mark("design slopes", Mark::Circle, "#404040"),
         LegendEntry::mark("evenly spaced slopes", Mark::Cross, "#808080"),
     ];
-    let reps: Vec<String> = r
-        .rows
+    f.legend.push(LegendEntry::line(
+        "equivalence bound (1 on the design)",
+        &Stroke::solid("#404040", 1.0).dashed("2 3"),
+    ));
+    f.notes = s
+        .series
         .iter()
-        .map(|row| {
-            format!(
-                "ξ {}: {}° ×{}",
-                fmt_f64(row.xi),
-                fmt_f64(row.delta_deg),
-                row.replicates
-            )
+        .map(|xi| {
+            let at: Vec<String> = r
+                .rows
+                .iter()
+                .filter(|row| row.xi == *xi)
+                .map(|row| format!("{}° ×{}", fmt_f64(row.delta_deg), row.replicates))
+                .collect();
+            format!("design at ξ = {}: {}", fmt_f64(*xi), at.join(", "))
         })
         .collect();
-    f.notes = vec![format!("design: {}", reps.join("; "))];
     f
 }

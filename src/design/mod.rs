@@ -334,14 +334,14 @@ pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
     let (approx, label, rival) = match s.criterion {
         Criterion::D => (
             optimal::multiplicative(&cands, &strata, &budgets, p, Crit::D),
-            "d(delta) / p: standardised variance (D)".to_string(),
+            "standardised variance d/λ (D)".to_string(),
             None,
         ),
         Criterion::C => {
             let k = target.expect("c has a target");
             (
                 optimal::multiplicative(&cands, &strata, &budgets, p, Crit::C(k)),
-                format!("variance share of {} (c)", prob.names[k]),
+                format!("information on {} ψ/λ (c)", prob.names[k]),
                 None,
             )
         }
@@ -350,7 +350,7 @@ pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
             strata = st;
             (
                 a,
-                "squared distance to the rival (T)".to_string(),
+                "squared distance to the rival ψ/λ (T)".to_string(),
                 Some(rival),
             )
         }

@@ -150,14 +150,12 @@ pub(crate) fn multiplicative(
             Crit::C(_) => 0.5,
         };
         for (st, &n) in strata.iter().zip(budgets) {
-            let mut sum = 0.0;
-            for &j in st {
-                w[j] *= sens[j].powf(r);
-                sum += w[j];
-            }
+            let sum: f64 = st.iter().map(|&j| w[j] * sens[j].powf(r)).sum();
+            // A series that carries no information on the criterion (the target is another
+            // series' own parameter) keeps its weights.
             if sum > 0.0 {
                 for &j in st {
-                    w[j] *= n / sum;
+                    w[j] *= sens[j].powf(r) * n / sum;
                 }
             }
         }
@@ -215,7 +213,7 @@ pub(crate) fn t_optimal(
 }
 
 /// The exact design of each stratum: the runs of neighbouring candidates that carry weight
-/// (above 1e-3 of the stratum's budget) each become one support point, at the candidate of
+/// (above 1e-3 of the stratum's largest) each become one support point, at the candidate of
 /// the run with the largest sensitivity and with the run's weight; the heaviest n_s of them
 /// are kept and rounded to n_s points by efficient rounding (Pukelsheim & Rieder 1992):
 /// m_i = ⌈(n − ℓ/2) w_i⌉, then points are added where m_i/w_i is smallest, or taken away
@@ -229,11 +227,14 @@ pub(crate) fn round(
         .iter()
         .zip(budgets)
         .map(|(st, &n)| {
-            let total: f64 = st.iter().map(|&j| a.w[j]).sum();
+            let top = st.iter().map(|&j| a.w[j]).fold(0.0, f64::max);
+            if !(top > 0.0) || st.iter().all(|&j| !(a.sens[j] > 0.0)) {
+                return spread(st, n);
+            }
             let mut runs: Vec<(usize, f64)> = Vec::new();
             let mut open = false;
             for &j in st {
-                if a.w[j] > 1e-3 * total {
+                if a.w[j] > 1e-3 * top {
                     if open {
                         let last = runs.last_mut().expect("an open run");
                         last.1 += a.w[j];
@@ -263,6 +264,24 @@ pub(crate) fn round(
             out
         })
         .collect()
+}
+
+/// n points spread evenly over a stratum's candidates (for a stratum whose slopes carry no
+/// information on the criterion).
+fn spread(st: &[usize], n: usize) -> Vec<(usize, usize)> {
+    let mut out: Vec<(usize, usize)> = Vec::new();
+    for i in 0..n {
+        let k = if n == 1 {
+            st.len() / 2
+        } else {
+            (i * (st.len() - 1) + (n - 1) / 2) / (n - 1)
+        };
+        match out.last_mut() {
+            Some(last) if last.0 == st[k] => last.1 += 1,
+            _ => out.push((st[k], 1)),
+        }
+    }
+    out
 }
 
 /// Efficient rounding of the weights `w` (adding up to 1, at most `n` of them) to `n` points.
@@ -351,5 +370,31 @@ mod tests {
         let a = multiplicative(&cands, &strata, &[9.0], 3, Crit::D);
         let r = round(&strata, &[9], &a);
         assert_eq!(r[0], vec![(0, 3), (50, 3), (100, 3)]);
+    }
+
+    /// Two series with a line each (parameters a1, b1 and a2, b2): the c-optimal design for
+    /// b1 puts series 1 at its ends and leaves series 2, which says nothing about b1, evenly
+    /// spread.
+    #[test]
+    fn a_series_without_information_is_spread() {
+        let mut cands = Vec::new();
+        for s in 0..2 {
+            for i in 0..11 {
+                let x = -1.0 + 2.0 * i as f64 / 10.0;
+                let mut g = vec![0.0; 4];
+                g[2 * s] = 1.0;
+                g[2 * s + 1] = x;
+                cands.push(Cand {
+                    series: s,
+                    delta: x,
+                    g,
+                });
+            }
+        }
+        let strata = vec![(0..11).collect::<Vec<_>>(), (11..22).collect()];
+        let a = multiplicative(&cands, &strata, &[4.0, 3.0], 4, Crit::C(1));
+        let r = round(&strata, &[4, 3], &a);
+        assert_eq!(r[0], vec![(0, 2), (10, 2)]);
+        assert_eq!(r[1], vec![(11, 1), (16, 1), (21, 1)]);
     }
 }

@@ -3,6 +3,7 @@
 //! [`Error`](enum@Error) wraps any of them, so `?` works across modules and into
 //! `Box<dyn std::error::Error>`.
 
+use crate::design::DesignError;
 use crate::fit::data::DataError;
 use crate::fit::error::FitError;
 use crate::fit::k::KFailure;
@@ -44,6 +45,9 @@ pub enum Error {
     /// A fit that cannot be made, or a parameter the fit does not have.
     #[error(transparent)]
     Fit(#[from] FitError),
+    /// Design settings that cannot make a design.
+    #[error(transparent)]
+    Design(#[from] DesignError),
     /// Reading or writing a file failed.
     #[error(transparent)]
     Io(#[from] std::io::Error),

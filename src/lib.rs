@@ -20,6 +20,8 @@
 //! ```text
 //!   io ─────────── CSV schemas, measurements with units (Dataset::from_csv), atomic files
 //!   report ─────── the paper's comparisons, figures, the work-precision engine
+//!   design ─────── optimal experimental design: the slopes to measure for a parameter
+//!                  (D, c criteria) or to tell two models apart (T)
 //!   fit ────────── the bead problems: K per point (eq 69), K(α) laws, Jan, Jaeger;
 //!                  typed results (FitResult) with a printable fit report, builders
 //!   inverse ────── solvers that know nothing of beads: Levenberg–Marquardt, profiles,
@@ -67,6 +69,7 @@
 // `!(x > 0.0)` is deliberate throughout: a NaN must land in the failure branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod design;
 pub mod error;
 pub mod fit;
 pub mod inverse;

@@ -1,5 +1,6 @@
 //! The names a typical program needs, in one import: `use fitbead::prelude::*;`.
 
+pub use crate::design::{design, Criterion, DesignFit, DesignResult, DesignRow, DesignSettings};
 pub use crate::error::Error;
 pub use crate::fit::builder::{JaegerFitter, JanFitter, KLawFitter};
 pub use crate::fit::data::Dataset;

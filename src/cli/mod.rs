@@ -2,6 +2,7 @@
 
 pub mod args;
 pub mod bench;
+pub mod design;
 pub mod fitargs;
 pub mod forward;
 pub mod jaeger;
@@ -54,6 +55,10 @@ pub enum Command {
     Report(report::Args),
     /// Synthetic measurements inside regime B, reproducible from a seed.
     Simulate(simulate::Args),
+    /// The slopes to measure, per series, for a fit's parameters (D, c criteria) or to tell
+    /// two models apart (T), with the predicted standard errors. With --plot: the sensitivity
+    /// of every candidate slope per series, the chosen slopes marked.
+    Design(design::Args),
     /// Work-precision report: error against time of every model and method variant, and of
     /// `--model auto`, against cross-checked references (CSV and SVG).
     Bench(bench::Args),
@@ -194,6 +199,7 @@ pub fn run(cli: Cli) -> i32 {
         Command::Report(a) => report::run(a),
         Command::Simulate(a) => simulate::run(a),
         Command::Bench(a) => bench::run(a),
+        Command::Design(a) => design::run(a),
     };
     // A signal that arrived after the last check still means the run was cut short.
     let r = match r {
@@ -272,6 +278,7 @@ fn check_stdout(c: &Command) -> Result<(), CliError> {
         Command::Report(_) => false,
         Command::Simulate(a) => a.out.output.is_none(),
         Command::Bench(a) => a.out.output.is_none(),
+        Command::Design(a) => a.out.output.is_none(),
     };
     if stdout_closed() && to_stdout {
         return Err(CliError::Other(
@@ -313,8 +320,18 @@ fn check_paths(c: &Command) -> Result<(), CliError> {
             vec![("--input", a.data.path()), ("--recipe", opt(&a.recipe))],
             vec![],
         ),
-        Command::Simulate(a) => (vec![], vec![("--output", opt(&a.out.output))]),
+        Command::Simulate(a) => (
+            vec![("--design", opt(&a.design))],
+            vec![("--output", opt(&a.out.output))],
+        ),
         Command::Bench(a) => (
+            vec![],
+            vec![
+                ("--output", opt(&a.out.output)),
+                ("--plot", opt(&a.plot.plot)),
+            ],
+        ),
+        Command::Design(a) => (
             vec![],
             vec![
                 ("--output", opt(&a.out.output)),

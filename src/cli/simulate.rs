@@ -60,6 +60,11 @@ pub struct Args {
     /// range has no upper end, the onset to the onset + 12°]
     #[arg(long)]
     pub delta_range: Option<String>,
+    /// A design (CSV: series,xi,delta_deg,replicates, as `fitbead design` writes it): the
+    /// data are made at exactly its slopes, `replicates` points at each, instead of spread
+    /// over the steady range.
+    #[arg(long, conflicts_with_all = ["series", "points", "delta_range", "v0"])]
+    pub design: Option<std::path::PathBuf>,
     /// Where the result goes.
     #[command(flatten)]
     pub out: OutputArgs,
@@ -240,6 +245,13 @@ pub fn run(a: Args) -> Result<(), CliError> {
         ));
     }
     if kind == ModelKind::Md {
+        if let Some(p) = &a.design {
+            return Err(super::flag_error(
+                "--design",
+                &p.display().to_string(),
+                "a design is simulated with the steady-state models, not --model md",
+            ));
+        }
         return run_md(&a, &series, &stop);
     }
     let jan = a
@@ -273,11 +285,11 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let io = |e: csv::Error| CliError::Other(e.to_string());
     w.write_record(["series", "xi", "delta_deg", "v", "sigma_v", "v_true"])
         .map_err(io)?;
-    for &xi in &series {
+    let model_for = |xi: f64| -> Result<Model, CliError> {
         let alpha = Scene::from_radians(xi, 0.1, a.contact.rho(), a.contact.f(), law)
             .map_err(|e| super::flag_error("--series", &xi.to_string(), e.to_string()))?
             .alpha_rad();
-        let model = match (kind, kind.contact_model()) {
+        Ok(match (kind, kind.contact_model()) {
             (ModelKind::Contact, _) => Model::Contact(contact),
             (_, Some(m)) => m,
             (ModelKind::Jan, None) => match &jan {
@@ -307,7 +319,13 @@ pub fn run(a: Args) -> Result<(), CliError> {
                         .map_err(|e| super::flag_error("--jaeger", "", e.to_string()))?,
                 )
             }
-        };
+        })
+    };
+    if let Some(path) = a.design.as_deref() {
+        return simulate_design(&a, path, law, &model_for, &mut rng);
+    }
+    for &xi in &series {
+        let model = model_for(xi)?;
         let Some((lo, hi)) = regime_b_interval(&model, xi, a.contact.rho(), a.contact.f(), law)
         else {
             return Err(super::flag_error(
@@ -360,6 +378,174 @@ pub fn run(a: Args) -> Result<(), CliError> {
                 fmt_f64(xi),
                 fmt_f64(xi),
                 fmt_f64(d_deg),
+                fmt_f64(v),
+                sigma_cell(a.noise * v_true),
+                fmt_f64(v_true),
+            ])
+            .map_err(io)?;
+        }
+    }
+    let bytes = w.into_inner().map_err(|e| CliError::Other(e.to_string()))?;
+    emit(a.out.output.as_deref(), &bytes)
+}
+
+/// One row of a design file: its line, series label, ξ, slope (degrees) and replicates.
+struct DesignLine {
+    line: u64,
+    series: String,
+    xi: f64,
+    delta_deg: f64,
+    replicates: usize,
+}
+
+/// Reads a design file (series,xi,delta_deg,replicates; other columns ignored), every cell
+/// checked: a bad one is an error naming file, line, column and value.
+fn read_design(path: &std::path::Path) -> Result<Vec<DesignLine>, CliError> {
+    use fitbead::io::InputError;
+    let file = path.display().to_string();
+    let err = |line: Option<u64>, column: Option<&str>, value: Option<&str>, message: String| {
+        CliError::Input(InputError {
+            file: file.clone(),
+            line,
+            column: column.map(str::to_string),
+            value: value.map(|v| fitbead::io::clip(v, fitbead::io::ECHO_CHARS).into_owned()),
+            message,
+        })
+    };
+    let mut r = csv::ReaderBuilder::new()
+        .flexible(false)
+        .from_path(path)
+        .map_err(|e| err(None, None, None, format!("cannot read: {e}")))?;
+    let header = r
+        .headers()
+        .map_err(|e| err(Some(1), None, None, e.to_string()))?
+        .clone();
+    let col = |name: &str| -> Result<usize, CliError> {
+        header.iter().position(|h| h.trim() == name).ok_or_else(|| {
+            err(
+                Some(1),
+                Some(name),
+                None,
+                "missing column: a design has the columns series,xi,delta_deg,replicates".into(),
+            )
+        })
+    };
+    let (cs, cx, cd, cr) = (
+        col("series")?,
+        col("xi")?,
+        col("delta_deg")?,
+        col("replicates")?,
+    );
+    let mut out = Vec::new();
+    let mut total: usize = 0;
+    for rec in r.records() {
+        let rec = rec.map_err(|e| {
+            let line = e.position().map(|p| p.line());
+            err(line, None, None, e.to_string())
+        })?;
+        let line = rec.position().map_or(0, |p| p.line());
+        let cell = |c: usize| rec.get(c).unwrap_or("").trim();
+        let num = |c: usize, name: &str, ok: &dyn Fn(f64) -> bool, what: &str| {
+            cell(c)
+                .parse::<f64>()
+                .ok()
+                .filter(|v| ok(*v))
+                .ok_or_else(|| err(Some(line), Some(name), Some(cell(c)), what.to_string()))
+        };
+        let xi = num(
+            cx,
+            "xi",
+            &|v| v.is_finite() && v > 0.0,
+            "expected a radius ratio > 0",
+        )?;
+        let delta_deg = num(
+            cd,
+            "delta_deg",
+            &|v| v.is_finite() && v > 0.0 && v < 90.0,
+            "expected a slope in degrees in (0, 90)",
+        )?;
+        let replicates = cell(cr)
+            .parse::<usize>()
+            .ok()
+            .filter(|n| (1..=MAX_POINTS).contains(n))
+            .ok_or_else(|| {
+                err(
+                    Some(line),
+                    Some("replicates"),
+                    Some(cell(cr)),
+                    format!("expected a whole number of points from 1 to {MAX_POINTS}"),
+                )
+            })?;
+        total = total.saturating_add(replicates);
+        if total > MAX_ROWS {
+            return Err(err(
+                Some(line),
+                Some("replicates"),
+                Some(cell(cr)),
+                format!("the design asks for more than {MAX_ROWS} points in all"),
+            ));
+        }
+        let series = if cell(cs).is_empty() {
+            fmt_f64(xi)
+        } else {
+            cell(cs).to_string()
+        };
+        out.push(DesignLine {
+            line,
+            series,
+            xi,
+            delta_deg,
+            replicates,
+        });
+    }
+    if out.is_empty() {
+        return Err(err(None, None, None, "the design has no rows".into()));
+    }
+    Ok(out)
+}
+
+/// `simulate --design FILE`: synthetic points at exactly the design's slopes, `replicates`
+/// at each, noise drawn from the seed's stream in the file's order.
+fn simulate_design(
+    a: &Args,
+    path: &std::path::Path,
+    law: CollisionLaw,
+    model_for: &dyn Fn(f64) -> Result<Model, CliError>,
+    rng: &mut ChaCha8Rng,
+) -> Result<(), CliError> {
+    let rows = read_design(path)?;
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let io = |e: csv::Error| CliError::Other(e.to_string());
+    w.write_record(["series", "xi", "delta_deg", "v", "sigma_v", "v_true"])
+        .map_err(io)?;
+    let stop = super::stop_flag();
+    for row in &rows {
+        if stop.load(Ordering::Relaxed) {
+            return Err(CliError::Interrupted);
+        }
+        let at = |message: String| {
+            CliError::Input(fitbead::io::InputError {
+                file: path.display().to_string(),
+                line: Some(row.line),
+                column: Some("delta_deg".into()),
+                value: Some(fmt_f64(row.delta_deg)),
+                message,
+            })
+        };
+        let model = model_for(row.xi)?;
+        let scene = Scene::new(row.xi, row.delta_deg, a.contact.rho(), a.contact.f(), law)
+            .map_err(|e| at(e.to_string()))?;
+        let v_true = model
+            .evaluate(&scene)
+            .map_err(|e| at(format!("no steady state at xi {}: {e}", fmt_f64(row.xi))))?
+            .mean_velocity;
+        for _ in 0..row.replicates {
+            let z: f64 = StandardNormal.sample(rng);
+            let v = v_true * (1.0 + a.noise * z);
+            w.write_record([
+                row.series.clone(),
+                fmt_f64(row.xi),
+                fmt_f64(row.delta_deg),
                 fmt_f64(v),
                 sigma_cell(a.noise * v_true),
                 fmt_f64(v_true),

@@ -10,6 +10,7 @@ mod cli_mcmc;
 mod contact;
 mod cross_solvers;
 mod csv_ranges;
+mod design;
 mod edges_cli;
 mod edges_files;
 mod edges_fits;

@@ -1,0 +1,400 @@
+//! Approximate designs over a grid of candidate slopes and their rounding to whole points:
+//! the multiplicative algorithm (D and c criteria), the Atkinson–Fedorov iteration (T
+//! criterion) and the efficient rounding of Pukelsheim & Rieder (1992).
+//!
+//! Every design here is stratified: the candidates fall into strata (one per series) and the
+//! weights of stratum s add up to its budget n_s (points per series). The Kiefer–Wolfowitz
+//! equivalence conditions then hold stratum by stratum: at the optimum, the sensitivity ψ_j of
+//! each candidate (d_j = g_jᵀ M⁻¹ g_j for D, (cᵀ M⁻¹ g_j)² for c, the squared distance of the
+//! two models' curves for T) is at most its stratum's weighted mean λ_s = Σ_{j∈s} w_j ψ_j / n_s,
+//! with equality on the support. The largest ψ_j/λ_s − 1 is the design's equivalence gap.
+
+use nalgebra::{DMatrix, DVector};
+
+/// One candidate point: its series, slope (radians) and scaled gradient g = (∂v̄/∂p)/σ.
+#[derive(Debug, Clone)]
+pub(crate) struct Cand {
+    pub series: usize,
+    pub delta: f64,
+    pub g: Vec<f64>,
+}
+
+/// An approximate design: weights, each candidate's sensitivity divided by its stratum's λ_s,
+/// and the equivalence gap reached.
+#[derive(Debug, Clone)]
+pub(crate) struct Approx {
+    pub w: Vec<f64>,
+    pub sens: Vec<f64>,
+    pub gap: f64,
+}
+
+/// The information matrix M = Σ_j w_j g_j g_jᵀ.
+pub(crate) fn information(cands: &[Cand], w: &[f64], p: usize) -> DMatrix<f64> {
+    let mut m = DMatrix::zeros(p, p);
+    for (c, &wj) in cands.iter().zip(w) {
+        if wj == 0.0 {
+            continue;
+        }
+        let g = DVector::from_column_slice(&c.g);
+        m += wj * &g * g.transpose();
+    }
+    m
+}
+
+/// M⁻¹ of a positive semi-definite M, scaled to a unit diagonal and lifted by a ridge of
+/// 1e-10 so that a singular M (a c-optimal design may support fewer points than parameters)
+/// still inverts.
+fn inverse(m: &DMatrix<f64>) -> DMatrix<f64> {
+    let p = m.nrows();
+    let d: Vec<f64> = (0..p)
+        .map(|i| {
+            let x = m[(i, i)];
+            if x > 0.0 {
+                1.0 / x.sqrt()
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    let dm = DMatrix::from_diagonal(&DVector::from_vec(d));
+    let a = &dm * m * &dm + DMatrix::identity(p, p) * 1e-10;
+    let ai = a
+        .cholesky()
+        .map(|c| c.inverse())
+        .unwrap_or_else(|| DMatrix::identity(p, p) * 1e10);
+    &dm * ai * &dm
+}
+
+/// The variance of each parameter under information M (the diagonal of its pseudo-inverse),
+/// `None` for a parameter M does not determine (its unit vector not in M's range). M is
+/// scaled to a unit diagonal first; eigenvalues below 1e-10 of the largest count as zero.
+pub(crate) fn variances(m: &DMatrix<f64>) -> Vec<Option<f64>> {
+    let p = m.nrows();
+    let diag: Vec<f64> = (0..p).map(|i| m[(i, i)]).collect();
+    let d: Vec<f64> = diag
+        .iter()
+        .map(|&x| if x > 0.0 { 1.0 / x.sqrt() } else { 0.0 })
+        .collect();
+    let dm = DMatrix::from_diagonal(&DVector::from_vec(d.clone()));
+    let a = &dm * m * &dm;
+    let e = a.symmetric_eigen();
+    let top = e.eigenvalues.iter().cloned().fold(0.0, f64::max);
+    (0..p)
+        .map(|k| {
+            if !(diag[k] > 0.0 && top > 0.0) {
+                return None;
+            }
+            let (mut var, mut null) = (0.0, 0.0);
+            for i in 0..p {
+                let u = e.eigenvectors[(k, i)];
+                if e.eigenvalues[i] > 1e-10 * top {
+                    var += u * u / e.eigenvalues[i];
+                } else {
+                    null += u * u;
+                }
+            }
+            (null < 1e-8).then_some(var * d[k] * d[k])
+        })
+        .collect()
+}
+
+/// The optimality criterion of the multiplicative algorithm.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Crit {
+    /// log det M.
+    D,
+    /// −(M⁻¹)_kk: the variance of parameter k.
+    C(usize),
+}
+
+/// Most iterations of the multiplicative algorithm.
+const MAX_ITER: usize = 5000;
+/// Equivalence gap at which the iteration stops.
+const GAP_TOL: f64 = 1e-4;
+
+/// The stratified multiplicative algorithm (Titterington 1976, Silvey, Titterington & Torsney
+/// 1978): w_j ← w_j (ψ_j/λ_s)^r within each stratum s, renormalised to n_s, with r = 1 for D
+/// (where the update keeps the budget by itself) and r = ½ for c (Fellman's square-root
+/// update, which keeps the c iteration from oscillating). Starts from equal weights.
+pub(crate) fn multiplicative(
+    cands: &[Cand],
+    strata: &[Vec<usize>],
+    budgets: &[f64],
+    p: usize,
+    crit: Crit,
+) -> Approx {
+    let mut w = vec![0.0; cands.len()];
+    for (st, &n) in strata.iter().zip(budgets) {
+        for &j in st {
+            w[j] = n / st.len() as f64;
+        }
+    }
+    let mut sens = vec![0.0; cands.len()];
+    let mut gap = f64::INFINITY;
+    for _ in 0..MAX_ITER {
+        let mi = inverse(&information(cands, &w, p));
+        for (j, c) in cands.iter().enumerate() {
+            let g = DVector::from_column_slice(&c.g);
+            let h = &mi * &g;
+            sens[j] = match crit {
+                Crit::D => g.dot(&h),
+                Crit::C(k) => h[k] * h[k],
+            };
+        }
+        gap = normalise(strata, budgets, &w, &mut sens);
+        if gap < GAP_TOL {
+            break;
+        }
+        let r = match crit {
+            Crit::D => 1.0,
+            Crit::C(_) => 0.5,
+        };
+        for (st, &n) in strata.iter().zip(budgets) {
+            let sum: f64 = st.iter().map(|&j| w[j] * sens[j].powf(r)).sum();
+            // A series that carries no information on the criterion (the target is another
+            // series' own parameter) keeps its weights.
+            if sum > 0.0 {
+                for &j in st {
+                    w[j] *= sens[j].powf(r) * n / sum;
+                }
+            }
+        }
+    }
+    Approx { w, sens, gap }
+}
+
+/// Divides each sensitivity by its stratum's λ_s = Σ w_j ψ_j / n_s; returns the largest
+/// ψ_j/λ_s − 1 (the equivalence gap).
+fn normalise(strata: &[Vec<usize>], budgets: &[f64], w: &[f64], sens: &mut [f64]) -> f64 {
+    let mut gap: f64 = 0.0;
+    for (st, &n) in strata.iter().zip(budgets) {
+        let lambda: f64 = st.iter().map(|&j| w[j] * sens[j]).sum::<f64>() / n;
+        for &j in st {
+            sens[j] = if lambda > 0.0 { sens[j] / lambda } else { 0.0 };
+            gap = gap.max(sens[j] - 1.0);
+        }
+    }
+    gap
+}
+
+/// The Atkinson–Fedorov iteration for T-optimality (Atkinson & Fedorov 1975): at step k the
+/// rival model is fitted to the true model's curve under the current weights (`fit`), the
+/// squared distances ψ_j of the two curves (divided by σ²) are computed at that fit (`psi`),
+/// and each stratum moves a step α_k = 1/(k + 1) of its budget to its candidate of largest
+/// ψ_j (a Fedorov–Wynn vertex step). Starts from `start`.
+pub(crate) fn t_optimal(
+    strata: &[Vec<usize>],
+    budgets: &[f64],
+    start: Vec<f64>,
+    steps: usize,
+    mut fit: impl FnMut(&[f64]) -> Option<Vec<f64>>,
+) -> Option<Approx> {
+    let mut w = start;
+    let mut sens = fit(&w)?;
+    for k in 1..=steps {
+        let alpha = 1.0 / (k as f64 + 1.0);
+        for (st, &n) in strata.iter().zip(budgets) {
+            let best = *st
+                .iter()
+                .max_by(|&&a, &&b| sens[a].total_cmp(&sens[b]))
+                .expect("a stratum has candidates");
+            for &j in st {
+                w[j] *= 1.0 - alpha;
+                if w[j] < 1e-9 * n {
+                    w[j] = 0.0;
+                }
+            }
+            w[best] += alpha * n;
+        }
+        sens = fit(&w)?;
+    }
+    let gap = normalise(strata, budgets, &w, &mut sens);
+    Some(Approx { w, sens, gap })
+}
+
+/// The exact design of each stratum: the runs of neighbouring candidates that carry weight
+/// (above 1e-3 of the stratum's largest) each become one support point, at the candidate of
+/// the run with the largest sensitivity and with the run's weight; the heaviest n_s of them
+/// are kept and rounded to n_s points by efficient rounding (Pukelsheim & Rieder 1992):
+/// m_i = ⌈(n − ℓ/2) w_i⌉, then points are added where m_i/w_i is smallest, or taken away
+/// where (m_i − 1)/w_i is largest, until they add up to n. Returns (candidate, replicates).
+pub(crate) fn round(
+    strata: &[Vec<usize>],
+    budgets: &[usize],
+    a: &Approx,
+) -> Vec<Vec<(usize, usize)>> {
+    strata
+        .iter()
+        .zip(budgets)
+        .map(|(st, &n)| {
+            let top = st.iter().map(|&j| a.w[j]).fold(0.0, f64::max);
+            if !(top > 0.0) || st.iter().all(|&j| !(a.sens[j] > 0.0)) {
+                return spread(st, n);
+            }
+            let mut runs: Vec<(usize, f64)> = Vec::new();
+            let mut open = false;
+            for &j in st {
+                if a.w[j] > 1e-3 * top {
+                    if open {
+                        let last = runs.last_mut().expect("an open run");
+                        last.1 += a.w[j];
+                        if a.sens[j] > a.sens[last.0] {
+                            last.0 = j;
+                        }
+                    } else {
+                        runs.push((j, a.w[j]));
+                    }
+                    open = true;
+                } else {
+                    open = false;
+                }
+            }
+            runs.sort_by(|x, y| y.1.total_cmp(&x.1));
+            runs.truncate(n);
+            let sum: f64 = runs.iter().map(|r| r.1).sum();
+            let w: Vec<f64> = runs.iter().map(|r| r.1 / sum).collect();
+            let mut m = efficient_rounding(&w, n);
+            let mut out: Vec<(usize, usize)> = runs
+                .iter()
+                .zip(m.drain(..))
+                .filter(|(_, k)| *k > 0)
+                .map(|(r, k)| (r.0, k))
+                .collect();
+            out.sort_by_key(|x| x.0);
+            out
+        })
+        .collect()
+}
+
+/// n points spread evenly over a stratum's candidates (for a stratum whose slopes carry no
+/// information on the criterion).
+fn spread(st: &[usize], n: usize) -> Vec<(usize, usize)> {
+    let mut out: Vec<(usize, usize)> = Vec::new();
+    for i in 0..n {
+        let k = if n == 1 {
+            st.len() / 2
+        } else {
+            (i * (st.len() - 1) + (n - 1) / 2) / (n - 1)
+        };
+        match out.last_mut() {
+            Some(last) if last.0 == st[k] => last.1 += 1,
+            _ => out.push((st[k], 1)),
+        }
+    }
+    out
+}
+
+/// Efficient rounding of the weights `w` (adding up to 1, at most `n` of them) to `n` points.
+pub(crate) fn efficient_rounding(w: &[f64], n: usize) -> Vec<usize> {
+    let l = w.len() as f64;
+    let q = n as f64 - 0.5 * l;
+    let mut m: Vec<usize> = w
+        .iter()
+        .map(|&x| (q * x).ceil().max(0.0) as usize)
+        .collect();
+    loop {
+        let total: usize = m.iter().sum();
+        if total == n {
+            return m;
+        }
+        if total < n {
+            let j = (0..w.len())
+                .min_by(|&a, &b| (m[a] as f64 / w[a]).total_cmp(&(m[b] as f64 / w[b])))
+                .expect("weights");
+            m[j] += 1;
+        } else {
+            let j = (0..w.len())
+                .filter(|&i| m[i] > 0)
+                .max_by(|&a, &b| ((m[a] - 1) as f64 / w[a]).total_cmp(&((m[b] - 1) as f64 / w[b])))
+                .expect("a positive count");
+            m[j] -= 1;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The rule worked by hand: weights (1/6, 1/3, 1/2) and n = 7 give q = 7 − 3/2 = 5.5,
+    /// ⌈5.5/6⌉ = 1, ⌈5.5/3⌉ = 2, ⌈5.5/2⌉ = 3: 6 points; the seventh goes where m/w is
+    /// smallest (1·6 = 2·3 = 3·2 = 6, a tie, taken at the first index): (2, 2, 3).
+    #[test]
+    fn efficient_rounding_by_hand() {
+        assert_eq!(
+            efficient_rounding(&[1.0 / 6.0, 1.0 / 3.0, 0.5], 7),
+            vec![2, 2, 3]
+        );
+        assert_eq!(efficient_rounding(&[1.0], 9), vec![9]);
+        assert_eq!(efficient_rounding(&[0.5, 0.5], 9).iter().sum::<usize>(), 9);
+    }
+
+    /// The straight line y = a + b x on [−1, 1]: the D-optimal design is half the weight at
+    /// each end (a textbook result, e.g. Atkinson, Donev & Tobias 2007, §9.2), and the
+    /// c-optimal design for the slope b is the same.
+    #[test]
+    fn line_designs_put_the_points_at_the_ends() {
+        let cands: Vec<Cand> = (0..101)
+            .map(|i| {
+                let x = -1.0 + 2.0 * i as f64 / 100.0;
+                Cand {
+                    series: 0,
+                    delta: x,
+                    g: vec![1.0, x],
+                }
+            })
+            .collect();
+        let strata = vec![(0..101).collect::<Vec<_>>()];
+        for crit in [Crit::D, Crit::C(1)] {
+            let a = multiplicative(&cands, &strata, &[10.0], 2, crit);
+            let r = round(&strata, &[10], &a);
+            assert_eq!(r[0], vec![(0, 5), (100, 5)], "{crit:?}");
+        }
+    }
+
+    /// A quadratic y = a + b x + c x² on [−1, 1]: D-optimal at −1, 0, 1 with weight 1/3 each
+    /// (Atkinson, Donev & Tobias 2007, §11.2); 9 points round to 3 each.
+    #[test]
+    fn quadratic_d_design() {
+        let cands: Vec<Cand> = (0..101)
+            .map(|i| {
+                let x = -1.0 + 2.0 * i as f64 / 100.0;
+                Cand {
+                    series: 0,
+                    delta: x,
+                    g: vec![1.0, x, x * x],
+                }
+            })
+            .collect();
+        let strata = vec![(0..101).collect::<Vec<_>>()];
+        let a = multiplicative(&cands, &strata, &[9.0], 3, Crit::D);
+        let r = round(&strata, &[9], &a);
+        assert_eq!(r[0], vec![(0, 3), (50, 3), (100, 3)]);
+    }
+
+    /// Two series with a line each (parameters a1, b1 and a2, b2): the c-optimal design for
+    /// b1 puts series 1 at its ends and leaves series 2, which says nothing about b1, evenly
+    /// spread.
+    #[test]
+    fn a_series_without_information_is_spread() {
+        let mut cands = Vec::new();
+        for s in 0..2 {
+            for i in 0..11 {
+                let x = -1.0 + 2.0 * i as f64 / 10.0;
+                let mut g = vec![0.0; 4];
+                g[2 * s] = 1.0;
+                g[2 * s + 1] = x;
+                cands.push(Cand {
+                    series: s,
+                    delta: x,
+                    g,
+                });
+            }
+        }
+        let strata = vec![(0..11).collect::<Vec<_>>(), (11..22).collect()];
+        let a = multiplicative(&cands, &strata, &[4.0, 3.0], 4, Crit::C(1));
+        let r = round(&strata, &[4, 3], &a);
+        assert_eq!(r[0], vec![(0, 2), (10, 2)]);
+        assert_eq!(r[1], vec![(11, 1), (16, 1), (21, 1)]);
+    }
+}

@@ -1,0 +1,207 @@
+//! The forward problem a design is made for: the fitted parameters, their guess, the mean
+//! velocity v̄(ξ, δ; p) of each series and its gradient in p by central differences.
+
+use super::DesignError;
+use crate::fit::jaeger::paper_values;
+use crate::fit::jan::PAPER_GLOBAL;
+use crate::models::jaeger::Jaeger;
+use crate::models::jan::Jan;
+use crate::models::regimes::{alpha_of_xi, regime_b_interval};
+use crate::models::{ForwardModel, JaegerBranch, Model};
+use crate::numfmt::fmt_f64;
+use crate::scene::{CollisionLaw, Scene};
+
+/// Which parameters are fitted, and how v̄ depends on them.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Kind {
+    /// K = cos 2α + c sin²α sin 2α under a contact model: p = (c).
+    KLawC(Model),
+    /// One K per series under a contact model: p = (K_1, …, K_S).
+    KFree(Model),
+    /// Jan's eq 74 at one ξ: p = (λ, μ).
+    JanSeries,
+    /// Jan's laws λ = λ0 e^{λ1 sin α}, μ = μ0 e^{μ1 sin α} (the form of eqs 75–76):
+    /// p = (λ0, λ1, μ0, μ1).
+    JanGlobal,
+    /// Jaeger's eqs 80–84 per series: p = (a1, a2, a3) of each series in turn.
+    Jaeger(JaegerBranch),
+}
+
+/// The forward problem: the series, the parameters and their guess.
+#[derive(Debug, Clone)]
+pub(crate) struct Problem {
+    pub kind: Kind,
+    pub series: Vec<f64>,
+    pub rho: f64,
+    pub f: f64,
+    pub names: Vec<String>,
+    pub guess: Vec<f64>,
+}
+
+/// Relative step of the central differences (in units of max(|p|, `FD_FLOOR`)).
+const FD_STEP: f64 = 1e-4;
+/// Smallest scale of a parameter for its difference step.
+const FD_FLOOR: f64 = 1e-3;
+
+impl Problem {
+    /// The velocity of series `s` at slope `delta` (radians) under parameters `p`, or `None`
+    /// where the model has no steady state there.
+    pub fn velocity(&self, s: usize, delta: f64, p: &[f64]) -> Option<f64> {
+        let xi = self.series[s];
+        let (model, law) = self.model_at(s, p)?;
+        let scene = Scene::from_radians(xi, delta, self.rho, self.f, law).ok()?;
+        let v = model.evaluate(&scene).ok()?.mean_velocity;
+        (v.is_finite() && v > 0.0).then_some(v)
+    }
+
+    /// The model and collision law of series `s` under parameters `p`.
+    pub fn model_at(&self, s: usize, p: &[f64]) -> Option<(Model, CollisionLaw)> {
+        let alpha = alpha_of_xi(self.series[s]);
+        let any = CollisionLaw::Value(0.5);
+        Some(match self.kind {
+            Kind::KLawC(m) => (m, CollisionLaw::C(p[0])),
+            Kind::KFree(m) => {
+                let k = p[s];
+                if !(k > 0.0 && k < 1.0) {
+                    return None;
+                }
+                (m, CollisionLaw::Value(k))
+            }
+            Kind::JanSeries => (Model::Jan(Jan::new(p[0], p[1]).ok()?), any),
+            Kind::JanGlobal => {
+                let sa = alpha.sin();
+                let (l, m) = (p[0] * (p[1] * sa).exp(), p[2] * (p[3] * sa).exp());
+                (Model::Jan(Jan::new(l, m).ok()?), any)
+            }
+            Kind::Jaeger(b) => {
+                let q = &p[3 * s..3 * s + 3];
+                (Model::Jaeger(Jaeger::new(q[0], q[1], q[2], b).ok()?), any)
+            }
+        })
+    }
+
+    /// ∂v̄/∂p at (s, δ) and the guess, by central differences with steps
+    /// h_j = 1e-4 · max(|p_j|, 1e-3); `None` where a step leaves the steady state.
+    pub fn gradient(&self, s: usize, delta: f64) -> Option<Vec<f64>> {
+        let mut p = self.guess.clone();
+        let mut g = vec![0.0; p.len()];
+        for j in 0..p.len() {
+            if !self.touches(s, j) {
+                continue;
+            }
+            let h = FD_STEP * p[j].abs().max(FD_FLOOR);
+            let p0 = p[j];
+            p[j] = p0 + h;
+            let up = self.velocity(s, delta, &p);
+            p[j] = p0 - h;
+            let down = self.velocity(s, delta, &p);
+            p[j] = p0;
+            g[j] = (up? - down?) / (2.0 * h);
+        }
+        Some(g)
+    }
+
+    /// Whether parameter `j` moves the velocities of series `s`.
+    fn touches(&self, s: usize, j: usize) -> bool {
+        match self.kind {
+            Kind::KFree(_) => j == s,
+            Kind::Jaeger(_) => j / 3 == s,
+            _ => true,
+        }
+    }
+
+    /// Regime B of series `s` at the guess (radians), cut to the onset + 12° for the models
+    /// whose steady range has no upper end (Jan, Jaeger), as `simulate` does.
+    pub fn regime_b(&self, s: usize) -> Option<(f64, f64)> {
+        let (model, law) = self.model_at(s, &self.guess)?;
+        let (lo, hi) = regime_b_interval(&model, self.series[s], self.rho, self.f, law)?;
+        let open = matches!(model, Model::Jan(_) | Model::Jaeger(_));
+        Some(if open {
+            (lo, (lo + 12f64.to_radians()).min(hi))
+        } else {
+            (lo, hi)
+        })
+    }
+}
+
+/// The problem of fit `fit` under `model` with the collision law `law` (for the K-law fits:
+/// `c=VALUE` fits c, a number K fits one K per series, both with the given guess).
+pub(crate) fn problem(
+    fit: super::DesignFit,
+    model: Model,
+    law: CollisionLaw,
+    series: &[f64],
+    rho: f64,
+    f: f64,
+    branch: JaegerBranch,
+) -> Result<Problem, DesignError> {
+    use super::DesignFit;
+    let label = |xi: f64| format!("xi={}", fmt_f64(xi));
+    let (kind, names, guess) = match fit {
+        DesignFit::KLaw => match law {
+            CollisionLaw::C(c) => (Kind::KLawC(model), vec!["c".to_string()], vec![c]),
+            CollisionLaw::Value(k) => (
+                Kind::KFree(model),
+                series
+                    .iter()
+                    .map(|&x| format!("K of series '{}'", label(x)))
+                    .collect(),
+                vec![k; series.len()],
+            ),
+            other => {
+                return Err(DesignError::new(
+                    "law",
+                    &other.to_string(),
+                    "the K-law design needs the fitted law with its guess: c=VALUE (law c) \
+                         or a number K (one K per series)",
+                ))
+            }
+        },
+        DesignFit::Jan if series.len() == 1 => {
+            let j = Jan::paper_fit(alpha_of_xi(series[0]));
+            (
+                Kind::JanSeries,
+                vec!["lambda".into(), "mu".into()],
+                vec![j.lambda, j.mu],
+            )
+        }
+        DesignFit::Jan => (
+            Kind::JanGlobal,
+            ["lambda0", "lambda1", "mu0", "mu1"]
+                .map(String::from)
+                .to_vec(),
+            PAPER_GLOBAL.to_vec(),
+        ),
+        DesignFit::Jaeger => {
+            let mut names = Vec::new();
+            let mut guess = Vec::new();
+            for &xi in series {
+                let p = paper_values(xi).ok_or_else(|| {
+                    DesignError::new(
+                        "series",
+                        &fmt_f64(xi),
+                        "the paper gives Jaeger's a1, a2, a3 (the guess) for xi = 0.8, 1, 1.6, 2 \
+                         only",
+                    )
+                })?;
+                for (n, v) in ["a1", "a2", "a3"].iter().zip(p) {
+                    names.push(if series.len() == 1 {
+                        n.to_string()
+                    } else {
+                        format!("{n} of series '{}'", label(xi))
+                    });
+                    guess.push(v);
+                }
+            }
+            (Kind::Jaeger(branch), names, guess)
+        }
+    };
+    Ok(Problem {
+        kind,
+        series: series.to_vec(),
+        rho,
+        f,
+        names,
+        guess,
+    })
+}

@@ -1,0 +1,388 @@
+//! `fitbead design` and the library's `design`: the command contract of the design, the
+//! simulated data at its slopes and the fit of them; refusals; and the validation by
+//! simulation: data sets drawn at the design and at evenly spaced slopes, each fitted by
+//! least squares through the library, whose realised scatter of the estimate must match the
+//! predicted standard error within Monte Carlo error.
+//!
+//! Monte Carlo error: the standard deviation s of n draws from a normal population with
+//! standard deviation σ has a standard deviation ≈ σ/√(2(n − 1)) (the large-n normal
+//! approximation of the χ² law of (n − 1)s²/σ²); for n = 200 that is 5.0 % of σ. The checks
+//! allow 3 of those (15 %); the ratio of two independent SDs has a relative error of √2 times
+//! that (7.1 %), and is allowed 3 of those (21 %).
+
+use crate::common::{bin, col, expect, read_table, s, stderr, stdout_ok, table, tmpdir, write};
+use fitbead::design::{design, Criterion, DesignFit, DesignResult, DesignRow, DesignSettings};
+use fitbead::fit::klaw::KLaw;
+use fitbead::models::jan::Jan;
+use fitbead::models::regimes::alpha_of_xi;
+use fitbead::models::{ForwardModel, Model, ModelKind};
+use fitbead::prelude::{Dataset, JanFitter, KLawFitter};
+use fitbead::scene::{CollisionLaw, Scene};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, StandardNormal};
+
+/// The three commands of the contract, run as written in a fresh directory.
+#[test]
+fn contract_runs_as_written() {
+    let dir = tmpdir();
+    let run = |args: &[&str]| {
+        let out = bin().current_dir(dir.path()).args(args).output().unwrap();
+        stdout_ok(&out)
+    };
+    let summary = run(&[
+        "design",
+        "--fit",
+        "klaw",
+        "--model",
+        "stickslip",
+        "--law",
+        "c=0.5",
+        "--series",
+        "0.8,1,1.6,2",
+        "--points",
+        "9",
+        "--noise",
+        "0.02",
+        "--criterion",
+        "c",
+        "--target",
+        "c",
+        "--output",
+        "design.csv",
+    ]);
+    assert!(summary.contains("predicted standard errors"), "{summary}");
+    let (h, rows) = read_table(&dir.path().join("design.csv"));
+    assert_eq!(h, ["series", "xi", "delta_deg", "replicates"]);
+    // 9 points per series, every slope steady under stick/slip at the guess c = 0.5.
+    for xi in ["0.8", "1", "1.6", "2"] {
+        let n: usize = rows
+            .iter()
+            .filter(|r| r[1] == xi)
+            .map(|r| r[3].parse::<usize>().unwrap())
+            .sum();
+        assert_eq!(n, 9, "xi {xi}");
+    }
+    for r in &rows {
+        let (xi, d): (f64, f64) = (r[1].parse().unwrap(), r[2].parse().unwrap());
+        let sc = Scene::new(xi, d, 0.4, 0.1, CollisionLaw::C(0.5)).unwrap();
+        assert!(Model::StickSlip.evaluate(&sc).is_ok(), "{r:?}");
+    }
+    run(&[
+        "simulate",
+        "--design",
+        "design.csv",
+        "--model",
+        "stickslip",
+        "--law",
+        "c=0.5",
+        "--noise",
+        "0.02",
+        "--seed",
+        "7",
+        "--output",
+        "data.csv",
+    ]);
+    let (dh, data) = read_table(&dir.path().join("data.csv"));
+    assert_eq!(data.len(), 36);
+    // The data sit at exactly the design's slopes, replicates included.
+    for r in &rows {
+        let n = data
+            .iter()
+            .filter(|d| d[col(&dh, "xi")] == r[1] && d[col(&dh, "delta_deg")] == r[2])
+            .count();
+        assert_eq!(n.to_string(), r[3], "{r:?}");
+    }
+    let fit = run(&["klaw", "--model", "stickslip", "data.csv", "--output", "-"]);
+    let (fh, frows) = table(&fit);
+    let c = frows
+        .iter()
+        .find(|r| r[col(&fh, "fit")] == "klaw-c")
+        .expect("the klaw-c row");
+    let value: f64 = c[col(&fh, "value")].parse().unwrap();
+    let se: f64 = c[col(&fh, "stderr")].parse().unwrap();
+    // Within 4 of its own standard errors of the truth, and that error near the design's
+    // prediction (a few per mille here).
+    assert!((value - 0.5).abs() < 4.0 * se, "c = {value} ± {se}");
+    assert!(se < 0.002, "{se}");
+}
+
+/// Bad flags and a guess without a regime-B range exit 2 with a message naming the flag (or
+/// the series) and the value; the output file is not created.
+#[test]
+fn refusals_exit_2() {
+    let dir = tmpdir();
+    let out = dir.path().join("d.csv");
+    let cases: &[(&[&str], &[&str])] = &[
+        (
+            &["--criterion", "e"],
+            &["--criterion", "'e'", "expected d, c or t"],
+        ),
+        (&["--fit", "lmfit"], &["--fit", "unknown fit"]),
+        (
+            &["--criterion", "c", "--target", "mu"],
+            &["--target", "'mu'", "expected one of c"],
+        ),
+        (
+            &["--prior", "c~N(0.5,0.1)"],
+            &["--prior", "not yet supported"],
+        ),
+        (&["--vs", "stick"], &["--vs", "goes with --criterion t"]),
+        (&["--criterion", "t"], &["--vs", "needs the rival model"]),
+        (&["--points", "0"], &["--points", "expected 1 to"]),
+        (&["--noise", "0"], &["--noise", "(0, 0.5)"]),
+        (&["--noise", "abs=-1"], &["--noise", "absolute noise"]),
+        (&["--delta-range", "5,4"], &["--delta-range", "LO < HI"]),
+        (&["--series", "1,1"], &["--series", "given twice"]),
+        (&["--model", "jan"], &["--model", "contact model"]),
+        (
+            &["--fit", "jaeger", "--series", "3"],
+            &["--series", "'3'", "0.8, 1, 1.6, 2 only"],
+        ),
+        // ξ = 0.3 is below the critical ξ (≈ 0.62, the paper): no steady slope at all.
+        (
+            &["--series", "0.8,0.3"],
+            &["--series", "'0.3'", "no regime-B slope range"],
+        ),
+        // A range entirely above lift-off.
+        (
+            &["--delta-range", "40,45"],
+            &["--series", "'0.8'", "outside regime B"],
+        ),
+    ];
+    for (args, must) in cases {
+        let o = bin()
+            .arg("design")
+            .args(*args)
+            .args(["--output", s(&out)])
+            .output()
+            .unwrap();
+        expect(&o, 2, must, &format!("{args:?}"));
+        assert!(!out.exists(), "{args:?}");
+    }
+}
+
+/// `simulate --design` refuses a malformed design naming file, line, column and value, and
+/// leaves an existing output untouched.
+#[test]
+fn simulate_design_refusals() {
+    let dir = tmpdir();
+    let out = write(dir.path(), "out.csv", "kept\n");
+    let cases = [
+        (
+            "series,xi,delta_deg,replicates\n1,1,10,x\n",
+            vec!["line 2", "replicates", "'x'"],
+        ),
+        (
+            "series,xi,delta_deg,replicates\n1,1,95,3\n",
+            vec!["line 2", "delta_deg", "'95'"],
+        ),
+        (
+            "series,xi,delta_deg\n1,1,10\n",
+            vec!["replicates", "missing column"],
+        ),
+        // Regime A at 1 degree: the bead stops.
+        (
+            "series,xi,delta_deg,replicates\n1,1,10,2\n1,1,1,2\n",
+            vec!["line 3", "delta_deg", "no steady state"],
+        ),
+        ("series,xi,delta_deg,replicates\n", vec!["no rows"]),
+    ];
+    for (text, must) in cases {
+        let d = write(dir.path(), "design.csv", text);
+        let o = bin()
+            .args(["simulate", "--design", s(&d), "--output", s(&out)])
+            .output()
+            .unwrap();
+        let mut m = must.clone();
+        m.push("design.csv");
+        expect(&o, 2, &m, text);
+        assert_eq!(std::fs::read_to_string(&out).unwrap(), "kept\n");
+    }
+    // --design with the flags it replaces is refused by the parser.
+    let d = write(
+        dir.path(),
+        "design.csv",
+        "series,xi,delta_deg,replicates\n1,1,10,2\n",
+    );
+    let o = bin()
+        .args(["simulate", "--design", s(&d), "--points", "5"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}
+
+/// Synthetic data at the rows of a design: `replicates` points at each slope, v = v̄ (1 +
+/// noise · z) with σ = noise · v̄ (as `fitbead simulate`).
+fn synthetic(
+    rows: &[DesignRow],
+    truth: &dyn Fn(f64, f64) -> f64,
+    noise: f64,
+    rng: &mut ChaCha8Rng,
+) -> Dataset {
+    let mut pts = Vec::new();
+    for r in rows {
+        let v_true = truth(r.xi, r.delta_deg);
+        let sc = Scene::new(r.xi, r.delta_deg, 0.4, 0.1, CollisionLaw::Value(0.5)).unwrap();
+        for _ in 0..r.replicates {
+            let z: f64 = StandardNormal.sample(rng);
+            pts.push((
+                r.series.clone(),
+                sc,
+                v_true * (1.0 + noise * z),
+                Some(noise * v_true),
+            ));
+        }
+    }
+    Dataset::new(pts).unwrap()
+}
+
+/// The relative noise of the validation data sets (the designs' default).
+const NOISE: f64 = 0.02;
+
+fn sd(x: &[f64]) -> f64 {
+    let n = x.len() as f64;
+    let m = x.iter().sum::<f64>() / n;
+    (x.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / (n - 1.0)).sqrt()
+}
+
+/// Draws `n` data sets at the design and `n` at the evenly spaced slopes, fits each with
+/// `estimate`, and checks the realised SDs and their ratio against the predictions.
+fn validate(
+    what: &str,
+    r: &DesignResult,
+    target: &str,
+    n: usize,
+    seed: u64,
+    truth: &dyn Fn(f64, f64) -> f64,
+    estimate: &dyn Fn(&Dataset) -> f64,
+) {
+    let noise = NOISE;
+    let e = r.errors.iter().find(|e| e.name == target).unwrap();
+    let (se_d, se_e) = (e.design.unwrap(), e.even.unwrap());
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut at_design = Vec::new();
+    let mut at_even = Vec::new();
+    for _ in 0..n {
+        at_design.push(estimate(&synthetic(&r.rows, truth, noise, &mut rng)));
+        at_even.push(estimate(&synthetic(&r.even, truth, noise, &mut rng)));
+    }
+    let (sd_d, sd_e) = (sd(&at_design), sd(&at_even));
+    let mc = 1.0 / (2.0 * (n as f64 - 1.0)).sqrt();
+    println!(
+        "{what}: {target}: design SD {sd_d:.4e} predicted {se_d:.4e} ({:+.1} %); even SD \
+         {sd_e:.4e} predicted {se_e:.4e} ({:+.1} %); ratio even/design realised {:.3} \
+         predicted {:.3}; Monte Carlo error of an SD {:.1} %",
+        100.0 * (sd_d / se_d - 1.0),
+        100.0 * (sd_e / se_e - 1.0),
+        sd_e / sd_d,
+        se_e / se_d,
+        100.0 * mc
+    );
+    assert!(
+        (sd_d / se_d - 1.0).abs() < 3.0 * mc,
+        "{what}: design SD {sd_d} vs {se_d}"
+    );
+    assert!(
+        (sd_e / se_e - 1.0).abs() < 3.0 * mc,
+        "{what}: even SD {sd_e} vs {se_e}"
+    );
+    let ratio = (sd_e / sd_d) / (se_e / se_d);
+    assert!(
+        (ratio - 1.0).abs() < 3.0 * 2f64.sqrt() * mc,
+        "{what}: ratio realised/predicted {ratio}"
+    );
+    // The design is the better one, as predicted.
+    assert!(se_d < se_e && sd_d < sd_e, "{what}");
+}
+
+/// K-law c under stick/slip, the paper's four ξ, 9 points per series, 2 % noise: the c-optimal
+/// design against evenly spaced slopes over the same ranges, 200 data sets each.
+#[test]
+fn validation_klaw_c_stickslip() {
+    let r = design(&DesignSettings {
+        criterion: Criterion::C,
+        target: Some("c".into()),
+        ..DesignSettings::default()
+    })
+    .unwrap();
+    let truth = |xi: f64, d: f64| {
+        let sc = Scene::new(xi, d, 0.4, 0.1, CollisionLaw::C(0.5)).unwrap();
+        Model::StickSlip.evaluate(&sc).unwrap().mean_velocity
+    };
+    let fitter = KLawFitter::new(Model::StickSlip, KLaw::C).least_squares(false);
+    let estimate = |d: &Dataset| fitter.fit(d).unwrap().param("c").unwrap().value;
+    validate("klaw c, stickslip", &r, "c", 200, 11, &truth, &estimate);
+}
+
+/// Jan's μ at ξ = 1 (guess: the paper's eqs 75–76), 9 points, 2 % noise.
+#[test]
+fn validation_jan_mu() {
+    let r = design(&DesignSettings {
+        fit: DesignFit::Jan,
+        series: vec![1.0],
+        criterion: Criterion::C,
+        target: Some("mu".into()),
+        ..DesignSettings::default()
+    })
+    .unwrap();
+    let jan = Jan::paper_fit(alpha_of_xi(1.0));
+    let truth = move |xi: f64, d: f64| {
+        let sc = Scene::new(xi, d, 0.4, 0.1, CollisionLaw::Value(0.5)).unwrap();
+        Model::Jan(jan).evaluate(&sc).unwrap().mean_velocity
+    };
+    let fitter = JanFitter::new().least_squares(false);
+    let estimate = |d: &Dataset| {
+        let f = fitter.fit(d).unwrap();
+        f.fits[0].param("mu").unwrap().value
+    };
+    validate("jan mu, xi = 1", &r, "mu", 200, 12, &truth, &estimate);
+}
+
+/// Stick/slip (the truth, c = 0.5) against stick, the paper's four ξ, 9 points per series,
+/// 10 % noise (so that evenly spaced slopes do not always tell them apart): the fraction of
+/// data sets where stick/slip has the lower AIC (both fits of law c, one parameter each) is
+/// higher at the T-optimal design than at evenly spaced slopes over the same ranges.
+#[test]
+fn discrimination_t_beats_even() {
+    let noise = 0.1;
+    let r = design(&DesignSettings {
+        criterion: Criterion::T,
+        vs: Some(ModelKind::Stick),
+        noise,
+        ..DesignSettings::default()
+    })
+    .unwrap();
+    let truth = |xi: f64, d: f64| {
+        let sc = Scene::new(xi, d, 0.4, 0.1, CollisionLaw::C(0.5)).unwrap();
+        Model::StickSlip.evaluate(&sc).unwrap().mean_velocity
+    };
+    let ss = KLawFitter::new(Model::StickSlip, KLaw::C).least_squares(false);
+    let st = KLawFitter::new(Model::Stick, KLaw::C).least_squares(false);
+    let right = |d: &Dataset| {
+        let a = ss.fit(d).map(|f| f.stats.aic).unwrap_or(f64::INFINITY);
+        let b = st.fit(d).map(|f| f.stats.aic).unwrap_or(f64::INFINITY);
+        a < b
+    };
+    let n = 200;
+    let mut rng = ChaCha8Rng::seed_from_u64(13);
+    let (mut hit_d, mut hit_e) = (0, 0);
+    for _ in 0..n {
+        hit_d += right(&synthetic(&r.rows, &truth, noise, &mut rng)) as usize;
+        hit_e += right(&synthetic(&r.even, &truth, noise, &mut rng)) as usize;
+    }
+    let (fd, fe) = (hit_d as f64 / n as f64, hit_e as f64 / n as f64);
+    let (td, te) = r.discrimination.unwrap();
+    // Standard error of the difference of two independent proportions.
+    let se = (fd * (1.0 - fd) / n as f64 + fe * (1.0 - fe) / n as f64).sqrt();
+    println!(
+        "stickslip vs stick, noise {noise}: T design {td:.3} even {te:.3}; true model has the \
+         lower AIC in {:.1} % at the design, {:.1} % at even slopes (margin {:.1} ± {:.1} points)",
+        100.0 * fd,
+        100.0 * fe,
+        100.0 * (fd - fe),
+        100.0 * se
+    );
+    assert!(td > te);
+    assert!(fd - fe > 2.0 * se, "design {fd} vs even {fe}");
+}

@@ -1237,3 +1237,156 @@ def fit_jaeger(
         min_ess=min_ess,
     )
     return FitSet([_fitted(x, {"branch": branch}) for x in fits], notes)
+
+
+class Design:
+    """An experimental design (:func:`design`): where to measure and what it buys.
+
+    Attributes
+    ----------
+    table : Table
+        The design: ``series``, ``xi``, ``delta_deg``, ``replicates`` (the columns of
+        ``fitbead design --output``; ``simulate --design`` reads them).
+    even : Table
+        Evenly spaced slopes over the same ranges with the same points per series.
+    errors : dict
+        Per parameter: ``{"guess", "stderr_design", "stderr_even"}`` (predicted standard
+        errors; NaN where the design does not determine the parameter).
+    target : str or None
+        The c-criterion's parameter.
+    efficiency : float
+        Efficiency of the evenly spaced slopes relative to the design (D: (det M_even /
+        det M)^(1/p); c: Var / Var_even; T: T_even / T).
+    gap : float
+        Equivalence gap of the approximate design (0 at the optimum).
+    discrimination, points_needed : tuple of float or None
+        T criterion: the noncentrality at the design and at evenly spaced slopes, and the
+        points needed in all for power 0.8 at significance 0.05.
+    ranges : list of (float, float)
+        The slope range of each series, degrees.
+    """
+
+    def __init__(self, raw: Mapping[str, Any]) -> None:
+        def table(d: Mapping[str, Any]) -> Table:
+            t = Table(
+                series=np.asarray(d["series"], dtype=object),
+                xi=np.asarray(d["xi"], dtype=float),
+                delta_deg=np.asarray(d["delta_deg"], dtype=float),
+                replicates=np.asarray(d["replicates"], dtype=np.int64),
+            )
+            t.shape = t["xi"].shape
+            return t
+
+        self.table = table(raw["design"])
+        self.even = table(raw["even"])
+        self.errors: Dict[str, Dict[str, float]] = {
+            e["parameter"]: {"guess": e["guess"], "stderr_design": e["stderr_design"], "stderr_even": e["stderr_even"]}
+            for e in raw["errors"]
+        }
+        self.target: Optional[str] = raw["target"]
+        self.efficiency: float = raw["efficiency"]
+        self.gap: float = raw["gap"]
+        self.discrimination: Optional[Tuple[float, float]] = raw["discrimination"]
+        self.points_needed: Optional[Tuple[float, float]] = raw["points_needed"]
+        self.ranges: List[Tuple[float, float]] = [tuple(r) for r in raw["ranges"]]  # type: ignore[misc]
+
+    def to_pandas(self):
+        """The design as a DataFrame (series, xi, delta_deg, replicates; needs pandas)."""
+        return self.table.to_pandas()
+
+    def to_csv(self, path: str) -> None:
+        """Writes the design as ``fitbead design --output`` does (for ``simulate --design``)."""
+        lines = ["series,xi,delta_deg,replicates"]
+        t = self.table
+        for i in range(len(t["xi"])):
+            lines.append(f"{t['series'][i]},{t['xi'][i]!r},{t['delta_deg'][i]!r},{t['replicates'][i]}")
+        with open(path, "w", encoding="utf-8") as fh:
+            fh.write("\n".join(lines) + "\n")
+
+    def __repr__(self) -> str:
+        errs = ", ".join(f"{k}: {v['stderr_design']:.3g} (even {v['stderr_even']:.3g})" for k, v in self.errors.items())
+        return f"Design({len(self.table['xi'])} slopes, {int(self.table['replicates'].sum())} points; {errs}; efficiency of even {self.efficiency:.3g})"
+
+
+def design(
+    fit: str = "klaw",
+    *,
+    model: Optional[str] = None,
+    law: str = "c=0.5",
+    series: Sequence[float] = (0.8, 1.0, 1.6, 2.0),
+    points: int = 9,
+    noise: Union[float, str] = 0.02,
+    delta_range: Optional[Tuple[float, float]] = None,
+    criterion: str = "d",
+    target: Optional[str] = None,
+    vs: Optional[str] = None,
+    branch: str = "upper",
+    rho: float = 0.4,
+    f: float = 0.1,
+) -> Design:
+    """Where to measure (``fitbead design``): locally optimal slopes for a fit's parameters,
+    or slopes that tell two models apart, from the Fisher information at a guess.
+
+    Parameters
+    ----------
+    fit : {"klaw", "jan", "jaeger"}
+        The fit the data are for.
+    model : str, optional
+        The model the data follow (a contact model for ``klaw``; default stickslip).
+    law : str, default "c=0.5"
+        For ``klaw``, the fitted law with its guess: ``c=VALUE``, or a number (one K per
+        series).
+    series : sequence of float
+        The radius ratios ξ of the series.
+    points : int
+        Points per series.
+    noise : float or str
+        Relative noise σ = noise · v̄ (as ``simulate --noise``), or ``"abs=S"`` for an
+        absolute σ of v̄.
+    delta_range : (float, float), optional
+        Slopes in degrees (cut to regime B of the guess); default regime B kept 5 % of its
+        width from each end.
+    criterion : {"d", "c", "t"}
+        D-optimal, c-optimal for ``target``, or T-optimal against ``vs``.
+    target : str, optional
+        The parameter of the c criterion.
+    vs : str, optional
+        The rival contact model of the T criterion.
+    branch : {"upper", "lower"}
+        Jaeger's root of eq 84.
+    rho, f : float
+        Gyration parameter and friction coefficient.
+
+    Returns
+    -------
+    Design
+
+    Raises
+    ------
+    FitbeadError
+        A setting the design cannot work with (e.g. a series without a regime-B range),
+        named as the command line names it.
+    """
+    absolute = False
+    if isinstance(noise, str):
+        text = noise.strip()
+        if not text.startswith("abs="):
+            raise FitbeadError(f"noise = {noise!r}: expected a number or abs=VALUE")
+        noise, absolute = float(text[4:]), True
+    raw = _core.design(
+        fit,
+        model=model,
+        law=law,
+        series=[float(x) for x in series],
+        points=int(points),
+        noise=float(noise),
+        noise_absolute=absolute,
+        delta_range=None if delta_range is None else (float(delta_range[0]), float(delta_range[1])),
+        criterion=criterion,
+        target=target,
+        vs=vs,
+        branch=branch,
+        rho=float(rho),
+        f=float(f),
+    )
+    return Design(raw)

@@ -2,7 +2,7 @@
 # (mypy) from the installed package; python/tests/test_habits.py checks them against it.
 import numpy as np
 from dataclasses import dataclass, field
-from typing import Any, Iterable, Sequence
+from typing import Any, Iterable, Mapping, Sequence
 
 __version__: str
 ArrayLike = float | Sequence[float] | np.ndarray
@@ -483,4 +483,90 @@ def fit_jaeger(data: Any = None, *, branch: str = 'upper', method: str = 'lsq', 
     -----
     UnitWarning, ConvergenceWarning, BoundWarning
         The command line\'s warnings on the data and the fits.
+    '''
+
+class Design:
+    '''An experimental design (:func:`design`): where to measure and what it buys.
+
+    Attributes
+    ----------
+    table : Table
+        The design: ``series``, ``xi``, ``delta_deg``, ``replicates`` (the columns of
+        ``fitbead design --output``; ``simulate --design`` reads them).
+    even : Table
+        Evenly spaced slopes over the same ranges with the same points per series.
+    errors : dict
+        Per parameter: ``{"guess", "stderr_design", "stderr_even"}`` (predicted standard
+        errors; NaN where the design does not determine the parameter).
+    target : str or None
+        The c-criterion\'s parameter.
+    efficiency : float
+        Efficiency of the evenly spaced slopes relative to the design (D: (det M_even /
+        det M)^(1/p); c: Var / Var_even; T: T_even / T).
+    gap : float
+        Equivalence gap of the approximate design (0 at the optimum).
+    discrimination, points_needed : tuple of float or None
+        T criterion: the noncentrality at the design and at evenly spaced slopes, and the
+        points needed in all for power 0.8 at significance 0.05.
+    ranges : list of (float, float)
+        The slope range of each series, degrees.
+    '''
+    table: Table
+    even: Table
+    errors: dict[str, dict[str, float]]
+    target: str | None
+    efficiency: float
+    gap: float
+    discrimination: tuple[float, float] | None
+    points_needed: tuple[float, float] | None
+    ranges: list[tuple[float, float]]
+    def __init__(self, raw: Mapping[str, Any]) -> None: ...
+    def to_pandas(self):
+        """The design as a DataFrame (series, xi, delta_deg, replicates; needs pandas)."""
+    def to_csv(self, path: str) -> None:
+        """Writes the design as ``fitbead design --output`` does (for ``simulate --design``)."""
+
+def design(fit: str = 'klaw', *, model: str | None = None, law: str = 'c=0.5', series: Sequence[float] = (0.8, 1.0, 1.6, 2.0), points: int = 9, noise: float | str = 0.02, delta_range: tuple[float, float] | None = None, criterion: str = 'd', target: str | None = None, vs: str | None = None, branch: str = 'upper', rho: float = 0.4, f: float = 0.1) -> Design:
+    '''Where to measure (``fitbead design``): locally optimal slopes for a fit\'s parameters,
+    or slopes that tell two models apart, from the Fisher information at a guess.
+
+    Parameters
+    ----------
+    fit : {"klaw", "jan", "jaeger"}
+        The fit the data are for.
+    model : str, optional
+        The model the data follow (a contact model for ``klaw``; default stickslip).
+    law : str, default "c=0.5"
+        For ``klaw``, the fitted law with its guess: ``c=VALUE``, or a number (one K per
+        series).
+    series : sequence of float
+        The radius ratios ξ of the series.
+    points : int
+        Points per series.
+    noise : float or str
+        Relative noise σ = noise · v̄ (as ``simulate --noise``), or ``"abs=S"`` for an
+        absolute σ of v̄.
+    delta_range : (float, float), optional
+        Slopes in degrees (cut to regime B of the guess); default regime B kept 5 % of its
+        width from each end.
+    criterion : {"d", "c", "t"}
+        D-optimal, c-optimal for ``target``, or T-optimal against ``vs``.
+    target : str, optional
+        The parameter of the c criterion.
+    vs : str, optional
+        The rival contact model of the T criterion.
+    branch : {"upper", "lower"}
+        Jaeger\'s root of eq 84.
+    rho, f : float
+        Gyration parameter and friction coefficient.
+
+    Returns
+    -------
+    Design
+
+    Raises
+    ------
+    FitbeadError
+        A setting the design cannot work with (e.g. a series without a regime-B range),
+        named as the command line names it.
     '''

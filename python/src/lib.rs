@@ -1342,6 +1342,89 @@ fn output_columns(command: &str, model: &str) -> PyResult<Vec<String>> {
     Ok(names.into_iter().map(String::from).collect())
 }
 
+/// An experimental design (`fitbead design`): the settings as the command line's flags, the
+/// result as a dict of plain values (rows as columns).
+#[pyfunction]
+#[pyo3(signature = (fit, model=None, law="c=0.5", series=vec![0.8, 1.0, 1.6, 2.0], points=9, noise=0.02, noise_absolute=false, delta_range=None, criterion="d", target=None, vs=None, branch="upper", rho=0.4, f=0.1))]
+#[allow(clippy::too_many_arguments)]
+fn design<'py>(
+    py: Python<'py>,
+    fit: &str,
+    model: Option<&str>,
+    law: &str,
+    series: Vec<f64>,
+    points: usize,
+    noise: f64,
+    noise_absolute: bool,
+    delta_range: Option<(f64, f64)>,
+    criterion: &str,
+    target: Option<String>,
+    vs: Option<&str>,
+    branch: &str,
+    rho: f64,
+    f: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    use fitbead::design::{Criterion, DesignFit, DesignSettings};
+    let kind = |name: &str, v: &str| {
+        v.parse::<ModelKind>()
+            .map_err(|e| value_error(format!("{name} = '{v}': {e}")))
+    };
+    let settings = DesignSettings {
+        fit: fit
+            .parse::<DesignFit>()
+            .map_err(|e| value_error(format!("fit = '{fit}': {e}")))?,
+        model: model.map(|m| kind("model", m)).transpose()?,
+        law: parse_law(law)?,
+        series,
+        rho,
+        f,
+        points,
+        noise,
+        noise_absolute,
+        delta_range,
+        criterion: criterion
+            .parse::<Criterion>()
+            .map_err(|e| value_error(format!("criterion = '{criterion}': {e}")))?,
+        target,
+        vs: vs.map(|m| kind("vs", m)).transpose()?,
+        branch: branch
+            .parse()
+            .map_err(|e: String| value_error(format!("branch = '{branch}': {e}")))?,
+        ..DesignSettings::default()
+    };
+    let r = py
+        .detach(|| fitbead::design::design(&settings))
+        .map_err(|e| value_error(e.to_string()))?;
+    let d = PyDict::new(py);
+    let rows = |rows: &[fitbead::design::DesignRow]| -> PyResult<Bound<'py, PyDict>> {
+        let t = PyDict::new(py);
+        t.set_item("series", rows.iter().map(|r| r.series.clone()).collect::<Vec<_>>())?;
+        t.set_item("xi", rows.iter().map(|r| r.xi).collect::<Vec<_>>())?;
+        t.set_item("delta_deg", rows.iter().map(|r| r.delta_deg).collect::<Vec<_>>())?;
+        t.set_item("replicates", rows.iter().map(|r| r.replicates).collect::<Vec<_>>())?;
+        Ok(t)
+    };
+    d.set_item("design", rows(&r.rows)?)?;
+    d.set_item("even", rows(&r.even)?)?;
+    let errors = PyList::empty(py);
+    for e in &r.errors {
+        let x = PyDict::new(py);
+        x.set_item("parameter", &e.name)?;
+        x.set_item("guess", e.guess)?;
+        x.set_item("stderr_design", opt(e.design))?;
+        x.set_item("stderr_even", opt(e.even))?;
+        errors.append(x)?;
+    }
+    d.set_item("errors", errors)?;
+    d.set_item("target", r.target.clone())?;
+    d.set_item("efficiency", r.efficiency)?;
+    d.set_item("gap", r.gap)?;
+    d.set_item("discrimination", r.discrimination)?;
+    d.set_item("points_needed", r.points_needed)?;
+    d.set_item("ranges", r.ranges.clone())?;
+    Ok(d)
+}
+
 #[pyfunction]
 fn version() -> &'static str {
     env!("CARGO_PKG_VERSION")
@@ -1364,6 +1447,7 @@ fn _fitbead(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(version, m)?)?;
     m.add_function(wrap_pyfunction!(record_columns, m)?)?;
     m.add_function(wrap_pyfunction!(output_columns, m)?)?;
+    m.add_function(wrap_pyfunction!(design, m)?)?;
     m.add("FitbeadError", m.py().get_type::<FitbeadError>())?;
     m.add_function(wrap_pyfunction!(threads, m)?)?;
     m.add_class::<PyDataset>()?;

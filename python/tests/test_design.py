@@ -1,0 +1,42 @@
+"""fitbead.design equals `fitbead design` (same library): the same slopes and replicates, and
+a design written by Design.to_csv is one `simulate --design` reads."""
+
+import numpy as np
+import pytest
+
+import fitbead
+from conftest import read_csv_text
+
+
+def test_design_equals_the_command_line(cli, tmp_path):
+    d = fitbead.design(
+        "klaw", model="stickslip", law="c=0.5", series=[0.8, 1, 1.6, 2], points=9, noise=0.02, criterion="c", target="c"
+    )
+    _, text, _ = cli(
+        "design", "--fit", "klaw", "--model", "stickslip", "--law", "c=0.5", "--series", "0.8,1,1.6,2",
+        "--points", "9", "--noise", "0.02", "--criterion", "c", "--target", "c", "--output", "-",
+    )
+    cols = read_csv_text(text)
+    assert list(d.table) == list(cols)
+    assert list(d.table["series"]) == cols["series"]
+    np.testing.assert_array_equal(d.table["xi"], [float(x) for x in cols["xi"]])
+    np.testing.assert_array_equal(d.table["delta_deg"], [float(x) for x in cols["delta_deg"]])
+    assert list(d.table["replicates"]) == [int(x) for x in cols["replicates"]]
+    assert d.table["replicates"].sum() == 4 * 9 and d.target == "c"
+    e = d.errors["c"]
+    assert e["stderr_design"] < e["stderr_even"] and 0 < d.efficiency < 1
+    df = d.to_pandas()
+    assert list(df.columns) == ["series", "xi", "delta_deg", "replicates"]
+    p = tmp_path / "design.csv"
+    d.to_csv(str(p))
+    cli("simulate", "--design", p, "--model", "stickslip", "--law", "c=0.5", "--noise", "0.02", "--seed", "7",
+        "--output", tmp_path / "data.csv")
+    data = fitbead.Dataset.read_csv(str(tmp_path / "data.csv"))
+    assert len(data) == 36
+
+
+def test_design_errors_name_the_setting():
+    with pytest.raises(fitbead.FitbeadError, match="criterion"):
+        fitbead.design("klaw", criterion="x")
+    with pytest.raises(fitbead.FitbeadError):
+        fitbead.design("klaw", series=[0.1])

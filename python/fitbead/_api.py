@@ -1299,7 +1299,7 @@ class Design:
         lines = ["series,xi,delta_deg,replicates"]
         t = self.table
         for i in range(len(t["xi"])):
-            lines.append(f"{t['series'][i]},{t['xi'][i]!r},{t['delta_deg'][i]!r},{t['replicates'][i]}")
+            lines.append(f"{t['series'][i]},{float(t['xi'][i])!r},{float(t['delta_deg'][i])!r},{int(t['replicates'][i])}")
         with open(path, "w", encoding="utf-8") as fh:
             fh.write("\n".join(lines) + "\n")
 

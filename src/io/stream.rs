@@ -3,16 +3,18 @@
 //!
 //! The engine is a pipeline of rayon tasks. One reading task at a time takes the next block
 //! of raw input and cuts it into ranges at record boundaries (a scan that follows the CSV
-//! quoting, so a quoted cell may hold newlines: [`super::ranges`]); each range becomes a task
+//! quoting, so a quoted cell may hold newlines); each range becomes a task
 //! that parses it with its own `csv` reader, then checks, computes and formats its rows into
 //! its own byte buffer; whichever task finishes the range that is next in input order takes
 //! the finished ranges in order, keeps what the plan keeps across rows
 //! ([`RowPlan::record`]) and writes their bytes. Ranges of many blocks are in flight at once:
 //! while the last ranges of a block are computed, the next block's are, and the bytes before
 //! them are written, so no thread waits for the slowest range of a step. A range holds about
-//! [`TASK_ROWS`] rows (from the mean bytes per line so far); the ranges read and not yet
-//! written are at most four per thread (8 to 128), and the reading task is started again when
-//! half of them have been written, which bounds the memory whatever the number of rows. The
+//! [`TASK_ROWS`] rows (from the mean bytes per line so far), a block half as many ranges as
+//! may be in flight: the reading task reads no further block once four ranges per thread (8
+//! to 128) are read and not yet written, and is started again when half of them have been
+//! written, so at most one and a half times that many are in flight, whatever the number of
+//! rows (and at most two chunks of output are held for the rule below). The
 //! rows keep the line numbers, checks and messages of one reader reading the whole input, and
 //! the output is in input order, byte for byte the same at any number of threads.
 //!
@@ -348,7 +350,7 @@ enum Work {
 /// What the writer takes, in input order.
 enum Item<N> {
     /// The rows of one task.
-    Rows(Done<N>),
+    Rows(Box<Done<N>>),
     /// The end of the input, with the error it ends with.
     End(Option<InputError>),
     /// The stop flag was raised before the next block was read.
@@ -594,7 +596,7 @@ impl<R: Read + Send, P: RowPlan> Pipe<'_, R, P> {
         if !self.drain.load(Ordering::Relaxed) && !self.halt.load(Ordering::Relaxed) {
             self.compute(&mut d);
         }
-        Item::Rows(d)
+        Item::Rows(Box::new(d))
     }
 
     fn compute(&self, d: &mut Done<P::Note>) {
@@ -809,7 +811,7 @@ impl<R: Read + Send, P: RowPlan> Pipe<'_, R, P> {
                 mut ends,
                 mut notes,
                 ..
-            } = d;
+            } = *d;
             out.clear();
             ends.clear();
             notes.clear();

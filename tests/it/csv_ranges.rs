@@ -340,8 +340,9 @@ fn errors_leave_whole_chunks_written_at_any_thread_count() {
         good[..end].to_vec()
     };
     let chunk = 1000;
-    // (row, its replacement, rows written before the error)
-    let cases: [(&[(usize, &[u8])], usize); 8] = [
+    // The rows replaced (row, its replacement), and the rows written before the error.
+    type Case<'a> = (&'a [(usize, &'a [u8])], usize);
+    let cases: [Case; 8] = [
         (&[(12_345, b"bad,1,2")], 12_000),
         (&[(12_345, b"1,2")], 11_000),
         (&[(12_000, b"1,2")], 11_000),

@@ -69,11 +69,9 @@ pub fn output_columns(auto: bool) -> Vec<&'static str> {
 }
 
 /// Rows per chunk of a K stream ([`super::stream::StreamOptions::chunk_rows`]), a quarter of
-/// the engine's [`super::stream::CHUNK_ROWS`]: a K row costs microseconds, so smaller chunks
-/// lose nothing to the pauses between them, while the memory the stream touches (two chunks
-/// of records, two of output) shrinks from about 47 MB to 16 MB, and with it the page faults
-/// of its first touch (measured on 100,000 simulated rows: 10,756 against 2,955 minor faults,
-/// 9 % less CPU time single-threaded; docs/PERFORMANCE.md).
+/// the engine's [`super::stream::CHUNK_ROWS`]: what `fitbead k` writes to a stream before a
+/// bad row is whole chunks of this many rows (the memory the stream uses does not depend on
+/// it).
 pub const CHUNK_ROWS: usize = 8 * 1024;
 
 /// Input columns that have their own output column.

@@ -1,7 +1,8 @@
-//! The rows of a CSV table parsed in parallel: one thread reads the raw bytes and cuts them
-//! at record boundaries into ranges; each range is parsed by its own `csv` reader on a rayon
-//! task; the rows come back in input order, with the line numbers, byte offsets, checks and
-//! messages of [`TableReader`](super::scenes::TableReader) reading the same input alone.
+//! A CSV table's rows cut into byte ranges that can be parsed in parallel: one thread reads
+//! the raw bytes and cuts them at record boundaries into ranges ([`Ranges::next_block`]);
+//! each range is parsed by its own `csv` reader ([`parse`]), with the line numbers, byte
+//! offsets, checks and messages of [`TableReader`](super::scenes::TableReader) reading the
+//! same input alone.
 //!
 //! A boundary is the position right after the byte that ends a record (`\n`, or the `\r` of
 //! `\r\n` or of a lone `\r`), where the `csv` reader begins the next record: a range that
@@ -10,28 +11,26 @@
 //! boundaries follows the quoting as the `csv` reader does (a quote opens a cell only at the
 //! start of a field; `""` inside one is a quote), so a newline inside a quoted cell never
 //! cuts a record; it runs byte by byte only over a block of input that holds a quote, and
-//! otherwise looks only at line ends. A range's reader gets its first byte alone, so that it keeps the bytes
-//! of a UTF-8 byte order mark at the range's start, as the one reader does after the header.
+//! otherwise looks only at line ends. A range's reader gets its first byte alone, so that it
+//! keeps the bytes of a UTF-8 byte order mark at the range's start, as the one reader does
+//! after the header.
 //!
-//! Errors keep their order: a range stops at its first malformed row (a row whose field count
-//! differs from the header's, or with invalid UTF-8), and that row is reported only after
-//! every row before it has been handed out; a quoted cell still open at the end of the input
-//! is reported after the last row.
+//! Errors keep their order once the ranges' results are taken in input order: a range stops
+//! at its first malformed row (a row whose field count differs from the header's, or with
+//! invalid UTF-8, [`Failure`]); a read error, or a quoted cell still open at the end of the
+//! input, comes after the last range ([`Next::End`]).
 
 use super::csvsyntax::{csv_error, ragged_row, unterminated_quote, utf8_error, Quoting};
 use super::InputError;
 use rayon::prelude::*;
-use std::collections::VecDeque;
 use std::io::Read;
 
 /// The fewest bytes read ahead at once.
 const MIN_BLOCK: usize = 64 * 1024;
 /// The bounds of one range's size in bytes.
-const MIN_RANGE: usize = 16 * 1024;
-const MAX_RANGE: usize = 1024 * 1024;
-/// Ranges per thread in one block (so that the tasks even out).
-const RANGES_PER_THREAD: usize = 4;
-/// Bytes per row assumed before any row has been parsed.
+pub(crate) const MIN_RANGE: usize = 4 * 1024;
+pub(crate) const MAX_RANGE: usize = 1024 * 1024;
+/// Bytes per row assumed before any row has been cut.
 const FIRST_ROW_BYTES: u64 = 128;
 
 /// A table's input after its header: what [`Ranges`] starts from.
@@ -56,46 +55,49 @@ pub(crate) struct Rest<R> {
     pub opened: u64,
 }
 
-/// Reads the rows of a table in parallel (see the module docs), [`read_chunk`] at a time.
-///
-/// [`read_chunk`]: Ranges::read_chunk
-pub struct Ranges<R> {
+/// The input of a table cut into ranges at record boundaries (see the module docs), one
+/// block of ranges at a time ([`next_block`](Ranges::next_block)); each range is then parsed
+/// on its own ([`parse`]).
+pub(crate) struct Ranges<R> {
     source: String,
     width: usize,
     input: R,
-    /// Raw bytes from a boundary on, not yet parsed.
+    /// Raw bytes from a boundary on, not yet cut.
     buf: Vec<u8>,
     /// Offset, line and quoting (as the reader's watch sees it) of `buf[0]`.
     byte: u64,
     line: u64,
     quoting: Quoting,
     opened: u64,
+    /// Records before `buf[0]`'s first range, as the header left them.
+    records: u64,
     /// The input has no more bytes (or failed: `read_error`).
     eof: bool,
     read_error: Option<std::io::Error>,
-    /// Nothing more to parse.
+    /// Nothing more to cut; `failed` is what the input ends with.
     exhausted: bool,
-    /// Rows parsed and not yet handed out.
-    ahead: VecDeque<csv::StringRecord>,
-    /// The malformed row (or input) after the rows of `ahead`.
     failed: Option<InputError>,
-    /// Records parsed, the header's and blank ones included.
-    records: u64,
-    rows_seen: u64,
-    /// Records to reuse.
-    spare: Vec<csv::StringRecord>,
-    /// Bytes and rows parsed so far, for the size of the next block.
-    parsed_bytes: u64,
-    parsed_rows: u64,
+    /// Bytes and line ends cut so far, for the size of the next ranges.
+    cut_bytes: u64,
+    cut_lines: u64,
 }
 
 /// One range to parse: its bytes in the block, and its offset and line in the input.
 #[derive(Clone, Copy)]
-struct Span {
-    start: usize,
-    end: usize,
-    byte: u64,
-    line: u64,
+pub(crate) struct Span {
+    pub start: usize,
+    pub end: usize,
+    pub byte: u64,
+    pub line: u64,
+}
+
+/// What [`Ranges::next_block`] gives.
+pub(crate) enum Next {
+    /// Bytes of the input and the ranges that cover them.
+    Block(Vec<u8>, Vec<Span>),
+    /// The end of the input, with the error it ends with (a read error, or a quoted cell still
+    /// open), which comes after every row.
+    End(Option<InputError>),
 }
 
 /// The ranges of a block: where the last ends, and the line and the watch's quoting there.
@@ -107,17 +109,18 @@ struct Cut {
     opened: u64,
 }
 
-/// What a range's task hands back.
-struct Parsed {
-    rows: Vec<csv::StringRecord>,
-    spare: Vec<csv::StringRecord>,
+/// What a range's parse gives.
+pub(crate) struct Parsed {
+    /// The rows, up to the first malformed one.
+    pub rows: Vec<csv::StringRecord>,
     /// Records read (blank ones included).
-    records: u64,
-    failure: Option<Failure>,
+    pub records: u64,
+    /// The malformed row after `rows`, if any.
+    pub failure: Option<Failure>,
 }
 
 /// A malformed row of a range, its record number counted from the range's start.
-enum Failure {
+pub(crate) enum Failure {
     Ragged {
         line: u64,
         len: u64,
@@ -127,6 +130,21 @@ enum Failure {
         err: csv::FromUtf8Error,
     },
     Other(InputError),
+}
+
+impl Failure {
+    /// The error to report for this failure of a table read from `source` under a header of
+    /// `width` fields, `records` being the records before the range (the header's included).
+    pub(crate) fn into_error(self, source: &str, width: usize, records: u64) -> InputError {
+        match self {
+            Failure::Ragged { line, len } => ragged_row(source, Some(line), len, width as u64),
+            Failure::Utf8 { mut pos, err } => {
+                pos.set_record(records + pos.record());
+                utf8_error(source, &pos, err)
+            }
+            Failure::Other(e) => e,
+        }
+    }
 }
 
 /// Where the `csv` reader's state machine stands, as far as boundaries go.
@@ -183,98 +201,42 @@ impl<R: Read> Ranges<R> {
             line: rest.line,
             quoting: rest.quoting,
             opened: rest.opened,
+            records: rest.records,
             eof: false,
             read_error: None,
             exhausted: false,
-            ahead: VecDeque::new(),
             failed: None,
-            records: rest.records,
-            rows_seen: 0,
-            spare: Vec::new(),
-            parsed_bytes: 0,
-            parsed_rows: 0,
+            cut_bytes: 0,
+            cut_lines: 0,
         }
     }
 
-    /// Bytes of the input consumed by the rows handed out so far (the header included).
-    pub fn bytes_read(&self) -> u64 {
-        self.ahead
-            .front()
-            .and_then(|r| r.position())
-            .map_or(self.byte, |p| p.byte())
+    /// Records before the first range (the header's).
+    pub(crate) fn records_before(&self) -> u64 {
+        self.records
+    }
+
+    /// The mean bytes per line of the input cut so far (a guess before any).
+    pub(crate) fn bytes_per_row(&self) -> u64 {
+        match self.cut_lines {
+            0 => FIRST_ROW_BYTES,
+            n => (self.cut_bytes / n).max(1),
+        }
     }
 
     /// The error for an input with a header and no data rows.
-    pub fn no_rows(&self) -> InputError {
+    pub(crate) fn no_rows(&self) -> InputError {
         InputError::file(&self.source, "no data rows after the header")
     }
 
-    /// Reads up to `max` rows into `recs[..n]` (reusing the records already there) and
-    /// returns `n`, as [`TableReader::read_chunk`](super::scenes::TableReader::read_chunk)
-    /// does: fewer than `max` only at the end of the input; a malformed row is an error once
-    /// the rows before it have been handed out.
-    pub fn read_chunk(
-        &mut self,
-        recs: &mut Vec<csv::StringRecord>,
-        max: usize,
-    ) -> Result<usize, InputError> {
-        let mut n = 0;
-        loop {
-            while n < max {
-                let Some(r) = self.ahead.pop_front() else {
-                    break;
-                };
-                match recs.get_mut(n) {
-                    Some(old) => self.spare.push(std::mem::replace(old, r)),
-                    None => recs.push(r),
-                }
-                n += 1;
-            }
-            if n == max {
-                return Ok(n);
-            }
-            if let Some(e) = self.failed.take() {
-                self.exhausted = true;
-                return Err(e);
-            }
-            if self.exhausted {
-                return Ok(n);
-            }
-            self.parse_more(max - n);
+    /// Reads about `block` more bytes (more when no record ends within them) and cuts them
+    /// into ranges of about `range` bytes, the block's bytes held in `bytes` (whose
+    /// allocation is reused); or the end of the input.
+    pub(crate) fn next_block(&mut self, block: usize, range: usize, bytes: Vec<u8>) -> Next {
+        if self.exhausted {
+            return Next::End(self.failed.take());
         }
-    }
-
-    /// Reads the rest of the input only to find what the whole table's reading would have
-    /// reported before any check of the values: a malformed row, or no data rows at all.
-    pub fn drain(&mut self) -> Option<InputError> {
-        loop {
-            if let Some(e) = self.failed.take() {
-                self.exhausted = true;
-                return Some(e);
-            }
-            if self.exhausted {
-                break;
-            }
-            let keep = self.spare.len().max(self.ahead.len());
-            self.spare.extend(self.ahead.drain(..));
-            self.spare.truncate(keep);
-            self.parse_more(1 << 20);
-        }
-        (self.rows_seen == 0).then(|| self.no_rows())
-    }
-
-    /// Reads and parses about enough input for `rows` more rows, appending them to `ahead`;
-    /// sets `failed` at a malformed row and `exhausted` at the end of the input.
-    fn parse_more(&mut self, rows: usize) {
-        let per_row = match self.parsed_rows {
-            0 => FIRST_ROW_BYTES,
-            n => (self.parsed_bytes / n).max(1),
-        };
-        let rows = rows as u64;
-        let want = rows
-            .saturating_mul(per_row)
-            .saturating_add(rows * per_row / 8);
-        let mut want = usize::try_from(want).unwrap_or(usize::MAX).max(MIN_BLOCK);
+        let mut want = block.max(MIN_BLOCK);
         let Cut {
             spans,
             end,
@@ -283,11 +245,11 @@ impl<R: Read> Ranges<R> {
             opened,
         } = loop {
             self.fill(want);
-            if let Some(cut) = self.cut() {
+            if let Some(cut) = self.cut(range) {
                 break cut;
             }
             if self.eof {
-                // A read error: the bytes after the last whole record stay unparsed.
+                // A read error: the bytes after the last whole record stay uncut.
                 break Cut {
                     spans: Vec::new(),
                     end: 0,
@@ -298,53 +260,18 @@ impl<R: Read> Ranges<R> {
             }
             want = want.max(self.buf.len()).saturating_mul(2);
         };
-        let tasks: Vec<(Span, Vec<csv::StringRecord>)> = spans
-            .iter()
-            .map(|s| {
-                let rows = (s.end - s.start) / per_row as usize + 1;
-                let from = self.spare.len().saturating_sub(rows);
-                (*s, self.spare.split_off(from))
-            })
-            .collect();
-        let (buf, width, source) = (&self.buf, self.width, self.source.as_str());
-        let parsed: Vec<Parsed> = tasks
-            .into_par_iter()
-            .map(|(s, spare)| parse(source, &buf[s.start..s.end], s, width, spare))
-            .collect();
-        let mut failed = false;
-        for p in parsed {
-            self.spare.extend(p.spare);
-            if failed {
-                self.spare.extend(p.rows);
-                continue;
-            }
-            self.rows_seen += p.rows.len() as u64;
-            self.parsed_rows += p.rows.len() as u64;
-            self.ahead.extend(p.rows);
-            if let Some(f) = p.failure {
-                self.failed = Some(match f {
-                    Failure::Ragged { line, len } => {
-                        ragged_row(&self.source, Some(line), len, width as u64)
-                    }
-                    Failure::Utf8 { mut pos, err } => {
-                        pos.set_record(self.records + pos.record());
-                        utf8_error(&self.source, &pos, err)
-                    }
-                    Failure::Other(e) => e,
-                });
-                failed = true;
-            }
-            self.records += p.records;
-        }
-        self.parsed_bytes += end as u64;
+        let mut rest = bytes;
+        rest.clear();
+        rest.extend_from_slice(&self.buf[end..]);
+        let mut block = std::mem::replace(&mut self.buf, rest);
+        block.truncate(end);
+        self.cut_bytes += end as u64;
+        self.cut_lines += line - self.line;
         self.byte += end as u64;
         self.line = line;
         self.quoting = quoting;
         self.opened = opened;
-        self.buf.drain(..end);
-        if failed {
-            self.exhausted = true;
-        } else if self.eof && (self.buf.is_empty() || self.read_error.is_some()) {
+        if self.eof && (self.buf.is_empty() || self.read_error.is_some()) {
             self.exhausted = true;
             if let Some(e) = self.read_error.take() {
                 self.failed = Some(InputError::file(&self.source, format!("cannot read: {e}")));
@@ -352,6 +279,41 @@ impl<R: Read> Ranges<R> {
                 self.failed = Some(unterminated_quote(&self.source, self.opened));
             }
         }
+        if spans.is_empty() {
+            return Next::End(self.failed.take());
+        }
+        Next::Block(block, spans)
+    }
+
+    /// Reads the rest of the input only to find what the whole table's reading would have
+    /// reported before any check of the values: a malformed row, or no data rows at all.
+    pub(crate) fn drain(&mut self) -> Option<InputError> {
+        let threads = rayon::current_num_threads().max(1);
+        let mut rows = 0u64;
+        let mut records = self.records;
+        let mut bytes = Vec::new();
+        loop {
+            let range = (self.bytes_per_row() as usize * 512).clamp(MIN_RANGE, MAX_RANGE);
+            let (block, spans) = match self.next_block(range * threads * 4, range, bytes) {
+                Next::Block(b, s) => (b, s),
+                Next::End(Some(e)) => return Some(e),
+                Next::End(None) => break,
+            };
+            let (source, width) = (self.source.as_str(), self.width);
+            let parsed: Vec<Parsed> = spans
+                .par_iter()
+                .map(|s| parse(source, &block[s.start..s.end], *s, width, Vec::new()))
+                .collect();
+            for p in parsed {
+                rows += p.rows.len() as u64;
+                if let Some(f) = p.failure {
+                    return Some(f.into_error(source, width, records));
+                }
+                records += p.records;
+            }
+            bytes = block;
+        }
+        (rows == 0).then(|| self.no_rows())
     }
 
     /// Reads until `buf` holds `want` bytes or the input ends.
@@ -373,15 +335,13 @@ impl<R: Read> Ranges<R> {
         }
     }
 
-    /// The ranges of `buf` to parse now, up to the last boundary where a range may start
-    /// (all of it at the end of the input), with the watch's quoting there; `None` when
-    /// `buf` holds no such boundary yet.
-    fn cut(&self) -> Option<Cut> {
+    /// The ranges of `buf` to parse now, about `step` bytes each, up to the last boundary
+    /// where a range may start (all of it at the end of the input), with the watch's quoting
+    /// there; `None` when `buf` holds no such boundary yet.
+    fn cut(&self, step: usize) -> Option<Cut> {
         let buf = &self.buf;
         // A read error ends the input after the last whole record.
         let eof = self.eof && self.read_error.is_none();
-        let threads = rayon::current_num_threads().max(1);
-        let size = |end: usize| (end / (threads * RANGES_PER_THREAD)).clamp(MIN_RANGE, MAX_RANGE);
         let mut cuts = vec![0];
         let (end, quoting, opened);
         if buf.contains(&b'"') {
@@ -389,7 +349,6 @@ impl<R: Read> Ranges<R> {
             let mut csv = Csv::RecordStart;
             let (mut q, mut line, mut op) = (self.quoting, self.line, self.opened);
             let mut last = None;
-            let step = size(buf.len());
             for (i, &b) in buf.iter().enumerate() {
                 if b == b'\n' {
                     line += 1;
@@ -434,7 +393,6 @@ impl<R: Read> Ranges<R> {
                 (_, Some(_)) => Quoting::Unquoted,
             };
             opened = self.opened;
-            let step = size(end);
             let mut at = step;
             while at < end {
                 let next = buf[at..end]
@@ -463,22 +421,17 @@ impl<R: Read> Ranges<R> {
         }
         cuts.retain(|&c| c < end);
         cuts.push(end);
-        let counts: Vec<u64> = cuts
-            .par_windows(2)
-            .map(|w| newlines(&buf[w[0]..w[1]]))
-            .collect();
         let mut line = self.line;
         let spans = cuts
             .windows(2)
-            .zip(counts)
-            .map(|(w, n)| {
+            .map(|w| {
                 let s = Span {
                     start: w[0],
                     end: w[1],
                     byte: self.byte + w[0] as u64,
                     line,
                 };
-                line += n;
+                line += newlines(&buf[w[0]..w[1]]);
                 s
             })
             .collect();
@@ -508,8 +461,8 @@ impl Read for FirstByteAlone<'_> {
 }
 
 /// Parses one range (`bytes`, at `at`'s offset and line of the input `source`) under a
-/// header of `width` fields, reusing the records of `spare`.
-fn parse(
+/// header of `width` fields, reusing the records of `spare` (whatever their contents).
+pub(crate) fn parse(
     source: &str,
     bytes: &[u8],
     at: Span,
@@ -520,7 +473,7 @@ fn parse(
     let mut rdr = csv::ReaderBuilder::new()
         .has_headers(false)
         .flexible(true)
-        .buffer_capacity(1 << 16)
+        .buffer_capacity((bytes.len() + 1).clamp(1 << 10, 1 << 16))
         .from_reader(FirstByteAlone(bytes, true));
     let mut rows = Vec::with_capacity(spare.len());
     let mut rec = spare.pop().unwrap_or_default();
@@ -565,7 +518,6 @@ fn parse(
     }
     Parsed {
         rows,
-        spare,
         records: rdr.position().record(),
         failure,
     }

@@ -50,12 +50,24 @@ fn echo(row: &Row<'_>, out: &mut Vec<u8>) {
 /// What the engine makes of `text` with [`Echo`] on `threads` threads, chunks of `chunk`
 /// rows: the output, or the error's message.
 fn streamed(text: &[u8], threads: usize, chunk: usize) -> Result<Vec<u8>, String> {
+    let (out, err) = streamed_into(text, threads, chunk);
+    match err {
+        None => Ok(out),
+        Some(e) => Err(e),
+    }
+}
+
+/// The bytes the engine writes for `text` (as [`streamed`]), and the error's message if any.
+fn streamed_into(text: &[u8], threads: usize, chunk: usize) -> (Vec<u8>, Option<String>) {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .unwrap();
     pool.install(|| {
-        let reader = TableReader::new("in.csv", text).map_err(|e| e.to_string())?;
+        let reader = match TableReader::new("in.csv", text) {
+            Ok(r) => r,
+            Err(e) => return (Vec::new(), Some(e.to_string())),
+        };
         let mut out = Vec::new();
         let opts = StreamOptions {
             chunk_rows: chunk,
@@ -63,8 +75,8 @@ fn streamed(text: &[u8], threads: usize, chunk: usize) -> Result<Vec<u8>, String
             ..StreamOptions::default()
         };
         match stream(reader, |_| Ok(Echo), (), &mut out, &opts) {
-            Ok(_) => Ok(out),
-            Err(StreamError::Input(e)) => Err(e.to_string()),
+            Ok(_) => (out, None),
+            Err(StreamError::Input(e)) => (out, Some(e.to_string())),
             Err(e) => panic!("{e:?}"),
         }
     })
@@ -306,4 +318,66 @@ fn forward_output_the_same_at_one_thread_and_several() {
     assert!(one.iter().filter(|&&c| c == b'\n').count() > 60_000);
     assert!(one == run(4), "4 threads differ from 1");
     assert!(one == run(3), "3 threads differ from 1");
+}
+
+/// What reaches the sink (standard output, for the commands) before an error, at 1, 3 and 4
+/// threads, by the rule the engine documents: the header and the rows of the whole chunks
+/// before a bad value's chunk; for a malformed row, of the chunks before the one before its
+/// chunk (a chunk goes out once the chunk after it has been read whole); nothing when that
+/// leaves no chunk. The expected bytes are the first rows of the whole table's output.
+#[test]
+fn errors_leave_whole_chunks_written_at_any_thread_count() {
+    let plain = table(6, 20_000, &[b"x"], b"\n");
+    let good = reference(&plain).unwrap();
+    // The header and the first `n` rows of the good output.
+    let first = |n: usize| -> Vec<u8> {
+        let end = good
+            .iter()
+            .enumerate()
+            .filter(|&(_, &b)| b == b'\n')
+            .nth(n)
+            .map_or(good.len(), |(i, _)| i + 1);
+        good[..end].to_vec()
+    };
+    let chunk = 1000;
+    // The rows replaced (row, its replacement), and the rows written before the error.
+    type Case<'a> = (&'a [(usize, &'a [u8])], usize);
+    let cases: [Case; 8] = [
+        (&[(12_345, b"bad,1,2")], 12_000),
+        (&[(12_345, b"1,2")], 11_000),
+        (&[(12_000, b"1,2")], 11_000),
+        (&[(11_999, b"1,2")], 10_000),
+        (&[(999, b"bad,1,2")], 0),
+        (&[(1_500, b"1,2")], 0),
+        // A bad value, then a malformed row in its chunk: the malformed row's rule.
+        (&[(7_100, b"bad,1,2"), (7_900, b"1,2")], 6_000),
+        // A bad value, then a malformed row two chunks on: the bad value's rule.
+        (&[(7_100, b"bad,1,2"), (9_050, b"1")], 7_000),
+    ];
+    for (rows, written) in cases {
+        let mut t = plain.clone();
+        for (i, r) in rows {
+            t = with_row(&t, *i, r);
+        }
+        let want = if written == 0 {
+            Vec::new()
+        } else {
+            first(written)
+        };
+        let message = reference(&t).unwrap_err();
+        for threads in [1, 3, 4] {
+            let (out, err) = streamed_into(&t, threads, chunk);
+            assert_eq!(
+                err.as_deref(),
+                Some(message.as_str()),
+                "{rows:?}, {threads} threads"
+            );
+            assert!(
+                out == want,
+                "{rows:?}, {threads} threads: {} lines written, want {}",
+                out.iter().filter(|&&b| b == b'\n').count(),
+                written + usize::from(written > 0)
+            );
+        }
+    }
 }

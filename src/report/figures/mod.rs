@@ -3,8 +3,10 @@
 //! posteriors ([`corner`]), and the scatter figure of `fitbead k`. `png` (feature `png`)
 //! renders any of them to PNG with resvg and the embedded font.
 //!
-//! Labels are markup: `_{…}` sets a subscript and `^{…}` a superscript (written as `tspan`s
-//! shifted with `dy`, which every SVG viewer supports); Greek letters and symbols are Unicode.
+//! Labels are markup: `_{…}` sets a subscript and `^{…}` a superscript; Greek letters and
+//! symbols are Unicode. Every run of a label is written as a `tspan` at an absolute position
+//! computed from the embedded font's advance widths (start-anchored, kerning off), so any
+//! conforming renderer draws the same picture.
 //! Every document names the font family list `FONT_FAMILY`, whose first member is the
 //! embedded DejaVu Sans (`assets/fonts/`), whose advance widths the layout measures text with.
 

@@ -266,9 +266,10 @@ impl FitArgs {
             None => Vec::new(),
         };
         let corner = match &self.plot.plot {
-            Some(_) => corner_svg(&CornerBlock::from_posteriors(posteriors))
-                .map_err(|e| CliError::Other(format!("corner plot: {e}")))?
-                .into_bytes(),
+            Some(_) => self.plot.bytes(
+                corner_svg(&CornerBlock::from_posteriors(posteriors))
+                    .map_err(|e| CliError::Other(format!("corner plot: {e}")))?,
+            )?,
             None => Vec::new(),
         };
         let files: Vec<(&std::path::Path, &[u8])> = self

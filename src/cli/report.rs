@@ -35,7 +35,8 @@ pub struct Args {
     /// posterior) [default: lsq]
     #[arg(long)]
     pub method: Option<String>,
-    /// Figure files: svg, png (rendered from the SVG) or both [default: svg]
+    /// Figure files: svg, png (rendered from the SVG), pdf (vector, the font embedded, text
+    /// selectable), both (svg and png) or all (svg, png and pdf) [default: svg]
     #[arg(long)]
     pub format: Option<String>,
     /// Velocities on the figures: dimensionless (units of sqrt(g (R + r))) or si (m/s, for
@@ -72,7 +73,7 @@ pub struct Recipe {
     pub out_dir: Option<PathBuf>,
     /// lsq or mcmc.
     pub method: Option<String>,
-    /// svg, png or both.
+    /// svg, png, pdf, both or all.
     pub format: Option<String>,
     /// dimensionless or si.
     pub units: Option<String>,

@@ -10,7 +10,9 @@ use fitbead::io::measurements::{dataset_of, read_measurements, Measurement};
 use fitbead::io::reports::{draws_csv, params_csv, stats_csv};
 use fitbead::io::scenes::Table;
 use fitbead::io::{fmt_sig, write_atomic_all};
+use fitbead::report::bands::Curve;
 use fitbead::report::figures::{corner_svg, CornerBlock};
+use fitbead::report::plots::lsq_fit_figure;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
@@ -96,10 +98,22 @@ pub struct FitArgs {
     /// step, one column per parameter, log_posterior; `-` writes it to stdout.
     #[arg(long)]
     pub draws: Option<PathBuf>,
-    /// MCMC: with --plot, a corner plot of every posterior (marginal histograms and pairwise
-    /// scatter).
+    /// With --plot: under lsq, v̄ against δ per series, the data with their σ bars, each
+    /// fitted curve and its confidence band at --level (delta method); under mcmc, a corner
+    /// plot of every posterior (marginal histograms and pairwise scatter).
     #[command(flatten)]
     pub plot: PlotArgs,
+}
+
+/// What the least-squares figure of `--plot` draws: its title, the data fitted and the curve
+/// of each fit passed to [`FitArgs::write`] (in the same order).
+pub struct LsqPlot<'a> {
+    /// Title of the figure.
+    pub title: &'a str,
+    /// The data the fits were made on.
+    pub data: &'a fitbead::fit::data::Dataset,
+    /// One curve per fit.
+    pub curves: &'a [Curve],
 }
 
 /// The estimation method asked for on the command line (a posterior run carries the stop
@@ -124,7 +138,6 @@ impl FitArgs {
             ("--prior", !self.priors.is_empty()),
             ("--fit-scatter", self.fit_scatter),
             ("--draws", self.draws.is_some()),
-            ("--plot", self.plot.plot.is_some()),
         ];
         match self.method.to_ascii_lowercase().as_str() {
             "lsq" => {
@@ -244,7 +257,7 @@ impl FitArgs {
     /// `posteriors` are the fits sampled by MCMC: their draws go to `--draws` and their corner
     /// plots to `--plot`, in the same atomic group. A run stopped by Ctrl-C writes everything
     /// and then returns [`CliError::Interrupted`].
-    pub fn write(&self, fits: &[&FitResult]) -> Result<(), CliError> {
+    pub fn write(&self, fits: &[&FitResult], plot: &LsqPlot<'_>) -> Result<(), CliError> {
         let posteriors: Vec<&FitResult> =
             fits.iter().copied().filter(|f| f.draws.is_some()).collect();
         let posteriors = posteriors.as_slice();
@@ -266,10 +279,21 @@ impl FitArgs {
             None => Vec::new(),
         };
         let corner = match &self.plot.plot {
-            Some(_) => self.plot.bytes(
+            Some(_) if !posteriors.is_empty() => self.plot.bytes(
                 corner_svg(&CornerBlock::from_posteriors(posteriors))
                     .map_err(|e| CliError::Other(format!("corner plot: {e}")))?,
             )?,
+            Some(_) => {
+                let with: Vec<(&FitResult, Curve)> = fits
+                    .iter()
+                    .zip(plot.curves)
+                    .map(|(f, c)| (*f, *c))
+                    .collect();
+                self.plot.bytes(
+                    lsq_fit_figure(plot.title, plot.data, &with)
+                        .map_err(|e| CliError::Other(format!("--plot: {e}")))?,
+                )?
+            }
             None => Vec::new(),
         };
         let files: Vec<(&std::path::Path, &[u8])> = self

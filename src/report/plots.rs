@@ -4,12 +4,14 @@
 //! residuals and one corner plot per posterior.
 
 use super::analysis::{k_of_c, lsq, Analysis};
-use super::bands::PosteriorBands;
+use super::bands::{lsq_band, Curve, PosteriorBands};
 use super::figures::corner::{corner_figure, CornerBlock};
+use super::figures::ErrPoint;
 use super::figures::{
     coincide, scatter_panel, series_style, Anchor, Axis, Figure, Item, LegendEntry, Mark, Panel,
     PointSeries, Scatter, Stroke, DASHES, PALETTE,
 };
+use crate::fit::data::Dataset;
 use crate::fit::jaeger::{paper_values, JaegerModel};
 use crate::fit::jan::velocity as jan_velocity;
 use crate::fit::k::estimate;
@@ -1150,4 +1152,102 @@ fn jaeger_law(
     }
     p.curve(sample(ustar, umax), upper.clone());
     ustar > 0.0
+}
+
+/// Figure of least-squares fits (`fitbead klaw`, `jan` and `jaeger` with `--plot`): one panel
+/// per series, v̄ against δ: the data with their σ bars, each fit's curve at the optimum and
+/// its confidence band at the fit's level by the delta method (the covariance at the
+/// optimum; see `bands::lsq_band`). Fits are told apart by colour and named by their
+/// params.csv name; a fit without a covariance is drawn without a band.
+pub fn lsq_fit_figure(
+    title: &str,
+    data: &Dataset,
+    fits: &[(&FitResult, Curve)],
+) -> Result<String, String> {
+    let mut names: Vec<&str> = Vec::new();
+    for (f, _) in fits {
+        if !names.contains(&f.stats.fit.as_str()) {
+            names.push(&f.stats.fit);
+        }
+    }
+    let level = fits
+        .iter()
+        .find_map(|(f, _)| f.params.first().map(|r| r.level))
+        .unwrap_or(0.95);
+    let mut panels = Vec::new();
+    let mut notes = Vec::new();
+    for (s, label) in data.labels.iter().enumerate() {
+        let pts: Vec<&crate::fit::data::Point> = data.series(s).collect();
+        let Some(first) = pts.first() else { continue };
+        let (lo, hi) = pts.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, p| {
+            (a.0.min(p.scene.delta), a.1.max(p.scene.delta))
+        });
+        let pad = 0.08 * (hi - lo).max(1f64.to_radians());
+        let grid: Vec<f64> = (0..=100)
+            .map(|i| (lo - pad).max(1e-4) + (hi - lo + 2.0 * pad) * i as f64 / 100.0)
+            .collect();
+        let xi = first.scene.xi;
+        let title = if label.parse::<f64>().ok() == Some(xi) {
+            format!("ξ = {label}")
+        } else {
+            format!("series {label} (ξ = {})", g4(xi))
+        };
+        let mut p = Panel::new(&title, Axis::new(DELTA_LABEL), Axis::new(V_LABEL));
+        for (f, curve) in fits {
+            let Some(b) = lsq_band(f, *curve, data, s, &grid) else {
+                continue;
+            };
+            let k = names.iter().position(|n| *n == f.stats.fit).unwrap_or(0);
+            let colour = PALETTE[k % PALETTE.len()];
+            let band: Vec<(f64, f64, f64)> = (0..b.delta_deg.len())
+                .filter(|&i| b.lo[i].is_finite() && b.hi[i].is_finite())
+                .map(|i| (b.delta_deg[i], b.lo[i], b.hi[i]))
+                .collect();
+            if band.len() > 1 {
+                p.band(band, colour, 0.22);
+            } else if !f.params.is_empty() {
+                notes.push(format!(
+                    "{title}: {} has no band (no covariance at the optimum)",
+                    f.stats.fit
+                ));
+            }
+            let line: Vec<(f64, f64)> = b.delta_deg.iter().copied().zip(b.v).collect();
+            p.curve(line, Stroke::solid(colour, 2.0));
+        }
+        let data_pts: Vec<ErrPoint> = pts
+            .iter()
+            .map(|q| {
+                let (x, y) = (q.scene.delta_deg(), q.v);
+                if data.sigma == SigmaKind::Absolute {
+                    (x, y, y - q.sigma, y + q.sigma)
+                } else {
+                    (x, y, y, y)
+                }
+            })
+            .collect();
+        p.points(data_pts, DATA, Mark::Circle);
+        panels.push(p);
+    }
+    if panels.is_empty() {
+        return Err("no series to draw".to_string());
+    }
+    let cols = panels.len().min(2);
+    let mut f = Figure::new(title, cols, GRID_PLOT, panels);
+    f.notes = notes;
+    f.legend
+        .push(LegendEntry::mark("data (± σ)", Mark::Circle, DATA));
+    for (k, n) in names.iter().enumerate() {
+        let colour = PALETTE[k % PALETTE.len()];
+        f.legend
+            .push(LegendEntry::line(n, &Stroke::solid(colour, 2.0)));
+    }
+    f.legend.push(LegendEntry::patch(
+        &format!(
+            "{} % confidence band (delta method)",
+            fmt_sig(100.0 * level, 3)
+        ),
+        REFERENCE,
+        0.3,
+    ));
+    Ok(f.to_svg())
 }

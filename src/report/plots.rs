@@ -307,17 +307,22 @@ impl Analysis {
     }
 
     /// Figure: v̄²/cos δ against tan δ with Jan's straight lines (the paper's Fig. 8), each
-    /// series' points and line in one colour.
-    pub fn jan_figure(&self) -> Result<String, String> {
-        let mut p = Panel::new(
-            "",
-            Axis::new("tan δ"),
-            Axis::new("v\u{304}^{2} / cos δ  (units of g(R + r))"),
-        );
+    /// series' points and line in one colour; with `units_m_s` (per series, as for
+    /// [`Analysis::velocity_figure_with`]) v̄² in m²/s².
+    pub fn jan_figure(&self, units_m_s: Option<&[f64]>) -> Result<String, String> {
+        let unit = |s: usize| units_m_s.and_then(|u| u.get(s).copied()).unwrap_or(1.0);
+        let y_label = if units_m_s.is_some() {
+            "v\u{304}^{2} / cos δ  (m^{2}/s^{2})"
+        } else {
+            "v\u{304}^{2} / cos δ  (units of g(R + r))"
+        };
+        let mut p = Panel::new("", Axis::new("tan δ"), Axis::new(y_label));
         for s in 0..self.data.labels.len() {
             let (colour, mark) = series_style(s);
-            let pts =
-                self.series_points(s, |q, v| (q.scene.delta.tan(), v * v / q.scene.delta.cos()));
+            let u2 = unit(s) * unit(s);
+            let pts = self.series_points(s, |q, v| {
+                (q.scene.delta.tan(), u2 * v * v / q.scene.delta.cos())
+            });
             let stroke = Stroke::solid(colour, 2.0);
             if let Some(j) = &self.jan.series[s] {
                 let (l, m) = (lsq(&j.params[0]), lsq(&j.params[1]));
@@ -325,7 +330,7 @@ impl Analysis {
                 let t1 = pts.iter().map(|q| q.0).fold(f64::NEG_INFINITY, f64::max) * 1.04;
                 // v̄²/cos δ = (2 sin α/λ)(tan δ − μ): a straight line from tan δ = μ (eq 74).
                 p.curve(
-                    vec![(m, 0.0), (t1, 2.0 * sa / l * (t1 - m))],
+                    vec![(m, 0.0), (t1, u2 * 2.0 * sa / l * (t1 - m))],
                     stroke.clone(),
                 );
                 p.legend.push(LegendEntry::mark_line(
@@ -374,8 +379,10 @@ impl Analysis {
     }
 
     /// Figure: K per point (eq 69, stick/slip) against the steady final velocity (the
-    /// paper's Figs. 5–6), with each series' K = cos 2α.
-    pub fn k_figure(&self) -> Result<String, String> {
+    /// paper's Figs. 5–6), with each series' K = cos 2α; with `units_m_s` (per series, as
+    /// for [`Analysis::velocity_figure_with`]) the velocity in m/s.
+    pub fn k_figure(&self, units_m_s: Option<&[f64]>) -> Result<String, String> {
+        let unit = |s: usize| units_m_s.and_then(|u| u.get(s).copied()).unwrap_or(1.0);
         let ks = self.k_points(Model::StickSlip);
         let series = ks
             .iter()
@@ -385,14 +392,18 @@ impl Analysis {
                 let c2 = CollisionLaw::Cos2a.k(p0.alpha, p0.rho);
                 PointSeries {
                     label: self.series_title(s),
-                    points: pts.iter().map(|q| (q.0, q.2, q.3, q.4)).collect(),
+                    points: pts.iter().map(|q| (q.0 * unit(s), q.2, q.3, q.4)).collect(),
                     reference: Some((c2, format!("K = cos 2α = {c2:.4}"))),
                 }
             })
             .collect();
         let fig = Scatter {
             title: "K per measurement (eq 69), stick/slip model (the paper's Figs. 5–6)".into(),
-            x_label: "steady final velocity v_{f} / √(g(R + r))".into(),
+            x_label: if units_m_s.is_some() {
+                "steady final velocity v_{f} (m/s)".into()
+            } else {
+                "steady final velocity v_{f} / √(g(R + r))".into()
+            },
             y_label: "K".into(),
             series,
         };

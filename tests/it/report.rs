@@ -204,6 +204,17 @@ fn report_md_states_the_si_conversion() {
     );
     let fig = std::fs::read_to_string(si_dir.join("velocity.svg")).unwrap();
     assert!(fig.contains("(m/s)"), "velocity.svg is not in m/s");
+    // Every velocity axis: Jan's v̄²/cos δ in m²/s² (the exponents are superscript runs),
+    // the final velocity of the K figure in m/s.
+    let jan = std::fs::read_to_string(si_dir.join("jan_linear.svg")).unwrap();
+    assert!(
+        jan.contains("(m</tspan>") && jan.contains(">/s</tspan>"),
+        "jan_linear.svg is not in m²/s²"
+    );
+    assert!(!jan.contains("g(R + r)"));
+    let k = std::fs::read_to_string(si_dir.join("k_final_velocity.svg")).unwrap();
+    assert!(k.contains("(m/s)"), "k_final_velocity.svg is not in m/s");
+    assert!(!k.contains("√(g(R + r))"));
     // The dimensionless data are refused with --units si.
     let out = bin()
         .args(["report", "--units", "si", "--out-dir"])

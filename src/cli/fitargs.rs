@@ -12,6 +12,7 @@ use fitbead::io::scenes::Table;
 use fitbead::io::{fmt_sig, write_atomic_all};
 use fitbead::report::bands::Curve;
 use fitbead::report::figures::{corner_svg, CornerBlock};
+use fitbead::report::file_stems;
 use fitbead::report::plots::lsq_fit_figure;
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -278,24 +279,43 @@ impl FitArgs {
             Some(_) => draws_csv(posteriors).map_err(|e| CliError::Other(e.to_string()))?,
             None => Vec::new(),
         };
-        let corner = match &self.plot.plot {
-            Some(_) if !posteriors.is_empty() => self.plot.bytes(
-                corner_svg(&CornerBlock::from_posteriors(posteriors))
-                    .map_err(|e| CliError::Other(format!("corner plot: {e}")))?,
-            )?,
-            Some(_) => {
+        // The figure files: under least squares one figure; under MCMC one corner plot per
+        // fit and series, PATH's stem followed by _FIT_SERIES (all stacked in one document
+        // when the figure goes to stdout).
+        let mut figures: Vec<(PathBuf, Vec<u8>)> = Vec::new();
+        if let Some(path) = &self.plot.plot {
+            if posteriors.is_empty() {
                 let with: Vec<(&FitResult, Curve)> = fits
                     .iter()
                     .zip(plot.curves)
                     .map(|(f, c)| (*f, *c))
                     .collect();
-                self.plot.bytes(
-                    lsq_fit_figure(plot.title, plot.data, &with)
-                        .map_err(|e| CliError::Other(format!("--plot: {e}")))?,
-                )?
+                let svg = lsq_fit_figure(plot.title, plot.data, &with)
+                    .map_err(|e| CliError::Other(format!("--plot: {e}")))?;
+                figures.push((path.clone(), self.plot.bytes(svg)?));
+            } else if path.as_os_str() == "-" {
+                let svg = corner_svg(&CornerBlock::from_posteriors(posteriors))
+                    .map_err(|e| CliError::Other(format!("corner plot: {e}")))?;
+                figures.push((path.clone(), svg.into_bytes()));
+            } else {
+                let labels: Vec<String> =
+                    posteriors.iter().map(|p| p.stats.series.clone()).collect();
+                let stems = file_stems(&labels);
+                let stem = path.file_stem().map_or_else(
+                    || "corner".to_string(),
+                    |s| s.to_string_lossy().into_owned(),
+                );
+                let ext = path
+                    .extension()
+                    .map_or_else(|| "svg".to_string(), |e| e.to_string_lossy().into_owned());
+                for (p, series) in posteriors.iter().zip(&stems) {
+                    let svg = corner_svg(&CornerBlock::from_posteriors(&[*p]))
+                        .map_err(|e| CliError::Other(format!("corner plot: {e}")))?;
+                    let name = format!("{stem}_{}_{series}.{ext}", p.stats.fit);
+                    figures.push((path.with_file_name(name), self.plot.bytes(svg)?));
+                }
             }
-            None => Vec::new(),
-        };
+        }
         let files: Vec<(&std::path::Path, &[u8])> = self
             .out
             .output
@@ -308,12 +328,7 @@ impl FitArgs {
                     .map(|q| (q.as_path(), s.as_slice())),
             )
             .chain(self.draws.iter().map(|q| (q.as_path(), d_csv.as_slice())))
-            .chain(
-                self.plot
-                    .plot
-                    .iter()
-                    .map(|q| (q.as_path(), corner.as_slice())),
-            )
+            .chain(figures.iter().map(|(q, b)| (q.as_path(), b.as_slice())))
             .collect();
         if !files.is_empty() {
             write_atomic_all(&files).map_err(|e| CliError::Other(format!("cannot write: {e}")))?;

@@ -345,7 +345,7 @@ impl Analysis {
             p.points(pts, colour, mark);
         }
         Ok(Figure::new(
-            "Jan's linearised plot (the paper's Fig. 8): straight lines from tan δ = μ",
+            "Jan's linearised plot: straight lines from tan δ = μ",
             1,
             SINGLE_PLOT,
             vec![p],
@@ -398,7 +398,7 @@ impl Analysis {
             })
             .collect();
         let fig = Scatter {
-            title: "K per measurement (eq 69), stick/slip model (the paper's Figs. 5–6)".into(),
+            title: "K per measurement (eq 69), stick/slip model".into(),
             x_label: if units_m_s.is_some() {
                 "steady final velocity v_{f} (m/s)".into()
             } else {
@@ -588,7 +588,7 @@ impl Analysis {
             panels.push(p);
         }
         let mut fig = Figure::new(
-            "Regime map (the paper's Fig. 4): A stops, B steady, C no steady motion",
+            "Regime map: A stops, B steady, C no steady motion",
             2,
             (470.0, 400.0),
             panels,
@@ -648,7 +648,7 @@ impl Analysis {
             panels.push(p);
         }
         let mut f = Figure::new(
-            "Jaeger's law tan δ = a_{3}u^{2} + a_{1}/(1 + a_{2}u^{2}) (the paper's Figs. 9–10)",
+            "Jaeger's law tan δ = a_{3}u^{2} + a_{1}/(1 + a_{2}u^{2})",
             2,
             GRID_PLOT,
             panels,
@@ -1055,7 +1055,8 @@ fn shade_regimes(
         });
         p.items.push(Item::Text {
             at: (ac, 0.93 * top),
-            text: format!(" ξ_{{c}} = {} ", g4(xc)),
+            // Two spaces of advance keep the label clear of its own line on either side.
+            text: format!("  ξ_{{c}} = {}  ", g4(xc)),
             anchor: if ac > 0.5 * (a_lo + a_hi) {
                 Anchor::End
             } else {

@@ -295,3 +295,42 @@ fn output_dash_is_standard_output_for_every_table_command() {
         );
     }
 }
+
+/// `--format all` writes every figure as SVG, PNG and PDF; each PDF is a PDF document with the
+/// embedded font subset into it and a ToUnicode map (its text is selectable), and report.md
+/// links all three. The figures' titles carry no reference to the paper's figures: report.md's
+/// captions do.
+#[test]
+fn report_writes_pdf_figures_with_the_font_embedded() {
+    let dir = tmpdir();
+    let out_dir = dir.path().join("r");
+    report_into(&out_dir, &["--format", "all"]);
+    let md = std::fs::read_to_string(out_dir.join("report.md")).unwrap();
+    let mut svgs = 0;
+    for e in std::fs::read_dir(&out_dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_some_and(|x| x == "svg") {
+            svgs += 1;
+            let svg = std::fs::read_to_string(&p).unwrap();
+            assert!(!svg.contains("the paper's"), "{}", p.display());
+            assert!(p.with_extension("png").exists(), "{}", p.display());
+            let pdf = std::fs::read(p.with_extension("pdf")).unwrap();
+            assert!(pdf.starts_with(b"%PDF-"), "{}", p.display());
+            let text = String::from_utf8_lossy(&pdf);
+            for key in ["DejaVuSans", "/FontFile2", "/ToUnicode"] {
+                assert!(text.contains(key), "{}: no {key}", p.display());
+            }
+            let name = p
+                .file_name()
+                .unwrap()
+                .to_string_lossy()
+                .replace(".svg", ".pdf");
+            assert!(
+                md.contains(&format!("[{name}]({name})")),
+                "{name} not linked"
+            );
+        }
+    }
+    assert_eq!(svgs, 8);
+    assert!(md.contains("(the paper's Fig. 4)"));
+}

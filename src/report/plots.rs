@@ -186,6 +186,13 @@ impl Analysis {
         } else {
             V_LABEL
         };
+        if let Some(b) = bands.filter(|b| {
+            b.bands
+                .iter()
+                .any(|x| VELOCITY_FITS.contains(&x.fit.as_str()))
+        }) {
+            return Ok(self.velocity_posterior_figure(b, &unit, v_label));
+        }
         let mut panels = Vec::new();
         let mut curves_by_panel = Vec::new();
         for s in 0..self.data.labels.len() {
@@ -304,6 +311,88 @@ impl Analysis {
         );
         f.legend = legend;
         Ok(f.to_svg())
+    }
+
+    /// The velocity figure of a posterior run: one row of panels per model (in its colour),
+    /// one column per series; each panel the data, the model's posterior-median v̄(δ) and its
+    /// 90 % posterior band, so that models whose curves nearly coincide stay apart.
+    fn velocity_posterior_figure(
+        &self,
+        bands: &PosteriorBands,
+        unit: &dyn Fn(usize) -> f64,
+        v_label: &str,
+    ) -> String {
+        let n = self.data.labels.len();
+        let mut panels = Vec::new();
+        let mut legend = vec![LegendEntry::mark(
+            if self.data.sigma == SigmaKind::Absolute {
+                "data (bars: ±σ)"
+            } else {
+                "data"
+            },
+            Mark::Circle,
+            DATA,
+        )];
+        for (m, (name, colour)) in VELOCITY_MODELS.iter().enumerate() {
+            let of_model: Vec<_> = bands
+                .bands
+                .iter()
+                .filter(|b| b.fit == VELOCITY_FITS[m])
+                .collect();
+            if of_model.is_empty() {
+                continue;
+            }
+            legend.push(LegendEntry::line(
+                &format!("{name}: posterior median"),
+                &Stroke::solid(colour, 2.2),
+            ));
+            for s in 0..n {
+                let u = unit(s);
+                let mut p = Panel::new(
+                    &format!("{name}, {}", self.series_title(s)),
+                    Axis::new(DELTA_LABEL),
+                    Axis::new(v_label),
+                );
+                if let Some(b) = of_model.iter().find(|b| b.series == self.data.labels[s]) {
+                    let band: Vec<(f64, f64, f64)> = b
+                        .delta_deg
+                        .iter()
+                        .zip(b.q05.iter().zip(&b.q95))
+                        .filter(|(_, (lo, hi))| lo.is_finite() && hi.is_finite())
+                        .map(|(&d, (&lo, &hi))| (d, lo * u, hi * u))
+                        .collect();
+                    if band.len() > 1 {
+                        p.band(band, colour, 0.25);
+                    }
+                    let median: Vec<(f64, f64)> = b
+                        .delta_deg
+                        .iter()
+                        .zip(&b.q50)
+                        .map(|(&d, &v)| (d, v * u))
+                        .collect();
+                    p.curve(median, Stroke::solid(colour, 2.2));
+                }
+                p.points(
+                    self.series_points(s, |q, v| (q.scene.delta_deg(), v * u)),
+                    DATA,
+                    Mark::Circle,
+                );
+                panels.push(p);
+            }
+        }
+        legend.push(LegendEntry::patch(
+            "shaded: 90 % posterior band of v\u{304}(δ) (5–95 % of the draws)",
+            "#808080",
+            0.3,
+        ));
+        let mut f = Figure::new(
+            "Mean velocity against slope: posterior of each model",
+            n.max(1),
+            (300.0, 210.0),
+            panels,
+        );
+        f.legend = legend;
+        f.to_svg()
     }
 
     /// Figure: v̄²/cos δ against tan δ with Jan's straight lines (the paper's Fig. 8), each

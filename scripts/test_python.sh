@@ -9,7 +9,9 @@ venv="${FITBEAD_VENV:-target/python-venv}"
 rm -rf "$venv"
 python3 -m venv "$venv"
 py="$venv/bin/python"
-"$py" -m pip install --quiet --disable-pip-version-check maturin numpy pytest pandas arviz
+# cairosvg: the second renderer of python/tests/test_figures.py (it needs the system's
+# libcairo; without it that one test is skipped, saying why).
+"$py" -m pip install --quiet --disable-pip-version-check maturin numpy pytest pandas arviz cairosvg
 start=$(date +%s)
 "$py" -m pip install --quiet --disable-pip-version-check ./python
 echo "pip install ./python: $(($(date +%s) - start)) s"

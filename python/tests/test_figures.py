@@ -183,21 +183,22 @@ def figures(cli, tmp_path_factory):
         assert svgs, f"report {name} wrote no figure"
         pairs += [(s, s.with_suffix(".png")) for s in svgs]
     plots = {
-        "k": ["k", "--model", "stickslip", "--input", DEFAULT_DATA, "--output", d / "k.csv"],
-        "klaw": ["klaw", "--model", "stickslip", "--input", DEFAULT_DATA, "--output", d / "klaw.csv"],
-        "jan": ["jan", "--input", DEFAULT_DATA, "--output", d / "jan.csv"],
-        "jaeger": ["jaeger", "--input", DEFAULT_DATA, "--output", d / "jaeger.csv"],
+        "k": ["k", "--model", "stickslip"],
+        "klaw": ["klaw", "--model", "stickslip"],
+        "jan": ["jan"],
+        "jaeger": ["jaeger"],
     }
-    for name, args in plots.items():
+    for name, cmd in plots.items():
+        args = [*cmd, "--input", DEFAULT_DATA, "--output", d / f"{name}.csv"]
         cli(*args, "--plot", d / f"{name}.svg")
         cli(*args, "--plot", d / f"{name}.png")
         pairs.append((d / f"{name}.svg", d / f"{name}.png"))
         if name == "k":
             continue
-        # Under MCMC: one corner plot per fit and series, corner_NAME_FIT_SERIES.svg.
+        # Under MCMC: one corner plot per fit and series, corner_FIT_SERIES.svg.
         sub = d / f"mcmc_{name}"
         sub.mkdir()
-        m = [a if not str(a).endswith(".csv") else sub / "out.csv" for a in args] + FIT_MCMC
+        m = [*cmd, "--input", DEFAULT_DATA, "--output", sub / "out.csv", *FIT_MCMC]
         run_mcmc(cli, *m, "--plot", sub / "corner.svg")
         run_mcmc(cli, *m, "--plot", sub / "corner.png")
         svgs = sorted(sub.glob("corner_*.svg"))

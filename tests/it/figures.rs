@@ -453,7 +453,7 @@ fn velocity_band_renders_under_the_curve() {
     };
     let svg = an.velocity_figure_with(Some(&bands), None).unwrap();
     assert!(svg.contains("posterior band"));
-    let band = svg.find("fill-opacity=\"0.18\"").expect("a band");
+    let band = svg.find("fill-opacity=\"0.25\"").expect("a band");
     let first_marker = svg.find("<circle").expect("markers");
     assert!(band < first_marker, "the band is drawn under the data");
     look(

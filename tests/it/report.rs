@@ -312,7 +312,7 @@ fn report_writes_pdf_figures_with_the_font_embedded() {
         if p.extension().is_some_and(|x| x == "svg") {
             svgs += 1;
             let svg = std::fs::read_to_string(&p).unwrap();
-            assert!(!svg.contains("the paper's"), "{}", p.display());
+            assert!(!svg.contains("(the paper's Fig"), "{}", p.display());
             assert!(p.with_extension("png").exists(), "{}", p.display());
             let pdf = std::fs::read(p.with_extension("pdf")).unwrap();
             assert!(pdf.starts_with(b"%PDF-"), "{}", p.display());

@@ -105,11 +105,33 @@ pub struct OutputArgs {
 /// `--plot`: the command's figure.
 #[derive(Debug, Clone, Default, clap::Args)]
 pub struct PlotArgs {
-    /// SVG figure of the result (the command's description says what it shows), written
-    /// atomically; `-` writes it to stdout (only one output may go there: without --output
-    /// the result takes it).
+    /// Figure of the result (the command's description says what it shows), written
+    /// atomically: PNG for a name ending .png, PDF for .pdf, SVG otherwise; `-` writes the SVG
+    /// to stdout (only one output may go there: without --output the result takes it).
     #[arg(long)]
     pub plot: Option<PathBuf>,
+}
+
+impl PlotArgs {
+    /// The figure `svg` as the bytes of the `--plot` file: rendered to PNG or converted to PDF
+    /// when the file's name ends .png or .pdf.
+    pub fn bytes(&self, svg: String) -> Result<Vec<u8>, super::CliError> {
+        let ext = self
+            .plot
+            .as_deref()
+            .and_then(|p| p.extension())
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        let format = match ext.as_deref() {
+            Some("png") => fitbead::report::figures::FigureFormat::Png,
+            Some("pdf") => fitbead::report::figures::FigureFormat::Pdf,
+            _ => return Ok(svg.into_bytes()),
+        };
+        let out = format
+            .apply(vec![("plot.svg".to_string(), svg.into_bytes())])
+            .map_err(|e| super::CliError::Other(format!("--plot: {e}")))?;
+        Ok(out.into_iter().next().map(|f| f.1).unwrap_or_default())
+    }
 }
 
 /// `--level`: the level of every interval.

@@ -87,19 +87,21 @@ pub fn run(a: Args) -> Result<(), CliError> {
     );
     let bytes = render(&res.rows).map_err(|e| CliError::Other(e.to_string()))?;
     let svg = match &a.plot.plot {
-        Some(_) => plot(
-            &res.rows,
-            &format!("Work-precision, {} scenes (seed {})", scenes.len(), a.seed),
-        )
-        .map_err(CliError::Other)?,
-        None => String::new(),
+        Some(_) => a.plot.bytes(
+            plot(
+                &res.rows,
+                &format!("Work-precision, {} scenes (seed {})", scenes.len(), a.seed),
+            )
+            .map_err(CliError::Other)?,
+        )?,
+        None => Vec::new(),
     };
     // The plot and the CSV file are written as one group: both or neither.
     let files: Vec<(&std::path::Path, &[u8])> = a
         .plot
         .plot
         .iter()
-        .map(|p| (p.as_path(), svg.as_bytes()))
+        .map(|p| (p.as_path(), svg.as_slice()))
         .chain(a.out.output.iter().map(|p| (p.as_path(), bytes.as_slice())))
         .collect();
     if !files.is_empty() {

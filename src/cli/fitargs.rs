@@ -10,7 +10,10 @@ use fitbead::io::measurements::{dataset_of, read_measurements, Measurement};
 use fitbead::io::reports::{draws_csv, params_csv, stats_csv};
 use fitbead::io::scenes::Table;
 use fitbead::io::{fmt_sig, write_atomic_all};
+use fitbead::report::bands::Curve;
 use fitbead::report::figures::{corner_svg, CornerBlock};
+use fitbead::report::file_stems;
+use fitbead::report::plots::lsq_fit_figure;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
@@ -96,10 +99,22 @@ pub struct FitArgs {
     /// step, one column per parameter, log_posterior; `-` writes it to stdout.
     #[arg(long)]
     pub draws: Option<PathBuf>,
-    /// MCMC: with --plot, a corner plot of every posterior (marginal histograms and pairwise
-    /// scatter).
+    /// With --plot: under lsq, v̄ against δ per series, the data with their σ bars, each
+    /// fitted curve and its confidence band at --level (delta method); under mcmc, a corner
+    /// plot of every posterior (marginal histograms and pairwise scatter).
     #[command(flatten)]
     pub plot: PlotArgs,
+}
+
+/// What the least-squares figure of `--plot` draws: its title, the data fitted and the curve
+/// of each fit passed to [`FitArgs::write`] (in the same order).
+pub struct LsqPlot<'a> {
+    /// Title of the figure.
+    pub title: &'a str,
+    /// The data the fits were made on.
+    pub data: &'a fitbead::fit::data::Dataset,
+    /// One curve per fit.
+    pub curves: &'a [Curve],
 }
 
 /// The estimation method asked for on the command line (a posterior run carries the stop
@@ -124,7 +139,6 @@ impl FitArgs {
             ("--prior", !self.priors.is_empty()),
             ("--fit-scatter", self.fit_scatter),
             ("--draws", self.draws.is_some()),
-            ("--plot", self.plot.plot.is_some()),
         ];
         match self.method.to_ascii_lowercase().as_str() {
             "lsq" => {
@@ -244,7 +258,7 @@ impl FitArgs {
     /// `posteriors` are the fits sampled by MCMC: their draws go to `--draws` and their corner
     /// plots to `--plot`, in the same atomic group. A run stopped by Ctrl-C writes everything
     /// and then returns [`CliError::Interrupted`].
-    pub fn write(&self, fits: &[&FitResult]) -> Result<(), CliError> {
+    pub fn write(&self, fits: &[&FitResult], plot: &LsqPlot<'_>) -> Result<(), CliError> {
         let posteriors: Vec<&FitResult> =
             fits.iter().copied().filter(|f| f.draws.is_some()).collect();
         let posteriors = posteriors.as_slice();
@@ -265,12 +279,43 @@ impl FitArgs {
             Some(_) => draws_csv(posteriors).map_err(|e| CliError::Other(e.to_string()))?,
             None => Vec::new(),
         };
-        let corner = match &self.plot.plot {
-            Some(_) => corner_svg(&CornerBlock::from_posteriors(posteriors))
-                .map_err(|e| CliError::Other(format!("corner plot: {e}")))?
-                .into_bytes(),
-            None => Vec::new(),
-        };
+        // The figure files: under least squares one figure; under MCMC one corner plot per
+        // fit and series, PATH's stem followed by _FIT_SERIES (all stacked in one document
+        // when the figure goes to stdout).
+        let mut figures: Vec<(PathBuf, Vec<u8>)> = Vec::new();
+        if let Some(path) = &self.plot.plot {
+            if posteriors.is_empty() {
+                let with: Vec<(&FitResult, Curve)> = fits
+                    .iter()
+                    .zip(plot.curves)
+                    .map(|(f, c)| (*f, *c))
+                    .collect();
+                let svg = lsq_fit_figure(plot.title, plot.data, &with)
+                    .map_err(|e| CliError::Other(format!("--plot: {e}")))?;
+                figures.push((path.clone(), self.plot.bytes(svg)?));
+            } else if path.as_os_str() == "-" {
+                let svg = corner_svg(&CornerBlock::from_posteriors(posteriors))
+                    .map_err(|e| CliError::Other(format!("corner plot: {e}")))?;
+                figures.push((path.clone(), svg.into_bytes()));
+            } else {
+                let labels: Vec<String> =
+                    posteriors.iter().map(|p| p.stats.series.clone()).collect();
+                let stems = file_stems(&labels);
+                let stem = path.file_stem().map_or_else(
+                    || "corner".to_string(),
+                    |s| s.to_string_lossy().into_owned(),
+                );
+                let ext = path
+                    .extension()
+                    .map_or_else(|| "svg".to_string(), |e| e.to_string_lossy().into_owned());
+                for (p, series) in posteriors.iter().zip(&stems) {
+                    let svg = corner_svg(&CornerBlock::from_posteriors(&[*p]))
+                        .map_err(|e| CliError::Other(format!("corner plot: {e}")))?;
+                    let name = format!("{stem}_{}_{series}.{ext}", p.stats.fit);
+                    figures.push((path.with_file_name(name), self.plot.bytes(svg)?));
+                }
+            }
+        }
         let files: Vec<(&std::path::Path, &[u8])> = self
             .out
             .output
@@ -283,12 +328,7 @@ impl FitArgs {
                     .map(|q| (q.as_path(), s.as_slice())),
             )
             .chain(self.draws.iter().map(|q| (q.as_path(), d_csv.as_slice())))
-            .chain(
-                self.plot
-                    .plot
-                    .iter()
-                    .map(|q| (q.as_path(), corner.as_slice())),
-            )
+            .chain(figures.iter().map(|(q, b)| (q.as_path(), b.as_slice())))
             .collect();
         if !files.is_empty() {
             write_atomic_all(&files).map_err(|e| CliError::Other(format!("cannot write: {e}")))?;

@@ -1,11 +1,13 @@
 //! `fitbead jaeger`: Jaeger's a1, a2, a3 per series (Jaeger units, eq 81), the branch used and
 //! the points in the bistable band (eq 90), beside the paper's Fig. 9 values.
 
-use super::fitargs::FitArgs;
+use super::fitargs::{FitArgs, LsqPlot};
 use super::CliError;
 use fitbead::fit::jaeger::fit_jaeger_with;
+use fitbead::fit::jaeger::JaegerModel;
 use fitbead::fit::summary::FitResult;
 use fitbead::io::measurements::locate_note;
+use fitbead::report::bands::Curve;
 
 /// Arguments of `fitbead jaeger`.
 #[derive(Debug, clap::Args)]
@@ -40,5 +42,16 @@ pub fn run(a: Args) -> Result<(), CliError> {
     for n in &notes {
         eprintln!("fitbead jaeger: {n}");
     }
-    a.io.write(&all)
+    let curves: Vec<Curve> = fits
+        .series
+        .iter()
+        .flatten()
+        .map(|f| Curve::Jaeger(JaegerModel(f.branch)))
+        .collect();
+    let plot = LsqPlot {
+        title: "Jaeger's law (eqs 80–84) fitted on v\u{304}",
+        data: &ds,
+        curves: &curves,
+    };
+    a.io.write(&all, &plot)
 }

@@ -1,11 +1,12 @@
 //! `fitbead jan`: Jan's λ and μ per series (eq 74, fitted on v̄) and the global laws
 //! λ = λ0 e^{λ1 sin α}, μ = μ0 e^{μ1 sin α} (form of eqs 75–76), beside the paper's values.
 
-use super::fitargs::FitArgs;
+use super::fitargs::{FitArgs, LsqPlot};
 use super::CliError;
 use fitbead::fit::jan::fit_jan_with;
 use fitbead::fit::summary::FitResult;
 use fitbead::io::measurements::locate_note;
+use fitbead::report::bands::Curve;
 
 /// Arguments of `fitbead jan`.
 #[derive(Debug, clap::Args)]
@@ -42,5 +43,17 @@ pub fn run(a: Args) -> Result<(), CliError> {
     for n in &notes {
         eprintln!("fitbead jan: {n}");
     }
-    a.io.write(&all)
+    let curves: Vec<Curve> = fits
+        .series
+        .iter()
+        .flatten()
+        .map(|_| Curve::JanSeries)
+        .chain(fits.global.iter().map(|_| Curve::JanGlobal))
+        .collect();
+    let plot = LsqPlot {
+        title: "Jan's law (eq 74) fitted on v\u{304}",
+        data: &ds,
+        curves: &curves,
+    };
+    a.io.write(&all, &plot)
 }

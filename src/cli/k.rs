@@ -134,8 +134,9 @@ pub fn run(a: Args) -> Result<(), CliError> {
             let cannot =
                 |e: std::io::Error| CliError::Other(format!("{}: cannot write: {e}", p.display()));
             let svg = ledger.plot_svg(&a.model).map_err(CliError::Other)?;
+            let bytes = a.plot.bytes(svg)?;
             let mut f = file.map_err(cannot)?;
-            f.write_all(svg.as_bytes()).map_err(cannot)?;
+            f.write_all(&bytes).map_err(cannot)?;
             f.commit().map_err(cannot)
         },
     )

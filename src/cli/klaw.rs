@@ -1,7 +1,7 @@
 //! `fitbead klaw`: a law K(α) fitted to all series at once (law c, one K per series), and the
 //! parameter-free impact law scored beside it.
 
-use super::fitargs::FitArgs;
+use super::fitargs::{FitArgs, LsqPlot};
 use super::k::parse_auto;
 use super::k::parse_model;
 use super::CliError;
@@ -12,6 +12,7 @@ use fitbead::fit::posterior::Method;
 use fitbead::io::fmt_f64;
 use fitbead::io::measurements::locate_point;
 use fitbead::models::Model;
+use fitbead::report::bands::Curve;
 use rayon::prelude::*;
 
 /// Arguments of `fitbead klaw`.
@@ -184,5 +185,19 @@ pub fn run(a: Args) -> Result<(), CliError> {
             };
         }
     }
-    a.io.write(&fits.iter().collect::<Vec<_>>())
+    let main_curve = match law {
+        KLaw::C => Curve::LawC(model),
+        KLaw::FreePerSeries => Curve::FreeK(model),
+        KLaw::Impact => Curve::Impact(model),
+    };
+    let curves: Vec<Curve> = std::iter::once(main_curve)
+        .chain((law != KLaw::Impact).then_some(Curve::Impact(model)))
+        .collect();
+    let title = format!("K(α) laws under the {} model, fitted on v\u{304}", a.model);
+    let plot = LsqPlot {
+        title: &title,
+        data: &ds,
+        curves: &curves,
+    };
+    a.io.write(&fits.iter().collect::<Vec<_>>(), &plot)
 }

@@ -35,11 +35,13 @@ pub struct Args {
     /// posterior) [default: lsq]
     #[arg(long)]
     pub method: Option<String>,
-    /// Figure files: svg, png (rendered from the SVG) or both [default: svg]
+    /// Figure files: svg, png (rendered from the SVG), pdf (vector, the font embedded, text
+    /// selectable), both (svg and png) or all (svg, png and pdf) [default: svg]
     #[arg(long)]
     pub format: Option<String>,
     /// Velocities on the figures: dimensionless (units of sqrt(g (R + r))) or si (m/s, for
-    /// data given in m/s with R_m) [default: dimensionless]
+    /// data given in m/s with R_m; every velocity axis: velocity.svg, jan_linear.svg in
+    /// m²/s², k_final_velocity.svg) [default: dimensionless]
     #[arg(long)]
     pub units: Option<String>,
     /// The level of every interval.
@@ -72,7 +74,7 @@ pub struct Recipe {
     pub out_dir: Option<PathBuf>,
     /// lsq or mcmc.
     pub method: Option<String>,
-    /// svg, png or both.
+    /// svg, png, pdf, both or all.
     pub format: Option<String>,
     /// dimensionless or si.
     pub units: Option<String>,
@@ -452,8 +454,11 @@ fn run_with(a: Args, r: Recipe) -> Result<(), CliError> {
         "velocity.svg",
         an.velocity_figure_with(bands.as_ref(), units_m_s.as_deref()),
     )?);
-    files.push(fig("jan_linear.svg", an.jan_figure())?);
-    files.push(fig("k_final_velocity.svg", an.k_figure())?);
+    files.push(fig("jan_linear.svg", an.jan_figure(units_m_s.as_deref()))?);
+    files.push(fig(
+        "k_final_velocity.svg",
+        an.k_figure(units_m_s.as_deref()),
+    )?);
     files.push(fig("regime_map.svg", an.regime_figure())?);
     files.push(fig("jaeger.svg", an.jaeger_figure())?);
     files.push(fig("k_alpha.svg", an.k_alpha_figure())?);

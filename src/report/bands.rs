@@ -25,6 +25,7 @@ use crate::inverse::CurveModel as _;
 use crate::models::{ForwardModel, Model};
 use crate::scene::{CollisionLaw, Scene};
 use rayon::prelude::*;
+use statrs::distribution::{ContinuousCDF, Normal};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Draws used per fit at most.
@@ -79,14 +80,21 @@ pub struct PosteriorBands {
     pub points: Vec<PointMedian>,
 }
 
-/// How a fit's draw gives v̄ at a point's ξ, ρ, f and a slope δ (radians); `column` is where
-/// the series' own parameters start in the draw.
-#[derive(Clone, Copy)]
-enum Curve {
+/// How a fit's parameters (a draw, or the least-squares optimum) give v̄ at a point's ξ, ρ, f
+/// and a slope δ (radians); `column` is where the series' own parameters start.
+#[derive(Debug, Clone, Copy)]
+pub enum Curve {
+    /// A contact model with K(α) = cos 2α + c sin²α sin 2α (parameter c).
     LawC(Model),
+    /// A contact model with one K per series (parameter K of the series).
     FreeK(Model),
+    /// A contact model with the impact law's K (no parameter).
+    Impact(Model),
+    /// Jan's eq 74 with the series' λ and μ.
     JanSeries,
+    /// Jan's eq 74 with λ = λ0 e^{λ1 sin α}, μ = μ0 e^{μ1 sin α}.
     JanGlobal,
+    /// Jaeger's eq 84 on a branch, v̄ from eq 81.
     Jaeger(JaegerModel),
 }
 
@@ -102,6 +110,7 @@ impl Curve {
         let v = match self {
             Curve::LawC(m) => contact(m, CollisionLaw::C(draw[0]))?,
             Curve::FreeK(m) => contact(m, CollisionLaw::Value(draw[column]))?,
+            Curve::Impact(m) => contact(m, CollisionLaw::Impact)?,
             Curve::JanSeries => JanSeries
                 .value(&(s.sin_alpha(), delta.sin(), delta.cos()), &draw[..2])
                 .ok()?,
@@ -291,4 +300,109 @@ fn subset(chains: &[Vec<Vec<f64>>]) -> Vec<&[f64]> {
         .collect();
     let stride = pooled.len().div_ceil(BAND_DRAWS).max(1);
     pooled.into_iter().step_by(stride).collect()
+}
+
+/// The least-squares curve of one fit over one series with its confidence band.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct LsqBand {
+    /// The slopes of the grid, degrees.
+    pub delta_deg: Vec<f64>,
+    /// v̄ at the optimum (NaN where the model has no steady state).
+    pub v: Vec<f64>,
+    /// The band's ends (NaN where it cannot be computed; all NaN without a covariance).
+    pub lo: Vec<f64>,
+    /// See `lo`.
+    pub hi: Vec<f64>,
+}
+
+/// The fitted v̄(δ) of `fit` (least squares: `value` of its rows) over series `s` of `data`,
+/// on `grid` (radians), with the band v̄ ± z σ_v̄ at the fit's level: σ_v̄² = gᵀ C g, the delta
+/// method, with C the covariance at the optimum (standard errors and correlation) and g the
+/// gradient of v̄ in the parameters by central differences of a thousandth of each standard
+/// error. `None` when the fit does not cover the series.
+pub(crate) fn lsq_band(
+    fit: &FitResult,
+    curve: Curve,
+    data: &Dataset,
+    s: usize,
+    grid: &[f64],
+) -> Option<LsqBand> {
+    let label = &data.labels[s];
+    let first = data.series(s).next()?;
+    let covers = fit.stats.series == *label || fit.stats.series == "all";
+    if !covers {
+        return None;
+    }
+    let theta: Vec<f64> = fit.params.iter().map(|r| r.value).collect();
+    let column = match curve {
+        Curve::FreeK(_) => fit.params.iter().position(|r| r.series == *label)?,
+        _ => 0,
+    };
+    let used: Vec<usize> = match curve {
+        Curve::LawC(_) => vec![0],
+        Curve::FreeK(_) => vec![column],
+        Curve::Impact(_) => vec![],
+        Curve::JanSeries => vec![0, 1],
+        Curve::JanGlobal => vec![0, 1, 2, 3],
+        Curve::Jaeger(_) => vec![0, 1, 2],
+    };
+    if used.iter().any(|&j| j >= theta.len()) {
+        return None;
+    }
+    let level = fit.params.first().map_or(0.95, |r| r.level);
+    let z = Normal::standard().inverse_cdf(0.5 + level / 2.0);
+    // The covariance of the parameters the curve uses.
+    let cov: Option<Vec<Vec<f64>>> = fit.correlation.as_ref().and_then(|corr| {
+        let se: Option<Vec<f64>> = used.iter().map(|&j| fit.params[j].stderr).collect();
+        let se = se?;
+        Some(
+            used.iter()
+                .enumerate()
+                .map(|(a, &i)| {
+                    used.iter()
+                        .enumerate()
+                        .map(|(b, &j)| corr[i][j] * se[a] * se[b])
+                        .collect()
+                })
+                .collect(),
+        )
+    });
+    let at = |th: &[f64], d: f64| curve.velocity(th, column, first, d).unwrap_or(f64::NAN);
+    let rows: Vec<(f64, f64, f64)> = grid
+        .par_iter()
+        .map(|&d| {
+            let v = at(&theta, d);
+            let Some(c) = &cov else {
+                return (v, f64::NAN, f64::NAN);
+            };
+            let g: Vec<f64> = used
+                .iter()
+                .enumerate()
+                .map(|(a, &j)| {
+                    let h = 1e-3 * c[a][a].sqrt().max(1e-12 * theta[j].abs().max(1.0));
+                    let (mut up, mut down) = (theta.clone(), theta.clone());
+                    up[j] += h;
+                    down[j] -= h;
+                    (at(&up, d) - at(&down, d)) / (2.0 * h)
+                })
+                .collect();
+            let var: f64 = (0..g.len())
+                .flat_map(|a| (0..g.len()).map(move |b| (a, b)))
+                .map(|(a, b)| g[a] * c[a][b] * g[b])
+                .sum();
+            // A covariance with undefined entries (a rank-deficient Jacobian) gives no band.
+            let sd = if var.is_finite() {
+                var.max(0.0).sqrt()
+            } else {
+                f64::NAN
+            };
+            (v, v - z * sd, v + z * sd)
+        })
+        .collect();
+    Some(LsqBand {
+        delta_deg: grid.iter().map(|d| d.to_degrees()).collect(),
+        v: rows.iter().map(|r| r.0).collect(),
+        lo: rows.iter().map(|r| r.1).collect(),
+        hi: rows.iter().map(|r| r.2).collect(),
+    })
 }

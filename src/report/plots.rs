@@ -4,12 +4,14 @@
 //! residuals and one corner plot per posterior.
 
 use super::analysis::{k_of_c, lsq, Analysis};
-use super::bands::PosteriorBands;
+use super::bands::{lsq_band, Curve, PosteriorBands};
 use super::figures::corner::{corner_figure, CornerBlock};
+use super::figures::ErrPoint;
 use super::figures::{
     coincide, scatter_panel, series_style, Anchor, Axis, Figure, Item, LegendEntry, Mark, Panel,
     PointSeries, Scatter, Stroke, DASHES, PALETTE,
 };
+use crate::fit::data::Dataset;
 use crate::fit::jaeger::{paper_values, JaegerModel};
 use crate::fit::jan::velocity as jan_velocity;
 use crate::fit::k::estimate;
@@ -184,6 +186,13 @@ impl Analysis {
         } else {
             V_LABEL
         };
+        if let Some(b) = bands.filter(|b| {
+            b.bands
+                .iter()
+                .any(|x| VELOCITY_FITS.contains(&x.fit.as_str()))
+        }) {
+            return Ok(self.velocity_posterior_figure(b, &unit, v_label));
+        }
         let mut panels = Vec::new();
         let mut curves_by_panel = Vec::new();
         for s in 0..self.data.labels.len() {
@@ -304,18 +313,105 @@ impl Analysis {
         Ok(f.to_svg())
     }
 
-    /// Figure: v̄²/cos δ against tan δ with Jan's straight lines (the paper's Fig. 8), each
-    /// series' points and line in one colour.
-    pub fn jan_figure(&self) -> Result<String, String> {
-        let mut p = Panel::new(
-            "",
-            Axis::new("tan δ"),
-            Axis::new("v\u{304}^{2} / cos δ  (units of g(R + r))"),
+    /// The velocity figure of a posterior run: one row of panels per model (in its colour),
+    /// one column per series; each panel the data, the model's posterior-median v̄(δ) and its
+    /// 90 % posterior band, so that models whose curves nearly coincide stay apart.
+    fn velocity_posterior_figure(
+        &self,
+        bands: &PosteriorBands,
+        unit: &dyn Fn(usize) -> f64,
+        v_label: &str,
+    ) -> String {
+        let n = self.data.labels.len();
+        let mut panels = Vec::new();
+        let mut legend = vec![LegendEntry::mark(
+            if self.data.sigma == SigmaKind::Absolute {
+                "data (bars: ±σ)"
+            } else {
+                "data"
+            },
+            Mark::Circle,
+            DATA,
+        )];
+        for (m, (name, colour)) in VELOCITY_MODELS.iter().enumerate() {
+            let of_model: Vec<_> = bands
+                .bands
+                .iter()
+                .filter(|b| b.fit == VELOCITY_FITS[m])
+                .collect();
+            if of_model.is_empty() {
+                continue;
+            }
+            legend.push(LegendEntry::line(
+                &format!("{name}: posterior median"),
+                &Stroke::solid(colour, 2.2),
+            ));
+            for s in 0..n {
+                let u = unit(s);
+                let mut p = Panel::new(
+                    &format!("{name}, {}", self.series_title(s)),
+                    Axis::new(DELTA_LABEL),
+                    Axis::new(v_label),
+                );
+                if let Some(b) = of_model.iter().find(|b| b.series == self.data.labels[s]) {
+                    let band: Vec<(f64, f64, f64)> = b
+                        .delta_deg
+                        .iter()
+                        .zip(b.q05.iter().zip(&b.q95))
+                        .filter(|(_, (lo, hi))| lo.is_finite() && hi.is_finite())
+                        .map(|(&d, (&lo, &hi))| (d, lo * u, hi * u))
+                        .collect();
+                    if band.len() > 1 {
+                        p.band(band, colour, 0.25);
+                    }
+                    let median: Vec<(f64, f64)> = b
+                        .delta_deg
+                        .iter()
+                        .zip(&b.q50)
+                        .map(|(&d, &v)| (d, v * u))
+                        .collect();
+                    p.curve(median, Stroke::solid(colour, 2.2));
+                }
+                p.points(
+                    self.series_points(s, |q, v| (q.scene.delta_deg(), v * u)),
+                    DATA,
+                    Mark::Circle,
+                );
+                panels.push(p);
+            }
+        }
+        legend.push(LegendEntry::patch(
+            "shaded: 90 % posterior band of v\u{304}(δ) (5–95 % of the draws)",
+            "#808080",
+            0.3,
+        ));
+        let mut f = Figure::new(
+            "Mean velocity against slope: posterior of each model",
+            n.max(1),
+            (300.0, 210.0),
+            panels,
         );
+        f.legend = legend;
+        f.to_svg()
+    }
+
+    /// Figure: v̄²/cos δ against tan δ with Jan's straight lines (the paper's Fig. 8), each
+    /// series' points and line in one colour; with `units_m_s` (per series, as for
+    /// [`Analysis::velocity_figure_with`]) v̄² in m²/s².
+    pub fn jan_figure(&self, units_m_s: Option<&[f64]>) -> Result<String, String> {
+        let unit = |s: usize| units_m_s.and_then(|u| u.get(s).copied()).unwrap_or(1.0);
+        let y_label = if units_m_s.is_some() {
+            "v\u{304}^{2} / cos δ  (m^{2}/s^{2})"
+        } else {
+            "v\u{304}^{2} / cos δ  (units of g(R + r))"
+        };
+        let mut p = Panel::new("", Axis::new("tan δ"), Axis::new(y_label));
         for s in 0..self.data.labels.len() {
             let (colour, mark) = series_style(s);
-            let pts =
-                self.series_points(s, |q, v| (q.scene.delta.tan(), v * v / q.scene.delta.cos()));
+            let u2 = unit(s) * unit(s);
+            let pts = self.series_points(s, |q, v| {
+                (q.scene.delta.tan(), u2 * v * v / q.scene.delta.cos())
+            });
             let stroke = Stroke::solid(colour, 2.0);
             if let Some(j) = &self.jan.series[s] {
                 let (l, m) = (lsq(&j.params[0]), lsq(&j.params[1]));
@@ -323,7 +419,7 @@ impl Analysis {
                 let t1 = pts.iter().map(|q| q.0).fold(f64::NEG_INFINITY, f64::max) * 1.04;
                 // v̄²/cos δ = (2 sin α/λ)(tan δ − μ): a straight line from tan δ = μ (eq 74).
                 p.curve(
-                    vec![(m, 0.0), (t1, 2.0 * sa / l * (t1 - m))],
+                    vec![(m, 0.0), (t1, u2 * 2.0 * sa / l * (t1 - m))],
                     stroke.clone(),
                 );
                 p.legend.push(LegendEntry::mark_line(
@@ -338,7 +434,7 @@ impl Analysis {
             p.points(pts, colour, mark);
         }
         Ok(Figure::new(
-            "Jan's linearised plot (the paper's Fig. 8): straight lines from tan δ = μ",
+            "Jan's linearised plot: straight lines from tan δ = μ",
             1,
             SINGLE_PLOT,
             vec![p],
@@ -372,8 +468,10 @@ impl Analysis {
     }
 
     /// Figure: K per point (eq 69, stick/slip) against the steady final velocity (the
-    /// paper's Figs. 5–6), with each series' K = cos 2α.
-    pub fn k_figure(&self) -> Result<String, String> {
+    /// paper's Figs. 5–6), with each series' K = cos 2α; with `units_m_s` (per series, as
+    /// for [`Analysis::velocity_figure_with`]) the velocity in m/s.
+    pub fn k_figure(&self, units_m_s: Option<&[f64]>) -> Result<String, String> {
+        let unit = |s: usize| units_m_s.and_then(|u| u.get(s).copied()).unwrap_or(1.0);
         let ks = self.k_points(Model::StickSlip);
         let series = ks
             .iter()
@@ -383,14 +481,18 @@ impl Analysis {
                 let c2 = CollisionLaw::Cos2a.k(p0.alpha, p0.rho);
                 PointSeries {
                     label: self.series_title(s),
-                    points: pts.iter().map(|q| (q.0, q.2, q.3, q.4)).collect(),
+                    points: pts.iter().map(|q| (q.0 * unit(s), q.2, q.3, q.4)).collect(),
                     reference: Some((c2, format!("K = cos 2α = {c2:.4}"))),
                 }
             })
             .collect();
         let fig = Scatter {
-            title: "K per measurement (eq 69), stick/slip model (the paper's Figs. 5–6)".into(),
-            x_label: "steady final velocity v_{f} / √(g(R + r))".into(),
+            title: "K per measurement (eq 69), stick/slip model".into(),
+            x_label: if units_m_s.is_some() {
+                "steady final velocity v_{f} (m/s)".into()
+            } else {
+                "steady final velocity v_{f} / √(g(R + r))".into()
+            },
             y_label: "K".into(),
             series,
         };
@@ -575,7 +677,7 @@ impl Analysis {
             panels.push(p);
         }
         let mut fig = Figure::new(
-            "Regime map (the paper's Fig. 4): A stops, B steady, C no steady motion",
+            "Regime map: A stops, B steady, C no steady motion",
             2,
             (470.0, 400.0),
             panels,
@@ -635,7 +737,7 @@ impl Analysis {
             panels.push(p);
         }
         let mut f = Figure::new(
-            "Jaeger's law tan δ = a_{3}u^{2} + a_{1}/(1 + a_{2}u^{2}) (the paper's Figs. 9–10)",
+            "Jaeger's law tan δ = a_{3}u^{2} + a_{1}/(1 + a_{2}u^{2})",
             2,
             GRID_PLOT,
             panels,
@@ -1042,7 +1144,8 @@ fn shade_regimes(
         });
         p.items.push(Item::Text {
             at: (ac, 0.93 * top),
-            text: format!(" ξ_{{c}} = {} ", g4(xc)),
+            // Two spaces of advance keep the label clear of its own line on either side.
+            text: format!("  ξ_{{c}} = {}  ", g4(xc)),
             anchor: if ac > 0.5 * (a_lo + a_hi) {
                 Anchor::End
             } else {
@@ -1150,4 +1253,102 @@ fn jaeger_law(
     }
     p.curve(sample(ustar, umax), upper.clone());
     ustar > 0.0
+}
+
+/// Figure of least-squares fits (`fitbead klaw`, `jan` and `jaeger` with `--plot`): one panel
+/// per series, v̄ against δ: the data with their σ bars, each fit's curve at the optimum and
+/// its confidence band at the fit's level by the delta method (the covariance at the
+/// optimum; see `bands::lsq_band`). Fits are told apart by colour and named by their
+/// params.csv name; a fit without a covariance is drawn without a band.
+pub fn lsq_fit_figure(
+    title: &str,
+    data: &Dataset,
+    fits: &[(&FitResult, Curve)],
+) -> Result<String, String> {
+    let mut names: Vec<&str> = Vec::new();
+    for (f, _) in fits {
+        if !names.contains(&f.stats.fit.as_str()) {
+            names.push(&f.stats.fit);
+        }
+    }
+    let level = fits
+        .iter()
+        .find_map(|(f, _)| f.params.first().map(|r| r.level))
+        .unwrap_or(0.95);
+    let mut panels = Vec::new();
+    let mut notes = Vec::new();
+    for (s, label) in data.labels.iter().enumerate() {
+        let pts: Vec<&crate::fit::data::Point> = data.series(s).collect();
+        let Some(first) = pts.first() else { continue };
+        let (lo, hi) = pts.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, p| {
+            (a.0.min(p.scene.delta), a.1.max(p.scene.delta))
+        });
+        let pad = 0.08 * (hi - lo).max(1f64.to_radians());
+        let grid: Vec<f64> = (0..=100)
+            .map(|i| (lo - pad).max(1e-4) + (hi - lo + 2.0 * pad) * i as f64 / 100.0)
+            .collect();
+        let xi = first.scene.xi;
+        let title = if label.parse::<f64>().ok() == Some(xi) {
+            format!("ξ = {label}")
+        } else {
+            format!("series {label} (ξ = {})", g4(xi))
+        };
+        let mut p = Panel::new(&title, Axis::new(DELTA_LABEL), Axis::new(V_LABEL));
+        for (f, curve) in fits {
+            let Some(b) = lsq_band(f, *curve, data, s, &grid) else {
+                continue;
+            };
+            let k = names.iter().position(|n| *n == f.stats.fit).unwrap_or(0);
+            let colour = PALETTE[k % PALETTE.len()];
+            let band: Vec<(f64, f64, f64)> = (0..b.delta_deg.len())
+                .filter(|&i| b.lo[i].is_finite() && b.hi[i].is_finite())
+                .map(|i| (b.delta_deg[i], b.lo[i], b.hi[i]))
+                .collect();
+            if band.len() > 1 {
+                p.band(band, colour, 0.22);
+            } else if !f.params.is_empty() {
+                notes.push(format!(
+                    "{title}: {} has no band (no covariance at the optimum)",
+                    f.stats.fit
+                ));
+            }
+            let line: Vec<(f64, f64)> = b.delta_deg.iter().copied().zip(b.v).collect();
+            p.curve(line, Stroke::solid(colour, 2.0));
+        }
+        let data_pts: Vec<ErrPoint> = pts
+            .iter()
+            .map(|q| {
+                let (x, y) = (q.scene.delta_deg(), q.v);
+                if data.sigma == SigmaKind::Absolute {
+                    (x, y, y - q.sigma, y + q.sigma)
+                } else {
+                    (x, y, y, y)
+                }
+            })
+            .collect();
+        p.points(data_pts, DATA, Mark::Circle);
+        panels.push(p);
+    }
+    if panels.is_empty() {
+        return Err("no series to draw".to_string());
+    }
+    let cols = panels.len().min(2);
+    let mut f = Figure::new(title, cols, GRID_PLOT, panels);
+    f.notes = notes;
+    f.legend
+        .push(LegendEntry::mark("data (± σ)", Mark::Circle, DATA));
+    for (k, n) in names.iter().enumerate() {
+        let colour = PALETTE[k % PALETTE.len()];
+        f.legend
+            .push(LegendEntry::line(n, &Stroke::solid(colour, 2.0)));
+    }
+    f.legend.push(LegendEntry::patch(
+        &format!(
+            "{} % confidence band (delta method)",
+            fmt_sig(100.0 * level, 3)
+        ),
+        REFERENCE,
+        0.3,
+    ));
+    Ok(f.to_svg())
 }

@@ -231,7 +231,8 @@ fn fit_reports(an: &Analysis) -> String {
     m
 }
 
-/// The report's figures of fixed name, with what each shows.
+/// The report's figures of fixed name, with their captions: what each shows and the paper's
+/// figure it corresponds to (the figures' own titles carry neither reference).
 const FIGURES: [(&str, &str); 8] = [
     (
         "velocity.svg",
@@ -243,15 +244,15 @@ const FIGURES: [(&str, &str); 8] = [
     ),
     (
         "jan_linear.svg",
-        "v̄²/cos δ against tan δ with Jan's lines (Fig. 8)",
+        "v̄²/cos δ against tan δ with Jan's lines (the paper's Fig. 8)",
     ),
     (
         "jaeger.svg",
-        "Jaeger's u against tan δ with both branches and the bistable band of eq 90 (Figs. 9–10)",
+        "Jaeger's u against tan δ with both branches and the bistable band of eq 90 (the paper's Figs. 9–10)",
     ),
     (
         "k_final_velocity.svg",
-        "K per point (eq 69, stick/slip) against the final velocity (Figs. 5–6)",
+        "K per point (eq 69, stick/slip) against the final velocity (the paper's Figs. 5–6)",
     ),
     (
         "k_alpha.svg",
@@ -263,7 +264,7 @@ const FIGURES: [(&str, &str); 8] = [
     ),
     (
         "regime_map.svg",
-        "regions A, B, C between each contact model's limits against α, with the points (Fig. 4)",
+        "regions A, B, C between each contact model's limits against α, with the points (the paper's Fig. 4)",
     ),
 ];
 

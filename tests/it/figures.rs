@@ -138,13 +138,50 @@ fn check(name: &str, args: &[&str], expected: &[[u8; 3]]) {
     );
 }
 
+/// Under MCMC, `--plot corner.svg` writes one corner plot per fit and series,
+/// corner_FIT_SERIES.svg beside it.
 #[test]
 fn corner_plot_renders() {
-    check(
-        "corner_jan",
-        &["jan", "--method", "mcmc", "--min-ess", "200"],
+    let dir = out_dir().join("corner_jan");
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = bin()
+        .args(["jan", "--method", "mcmc", "--min-ess", "200", "--plot"])
+        .arg(dir.join("corner.svg"))
+        .arg("--output")
+        .arg(dir.join("jan.csv"))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(!dir.join("corner.svg").exists());
+    for series in ["0.8", "1", "1.6", "2"] {
+        let f = dir.join(format!("corner_jan-series_{series}.svg"));
+        assert!(f.exists(), "{} missing", f.display());
+    }
+    let text = std::fs::read_to_string(dir.join("corner_jan-global_all.svg")).unwrap();
+    let l = look(
+        "corner_jan_global",
+        &text,
+        &out_dir().join("corner_jan_global.png"),
         &[rgb(PALETTE[0], 1.0), rgb(PALETTE[1], 1.0)],
     );
+    assert!(l.width >= 400 && l.height >= 100);
+}
+
+/// Under least squares, `--plot` draws the data, the fitted curves and their confidence
+/// bands: every fit's colour and the band's shade are on the canvas.
+#[test]
+fn lsq_fit_plots_render() {
+    check(
+        "lsq_jan",
+        &["jan"],
+        &[rgb(PALETTE[0], 1.0), rgb(PALETTE[1], 1.0)],
+    );
+    check(
+        "lsq_klaw",
+        &["klaw", "--model", "stickslip"],
+        &[rgb(PALETTE[0], 1.0), rgb(PALETTE[1], 1.0)],
+    );
+    check("lsq_jaeger", &["jaeger"], &[rgb(PALETTE[0], 1.0)]);
 }
 
 /// A corner plot of 20 000 correlated normal draws: contours, quantiles and titles render
@@ -176,8 +213,9 @@ fn corner_plot_of_many_draws_stays_small() {
     };
     let svg = corner_figure(&block).to_svg();
     assert!(svg.len() < 400_000, "{} bytes", svg.len());
-    // The axis label a₁: a subscript 1 set smaller and lower.
-    assert!(svg.contains("<tspan>a</tspan><tspan dy=\"4\" font-size=\"11.52\">1</tspan>"));
+    // The axis label a₁: a subscript 1 set smaller (0.72 of 16 px), at its own position.
+    assert!(svg.contains(">a</tspan><tspan x=\""));
+    assert!(svg.contains("font-size=\"11.52\">1</tspan>"));
     let l = look(
         "corner_synthetic",
         &svg,
@@ -415,7 +453,7 @@ fn velocity_band_renders_under_the_curve() {
     };
     let svg = an.velocity_figure_with(Some(&bands), None).unwrap();
     assert!(svg.contains("posterior band"));
-    let band = svg.find("fill-opacity=\"0.18\"").expect("a band");
+    let band = svg.find("fill-opacity=\"0.25\"").expect("a band");
     let first_marker = svg.find("<circle").expect("markers");
     assert!(band < first_marker, "the band is drawn under the data");
     look(

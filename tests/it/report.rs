@@ -204,6 +204,17 @@ fn report_md_states_the_si_conversion() {
     );
     let fig = std::fs::read_to_string(si_dir.join("velocity.svg")).unwrap();
     assert!(fig.contains("(m/s)"), "velocity.svg is not in m/s");
+    // Every velocity axis: Jan's v̄²/cos δ in m²/s² (the exponents are superscript runs),
+    // the final velocity of the K figure in m/s.
+    let jan = std::fs::read_to_string(si_dir.join("jan_linear.svg")).unwrap();
+    assert!(
+        jan.contains("(m</tspan>") && jan.contains(">/s</tspan>"),
+        "jan_linear.svg is not in m²/s²"
+    );
+    assert!(!jan.contains("g(R + r)"));
+    let k = std::fs::read_to_string(si_dir.join("k_final_velocity.svg")).unwrap();
+    assert!(k.contains("(m/s)"), "k_final_velocity.svg is not in m/s");
+    assert!(!k.contains("√(g(R + r))"));
     // The dimensionless data are refused with --units si.
     let out = bin()
         .args(["report", "--units", "si", "--out-dir"])
@@ -283,4 +294,43 @@ fn output_dash_is_standard_output_for_every_table_command() {
             "{args:?}: a file named '-' was written"
         );
     }
+}
+
+/// `--format all` writes every figure as SVG, PNG and PDF; each PDF is a PDF document with the
+/// embedded font subset into it and a ToUnicode map (its text is selectable), and report.md
+/// links all three. The figures' titles carry no reference to the paper's figures: report.md's
+/// captions do.
+#[test]
+fn report_writes_pdf_figures_with_the_font_embedded() {
+    let dir = tmpdir();
+    let out_dir = dir.path().join("r");
+    report_into(&out_dir, &["--format", "all"]);
+    let md = std::fs::read_to_string(out_dir.join("report.md")).unwrap();
+    let mut svgs = 0;
+    for e in std::fs::read_dir(&out_dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_some_and(|x| x == "svg") {
+            svgs += 1;
+            let svg = std::fs::read_to_string(&p).unwrap();
+            assert!(!svg.contains("(the paper's Fig"), "{}", p.display());
+            assert!(p.with_extension("png").exists(), "{}", p.display());
+            let pdf = std::fs::read(p.with_extension("pdf")).unwrap();
+            assert!(pdf.starts_with(b"%PDF-"), "{}", p.display());
+            let text = String::from_utf8_lossy(&pdf);
+            for key in ["DejaVuSans", "/FontFile2", "/ToUnicode"] {
+                assert!(text.contains(key), "{}: no {key}", p.display());
+            }
+            let name = p
+                .file_name()
+                .unwrap()
+                .to_string_lossy()
+                .replace(".svg", ".pdf");
+            assert!(
+                md.contains(&format!("[{name}]({name})")),
+                "{name} not linked"
+            );
+        }
+    }
+    assert_eq!(svgs, 8);
+    assert!(md.contains("(the paper's Fig. 4)"));
 }

@@ -1,15 +1,20 @@
 //! The figures: SVG documents written by the crate's own engine ([`svg`] for the document
 //! and its text, [`plot`] for axes, legends and grids of panels), the corner plots of
 //! posteriors ([`corner`]), and the scatter figure of `fitbead k`. `png` (feature `png`)
-//! renders any of them to PNG with resvg and the embedded font.
+//! renders any of them to PNG with resvg and the embedded font; feature `pdf` converts them to
+//! PDF (svg2pdf over the same tree, the font embedded).
 //!
-//! Labels are markup: `_{…}` sets a subscript and `^{…}` a superscript (written as `tspan`s
-//! shifted with `dy`, which every SVG viewer supports); Greek letters and symbols are Unicode.
+//! Labels are markup: `_{…}` sets a subscript and `^{…}` a superscript; Greek letters and
+//! symbols are Unicode. Every run of a label is written as a `tspan` at an absolute position
+//! computed from the embedded font's advance widths (start-anchored, kerning off), so any
+//! conforming renderer draws the same picture.
 //! Every document names the font family list `FONT_FAMILY`, whose first member is the
 //! embedded DejaVu Sans (`assets/fonts/`), whose advance widths the layout measures text with.
 
 pub mod corner;
 mod metrics;
+#[cfg(feature = "pdf")]
+mod pdf;
 pub mod plot;
 #[cfg(feature = "png")]
 pub mod png;
@@ -85,8 +90,12 @@ pub enum FigureFormat {
     Svg,
     /// PNG only (rendered from the SVG).
     Png,
+    /// PDF only (converted from the SVG: vector, the font embedded, text selectable).
+    Pdf,
     /// SVG and PNG.
     Both,
+    /// SVG, PNG and PDF.
+    All,
 }
 
 impl std::str::FromStr for FigureFormat {
@@ -95,42 +104,57 @@ impl std::str::FromStr for FigureFormat {
         match s.trim().to_ascii_lowercase().as_str() {
             "svg" => Ok(FigureFormat::Svg),
             "png" => Ok(FigureFormat::Png),
+            "pdf" => Ok(FigureFormat::Pdf),
             "both" => Ok(FigureFormat::Both),
-            _ => Err("must be svg, png or both".into()),
+            "all" => Ok(FigureFormat::All),
+            _ => Err("must be svg, png, pdf, both (svg and png) or all".into()),
         }
     }
 }
 
 impl FigureFormat {
-    /// The file names a figure `NAME.svg` is written as.
-    pub fn names(self, svg_name: &str) -> Vec<String> {
-        let png = || format!("{}.png", svg_name.trim_end_matches(".svg"));
+    /// The extensions this format writes, in order.
+    fn extensions(self) -> &'static [&'static str] {
         match self {
-            FigureFormat::Svg => vec![svg_name.to_string()],
-            FigureFormat::Png => vec![png()],
-            FigureFormat::Both => vec![svg_name.to_string(), png()],
+            FigureFormat::Svg => &["svg"],
+            FigureFormat::Png => &["png"],
+            FigureFormat::Pdf => &["pdf"],
+            FigureFormat::Both => &["svg", "png"],
+            FigureFormat::All => &["svg", "png", "pdf"],
         }
     }
 
-    /// `files` (name, bytes) with every `*.svg` written in this format: kept, replaced by its
-    /// PNG rendering (`png::svg_to_png` at `png::REPORT_SCALE`), or both. Without the
-    /// `png` feature a PNG format is an error.
+    /// The file names a figure `NAME.svg` is written as.
+    pub fn names(self, svg_name: &str) -> Vec<String> {
+        let stem = svg_name.trim_end_matches(".svg");
+        self.extensions()
+            .iter()
+            .map(|e| format!("{stem}.{e}"))
+            .collect()
+    }
+
+    /// `files` (name, bytes) with every `*.svg` written in this format: kept, rendered to PNG
+    /// (`png::svg_to_png` at `png::REPORT_SCALE`), converted to PDF, or several of these.
+    /// Without the `png` or `pdf` feature such a format is an error.
     pub fn apply(self, files: Vec<(String, Vec<u8>)>) -> Result<Vec<(String, Vec<u8>)>, String> {
         if self == FigureFormat::Svg {
             return Ok(files);
         }
-        let mut out = Vec::with_capacity(files.len() * 2);
+        let mut out = Vec::with_capacity(files.len() * 3);
         for (name, bytes) in files {
             if !name.ends_with(".svg") {
                 out.push((name, bytes));
                 continue;
             }
-            let png = render_png(&name, &bytes)?;
-            let png_name = format!("{}.png", name.trim_end_matches(".svg"));
-            if self == FigureFormat::Both {
-                out.push((name, bytes));
+            let stem = name.trim_end_matches(".svg").to_string();
+            for ext in self.extensions() {
+                let file = match *ext {
+                    "png" => render_png(&name, &bytes)?,
+                    "pdf" => render_pdf(&name, &bytes)?,
+                    _ => bytes.clone(),
+                };
+                out.push((format!("{stem}.{ext}"), file));
             }
-            out.push((png_name, png));
         }
         Ok(out)
     }
@@ -146,5 +170,18 @@ fn render_png(name: &str, svg: &[u8]) -> Result<Vec<u8>, String> {
 fn render_png(name: &str, _svg: &[u8]) -> Result<Vec<u8>, String> {
     Err(format!(
         "{name}: PNG figures need the crate feature `png` (built without it)"
+    ))
+}
+
+#[cfg(feature = "pdf")]
+fn render_pdf(name: &str, svg: &[u8]) -> Result<Vec<u8>, String> {
+    let text = std::str::from_utf8(svg).map_err(|e| format!("{name}: {e}"))?;
+    pdf::svg_to_pdf(text).map_err(|e| format!("{name}: {e}"))
+}
+
+#[cfg(not(feature = "pdf"))]
+fn render_pdf(name: &str, _svg: &[u8]) -> Result<Vec<u8>, String> {
+    Err(format!(
+        "{name}: PDF figures need the crate feature `pdf` (built without it)"
     ))
 }

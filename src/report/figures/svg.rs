@@ -172,16 +172,6 @@ pub enum Anchor {
     End,
 }
 
-impl Anchor {
-    fn attr(self) -> &'static str {
-        match self {
-            Anchor::Start => "start",
-            Anchor::Middle => "middle",
-            Anchor::End => "end",
-        }
-    }
-}
-
 /// A stroke: colour, width in px and an optional dash pattern (SVG `stroke-dasharray`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Stroke {
@@ -441,6 +431,13 @@ impl Svg {
     /// Text: `markup` (`text_width`'s sub- and superscripts) at `size` px with its
     /// baseline at (x, y), anchored by `anchor`, rotated by −90° about (x, y) when
     /// `vertical`.
+    ///
+    /// Every run of the markup is its own `tspan` with absolute positions computed from the
+    /// embedded font's advance widths: one x per character (start-anchored) and the run's
+    /// baseline y, so the drawing does not depend on how a renderer anchors text, shifts
+    /// scripts, kerns or hints advances: resvg, cairosvg and browsers put every glyph at the
+    /// same point. Spaces at either end of a run are left out of the document and kept as
+    /// advance.
     #[allow(clippy::too_many_arguments)]
     pub fn text(
         &mut self,
@@ -451,6 +448,12 @@ impl Svg {
         vertical: bool,
         colour: &str,
     ) {
+        let width = text_width(markup, size);
+        let x0 = match anchor {
+            Anchor::Start => x,
+            Anchor::Middle => x - width / 2.0,
+            Anchor::End => x - width,
+        };
         let rot = if vertical {
             format!(" transform=\"rotate(-90 {} {})\"", num(x), num(y))
         } else {
@@ -458,28 +461,50 @@ impl Svg {
         };
         let _ = write!(
             self.body,
-            "<text x=\"{}\" y=\"{}\" font-size=\"{}\" text-anchor=\"{}\" fill=\"{colour}\"{rot}>",
-            num(x),
+            "<text x=\"{}\" y=\"{}\" font-size=\"{}\" fill=\"{colour}\"{rot}>",
+            num(x0),
             num(y),
-            num(size),
-            anchor.attr()
+            num(size)
         );
-        let mut at = 0.0;
+        let mut at = x0;
         for (shift, t) in runs(markup) {
-            let off = shift.offset() * size;
-            let dy = off - at;
-            at = off;
-            let fs = if shift == Shift::Base {
+            let fs = size * shift.scale();
+            // Each character at its own x: the advance widths decide every glyph's place, not
+            // the renderer's hinting or kerning. Spaces are advance only (a renderer may
+            // collapse or drop them), except one between words, kept for copied text.
+            let mut xs = String::new();
+            let mut chars = String::new();
+            let mut prev_space = true;
+            for c in t.chars() {
+                let space = c == ' ';
+                if !(space && prev_space) {
+                    if !xs.is_empty() {
+                        xs.push(' ');
+                    }
+                    xs.push_str(&num(at));
+                    chars.push(c);
+                }
+                prev_space = space;
+                at += advance(c) * fs;
+            }
+            if chars.ends_with(' ') {
+                chars.pop();
+                xs.truncate(xs.rfind(' ').unwrap_or(0));
+            }
+            if chars.is_empty() {
+                continue;
+            }
+            let size_attr = if shift == Shift::Base {
                 String::new()
             } else {
-                format!(" font-size=\"{}\"", num(size * SCRIPT))
+                format!(" font-size=\"{}\"", num(fs))
             };
-            let dy = if dy == 0.0 {
-                String::new()
-            } else {
-                format!(" dy=\"{}\"", num(dy))
-            };
-            let _ = write!(self.body, "<tspan{dy}{fs}>{}</tspan>", escape(&t));
+            let _ = write!(
+                self.body,
+                "<tspan x=\"{xs}\" y=\"{}\"{size_attr}>{}</tspan>",
+                num(y + shift.offset() * size),
+                escape(&chars)
+            );
         }
         self.body.push_str("</text>\n");
     }
@@ -490,7 +515,8 @@ impl Svg {
         let _ = writeln!(
             s,
             "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" \
-             viewBox=\"0 0 {w} {h}\" font-family=\"{FONT_FAMILY}\">",
+             viewBox=\"0 0 {w} {h}\" font-family=\"{FONT_FAMILY}\" \
+             style=\"font-kerning:none\">",
             w = num(self.width),
             h = num(self.height)
         );
@@ -607,6 +633,40 @@ mod tests {
         let mut s = Svg::new(10.0, 10.0);
         s.text((1.0, 2.0), "a<b_{1}", 14.0, Anchor::Start, false, "#000");
         let out = s.finish();
-        assert!(out.contains("a&lt;b</tspan><tspan dy=\"3.5\" font-size=\"10.08\">1</tspan>"));
+        // DejaVu Sans advances: a 1255, < 1716, b 1300 font units of 2048. The subscript
+        // starts after "a<b", a quarter of the size (3.5 px) below the baseline, at 0.72 of
+        // the size.
+        let em = 14.0 / 2048.0;
+        let xs = [1.0, 1.0 + 1255.0 * em, 1.0 + (1255.0 + 1716.0) * em];
+        let sub = 1.0 + (1255.0 + 1716.0 + 1300.0) * em;
+        assert!(out.contains(&format!(
+            "<tspan x=\"{} {} {}\" y=\"2\">a&lt;b</tspan><tspan x=\"{}\" y=\"5.5\" \
+             font-size=\"10.08\">1</tspan>",
+            num(xs[0]),
+            num(xs[1]),
+            num(xs[2]),
+            num(sub)
+        )));
+    }
+
+    #[test]
+    fn anchored_text_starts_where_its_width_puts_it() {
+        let mut s = Svg::new(10.0, 10.0);
+        s.text((100.0, 20.0), "v v", 20.0, Anchor::Middle, false, "#000");
+        s.text((100.0, 40.0), " v  ", 20.0, Anchor::End, false, "#000");
+        let out = s.finish();
+        // v 1212, space 651 font units of 2048.
+        let (v, sp) = (20.0 * 1212.0 / 2048.0, 20.0 * 651.0 / 2048.0);
+        let x0 = 100.0 - (2.0 * v + sp) / 2.0;
+        assert!(out.contains(&format!(
+            "<tspan x=\"{} {} {}\" y=\"20\">v v</tspan>",
+            num(x0),
+            num(x0 + v),
+            num(x0 + v + sp)
+        )));
+        // Spaces at the ends are advance, not text.
+        let x1 = 100.0 - (3.0 * sp + v);
+        assert!(out.contains(&format!("<tspan x=\"{}\" y=\"40\">v</tspan>", num(x1 + sp))));
+        assert!(!out.contains("text-anchor"));
     }
 }

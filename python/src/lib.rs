@@ -1398,10 +1398,19 @@ fn design<'py>(
     let d = PyDict::new(py);
     let rows = |rows: &[fitbead::design::DesignRow]| -> PyResult<Bound<'py, PyDict>> {
         let t = PyDict::new(py);
-        t.set_item("series", rows.iter().map(|r| r.series.clone()).collect::<Vec<_>>())?;
+        t.set_item(
+            "series",
+            rows.iter().map(|r| r.series.clone()).collect::<Vec<_>>(),
+        )?;
         t.set_item("xi", rows.iter().map(|r| r.xi).collect::<Vec<_>>())?;
-        t.set_item("delta_deg", rows.iter().map(|r| r.delta_deg).collect::<Vec<_>>())?;
-        t.set_item("replicates", rows.iter().map(|r| r.replicates).collect::<Vec<_>>())?;
+        t.set_item(
+            "delta_deg",
+            rows.iter().map(|r| r.delta_deg).collect::<Vec<_>>(),
+        )?;
+        t.set_item(
+            "replicates",
+            rows.iter().map(|r| r.replicates).collect::<Vec<_>>(),
+        )?;
         Ok(t)
     };
     d.set_item("design", rows(&r.rows)?)?;

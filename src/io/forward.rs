@@ -82,7 +82,7 @@ pub(crate) const OUTPUT_COLUMNS: [&str; 12] = [
 ];
 
 /// The columns `forward` adds after the input's own under a model of `kind`, in order:
-/// [`OUTPUT_COLUMNS`], then the contact model's or auto's own.
+/// the columns every model adds (v, regime, status, …), then the contact model's or auto's own.
 pub fn output_columns(kind: ModelKind) -> Vec<&'static str> {
     let mut outputs = OUTPUT_COLUMNS.to_vec();
     if kind == ModelKind::Contact {

@@ -7,4 +7,6 @@ cd "$(dirname "$0")/.."
 cargo test --release
 # The binary `cargo test` built serves the Python tests (a plain `cargo build` would build it
 # again: the tests build with the dev-dependencies' features).
-FITBEAD_BIN_BUILT=1 scripts/test_python.sh
+# The wheel builds in the root's target directory here, reusing the dependencies just built
+# (nothing else builds beside it in this script).
+FITBEAD_BIN_BUILT=1 FITBEAD_WHEEL_TARGET=target scripts/test_python.sh

@@ -20,7 +20,11 @@ if [ ! -x "$build_venv/bin/maturin" ]; then
 fi
 rm -f python/target/wheels/fitbead-*.whl
 start=$(date +%s)
-(cd python && "$root/$build_venv/bin/maturin" build --release --quiet \
+# FITBEAD_WHEEL_TARGET: the cargo target directory of the wheel's build (default
+# python/target, its own; scripts/test.sh points it at the root's target, whose dependencies
+# `cargo test --release` has just built, when nothing else is building).
+(cd python && CARGO_TARGET_DIR="$root/${FITBEAD_WHEEL_TARGET:-python/target}" \
+  "$root/$build_venv/bin/maturin" build --release --quiet \
   --interpreter "$root/$build_venv/bin/python" --out target/wheels)
 wheel=$(ls python/target/wheels/fitbead-*.whl)
 echo "wheel: $(basename "$wheel"), $(stat -c %s "$wheel") bytes, built in $(($(date +%s) - start)) s"

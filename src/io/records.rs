@@ -437,9 +437,18 @@ mod tests {
     #[test]
     fn columns_are_the_fields_in_order_with_their_serde_names() {
         let p = columns::<ParamRecord>();
-        assert_eq!(p.len(), 30);
+        assert_eq!(p.len(), 33);
         assert_eq!(&p[..4], ["fit", "series", "parameter", "value"]);
         assert_eq!(&p[22..25], ["q2.5", "q50", "q97.5"]);
+        assert_eq!(
+            &p[29..],
+            [
+                "lsq_value",
+                "prior_sensitivity",
+                "likelihood_sensitivity",
+                "prior_diagnosis"
+            ]
+        );
         assert_eq!(columns::<StatsRecord>().len(), 28);
         assert_eq!(columns::<ResidualRecord>().len(), 9);
         assert_eq!(columns::<CorrelationRecord>().len(), 5);

@@ -46,6 +46,8 @@ except OSError as e:  # cairocffi raises OSError when libcairo is missing
 from PIL import Image, ImageFilter
 
 SCALE = 2
+PRINT_SCALE = 300 / 96
+MIN_PRINT_PT = 7
 THRESHOLD = 0.25
 TILE = 64
 MAX_TILE_FRACTION = 0.06
@@ -161,6 +163,15 @@ def overlaps(boxes, tol=0.25):
     return bad
 
 
+def print_size(svg_path):
+    """(printed width in mm, layout width in document units) of a figure sized for print, else None."""
+    root = ET.parse(svg_path).getroot()
+    w = root.get("width")
+    if not w.endswith("mm"):
+        return None
+    return float(w[:-2]), float(root.get("viewBox").split()[2])
+
+
 def run_mcmc(cli, *args):
     code, _, err = cli(*args, check=False)
     assert code in (0, 1), f"fitbead {' '.join(map(str, args))} failed ({code}): {err}"
@@ -172,10 +183,11 @@ def figures(cli, tmp_path_factory):
     report and every --plot."""
     d = tmp_path_factory.mktemp("figures")
     pairs = []
-    for name, extra in {"lsq": [], "mcmc": MCMC}.items():
+    runs = {"lsq": [], "mcmc": MCMC, "single": ["--figure-width", "single"]}
+    for name, extra in runs.items():
         out = d / name
         args = ["report", "--input", DEFAULT_DATA, "--format", "both", "--out-dir", out, *extra]
-        if extra:
+        if extra == MCMC:
             run_mcmc(cli, *args)
         else:
             cli(*args)
@@ -213,11 +225,18 @@ def test_every_figure_draws_the_same_with_resvg_and_cairosvg(figures):
     for svg, png in figures:
         ours = Image.open(png)
         cairo_png = svg.with_suffix(".cairo.png")
-        cairosvg.svg2png(url=str(svg), write_to=str(cairo_png), scale=SCALE)
+        # A figure sized for print (its width in mm) is rendered at 300 dpi, others at SCALE.
+        scale = PRINT_SCALE if print_size(svg) else SCALE
+        cairosvg.svg2png(url=str(svg), write_to=str(cairo_png), scale=scale)
         theirs = Image.open(cairo_png)
-        if ours.size != theirs.size:
+        # A size in mm is rarely a whole number of pixels: the renderers may round it apart by
+        # one pixel; both are then compared on their common area.
+        slack = 1 if print_size(svg) else 0
+        if any(abs(a - b) > slack for a, b in zip(ours.size, theirs.size)):
             failures.append(f"{svg.name}: resvg {ours.size} px, cairosvg {theirs.size} px")
             continue
+        common = (0, 0, min(ours.size[0], theirs.size[0]), min(ours.size[1], theirs.size[1]))
+        ours, theirs = ours.crop(common), theirs.crop(common)
         worst, at = worst_tile(ours, theirs)
         if worst > MAX_TILE_FRACTION:
             failures.append(f"{svg.name}: {worst:.1%} of the tile at {at} differs between resvg and cairosvg")
@@ -225,3 +244,24 @@ def test_every_figure_draws_the_same_with_resvg_and_cairosvg(figures):
         if bad:
             failures.append(f"{svg.name}: overlapping labels {bad[:5]}")
     assert not failures, "\n".join(failures)
+
+
+def test_print_sized_figures_keep_every_text_at_7_pt_or_more(figures):
+    """`report --figure-width single` (86 mm, the narrowest named width): every figure is sized
+    in mm, and every label's base font size (sub- and superscripts aside) prints at 7 pt or
+    more."""
+    sized = [svg for svg, _ in figures if svg.parent.name == "single"]
+    assert len(sized) == 8, [s.name for s in sized]
+    failures = []
+    for svg in sized:
+        size = print_size(svg)
+        assert size is not None, f"{svg}: not sized in mm"
+        mm, layout = size
+        assert mm == 86
+        pt_per_unit = mm / layout * 72 / 25.4
+        sizes = [float(t.get("font-size")) for t in ET.parse(svg).getroot().iter(SVG_NS + "text")]
+        assert sizes, svg
+        smallest = min(sizes) * pt_per_unit
+        if smallest < MIN_PRINT_PT - 1e-9:
+            failures.append(f"{svg.parent.name}/{svg.name}: {smallest:.2f} pt")
+    assert not failures, failures

@@ -34,6 +34,14 @@ pub struct Args {
     pub tol: f64,
 }
 
+/// The model flag's name in prose for titles ("stick/slip" for `stickslip`); the flag as given
+/// when it names no model.
+pub fn prose_model_name(name: &str) -> String {
+    name.parse::<ModelKind>()
+        .map(|k| k.prose_name().to_string())
+        .unwrap_or_else(|_| name.to_string())
+}
+
 /// Parses the model flag of `k` (the five contact models).
 pub fn parse_model(name: &str) -> Result<Model, CliError> {
     let err = || {
@@ -133,7 +141,9 @@ pub fn run(a: Args) -> Result<(), CliError> {
             };
             let cannot =
                 |e: std::io::Error| CliError::Other(format!("{}: cannot write: {e}", p.display()));
-            let svg = ledger.plot_svg(&a.model).map_err(CliError::Other)?;
+            let svg = ledger
+                .plot_svg(&prose_model_name(&a.model))
+                .map_err(CliError::Other)?;
             let bytes = a.plot.bytes(svg)?;
             let mut f = file.map_err(cannot)?;
             f.write_all(&bytes).map_err(cannot)?;

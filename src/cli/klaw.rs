@@ -3,7 +3,7 @@
 
 use super::fitargs::{FitArgs, LsqPlot};
 use super::k::parse_auto;
-use super::k::parse_model;
+use super::k::{parse_model, prose_model_name};
 use super::CliError;
 use fitbead::fit::k::auto::{self as kauto, KChoice};
 use fitbead::fit::k::unsteady_points;
@@ -14,6 +14,27 @@ use fitbead::io::measurements::locate_point;
 use fitbead::models::Model;
 use fitbead::report::bands::Curve;
 use rayon::prelude::*;
+
+/// Why a law cannot be fitted, in words, with the points an empty box names located by
+/// `locate` (given an index into the fitted data set).
+pub fn law_error(e: &KLawError, locate: &dyn Fn(usize) -> String) -> String {
+    match e {
+        KLawError::EmptyBox {
+            param,
+            lower,
+            upper,
+        } if lower.0.is_finite() && upper.0.is_finite() => format!(
+            "no value of {param} keeps every point in regime B: {} needs {param} > {} \
+             (below, the bead stops), while {} needs {param} <= {} (above, it lifts off or runs \
+             away)",
+            locate(lower.1),
+            fmt_f64(lower.0),
+            locate(upper.1),
+            fmt_f64(upper.0)
+        ),
+        e => e.to_string(),
+    }
+}
 
 /// Arguments of `fitbead klaw`.
 #[derive(Debug, clap::Args)]
@@ -129,21 +150,11 @@ pub fn run(a: Args) -> Result<(), CliError> {
     if ds.points.is_empty() {
         return Err(CliError::Other("klaw: no point is left to fit".to_string()));
     }
-    let fail = |e: KLawError| match e {
-        KLawError::EmptyBox {
-            param,
-            lower,
-            upper,
-        } if lower.0.is_finite() && upper.0.is_finite() => CliError::Other(format!(
-            "klaw: no value of {param} keeps every point in regime B: {} needs {param} > {} \
-             (below, the bead stops), while {} needs {param} <= {} (above, it lifts off or runs \
-             away)",
-            locate(&all, orig[lower.1]),
-            fmt_f64(lower.0),
-            locate(&all, orig[upper.1]),
-            fmt_f64(upper.0)
-        )),
-        e => CliError::Other(format!("klaw: {e}")),
+    let fail = |e: KLawError| {
+        CliError::Other(format!(
+            "klaw: {}",
+            law_error(&e, &|i| locate(&all, orig[i]))
+        ))
     };
     let interrupted = |e: CliError| {
         if super::stop_requested() {
@@ -193,7 +204,10 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let curves: Vec<Curve> = std::iter::once(main_curve)
         .chain((law != KLaw::Impact).then_some(Curve::Impact(model)))
         .collect();
-    let title = format!("K(α) laws under the {} model, fitted on v\u{304}", a.model);
+    let title = format!(
+        "K(α) laws under the {} model, fitted on v\u{304}",
+        prose_model_name(&a.model)
+    );
     let plot = LsqPlot {
         title: &title,
         data: &ds,

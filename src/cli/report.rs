@@ -4,12 +4,13 @@
 
 use super::args::{ContactArgs, DataArgs, LevelArgs, PlotArgs};
 use super::fitargs::{flag_absurd, not_converged, FitArgs, FitOutputArgs};
+use super::klaw::law_error;
 use super::CliError;
 use fitbead::fit::k::unsteady_points;
 use fitbead::io::measurements::locate_point;
 use fitbead::io::measurements::{is_shipped_data, si_conversion};
 use fitbead::report::analysis::analyse;
-use fitbead::report::figures::FigureFormat;
+use fitbead::report::figures::{FigureFormat, FigureWidth};
 use fitbead::report::text::{markdown, one_line, terminal_summary, ReportContext};
 use std::path::{Path, PathBuf};
 
@@ -18,6 +19,9 @@ const CONTACT_MODELS: [fitbead::models::Model; 2] = [
     fitbead::models::Model::Stick,
     fitbead::models::Model::StickSlip,
 ];
+
+/// [`CONTACT_MODELS`] in prose.
+const CONTACT_NAMES: [&str; 2] = ["rolling", "stick/slip"];
 
 /// Arguments of `fitbead report`.
 #[derive(Debug, clap::Args)]
@@ -44,6 +48,12 @@ pub struct Args {
     /// m²/s², k_final_velocity.svg) [default: dimensionless]
     #[arg(long)]
     pub units: Option<String>,
+    /// Print width of the figures: single (one journal column, 86 mm), double (two columns,
+    /// 178 mm) or a width in mm (40-500); each figure is laid out for it (fewer columns,
+    /// narrower panels, titles broken into lines) so that no text prints below 7 pt, sized in
+    /// mm in SVG and PDF, PNG at 300 dpi [default: each figure's natural size]
+    #[arg(long)]
+    pub figure_width: Option<String>,
     /// The level of every interval.
     #[command(flatten)]
     pub level: LevelArgs,
@@ -56,12 +66,19 @@ pub struct Args {
     /// MCMC: maximum steps per fit [default: 100000]
     #[arg(long)]
     pub max_steps: Option<usize>,
-    /// A TOML recipe with any of the keys input, out_dir, method, format, units, rho, f, g,
+    /// A TOML recipe with any of the keys input, out_dir, method, format, units, figure_width,
+    /// rho, f, g,
     /// level, seed, min_ess, max_steps (paths relative to the recipe's directory, never
     /// empty); flags given on the command line win. seed, min_ess and max_steps apply to mcmc
     /// and are ignored under lsq. A bad value is reported with the recipe file, line and key
     #[arg(long)]
     pub recipe: Option<PathBuf>,
+    /// Write what can be written when the data fail a fit command's input check (points that
+    /// the rolling or the stick/slip model cannot make steady, a K(α) law that cannot be
+    /// fitted): the fits leave those points out and report.md opens with the warnings.
+    /// Without it such data exit 2 (as `klaw` does) and nothing is written
+    #[arg(long)]
+    pub keep_going: bool,
 }
 
 /// The keys of a recipe file.
@@ -78,6 +95,8 @@ pub struct Recipe {
     pub format: Option<String>,
     /// dimensionless or si.
     pub units: Option<String>,
+    /// single, double or a width in mm.
+    pub figure_width: Option<String>,
     /// ρ.
     pub rho: Option<f64>,
     /// f.
@@ -99,12 +118,13 @@ pub struct Recipe {
 }
 
 /// The recipe's keys that a flag of the same meaning overrides, with that flag.
-const RECIPE_FLAGS: [(&str, &str); 12] = [
+const RECIPE_FLAGS: [(&str, &str); 13] = [
     ("input", "--input"),
     ("out_dir", "--out-dir"),
     ("method", "--method"),
     ("format", "--format"),
     ("units", "--units"),
+    ("figure_width", "--figure-width"),
     ("rho", "--rho"),
     ("f", "--f"),
     ("g", "--g"),
@@ -190,6 +210,7 @@ fn from_recipe(a: &Args, r: &Recipe, key: &str) -> bool {
         "method" => a.method.is_none() && r.method.is_some(),
         "format" => a.format.is_none() && r.format.is_some(),
         "units" => a.units.is_none() && r.units.is_some(),
+        "figure_width" => a.figure_width.is_none() && r.figure_width.is_some(),
         "rho" => a.data.contact.rho.is_none() && r.rho.is_some(),
         "f" => a.data.contact.f.is_none() && r.f.is_some(),
         "g" => a.data.g.is_none() && r.g.is_some(),
@@ -283,6 +304,13 @@ fn run_with(a: Args, r: Recipe) -> Result<(), CliError> {
             .map_err(|e: String| super::flag_error("--format", f, e))?,
         None => FigureFormat::Svg,
     };
+    let figure_width: Option<FigureWidth> = match a.figure_width.clone().or(r.figure_width) {
+        Some(w) => Some(
+            w.parse()
+                .map_err(|e: String| super::flag_error("--figure-width", &w, e))?,
+        ),
+        None => None,
+    };
     let out_dir = a
         .out_dir
         .clone()
@@ -359,7 +387,37 @@ fn run_with(a: Args, r: Recipe) -> Result<(), CliError> {
         )));
     }
     let implausible = fitbead::io::measurements::plausibility(&t, &rows);
-    let an = analyse(&ds, io.level.level(), &choice.method);
+    // The input checks of `klaw`, per contact model: points that model cannot make steady.
+    let mut input_warnings = Vec::new();
+    for (model, name) in CONTACT_MODELS.iter().zip(CONTACT_NAMES) {
+        let unsteady = unsteady_points(std::slice::from_ref(model), &ds, Some(&super::stop_flag()));
+        if let Some((i, why)) = unsteady.first() {
+            input_warnings.push(format!(
+                "{}: {why} (and {} more such point(s)); no K of the {name} model makes this \
+                 point steady (the {name} fits leave such points out)",
+                locate_point(&t, &ds, *i),
+                unsteady.len() - 1
+            ));
+        }
+    }
+    if super::stop_requested() {
+        return Err(CliError::Interrupted);
+    }
+    refuse_unless_keep_going(a.keep_going, &input_warnings)?;
+    let mut an = analyse(&ds, io.level.level(), &choice.method);
+    an.print_width_mm = figure_width.map(FigureWidth::mm);
+    // The K(α) laws `klaw` would have refused to fit (on the points each model keeps).
+    let mut law_failures = Vec::new();
+    for (c, name) in an.contact.iter().zip(CONTACT_NAMES) {
+        for (law, e) in &c.law_failures {
+            let located = law_error(e, &|i| locate_point(&t, &ds, c.used[i]));
+            law_failures.push(format!("{name} law {}: {located}", law.name()));
+        }
+    }
+    if !super::stop_requested() {
+        refuse_unless_keep_going(a.keep_going, &law_failures)?;
+    }
+    input_warnings.extend(law_failures);
     let interrupted = an
         .posteriors()
         .iter()
@@ -480,14 +538,6 @@ fn run_with(a: Args, r: Recipe) -> Result<(), CliError> {
             eprintln!("fitbead: warning: {w}");
         }
     }
-    let context = ReportContext {
-        source: shown.unwrap_or_else(|| t.source.clone()),
-        shipped_synthetic: is_shipped_data(&ds),
-        si,
-        figure_format: format,
-        corner_files,
-    };
-    let mut md = markdown(&an, &context, &io.method);
     let absurd: Vec<String> = stats
         .iter()
         .filter_map(|s| {
@@ -495,19 +545,20 @@ fn run_with(a: Args, r: Recipe) -> Result<(), CliError> {
                 .map(|w| format!("{} [{}]: {w}", s.fit, s.series))
         })
         .collect();
-    if !implausible.is_empty() || !absurd.is_empty() {
-        md.push_str("\n## Plausibility checks\n\n");
-        md.push_str(
-            "The data read fine but look like a unit mistake (thresholds in docs/GUIDE.md, \
-             \"Plausibility checks\"):\n\n",
-        );
-        for w in &implausible {
-            md.push_str(&format!("- {}\n", one_line(&w.to_string())));
-        }
-        for w in &absurd {
-            md.push_str(&format!("- {}\n", one_line(w)));
-        }
-    }
+    let context = ReportContext {
+        source: shown.unwrap_or_else(|| t.source.clone()),
+        shipped_synthetic: is_shipped_data(&ds),
+        si,
+        figure_format: format,
+        corner_files,
+        input_warnings,
+        plausibility: implausible
+            .iter()
+            .map(|w| w.to_string())
+            .chain(absurd)
+            .collect(),
+    };
+    let mut md = markdown(&an, &context, &io.method);
     if !warnings.is_empty() {
         md.push_str(
             "
@@ -545,6 +596,23 @@ fn run_with(a: Args, r: Recipe) -> Result<(), CliError> {
         return Err(CliError::InterruptedPartial);
     }
     not_converged(&stats)
+}
+
+/// Exit 2 on `problems` (the input checks a fit command would have failed), unless
+/// `--keep-going`.
+fn refuse_unless_keep_going(keep_going: bool, problems: &[String]) -> Result<(), CliError> {
+    if keep_going || problems.is_empty() {
+        return Ok(());
+    }
+    Err(CliError::Other(format!(
+        "{}{}; nothing written (--keep-going writes the report without what these leave out, \
+         report.md opening with the warnings)",
+        problems[0],
+        match problems.len() {
+            1 => String::new(),
+            n => format!("; and {} more problem(s)", n - 1),
+        }
+    )))
 }
 
 /// Creates `dir` and its missing parents; returns the directories it made, outermost first.

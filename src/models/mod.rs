@@ -393,6 +393,23 @@ impl ModelKind {
             ModelKind::Auto => Model::Auto(auto::Auto::default()),
         })
     }
+
+    /// The model's name in prose (titles and sentences): "stick/slip" for `stickslip`, the
+    /// command-line name otherwise.
+    pub fn prose_name(self) -> &'static str {
+        match self {
+            ModelKind::Stick => "stick",
+            ModelKind::StickApprox => "stick-approx",
+            ModelKind::Slip => "slip",
+            ModelKind::SlipApprox => "slip-approx",
+            ModelKind::StickSlip => "stick/slip",
+            ModelKind::Jan => "Jan",
+            ModelKind::Jaeger => "Jaeger",
+            ModelKind::Contact => "contact",
+            ModelKind::Md => "md",
+            ModelKind::Auto => "auto",
+        }
+    }
 }
 
 impl FromStr for ModelKind {

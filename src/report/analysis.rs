@@ -6,7 +6,7 @@ use crate::fit::data::Dataset;
 use crate::fit::jaeger::{fit_jaeger_with, JaegerFits};
 use crate::fit::jan::{fit_jan_with, JanFits};
 use crate::fit::k::bracket;
-use crate::fit::klaw::{fit_law_with, KLaw, KLawFit, KLawProblem};
+use crate::fit::klaw::{fit_law_with, KLaw, KLawError, KLawFit, KLawProblem};
 use crate::fit::posterior::Method;
 use crate::fit::summary::{FitResult, ParamRow};
 use crate::inverse::{CurveModel as _, Residuals, SigmaKind};
@@ -68,6 +68,9 @@ pub struct ContactFits {
     pub energy: Vec<Option<energy::EnergyPartition>>,
     /// Why a fit is missing.
     pub notes: Vec<String>,
+    /// The K(α) laws (c, or one K per series) that could not be fitted, with why (also among
+    /// `notes`): what makes `klaw` exit 2. Point indices in the errors are into `data`.
+    pub law_failures: Vec<(KLaw, KLawError)>,
 }
 
 /// Everything the report computes.
@@ -84,6 +87,9 @@ pub struct Analysis {
     pub jan: JanFits,
     /// Jaeger's fits (upper branch).
     pub jaeger: JaegerFits,
+    /// The width the report's figures are printed at, mm (`None`, as [`analyse`] leaves it:
+    /// their natural size); see [`Figure::print_width_mm`](crate::report::figures::plot::Figure::print_width_mm).
+    pub print_width_mm: Option<f64>,
 }
 
 fn chi2_at(problem: &KLawProblem<'_>, p: &[f64], m: usize) -> (f64, usize) {
@@ -144,6 +150,7 @@ pub fn analyse(data: &Dataset, level: f64, method: &Method) -> Analysis {
         contact,
         jan,
         jaeger,
+        print_width_mm: None,
     }
 }
 
@@ -184,15 +191,21 @@ fn contact_fits(
         })
     };
     let (law_c, free) = rayon::join(|| fit(KLaw::C), || fit(KLaw::FreePerSeries));
+    let mut law_failures = Vec::new();
     let mut keep_fit = |law: KLaw, r: Result<KLawFit, _>| match r {
         Ok(f) => Some(f),
         Err(e) => {
-            notes.push(format!("{name} law {}: {e}", law.name()));
+            law_failures.push((law, e));
             None
         }
     };
     let law_c = keep_fit(KLaw::C, law_c);
     let free = keep_fit(KLaw::FreePerSeries, free);
+    notes.extend(
+        law_failures
+            .iter()
+            .map(|(law, e)| format!("{name} law {}: {e}", law.name())),
+    );
     let m = sub.points.len();
     let stop = method.stop().cloned();
     let cos2a_chi2 = KLawProblem::new_until(model, &sub, KLaw::C, stop.clone())
@@ -231,6 +244,7 @@ fn contact_fits(
         impact_chi2,
         energy,
         notes,
+        law_failures,
     }
 }
 
@@ -1066,12 +1080,11 @@ impl Analysis {
                     "not clearly supported"
                 };
                 out.push(format!(
-                    "{what}: {verdict} — `{rich}` ({} parameters) against `{simple}` ({}): \
-                     AIC lower by {}, BIC lower by {}.",
-                    b.k,
-                    a.k,
-                    sig3(da),
-                    sig3(db)
+                    "{what}: {verdict} — `{rich}` ({}) against `{simple}` ({}): AIC {}, BIC {}.",
+                    parameter_count(b.k),
+                    parameter_count(a.k),
+                    lower_by(da),
+                    lower_by(db)
                 ));
             }
         };
@@ -1213,4 +1226,18 @@ fn waic_sum<'a>(fits: impl IntoIterator<Item = &'a FitResult>) -> Option<f64> {
 /// Three significant digits (report tables and messages).
 pub(crate) fn sig3(x: f64) -> String {
     crate::numfmt::fmt_sig(x, 3)
+}
+
+/// "1 parameter", "2 parameters".
+fn parameter_count(k: usize) -> String {
+    format!("{k} parameter{}", if k == 1 { "" } else { "s" })
+}
+
+/// A criterion's difference (simpler minus richer) as "lower by d" or "higher by |d|".
+fn lower_by(d: f64) -> String {
+    if d < 0.0 {
+        format!("higher by {}", sig3(-d))
+    } else {
+        format!("lower by {}", sig3(d))
+    }
 }

@@ -60,6 +60,12 @@ const VELOCITY_MODELS: [(&str, &str); 4] = [
 ];
 
 impl Analysis {
+    /// `f` as an SVG document at the report's print width ([`Analysis::print_width_mm`]).
+    fn render(&self, mut f: Figure) -> String {
+        f.print_width_mm = self.print_width_mm;
+        f.to_svg()
+    }
+
     /// "ξ = 0.8" for a series whose label is its ξ, else "series L (ξ = …)".
     fn series_title(&self, s: usize) -> String {
         let label = &self.data.labels[s];
@@ -310,7 +316,7 @@ impl Analysis {
             panels,
         );
         f.legend = legend;
-        Ok(f.to_svg())
+        Ok(self.render(f))
     }
 
     /// The velocity figure of a posterior run: one row of panels per model (in its colour),
@@ -392,7 +398,7 @@ impl Analysis {
             panels,
         );
         f.legend = legend;
-        f.to_svg()
+        self.render(f)
     }
 
     /// Figure: v̄²/cos δ against tan δ with Jan's straight lines (the paper's Fig. 8), each
@@ -433,13 +439,12 @@ impl Analysis {
             }
             p.points(pts, colour, mark);
         }
-        Ok(Figure::new(
+        Ok(self.render(Figure::new(
             "Jan's linearised plot: straight lines from tan δ = μ",
             1,
             SINGLE_PLOT,
             vec![p],
-        )
-        .to_svg())
+        )))
     }
 
     /// K per point (eq 69) under `model`, per series in the order of the slopes: (final
@@ -496,7 +501,12 @@ impl Analysis {
             y_label: "K".into(),
             series,
         };
-        Ok(Figure::new(&fig.title, 1, SINGLE_PLOT, vec![scatter_panel(&fig)]).to_svg())
+        Ok(self.render(Figure::new(
+            &fig.title,
+            1,
+            SINGLE_PLOT,
+            vec![scatter_panel(&fig)],
+        )))
     }
 
     /// Figure: K per point (eq 69) against α under each contact model, with its fitted law c,
@@ -567,7 +577,7 @@ impl Analysis {
             "The points of a series share one α: they are spread {SPREAD}° apart in the order \
              of their slopes."
         ));
-        Ok(f.to_svg())
+        Ok(self.render(f))
     }
 
     /// Figure: the regime map (the paper's Fig. 4), one panel per contact model at its
@@ -683,7 +693,7 @@ impl Analysis {
             panels,
         );
         fig.legend = regime_legend();
-        Ok(fig.to_svg())
+        Ok(self.render(fig))
     }
 
     /// Figure: Jaeger's plane (the paper's Figs. 9–10): Jaeger's velocity u against tan δ per
@@ -763,7 +773,7 @@ impl Analysis {
                 &paper_stroke,
             ));
         }
-        Ok(f.to_svg())
+        Ok(self.render(f))
     }
 
     /// Figure: the energy partition of every point under each contact model at its law-c
@@ -836,19 +846,14 @@ impl Analysis {
                 panels.push(p);
             }
         }
-        // One y axis per row: the panels right of the first share it.
-        for (i, p) in panels.iter_mut().enumerate() {
-            if i % 4 != 0 {
-                p.y.label.clear();
-                p.y.hide_tick_labels = true;
-            }
-        }
         let mut f = Figure::new(
             "Energy partition per point at each model's law-c fit (§4.6, eqs 70–72)",
             4,
             (250.0, 210.0),
             panels,
         );
+        // One y axis per row: the panels right of the first share it.
+        f.share_y = true;
         f.legend = parts
             .iter()
             .map(|(l, c)| LegendEntry::patch(l, c, 1.0))
@@ -874,7 +879,7 @@ impl Analysis {
                 shares.join(", ")
             ));
         }
-        Ok(f.to_svg())
+        Ok(self.render(f))
     }
 
     /// The fits of the report with their names as in `params.csv`: (name, fits) where a
@@ -960,7 +965,7 @@ impl Analysis {
             "±2",
             &Stroke::solid(REFERENCE, 1.2).dashed(DASHES[0]),
         ));
-        Ok(f.to_svg())
+        Ok(self.render(f))
     }
 
     /// One corner plot per posterior: (file name `corner_<fit>_<series>.svg` with the fit
@@ -993,7 +998,7 @@ impl Analysis {
                 }
                 Some((
                     format!("corner_{name}_{}.svg", stem(&f.stats.series)),
-                    corner_figure(&b).to_svg(),
+                    self.render(corner_figure(&b)),
                 ))
             })
             .collect()

@@ -22,6 +22,42 @@ pub struct ReportContext {
     pub figure_format: FigureFormat,
     /// The corner plots written (their SVG names, `corner_<fit>_<series>.svg`).
     pub corner_files: Vec<String>,
+    /// What the input checks of the fit commands found and `report --keep-going` let pass
+    /// (points left out of a model's fits, laws not fitted): report.md opens with them.
+    pub input_warnings: Vec<String>,
+    /// Unit mistakes the data look like, and fits whose misfit is absurd: report.md opens
+    /// with them too.
+    pub plausibility: Vec<String>,
+}
+
+/// The section report.md opens with when the data failed an input check (`--keep-going`) or
+/// look like a unit mistake; empty otherwise.
+fn warnings_section(ctx: &ReportContext) -> String {
+    if ctx.input_warnings.is_empty() && ctx.plausibility.is_empty() {
+        return String::new();
+    }
+    let mut m = String::from("## Warnings\n\n");
+    if !ctx.input_warnings.is_empty() {
+        m.push_str(
+            "The data fail input checks that make the fit commands exit 2; this report was \
+             written anyway (`--keep-going`), without what they leave out:\n\n",
+        );
+        for w in &ctx.input_warnings {
+            m.push_str(&format!("- {}\n", one_line(w)));
+        }
+        m.push('\n');
+    }
+    if !ctx.plausibility.is_empty() {
+        m.push_str(
+            "The data read fine but look like a unit mistake (thresholds in docs/GUIDE.md, \
+             \"Plausibility checks\"):\n\n",
+        );
+        for w in &ctx.plausibility {
+            m.push_str(&format!("- {}\n", one_line(w)));
+        }
+        m.push('\n');
+    }
+    m
 }
 
 /// `s` as a Markdown table cell: `|` escaped (`\|`), every line break a space. Series labels
@@ -399,6 +435,7 @@ pub fn markdown(an: &Analysis, ctx: &ReportContext, method: &str) -> String {
     if ctx.shipped_synthetic {
         m.push_str(SYNTHETIC_BANNER);
     }
+    m.push_str(&warnings_section(ctx));
     m.push_str(&format!(
         "Data: `{source}`, {} points in {} series; rho = {}, f = {} (per row where given); \
          method `{method}`; intervals at level {}; sigma {}.\n\n",

@@ -801,11 +801,41 @@ fn unit_mistakes_are_flagged_loudly() {
     );
     let out = fb(&["k", "--model", "stick", s(&rad)]);
     expect(&out, 0, &["warning", "are these radians?"], "k radians");
+    // The report refuses what klaw refuses (stick/slip cannot make some of these points
+    // steady), writing nothing; with --keep-going it writes what it can, report.md opening
+    // with the warnings.
     let rep = dir.path().join("rep");
     let out = fb(&["report", s(&rad), "--out-dir", s(&rep)]);
-    expect(&out, 0, &["are these radians?"], "report radians");
+    expect(
+        &out,
+        2,
+        &[
+            "are these radians?",
+            "stick/slip model",
+            "--keep-going",
+            "nothing written",
+        ],
+        "report radians",
+    );
+    assert!(!rep.exists(), "a refused report writes nothing");
+    let out = fb(&["report", s(&rad), "--out-dir", s(&rep), "--keep-going"]);
+    expect(
+        &out,
+        0,
+        &["are these radians?"],
+        "report radians --keep-going",
+    );
     let md = std::fs::read_to_string(rep.join("report.md")).unwrap();
-    assert!(md.contains("## Plausibility checks") && md.contains("are these radians?"));
+    let warnings = md.find("## Warnings").expect("a warnings section");
+    let first_table = md.find("## Fitted parameters").unwrap();
+    assert!(warnings < first_table, "report.md opens with the warnings");
+    let section = &md[warnings..first_table];
+    assert!(section.contains("are these radians?"), "{section}");
+    assert!(
+        section.contains("no K of the stick/slip model"),
+        "{section}"
+    );
+    assert!(!md.contains("## Plausibility checks"));
     // m/s in the dimensionless column (R = 2.5 mm).
     let ms = write(
         &dir,

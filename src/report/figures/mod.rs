@@ -82,6 +82,51 @@ pub(crate) fn scatter_svg(fig: &Scatter) -> Result<String, String> {
     Ok(Figure::new(&fig.title, 1, (720.0, 460.0), vec![scatter_panel(fig)]).to_svg())
 }
 
+/// The width a report's figures are printed at: a journal's column, both columns, or any width
+/// in mm. The figures are laid out for it (see
+/// [`Figure::print_width_mm`](plot::Figure::print_width_mm)): text never prints below 7 pt.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum FigureWidth {
+    /// One column: 86 mm (8.6 cm, as the Physical Review journals).
+    Single,
+    /// Both columns: 178 mm (17.8 cm, as the Physical Review journals).
+    Double,
+    /// A width in mm, 40 to 500.
+    Mm(f64),
+}
+
+impl FigureWidth {
+    /// The width, mm.
+    pub fn mm(self) -> f64 {
+        match self {
+            FigureWidth::Single => 86.0,
+            FigureWidth::Double => 178.0,
+            FigureWidth::Mm(w) => w,
+        }
+    }
+}
+
+impl std::str::FromStr for FigureWidth {
+    type Err = String;
+    /// `single`, `double`, or a width in mm (`120`, or `120mm`).
+    fn from_str(s: &str) -> Result<Self, String> {
+        let t = s.trim().to_ascii_lowercase();
+        match t.as_str() {
+            "single" => return Ok(FigureWidth::Single),
+            "double" => return Ok(FigureWidth::Double),
+            _ => {}
+        }
+        let mm: f64 =
+            t.trim_end_matches("mm").trim().parse().map_err(|_| {
+                "must be single (86 mm), double (178 mm) or a width in mm".to_string()
+            })?;
+        if !(40.0..=500.0).contains(&mm) {
+            return Err("a width in mm must be between 40 and 500".into());
+        }
+        Ok(FigureWidth::Mm(mm))
+    }
+}
+
 /// The file formats of a report's figures.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum FigureFormat {
@@ -163,7 +208,13 @@ impl FigureFormat {
 #[cfg(feature = "png")]
 fn render_png(name: &str, svg: &[u8]) -> Result<Vec<u8>, String> {
     let text = std::str::from_utf8(svg).map_err(|e| format!("{name}: {e}"))?;
-    png::svg_to_png(text, png::REPORT_SCALE).map_err(|e| format!("{name}: {e}"))
+    // A figure sized for print (width in mm) is rendered at 300 dots per inch.
+    let scale = if svg::print_sized(text) {
+        png::PRINT_SCALE
+    } else {
+        png::REPORT_SCALE
+    };
+    png::svg_to_png(text, scale).map_err(|e| format!("{name}: {e}"))
 }
 
 #[cfg(not(feature = "png"))]

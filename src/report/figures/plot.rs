@@ -983,7 +983,26 @@ pub struct Figure {
     pub legend: Vec<LegendEntry>,
     /// Lines of small print under the grid (markup).
     pub notes: Vec<String>,
+    /// The width the figure is printed at, mm (`None`: its natural size, a px to the CSS
+    /// pixel). The figure is then laid out ([`Figure::fitted`]) no wider than lets its
+    /// smallest text, [`TICK_SIZE`] px, print at [`MIN_PRINT_PT`] or larger, and its SVG
+    /// document is sized in mm.
+    pub print_width_mm: Option<f64>,
+    /// The panels of a row share the y axis of its first panel: the others draw neither its
+    /// label nor its tick labels (their ranges must be the same).
+    pub share_y: bool,
+    /// The shared legend under the grid (set by [`Figure::fitted`]).
+    legend_below: bool,
 }
+
+/// The smallest text size of a figure printed at its [`Figure::print_width_mm`], pt.
+pub const MIN_PRINT_PT: f64 = 7.0;
+
+/// The narrowest plot area a figure is shrunk to, px.
+const MIN_PLOT: f64 = 150.0;
+
+/// The narrowest plot area a grid keeps its columns for when shrunk, px.
+const COMFORTABLE_PLOT: f64 = 170.0;
 
 impl Figure {
     /// A figure of `panels` in `cols` columns with plot areas of `plot` px.
@@ -995,13 +1014,103 @@ impl Figure {
             panels: panels.into_iter().map(Some).collect(),
             legend: Vec::new(),
             notes: Vec::new(),
+            print_width_mm: None,
+            share_y: false,
+            legend_below: false,
         }
     }
 
     /// Width and height of the figure, whole px.
     pub fn size(&self) -> (f64, f64) {
-        let g = self.grid();
+        let g = self.fitted().grid();
         (g.width.ceil(), g.height.ceil())
+    }
+
+    /// The widest layout, px, whose [`TICK_SIZE`] text prints at [`MIN_PRINT_PT`] or larger
+    /// when the figure is `print_mm` wide.
+    pub fn max_layout_width(print_mm: f64) -> f64 {
+        print_mm * TICK_SIZE / (MIN_PRINT_PT * 25.4 / 72.0)
+    }
+
+    /// The figure laid out for its [`Figure::print_width_mm`]: a grid without empty cells first
+    /// loses columns, then its plot areas narrow (their aspect kept, down to [`MIN_PLOT`]
+    /// px); the shared legend moves under the grid, and the title and notes are broken into
+    /// lines at spaces. Without a maximum, or when the figure fits, the figure as it is.
+    pub fn fitted(&self) -> Figure {
+        let mut f = self.clone();
+        f.print_width_mm = None;
+        if let Some(max) = self.print_width_mm {
+            f.fit_within(Figure::max_layout_width(max).floor());
+        }
+        f.apply_share_y();
+        f
+    }
+
+    /// With [`Figure::share_y`]: the y labels and tick labels of every panel but the first of
+    /// each row removed (and the flag cleared).
+    fn apply_share_y(&mut self) {
+        if !self.share_y {
+            return;
+        }
+        self.share_y = false;
+        let cols = self.cols;
+        for (i, p) in self.panels.iter_mut().enumerate() {
+            if let Some(p) = p.as_mut().filter(|_| i % cols != 0) {
+                p.y.label.clear();
+                p.y.hide_tick_labels = true;
+            }
+        }
+    }
+
+    /// Lays the figure out again within `max` px (see [`Figure::fitted`]).
+    fn fit_within(&mut self, max: f64) {
+        let f = self;
+        f.title = wrap(&f.title, TITLE_SIZE, max - 4.0 * GAP);
+        f.notes = f
+            .notes
+            .iter()
+            .flat_map(|n| {
+                wrap(n, LEGEND_SIZE, max - 4.0 * GAP)
+                    .split('\n')
+                    .map(str::to_string)
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        if f.grid().width <= max {
+            return;
+        }
+        f.legend_below = true;
+        // The most columns whose plot areas stay at least COMFORTABLE_PLOT px wide (one column
+        // when none does; a grid with empty cells, a corner plot, keeps its columns).
+        let reflow = f.panels.iter().all(Option::is_some);
+        let (w0, h0) = f.plot;
+        let shrunk = |f: &Figure| -> f64 {
+            let mut g = f.clone();
+            g.apply_share_y();
+            for _ in 0..4 {
+                let width = g.grid().width;
+                if width <= max || g.plot.0 <= MIN_PLOT {
+                    break;
+                }
+                // The width is the columns' plot areas plus margins that do not scale with them.
+                let fixed = width - g.cols as f64 * g.plot.0;
+                let w = ((max - fixed) / g.cols as f64).clamp(MIN_PLOT, g.plot.0);
+                g.plot = (w, h0);
+            }
+            g.plot.0
+        };
+        while reflow && f.cols > 1 && shrunk(&f) < COMFORTABLE_PLOT.min(w0) {
+            f.cols -= 1;
+        }
+        let w = shrunk(&f);
+        // The aspect kept, but never shorter than the longest y label needs.
+        let y_label = f
+            .panels
+            .iter()
+            .flatten()
+            .map(|p| text_width(&p.y.label, LABEL_SIZE) + 2.0 * GAP)
+            .fold(0.0, f64::max);
+        f.plot = (w, (h0 * w / w0).max(y_label.min(h0)));
     }
 
     fn grid(&self) -> Grid {
@@ -1042,14 +1151,20 @@ impl Figure {
                 ys: p.y.scale,
             };
             if p.legend_spot(&f).is_none() {
-                let c = i % cols;
-                right[c] = right[c].max(legend_size(&p.legend).0 + 3.0 * GAP);
+                let (r, c) = (i / cols, i % cols);
+                let (lw, lh) = legend_size(&p.legend);
+                if self.legend_below {
+                    bottom[r] = bottom[r].max(l.bottom + lh + 2.0 * GAP);
+                    right[c] = right[c].max(lw + GAP - left[c] - w);
+                } else {
+                    right[c] = right[c].max(lw + 3.0 * GAP);
+                }
             }
         }
         let title_h = if self.title.is_empty() {
             GAP
         } else {
-            line_height(TITLE_SIZE) + 2.0 * GAP
+            self.title.lines().count() as f64 * line_height(TITLE_SIZE) + 2.0 * GAP
         };
         let mut xs = vec![GAP; cols];
         let mut x = GAP;
@@ -1105,22 +1220,29 @@ impl Figure {
         } else {
             Some((0.0, 0.0))
         };
-        let extra = if legend_at.is_none() {
-            lw + 3.0 * GAP
-        } else {
-            GAP
+        let title_w = self
+            .title
+            .lines()
+            .map(|l| text_width(l, TITLE_SIZE) + 4.0 * GAP)
+            .fold(0.0, f64::max);
+        let (legend_at, width, notes_y) = match legend_at {
+            // Under the grid, the notes under it.
+            None if self.legend_below => (
+                (2.0 * GAP, y + GAP),
+                (grid_w + GAP).max(lw + 4.0 * GAP),
+                y + lh + 2.0 * GAP,
+            ),
+            None => ((grid_w + GAP, ys[0]), grid_w + lw + 3.0 * GAP, y),
+            Some(at) => (at, grid_w + GAP, y),
         };
-        let legend_at = legend_at.unwrap_or((grid_w + GAP, ys[0]));
-        let width = (grid_w + extra)
-            .max(notes_w)
-            .max(text_width(&self.title, TITLE_SIZE) + 4.0 * GAP);
-        let height = (y + notes_h + GAP).max(title_h + lh + 2.0 * GAP);
+        let width = width.max(notes_w).max(title_w);
+        let height = (notes_y + notes_h + GAP).max(title_h + lh + 2.0 * GAP);
         Grid {
             lays,
             xs,
             ys,
             legend_at,
-            grid_h: y,
+            notes_y,
             width,
             height,
         }
@@ -1128,13 +1250,19 @@ impl Figure {
 
     /// Draws the figure with its top-left corner at (x, y) of `svg`.
     pub fn draw(&self, svg: &mut Svg, x: f64, y: f64) {
+        if self.print_width_mm.is_some() || self.share_y {
+            return self.fitted().draw(svg, x, y);
+        }
         let g = self.grid();
         let (w, h) = self.plot;
         svg.begin_translate(x, y);
-        if !self.title.is_empty() {
+        for (k, line) in self.title.lines().enumerate() {
             svg.text(
-                (g.width / 2.0, GAP + ascent(TITLE_SIZE)),
-                &self.title,
+                (
+                    g.width / 2.0,
+                    GAP + ascent(TITLE_SIZE) + k as f64 * line_height(TITLE_SIZE),
+                ),
+                line,
                 TITLE_SIZE,
                 Anchor::Middle,
                 false,
@@ -1154,13 +1282,19 @@ impl Figure {
                 xs: p.x.scale,
                 ys: p.y.scale,
             };
-            p.draw(svg, l, f, (g.xs[c] + w + 2.0 * GAP, g.ys[r]));
+            let legend_out = if self.legend_below {
+                (g.xs[c] - l.left + GAP, g.ys[r] + h + l.bottom + GAP)
+            } else {
+                (g.xs[c] + w + 2.0 * GAP, g.ys[r])
+            };
+            p.draw(svg, l, f, legend_out);
         }
         if !self.legend.is_empty() {
             draw_legend(svg, &self.legend, g.legend_at.0, g.legend_at.1);
         }
         for (k, n) in self.notes.iter().enumerate() {
-            let yy = g.grid_h + (k as f64) * (line_height(LEGEND_SIZE) + 2.0) + ascent(LEGEND_SIZE);
+            let yy =
+                g.notes_y + (k as f64) * (line_height(LEGEND_SIZE) + 2.0) + ascent(LEGEND_SIZE);
             svg.text((2.0 * GAP, yy), n, LEGEND_SIZE, Anchor::Start, false, INK);
         }
         svg.end_group();
@@ -1170,9 +1304,52 @@ impl Figure {
     pub fn to_svg(&self) -> String {
         let (w, h) = self.size();
         let mut svg = Svg::new(w, h);
+        svg.print_width_mm = self.print_width_mm;
         self.draw(&mut svg, 0.0, 0.0);
         svg.finish()
     }
+}
+
+/// `markup` broken into lines (joined by '\n') at spaces outside `{…}` groups, each line at
+/// most `max` px wide at `size` where a break allows.
+fn wrap(markup: &str, size: f64, max: f64) -> String {
+    if text_width(markup, size) <= max {
+        return markup.to_string();
+    }
+    let mut words = Vec::new();
+    let (mut depth, mut start) = (0i32, 0);
+    for (i, c) in markup.char_indices() {
+        match c {
+            '{' => depth += 1,
+            '}' => depth -= 1,
+            ' ' if depth == 0 => {
+                words.push(&markup[start..i]);
+                start = i + 1;
+            }
+            _ => {}
+        }
+    }
+    words.push(&markup[start..]);
+    let greedy = |limit: f64| {
+        let mut lines: Vec<String> = Vec::new();
+        for w in &words {
+            match lines.last_mut() {
+                Some(l) if text_width(&format!("{l} {w}"), size) <= limit => {
+                    l.push(' ');
+                    l.push_str(w);
+                }
+                _ => lines.push(w.to_string()),
+            }
+        }
+        lines
+    };
+    // As few lines as the greedy fill at `max`, of about equal widths.
+    let n = greedy(max).len();
+    let mut limit = text_width(markup, size) / n as f64;
+    while limit < max && greedy(limit).len() > n {
+        limit *= 1.05;
+    }
+    greedy(limit.min(max)).join("\n")
 }
 
 /// Figures one under the other in one document.
@@ -1181,6 +1358,7 @@ pub fn stack_svg(figs: &[Figure]) -> String {
     let w = sizes.iter().map(|s| s.0).fold(100.0, f64::max);
     let h: f64 = sizes.iter().map(|s| s.1).sum::<f64>().max(100.0);
     let mut svg = Svg::new(w, h);
+    svg.print_width_mm = figs.iter().find_map(|f| f.print_width_mm);
     let mut y = 0.0;
     for (f, s) in figs.iter().zip(&sizes) {
         f.draw(&mut svg, 0.0, y);
@@ -1194,7 +1372,8 @@ struct Grid {
     xs: Vec<f64>,
     ys: Vec<f64>,
     legend_at: (f64, f64),
-    grid_h: f64,
+    /// Top of the notes.
+    notes_y: f64,
     width: f64,
     height: f64,
 }

@@ -60,6 +60,10 @@ pub(crate) fn svg_to_png(svg: &str, scale: f32) -> Result<Vec<u8>, String> {
 /// high-density screen and in print at the figure's size).
 pub(crate) const REPORT_SCALE: f32 = 2.0;
 
+/// The pixel scale of the PNG files of figures sized for print (`--figure-width`): 300 dots per
+/// inch of the printed width (the SVG's mm read at 96 px to the inch).
+pub(crate) const PRINT_SCALE: f32 = 300.0 / 96.0;
+
 #[cfg(test)]
 mod tests {
     use super::*;

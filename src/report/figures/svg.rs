@@ -144,6 +144,12 @@ pub(crate) fn text_width(markup: &str, size: f64) -> f64 {
         .sum()
 }
 
+/// Whether `svg`, a document of [`Svg::finish`], is sized for print (its width in mm).
+pub(crate) fn print_sized(svg: &str) -> bool {
+    svg.split_once('>')
+        .is_some_and(|(root, _)| root.starts_with("<svg") && root.contains("mm\" height="))
+}
+
 /// Height in px above the baseline of text at `size` (the font's ascender; a superscript
 /// reaches no higher).
 pub(crate) fn ascent(size: f64) -> f64 {
@@ -244,6 +250,8 @@ pub const MARKS: [Mark; 5] = [
 pub struct Svg {
     width: f64,
     height: f64,
+    /// The document's printed width, mm (`None`: `width` CSS pixels).
+    pub print_width_mm: Option<f64>,
     body: String,
     defs: String,
     ids: usize,
@@ -255,6 +263,7 @@ impl Svg {
         Svg {
             width,
             height,
+            print_width_mm: None,
             body: String::new(),
             defs: String::new(),
             ids: 0,
@@ -512,9 +521,18 @@ impl Svg {
     /// The finished document.
     pub fn finish(self) -> String {
         let mut s = String::with_capacity(self.body.len() + self.defs.len() + 400);
+        // The printed size: px (CSS pixels), or the print width in mm with the height in
+        // proportion; the drawing's own units (the viewBox) are px either way.
+        let (pw, ph) = match self.print_width_mm {
+            Some(mm) => (
+                format!("{}mm", num(mm)),
+                format!("{}mm", num(mm * self.height / self.width)),
+            ),
+            None => (num(self.width), num(self.height)),
+        };
         let _ = writeln!(
             s,
-            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" \
+            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{pw}\" height=\"{ph}\" \
              viewBox=\"0 0 {w} {h}\" font-family=\"{FONT_FAMILY}\" \
              style=\"font-kerning:none\">",
             w = num(self.width),

@@ -3,8 +3,9 @@
 # 1. a build environment (target/python-build-venv) with maturin, which builds one abi3 wheel
 #    (CPython >= 3.9, manylinux tag checked by maturin) into python/target/wheels; the
 #    extension compiles in its own target directory, python/target (python/.cargo/config.toml);
-# 2. a fresh test environment (target/python-venv) where the wheel is installed with cargo
-#    off PATH, as on a machine without Rust, with the test dependencies;
+# 2. a fresh test environment (target/python-venv) with the test dependencies (installed while
+#    the wheel compiles), where the wheel is installed with cargo off PATH, as on a machine
+#    without Rust;
 # 3. pytest against the command-line binary target/release/fitbead (built here unless
 #    FITBEAD_BIN_BUILT=1 says it is built), with cargo still off PATH.
 set -euo pipefail
@@ -18,6 +19,17 @@ if [ ! -x "$build_venv/bin/maturin" ]; then
   python3 -m venv "$build_venv"
   "$build_venv/bin/python" -m pip install "${pipq[@]}" "maturin>=1.7,<2"
 fi
+
+# The test environment and its dependencies are downloaded and installed while the wheel
+# compiles (the one waits on the network, the other on the CPU); the wheel goes in after both.
+rm -rf "$venv"
+py="$root/$venv/bin/python"
+deps_log="$root/target/python-test-deps.log"
+mkdir -p "$root/target"
+(python3 -m venv "$venv" && "$py" -m pip install "${pipq[@]}" -r python/tests/requirements.txt) \
+  >"$deps_log" 2>&1 &
+deps_pid=$!
+
 rm -f python/target/wheels/fitbead-*.whl
 start=$(date +%s)
 # FITBEAD_WHEEL_TARGET: the cargo target directory of the wheel's build (default
@@ -42,10 +54,11 @@ nocargo=$(printf '%s' "$PATH" | tr ':' '\n' | while read -r d; do
   [ -n "$d" ] && [ ! -x "$d/cargo" ] && [ ! -x "$d/rustc" ] && printf '%s:' "$d"; done)
 nocargo=${nocargo%:}
 
-rm -rf "$venv"
-python3 -m venv "$venv"
-py="$root/$venv/bin/python"
-"$py" -m pip install "${pipq[@]}" -r python/tests/requirements.txt
+if ! wait "$deps_pid"; then
+  cat "$deps_log" >&2
+  echo "the test environment could not be made (log above)" >&2
+  exit 1
+fi
 PATH="$nocargo" "$py" -m pip install "${pipq[@]}" "$wheel"
 PATH="$nocargo" "$py" -c "import fitbead, shutil; assert shutil.which('cargo') is None; print('import fitbead:', fitbead.__version__, 'on', fitbead.threads(), 'threads, cargo not on PATH')"
 PATH="$nocargo" FITBEAD_BIN="$root/target/release/fitbead" MPLBACKEND=Agg \

@@ -987,8 +987,18 @@ fn rival(s: &DesignSettings, prob: &Problem) -> Result<Problem, DesignError> {
             }
             (DesignFit::KLaw, m)
         }
+        // Jan's eq 74 is Jaeger's eq 80 with a2 = 0 (tan δ = μ + λ u²/(ε sin α)): Jaeger
+        // fits Jan's curve exactly at any slopes, so no design tells them apart when Jan's
+        // model is true.
         DesignFit::Jan if kind == ModelKind::Jaeger => {
-            (DesignFit::Jaeger, crate::models::Model::StickSlip)
+            return Err(DesignError::new(
+                "vs",
+                "jaeger",
+                "Jan's model (eq 74) is Jaeger's (eq 80) with a2 = 0, tan delta = mu + \
+                 lambda u^2/(eps sin alpha): Jaeger's curve fits Jan's exactly at any slopes, \
+                 so no design tells them apart when Jan's model holds (the T criterion is 0). \
+                 To find the slopes that show a2 > 0, design for --fit jaeger --vs jan",
+            ));
         }
         DesignFit::Jaeger if kind == ModelKind::Jan => {
             (DesignFit::Jan, crate::models::Model::StickSlip)

@@ -144,21 +144,46 @@ pub(crate) fn multiplicative(
     let mut sens = vec![0.0; n_cand];
     let mut gap = f64::INFINITY;
     let nd = draws.len() as f64;
-    for _ in 0..MAX_ITER {
-        sens.iter_mut().for_each(|x| *x = 0.0);
-        for d in draws {
-            let mi = inverse(&information(&d.cands, &w, p));
-            let c = DVector::from_column_slice(&d.c);
-            for (j, cand) in d.cands.iter().enumerate() {
-                let g = DVector::from_column_slice(&cand.g);
-                let h = &mi * &g;
-                sens[j] += match crit {
+    let gs: Vec<Vec<DVector<f64>>> = draws
+        .iter()
+        .map(|d| {
+            d.cands
+                .iter()
+                .map(|c| DVector::from_column_slice(&c.g))
+                .collect()
+        })
+        .collect();
+    // ψ of every candidate at one draw.
+    let psi = |i: usize, w: &[f64]| -> Vec<f64> {
+        let d = &draws[i];
+        let mi = inverse(&information(&d.cands, w, p));
+        let c = DVector::from_column_slice(&d.c);
+        let mut h = DVector::zeros(p);
+        gs[i]
+            .iter()
+            .map(|g| {
+                mi.mul_to(g, &mut h);
+                match crit {
                     Crit::D => g.dot(&h),
                     Crit::C => {
                         let x = c.dot(&h);
                         x * x
                     }
-                };
+                }
+            })
+            .collect()
+    };
+    for _ in 0..MAX_ITER {
+        let per_draw: Vec<Vec<f64>> = if draws.len() == 1 {
+            vec![psi(0, &w)]
+        } else {
+            use rayon::prelude::*;
+            (0..draws.len()).into_par_iter().map(|i| psi(i, &w)).collect()
+        };
+        sens.iter_mut().for_each(|x| *x = 0.0);
+        for v in &per_draw {
+            for (x, y) in sens.iter_mut().zip(v) {
+                *x += y;
             }
         }
         sens.iter_mut().for_each(|x| *x /= nd);
@@ -204,10 +229,8 @@ pub(crate) fn variance_of(m: &DMatrix<f64>, c: &[f64]) -> Option<f64> {
     if !(top > 0.0) {
         return None;
     }
-    // c in the scaled coordinates: c_i / d_i.
-    let cs: Vec<f64> = (0..p)
-        .map(|i| if d[i] > 0.0 { c[i] / d[i] } else { 0.0 })
-        .collect();
+    // M⁺ = D A⁺ D with A = D M D, so cᵀ M⁺ c = (Dc)ᵀ A⁺ (Dc).
+    let cs: Vec<f64> = (0..p).map(|i| c[i] * d[i]).collect();
     let norm: f64 = cs.iter().map(|x| x * x).sum();
     let (mut var, mut null) = (0.0, 0.0);
     for i in 0..p {
@@ -493,12 +516,16 @@ mod tests {
         assert_eq!(r[0], vec![(0, 2), (10, 2), (11, 2), (21, 2)]);
     }
 
-    /// The variance of a combination by hand: M = diag(4, 1) gives Var(p1 + p2) = 1/4 + 1;
-    /// M = diag(4, 0) determines p1 (1/4) but not p1 + p2.
+    /// The variance of a combination by hand: M = diag(4, 1) gives Var(p1 + p2) = 1/4 + 1 and
+    /// Var(3 p1) = 9/4; M = [[2, 1], [1, 1]] has M⁻¹ = [[1, −1], [−1, 2]], so Var(p1 + p2) =
+    /// 1 − 2 + 2 = 1; M = diag(4, 0) determines p1 (1/4) but not p1 + p2.
     #[test]
     fn variance_of_a_combination_by_hand() {
         let m = DMatrix::from_diagonal(&DVector::from_vec(vec![4.0, 1.0]));
         assert!((variance_of(&m, &[1.0, 1.0]).unwrap() - 1.25).abs() < 1e-12);
+        assert!((variance_of(&m, &[3.0, 0.0]).unwrap() - 2.25).abs() < 1e-12);
+        let m = DMatrix::from_row_slice(2, 2, &[2.0, 1.0, 1.0, 1.0]);
+        assert!((variance_of(&m, &[1.0, 1.0]).unwrap() - 1.0).abs() < 1e-12);
         let m = DMatrix::from_diagonal(&DVector::from_vec(vec![4.0, 0.0]));
         assert!((variance_of(&m, &[1.0, 0.0]).unwrap() - 0.25).abs() < 1e-12);
         assert_eq!(variance_of(&m, &[1.0, 1.0]), None);

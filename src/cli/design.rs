@@ -57,7 +57,8 @@ pub struct Args {
     #[arg(long)]
     pub target: Option<String>,
     /// The rival model of --criterion t: for --fit klaw a contact model whose law's parameter
-    /// is fitted; for --fit jan, jaeger (a1, a2, a3 per series); for --fit jaeger, jan.
+    /// is fitted; for --fit jaeger, jan (λ, μ, or the laws of eqs 75–76 across series). --fit
+    /// jan has no rival: Jan's model is Jaeger's with a2 = 0.
     #[arg(long)]
     pub vs: Option<String>,
     /// A prior of a parameter, NAME=DIST, repeatable, for a Bayesian design (the criterion

@@ -123,11 +123,22 @@ fn refusals_exit_2() {
             &["--criterion", "c", "--target", "mu"],
             &["--target", "'mu'", "expected one of c"],
         ),
-        (&["--prior", "c~N(0.5,0.1)"], &["--prior", "expected NAME=DIST"]),
-        (&["--prior", "c=flat"], &["--prior", "'c=flat'", "improper"]),
-        (&["--prior", "k=normal(0.5,0.1)"], &["--prior", "no parameter 'k'"]),
         (
-            &["--prior", "c=normal(0.5,0.1)", "--prior", "c=uniform(0.4,0.6)"],
+            &["--prior", "c~N(0.5,0.1)"],
+            &["--prior", "expected NAME=DIST"],
+        ),
+        (&["--prior", "c=flat"], &["--prior", "'c=flat'", "improper"]),
+        (
+            &["--prior", "k=normal(0.5,0.1)"],
+            &["--prior", "no parameter 'k'"],
+        ),
+        (
+            &[
+                "--prior",
+                "c=normal(0.5,0.1)",
+                "--prior",
+                "c=uniform(0.4,0.6)",
+            ],
             &["--prior", "second prior"],
         ),
         (
@@ -135,7 +146,14 @@ fn refusals_exit_2() {
             &["--draws", "expected 1 to"],
         ),
         (
-            &["--criterion", "t", "--vs", "stick", "--prior", "c=normal(0.5,0.1)"],
+            &[
+                "--criterion",
+                "t",
+                "--vs",
+                "stick",
+                "--prior",
+                "c=normal(0.5,0.1)",
+            ],
             &["--prior", "d and c criteria"],
         ),
         // Every draw of c puts K above 1 at xi = 0.8: no steady slope in its range.
@@ -144,15 +162,36 @@ fn refusals_exit_2() {
             &["--prior", "80 of 80 draws"],
         ),
         (
-            &["--fit", "jan", "--series", "1", "--criterion", "t", "--vs", "jaeger"],
+            &[
+                "--fit",
+                "jan",
+                "--series",
+                "1",
+                "--criterion",
+                "t",
+                "--vs",
+                "jaeger",
+            ],
             &["--vs", "'jaeger'", "a2 = 0"],
         ),
         (
-            &["--fit", "jaeger", "--series", "1", "--criterion", "t", "--vs", "stick"],
+            &[
+                "--fit",
+                "jaeger",
+                "--series",
+                "1",
+                "--criterion",
+                "t",
+                "--vs",
+                "stick",
+            ],
             &["--vs", "'stick'", "rival of the jaeger fit is jan"],
         ),
         (&["--total", "3"], &["--total", "'3'", "expected 4"]),
-        (&["--criterion", "c", "--target", "mu"], &["--target", "mu of series 'xi=1'"]),
+        (
+            &["--criterion", "c", "--target", "mu"],
+            &["--target", "mu of series 'xi=1'"],
+        ),
         (&["--vs", "stick"], &["--vs", "goes with --criterion t"]),
         (&["--criterion", "t"], &["--vs", "needs the rival model"]),
         (&["--points", "0"], &["--points", "expected 1 to"]),
@@ -444,7 +483,15 @@ fn validation_mu_eq79_klaw() {
     };
     let fitter = KLawFitter::new(Model::StickSlip, KLaw::C).least_squares(false);
     let estimate = |d: &Dataset| mu_eq79(1.0, fitter.fit(d).unwrap().param("c").unwrap().value);
-    validate("mu (eq 79) via klaw c", &r, target, 200, 14, &truth, &estimate);
+    validate(
+        "mu (eq 79) via klaw c",
+        &r,
+        target,
+        200,
+        14,
+        &truth,
+        &estimate,
+    );
 }
 
 /// A total budget: 24 points over the paper's four ξ for c of the K law under stick/slip (the
@@ -470,7 +517,15 @@ fn validation_total_budget_klaw_c() {
     };
     let fitter = KLawFitter::new(Model::StickSlip, KLaw::C).least_squares(false);
     let estimate = |d: &Dataset| fitter.fit(d).unwrap().param("c").unwrap().value;
-    validate("klaw c, 24 points in all", &r, "c", 200, 15, &truth, &estimate);
+    validate(
+        "klaw c, 24 points in all",
+        &r,
+        "c",
+        200,
+        15,
+        &truth,
+        &estimate,
+    );
 }
 
 /// The prior of the Bayesian validation: Jan's μ at ξ = 1 uniform on [0.095, 0.112] (the
@@ -517,7 +572,9 @@ fn validation_bayesian_jan_mu() {
             Model::Jan(jan).evaluate(&sc).unwrap().mean_velocity
         };
         for (rows, out) in [(&r.rows, &mut sq_d), (&r.even, &mut sq_e)] {
-            let f = fitter.fit(&synthetic(rows, &truth, NOISE, &mut rng)).unwrap();
+            let f = fitter
+                .fit(&synthetic(rows, &truth, NOISE, &mut rng))
+                .unwrap();
             let m = f.fits[0].param("mu").unwrap().value;
             out.push((m - mu) * (m - mu));
         }
@@ -534,8 +591,16 @@ fn validation_bayesian_jan_mu() {
         (msd - se_d * se_d) / mc_d,
         (mse - se_e * se_e) / mc_e
     );
-    assert!((msd - se_d * se_d).abs() < 3.0 * mc_d, "design {msd} vs {}", se_d * se_d);
-    assert!((mse - se_e * se_e).abs() < 3.0 * mc_e, "even {mse} vs {}", se_e * se_e);
+    assert!(
+        (msd - se_d * se_d).abs() < 3.0 * mc_d,
+        "design {msd} vs {}",
+        se_d * se_d
+    );
+    assert!(
+        (mse - se_e * se_e).abs() < 3.0 * mc_e,
+        "even {mse} vs {}",
+        se_e * se_e
+    );
     assert!(se_d < se_e && msd < mse);
 }
 
@@ -567,8 +632,14 @@ fn discrimination_jaeger_vs_jan() {
     let jf = JaegerFitter::new().least_squares(false);
     let nf = JanFitter::new().least_squares(false);
     let right = |d: &Dataset| {
-        let a = jf.fit(d).ok().and_then(|f| f.fits.first().map(|x| x.stats.aic));
-        let b = nf.fit(d).ok().and_then(|f| f.fits.first().map(|x| x.stats.aic));
+        let a = jf
+            .fit(d)
+            .ok()
+            .and_then(|f| f.fits.first().map(|x| x.stats.aic));
+        let b = nf
+            .fit(d)
+            .ok()
+            .and_then(|f| f.fits.first().map(|x| x.stats.aic));
         a.unwrap_or(f64::INFINITY) < b.unwrap_or(f64::INFINITY)
     };
     let n = 300;

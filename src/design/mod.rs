@@ -33,6 +33,19 @@
 //! For T, the points needed are those, in the design's proportions, at which the
 //! noncentrality λ = N · T/N_design of the one-degree-of-freedom χ² test of B reaches
 //! (z_{1−α/2} + z_{power})² (significance α = 0.05, power 0.8: λ ≈ 7.85).
+//!
+//! Extensions:
+//! - **Total budget** (`total`): one stratum over every candidate of every series, its
+//!   weights adding up to the total; the design decides the points per series.
+//! - **Bayesian designs** (`priors`): D and c averaged over `draws` seeded draws from the
+//!   priors (E[log det M], E[cᵀ M⁻¹ c]; Chaloner & Verdinelli 1995), each draw with its own
+//!   gradients (zero at a slope not steady at that draw); a draw leaving a series no steady
+//!   candidate is redrawn. The rounded design is then improved by point exchange (Fedorov
+//!   1972) on the averaged criterion. Standard errors are the root of the mean variance
+//!   over the draws.
+//! - **μ of eq 79** as a c target of the K-law fits: c = ∇μ_s, the delta method.
+//! - **Jaeger against Jan** (T): Jan's fitted to Jaeger's curve. The reverse is refused: Jan's
+//!   eq 74 is Jaeger's eq 80 with a2 = 0, so T = 0 at every design.
 
 mod optimal;
 mod problem;

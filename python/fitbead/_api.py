@@ -1264,6 +1264,9 @@ class Design:
         points needed in all for power 0.8 at significance 0.05.
     ranges : list of (float, float)
         The slope range of each series, degrees.
+    bayes : tuple of int or None
+        A Bayesian design: the prior draws averaged over and the draws redrawn (a series
+        without a steady slope in its range).
     """
 
     def __init__(self, raw: Mapping[str, Any]) -> None:
@@ -1289,6 +1292,7 @@ class Design:
         self.discrimination: Optional[Tuple[float, float]] = raw["discrimination"]
         self.points_needed: Optional[Tuple[float, float]] = raw["points_needed"]
         self.ranges: List[Tuple[float, float]] = [tuple(r) for r in raw["ranges"]]  # type: ignore[misc]
+        self.bayes: Optional[Tuple[int, int]] = None if raw.get("bayes") is None else tuple(raw["bayes"])  # type: ignore[assignment]
 
     def to_pandas(self):
         """The design as a DataFrame (series, xi, delta_deg, replicates; needs pandas)."""
@@ -1323,6 +1327,10 @@ def design(
     branch: str = "upper",
     rho: float = 0.4,
     f: float = 0.1,
+    prior: Optional[Mapping[str, str]] = None,
+    draws: int = 64,
+    seed: int = 1,
+    total: Optional[int] = None,
 ) -> Design:
     """Where to measure (``fitbead design``): locally optimal slopes for a fit's parameters,
     or slopes that tell two models apart, from the Fisher information at a guess.
@@ -1349,13 +1357,27 @@ def design(
     criterion : {"d", "c", "t"}
         D-optimal, c-optimal for ``target``, or T-optimal against ``vs``.
     target : str, optional
-        The parameter of the c criterion.
+        The parameter of the c criterion; for ``klaw`` also the bulk friction μ of eq 79 at
+        the fitted K (``"mu"`` for one series, ``"mu of series 'xi=X'"`` for several), its
+        standard error by the delta method.
     vs : str, optional
-        The rival contact model of the T criterion.
+        The rival of the T criterion: a contact model for ``klaw``; ``"jan"`` for
+        ``jaeger`` (``jan`` against ``jaeger`` is refused: Jan's model is Jaeger's with
+        a2 = 0, so no design tells them apart when Jan's holds).
     branch : {"upper", "lower"}
         Jaeger's root of eq 84.
     rho, f : float
         Gyration parameter and friction coefficient.
+    prior : mapping of str to str, optional
+        Priors by parameter name (``{"c": "normal(0.5,0.1)"}``; uniform, normal, lognormal or
+        halfnormal, as ``--prior``) for a Bayesian design: the criterion averaged over
+        ``draws`` draws; the other parameters stay at the guess.
+    draws : int
+        Prior draws of a Bayesian design.
+    seed : int
+        Seed of the prior draws.
+    total : int, optional
+        Points over all series, shared out by the design (replaces ``points``).
 
     Returns
     -------
@@ -1388,5 +1410,9 @@ def design(
         branch=branch,
         rho=float(rho),
         f=float(f),
+        priors=[(str(k), str(v)) for k, v in (prior or {}).items()],
+        draws=int(draws),
+        seed=int(seed),
+        total=None if total is None else int(total),
     )
     return Design(raw)

@@ -1345,7 +1345,7 @@ fn output_columns(command: &str, model: &str) -> PyResult<Vec<String>> {
 /// An experimental design (`fitbead design`): the settings as the command line's flags, the
 /// result as a dict of plain values (rows as columns).
 #[pyfunction]
-#[pyo3(signature = (fit, model=None, law="c=0.5", series=vec![0.8, 1.0, 1.6, 2.0], points=9, noise=0.02, noise_absolute=false, delta_range=None, criterion="d", target=None, vs=None, branch="upper", rho=0.4, f=0.1))]
+#[pyo3(signature = (fit, model=None, law="c=0.5", series=vec![0.8, 1.0, 1.6, 2.0], points=9, noise=0.02, noise_absolute=false, delta_range=None, criterion="d", target=None, vs=None, branch="upper", rho=0.4, f=0.1, priors=vec![], draws=64, seed=1, total=None))]
 #[allow(clippy::too_many_arguments)]
 fn design<'py>(
     py: Python<'py>,
@@ -1363,8 +1363,20 @@ fn design<'py>(
     branch: &str,
     rho: f64,
     f: f64,
+    priors: Vec<(String, String)>,
+    draws: usize,
+    seed: u64,
+    total: Option<usize>,
 ) -> PyResult<Bound<'py, PyDict>> {
     use fitbead::design::{Criterion, DesignFit, DesignSettings};
+    let priors = priors
+        .into_iter()
+        .map(|(name, dist)| {
+            dist.parse::<fitbead::prelude::Prior>()
+                .map(|p| (name.clone(), p))
+                .map_err(|e| value_error(format!("prior = '{name}={dist}': {e}")))
+        })
+        .collect::<PyResult<Vec<_>>>()?;
     let kind = |name: &str, v: &str| {
         v.parse::<ModelKind>()
             .map_err(|e| value_error(format!("{name} = '{v}': {e}")))
@@ -1390,6 +1402,10 @@ fn design<'py>(
         branch: branch
             .parse()
             .map_err(|e: String| value_error(format!("branch = '{branch}': {e}")))?,
+        priors,
+        draws,
+        seed,
+        total,
         ..DesignSettings::default()
     };
     let r = py
@@ -1431,6 +1447,7 @@ fn design<'py>(
     d.set_item("discrimination", r.discrimination)?;
     d.set_item("points_needed", r.points_needed)?;
     d.set_item("ranges", r.ranges.clone())?;
+    d.set_item("bayes", r.bayes)?;
     Ok(d)
 }
 

@@ -40,3 +40,22 @@ def test_design_errors_name_the_setting():
         fitbead.design("klaw", criterion="x")
     with pytest.raises(fitbead.FitbeadError):
         fitbead.design("klaw", series=[0.1])
+
+
+def test_new_options_equal_the_command_line(cli):
+    """A Bayesian design, a total budget and the μ (eq 79) target through both doors."""
+    d = fitbead.design(
+        "jan", series=[1], criterion="c", target="mu", prior={"mu": "uniform(0.095,0.112)"}, draws=8, seed=5
+    )
+    _, text, _ = cli(
+        "design", "--fit", "jan", "--series", "1", "--criterion", "c", "--target", "mu",
+        "--prior", "mu=uniform(0.095,0.112)", "--draws", "8", "--seed", "5", "--output", "-",
+    )
+    cols = read_csv_text(text)
+    np.testing.assert_array_equal(d.table["delta_deg"], [float(x) for x in cols["delta_deg"]])
+    assert d.bayes == (8, 0)
+    t = fitbead.design("klaw", criterion="c", target="mu of series 'xi=1'", total=24)
+    assert t.table["replicates"].sum() == 24 and t.bayes is None
+    assert "mu of series 'xi=1'" in t.errors
+    with pytest.raises(fitbead.FitbeadError, match="improper"):
+        fitbead.design("klaw", prior={"c": "flat"})

@@ -7,6 +7,7 @@ use super::{emit, parse_list, CliError};
 use fitbead::design::{design, Criterion, DesignError, DesignFit, DesignResult, DesignSettings};
 use fitbead::io::{fmt_f64, fmt_sig, AtomicFile};
 use fitbead::models::ModelKind;
+use fitbead::prelude::Prior;
 use fitbead::report::figures::plot::{Axis, Figure, LegendEntry, Panel, PALETTE};
 use fitbead::report::figures::svg::{Mark, Stroke};
 use fitbead::scene::CollisionLaw;
@@ -34,6 +35,10 @@ pub struct Args {
     /// Points per series.
     #[arg(long, default_value_t = 9)]
     pub points: usize,
+    /// Points over all series, shared out by the design (a series may get none); the evenly
+    /// spaced comparison spreads them as evenly as they go. Replaces --points.
+    #[arg(long, conflicts_with = "points")]
+    pub total: Option<usize>,
     /// Noise of v̄: relative (σ = noise · v̄, as `simulate --noise`), or abs=SIGMA for an
     /// absolute σ (dimensionless).
     #[arg(long, default_value = "0.02")]
@@ -46,17 +51,27 @@ pub struct Args {
     /// (model discrimination against --vs).
     #[arg(long, default_value = "d")]
     pub criterion: String,
-    /// The parameter of --criterion c (c, mu, a1, …; needed when the fit has several).
+    /// The parameter of --criterion c (c, mu, a1, …; needed when the fit has several). For
+    /// --fit klaw also the bulk friction μ (eq 79, dimensionless) at the fitted K: mu (one
+    /// series) or "mu of series 'xi=X'", its standard error by the delta method.
     #[arg(long)]
     pub target: Option<String>,
-    /// The rival model of --criterion t (a contact model whose law's parameter is fitted).
+    /// The rival model of --criterion t: for --fit klaw a contact model whose law's parameter
+    /// is fitted; for --fit jaeger, jan (λ, μ, or the laws of eqs 75–76 across series). --fit
+    /// jan has no rival: Jan's model is Jaeger's with a2 = 0.
     #[arg(long)]
     pub vs: Option<String>,
-    /// A prior of the parameters, for a Bayesian design (not yet supported).
-    #[arg(long)]
-    pub prior: Option<String>,
-    /// Seed of the random stream (Bayesian designs draw from the prior; a locally optimal
-    /// design uses none).
+    /// A prior of a parameter, NAME=DIST, repeatable, for a Bayesian design (the criterion
+    /// averaged over --draws draws; parameters without a prior stay at the guess). DIST is
+    /// uniform(a,b), normal(mean,sd), lognormal(mu,sigma) or halfnormal(scale), in the
+    /// parameter's own units; quote it for the shell ('c=normal(0.5,0.1)'). Draws that leave
+    /// a series no steady slope in its range are redrawn.
+    #[arg(long = "prior", value_name = "NAME=DIST")]
+    pub priors: Vec<String>,
+    /// Prior draws the Bayesian criterion is averaged over (with --prior).
+    #[arg(long, default_value_t = DesignSettings::default().draws)]
+    pub draws: usize,
+    /// Seed of the prior draws (a locally optimal design draws nothing).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Branch of eq 84 for --fit jaeger: upper or lower.
@@ -124,13 +139,20 @@ fn design_error(e: DesignError) -> CliError {
 
 /// The library's settings from the flags.
 fn settings(a: &Args) -> Result<DesignSettings, CliError> {
-    if let Some(p) = &a.prior {
-        return Err(super::flag_error(
-            "--prior",
-            p,
-            "Bayesian designs (a prior of the parameters) are not yet supported: give the \
-             guess (--law for klaw) for a locally optimal design",
-        ));
+    let mut priors = Vec::new();
+    for p in &a.priors {
+        // The name may hold '=' (K of series 'xi=1'); the distribution never does.
+        let Some((name, dist)) = p.rsplit_once('=') else {
+            return Err(super::flag_error(
+                "--prior",
+                p,
+                "expected NAME=DIST, e.g. c=normal(0.5,0.1)",
+            ));
+        };
+        let prior: Prior = dist
+            .parse()
+            .map_err(|e: String| super::flag_error("--prior", p, e))?;
+        priors.push((name.trim().to_string(), prior));
     }
     let fit: DesignFit = a
         .fit
@@ -196,6 +218,10 @@ fn settings(a: &Args) -> Result<DesignSettings, CliError> {
         target: a.target.clone(),
         vs,
         branch: super::jaeger_branch(&a.branch)?,
+        priors,
+        draws: a.draws,
+        seed: a.seed,
+        total: a.total,
         ..DesignSettings::default()
     })
 }
@@ -227,10 +253,13 @@ fn summary(s: &DesignSettings, r: &DesignResult) -> String {
         Criterion::C => format!("c-optimal for {}", r.target.as_deref().unwrap_or("")),
         Criterion::T => "T-optimal (model discrimination)".to_string(),
     };
+    let budget = match s.total {
+        None => format!("{} points per series", s.points),
+        Some(n) => format!("{n} points in all (shared out by the design)"),
+    };
     let _ = writeln!(
         o,
-        "design: {crit}, {} points per series, noise {}{}",
-        s.points,
+        "design: {crit}, {budget}, noise {}{}",
         fmt_sig(s.noise, 3),
         if s.noise_absolute {
             " (absolute)"
@@ -238,6 +267,17 @@ fn summary(s: &DesignSettings, r: &DesignResult) -> String {
             " (relative)"
         }
     );
+    if let Some((n, redrawn)) = r.bayes {
+        let priors: Vec<String> = s.priors.iter().map(|(n, p)| format!("{n}={p}")).collect();
+        let _ = writeln!(
+            o,
+            "Bayesian design: the criterion averaged over {n} prior draws (seed {}; {}); {redrawn} \
+             draws redrawn (a series without a steady slope in its range); standard errors are \
+             root mean variances over the draws",
+            s.seed,
+            priors.join(", ")
+        );
+    }
     for (k, xi) in s.series.iter().enumerate() {
         let (lo, hi) = r.ranges[k];
         let slopes: Vec<String> = r
@@ -246,6 +286,11 @@ fn summary(s: &DesignSettings, r: &DesignResult) -> String {
             .filter(|row| row.xi == *xi)
             .map(|row| format!("{} deg x{}", fmt_f64(row.delta_deg), row.replicates))
             .collect();
+        let slopes = if slopes.is_empty() {
+            vec!["no points".to_string()]
+        } else {
+            slopes
+        };
         let _ = writeln!(
             o,
             "  xi {}: range {}-{} deg: {}",

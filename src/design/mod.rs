@@ -33,14 +33,28 @@
 //! For T, the points needed are those, in the design's proportions, at which the
 //! noncentrality λ = N · T/N_design of the one-degree-of-freedom χ² test of B reaches
 //! (z_{1−α/2} + z_{power})² (significance α = 0.05, power 0.8: λ ≈ 7.85).
+//!
+//! Extensions:
+//! - **Total budget** (`total`): one stratum over every candidate of every series, its
+//!   weights adding up to the total; the design decides the points per series.
+//! - **Bayesian designs** (`priors`): D and c averaged over `draws` seeded draws from the
+//!   priors (E[log det M], E[cᵀ M⁻¹ c]; Chaloner & Verdinelli 1995), each draw with its own
+//!   gradients (zero at a slope not steady at that draw); a draw leaving a series no steady
+//!   candidate is redrawn. The rounded design is then improved by point exchange (Fedorov
+//!   1972) on the averaged criterion. Standard errors are the root of the mean variance
+//!   over the draws.
+//! - **μ of eq 79** as a c target of the K-law fits: c = ∇μ_s, the delta method.
+//! - **Jaeger against Jan** (T): Jan's fitted to Jaeger's curve. The reverse is refused: Jan's
+//!   eq 74 is Jaeger's eq 80 with a2 = 0, so T = 0 at every design.
 
 mod optimal;
 mod problem;
 
+use crate::inverse::posterior::Prior;
 use crate::models::{JaegerBranch, ModelKind};
 use crate::numfmt::fmt_f64;
 use crate::scene::CollisionLaw;
-use optimal::{information, variances, Approx, Cand, Crit};
+use optimal::{information, variance_of, variances, Approx, Cand, Crit, Draw};
 use problem::Problem;
 use std::fmt;
 
@@ -133,10 +147,22 @@ pub struct DesignSettings {
     pub branch: JaegerBranch,
     /// Candidate slopes per series.
     pub grid: usize,
+    /// Priors of parameters, by name, for a Bayesian design (the criterion averaged over
+    /// draws from them; the parameters without one stay at the guess). Empty: a locally
+    /// optimal design at the guess.
+    pub priors: Vec<(String, Prior)>,
+    /// Prior draws a Bayesian design averages over.
+    pub draws: usize,
+    /// Seed of the prior draws.
+    pub seed: u64,
+    /// Points over all series, shared out by the design (`points` is then unused); `None`:
+    /// `points` per series.
+    pub total: Option<usize>,
 }
 
 impl Default for DesignSettings {
-    /// K-law c = 0.5 under stick/slip, the paper's four ξ, 9 points per series, 2 % noise, D.
+    /// K-law c = 0.5 under stick/slip, the paper's four ξ, 9 points per series, 2 % noise, D,
+    /// locally optimal (64 draws, seed 1, should priors be added).
     fn default() -> Self {
         DesignSettings {
             fit: DesignFit::KLaw,
@@ -154,6 +180,10 @@ impl Default for DesignSettings {
             vs: None,
             branch: JaegerBranch::Upper,
             grid: 200,
+            priors: Vec::new(),
+            draws: DEFAULT_DRAWS,
+            seed: 1,
+            total: None,
         }
     }
 }
@@ -214,6 +244,10 @@ pub struct DesignResult {
     pub sensitivity: Vec<Vec<(f64, f64)>>,
     /// What the sensitivity is (for the figure's axis).
     pub sensitivity_label: String,
+    /// A Bayesian design: the prior draws the criterion was averaged over, and the draws
+    /// redrawn because some series had no steady slope in its range there (or, for a μ
+    /// target, K left (0, 1)); `None` for a locally optimal design.
+    pub bayes: Option<(usize, usize)>,
 }
 
 /// A setting [`design`] cannot work with.
@@ -247,8 +281,21 @@ impl std::error::Error for DesignError {}
 
 /// Most points per series.
 const MAX_POINTS: usize = 100_000;
+/// Prior draws of a Bayesian design unless told otherwise.
+const DEFAULT_DRAWS: usize = 64;
+/// Most prior draws.
+const MAX_DRAWS: usize = 10_000;
+/// Draws tried per draw kept before a prior is refused as leaving no steady slope.
+const TRIES_PER_DRAW: usize = 20;
 /// Steps of the Atkinson–Fedorov iteration.
 const T_STEPS: usize = 150;
+
+/// The target of the c criterion: a parameter, or μ of eq 79 of a series (K-law fits).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Target {
+    Param(usize),
+    Mu(usize),
+}
 
 /// The optimal design for `s` (see the module docs for the method).
 pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
@@ -283,12 +330,13 @@ pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
     };
     let prob = problem::problem(s.fit, model, s.law, &s.series, s.rho, s.f, s.branch)?;
     let p = prob.names.len();
+    let priors = prior_indices(s, &prob)?;
     let rival_prob = match s.criterion {
         Criterion::T => Some(rival(s, &prob)?),
         _ => None,
     };
     let ranges = ranges(s, &prob, rival_prob.as_ref())?;
-    // Candidates, stratum by stratum.
+    // Candidates at the guess, series by series.
     let mut cands = Vec::new();
     let mut strata: Vec<Vec<usize>> = Vec::new();
     for (k, &(lo, hi)) in ranges.iter().enumerate() {
@@ -308,8 +356,16 @@ pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
         }
         strata.push(st);
     }
-    let budgets: Vec<f64> = vec![s.points as f64; s.series.len()];
-    let counts = vec![s.points; s.series.len()];
+    let n_series = s.series.len();
+    // Points per series of the evenly spaced design (the budget shared out as evenly as it
+    // goes under a total).
+    let even_counts: Vec<usize> = match s.total {
+        None => vec![s.points; n_series],
+        Some(n) => (0..n_series)
+            .map(|k| n / n_series + usize::from(k < n % n_series))
+            .collect(),
+    };
+    let total_points: usize = even_counts.iter().sum();
     let target = match s.criterion {
         Criterion::C => Some(target_index(s, &prob)?),
         _ => None,
@@ -317,11 +373,12 @@ pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
     // The evenly spaced comparison design.
     let mut even_cands = Vec::new();
     for (k, &(lo, hi)) in ranges.iter().enumerate() {
-        for j in 0..s.points {
-            let frac = if s.points == 1 {
+        let m = even_counts[k];
+        for j in 0..m {
+            let frac = if m == 1 {
                 0.5
             } else {
-                j as f64 / (s.points - 1) as f64
+                j as f64 / (m - 1) as f64
             };
             let d = round_deg(lo + (hi - lo) * frac);
             let c = candidate(s, &prob, k, d).ok_or_else(|| {
@@ -331,31 +388,89 @@ pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
         }
     }
     let ones = vec![1.0; even_cands.len()];
-    let (approx, label, rival) = match s.criterion {
-        Criterion::D => (
-            optimal::multiplicative(&cands, &strata, &budgets, p, Crit::D),
-            "standardised variance d/λ (D)".to_string(),
+    // The draws the criterion is averaged over: the guess alone, or draws from the priors.
+    let target_c = |theta: &[f64]| -> Option<Vec<f64>> {
+        match target {
+            Some(Target::Mu(k)) => prob.mu_gradient(k, theta),
+            Some(Target::Param(k)) => {
+                let mut c = vec![0.0; p];
+                c[k] = 1.0;
+                Some(c)
+            }
+            None => Some(vec![0.0; p]),
+        }
+    };
+    let (draws, even_draws, bayes) = if priors.is_empty() {
+        let c = target_c(&prob.guess).ok_or_else(|| {
+            DesignError::new(
+                "law",
+                &s.law.to_string(),
+                "K at the guess is outside (0, 1): eq 79 has no μ there",
+            )
+        })?;
+        (
+            vec![Draw {
+                cands: cands.clone(),
+                c: c.clone(),
+            }],
+            vec![Draw {
+                cands: even_cands.clone(),
+                c,
+            }],
             None,
-        ),
+        )
+    } else {
+        let (d, e, redrawn) =
+            prior_draws(s, &prob, &priors, &cands, &strata, &even_cands, &target_c)?;
+        let n = d.len();
+        (d, e, Some((n, redrawn)))
+    };
+    let series_of: Vec<usize> = cands.iter().map(|c| c.series).collect();
+    let label = |k: Target| match k {
+        Target::Param(k) => prob.names[k].clone(),
+        Target::Mu(k) => prob.mu_names()[k].clone(),
+    };
+    let (approx, sens_label, rival, strata, alg) = match s.criterion {
+        Criterion::D => {
+            let alg = algorithm_strata(s, &strata);
+            (
+                optimal::multiplicative(&draws, &alg.0, &alg.1, p, Crit::D),
+                "standardised variance d/λ (D)".to_string(),
+                None,
+                strata,
+                alg,
+            )
+        }
         Criterion::C => {
             let k = target.expect("c has a target");
+            let alg = algorithm_strata(s, &strata);
             (
-                optimal::multiplicative(&cands, &strata, &budgets, p, Crit::C(k)),
-                format!("information on {} ψ/λ (c)", prob.names[k]),
+                optimal::multiplicative(&draws, &alg.0, &alg.1, p, Crit::C),
+                format!("information on {} ψ/λ (c)", label(k)),
                 None,
+                strata,
+                alg,
             )
         }
         Criterion::T => {
-            let (a, rival, st) = t_design(s, &prob, &cands, &strata, &budgets)?;
-            strata = st;
+            let (a, rival, st, alg) = t_design(s, &prob, &cands, &strata)?;
             (
                 a,
                 "squared distance to the rival ψ/λ (T)".to_string(),
                 Some(rival),
+                st,
+                alg,
             )
         }
     };
-    let exact = optimal::round(&strata, &counts, &approx);
+    let counts: Vec<usize> = alg.1.iter().map(|&n| n as usize).collect();
+    let exact = optimal::round(&alg.0, &counts, &approx, &series_of);
+    // A Bayesian design's exact slopes are improved on the averaged criterion itself.
+    let exact = match (bayes, s.criterion) {
+        (Some(_), Criterion::D) => optimal::exchange(&draws, &alg.0, &exact, p, Crit::D),
+        (Some(_), Criterion::C) => optimal::exchange(&draws, &alg.0, &exact, p, Crit::C),
+        _ => exact,
+    };
     let mut w = vec![0.0; cands.len()];
     let mut rows = Vec::new();
     for st in &exact {
@@ -369,10 +484,30 @@ pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
         .iter()
         .map(|c| row(s.series[c.series], c.delta, 1))
         .collect();
-    let m_design = information(&cands, &w, p);
-    let m_even = information(&even_cands, &ones, p);
-    let (v_design, v_even) = (variances(&m_design), variances(&m_even));
-    let errors = (0..p)
+    let m_design: Vec<_> = draws.iter().map(|d| information(&d.cands, &w, p)).collect();
+    let m_even: Vec<_> = even_draws
+        .iter()
+        .map(|d| information(&d.cands, &ones, p))
+        .collect();
+    // Each variance averaged over the draws (the expected posterior variance of a Bayesian
+    // design); undetermined where any draw leaves it undetermined.
+    let mean_var = |ms: &[nalgebra::DMatrix<f64>],
+                    f: &dyn Fn(usize, &nalgebra::DMatrix<f64>) -> Option<f64>| {
+        let mut sum = 0.0;
+        for (i, m) in ms.iter().enumerate() {
+            sum += f(i, m)?;
+        }
+        Some(sum / ms.len() as f64)
+    };
+    let vd: Vec<Vec<Option<f64>>> = m_design.iter().map(variances).collect();
+    let ve: Vec<Vec<Option<f64>>> = m_even.iter().map(variances).collect();
+    let v_design: Vec<Option<f64>> = (0..p)
+        .map(|k| mean_var(&m_design, &|i, _| vd[i][k]))
+        .collect();
+    let v_even: Vec<Option<f64>> = (0..p)
+        .map(|k| mean_var(&m_even, &|i, _| ve[i][k]))
+        .collect();
+    let mut errors: Vec<PredictedError> = (0..p)
         .map(|k| PredictedError {
             name: prob.names[k].clone(),
             guess: prob.guess[k],
@@ -380,20 +515,50 @@ pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
             even: v_even[k].map(f64::sqrt),
         })
         .collect();
+    let mut mu_var = None;
+    if let Some(Target::Mu(k)) = target {
+        let vd = mean_var(&m_design, &|i, m| variance_of(m, &draws[i].c));
+        let ve = mean_var(&m_even, &|i, m| variance_of(m, &even_draws[i].c));
+        mu_var = Some((vd, ve));
+        errors.push(PredictedError {
+            name: label(Target::Mu(k)),
+            guess: prob.mu(k, &prob.guess).unwrap_or(f64::NAN),
+            design: vd.map(f64::sqrt),
+            even: ve.map(f64::sqrt),
+        });
+    }
     let mut discrimination = None;
     let mut points_needed = None;
     let efficiency = match s.criterion {
-        Criterion::D => {
-            let (a, b) = (m_even.determinant(), m_design.determinant());
+        Criterion::D if bayes.is_none() => {
+            let (a, b) = (m_even[0].determinant(), m_design[0].determinant());
             if b > 0.0 {
                 (a.max(0.0) / b).powf(1.0 / p as f64)
             } else {
                 f64::NAN
             }
         }
+        Criterion::D => {
+            // exp(E[log det M_even] − E[log det M])^{1/p}.
+            let mut sum = 0.0;
+            for (a, b) in m_even.iter().zip(&m_design) {
+                let (a, b) = (a.determinant(), b.determinant());
+                sum += if b > 0.0 && a > 0.0 {
+                    (a / b).ln()
+                } else if b > 0.0 {
+                    f64::NEG_INFINITY
+                } else {
+                    f64::NAN
+                };
+            }
+            (sum / (m_design.len() * p) as f64).exp()
+        }
         Criterion::C => {
-            let k = target.expect("c has a target");
-            match (v_design[k], v_even[k]) {
+            let (vd, ve) = match target.expect("c has a target") {
+                Target::Param(k) => (v_design[k], v_even[k]),
+                Target::Mu(_) => mu_var.expect("a μ target has its variances"),
+            };
+            match (vd, ve) {
                 (Some(a), Some(b)) => a / b,
                 (Some(_), None) => 0.0,
                 _ => f64::NAN,
@@ -410,7 +575,7 @@ pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
             let t_design = t_value(s, &prob, &rival, &pts, &wts).unwrap_or(f64::NAN);
             let t_even = t_value(s, &prob, &rival, &even_cands, &ones).unwrap_or(f64::NAN);
             discrimination = Some((t_design, t_even));
-            let total = (s.points * s.series.len()) as f64;
+            let total = total_points as f64;
             let need = |t: f64| {
                 let per_point = t / total;
                 if per_point > 0.0 {
@@ -439,14 +604,150 @@ pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
             .map(|r| (r.0.to_degrees(), r.1.to_degrees()))
             .collect(),
         errors,
-        target: target.map(|k| prob.names[k].clone()),
+        target: target.map(label),
         efficiency,
         gap: approx.gap,
         discrimination,
         points_needed,
         sensitivity,
-        sensitivity_label: label,
+        sensitivity_label: sens_label,
+        bayes,
     })
+}
+
+/// The strata and budgets of the approximate design: one stratum per series with `points`
+/// each, or, under a total, one stratum of every candidate with the total.
+fn algorithm_strata(s: &DesignSettings, strata: &[Vec<usize>]) -> (Vec<Vec<usize>>, Vec<f64>) {
+    match s.total {
+        None => (strata.to_vec(), vec![s.points as f64; strata.len()]),
+        Some(n) => (vec![strata.concat()], vec![n as f64]),
+    }
+}
+
+/// The index of each prior's parameter, checked: a known name, given once, a proper prior.
+fn prior_indices(s: &DesignSettings, prob: &Problem) -> Result<Vec<(usize, Prior)>, DesignError> {
+    let mut out: Vec<(usize, Prior)> = Vec::new();
+    for (name, prior) in &s.priors {
+        let text = format!("{name}={prior}");
+        let k = prob.names.iter().position(|n| n == name).ok_or_else(|| {
+            DesignError::new(
+                "prior",
+                &text,
+                format!(
+                    "no parameter '{name}' in this fit; expected one of {}",
+                    prob.names.join(", ")
+                ),
+            )
+        })?;
+        if out.iter().any(|(j, _)| *j == k) {
+            return Err(DesignError::new(
+                "prior",
+                &text,
+                "a second prior of the same parameter",
+            ));
+        }
+        if prior.draw(0.0, 0.5).is_none() {
+            return Err(DesignError::new(
+                "prior",
+                &text,
+                "a Bayesian design draws from the prior: flat and jeffreys are improper; \
+                 give uniform(a,b), normal(mean,sd), lognormal(mu,sigma) or halfnormal(scale)",
+            ));
+        }
+        out.push((k, prior.clone()));
+    }
+    Ok(out)
+}
+
+/// The draws of a Bayesian design: `s.draws` parameter vectors from the priors (the other
+/// parameters at the guess), each with the candidates' and the evenly spaced slopes' scaled
+/// gradients there (zero at a slope where that draw has no steady state) and the target's
+/// gradient. A draw that leaves a series no steady candidate in its range (or, for a μ
+/// target, puts K outside (0, 1)) is redrawn: the prior is cut to the parameters where every
+/// series has a steady slope in its range, as the fits cut theirs to the feasible region.
+/// Returns the draws, the evenly spaced slopes' draws and the number redrawn.
+#[allow(clippy::too_many_arguments)]
+fn prior_draws(
+    s: &DesignSettings,
+    prob: &Problem,
+    priors: &[(usize, Prior)],
+    cands: &[Cand],
+    strata: &[Vec<usize>],
+    even_cands: &[Cand],
+    target_c: &(dyn Fn(&[f64]) -> Option<Vec<f64>> + Sync),
+) -> Result<(Vec<Draw>, Vec<Draw>, usize), DesignError> {
+    use rand::{Rng, SeedableRng};
+    use rand_distr::{Distribution, StandardNormal};
+    use rayon::prelude::*;
+    // A candidate at a draw, and whether that draw is steady there.
+    let at = |theta: &[f64], c: &Cand| -> (Cand, bool) {
+        let g = prob.velocity(c.series, c.delta, theta).and_then(|v| {
+            let sg = sigma(s, v);
+            prob.gradient_at(c.series, c.delta, theta)
+                .map(|g| g.iter().map(|x| x / sg).collect::<Vec<f64>>())
+        });
+        let steady = g.is_some();
+        let c = Cand {
+            series: c.series,
+            delta: c.delta,
+            g: g.unwrap_or_else(|| vec![0.0; theta.len()]),
+        };
+        (c, steady)
+    };
+    let build = |theta: &Vec<f64>| -> Option<(Draw, Draw)> {
+        let c = target_c(theta)?;
+        let (d, steady): (Vec<Cand>, Vec<bool>) = cands.iter().map(|x| at(theta, x)).unzip();
+        if !strata.iter().all(|st| st.iter().any(|&j| steady[j])) {
+            return None;
+        }
+        let e: Vec<Cand> = even_cands.iter().map(|x| at(theta, x).0).collect();
+        Some((
+            Draw {
+                cands: d,
+                c: c.clone(),
+            },
+            Draw { cands: e, c },
+        ))
+    };
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(s.seed);
+    let (mut kept, mut even, mut redrawn, mut tried) = (Vec::new(), Vec::new(), 0, 0);
+    while kept.len() < s.draws {
+        let need = s.draws - kept.len();
+        if tried + need > TRIES_PER_DRAW * s.draws {
+            let text: Vec<String> = s.priors.iter().map(|(n, p)| format!("{n}={p}")).collect();
+            return Err(DesignError::new(
+                "prior",
+                &text.join(" "),
+                format!(
+                    "{redrawn} of {tried} draws leave a series no steady slope in its range \
+                     (or K outside (0, 1)): narrow the prior or the series"
+                ),
+            ));
+        }
+        let batch: Vec<Vec<f64>> = (0..need)
+            .map(|_| {
+                let mut theta = prob.guess.clone();
+                for (k, prior) in priors {
+                    let z: f64 = StandardNormal.sample(&mut rng);
+                    let u: f64 = rng.random();
+                    theta[*k] = prior.draw(z, u).expect("a proper prior");
+                }
+                theta
+            })
+            .collect();
+        tried += need;
+        let built: Vec<Option<(Draw, Draw)>> = batch.par_iter().map(build).collect();
+        for b in built {
+            match b {
+                Some((d, e)) => {
+                    kept.push(d);
+                    even.push(e);
+                }
+                None => redrawn += 1,
+            }
+        }
+    }
+    Ok((kept, even, redrawn))
 }
 
 /// The settings' own checks.
@@ -469,6 +770,34 @@ fn check(s: &DesignSettings) -> Result<(), DesignError> {
                 "xi is given twice: each series needs its own xi",
             ));
         }
+    }
+    if let Some(n) = s.total {
+        if n < s.series.len() || n > MAX_POINTS {
+            return Err(DesignError::new(
+                "total",
+                &n.to_string(),
+                format!(
+                    "expected {} (one point per series) to {MAX_POINTS} points in all",
+                    s.series.len()
+                ),
+            ));
+        }
+    }
+    if !s.priors.is_empty() && (s.draws == 0 || s.draws > MAX_DRAWS) {
+        return Err(DesignError::new(
+            "draws",
+            &s.draws.to_string(),
+            format!("expected 1 to {MAX_DRAWS} prior draws"),
+        ));
+    }
+    if !s.priors.is_empty() && s.criterion == Criterion::T {
+        let text: Vec<String> = s.priors.iter().map(|(n, p)| format!("{n}={p}")).collect();
+        return Err(DesignError::new(
+            "prior",
+            &text.join(" "),
+            "a Bayesian design is made for the d and c criteria; the t criterion is locally \
+             optimal at the guess",
+        ));
     }
     if s.points == 0 || s.points > MAX_POINTS {
         return Err(DesignError::new(
@@ -520,11 +849,6 @@ fn check(s: &DesignSettings) -> Result<(), DesignError> {
             "vs",
             "",
             "the T criterion needs the rival model (--vs MODEL)",
-        )),
-        (Criterion::T, Some(_)) if s.fit != DesignFit::KLaw => Err(DesignError::new(
-            "criterion",
-            "t",
-            "model discrimination is made for the K-law fits (--fit klaw)",
         )),
         (c, Some(v)) if c != Criterion::T => Err(DesignError::new(
             "vs",
@@ -627,49 +951,93 @@ fn candidate(s: &DesignSettings, prob: &Problem, k: usize, d: f64) -> Option<Can
     })
 }
 
-/// The index of the c criterion's target.
-fn target_index(s: &DesignSettings, prob: &Problem) -> Result<usize, DesignError> {
+/// The c criterion's target: a parameter, or (K-law fits) μ of eq 79 of a series.
+fn target_index(s: &DesignSettings, prob: &Problem) -> Result<Target, DesignError> {
+    let mus = prob.mu_names();
+    let expected = || {
+        let mut all = prob.names.clone();
+        all.extend(mus.iter().cloned());
+        all.join(", ")
+    };
     match &s.target {
-        None if prob.names.len() == 1 => Ok(0),
+        None if prob.names.len() == 1 => Ok(Target::Param(0)),
         None => Err(DesignError::new(
             "target",
             "",
             format!(
                 "the c criterion needs the target parameter: one of {}",
-                prob.names.join(", ")
+                expected()
             ),
         )),
-        Some(t) => prob.names.iter().position(|n| n == t).ok_or_else(|| {
-            DesignError::new(
+        Some(t) => {
+            if let Some(k) = prob.names.iter().position(|n| n == t) {
+                return Ok(Target::Param(k));
+            }
+            if let Some(k) = mus.iter().position(|n| n == t) {
+                return Ok(Target::Mu(k));
+            }
+            Err(DesignError::new(
                 "target",
                 t,
-                format!(
-                    "no such parameter: expected one of {}",
-                    prob.names.join(", ")
-                ),
-            )
-        }),
+                format!("no such parameter: expected one of {}", expected()),
+            ))
+        }
     }
 }
 
-/// The rival's problem for the T criterion: its own model, the same law's parameter free.
+/// The rival's problem for the T criterion: for a K-law fit, another contact model with the
+/// same law's parameter free; for Jan's fit, Jaeger's (a1, a2, a3 per series); for Jaeger's,
+/// Jan's (λ, μ at one series, the laws of eqs 75–76 across several).
 fn rival(s: &DesignSettings, prob: &Problem) -> Result<Problem, DesignError> {
     let kind = s.vs.expect("checked");
-    let m = kind.contact_model().ok_or_else(|| {
-        DesignError::new(
-            "vs",
-            &kind_name(kind),
-            "the rival of a K-law fit is a contact model",
-        )
-    })?;
-    if Some(kind) == s.model || (s.model.is_none() && kind == ModelKind::StickSlip) {
-        return Err(DesignError::new(
-            "vs",
-            &kind_name(kind),
-            "the rival must differ from --model",
-        ));
-    }
-    problem::problem(s.fit, m, s.law, &prob.series, prob.rho, prob.f, s.branch)
+    let (fit, m) = match s.fit {
+        DesignFit::KLaw => {
+            let m = kind.contact_model().ok_or_else(|| {
+                DesignError::new(
+                    "vs",
+                    &kind_name(kind),
+                    "the rival of a K-law fit is a contact model",
+                )
+            })?;
+            if Some(kind) == s.model || (s.model.is_none() && kind == ModelKind::StickSlip) {
+                return Err(DesignError::new(
+                    "vs",
+                    &kind_name(kind),
+                    "the rival must differ from --model",
+                ));
+            }
+            (DesignFit::KLaw, m)
+        }
+        // Jan's eq 74 is Jaeger's eq 80 with a2 = 0 (tan δ = μ + λ u²/(ε sin α)): Jaeger
+        // fits Jan's curve exactly at any slopes, so no design tells them apart when Jan's
+        // model is true.
+        DesignFit::Jan if kind == ModelKind::Jaeger => {
+            return Err(DesignError::new(
+                "vs",
+                "jaeger",
+                "Jan's model (eq 74) is Jaeger's (eq 80) with a2 = 0, tan delta = mu + \
+                 lambda u^2/(eps sin alpha): Jaeger's curve fits Jan's exactly at any slopes, \
+                 so no design tells them apart when Jan's model holds (the T criterion is 0). \
+                 To find the slopes that show a2 > 0, design for --fit jaeger --vs jan",
+            ));
+        }
+        DesignFit::Jaeger if kind == ModelKind::Jan => {
+            (DesignFit::Jan, crate::models::Model::StickSlip)
+        }
+        DesignFit::Jan | DesignFit::Jaeger => {
+            let (own, other) = if s.fit == DesignFit::Jan {
+                ("jan", "jaeger")
+            } else {
+                ("jaeger", "jan")
+            };
+            return Err(DesignError::new(
+                "vs",
+                &kind_name(kind),
+                format!("the rival of the {own} fit is {other} (--vs {other})"),
+            ));
+        }
+    };
+    problem::problem(fit, m, s.law, &prob.series, prob.rho, prob.f, s.branch)
 }
 
 /// The rival's least-squares fit to the true curve at points `pts` with weights `w` (the
@@ -729,13 +1097,21 @@ fn t_value(
 /// fifth candidate.
 /// Only the candidates where the rival at its guess is steady take part (the rival is
 /// fitted there); these strata are returned with the design.
+#[allow(clippy::type_complexity)]
 fn t_design(
     s: &DesignSettings,
     prob: &Problem,
     cands: &[Cand],
     strata: &[Vec<usize>],
-    budgets: &[f64],
-) -> Result<(Approx, Problem, Vec<Vec<usize>>), DesignError> {
+) -> Result<
+    (
+        Approx,
+        Problem,
+        Vec<Vec<usize>>,
+        (Vec<Vec<usize>>, Vec<f64>),
+    ),
+    DesignError,
+> {
     let rival = rival(s, prob)?;
     let strata: Vec<Vec<usize>> = strata
         .iter()
@@ -755,13 +1131,14 @@ fn t_design(
             "the rival model at the guess has no steady state in its range",
         ));
     }
-    let strata = &strata[..];
+    let alg = algorithm_strata(s, &strata);
+    let (alg_strata, budgets) = (&alg.0[..], &alg.1[..]);
     let truth: Vec<Option<f64>> = cands
         .iter()
         .map(|c| prob.velocity(c.series, c.delta, &prob.guess))
         .collect();
     let mut start = vec![0.0; cands.len()];
-    for (st, &n) in strata.iter().zip(budgets) {
+    for (st, &n) in alg_strata.iter().zip(budgets) {
         let picks: Vec<usize> = st.iter().copied().step_by(5).collect();
         for &j in &picks {
             start[j] = n / picks.len() as f64;
@@ -791,14 +1168,14 @@ fn t_design(
                 .collect(),
         )
     };
-    let a = optimal::t_optimal(strata, budgets, start, T_STEPS, fit).ok_or_else(|| {
+    let a = optimal::t_optimal(alg_strata, budgets, start, T_STEPS, fit).ok_or_else(|| {
         DesignError::new(
             "vs",
             &s.vs.map(kind_name).unwrap_or_default(),
             "the rival model could not be fitted to the true curve",
         )
     })?;
-    Ok((a, rival, strata.to_vec()))
+    Ok((a, rival, strata, alg))
 }
 
 /// The noncentrality at which a one-degree-of-freedom χ² test at significance `alpha` has

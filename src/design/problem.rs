@@ -6,7 +6,7 @@ use crate::fit::jaeger::paper_values;
 use crate::fit::jan::PAPER_GLOBAL;
 use crate::models::jaeger::Jaeger;
 use crate::models::jan::Jan;
-use crate::models::regimes::{alpha_of_xi, regime_b_interval};
+use crate::models::regimes::{alpha_of_xi, bulk_friction_law, regime_b_interval};
 use crate::models::{ForwardModel, JaegerBranch, Model};
 use crate::numfmt::fmt_f64;
 use crate::scene::{CollisionLaw, Scene};
@@ -83,22 +83,71 @@ impl Problem {
     /// ∂v̄/∂p at (s, δ) and the guess, by central differences with steps
     /// h_j = 1e-4 · max(|p_j|, 1e-3); `None` where a step leaves the steady state.
     pub fn gradient(&self, s: usize, delta: f64) -> Option<Vec<f64>> {
-        let mut p = self.guess.clone();
+        self.gradient_at(s, delta, &self.guess)
+    }
+
+    /// ∂v̄/∂p at (s, δ) and parameters `at`, with the steps of [`Problem::gradient`].
+    pub fn gradient_at(&self, s: usize, delta: f64, at: &[f64]) -> Option<Vec<f64>> {
+        self.differences(at, |j| self.touches(s, j), |p| self.velocity(s, delta, p))
+    }
+
+    /// Central differences of `f` at `at` in the parameters `touches` selects (the others
+    /// get 0); `None` where a step leaves `f`'s domain.
+    fn differences(
+        &self,
+        at: &[f64],
+        touches: impl Fn(usize) -> bool,
+        f: impl Fn(&[f64]) -> Option<f64>,
+    ) -> Option<Vec<f64>> {
+        let mut p = at.to_vec();
         let mut g = vec![0.0; p.len()];
         for j in 0..p.len() {
-            if !self.touches(s, j) {
+            if !touches(j) {
                 continue;
             }
             let h = FD_STEP * p[j].abs().max(FD_FLOOR);
             let p0 = p[j];
             p[j] = p0 + h;
-            let up = self.velocity(s, delta, &p);
+            let up = f(&p);
             p[j] = p0 - h;
-            let down = self.velocity(s, delta, &p);
+            let down = f(&p);
             p[j] = p0;
             g[j] = (up? - down?) / (2.0 * h);
         }
         Some(g)
+    }
+
+    /// The bulk friction μ of series `s` through the rolling model's eq 79,
+    /// μ = (1 − K²) sin α / ((1 + K²) cos α + 2K), at the K the parameters `p` give that
+    /// series (a K-law fit only; `None` for the other fits and where K is outside (0, 1)).
+    pub fn mu(&self, s: usize, p: &[f64]) -> Option<f64> {
+        let alpha = alpha_of_xi(self.series[s]);
+        let law = match self.kind {
+            Kind::KLawC(_) => CollisionLaw::C(p[0]),
+            Kind::KFree(_) => CollisionLaw::Value(p[s]),
+            _ => return None,
+        };
+        let k = law.k(alpha, self.rho);
+        (k > 0.0 && k < 1.0).then(|| bulk_friction_law(alpha, law, self.rho))
+    }
+
+    /// ∂μ/∂p of series `s` (eq 79 through the law) at `at`, by central differences.
+    pub fn mu_gradient(&self, s: usize, at: &[f64]) -> Option<Vec<f64>> {
+        self.differences(at, |j| self.touches(s, j), |p| self.mu(s, p))
+    }
+
+    /// The names of the derived targets (μ of eq 79 per series) of a K-law fit: `mu` for
+    /// one series, `mu of series 'xi=X'` for several; none for the other fits.
+    pub fn mu_names(&self) -> Vec<String> {
+        match self.kind {
+            Kind::KLawC(_) | Kind::KFree(_) if self.series.len() == 1 => vec!["mu".into()],
+            Kind::KLawC(_) | Kind::KFree(_) => self
+                .series
+                .iter()
+                .map(|&x| format!("mu of series 'xi={}'", fmt_f64(x)))
+                .collect(),
+            _ => Vec::new(),
+        }
     }
 
     /// Whether parameter `j` moves the velocities of series `s`.

@@ -116,6 +116,21 @@ impl Prior {
     }
 }
 
+impl Prior {
+    /// One draw from the prior given a standard normal `z` and a uniform `u` on [0, 1), or
+    /// `None` for the improper priors (flat, jeffreys), which cannot be drawn from.
+    pub(crate) fn draw(&self, z: f64, u: f64) -> Option<f64> {
+        use statrs::statistics::Distribution as _;
+        match &self.kind {
+            PriorKind::Flat | PriorKind::Jeffreys => None,
+            PriorKind::Uniform(d) => Some(d.min() + u * (d.max() - d.min())),
+            PriorKind::Normal(d) => Some(d.mean()? + d.std_dev()? * z),
+            PriorKind::LogNormal(d) => Some((d.location() + d.scale() * z).exp()),
+            PriorKind::HalfNormal(d) => Some((d.std_dev()? * z).abs()),
+        }
+    }
+}
+
 impl fmt::Display for Prior {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(&self.text)

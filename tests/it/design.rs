@@ -125,7 +125,72 @@ fn refusals_exit_2() {
         ),
         (
             &["--prior", "c~N(0.5,0.1)"],
-            &["--prior", "not yet supported"],
+            &["--prior", "expected NAME=DIST"],
+        ),
+        (&["--prior", "c=flat"], &["--prior", "'c=flat'", "improper"]),
+        (
+            &["--prior", "k=normal(0.5,0.1)"],
+            &["--prior", "no parameter 'k'"],
+        ),
+        (
+            &[
+                "--prior",
+                "c=normal(0.5,0.1)",
+                "--prior",
+                "c=uniform(0.4,0.6)",
+            ],
+            &["--prior", "second prior"],
+        ),
+        (
+            &["--prior", "c=normal(0.5,0.1)", "--draws", "0"],
+            &["--draws", "expected 1 to"],
+        ),
+        (
+            &[
+                "--criterion",
+                "t",
+                "--vs",
+                "stick",
+                "--prior",
+                "c=normal(0.5,0.1)",
+            ],
+            &["--prior", "d and c criteria"],
+        ),
+        // Every draw of c puts K above 1 at xi = 0.8: no steady slope in its range.
+        (
+            &["--prior", "c=uniform(50,60)", "--draws", "4"],
+            &["--prior", "80 of 80 draws"],
+        ),
+        (
+            &[
+                "--fit",
+                "jan",
+                "--series",
+                "1",
+                "--criterion",
+                "t",
+                "--vs",
+                "jaeger",
+            ],
+            &["--vs", "'jaeger'", "a2 = 0"],
+        ),
+        (
+            &[
+                "--fit",
+                "jaeger",
+                "--series",
+                "1",
+                "--criterion",
+                "t",
+                "--vs",
+                "stick",
+            ],
+            &["--vs", "'stick'", "rival of the jaeger fit is jan"],
+        ),
+        (&["--total", "3"], &["--total", "'3'", "expected 4"]),
+        (
+            &["--criterion", "c", "--target", "mu"],
+            &["--target", "mu of series 'xi=1'"],
         ),
         (&["--vs", "stick"], &["--vs", "goes with --criterion t"]),
         (&["--criterion", "t"], &["--vs", "needs the rival model"]),
@@ -385,4 +450,257 @@ fn discrimination_t_beats_even() {
     );
     assert!(td > te);
     assert!(fd - fe > 2.0 * se, "design {fd} vs even {fe}");
+}
+
+/// The bulk friction μ of eq 79, (1 − K²) sin α / ((1 + K²) cos α + 2K), at K of law c
+/// (K = cos 2α + c sin²α sin 2α), written out here from MODEL.md §5 and §3.
+fn mu_eq79(xi: f64, c: f64) -> f64 {
+    let a = (1.0 / (1.0 + xi)).asin();
+    let k = (2.0 * a).cos() + c * a.sin().powi(2) * (2.0 * a).sin();
+    (1.0 - k * k) * a.sin() / ((1.0 + k * k) * a.cos() + 2.0 * k)
+}
+
+/// μ of eq 79 at ξ = 1 as the target of a K-law c fit under stick/slip (series ξ = 1 and 1.6,
+/// 9 points each, 2 % noise): the c-optimal design for μ, whose predicted standard error is
+/// the delta method through eq 79, against evenly spaced slopes; each data set's μ is eq 79 at
+/// its fitted c.
+#[test]
+fn validation_mu_eq79_klaw() {
+    let target = "mu of series 'xi=1'";
+    let r = design(&DesignSettings {
+        series: vec![1.0, 1.6],
+        criterion: Criterion::C,
+        target: Some(target.into()),
+        ..DesignSettings::default()
+    })
+    .unwrap();
+    let e = r.errors.iter().find(|e| e.name == target).unwrap();
+    // The guess: eq 79 at c = 0.5, ξ = 1 (K = 0.6083, μ = 0.1311).
+    assert!((e.guess - mu_eq79(1.0, 0.5)).abs() < 1e-12, "{}", e.guess);
+    let truth = |xi: f64, d: f64| {
+        let sc = Scene::new(xi, d, 0.4, 0.1, CollisionLaw::C(0.5)).unwrap();
+        Model::StickSlip.evaluate(&sc).unwrap().mean_velocity
+    };
+    let fitter = KLawFitter::new(Model::StickSlip, KLaw::C).least_squares(false);
+    let estimate = |d: &Dataset| mu_eq79(1.0, fitter.fit(d).unwrap().param("c").unwrap().value);
+    validate(
+        "mu (eq 79) via klaw c",
+        &r,
+        target,
+        200,
+        14,
+        &truth,
+        &estimate,
+    );
+}
+
+/// A total budget: 24 points over the paper's four ξ for c of the K law under stick/slip (the
+/// design shares them out; the evenly spaced comparison has 6 per series).
+#[test]
+fn validation_total_budget_klaw_c() {
+    let r = design(&DesignSettings {
+        criterion: Criterion::C,
+        target: Some("c".into()),
+        total: Some(24),
+        ..DesignSettings::default()
+    })
+    .unwrap();
+    let n: usize = r.rows.iter().map(|x| x.replicates).sum();
+    assert_eq!(n, 24);
+    assert_eq!(r.even.len(), 24);
+    for xi in [0.8, 1.0, 1.6, 2.0] {
+        assert_eq!(r.even.iter().filter(|x| x.xi == xi).count(), 6, "xi {xi}");
+    }
+    let truth = |xi: f64, d: f64| {
+        let sc = Scene::new(xi, d, 0.4, 0.1, CollisionLaw::C(0.5)).unwrap();
+        Model::StickSlip.evaluate(&sc).unwrap().mean_velocity
+    };
+    let fitter = KLawFitter::new(Model::StickSlip, KLaw::C).least_squares(false);
+    let estimate = |d: &Dataset| fitter.fit(d).unwrap().param("c").unwrap().value;
+    validate(
+        "klaw c, 24 points in all",
+        &r,
+        "c",
+        200,
+        15,
+        &truth,
+        &estimate,
+    );
+}
+
+/// The prior of the Bayesian validation: Jan's μ at ξ = 1 uniform on [0.095, 0.112] (the
+/// paper's eq 76 gives 0.1042), λ at eq 75.
+const MU_PRIOR: (f64, f64) = (0.095, 0.112);
+
+/// A Bayesian c-optimal design for Jan's μ at ξ = 1 (9 points, 2 % noise, 32 prior draws):
+/// data sets each drawn at a μ of the prior (the test's own stream), at the design and at
+/// evenly spaced slopes; the mean squared error of the fitted μ must match the predicted
+/// expected variance (the squared standard error the design reports) within 3 of its own Monte
+/// Carlo standard errors (the sample SD of the squared errors over √n: no normality assumed).
+#[test]
+fn validation_bayesian_jan_mu() {
+    use fitbead::prelude::Prior;
+    let prior: Prior = format!("uniform({},{})", MU_PRIOR.0, MU_PRIOR.1)
+        .parse()
+        .unwrap();
+    let r = design(&DesignSettings {
+        fit: DesignFit::Jan,
+        series: vec![1.0],
+        criterion: Criterion::C,
+        target: Some("mu".into()),
+        priors: vec![("mu".into(), prior)],
+        draws: 32,
+        seed: 3,
+        ..DesignSettings::default()
+    })
+    .unwrap();
+    assert_eq!(r.bayes, Some((32, 0)));
+    let e = r.errors.iter().find(|e| e.name == "mu").unwrap();
+    let (se_d, se_e) = (e.design.unwrap(), e.even.unwrap());
+    let lambda = Jan::paper_fit(alpha_of_xi(1.0)).lambda;
+    let fitter = JanFitter::new().least_squares(false);
+    let n = 300;
+    let mut rng = ChaCha8Rng::seed_from_u64(16);
+    let mut sq_d = Vec::new();
+    let mut sq_e = Vec::new();
+    for _ in 0..n {
+        let u: f64 = rand::Rng::random(&mut rng);
+        let mu = MU_PRIOR.0 + u * (MU_PRIOR.1 - MU_PRIOR.0);
+        let jan = Jan::new(lambda, mu).unwrap();
+        let truth = move |xi: f64, d: f64| {
+            let sc = Scene::new(xi, d, 0.4, 0.1, CollisionLaw::Value(0.5)).unwrap();
+            Model::Jan(jan).evaluate(&sc).unwrap().mean_velocity
+        };
+        for (rows, out) in [(&r.rows, &mut sq_d), (&r.even, &mut sq_e)] {
+            let f = fitter
+                .fit(&synthetic(rows, &truth, NOISE, &mut rng))
+                .unwrap();
+            let m = f.fits[0].param("mu").unwrap().value;
+            out.push((m - mu) * (m - mu));
+        }
+    }
+    let mean = |x: &[f64]| x.iter().sum::<f64>() / x.len() as f64;
+    let (msd, mse) = (mean(&sq_d), mean(&sq_e));
+    let (mc_d, mc_e) = (sd(&sq_d) / (n as f64).sqrt(), sd(&sq_e) / (n as f64).sqrt());
+    println!(
+        "bayesian jan mu: design RMS error {:.4e} predicted {se_d:.4e}; even RMS error {:.4e} \
+         predicted {se_e:.4e}; mean squared error vs predicted: design {:+.1} MC SE, even \
+         {:+.1} MC SE",
+        msd.sqrt(),
+        mse.sqrt(),
+        (msd - se_d * se_d) / mc_d,
+        (mse - se_e * se_e) / mc_e
+    );
+    assert!(
+        (msd - se_d * se_d).abs() < 3.0 * mc_d,
+        "design {msd} vs {}",
+        se_d * se_d
+    );
+    assert!(
+        (mse - se_e * se_e).abs() < 3.0 * mc_e,
+        "even {mse} vs {}",
+        se_e * se_e
+    );
+    assert!(se_d < se_e && msd < mse);
+}
+
+/// Jaeger's law true (Fig. 9's a1, a2, a3 at ξ = 1), Jan's the rival, 9 points, 4 % noise: the
+/// fraction of data sets where Jaeger's fit has the lower AIC is higher at the T-optimal
+/// design than at evenly spaced slopes by more than 2 standard errors of the difference.
+#[test]
+fn discrimination_jaeger_vs_jan() {
+    use fitbead::fit::jaeger::paper_values;
+    use fitbead::models::jaeger::Jaeger;
+    use fitbead::models::JaegerBranch;
+    use fitbead::prelude::JaegerFitter;
+    let noise = 0.04;
+    let r = design(&DesignSettings {
+        fit: DesignFit::Jaeger,
+        series: vec![1.0],
+        criterion: Criterion::T,
+        vs: Some(ModelKind::Jan),
+        noise,
+        ..DesignSettings::default()
+    })
+    .unwrap();
+    let [a1, a2, a3] = paper_values(1.0).unwrap();
+    let jaeger = Jaeger::new(a1, a2, a3, JaegerBranch::Upper).unwrap();
+    let truth = move |xi: f64, d: f64| {
+        let sc = Scene::new(xi, d, 0.4, 0.1, CollisionLaw::Value(0.5)).unwrap();
+        Model::Jaeger(jaeger).evaluate(&sc).unwrap().mean_velocity
+    };
+    let jf = JaegerFitter::new().least_squares(false);
+    let nf = JanFitter::new().least_squares(false);
+    let right = |d: &Dataset| {
+        let a = jf
+            .fit(d)
+            .ok()
+            .and_then(|f| f.fits.first().map(|x| x.stats.aic));
+        let b = nf
+            .fit(d)
+            .ok()
+            .and_then(|f| f.fits.first().map(|x| x.stats.aic));
+        a.unwrap_or(f64::INFINITY) < b.unwrap_or(f64::INFINITY)
+    };
+    let n = 300;
+    let mut rng = ChaCha8Rng::seed_from_u64(17);
+    let (mut hit_d, mut hit_e) = (0, 0);
+    for _ in 0..n {
+        hit_d += right(&synthetic(&r.rows, &truth, noise, &mut rng)) as usize;
+        hit_e += right(&synthetic(&r.even, &truth, noise, &mut rng)) as usize;
+    }
+    let (fd, fe) = (hit_d as f64 / n as f64, hit_e as f64 / n as f64);
+    let (td, te) = r.discrimination.unwrap();
+    let se = (fd * (1.0 - fd) / n as f64 + fe * (1.0 - fe) / n as f64).sqrt();
+    println!(
+        "jaeger vs jan, noise {noise}: T design {td:.3} even {te:.3}; true model has the \
+         lower AIC in {:.1} % at the design, {:.1} % at even slopes (margin {:.1} ± {:.1} points)",
+        100.0 * fd,
+        100.0 * fe,
+        100.0 * (fd - fe),
+        100.0 * se
+    );
+    assert!(td > te);
+    assert!(fd - fe > 2.0 * se, "design {fd} vs even {fe}");
+}
+
+/// `design --prior` through the command line: the summary names a Bayesian design and its
+/// draws; the same seed gives the same bytes, and the μ target prints its delta-method line.
+#[test]
+fn bayesian_design_cli_is_seeded() {
+    let dir = tmpdir();
+    let run = |seed: &str, out: &str| {
+        let o = bin()
+            .current_dir(dir.path())
+            .args([
+                "design",
+                "--fit",
+                "jan",
+                "--series",
+                "1",
+                "--criterion",
+                "c",
+                "--target",
+                "mu",
+                "--prior",
+                "mu=uniform(0.095,0.112)",
+                "--draws",
+                "8",
+                "--seed",
+                seed,
+                "--output",
+                out,
+            ])
+            .output()
+            .unwrap();
+        (stdout_ok(&o), std::fs::read(dir.path().join(out)).unwrap())
+    };
+    let (s1, a) = run("5", "a.csv");
+    let (s2, b) = run("5", "b.csv");
+    assert!(
+        s1.contains("Bayesian design: the criterion averaged over 8 prior draws (seed 5"),
+        "{s1}"
+    );
+    assert_eq!(s1, s2);
+    assert_eq!(a, b);
 }

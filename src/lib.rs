@@ -33,9 +33,11 @@
 //! ```
 //!
 //! Each layer uses only the layers below it (`numfmt`, `progress` and `error` are leaves or
-//! the crate's top). The command line is the binary's (`src/main.rs`, `src/cli/`), built with
-//! the default feature `cli`; without it (`default-features = false`) the library has no
-//! command-line dependencies.
+//! the crate's top). The command line is the module `cli` (`src/cli/`, one module per
+//! subcommand), compiled with the default feature `cli` and above every layer; its one public
+//! function, `cli::main`, is the whole of the binary `src/main.rs`. Without the feature
+//! (`default-features = false`) the library has no command-line module and no command-line
+//! dependencies.
 //!
 //! ## Which crate does what
 //!
@@ -82,6 +84,9 @@ pub mod special;
 
 pub mod io;
 pub mod prelude;
+
+#[cfg(feature = "cli")]
+pub mod cli;
 
 pub use error::{Error, Result};
 pub use fit::data::Dataset;

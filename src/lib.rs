@@ -54,7 +54,7 @@
 //! | thiserror, tempfile | error types; atomic output files |
 //!
 //! What is hand-written instead, and the measurement that keeps it so, is said where it lives:
-//! the SVG figures ([`report::figures::svg`]: a plotting crate's backend rounds coordinates to
+//! the SVG figures (`report::figures::svg`: a plotting crate's backend rounds coordinates to
 //! whole pixels and cannot measure text), Carlson's R_F ([`special::elliptic::rf`]), the Brent root finder ([`special::root`]), the
 //! double-double arithmetic ([`special::dd`]) and the Levenberg–Marquardt iteration itself
 //! (argmin has none; the NIST cross-checks in `docs/ACCURACY.md`).

@@ -819,7 +819,7 @@ pub fn fit_law_with(
 
 /// What a K-law fit may be given besides its model, data, law, level and method.
 #[derive(Debug, Clone, Default)]
-pub struct KLawContext {
+pub(crate) struct KLawContext {
     /// The brackets of K of every point (one per point, in the order of the points), when
     /// the caller already has them; computed otherwise.
     pub brackets: Option<Vec<KBracket>>,
@@ -842,7 +842,7 @@ impl Drop for Finish<'_> {
 }
 
 /// As [`fit_law_with`], given the brackets or a progress sink (see [`KLawContext`]).
-pub fn fit_law_in(
+pub(crate) fn fit_law_in(
     model: Model,
     data: &Dataset,
     law: KLaw,

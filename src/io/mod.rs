@@ -93,8 +93,8 @@ impl fmt::Display for InputError {
     /// `file, line L, column 'C', value 'V': message` (for a flag of the command line,
     /// `<command line>, flag '--NAME', value 'V': message`, without an empty value), with the
     /// file name, the column name and
-    /// the value each cut at [`ECHO_CHARS`] characters and the message at `MESSAGE_CHARS`
-    /// ([`clip`]).
+    /// the value each cut at `ECHO_CHARS` characters and the message at `MESSAGE_CHARS`
+    /// (`clip`).
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "{}", clip(&self.file, 4 * ECHO_CHARS))?;
         if let Some(l) = self.line {

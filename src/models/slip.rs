@@ -20,7 +20,7 @@ pub(crate) fn slip_coefficients(f: f64) -> (f64, f64) {
 /// A forward-slip phase (friction T = f N opposing the motion, eq 37) that starts at angle
 /// `theta_s` with squared speed `ws_sq`.
 #[derive(Debug, Clone, Copy)]
-pub struct SlipPhase {
+pub(crate) struct SlipPhase {
     /// Angle where the slip starts.
     pub theta_s: f64,
     /// Squared speed there.

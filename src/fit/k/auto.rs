@@ -80,7 +80,7 @@ pub fn choose(auto: &Auto, scene: &Scene, v: f64) -> KChoice {
 
 /// The most general model any of the points needs (contact over stickslip over stick), with
 /// the count of points per model: auto for fits that need one model for all points.
-pub fn most_general(choices: &[KChoice]) -> (Choice, [usize; 3]) {
+pub(crate) fn most_general(choices: &[KChoice]) -> (Choice, [usize; 3]) {
     let mut n = [0usize; 3];
     for c in choices {
         n[match c.choice {

@@ -15,7 +15,7 @@
 //!   of MCMC", Bayesian Analysis 16, 2021, with Geyer's initial monotone sequence (C. J. Geyer,
 //!   "Practical Markov chain Monte Carlo", Statistical Science 7, 1992), as in Stan and the R
 //!   package `posterior`; [`convergence`] computes the three together, sharing their sorts;
-//! * [`summarise`] — all of the above plus mean, standard deviation and quantiles of the pooled
+//! * `summarise` — all of the above plus mean, standard deviation and quantiles of the pooled
 //!   draws, per parameter.
 
 use realfft::num_complex::Complex;
@@ -129,7 +129,7 @@ pub fn integrated_time(chains: &[Vec<f64>], c: f64) -> f64 {
 
 /// Integrated autocorrelation times of every parameter of chains laid out
 /// `[chain][step][parameter]` (see [`integrated_time`]).
-pub fn integrated_times(chains: &[Vec<Vec<f64>>], c: f64) -> Vec<f64> {
+pub(crate) fn integrated_times(chains: &[Vec<Vec<f64>>], c: f64) -> Vec<f64> {
     let dim = chains
         .first()
         .and_then(|c| c.first())
@@ -427,7 +427,7 @@ pub struct ParameterDiagnostics {
     pub median: f64,
     /// 97.5 % quantile.
     pub q975: f64,
-    /// Central interval at the level asked of [`summarise`]: (quantile (1−level)/2,
+    /// Central interval at the level asked of `summarise`: (quantile (1−level)/2,
     /// quantile (1+level)/2).
     pub interval: (f64, f64),
     /// Integrated autocorrelation time (in steps of the chains given), see [`integrated_time`].
@@ -442,7 +442,7 @@ pub struct ParameterDiagnostics {
 
 /// Diagnostics of one scalar quantity given as one vector of draws per chain; `level` is the
 /// probability of the central interval (e.g. 0.95).
-pub fn summarise_scalar(chains: &[Vec<f64>], level: f64) -> ParameterDiagnostics {
+pub(crate) fn summarise_scalar(chains: &[Vec<f64>], level: f64) -> ParameterDiagnostics {
     let mut sorted: Vec<f64> = chains.iter().flatten().copied().collect();
     let s = sorted.len() as f64;
     let mean = sorted.iter().sum::<f64>() / s;
@@ -469,7 +469,7 @@ pub fn summarise_scalar(chains: &[Vec<f64>], level: f64) -> ParameterDiagnostics
 
 /// Diagnostics of every parameter of chains laid out `[chain][step][parameter]`; `level` is
 /// the probability of the central interval (e.g. 0.95).
-pub fn summarise(chains: &[Vec<Vec<f64>>], level: f64) -> Vec<ParameterDiagnostics> {
+pub(crate) fn summarise(chains: &[Vec<Vec<f64>>], level: f64) -> Vec<ParameterDiagnostics> {
     let dim = chains
         .first()
         .and_then(|c| c.first())

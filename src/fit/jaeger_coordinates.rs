@@ -61,7 +61,7 @@
 //! ```
 //!
 //! The posterior in y is p(a(y)) |det ∂a/∂y|: the priors stated on a1, a2, a3 keep their
-//! meaning, and the draws are reported in a1, a2, a3. `tests/it/jaeger_posterior.rs` checks
+//! meaning, and the draws are reported in a1, a2, a3. `src/fit/suite/jaeger_posterior.rs` checks
 //! (J1) against its inverse, (J2) against finite differences, and the posterior quantiles
 //! against those sampled in (ln a1, ln a2, ln a3).
 

@@ -13,4 +13,6 @@ pub mod k;
 pub mod klaw;
 pub mod posterior;
 pub mod report;
+#[cfg(test)]
+mod suite;
 pub mod summary;

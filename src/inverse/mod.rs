@@ -39,6 +39,8 @@ pub mod profile;
 mod qr;
 pub mod state;
 #[cfg(test)]
+mod suite;
+#[cfg(test)]
 mod tests;
 
 pub use estimate::{fit, fit_result, Covariance, Fit};

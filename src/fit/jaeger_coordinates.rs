@@ -85,7 +85,7 @@ const ROOT_CHECK: f64 = 1e-9;
 
 /// The sampling coordinates of Jaeger's law for one series (module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct JaegerCoordinates {
+pub(crate) struct JaegerCoordinates {
     /// t₀ = tan δ̄, δ̄ the mean slope of the series' points.
     pub tan_mean_slope: f64,
     /// The branch fitted.

@@ -15,7 +15,7 @@
 //!   into the box;
 //! - the Jacobian costs two forward evaluations per point whatever the number of parameters:
 //!   ∂r_i/∂p_j = −(dv̄/dK)_i b_i/σ_i for j = g(i), else 0, with dv̄/dK from
-//!   [`crate::fit::k::dv_dk`] (the derivative of the K inversion: steps uniform in
+//!   `crate::fit::k::dv_dk` (the derivative of the K inversion: steps uniform in
 //!   s = ln(K − K_min), accurate where the slope in K is nearly infinite, differenced over the
 //!   K values actually evaluated), v̄ at the point itself being the one the residuals just
 //!   computed there;

@@ -21,7 +21,7 @@
 //! [`Infeasible`](crate::inverse::Infeasible), never NaN.
 //!
 //! Coordinates: a parameter whose box is [0, ∞), and the scale, is sampled as ln x; Jaeger's
-//! a1, a2, a3 in the coordinates of [`super::jaeger_coordinates`] (the velocity at the
+//! a1, a2, a3 in the coordinates of `super::jaeger_coordinates` (the velocity at the
 //! series' mean slope, the slope of the law there and a shape), through
 //! `summarise_reparameterised`. Either way the log density carries the Jacobian, so the
 //! priors are those of the parameters, and the sampler records the parameters: the draws and

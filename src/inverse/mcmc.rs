@@ -40,8 +40,7 @@ use rayon::prelude::*;
 use thiserror::Error;
 
 pub use diagnostics::{
-    convergence, ess_basic, ess_bulk, ess_mean, ess_tail, integrated_time, rhat, Convergence,
-    ParameterDiagnostics,
+    ess_bulk, ess_mean, ess_tail, integrated_time, rhat, Convergence, ParameterDiagnostics,
 };
 pub(crate) use diagnostics::{integrated_times, summarise};
 

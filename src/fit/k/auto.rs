@@ -26,7 +26,7 @@ pub struct KChoice {
 }
 
 /// The K estimate of one measurement (eq 69) under `model`, or under the model `auto`
-/// chooses for it ([`choose`]) when `auto` is given, with that choice.
+/// chooses for it (`choose`) when `auto` is given, with that choice.
 pub fn estimate_with(
     model: &Model,
     auto: Option<&Auto>,
@@ -44,7 +44,7 @@ pub fn estimate_with(
 }
 
 /// Chooses the model for inverting one point (ξ, δ, ρ, f of `scene`, measured `v`).
-pub fn choose(auto: &Auto, scene: &Scene, v: f64) -> KChoice {
+pub(crate) fn choose(auto: &Auto, scene: &Scene, v: f64) -> KChoice {
     let model_of = |c: Choice| match c {
         Choice::Stick => Model::Stick,
         Choice::StickSlip => Model::StickSlip,

@@ -36,5 +36,6 @@ pub mod types;
 pub use bracket::bracket;
 pub(crate) use bracket::unsteady_points;
 pub use estimate::estimate;
-pub use search::{dv_dk, estimate_in_k, solve};
+pub(crate) use search::dv_dk;
+pub use search::solve;
 pub use types::{KBracket, KEstimate, KFailure, KRoot, LowerLimit, UpperLimit};

@@ -344,7 +344,12 @@ fn clamp_end(
 }
 
 /// [`estimate`](fn@super::estimate) by the general search in K: [`bracket`], then [`solve`] at v and v ± σ.
-pub fn estimate_in_k(model: &Model, scene: &Scene, v: f64, sigma_v: Option<f64>) -> KEstimate {
+pub(crate) fn estimate_in_k(
+    model: &Model,
+    scene: &Scene,
+    v: f64,
+    sigma_v: Option<f64>,
+) -> KEstimate {
     let br = match bracket(model, scene) {
         Ok(b) => b,
         Err(e) => {
@@ -419,7 +424,7 @@ fn slope(model: &Model, scene: &Scene, br: &KBracket, r: &KRoot) -> Option<f64> 
 /// difference would be off by 5e-4 below lift-off (src/fit/suite/k_inversion.rs, mpmath
 /// references). Used by the K inversion (`dv_dK` of `fitbead k`) and by the K-law fits'
 /// Jacobian ([`crate::fit::klaw`]).
-pub fn dv_dk(
+pub(crate) fn dv_dk(
     br: &KBracket,
     k0: f64,
     v0: f64,

@@ -8,7 +8,8 @@
 //! (mpmath: the bracket ends from their closed forms, v̄ by quadrature at 40 digits, K_ref
 //! solving v̄(K_ref) = v exactly; every row rechecked at 60 digits by other routes).
 
-use crate::fit::k::{bracket, estimate, estimate_in_k, KFailure};
+use crate::fit::k::search::estimate_in_k;
+use crate::fit::k::{bracket, estimate, KFailure};
 use crate::{CollisionLaw, ForwardModel, Model, Scene};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

@@ -33,9 +33,11 @@
 //! ```
 //!
 //! Each layer uses only the layers below it (`numfmt`, `progress` and `error` are leaves or
-//! the crate's top). The command line is the binary's (`src/main.rs`, `src/cli/`), built with
-//! the default feature `cli`; without it (`default-features = false`) the library has no
-//! command-line dependencies.
+//! the crate's top). The command line is the module `cli` (`src/cli/`, one module per
+//! subcommand), compiled with the default feature `cli` and above every layer; its one public
+//! function, `cli::main`, is the whole of the binary `src/main.rs`. Without the feature
+//! (`default-features = false`) the library has no command-line module and no command-line
+//! dependencies.
 //!
 //! ## Which crate does what
 //!
@@ -52,7 +54,7 @@
 //! | thiserror, tempfile | error types; atomic output files |
 //!
 //! What is hand-written instead, and the measurement that keeps it so, is said where it lives:
-//! the SVG figures ([`report::figures::svg`]: a plotting crate's backend rounds coordinates to
+//! the SVG figures (`report::figures::svg`: a plotting crate's backend rounds coordinates to
 //! whole pixels and cannot measure text), Carlson's R_F ([`special::elliptic::rf`]), the Brent root finder ([`special::root`]), the
 //! double-double arithmetic ([`special::dd`]) and the Levenberg–Marquardt iteration itself
 //! (argmin has none; the NIST cross-checks in `docs/ACCURACY.md`).
@@ -68,6 +70,10 @@
 #![doc = "```"]
 // `!(x > 0.0)` is deliberate throughout: a NaN must land in the failure branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
+// Without the feature `cli`, the crate-private helpers only the command line calls (its file
+// formats, streaming plans and figure writers) are unused; the default build, where the lints
+// are errors, still reports dead code.
+#![cfg_attr(not(feature = "cli"), allow(dead_code, unused_imports))]
 
 pub mod design;
 pub mod error;
@@ -82,6 +88,9 @@ pub mod special;
 
 pub mod io;
 pub mod prelude;
+
+#[cfg(feature = "cli")]
+pub mod cli;
 
 pub use error::{Error, Result};
 pub use fit::data::Dataset;

@@ -3,7 +3,7 @@
 
 /// `x` rounded to `digits` significant digits, written as the shortest decimal of that
 /// value (for messages and terminal tables; `inf`/`NaN` spelled out).
-pub fn fmt_sig(x: f64, digits: usize) -> String {
+pub(crate) fn fmt_sig(x: f64, digits: usize) -> String {
     if x.is_finite() {
         let s = format!("{:.*e}", digits.max(1) - 1, x);
         s.parse::<f64>().map(fmt_f64).unwrap_or(s)
@@ -20,7 +20,7 @@ pub fn fmt_f64(x: f64) -> String {
 
 /// `x` as a message echoes it: the shortest decimal that reads back as the same double
 /// (`1e300`, never its 301 digits), `NaN`, `inf` or `-inf`.
-pub fn echo_f64(x: f64) -> String {
+pub(crate) fn echo_f64(x: f64) -> String {
     if x.is_finite() {
         fmt_f64(x)
     } else {
@@ -29,7 +29,7 @@ pub fn echo_f64(x: f64) -> String {
 }
 
 /// [`fmt_f64`] appended to `out`, without allocating.
-pub fn push_f64(out: &mut Vec<u8>, x: f64) {
+pub(crate) fn push_f64(out: &mut Vec<u8>, x: f64) {
     let mut b = ryu::Buffer::new();
     out.extend_from_slice(f64_str(&mut b, x).as_bytes());
 }
@@ -44,12 +44,12 @@ fn f64_str(b: &mut ryu::Buffer, x: f64) -> &str {
 }
 
 /// Longest echo of a user's value in a message, in characters ([`clip`]).
-pub const ECHO_CHARS: usize = 80;
+pub(crate) const ECHO_CHARS: usize = 80;
 
 /// `s` cut to at most `max` characters for a message: a longer text keeps its first
 /// `max` − 1 characters followed by `…` and its full length in bytes, so that a huge cell or
 /// argument is never echoed whole.
-pub fn clip(s: &str, max: usize) -> std::borrow::Cow<'_, str> {
+pub(crate) fn clip(s: &str, max: usize) -> std::borrow::Cow<'_, str> {
     match s.char_indices().nth(max) {
         None => std::borrow::Cow::Borrowed(s),
         Some(_) => {

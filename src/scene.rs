@@ -23,14 +23,14 @@ pub enum ParameterError {
         reason: &'static str,
     },
     /// A collision law name that fitbead does not know (the text is cut for the message: the
-    /// value at [`ECHO_CHARS`] characters, a short description around it allowed).
+    /// value at `ECHO_CHARS` characters, a short description around it allowed).
     #[error(
         "unknown collision law '{}' (expected a number, cos2a, adjusted, impact or c=VALUE)",
         clip(.0, ECHO_CHARS + 64)
     )]
     UnknownLaw(String),
     /// A spin rule of the contact model that fitbead does not know (the text is cut for the
-    /// message at [`ECHO_CHARS`] characters).
+    /// message at `ECHO_CHARS` characters).
     #[error(
         "unknown spin rule '{}' (expected roll, keep, impact or factor=L)",
         clip(.0, ECHO_CHARS)

@@ -14,7 +14,7 @@ use fitbead::fit::klaw::KLaw;
 use fitbead::fit::report::FitSet;
 use fitbead::fit::summary::FitResult as RsFitResult;
 use fitbead::inverse::posterior::McmcSettings;
-use fitbead::io::measurements::{plausibility, MeasurementDefaults, MeasurementFile};
+use fitbead::io::measurements::{MeasurementDefaults, MeasurementFile};
 use fitbead::io::records::{
     cells, columns, Cell, CorrelationRecord, ParamRecord, ResidualRecord, StatsRecord,
 };
@@ -816,12 +816,13 @@ struct PyDataset {
 
 impl PyDataset {
     fn of_file(m: MeasurementFile) -> Self {
-        let warnings = plausibility(&m.table, &m.rows)
+        let warnings = m
+            .plausibility()
             .iter()
-            .map(|w| format!("{}: {w}", m.table.source))
+            .map(|w| format!("{}: {w}", m.source()))
             .collect();
         PyDataset {
-            inner: m.dataset,
+            inner: m.into_dataset(),
             warnings,
         }
     }

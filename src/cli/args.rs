@@ -3,9 +3,9 @@
 //! f, the output file, the figure and the interval level.
 
 use super::CliError;
-use fitbead::io::measurements::{MeasurementDefaults, MEASUREMENT_COLUMNS};
-use fitbead::io::scenes::{check_columns, Header};
-use fitbead::io::InputError;
+use crate::io::measurements::{MeasurementDefaults, MEASUREMENT_COLUMNS};
+use crate::io::scenes::{check_columns, Header};
+use crate::io::InputError;
 use std::path::{Path, PathBuf};
 
 /// `--rho` and `--f`: the defaults of rows without a `rho` or `f` column.
@@ -123,8 +123,8 @@ impl PlotArgs {
             .and_then(|e| e.to_str())
             .map(str::to_ascii_lowercase);
         let format = match ext.as_deref() {
-            Some("png") => fitbead::report::figures::FigureFormat::Png,
-            Some("pdf") => fitbead::report::figures::FigureFormat::Pdf,
+            Some("png") => crate::report::figures::FigureFormat::Png,
+            Some("pdf") => crate::report::figures::FigureFormat::Pdf,
             _ => return Ok(svg.into_bytes()),
         };
         let out = format

@@ -1,10 +1,10 @@
-//! `fitbead bench`: the work-precision report of `fitbead::report::workprecision`, as CSV and
+//! `fitbead bench`: the work-precision report of `crate::report::workprecision`, as CSV and
 //! SVG.
 
 use super::args::{OutputArgs, PlotArgs};
 use super::{emit, CliError};
-use fitbead::io::write_atomic_all;
-use fitbead::report::workprecision::{draw_scenes, plot, render, run_bench_until, XCHECK_BOUNDS};
+use crate::io::write_atomic_all;
+use crate::report::workprecision::{draw_scenes, plot, render, run_bench_until, XCHECK_BOUNDS};
 
 /// Arguments of `fitbead bench`.
 #[derive(Debug, clap::Args)]

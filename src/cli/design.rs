@@ -4,13 +4,13 @@
 
 use super::args::{ContactArgs, OutputArgs, PlotArgs};
 use super::{emit, parse_list, CliError};
-use fitbead::design::{design, Criterion, DesignError, DesignFit, DesignResult, DesignSettings};
-use fitbead::io::{fmt_f64, fmt_sig, AtomicFile};
-use fitbead::models::ModelKind;
-use fitbead::prelude::Prior;
-use fitbead::report::figures::plot::{Axis, Figure, LegendEntry, Panel, PALETTE};
-use fitbead::report::figures::svg::{Mark, Stroke};
-use fitbead::scene::CollisionLaw;
+use crate::design::{design, Criterion, DesignError, DesignFit, DesignResult, DesignSettings};
+use crate::io::{fmt_f64, fmt_sig, AtomicFile};
+use crate::models::ModelKind;
+use crate::prelude::Prior;
+use crate::report::figures::plot::{Axis, Figure, LegendEntry, Panel, PALETTE};
+use crate::report::figures::svg::{Mark, Stroke};
+use crate::scene::CollisionLaw;
 use std::io::Write;
 use std::path::Path;
 
@@ -164,7 +164,7 @@ fn settings(a: &Args) -> Result<DesignSettings, CliError> {
     };
     let model = a.model.as_deref().map(|m| kind("--model", m)).transpose()?;
     let vs = a.vs.as_deref().map(|m| kind("--vs", m)).transpose()?;
-    let law: CollisionLaw = a.law.parse().map_err(|e: fitbead::scene::ParameterError| {
+    let law: CollisionLaw = a.law.parse().map_err(|e: crate::scene::ParameterError| {
         super::flag_error("--law", &a.law, e.to_string())
     })?;
     let criterion: Criterion = a
@@ -387,12 +387,12 @@ fn figure(s: &DesignSettings, r: &DesignResult) -> Figure {
             })
             .collect();
         for row in r.rows.iter().filter(|row| row.xi == *xi) {
-            p.items.push(fitbead::report::figures::plot::Item::VLine {
+            p.items.push(crate::report::figures::plot::Item::VLine {
                 x: row.delta_deg,
                 stroke: Stroke::solid("#808080", 1.0).dashed("4 3"),
             });
         }
-        p.items.push(fitbead::report::figures::plot::Item::HLine {
+        p.items.push(crate::report::figures::plot::Item::HLine {
             y: 1.0,
             stroke: Stroke::solid("#404040", 1.0).dashed("2 3"),
         });

@@ -2,18 +2,18 @@
 
 use super::args::{DataArgs, LevelArgs, PlotArgs};
 use super::{emit, read_input, CliError};
-use fitbead::fit::data::Dataset;
-use fitbead::fit::posterior::{McmcSettings, Method, Prior, SCALE_NAME};
-use fitbead::fit::summary::{FitResult, McmcFailure, ParamRow, StatsRow};
-use fitbead::inverse::mcmc::McmcOptions;
-use fitbead::io::measurements::{dataset_of, read_measurements, Measurement};
-use fitbead::io::reports::{draws_csv, params_csv, stats_csv};
-use fitbead::io::scenes::Table;
-use fitbead::io::{fmt_sig, write_atomic_all};
-use fitbead::report::bands::Curve;
-use fitbead::report::figures::{corner_svg, CornerBlock};
-use fitbead::report::file_stems;
-use fitbead::report::plots::lsq_fit_figure;
+use crate::fit::data::Dataset;
+use crate::fit::posterior::{McmcSettings, Method, Prior, SCALE_NAME};
+use crate::fit::summary::{FitResult, McmcFailure, ParamRow, StatsRow};
+use crate::inverse::mcmc::McmcOptions;
+use crate::io::measurements::{dataset_of, read_measurements, Measurement};
+use crate::io::reports::{draws_csv, params_csv, stats_csv};
+use crate::io::scenes::Table;
+use crate::io::{fmt_sig, write_atomic_all};
+use crate::report::bands::Curve;
+use crate::report::figures::{corner_svg, CornerBlock};
+use crate::report::file_stems;
+use crate::report::plots::lsq_fit_figure;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
@@ -112,7 +112,7 @@ pub struct LsqPlot<'a> {
     /// Title of the figure.
     pub title: &'a str,
     /// The data the fits were made on.
-    pub data: &'a fitbead::fit::data::Dataset,
+    pub data: &'a crate::fit::data::Dataset,
     /// One curve per fit.
     pub curves: &'a [Curve],
 }

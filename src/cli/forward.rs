@@ -1,18 +1,16 @@
 //! `fitbead forward`: mean velocity, regime and diagnostics of each scene under one model.
-//! The rows stream through the library's engine (`fitbead::io::stream`) with the scene plan
-//! of `fitbead::io::forward`; md, whose runs are long and few, reads the whole table.
+//! The rows stream through the library's engine (`crate::io::stream`) with the scene plan
+//! of `crate::io::forward`; md, whose runs are long and few, reads the whole table.
 
 use super::args::{ContactArgs, OutputArgs};
 use super::{emit, read_input, CliError};
-use fitbead::io::forward::{scene_columns, ForwardPlan, ForwardSettings, ForwardText};
-use fitbead::io::md::{md_csv, md_jobs, MdTable};
-use fitbead::io::scenes::{check_columns, Header, Table, TableReader};
-use fitbead::io::stream::{stream, RowPlan, StreamError, StreamOptions, Streamed};
-use fitbead::io::{fmt_f64, AtomicFile, InputError};
-use fitbead::models::md::{
-    Md, MdParams, MdResult, MdRunConfig, MdSetting, MdSettings, ReducedMass,
-};
-use fitbead::models::{JaegerBranch, Model, ModelKind};
+use crate::io::forward::{scene_columns, ForwardPlan, ForwardSettings, ForwardText};
+use crate::io::md::{md_csv, md_jobs, MdTable};
+use crate::io::scenes::{check_columns, Header, Table, TableReader};
+use crate::io::stream::{stream, RowPlan, StreamError, StreamOptions, Streamed};
+use crate::io::{fmt_f64, AtomicFile, InputError};
+use crate::models::md::{Md, MdParams, MdResult, MdRunConfig, MdSetting, MdSettings, ReducedMass};
+use crate::models::{JaegerBranch, Model, ModelKind};
 use rayon::prelude::*;
 use std::io::{Cursor, Read, Write};
 use std::path::{Path, PathBuf};
@@ -104,7 +102,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         if let Some(x) = x.filter(|x| !x.is_finite()) {
             return Err(super::flag_error(
                 flag,
-                &fitbead::numfmt::echo_f64(x),
+                &crate::numfmt::echo_f64(x),
                 "not a finite number",
             ));
         }
@@ -122,7 +120,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
     };
     if kind == ModelKind::Md {
         let (source, text) = match single {
-            Some(text) => (fitbead::io::SETTINGS_ORIGIN.to_string(), text),
+            Some(text) => (crate::io::SETTINGS_ORIGIN.to_string(), text),
             None => read_input(a.input.as_deref())?,
         };
         let t = Table::parse(&source, &text)?;
@@ -133,7 +131,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         Some(text) => {
             let n = text.len() as u64;
             (
-                fitbead::io::SETTINGS_ORIGIN.to_string(),
+                crate::io::SETTINGS_ORIGIN.to_string(),
                 Input::Text(Cursor::new(text)),
                 n,
             )

@@ -3,11 +3,11 @@
 
 use super::fitargs::{FitArgs, LsqPlot};
 use super::CliError;
-use fitbead::fit::jaeger::fit_jaeger_with;
-use fitbead::fit::jaeger::JaegerModel;
-use fitbead::fit::summary::FitResult;
-use fitbead::io::measurements::locate_note;
-use fitbead::report::bands::Curve;
+use crate::fit::jaeger::fit_jaeger_with;
+use crate::fit::jaeger::JaegerModel;
+use crate::fit::summary::FitResult;
+use crate::io::measurements::locate_note;
+use crate::report::bands::Curve;
 
 /// Arguments of `fitbead jaeger`.
 #[derive(Debug, clap::Args)]

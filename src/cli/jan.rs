@@ -3,10 +3,10 @@
 
 use super::fitargs::{FitArgs, LsqPlot};
 use super::CliError;
-use fitbead::fit::jan::fit_jan_with;
-use fitbead::fit::summary::FitResult;
-use fitbead::io::measurements::locate_note;
-use fitbead::report::bands::Curve;
+use crate::fit::jan::fit_jan_with;
+use crate::fit::summary::FitResult;
+use crate::io::measurements::locate_note;
+use crate::report::bands::Curve;
 
 /// Arguments of `fitbead jan`.
 #[derive(Debug, clap::Args)]

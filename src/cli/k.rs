@@ -4,12 +4,12 @@
 use super::args::{DataArgs, OutputArgs, PlotArgs};
 use super::forward::{open_input, stream_options, stream_to, Input};
 use super::CliError;
-use fitbead::io::kstream::{self, KLedger, KPlan, KSettings};
-use fitbead::io::scenes::TableReader;
-use fitbead::io::stream::StreamOptions;
-use fitbead::io::{AtomicFile, InputError};
-use fitbead::models::auto::Auto;
-use fitbead::models::{Model, ModelKind};
+use crate::io::kstream::{self, KLedger, KPlan, KSettings};
+use crate::io::scenes::TableReader;
+use crate::io::stream::StreamOptions;
+use crate::io::{AtomicFile, InputError};
+use crate::models::auto::Auto;
+use crate::models::{Model, ModelKind};
 use std::io::Write;
 
 /// Arguments of `fitbead k`.
@@ -85,7 +85,7 @@ pub fn parse_auto(name: &str, tol: f64) -> Result<Option<Auto>, CliError> {
 }
 
 /// Runs `fitbead k`: the rows stream through the library's engine with the K plan of
-/// `fitbead::io::kstream`; `--plot` keeps the inverted points for the figure.
+/// `crate::io::kstream`; `--plot` keeps the inverted points for the figure.
 pub fn run(a: Args) -> Result<(), CliError> {
     // Per row, the model chosen at the stick K
     let auto = parse_auto(&a.model, a.tol)?;
@@ -110,12 +110,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         let d = match defaults {
             Ok(d) => d,
             Err(CliError::Input(e)) => return Err(e),
-            Err(e) => {
-                return Err(InputError::file(
-                    fitbead::io::SETTINGS_ORIGIN,
-                    e.to_string(),
-                ))
-            }
+            Err(e) => return Err(InputError::file(crate::io::SETTINGS_ORIGIN, e.to_string())),
         };
         KPlan::new(r, &d, settings)
     };

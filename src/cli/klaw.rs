@@ -5,14 +5,14 @@ use super::fitargs::{FitArgs, LsqPlot};
 use super::k::parse_auto;
 use super::k::{parse_model, prose_model_name};
 use super::CliError;
-use fitbead::fit::k::auto::{self as kauto, KChoice};
-use fitbead::fit::k::unsteady_points;
-use fitbead::fit::klaw::{fit_law, fit_law_in, KLaw, KLawContext, KLawError};
-use fitbead::fit::posterior::Method;
-use fitbead::io::fmt_f64;
-use fitbead::io::measurements::locate_point;
-use fitbead::models::Model;
-use fitbead::report::bands::Curve;
+use crate::fit::k::auto::{self as kauto, KChoice};
+use crate::fit::k::unsteady_points;
+use crate::fit::klaw::{fit_law, fit_law_in, KLaw, KLawContext, KLawError};
+use crate::fit::posterior::Method;
+use crate::io::fmt_f64;
+use crate::io::measurements::locate_point;
+use crate::models::Model;
+use crate::report::bands::Curve;
 use rayon::prelude::*;
 
 /// Why a law cannot be fitted, in words, with the points an empty box names located by
@@ -121,7 +121,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         return Err(CliError::Interrupted);
     }
     let all = ds.clone();
-    let locate = |d: &fitbead::fit::data::Dataset, i: usize| locate_point(&t, d, i);
+    let locate = |d: &crate::fit::data::Dataset, i: usize| locate_point(&t, d, i);
     let describe = |i: usize, why: &str| format!("{}: {why}", locate(&all, i));
     let mut skipped_note = String::new();
     let (ds, orig) = if unsteady.is_empty() {

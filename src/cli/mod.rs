@@ -1,42 +1,42 @@
 //! The command line: one module per subcommand. Errors are rendered here, once.
 
-pub mod args;
-pub mod bench;
-pub mod design;
-pub mod fitargs;
-pub mod forward;
-pub mod jaeger;
-pub mod jan;
-pub mod k;
-pub mod klaw;
-pub mod regimes;
-pub mod report;
-pub mod simulate;
+mod args;
+mod bench;
+mod design;
+mod fitargs;
+mod forward;
+mod jaeger;
+mod jan;
+mod k;
+mod klaw;
+mod regimes;
+mod report;
+mod simulate;
 
+use crate::fit::posterior::Method;
+use crate::io::{clip, distinct_paths, write_atomic, InputError, ECHO_CHARS};
+use crate::progress::{Progress, ProgressEvent};
 use clap::{Parser, Subcommand};
-use fitbead::fit::posterior::Method;
-use fitbead::io::{clip, distinct_paths, write_atomic, InputError, ECHO_CHARS};
-use fitbead::progress::{Progress, ProgressEvent};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 
-use fitbead::io::measurements::{plausibility, DEFAULT_DATA, DEFAULT_DATA_NAME};
+use crate::io::measurements::{plausibility, DEFAULT_DATA, DEFAULT_DATA_NAME};
 
 /// fitbead: a bead rolling down a row of beads (Ancey, Evesque & Coussot 1996) — forward
 /// models, regime limits and synthetic data. Velocities are dimensionless (units
 /// sqrt(g (R + r))), slopes in degrees.
 #[derive(Debug, Parser)]
 #[command(name = "fitbead", version, about, long_about = None)]
-pub struct Cli {
+pub(crate) struct Cli {
     /// The subcommand.
     #[command(subcommand)]
-    pub command: Command,
+    pub(crate) command: Command,
 }
 
 /// Subcommands.
 #[derive(Debug, Subcommand)]
-pub enum Command {
+pub(crate) enum Command {
     /// Mean velocity, regime and diagnostics of scenes under one forward model.
     Forward(forward::Args),
     /// The collisional parameter K of every measured point (eq 69), with its interval.
@@ -68,7 +68,7 @@ pub enum Command {
 /// written), a fit that produced no converged estimate (exit 1, after writing its outputs), or
 /// an interruption by SIGINT or SIGTERM (exit 130).
 #[derive(Debug)]
-pub enum CliError {
+pub(crate) enum CliError {
     /// Bad input, located.
     Input(InputError),
     /// Any other failure, with a message.
@@ -106,11 +106,11 @@ impl From<csv::Error> for CliError {
     }
 }
 
-impl From<fitbead::Error> for CliError {
-    fn from(e: fitbead::Error) -> Self {
+impl From<crate::Error> for CliError {
+    fn from(e: crate::Error) -> Self {
         match e {
-            fitbead::Error::Input(i) => CliError::Input(i),
-            fitbead::Error::Io(io) => CliError::Io(io),
+            crate::Error::Input(i) => CliError::Input(i),
+            crate::Error::Io(io) => CliError::Io(io),
             e => CliError::Other(e.to_string()),
         }
     }
@@ -160,7 +160,7 @@ fn clip_message(message: &str) -> String {
 /// values of every flag (`--xi -1` is the value −1 given to `--xi`, refused by its check, not
 /// an unknown flag `-1`), and any value starting with `-` taken by a flag that reads a number
 /// (`--delta-deg -inf` is the value −∞, refused by the flag's check, not a flag `-i`).
-pub fn parse() -> Cli {
+pub(crate) fn parse() -> Cli {
     use clap::{CommandFactory, FromArgMatches};
     let mut cmd = Cli::command();
     let names: Vec<String> = cmd
@@ -184,7 +184,7 @@ pub fn parse() -> Cli {
 }
 
 /// Runs the parsed command line; returns the process exit code.
-pub fn run(cli: Cli) -> i32 {
+pub(crate) fn run(cli: Cli) -> i32 {
     if let Err(e) = check_stdout(&cli.command).and_then(|()| check_paths(&cli.command)) {
         eprintln!("fitbead: error: {}", clip_message(&e.to_string()));
         return 2;
@@ -229,7 +229,7 @@ pub fn run(cli: Cli) -> i32 {
 /// without an error; that descriptor is recognised here (on Linux, from /proc: `/dev/null`
 /// opened read-write, which a shell's `>/dev/null` never does). Elsewhere only a descriptor
 /// that is not open at all counts.
-pub fn stdout_closed() -> bool {
+pub(crate) fn stdout_closed() -> bool {
     static CLOSED: OnceLock<bool> = OnceLock::new();
     *CLOSED.get_or_init(|| {
         #[cfg(target_os = "linux")]
@@ -291,7 +291,7 @@ fn check_stdout(c: &Command) -> Result<(), CliError> {
 }
 
 /// Paths named by the flag that gives them (absent when the flag is not given).
-pub type NamedPaths<'a> = Vec<(&'static str, Option<&'a Path>)>;
+pub(crate) type NamedPaths<'a> = Vec<(&'static str, Option<&'a Path>)>;
 
 /// Refuses, before any work, an output that is also an input or another output of the same
 /// run (after following symbolic links), an output that is a directory, and two outputs to
@@ -345,7 +345,7 @@ fn check_paths(c: &Command) -> Result<(), CliError> {
         matches!(outputs.first(), Some(("--output", None))) && !matches!(c, Command::Report(_));
     if result_on_stdout {
         for (flag, p) in outputs.iter().skip(1) {
-            if let Some(p) = p.filter(|p| fitbead::io::stream_of(p) == Some(1)) {
+            if let Some(p) = p.filter(|p| crate::io::stream_of(p) == Some(1)) {
                 return Err(flag_error(
                     flag,
                     &p.display().to_string(),
@@ -361,7 +361,7 @@ fn check_paths(c: &Command) -> Result<(), CliError> {
 /// The stop flag raised by SIGINT (Ctrl-C), SIGTERM or SIGHUP: the handler is installed on the
 /// first call and every later call returns the same flag. Long computations poll it (the
 /// library takes it as an option) and stop within about a second.
-pub fn stop_flag() -> Arc<AtomicBool> {
+pub(crate) fn stop_flag() -> Arc<AtomicBool> {
     STOP.get_or_init(|| {
         let stop = Arc::new(AtomicBool::new(false));
         let flag = stop.clone();
@@ -375,7 +375,7 @@ pub fn stop_flag() -> Arc<AtomicBool> {
 }
 
 /// True once SIGINT, SIGTERM or SIGHUP arrived (false when [`stop_flag`] was never called).
-pub fn stop_requested() -> bool {
+pub(crate) fn stop_requested() -> bool {
     STOP.get().is_some_and(|f| f.load(Ordering::SeqCst))
 }
 
@@ -384,7 +384,7 @@ static STOP: OnceLock<Arc<AtomicBool>> = OnceLock::new();
 
 /// Reads an input file (or the embedded default data when `path` is `None`; standard input
 /// when it is `-`).
-pub fn read_input(path: Option<&Path>) -> Result<(String, Vec<u8>), CliError> {
+pub(crate) fn read_input(path: Option<&Path>) -> Result<(String, Vec<u8>), CliError> {
     match path {
         None => Ok((
             DEFAULT_DATA_NAME.to_string(),
@@ -411,7 +411,7 @@ pub fn read_input(path: Option<&Path>) -> Result<(String, Vec<u8>), CliError> {
 }
 
 /// Writes output bytes to a file atomically, or to stdout.
-pub fn emit(output: Option<&Path>, bytes: &[u8]) -> Result<(), CliError> {
+pub(crate) fn emit(output: Option<&Path>, bytes: &[u8]) -> Result<(), CliError> {
     // `--output -` is standard output, as for the fit commands.
     match output.filter(|p| *p != Path::new("-")) {
         Some(p) => write_atomic(p, bytes)
@@ -422,7 +422,7 @@ pub fn emit(output: Option<&Path>, bytes: &[u8]) -> Result<(), CliError> {
 
 /// Writes `bytes` to stdout. A reader that closed the pipe early (`fitbead … | head -1`) is
 /// [`CliError::Io`] with kind `BrokenPipe`, which [`run`] turns into a quiet exit 0.
-pub fn print_stdout(bytes: &[u8]) -> Result<(), CliError> {
+pub(crate) fn print_stdout(bytes: &[u8]) -> Result<(), CliError> {
     use std::io::Write;
     if stdout_closed() {
         return Err(CliError::Other(
@@ -439,10 +439,10 @@ pub fn print_stdout(bytes: &[u8]) -> Result<(), CliError> {
 
 /// Prints the plausibility warnings of measurements read from `t` (unit mistakes:
 /// [`plausibility`]) on stderr, and returns them.
-pub fn warn_implausible(
-    t: &fitbead::io::scenes::Table,
-    rows: &[fitbead::io::measurements::Measurement],
-) -> Vec<fitbead::io::measurements::Implausible> {
+pub(crate) fn warn_implausible(
+    t: &crate::io::scenes::Table,
+    rows: &[crate::io::measurements::Measurement],
+) -> Vec<crate::io::measurements::Implausible> {
     let w = plausibility(t, rows);
     for x in &w {
         eprintln!("fitbead: warning: {}: {x}", t.source);
@@ -452,7 +452,7 @@ pub fn warn_implausible(
 
 /// A progress bar on stderr for posterior runs: one bar per run, drawn from the library's
 /// progress events.
-pub fn sampler_progress_bar() -> Progress {
+pub(crate) fn sampler_progress_bar() -> Progress {
     let bar: Mutex<Option<indicatif::ProgressBar>> = Mutex::new(None);
     Progress::new(move |e| {
         let Ok(mut slot) = bar.lock() else { return };
@@ -491,7 +491,7 @@ pub fn sampler_progress_bar() -> Progress {
 /// drawn from the library's progress events only once a task has run for two seconds, so
 /// that short runs show nothing. Totals count `unit`s; a task of unknown total (0) shows a
 /// spinner with the count.
-pub fn delayed_progress_bar(unit: &'static str) -> Option<Progress> {
+pub(crate) fn delayed_progress_bar(unit: &'static str) -> Option<Progress> {
     use std::io::IsTerminal;
     use std::time::{Duration, Instant};
     if !std::io::stderr().is_terminal() {
@@ -567,7 +567,7 @@ fn progress_delay() -> std::time::Duration {
 }
 
 /// A task on a progress sink, reported finished when dropped.
-pub struct Task(Option<Progress>);
+pub(crate) struct Task(Option<Progress>);
 
 impl Drop for Task {
     fn drop(&mut self) {
@@ -581,7 +581,7 @@ impl Drop for Task {
 /// ([`delayed_progress_bar`], task `label`, in model evaluations: residual vectors and
 /// Jacobians over the data); a posterior run keeps its sampler's own bar. The bar goes when
 /// the returned [`Task`] is dropped.
-pub fn counted_fit(label: &str, method: Method) -> (Method, Task) {
+pub(crate) fn counted_fit(label: &str, method: Method) -> (Method, Task) {
     let bar = match method {
         Method::Lsq { .. } => delayed_progress_bar("model evaluations"),
         Method::Mcmc(_) => None,
@@ -593,12 +593,12 @@ pub fn counted_fit(label: &str, method: Method) -> (Method, Task) {
             check_every: 0,
         });
     }
-    let tally = bar.clone().map(fitbead::progress::Tally::new);
+    let tally = bar.clone().map(crate::progress::Tally::new);
     (method.with_progress(tally), Task(bar))
 }
 
 /// Parses a comma-separated list of numbers given on the command line.
-pub fn parse_list(flag: &str, s: &str) -> Result<Vec<f64>, CliError> {
+pub(crate) fn parse_list(flag: &str, s: &str) -> Result<Vec<f64>, CliError> {
     s.split(',')
         .map(|t| {
             let t = t.trim();
@@ -607,7 +607,7 @@ pub fn parse_list(flag: &str, s: &str) -> Result<Vec<f64>, CliError> {
                 .filter(|v| v.is_finite())
                 .ok_or_else(|| {
                     CliError::Input(InputError {
-                        file: fitbead::io::SETTINGS_ORIGIN.into(),
+                        file: crate::io::SETTINGS_ORIGIN.into(),
                         line: None,
                         column: Some(flag.to_string()),
                         value: Some(t.to_string()),
@@ -619,19 +619,26 @@ pub fn parse_list(flag: &str, s: &str) -> Result<Vec<f64>, CliError> {
 }
 
 /// The Jaeger root of `--branch` (`upper`, the default, or `lower`; eqs 80–89).
-pub fn jaeger_branch(value: &str) -> Result<fitbead::models::JaegerBranch, CliError> {
+pub(crate) fn jaeger_branch(value: &str) -> Result<crate::models::JaegerBranch, CliError> {
     value
         .parse()
         .map_err(|e: String| flag_error("--branch", value, e))
 }
 
 /// An error about a command-line flag value.
-pub fn flag_error(flag: &str, value: &str, message: impl Into<String>) -> CliError {
+pub(crate) fn flag_error(flag: &str, value: &str, message: impl Into<String>) -> CliError {
     CliError::Input(InputError {
-        file: fitbead::io::SETTINGS_ORIGIN.into(),
+        file: crate::io::SETTINGS_ORIGIN.into(),
         line: None,
         column: Some(flag.to_string()),
         value: Some(value.to_string()),
         message: message.into(),
     })
+}
+
+/// The `fitbead` command: parses the process's arguments, runs the subcommand, and returns the
+/// exit code (0 done, 1 a fit that did not converge, 2 bad input or a failed read or write,
+/// 130 interrupted by a signal; `docs/GUIDE.md`, "Exit codes"). The binary is this call.
+pub fn main() -> i32 {
+    run(parse())
 }

@@ -3,11 +3,11 @@
 
 use super::args::OutputArgs;
 use super::{emit, CliError};
-use fitbead::io::fmt_f64;
-use fitbead::models::regimes::{
+use crate::io::fmt_f64;
+use crate::models::regimes::{
     alpha_of_xi, bulk_friction_law, critical_xi, delta_d_law, delta_m_law,
 };
-use fitbead::scene::CollisionLaw;
+use crate::scene::CollisionLaw;
 
 /// Arguments of `fitbead regimes`.
 #[derive(Debug, clap::Args)]
@@ -28,7 +28,7 @@ pub struct Args {
 
 /// Runs `fitbead regimes`.
 pub fn run(a: Args) -> Result<(), CliError> {
-    let law: CollisionLaw = a.law.parse().map_err(|e: fitbead::scene::ParameterError| {
+    let law: CollisionLaw = a.law.parse().map_err(|e: crate::scene::ParameterError| {
         super::flag_error("--law", &a.law, e.to_string())
     })?;
     if !(a.rho.is_finite() && a.rho >= 0.0) {
@@ -69,8 +69,8 @@ pub fn run(a: Args) -> Result<(), CliError> {
                 format!(
                     "K = {} at xi = {}: a law's K must be in (0, 1) (a collision cannot return \
                      more velocity than it receives)",
-                    fitbead::numfmt::echo_f64(k),
-                    fitbead::numfmt::echo_f64(xi)
+                    crate::numfmt::echo_f64(k),
+                    crate::numfmt::echo_f64(xi)
                 ),
             ));
         }

@@ -6,19 +6,17 @@ use super::args::{ContactArgs, DataArgs, LevelArgs, PlotArgs};
 use super::fitargs::{flag_absurd, not_converged, FitArgs, FitOutputArgs};
 use super::klaw::law_error;
 use super::CliError;
-use fitbead::fit::k::unsteady_points;
-use fitbead::io::measurements::locate_point;
-use fitbead::io::measurements::{is_shipped_data, si_conversion};
-use fitbead::report::analysis::analyse;
-use fitbead::report::figures::{FigureFormat, FigureWidth};
-use fitbead::report::text::{markdown, one_line, terminal_summary, ReportContext};
+use crate::fit::k::unsteady_points;
+use crate::io::measurements::locate_point;
+use crate::io::measurements::{is_shipped_data, si_conversion};
+use crate::report::analysis::analyse;
+use crate::report::figures::{FigureFormat, FigureWidth};
+use crate::report::text::{markdown, one_line, terminal_summary, ReportContext};
 use std::path::{Path, PathBuf};
 
 /// The contact models the report fits (a point must be steady under one of them).
-const CONTACT_MODELS: [fitbead::models::Model; 2] = [
-    fitbead::models::Model::Stick,
-    fitbead::models::Model::StickSlip,
-];
+const CONTACT_MODELS: [crate::models::Model; 2] =
+    [crate::models::Model::Stick, crate::models::Model::StickSlip];
 
 /// [`CONTACT_MODELS`] in prose.
 const CONTACT_NAMES: [&str; 2] = ["rolling", "stick/slip"];
@@ -156,7 +154,7 @@ impl RecipeFile {
 
     /// An error about the recipe's `key`, located on its line.
     fn error(&self, key: &str, value: &str, message: impl Into<String>) -> CliError {
-        CliError::Input(fitbead::io::InputError {
+        CliError::Input(crate::io::InputError {
             file: self.name.clone(),
             line: self.line_of(key),
             column: Some(key.to_string()),
@@ -169,13 +167,13 @@ impl RecipeFile {
 fn read_recipe(path: &Path) -> Result<RecipeFile, CliError> {
     let name = path.display().to_string();
     let text = std::fs::read_to_string(path).map_err(|e| {
-        CliError::Input(fitbead::io::InputError::file(
+        CliError::Input(crate::io::InputError::file(
             &name,
             format!("cannot read: {e}"),
         ))
     })?;
     let mut r: Recipe = toml::from_str(&text).map_err(|e| {
-        CliError::Input(fitbead::io::InputError::file(
+        CliError::Input(crate::io::InputError::file(
             &name,
             format!("not a valid recipe: {e}"),
         ))
@@ -226,7 +224,7 @@ fn from_recipe(a: &Args, r: &Recipe, key: &str) -> bool {
 /// recipe file, the key's line, the key.
 fn blame_recipe(e: CliError, file: &RecipeFile, keys: &[&str]) -> CliError {
     let CliError::Input(ie) = e else { return e };
-    if ie.file != fitbead::io::SETTINGS_ORIGIN {
+    if ie.file != crate::io::SETTINGS_ORIGIN {
         return CliError::Input(ie);
     }
     let flag = ie.column.clone().unwrap_or_default();
@@ -235,7 +233,7 @@ fn blame_recipe(e: CliError, file: &RecipeFile, keys: &[&str]) -> CliError {
         .find(|(_, f)| *f == flag)
         .map(|(k, _)| *k);
     match key.filter(|k| keys.contains(k)) {
-        Some(k) => CliError::Input(fitbead::io::InputError {
+        Some(k) => CliError::Input(crate::io::InputError {
             file: file.name.clone(),
             line: file.line_of(k),
             column: Some(k.to_string()),
@@ -349,7 +347,7 @@ fn run_with(a: Args, r: Recipe) -> Result<(), CliError> {
         plot: PlotArgs::default(),
     };
     // No file of the report may be the input (or the recipe).
-    let targets: Vec<PathBuf> = fitbead::report::REPORT_FILES
+    let targets: Vec<PathBuf> = crate::report::REPORT_FILES
         .iter()
         .flat_map(|f| {
             if f.ends_with(".svg") {
@@ -364,7 +362,7 @@ fn run_with(a: Args, r: Recipe) -> Result<(), CliError> {
         .iter()
         .map(|p| ("--out-dir", Some(p.as_path())))
         .collect();
-    fitbead::io::distinct_paths(
+    crate::io::distinct_paths(
         &[
             ("--input", input.as_deref()),
             ("--recipe", a.recipe.as_deref()),
@@ -386,7 +384,7 @@ fn run_with(a: Args, r: Recipe) -> Result<(), CliError> {
             unsteady.len() - 1
         )));
     }
-    let implausible = fitbead::io::measurements::plausibility(&t, &rows);
+    let implausible = crate::io::measurements::plausibility(&t, &rows);
     // The input checks of `klaw`, per contact model: points that model cannot make steady.
     let mut input_warnings = Vec::new();
     for (model, name) in CONTACT_MODELS.iter().zip(CONTACT_NAMES) {
@@ -443,7 +441,7 @@ fn run_with(a: Args, r: Recipe) -> Result<(), CliError> {
     // A run whose sampling was interrupted has none (the bands of every fit's draws cost
     // model evaluations by the million); a stop while they are drawn writes nothing.
     let bands = if an.mcmc && !interrupted {
-        match fitbead::report::bands::posterior_bands_until(&an, &super::stop_flag()) {
+        match crate::report::bands::posterior_bands_until(&an, &super::stop_flag()) {
             Some(b) => Some(b),
             None => return Err(CliError::Interrupted),
         }
@@ -456,11 +454,11 @@ fn run_with(a: Args, r: Recipe) -> Result<(), CliError> {
     let stats = flag_absurd(&stats);
     files.push((
         "params.csv".into(),
-        fitbead::io::reports::params_csv(&params).map_err(csv_err)?,
+        crate::io::reports::params_csv(&params).map_err(csv_err)?,
     ));
     files.push((
         "stats.csv".into(),
-        fitbead::io::reports::stats_csv(&stats).map_err(csv_err)?,
+        crate::io::reports::stats_csv(&stats).map_err(csv_err)?,
     ));
     // Velocities in m/s on the figures (--units si): each series' unit sqrt(g R (1 + ξ)).
     let si = si_conversion(&t, &io.data.defaults()?);
@@ -495,14 +493,14 @@ fn run_with(a: Args, r: Recipe) -> Result<(), CliError> {
             Some(u)
         }
     };
-    let fit_refs: Vec<&fitbead::fit::summary::FitResult> = fits.iter().collect();
+    let fit_refs: Vec<&crate::fit::summary::FitResult> = fits.iter().collect();
     files.push((
         "residuals.csv".into(),
-        fitbead::io::reports::residuals_csv(&fit_refs).map_err(csv_err)?,
+        crate::io::reports::residuals_csv(&fit_refs).map_err(csv_err)?,
     ));
     files.push((
         "correlations.csv".into(),
-        fitbead::io::reports::correlations_csv(&fit_refs).map_err(csv_err)?,
+        crate::io::reports::correlations_csv(&fit_refs).map_err(csv_err)?,
     ));
     let fig = |name: &str, r: Result<String, String>| {
         r.map(|s| (name.to_string(), s.into_bytes()))
@@ -578,7 +576,7 @@ fn run_with(a: Args, r: Recipe) -> Result<(), CliError> {
     }
     let created = create_dirs(&out_dir)
         .map_err(|e| CliError::Other(format!("{}: cannot create: {e}", out_dir.display())))?;
-    if let Err(e) = fitbead::io::outdir::write_dir(&out_dir, &files) {
+    if let Err(e) = crate::io::outdir::write_dir(&out_dir, &files) {
         // All or nothing: directories made for this report go as well.
         for d in created.iter().rev() {
             let _ = std::fs::remove_dir(d);

@@ -3,16 +3,16 @@
 
 use super::args::{ContactArgs, OutputArgs};
 use super::{emit, parse_list, CliError};
-use fitbead::io::fmt_f64;
-use fitbead::models::contact::{Contact, SpinRule};
-use fitbead::models::jaeger::Jaeger;
-use fitbead::models::jan::Jan;
-use fitbead::models::md::{
+use crate::io::fmt_f64;
+use crate::models::contact::{Contact, SpinRule};
+use crate::models::jaeger::Jaeger;
+use crate::models::jan::Jan;
+use crate::models::md::{
     regime_b_interval_until as md_regime_b_interval, MD_NARROW, MD_REFINE, MD_SCAN_POINTS,
 };
-use fitbead::models::regimes::regime_b_interval;
-use fitbead::models::{ForwardModel, Model, ModelKind};
-use fitbead::scene::{CollisionLaw, Scene};
+use crate::models::regimes::regime_b_interval;
+use crate::models::{ForwardModel, Model, ModelKind};
+use crate::scene::{CollisionLaw, Scene};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
@@ -99,7 +99,7 @@ fn trace(
     v0: f64,
     model: Contact,
 ) -> Result<(), CliError> {
-    use fitbead::io::reports::transient_csv;
+    use crate::io::reports::transient_csv;
     if !(v0.is_finite() && v0 >= 0.0) {
         return Err(super::flag_error(
             "--v0",
@@ -138,12 +138,9 @@ fn trace(
 /// `--spin`: the contact model's spin rule. A rule other than the default `roll` is refused
 /// for the other models, which have no spin rule.
 fn spin_rule(a: &Args, kind: ModelKind) -> Result<SpinRule, CliError> {
-    let spin: SpinRule = a
-        .spin
-        .parse()
-        .map_err(|e: fitbead::scene::ParameterError| {
-            super::flag_error("--spin", &a.spin, e.to_string())
-        })?;
+    let spin: SpinRule = a.spin.parse().map_err(|e: crate::scene::ParameterError| {
+        super::flag_error("--spin", &a.spin, e.to_string())
+    })?;
     if kind != ModelKind::Contact && spin != SpinRule::Roll {
         return Err(super::flag_error(
             "--spin",
@@ -176,7 +173,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         .model
         .parse()
         .map_err(|_| super::flag_error("--model", &a.model, "unknown model"))?;
-    let law: CollisionLaw = a.law.parse().map_err(|e: fitbead::scene::ParameterError| {
+    let law: CollisionLaw = a.law.parse().map_err(|e: crate::scene::ParameterError| {
         super::flag_error("--law", &a.law, e.to_string())
     })?;
     // The contact model under the --spin rule (other models have none).
@@ -305,7 +302,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
             _ => {
                 let p = match &jaeger {
                     Some(p) => [p[0], p[1], p[2]],
-                    None => fitbead::fit::jaeger::paper_values(xi).ok_or_else(|| {
+                    None => crate::fit::jaeger::paper_values(xi).ok_or_else(|| {
                         super::flag_error(
                             "--series",
                             &xi.to_string(),
@@ -401,14 +398,14 @@ struct DesignLine {
 /// Reads a design file (series,xi,delta_deg,replicates; other columns ignored), every cell
 /// checked: a bad one is an error naming file, line, column and value.
 fn read_design(path: &std::path::Path) -> Result<Vec<DesignLine>, CliError> {
-    use fitbead::io::InputError;
+    use crate::io::InputError;
     let file = path.display().to_string();
     let err = |line: Option<u64>, column: Option<&str>, value: Option<&str>, message: String| {
         CliError::Input(InputError {
             file: file.clone(),
             line,
             column: column.map(str::to_string),
-            value: value.map(|v| fitbead::io::clip(v, fitbead::io::ECHO_CHARS).into_owned()),
+            value: value.map(|v| crate::io::clip(v, crate::io::ECHO_CHARS).into_owned()),
             message,
         })
     };
@@ -524,7 +521,7 @@ fn simulate_design(
             return Err(CliError::Interrupted);
         }
         let at = |message: String| {
-            CliError::Input(fitbead::io::InputError {
+            CliError::Input(crate::io::InputError {
                 file: path.display().to_string(),
                 line: Some(row.line),
                 column: Some("delta_deg".into()),
@@ -568,8 +565,8 @@ fn sigma_cell(sigma: f64) -> String {
 }
 
 fn run_md(a: &Args, series: &[f64], stop: &AtomicBool) -> Result<(), CliError> {
-    use fitbead::models::md::{Md, MdResult};
-    use fitbead::models::Regime;
+    use crate::models::md::{Md, MdResult};
+    use crate::models::Regime;
     use rayon::prelude::*;
     let md: Md = a.md.model()?;
     if !(a.contact.rho() > 0.0) {
@@ -729,8 +726,8 @@ fn run_md(a: &Args, series: &[f64], stop: &AtomicBool) -> Result<(), CliError> {
 }
 
 /// A scene outside the md model's domain, as the flag to change.
-fn md_error(a: &Args, xi: f64, e: fitbead::scene::ParameterError) -> CliError {
-    use fitbead::scene::ParameterError;
+fn md_error(a: &Args, xi: f64, e: crate::scene::ParameterError) -> CliError {
+    use crate::scene::ParameterError;
     let (flag, value) = match &e {
         ParameterError::InvalidParameter { field: "rho", .. } => {
             ("--rho", fmt_f64(a.contact.rho()))
@@ -740,7 +737,7 @@ fn md_error(a: &Args, xi: f64, e: fitbead::scene::ParameterError) -> CliError {
     };
     let flag = match flag {
         "--rho" | "--series" => flag.to_string(),
-        f => match fitbead::models::md::MdSetting::from_column(f) {
+        f => match crate::models::md::MdSetting::from_column(f) {
             Some(s) => format!("--{}", s.flag()),
             None => format!("--{}", f.replace('_', "-")),
         },

@@ -166,7 +166,7 @@ impl Dataset {
 /// How one series' velocities were made dimensionless (input in m/s): the ranges over its rows
 /// of the row beads' radius, of g and of the velocity unit sqrt(g R (1 + ξ)).
 #[derive(Debug, Clone, PartialEq)]
-pub struct SiSeries {
+pub(crate) struct SiSeries {
     /// Series label.
     pub series: String,
     /// Radius ratio ξ.

@@ -17,7 +17,7 @@
 //! series the grid reaches the best optimum either finds in 96.2 % of the 800 fits, the swarm
 //! in 94.9 %, at 100 times the cost (`tests/it/cross_solvers.rs`).
 //!
-//! A posterior run samples a1, a2, a3 in the coordinates of [`super::jaeger_coordinates`]
+//! A posterior run samples a1, a2, a3 in the coordinates of `super::jaeger_coordinates`
 //! (the velocity at the series' mean slope, the slope of the law there and a shape), where the
 //! ridge of a1 and a2 is straight; priors, draws and reported values are those of a1, a2, a3.
 
@@ -180,7 +180,7 @@ pub fn fit_jaeger(data: &Dataset, branch: JaegerBranch, level: f64, profile: boo
 /// As [`fit_jaeger`], with the parameters estimated by `method` (least squares, or a
 /// posterior run per series started from its least-squares optimum; see
 /// [`super::posterior`]). The branch notes are those of the least-squares optimum.
-pub fn fit_jaeger_with(
+pub(crate) fn fit_jaeger_with(
     data: &Dataset,
     branch: JaegerBranch,
     level: f64,

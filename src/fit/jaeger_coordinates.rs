@@ -61,7 +61,7 @@
 //! ```
 //!
 //! The posterior in y is p(a(y)) |det ∂a/∂y|: the priors stated on a1, a2, a3 keep their
-//! meaning, and the draws are reported in a1, a2, a3. `tests/it/jaeger_posterior.rs` checks
+//! meaning, and the draws are reported in a1, a2, a3. `src/fit/suite/jaeger_posterior.rs` checks
 //! (J1) against its inverse, (J2) against finite differences, and the posterior quantiles
 //! against those sampled in (ln a1, ln a2, ln a3).
 
@@ -85,7 +85,7 @@ const ROOT_CHECK: f64 = 1e-9;
 
 /// The sampling coordinates of Jaeger's law for one series (module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct JaegerCoordinates {
+pub(crate) struct JaegerCoordinates {
     /// t₀ = tan δ̄, δ̄ the mean slope of the series' points.
     pub tan_mean_slope: f64,
     /// The branch fitted.
@@ -108,7 +108,7 @@ impl JaegerCoordinates {
 
     /// (a1, a2, a3) from the coordinates y (J1), with ln |det ∂a/∂y| (J2); `None` outside the
     /// domain (a1 < 0, a3 ≤ 0, not finite, or on the lower branch X₀ not the lower root).
-    pub fn to_params(&self, y: &[f64]) -> Option<([f64; 3], f64)> {
+    pub fn to_params(self, y: &[f64]) -> Option<([f64; 3], f64)> {
         let t0 = self.tan_mean_slope;
         let x0 = (2.0 * y[0]).exp();
         let (s, ln_ds) = match self.branch {
@@ -141,7 +141,7 @@ impl JaegerCoordinates {
 
     /// The coordinates of (a1, a2, a3): `None` where eq 84 has no root at t₀ on the branch,
     /// where a2 = 0 (ln w = −∞), or on the upper branch where s ≤ 0 (a double root).
-    pub fn to_coordinates(&self, a: &[f64]) -> Option<[f64; 3]> {
+    pub fn to_coordinates(self, a: &[f64]) -> Option<[f64; 3]> {
         let y = self.coordinates_of(a)?;
         y.iter().all(|v| v.is_finite()).then_some(y)
     }

@@ -134,7 +134,7 @@ pub fn fit_jan(data: &Dataset, level: f64, profile: bool) -> JanFits {
 /// As [`fit_jan`], with the parameters estimated by `method` (least squares, or a posterior
 /// run per fit started from its least-squares optimum; see [`super::posterior`]). The global
 /// fit starts from the per-series least-squares optima either way.
-pub fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFits {
+pub(crate) fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFits {
     let mut notes = Vec::new();
     let mut per = Vec::new();
     let mut lam_pts: Vec<(f64, f64, f64)> = Vec::new(); // (sin α, ln λ, weight σ of ln λ)

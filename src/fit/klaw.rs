@@ -15,7 +15,7 @@
 //!   into the box;
 //! - the Jacobian costs two forward evaluations per point whatever the number of parameters:
 //!   ∂r_i/∂p_j = −(dv̄/dK)_i b_i/σ_i for j = g(i), else 0, with dv̄/dK from
-//!   [`crate::fit::k::dv_dk`] (the derivative of the K inversion: steps uniform in
+//!   `crate::fit::k::dv_dk` (the derivative of the K inversion: steps uniform in
 //!   s = ln(K − K_min), accurate where the slope in K is nearly infinite, differenced over the
 //!   K values actually evaluated), v̄ at the point itself being the one the residuals just
 //!   computed there;
@@ -819,7 +819,7 @@ pub fn fit_law_with(
 
 /// What a K-law fit may be given besides its model, data, law, level and method.
 #[derive(Debug, Clone, Default)]
-pub struct KLawContext {
+pub(crate) struct KLawContext {
     /// The brackets of K of every point (one per point, in the order of the points), when
     /// the caller already has them; computed otherwise.
     pub brackets: Option<Vec<KBracket>>,
@@ -842,7 +842,7 @@ impl Drop for Finish<'_> {
 }
 
 /// As [`fit_law_with`], given the brackets or a progress sink (see [`KLawContext`]).
-pub fn fit_law_in(
+pub(crate) fn fit_law_in(
     model: Model,
     data: &Dataset,
     law: KLaw,

@@ -7,10 +7,12 @@ pub mod builder;
 pub mod data;
 pub mod error;
 pub mod jaeger;
-pub mod jaeger_coordinates;
+pub(crate) mod jaeger_coordinates;
 pub mod jan;
 pub mod k;
 pub mod klaw;
 pub mod posterior;
 pub mod report;
+#[cfg(test)]
+mod suite;
 pub mod summary;

@@ -21,7 +21,7 @@
 //! [`Infeasible`](crate::inverse::Infeasible), never NaN.
 //!
 //! Coordinates: a parameter whose box is [0, ∞), and the scale, is sampled as ln x; Jaeger's
-//! a1, a2, a3 in the coordinates of [`super::jaeger_coordinates`] (the velocity at the
+//! a1, a2, a3 in the coordinates of `super::jaeger_coordinates` (the velocity at the
 //! series' mean slope, the slope of the law there and a shape), through
 //! `summarise_reparameterised`. Either way the log density carries the Jacobian, so the
 //! priors are those of the parameters, and the sampler records the parameters: the draws and
@@ -39,7 +39,8 @@ use crate::inverse::mcmc::sensitivity::sensitivity;
 use crate::inverse::mcmc::{EnsembleSampler, StopReason};
 use crate::inverse::posterior::Posterior;
 pub use crate::inverse::posterior::Reparameterisation;
-pub use crate::inverse::posterior::{Draws, McmcSettings, Method, Prior, SCALE_NAME};
+pub(crate) use crate::inverse::posterior::SCALE_NAME;
+pub use crate::inverse::posterior::{Draws, McmcSettings, Method, Prior};
 use crate::inverse::{Residuals, SigmaKind};
 use crate::numfmt::{fmt_f64, fmt_sig};
 use crate::progress::ProgressEvent;

@@ -423,7 +423,7 @@ impl ParamRow {
 /// A parameter's name, unit, the paper's value (with its source) if there is one, and its
 /// default prior for a posterior run.
 #[derive(Debug, Clone, PartialEq)]
-pub struct ParamSpec {
+pub(crate) struct ParamSpec {
     /// Name.
     pub name: &'static str,
     /// Unit.
@@ -455,7 +455,7 @@ fn termination_name(t: Termination) -> &'static str {
 /// A finished least-squares fit with what its summary needs: the fit's name and series, the
 /// parameters' specifications, the problem, the solver's result and options, and the
 /// confidence level of the intervals.
-pub struct Solved<'a, R: ?Sized> {
+pub(crate) struct Solved<'a, R: ?Sized> {
     /// Name of the fit (e.g. `klaw-c`).
     pub name: &'a str,
     /// Series label, or `all`.

@@ -40,9 +40,9 @@ use rayon::prelude::*;
 use thiserror::Error;
 
 pub use diagnostics::{
-    convergence, ess_basic, ess_bulk, ess_mean, ess_tail, integrated_time, integrated_times, rhat,
-    summarise, summarise_scalar, Convergence, ParameterDiagnostics,
+    ess_bulk, ess_mean, ess_tail, integrated_time, rhat, Convergence, ParameterDiagnostics,
 };
+pub(crate) use diagnostics::{integrated_times, summarise};
 
 /// An unnormalised log probability density on ℝⁿ.
 ///

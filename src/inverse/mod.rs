@@ -39,6 +39,8 @@ pub mod profile;
 mod qr;
 pub mod state;
 #[cfg(test)]
+mod suite;
+#[cfg(test)]
 mod tests;
 
 pub use estimate::{fit, fit_result, Covariance, Fit};
@@ -53,7 +55,7 @@ pub use mcmc::{
 pub use observer::ProgressObserver;
 pub use problem::{ArgminResiduals, LeastSquares};
 pub use profile::{
-    confidence_intervals, covariance_intervals, profile_interval, ConfidenceIntervals, Interval,
-    ProfileEnd, ProfileInterval, DEFAULT_LEVEL,
+    confidence_intervals, ConfidenceIntervals, Interval, ProfileEnd, ProfileInterval, DEFAULT_LEVEL,
 };
+pub(crate) use profile::{covariance_intervals, profile_interval};
 pub use state::{LmStage, LmState};

@@ -22,7 +22,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 /// Name of the error-scale parameter.
-pub const SCALE_NAME: &str = "sigma_scale";
+pub(crate) const SCALE_NAME: &str = "sigma_scale";
 
 /// A prior density of one parameter, parsed from `flat`, `jeffreys`, `uniform(a,b)`,
 /// `normal(mean,sd)`, `lognormal(mu,sigma)` (of ln x) or `halfnormal(scale)`.

@@ -224,7 +224,10 @@ fn thresholds(fit: &Fit, level: f64) -> Result<(f64, f64), LsqError> {
 
 /// Covariance (Wald) intervals p̂ ± q·se at `level`: q is the standard normal quantile when σ
 /// are absolute, Student-t on `fit.dof` when relative. `None` without a covariance.
-pub fn covariance_intervals(fit: &Fit, level: f64) -> Result<Option<Vec<Interval>>, LsqError> {
+pub(crate) fn covariance_intervals(
+    fit: &Fit,
+    level: f64,
+) -> Result<Option<Vec<Interval>>, LsqError> {
     let (q, _) = thresholds(fit, level)?;
     Ok(fit.covariance.as_ref().map(|c| {
         fit.params
@@ -241,7 +244,7 @@ pub fn covariance_intervals(fit: &Fit, level: f64) -> Result<Option<Vec<Interval
 /// Profile-likelihood interval of parameter `index` at `level` (see the module docs). `fit`
 /// must be a converged fit of `problem` made with `opts` (the same bounds and tolerances are
 /// used for the constrained fits).
-pub fn profile_interval<R: Residuals + ?Sized>(
+pub(crate) fn profile_interval<R: Residuals + ?Sized>(
     problem: &R,
     fit: &Fit,
     index: usize,

@@ -613,8 +613,7 @@ pub fn write_atomic_all(files: &[(&Path, &[u8])]) -> std::io::Result<()> {
 /// [`write_atomic_all`] with `before_rename` called once every temporary file is written,
 /// just before the first rename: a hook for tests of the roll-back (a target can be made to
 /// fail there).
-#[doc(hidden)]
-pub fn write_atomic_all_then(
+pub(crate) fn write_atomic_all_then(
     files: &[(&Path, &[u8])],
     before_rename: impl FnOnce(),
 ) -> std::io::Result<()> {
@@ -754,4 +753,81 @@ pub fn distinct_paths(
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::{Path, PathBuf};
+
+    fn tmpdir() -> tempfile::TempDir {
+        tempfile::tempdir().unwrap()
+    }
+
+    fn write(dir: impl AsRef<Path>, name: &str, text: &str) -> PathBuf {
+        let p = dir.as_ref().join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    }
+
+    /// Names in `dir` that start with `.fitbead-` (temporary or backup files).
+    fn leftovers(dir: &Path) -> Vec<String> {
+        std::fs::read_dir(dir)
+            .unwrap()
+            .filter_map(|e| e.ok())
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .filter(|n| n.starts_with(".fitbead-"))
+            .collect()
+    }
+
+    #[test]
+    fn a_failed_group_of_renames_is_rolled_back() {
+        // A target that turns into a directory after the group was checked (a
+        // race) fails its rename; the file renamed before it is put back.
+        let dir = tmpdir();
+        let a = write(&dir, "a.csv", "old a\n");
+        let b = dir.path().join("b.csv");
+        let r = super::write_atomic_all_then(&[(&a, b"new a\n"), (&b, b"new b\n")], || {
+            std::fs::create_dir(&b).unwrap()
+        });
+        assert!(r.is_err());
+        assert_eq!(std::fs::read_to_string(&a).unwrap(), "old a\n");
+        assert!(b.is_dir());
+        assert!(
+            leftovers(dir.path()).is_empty(),
+            "{:?}",
+            leftovers(dir.path())
+        );
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_symlink_swapped_in_before_the_rename_stays_a_link() {
+        use std::io::Write;
+        let dir = tmpdir();
+        let out = write(&dir, "out.csv", "old\n");
+        let elsewhere = dir.path().join("sub");
+        std::fs::create_dir(&elsewhere).unwrap();
+        let real = write(&elsewhere, "real.csv", "real old\n");
+        let mut f = super::AtomicFile::create(&out).unwrap();
+        f.write_all(b"new\n").unwrap();
+        // During the run, out.csv becomes a link to a file in another directory.
+        std::fs::remove_file(&out).unwrap();
+        std::os::unix::fs::symlink(&real, &out).unwrap();
+        f.commit().unwrap();
+        assert!(std::fs::symlink_metadata(&out)
+            .unwrap()
+            .file_type()
+            .is_symlink());
+        assert_eq!(std::fs::read_to_string(&real).unwrap(), "new\n");
+        assert!(
+            leftovers(dir.path()).is_empty(),
+            "{:?}",
+            leftovers(dir.path())
+        );
+        assert!(
+            leftovers(&elsewhere).is_empty(),
+            "{:?}",
+            leftovers(&elsewhere)
+        );
+    }
 }

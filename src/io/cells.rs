@@ -6,19 +6,7 @@ use super::push_csv_field;
 use crate::numfmt::push_f64;
 use std::io::Write;
 
-/// The cells of one CSV record, appended to a byte buffer.
-///
-/// ```
-/// use fitbead::io::cells::Cells;
-/// let mut out = Vec::new();
-/// let mut w = Cells::new(&mut out);
-/// w.text("a,b");
-/// w.num(0.5);
-/// w.empty();
-/// w.show(3);
-/// w.end();
-/// assert_eq!(out, b"\"a,b\",0.5,,3\n");
-/// ```
+/// The cells of one CSV record, appended to a byte buffer (the test below shows the calls).
 pub struct Cells<'b> {
     out: &'b mut Vec<u8>,
     first: bool,
@@ -135,5 +123,22 @@ impl<'b> Cells<'b> {
     /// Ends the record.
     pub fn end(self) {
         self.out.push(b'\n');
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Cells;
+
+    #[test]
+    fn a_record_of_text_number_empty_and_shown_cells() {
+        let mut out = Vec::new();
+        let mut w = Cells::new(&mut out);
+        w.text("a,b");
+        w.num(0.5);
+        w.empty();
+        w.show(3);
+        w.end();
+        assert_eq!(out, b"\"a,b\",0.5,,3\n");
     }
 }

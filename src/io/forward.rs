@@ -1,7 +1,7 @@
 //! Scenes in, mean velocities out: the rows of a scenes table as typed scenes and models (a
-//! column map, [`SceneColumns`], and the settings rows fall back on, [`ForwardSettings`]),
-//! evaluated and formatted as `fitbead forward`'s output records by a [`ForwardPlan`] that
-//! [`super::stream::stream`] runs over a table of any size.
+//! column map, `SceneColumns`, and the settings rows fall back on, `ForwardSettings`),
+//! evaluated and formatted as `fitbead forward`'s output records by a `ForwardPlan` that
+//! `super::stream::stream` runs over a table of any size.
 //!
 //! Input columns `xi`, `delta_deg` (required), `K` (a number or a law name), `rho`, `f`,
 //! `lambda`, `mu` (Jan), `a1`, `a2`, `a3` (Jaeger) and `spin` (contact); an empty cell or an
@@ -10,7 +10,7 @@
 //! `CONTACT_COLUMNS` (contact model) or `AUTO_COLUMNS` (auto).
 //!
 //! Settings are named in messages as the command line's flags (`--rho` of
-//! [`SETTINGS_ORIGIN`]), since that is where they come from.
+//! `SETTINGS_ORIGIN`), since that is where they come from.
 
 use super::cells::Cells;
 use super::scenes::{Row, TableReader};
@@ -27,7 +27,7 @@ use std::io::Read;
 
 /// Every column a scenes table may have: the scene's, `SCENE_CELL_COLUMNS` and md's
 /// settings; any other passes through ([`super::scenes::check_columns`]).
-pub fn scene_columns() -> Vec<&'static str> {
+pub(crate) fn scene_columns() -> Vec<&'static str> {
     let mut v = vec![
         "xi",
         "delta_deg",
@@ -94,12 +94,12 @@ pub fn output_columns(kind: ModelKind) -> Vec<&'static str> {
     outputs
 }
 
-pub use super::{setting_error, SETTINGS_ORIGIN};
+pub(crate) use super::{setting_error, SETTINGS_ORIGIN};
 
 /// The values rows fall back on where their column is absent or their cell empty, and the
 /// model to evaluate.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ForwardSettings {
+pub(crate) struct ForwardSettings {
     /// The model (every kind but md, which does not stream).
     pub kind: ModelKind,
     /// Collision law of rows without a `K` cell.
@@ -143,7 +143,7 @@ impl Default for ForwardSettings {
 
 /// Where the scene columns are in a table.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct SceneColumns {
+pub(crate) struct SceneColumns {
     /// `xi`.
     pub xi: usize,
     /// `delta_deg`.
@@ -392,7 +392,7 @@ pub(crate) fn scene_error(
 /// `fitbead forward`'s rows as a [`RowPlan`]: each row's scene and model from its cells and
 /// the settings, its outcome, and its output record (module docs).
 #[derive(Debug, Clone)]
-pub struct ForwardPlan {
+pub(crate) struct ForwardPlan {
     settings: ForwardSettings,
     cols: SceneColumns,
     headers: Vec<String>,
@@ -402,7 +402,7 @@ pub struct ForwardPlan {
 /// rule as text (parsed by [`ForwardPlan::from_text`], errors naming `--K` and `--spin`), the
 /// rest in `base` (whose `law` and `spin` are replaced).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ForwardText<'a> {
+pub(crate) struct ForwardText<'a> {
     /// The collision law: a number, `cos2a`, `adjusted`, `impact` or `c=VALUE`.
     pub k: &'a str,
     /// The spin rule: `roll`, `keep`, `factor=L` or `impact`.
@@ -461,7 +461,7 @@ impl ForwardPlan {
 
 /// A row ready to evaluate.
 #[derive(Debug, Clone, Copy)]
-pub struct Job {
+pub(crate) struct Job {
     scene: Scene,
     model: Model,
 }

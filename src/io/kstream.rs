@@ -1,5 +1,5 @@
-//! Measurements in, K out: `fitbead k`'s rows as a [`KPlan`] that
-//! [`super::stream::stream`] runs over a table of any size. Each row is read and checked as
+//! Measurements in, K out: `fitbead k`'s rows as a `KPlan` that
+//! `super::stream::stream` runs over a table of any size. Each row is read and checked as
 //! [`super::measurements`] reads a whole file (the series check in input order, keeping one
 //! entry per series), inverted (eq 69: [`crate::fit::k::estimate()`]) and written as one
 //! record of `COLUMNS`, `EXTRA_COLUMNS`, `AUTO_COLUMNS` (auto only), then the input's
@@ -72,14 +72,14 @@ pub fn output_columns(auto: bool) -> Vec<&'static str> {
 /// the engine's [`super::stream::CHUNK_ROWS`]: what `fitbead k` writes to a stream before a
 /// bad row is whole chunks of this many rows (the memory the stream uses does not depend on
 /// it).
-pub const CHUNK_ROWS: usize = 8 * 1024;
+pub(crate) const CHUNK_ROWS: usize = 8 * 1024;
 
 /// Input columns that have their own output column.
 const INPUT_OWN: [&str; 5] = ["series", "xi", "delta_deg", "v", "sigma_v"];
 
 /// How to invert the rows.
 #[derive(Debug, Clone, PartialEq)]
-pub struct KSettings {
+pub(crate) struct KSettings {
     /// The model every row is inverted with (ignored with `auto`).
     pub model: Model,
     /// Per row the model chosen at the row's stick K (eq 69 under stick first).
@@ -94,7 +94,7 @@ pub struct KSettings {
 /// What a stream of K rows keeps across rows: one entry per series for the ξ check, and the
 /// points of the plot when [`KSettings::plot`] asks for them.
 #[derive(Debug, Clone, Default)]
-pub struct KLedger {
+pub(crate) struct KLedger {
     series: SeriesLedger,
     plausibility: Option<Plausibility>,
     labels: HashMap<String, usize>,
@@ -105,7 +105,7 @@ pub struct KLedger {
 /// series usually follow each other): ξ and the three named laws' K, formatted, and the last
 /// scene read (whose quantities of ξ alone the next row of the same ξ reuses).
 #[derive(Debug, Clone, Default)]
-pub struct KScratch {
+pub(crate) struct KScratch {
     scene: Option<Scene>,
     key: Option<(u64, u64)>,
     cos2a: f64,
@@ -138,14 +138,14 @@ impl KScratch {
 /// What a written row hands on, in input order: what the series and plausibility checks need
 /// of it, and its point on the plot.
 #[derive(Debug, Clone, Copy)]
-pub struct KNote {
+pub(crate) struct KNote {
     point: PlausiblePoint,
     plot: Option<PlotNote>,
 }
 
 /// A row's point on the plot: final velocity, K, K_lo, K_hi, and K = cos 2α at its ξ.
 #[derive(Debug, Clone, Copy)]
-pub struct PlotNote {
+pub(crate) struct PlotNote {
     point: (f64, f64, f64, f64),
     cos2a: f64,
 }
@@ -183,7 +183,7 @@ impl KLedger {
 
 /// `fitbead k`'s rows as a [`RowPlan`] (module docs).
 #[derive(Debug, Clone)]
-pub struct KPlan {
+pub(crate) struct KPlan {
     settings: KSettings,
     cols: MeasurementColumns,
     headers: Vec<String>,

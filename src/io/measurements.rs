@@ -9,12 +9,12 @@
 //!
 //! Units are never guessed: `sigma_v_m_s` beside `v`, `sigma_v` beside `v_m_s`, and `v` beside
 //! `v_m_s` with `R_m` are errors. A file can still read fine in the wrong unit (slopes in
-//! radians, m/s in the column `v`, `R_m` in millimetres): [`plausibility`] looks for that with
+//! radians, m/s in the column `v`, `R_m` in millimetres): `plausibility` looks for that with
 //! the physics of the rolling model and returns warnings.
 
 use super::scenes::{Header, Row, Table};
 use super::InputError;
-pub use crate::fit::data::SiSeries;
+pub(crate) use crate::fit::data::SiSeries;
 use crate::fit::data::{DataError, Dataset};
 use crate::numfmt::fmt_f64;
 use crate::scene::{CollisionLaw, Scene};
@@ -22,13 +22,13 @@ use std::collections::HashMap;
 use std::path::Path;
 
 /// The shipped default data set (synthetic; provenance in data/README.md).
-pub const DEFAULT_DATA: &str = include_str!("../../data/default.csv");
+pub(crate) const DEFAULT_DATA: &str = include_str!("../../data/default.csv");
 /// The name the default data set goes by in messages.
-pub const DEFAULT_DATA_NAME: &str = "<embedded default data: data/default.csv>";
+pub(crate) const DEFAULT_DATA_NAME: &str = "<embedded default data: data/default.csv>";
 
 /// Every column a measurement file may have (module docs); any other passes through `fitbead
 /// k` and is otherwise unused ([`super::scenes::check_columns`]).
-pub const MEASUREMENT_COLUMNS: [&str; 11] = [
+pub(crate) const MEASUREMENT_COLUMNS: [&str; 11] = [
     "xi",
     "delta_deg",
     "series",
@@ -107,7 +107,7 @@ impl MeasurementDefaults {
 
 /// One measurement, validated.
 #[derive(Debug, Clone)]
-pub struct Measurement {
+pub(crate) struct Measurement {
     /// Series label (empty when the file has none).
     pub series: String,
     /// The scene (its K is a placeholder).
@@ -122,7 +122,7 @@ pub struct Measurement {
 /// columns a table may leave out: reads one row at a time ([`MeasurementColumns::read`]),
 /// so that a table streamed in chunks is checked exactly as one read whole.
 #[derive(Debug, Clone, PartialEq)]
-pub struct MeasurementColumns {
+pub(crate) struct MeasurementColumns {
     xi: usize,
     delta_deg: usize,
     series: Option<usize>,
@@ -139,7 +139,7 @@ pub struct MeasurementColumns {
 
 /// One measurement row, validated; its series label is the row's `series` cell.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Measured {
+pub(crate) struct Measured {
     /// The scene (its K is a placeholder).
     pub scene: Scene,
     /// Dimensionless mean velocity.
@@ -151,7 +151,7 @@ pub struct Measured {
 /// What the checks across rows keep: per series, the first ξ and its line (a series may not
 /// mix ξ values). Its size grows with the number of series, not of rows.
 #[derive(Debug, Clone, Default)]
-pub struct SeriesLedger {
+pub(crate) struct SeriesLedger {
     first_xi: HashMap<String, (f64, u64)>,
     /// The last series checked, with its first ξ and line.
     last: Option<(String, f64, u64)>,
@@ -372,7 +372,7 @@ fn positive(r: &Row<'_>, c: usize, what: &str) -> Result<f64, InputError> {
 
 /// Reads and validates the measurements (dimensional input converted with
 /// v = v_m_s / sqrt(g R (1 + ξ))).
-pub fn read_measurements(
+pub(crate) fn read_measurements(
     t: &Table,
     defaults: &MeasurementDefaults,
 ) -> Result<Vec<Measurement>, InputError> {
@@ -395,7 +395,7 @@ pub fn read_measurements(
 
 /// Whether `ds` holds the measurements of the shipped synthetic data set ([`DEFAULT_DATA`]):
 /// the same series, ξ, δ, v and σ, whatever ρ and f it was read with.
-pub fn is_shipped_data(ds: &Dataset) -> bool {
+pub(crate) fn is_shipped_data(ds: &Dataset) -> bool {
     let d = Dataset::default_data();
     ds.labels == d.labels
         && ds.sigma == d.sigma
@@ -413,7 +413,7 @@ pub fn is_shipped_data(ds: &Dataset) -> bool {
 /// dimensionless (v = v_m_s / sqrt(g R (1 + ξ))); `None` when the velocities were given
 /// dimensionless (column `v`). The rows must have been read by [`read_measurements`] with the
 /// same `defaults`.
-pub fn si_conversion(t: &Table, defaults: &MeasurementDefaults) -> Option<Vec<SiSeries>> {
+pub(crate) fn si_conversion(t: &Table, defaults: &MeasurementDefaults) -> Option<Vec<SiSeries>> {
     let cols = MeasurementColumns::new(t, defaults).ok()?;
     let mut out: Vec<SiSeries> = Vec::new();
     for i in 0..t.rows.len() {
@@ -446,7 +446,7 @@ pub fn si_conversion(t: &Table, defaults: &MeasurementDefaults) -> Option<Vec<Si
 
 /// Groups validated measurements into a [`Dataset`]; `t` is the table they were read from
 /// (for the location of an error).
-pub fn dataset_of(t: &Table, rows: &[Measurement]) -> Result<Dataset, InputError> {
+pub(crate) fn dataset_of(t: &Table, rows: &[Measurement]) -> Result<Dataset, InputError> {
     Dataset::new(
         rows.iter()
             .map(|r| (r.series.clone(), r.scene, r.v, r.sigma_v)),
@@ -472,11 +472,11 @@ pub fn dataset_of(t: &Table, rows: &[Measurement]) -> Result<Dataset, InputError
 #[derive(Debug, Clone)]
 pub struct MeasurementFile {
     /// The parsed table (cells as text, with line numbers).
-    pub table: Table,
+    pub(crate) table: Table,
     /// One validated measurement per data row.
-    pub rows: Vec<Measurement>,
+    pub(crate) rows: Vec<Measurement>,
     /// The rows grouped in series.
-    pub dataset: Dataset,
+    pub(crate) dataset: Dataset,
 }
 
 impl MeasurementFile {
@@ -503,6 +503,29 @@ impl MeasurementFile {
             .map_err(|e| InputError::file(&name, format!("cannot read: {e}")))?;
         Self::parse(&name, &bytes, defaults)
     }
+
+    /// The name the file was read under (its path, or the `source` given to
+    /// [`MeasurementFile::parse`]), as errors and warnings name it.
+    pub fn source(&self) -> &str {
+        &self.table.source
+    }
+
+    /// The data set: the rows grouped in series.
+    pub fn dataset(&self) -> &Dataset {
+        &self.dataset
+    }
+
+    /// The data set, taking it out of the file.
+    pub fn into_dataset(self) -> Dataset {
+        self.dataset
+    }
+
+    /// The warnings of the command line about data that read fine but look like a unit
+    /// mistake (slopes in radians, velocities in m/s in the dimensionless column, row-bead
+    /// radii in millimetres), in its order; none when the data look plausible.
+    pub fn plausibility(&self) -> Vec<Implausible> {
+        plausibility(&self.table, &self.rows)
+    }
 }
 
 impl Dataset {
@@ -520,7 +543,7 @@ impl Dataset {
         Ok(MeasurementFile::read(path.as_ref(), defaults)?.dataset)
     }
 
-    /// The shipped default data set ([`DEFAULT_DATA`]: synthetic, 36 points in 4 series).
+    /// The shipped default data set (`DEFAULT_DATA`: synthetic, 36 points in 4 series).
     pub fn default_data() -> Dataset {
         MeasurementFile::parse(
             DEFAULT_DATA_NAME,
@@ -534,7 +557,7 @@ impl Dataset {
 
 /// Where point `i` of `ds` (read from `t`, in the same order) is: file, line, series, ξ and
 /// δ as written in the file.
-pub fn locate_point(t: &Table, ds: &Dataset, i: usize) -> String {
+pub(crate) fn locate_point(t: &Table, ds: &Dataset, i: usize) -> String {
     let p = &ds.points[i];
     let d = t
         .col("delta_deg")
@@ -561,7 +584,7 @@ pub(crate) fn series_lines(t: &Table, ds: &Dataset, s: usize) -> String {
 
 /// A note of the fits that starts `series 'LABEL': ` located in the file: `FILE, lines …
 /// (series 'LABEL'): …`; other notes unchanged.
-pub fn locate_note(t: &Table, ds: &Dataset, note: &str) -> String {
+pub(crate) fn locate_note(t: &Table, ds: &Dataset, note: &str) -> String {
     for (s, label) in ds.labels.iter().enumerate() {
         if let Some(rest) = note.strip_prefix(&format!("series '{label}': ")) {
             return format!(
@@ -576,7 +599,7 @@ pub fn locate_note(t: &Table, ds: &Dataset, note: &str) -> String {
 }
 
 /// A warning about measurements that read fine but look like a unit mistake
-/// ([`plausibility`]).
+/// (`plausibility`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Implausible {
     /// The column in doubt.
@@ -619,7 +642,7 @@ pub(crate) const MAX_RATIOS: usize = 10_000;
 /// (`SLOPE_FRACTION`, `VELOCITY_FACTOR`, `MAX_ROW_RADIUS_M`). Nothing is refused: the
 /// caller shows the warnings. A table streamed row by row gets the same checks from a
 /// [`Plausibility`].
-pub fn plausibility(t: &Table, rows: &[Measurement]) -> Vec<Implausible> {
+pub(crate) fn plausibility(t: &Table, rows: &[Measurement]) -> Vec<Implausible> {
     let mut p = Plausibility::new(t);
     for (i, m) in rows.iter().enumerate() {
         let measured = Measured {
@@ -635,7 +658,7 @@ pub fn plausibility(t: &Table, rows: &[Measurement]) -> Vec<Implausible> {
 /// What the checks of [`Plausibility`] need of one validated row: its scene's ξ, δ (radians),
 /// ρ, f and α, and its dimensionless v.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PlausiblePoint {
+pub(crate) struct PlausiblePoint {
     /// Radius ratio ξ.
     pub xi: f64,
     /// Slope δ (radians).
@@ -667,7 +690,7 @@ impl From<&Measured> for PlausiblePoint {
 /// The checks of [`plausibility`], fed one validated row at a time in file order; its memory
 /// is bounded (at most `MAX_RATIOS` velocity ratios). [`Plausibility::warnings`] says what it found.
 #[derive(Debug, Clone)]
-pub struct Plausibility {
+pub(crate) struct Plausibility {
     /// The velocities are `v_m_s` (no column `v`).
     dimensional: bool,
     /// `v` and `v_m_s` without `R_m`: `v` is used.

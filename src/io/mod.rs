@@ -1,37 +1,36 @@
 //! Files: CSV reading with errors that name file, line, column and value; atomic writing
-//! ([`AtomicFile`], [`write_atomic_all`]: whole files or none, modes kept, links followed;
-//! directories of outputs written as one unit: [`outdir`]);
-//! tables streamed through a per-row computation in bounded memory ([`stream`]), with the
+//! (`AtomicFile`, `write_atomic_all`: whole files or none, modes kept, links followed;
+//! directories of outputs written as one unit: `outdir`);
+//! tables streamed through a per-row computation in bounded memory (`stream`), with the
 //! row plans of `fitbead forward` ([`forward`]) and `fitbead k` ([`kstream`]).
 
 mod atomic;
-pub mod cells;
+pub(crate) mod cells;
 mod csvsyntax;
 pub mod forward;
 pub mod kstream;
-pub mod md;
+pub(crate) mod md;
 pub mod measurements;
-pub mod outdir;
+pub(crate) mod outdir;
 mod ranges;
 pub mod records;
-pub mod reports;
-pub mod scenes;
-pub mod stream;
+pub(crate) mod reports;
+pub(crate) mod scenes;
+pub(crate) mod stream;
 
-pub use atomic::{
-    distinct_paths, remove_stale_temporaries, same_file, stream_of, write_atomic, write_atomic_all,
-    write_atomic_all_then, AtomicFile, STALE_UNOWNED_SECS,
+pub(crate) use atomic::{
+    distinct_paths, remove_stale_temporaries, stream_of, write_atomic, write_atomic_all, AtomicFile,
 };
 
-pub use crate::numfmt::{clip, fmt_f64, fmt_sig, push_f64, ECHO_CHARS};
+pub(crate) use crate::numfmt::{clip, fmt_f64, fmt_sig, ECHO_CHARS};
 
 use std::fmt;
 
 /// Where the settings come from, as messages name it.
-pub const SETTINGS_ORIGIN: &str = "<command line>";
+pub(crate) const SETTINGS_ORIGIN: &str = "<command line>";
 
 /// An error about a setting (named `--NAME` of [`SETTINGS_ORIGIN`]).
-pub fn setting_error(name: &str, value: &str, message: impl Into<String>) -> InputError {
+pub(crate) fn setting_error(name: &str, value: &str, message: impl Into<String>) -> InputError {
     InputError {
         file: SETTINGS_ORIGIN.into(),
         line: None,
@@ -88,14 +87,14 @@ impl InputError {
 
 /// Longest message shown by [`InputError`]'s `Display`, in characters: a message that quotes
 /// a huge cell is cut (the value itself is cut at [`ECHO_CHARS`]).
-pub const MESSAGE_CHARS: usize = 1000;
+pub(crate) const MESSAGE_CHARS: usize = 1000;
 
 impl fmt::Display for InputError {
     /// `file, line L, column 'C', value 'V': message` (for a flag of the command line,
     /// `<command line>, flag '--NAME', value 'V': message`, without an empty value), with the
     /// file name, the column name and
-    /// the value each cut at [`ECHO_CHARS`] characters and the message at [`MESSAGE_CHARS`]
-    /// ([`clip`]).
+    /// the value each cut at `ECHO_CHARS` characters and the message at `MESSAGE_CHARS`
+    /// (`clip`).
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "{}", clip(&self.file, 4 * ECHO_CHARS))?;
         if let Some(l) = self.line {

@@ -160,13 +160,11 @@ impl From<InputError> for StreamError {
     }
 }
 
-/// What a finished stream returns: the plan's ledger and the number of rows.
+/// What a finished stream returns: the plan's ledger.
 #[derive(Debug)]
 pub struct Streamed<L> {
     /// What the plan kept across the rows.
     pub ledger: L,
-    /// Data rows read.
-    pub rows: u64,
 }
 
 /// The source and column names every [`Row`] of the stream refers to.
@@ -281,10 +279,7 @@ where
     match w.outcome {
         Some(Ok(())) => match w.failed {
             Some(e) => Err(StreamError::Write(e)),
-            None => Ok(Streamed {
-                ledger: w.ledger,
-                rows: w.parsed,
-            }),
+            None => Ok(Streamed { ledger: w.ledger }),
         },
         Some(Err(e)) => Err(e),
         None => Err(StreamError::Stopped),

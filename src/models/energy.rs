@@ -39,7 +39,7 @@ impl EnergyPartition {
 }
 
 /// Partition for pure rolling: no friction work, collision loss ½ (1+ρ)(1 − K²) L² (eq 70).
-pub fn rolling(scene: &Scene, s: &Steady) -> EnergyPartition {
+pub(crate) fn rolling(scene: &Scene, s: &Steady) -> EnergyPartition {
     let l2 = s.final_velocity * s.final_velocity;
     let omk2 = scene.one_minus_k2();
     EnergyPartition {
@@ -54,7 +54,7 @@ pub fn rolling(scene: &Scene, s: &Steady) -> EnergyPartition {
 /// ρ Ψ̇ = f N = sin Θ − Θ̈ (eqs 37, 43), i.e. ρ (Ψf − Ψ_G) = ∫ sin θ dθ/Θ̇ − (Θ̇f − Θ̇_G);
 /// the friction work W = ∫ f N (Θ̇ − Ψ) dt is integrated on its own (nested quadrature), so the
 /// closure of the balance is a genuine check of the fixed point, the phases and both integrals.
-pub fn stickslip(scene: &Scene, s: &Steady) -> Result<EnergyPartition, NotSteady> {
+pub(crate) fn stickslip(scene: &Scene, s: &Steady) -> Result<EnergyPartition, NotSteady> {
     let x = s.final_velocity;
     let step = map(scene, x)?;
     let w0sq = scene.k * scene.k * x * x;

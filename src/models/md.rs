@@ -343,7 +343,7 @@ impl MdRunConfig {
 /// A setting of the md model a caller may give (a flag, a column of a scenes table), named
 /// as its column and as the `field` of the [`crate::scene::ParameterError`] that refuses it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum MdSetting {
+pub(crate) enum MdSetting {
     /// `row_radius_m`: radius R of the row beads, m.
     RowRadius,
     /// `young_pa`: Young's modulus E, Pa.
@@ -438,21 +438,13 @@ impl MdSetting {
     pub fn from_column(name: &str) -> Option<MdSetting> {
         MdSetting::ALL.into_iter().find(|s| s.column() == name)
     }
-
-    /// Whether it counts row beads or blocks (a whole number).
-    pub fn is_count(self) -> bool {
-        matches!(
-            self,
-            MdSetting::Beads | MdSetting::Transient | MdSetting::Blocks
-        )
-    }
 }
 
 /// Values given for some md settings, laid over a preset by [`MdSettings::apply`]; a setting
 /// left `None` keeps the preset's value. Counts are held as numbers so that a value such as
 /// 2.5 can be refused with the setting named.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct MdSettings {
+pub(crate) struct MdSettings {
     /// Radius R of the row beads, m.
     pub row_radius_m: Option<f64>,
     /// Young's modulus E, Pa.
@@ -1457,11 +1449,11 @@ fn run(
 
 /// The md scan of slopes for regime B: every 0.5° from 0.5° to 45°.
 pub(crate) const MD_SCAN_STEP_DEG: f64 = 0.5;
-pub const MD_SCAN_POINTS: usize = 90;
+pub(crate) const MD_SCAN_POINTS: usize = 90;
 /// Bisection steps refining each end of the md regime B range (0.5°/2⁷ ≈ 0.004°).
-pub const MD_REFINE: usize = 7;
+pub(crate) const MD_REFINE: usize = 7;
 /// How many times a hole in regime B may narrow the md range before `simulate` gives up.
-pub const MD_NARROW: usize = 8;
+pub(crate) const MD_NARROW: usize = 8;
 
 /// The slopes (degrees) where the md model is in regime B at this ξ: the longest run of the
 /// 0.5° scan (slopes in parallel), each end refined by bisection.
@@ -1476,7 +1468,7 @@ pub fn regime_b_interval(
 
 /// As [`regime_b_interval`], its runs stopped early once `stop` is raised (the result is then
 /// meaningless: the caller checks the flag).
-pub fn regime_b_interval_until(
+pub(crate) fn regime_b_interval_until(
     md: &Md,
     xi: f64,
     rho: f64,

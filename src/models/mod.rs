@@ -16,6 +16,8 @@ pub mod slip;
 pub mod stick;
 pub mod stickquad;
 pub mod stickslip;
+#[cfg(test)]
+mod suite;
 
 use crate::scene::Scene;
 use crate::scene::{ParameterError as Error, ParameterResult as Result};

@@ -20,7 +20,7 @@ pub(crate) fn slip_coefficients(f: f64) -> (f64, f64) {
 /// A forward-slip phase (friction T = f N opposing the motion, eq 37) that starts at angle
 /// `theta_s` with squared speed `ws_sq`.
 #[derive(Debug, Clone, Copy)]
-pub struct SlipPhase {
+pub(crate) struct SlipPhase {
     /// Angle where the slip starts.
     pub theta_s: f64,
     /// Squared speed there.
@@ -185,7 +185,7 @@ fn minimum_angle(ph: &SlipPhase, a: f64, b: f64) -> Result<(f64, f64, f64), NotS
 }
 
 /// The least squared speed of the slip model's steady contact (§4.3) and where it lies:
-/// (θm, Θ̇²(θm)), in double-double ([`SlipDd`]) when θm is interior. It vanishes at the slip
+/// (θm, Θ̇²(θm)), in double-double (`SlipDd`) when θm is interior. It vanishes at the slip
 /// model's stop limit, like the squared top speed of rolling at δ_m.
 pub fn speed_minimum(scene: &Scene) -> Result<(f64, f64), NotSteady> {
     let l2 = final_velocity_sq(scene)?;
@@ -336,7 +336,7 @@ fn slip_time_in(
 /// the speed minimum of a bead crawling over the top, a difference of O(1) terms, and the
 /// same minimum under the slip approximation ([`SlipDd::approx_speeds_sq`]).
 #[derive(Debug, Clone, Copy)]
-pub struct SlipDd {
+pub(crate) struct SlipDd {
     f: f64,
     th0: Dd,
     sc0: (Dd, Dd),
@@ -426,7 +426,7 @@ impl SlipDd {
 
 /// Squared speeds of the slip approximation from [`SlipDd::approx_speeds_sq`].
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ApproxSpeedsSq {
+pub(crate) struct ApproxSpeedsSq {
     /// a′ − p: the least value over all θ (eq 58c).
     pub least: f64,
     /// At Θ0.
@@ -651,7 +651,7 @@ fn approx_speeds_sq_dd(scene: &Scene) -> Result<ApproxSpeedsSq, NotSteady> {
 /// (eqs 54–56 as used): Θ̇² ≈ a' + b' sin θ + c' cos θ = a' + p cos(θ − θ*), whose time is an
 /// elliptic integral (eqs 57–59), evaluated by [`cos_integral`]. Near the approximation's own
 /// stop limit, where its least squared speed is below 1e-2 a′, that least value and the
-/// squared speeds at Θ0 and Θf come from double-double ([`SlipDd::approx_speeds_sq`]).
+/// squared speeds at Θ0 and Θf come from double-double (`SlipDd::approx_speeds_sq`).
 pub fn steady_approx(scene: &Scene) -> Outcome {
     let l2 = slip_state(scene)?;
     let (b, c) = slip_coefficients(scene.f);

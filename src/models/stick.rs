@@ -49,7 +49,7 @@ fn lower_limit_bracket_dd(scene: &Scene, omk: f64) -> f64 {
 /// Squared velocity at the top Θ = 0 in the steady rolling state:
 /// Θ̇_top² = A − B = 2B (K sin(Θf/2) + sin(Θ0/2)) (K sin(Θf/2) − sin(Θ0/2)) / (1 − K²)
 /// (eq 9 at Θ = 0 with eqs 19–20, factored so that no digits cancel).
-pub fn top_velocity_sq(scene: &Scene) -> f64 {
+pub(crate) fn top_velocity_sq(scene: &Scene) -> f64 {
     let p = lower_limit_factor(scene);
     let q = scene.k * scene.sc_half_f.s - scene.sc_half_0.s;
     2.0 * scene.b * p * q / scene.one_minus_k2()

@@ -14,7 +14,7 @@ use crate::special::root::{brent, golden_max};
 
 /// Which phases one contact goes through under the stick/slip model.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Branch {
+pub(crate) enum Branch {
     /// Θ_G ≥ Θf: rolls over the whole contact.
     NoSlip,
     /// Θ0 < Θ_G < Θf: rolls, then slips.
@@ -25,7 +25,7 @@ pub enum Branch {
 
 /// One application of the final-velocity map.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct MapStep {
+pub(crate) struct MapStep {
     /// Final velocity on this bead.
     pub final_velocity: f64,
     /// Phases of this contact.
@@ -36,7 +36,7 @@ pub struct MapStep {
 
 /// The final-velocity map H: final velocity `x` on the previous bead → final velocity on this
 /// one (collision Θ̇0 = K x, rolling restarts, eqs 64–67).
-pub fn map(scene: &Scene, x: f64) -> Result<MapStep, NotSteady> {
+pub(crate) fn map(scene: &Scene, x: f64) -> Result<MapStep, NotSteady> {
     let w0sq = scene.k * scene.k * x * x;
     let s0 = scene.sc_half_0.s;
     launch(scene, w0sq, w0sq - 2.0 * scene.b * s0 * s0)
@@ -46,7 +46,7 @@ pub fn map(scene: &Scene, x: f64) -> Result<MapStep, NotSteady> {
 /// does not involve K). `top_sq` = w0sq − 2B sin²(Θ0/2) is the squared speed the rolling law
 /// gives at the top Θ = 0, passed by the caller so that a launch just above the crawl speed
 /// keeps its digits (it decides whether the bead passes the top when Θ0 < 0).
-pub fn launch(scene: &Scene, w0sq: f64, top_sq: f64) -> Result<MapStep, NotSteady> {
+pub(crate) fn launch(scene: &Scene, w0sq: f64, top_sq: f64) -> Result<MapStep, NotSteady> {
     let b = scene.b;
     let Some(tg) = theta_g(scene, w0sq) else {
         return Err(NotSteady::LiftOff {
@@ -188,7 +188,7 @@ fn refine(scene: &Scene, a: f64, b: f64, ga: f64, gb: f64) -> Result<f64, NotSte
 
 /// Fixed point of the final-velocity map reached from `x0` (the way a bead launched there
 /// evolves), with the bracket search accelerated by Aitken extrapolation.
-pub fn fixed_point_from(scene: &Scene, x0: f64) -> Result<f64, NotSteady> {
+pub(crate) fn fixed_point_from(scene: &Scene, x0: f64) -> Result<f64, NotSteady> {
     // Where the map's asymptotic slope K e^{2fα} is well below 1 the fixed point is unique (the
     // same premise as [`steady_tol`]'s search for a second one), so any convergent iteration
     // finds the one the bead settles on: try the secant method first.

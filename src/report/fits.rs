@@ -54,7 +54,7 @@ impl Analysis {
 
     /// [`Analysis::fit_results`] with, for a posterior run, every point's fitted v̄ replaced by
     /// its posterior median (`medians`, from
-    /// [`posterior_bands`](super::bands::posterior_bands)), and its residuals recomputed from
+    /// [`posterior_bands_until`](super::bands::posterior_bands_until)), and its residuals recomputed from
     /// it: v − v̄, divided by σ (without σ, by the scatter sqrt(χ²/dof) of the fit).
     pub fn fit_results_at(&self, medians: Option<&PosteriorBands>) -> Vec<FitResult> {
         let mut fits = self.fit_results();

@@ -1,14 +1,14 @@
-//! Reports: the comparisons of `fitbead report` ([`analysis`]) and their posterior bands
-//! ([`bands`]), the list of its fits ([`fits`]), its figures ([`plots`], drawn with the engine
-//! in [`figures`]), its text ([`text`]) and the work-precision engine of `fitbead bench`
+//! Reports: the comparisons of `fitbead report` (`analysis`) and their posterior bands
+//! (`bands`), the list of its fits (`fits`), its figures (`plots`, drawn with the engine
+//! in [`figures`]), its text (`text`) and the work-precision engine of `fitbead bench`
 //! ([`workprecision`]).
 
-pub mod analysis;
-pub mod bands;
+pub(crate) mod analysis;
+pub(crate) mod bands;
 pub mod figures;
-pub mod fits;
-pub mod plots;
-pub mod text;
+pub(crate) mod fits;
+pub(crate) mod plots;
+pub(crate) mod text;
 pub mod workprecision;
 
 /// Longest file-name part made of a series label ([`file_stems`]), in bytes.
@@ -19,7 +19,7 @@ pub(crate) const STEM_BYTES: usize = 64;
 /// label that had to change and now shares its name with another label gets `-` and eight
 /// hexadecimal digits of a hash of the label appended (stable: the same label gets the same
 /// name whatever the other labels). A label already safe keeps its name.
-pub fn file_stems(labels: &[String]) -> Vec<String> {
+pub(crate) fn file_stems(labels: &[String]) -> Vec<String> {
     let safe = |l: &str| -> String {
         let mut s: String = l
             .chars()
@@ -64,7 +64,7 @@ pub fn file_stems(labels: &[String]) -> Vec<String> {
 /// or `both`, each figure `NAME.svg` also, or instead, as `NAME.png`; with `--method mcmc`, one
 /// corner plot per posterior, `corner_<fit>_<series>.svg` with the fit named as in
 /// `params.csv` and the series label made a safe file name by [`file_stems`]).
-pub const REPORT_FILES: [&str; 19] = [
+pub(crate) const REPORT_FILES: [&str; 19] = [
     "bulk_friction.csv",
     "energy.csv",
     "regime_map.csv",
@@ -85,3 +85,33 @@ pub const REPORT_FILES: [&str; 19] = [
     "residuals.svg",
     "report.md",
 ];
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn series_labels_become_safe_unique_file_names() {
+        let labels: Vec<String> = ["../../x/evil", "a|b\nc", "0.8", "a_b_c", "a/b/c", "", ".."]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        let stems = super::file_stems(&labels);
+        assert_eq!(stems[0], ".._.._x_evil");
+        assert_eq!(stems[2], "0.8");
+        assert_eq!(stems[3], "a_b_c", "a safe label keeps its name");
+        for (l, st) in labels.iter().zip(&stems) {
+            assert!(!st.is_empty() && st != "." && st != "..", "{l:?} -> {st:?}");
+            assert!(
+                st.chars()
+                    .all(|c| c.is_ascii_alphanumeric() || matches!(c, '.' | '_' | '-')),
+                "{l:?} -> {st:?}"
+            );
+        }
+        let mut unique = stems.clone();
+        unique.sort();
+        unique.dedup();
+        assert_eq!(unique.len(), stems.len(), "{stems:?}");
+        // Stable: a label's name does not depend on the other labels.
+        let again = super::file_stems(&[labels[4].clone(), labels[3].clone()]);
+        assert_eq!(again[0], stems[4]);
+    }
+}

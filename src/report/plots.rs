@@ -171,13 +171,8 @@ impl Analysis {
 
     /// Figure: v̄ against δ per series with every fitted model (the paper's Figs. 2–3, 8
     /// and 9). A model whose curve lies on an earlier one is dashed, and its legend entry
-    /// says on which.
-    pub fn velocity_figure(&self) -> Result<String, String> {
-        self.velocity_figure_with(None, None)
-    }
-
-    /// [`Analysis::velocity_figure`] with, for a posterior run, each model's 90 % posterior
-    /// band of v̄(δ) (from [`posterior_bands`](super::bands::posterior_bands): the 5 % and 95 %
+    /// says on which. With `bands`, for a posterior run, each model's 90 % posterior
+    /// band of v̄(δ) (from [`posterior_bands_until`](super::bands::posterior_bands_until): the 5 % and 95 %
     /// quantiles of the model's v̄ over the draws) shaded under its curve; with `units_m_s`
     /// (per series, in the order of [`Dataset::labels`](crate::fit::data::Dataset::labels),
     /// the velocity unit sqrt(g R (1 + ξ)) in m/s of velocities given in m/s), in m/s.
@@ -896,12 +891,7 @@ impl Analysis {
     }
 
     /// Figure: normalised residuals (v − v̄_fit)/σ against δ, one panel per fit, points
-    /// coloured by series, with the ±2 lines.
-    pub fn residuals_figure(&self) -> Result<String, String> {
-        self.residuals_figure_with(&self.fit_results())
-    }
-
-    /// [`Analysis::residuals_figure`] of `fits` as [`Analysis::fit_results`] or
+    /// coloured by series, with the ±2 lines, of `fits` as [`Analysis::fit_results`] or
     /// [`Analysis::fit_results_at`] give them (under a posterior run, residuals at the
     /// posterior medians); fits of one name make one panel.
     pub fn residuals_figure_with(&self, fits: &[FitResult]) -> Result<String, String> {
@@ -1356,4 +1346,60 @@ pub fn lsq_fit_figure(
         0.3,
     ));
     Ok(f.to_svg())
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::fit::data::Dataset;
+    use crate::inverse::posterior::Method;
+    use crate::report::analysis::analyse;
+    use crate::report::bands::{Band, PosteriorBands};
+
+    /// A posterior band under a model's curve in the velocity figure is drawn in that model's
+    /// colour (Jaeger's, #CC79A7, at the band's opacity 0.18 over white), under the data,
+    /// with its legend entry.
+    #[test]
+    fn velocity_band_renders_under_the_curve() {
+        let ds = Dataset::default_data();
+        let an = analyse(&ds, 0.95, &Method::lsq(false));
+        let delta_deg: Vec<f64> = (0..=20).map(|i| 11.0 + 2.5 * i as f64 / 20.0).collect();
+        let line =
+            |a: f64| -> Vec<f64> { delta_deg.iter().map(|d| a + 0.03 * (d - 11.0)).collect() };
+        let bands = PosteriorBands {
+            bands: vec![Band {
+                fit: "jaeger".into(),
+                series: ds.labels[0].clone(),
+                xi: 0.8,
+                q05: line(0.30),
+                q50: line(0.32),
+                q95: line(0.34),
+                delta_deg: delta_deg.clone(),
+                draws: 1000,
+            }],
+            points: Vec::new(),
+        };
+        let svg = an.velocity_figure_with(Some(&bands), None).unwrap();
+        assert!(svg.contains("posterior band"));
+        let band = svg.find("fill-opacity=\"0.25\"").expect("a band");
+        let first_marker = svg.find("<circle").expect("markers");
+        assert!(band < first_marker, "the band is drawn under the data");
+        #[cfg(feature = "png")]
+        {
+            // #CC79A7 = (204, 121, 167) at opacity 0.18 over white, and at full opacity.
+            let pixmap = crate::report::figures::png::render_pixmap(&svg, 1.0).unwrap();
+            let mix = |c: f64| (0.18 * c + 0.82 * 255.0_f64).round() as i32;
+            for want in [[mix(204.0), mix(121.0), mix(167.0)], [204, 121, 167]] {
+                let n = pixmap
+                    .pixels()
+                    .iter()
+                    .filter(|p| {
+                        (p.red() as i32 - want[0]).abs() <= 6
+                            && (p.green() as i32 - want[1]).abs() <= 6
+                            && (p.blue() as i32 - want[2]).abs() <= 6
+                    })
+                    .count();
+                assert!(n >= 20, "colour {want:?} on {n} pixels");
+            }
+        }
+    }
 }

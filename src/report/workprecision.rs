@@ -41,7 +41,7 @@ const K_CONTACT_TOLS: [f64; 3] = [1e-6, 1e-10, 1e-14];
 pub(crate) const K_SCENES: usize = 100;
 
 /// Bounds the references' cross-checks must meet (maximum relative disagreement of v̄).
-pub const XCHECK_BOUNDS: [(&str, f64); 4] = [
+pub(crate) const XCHECK_BOUNDS: [(&str, f64); 4] = [
     ("stick", 1e-13),
     ("slip", 1e-11),
     ("stickslip", 1e-11),
@@ -87,7 +87,7 @@ fn slip_raw(scene: &Scene) -> Option<f64> {
 
 /// The references of one scene.
 #[derive(Debug, Clone, Copy)]
-pub struct References {
+pub(crate) struct References {
     /// Stick, elliptic closed form.
     pub stick: Outcome,
     /// Stick by quadrature at 1e-15 (cross-check).
@@ -110,7 +110,7 @@ pub struct References {
 /// The physics reference of a scene: the general contact model's v̄ computed by the most
 /// accurate path that describes its phase sequence.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PhysicsSource {
+pub(crate) enum PhysicsSource {
     /// The contact model rolls throughout: the exact rolling closed form (cross-checked by
     /// quadrature). Near δ_m the contact model itself loses digits to cancellation in the
     /// squared top velocity, which the closed form computes without cancellation.
@@ -396,7 +396,7 @@ fn error_of(o: &Outcome, r: Option<f64>, ref_ok: bool) -> Option<f64> {
 
 /// Everything the bench measures.
 #[derive(Debug, Clone)]
-pub struct BenchResult {
+pub(crate) struct BenchResult {
     /// The rows, in order.
     pub rows: Vec<WpRow>,
     /// Per auto tolerance: the cheapest single variant (by median time) that meets it on all
@@ -408,7 +408,7 @@ pub struct BenchResult {
 
 /// Runs the whole bench on `scenes` (single thread), stopping with [`Interrupted`] once `stop` is raised (polled before every
 /// scene of every variant: a few milliseconds apart at most).
-pub fn run_bench_until(
+pub(crate) fn run_bench_until(
     scenes: &[(Scene, Draw)],
     stop: &AtomicBool,
 ) -> Result<BenchResult, Interrupted> {

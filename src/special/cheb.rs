@@ -28,7 +28,7 @@ fn cos_table() -> &'static [[f64; NMAX + 1]; NMAX + 1] {
 
 /// The antiderivative of a smooth f on [a, b] as a Chebyshev series.
 #[derive(Debug, Clone, Copy)]
-pub struct ChebIntegral {
+pub(crate) struct ChebIntegral {
     a: f64,
     b: f64,
     n: usize,

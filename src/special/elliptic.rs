@@ -4,7 +4,7 @@
 //! Carlson's R_F is the duplication algorithm of Carlson (1995), as in the `ellip` crate (a port
 //! of Boost.Math, ≤ 4.5e-16 relative on Boost's test data) but without its per-call `powf` (see
 //! [`rf`]); the unit test below holds it against Carlson's (1995) published values,
-//! and `tests/it/reference_models.rs` holds the rolling models built on it against 40-digit mpmath
+//! and `src/models/suite/reference_models.rs` holds the rolling models built on it against 40-digit mpmath
 //! quadrature down to δ = δ_m (1 + 1e-9), where its log singularity is exercised.
 
 use super::SinCos;
@@ -19,7 +19,7 @@ use super::SinCos;
 /// `powf` and rescales on every call, which the stick model, whose time is mostly R_F, pays for
 /// (measured in docs/PERFORMANCE.md, "Forward models"). The arithmetic is otherwise the
 /// crate's, operation for operation, so the results are the same; the unit test below holds it
-/// against Carlson's published values and `tests/it/reference_models.rs` holds the rolling
+/// against Carlson's published values and `src/models/suite/reference_models.rs` holds the rolling
 /// models against 40-digit mpmath quadrature.
 /// Arguments whose largest is outside [1e-30, 1e30] (never met by the models) are brought to
 /// about 1 by the homogeneity R_F(λx, λy, λz) = λ^{-1/2} R_F(x, y, z) with λ = 4^k, exact in

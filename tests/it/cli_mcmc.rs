@@ -119,7 +119,8 @@ fn klaw_mcmc_report_draws_and_seed() {
 fn scale_is_sampled_without_sigma_and_with_fit_scatter() {
     let dir = tmpdir();
     // The default data without its sigma_v column: the scatter is a parameter.
-    let text: String = fitbead::io::measurements::DEFAULT_DATA
+    let text: String = std::fs::read_to_string(crate::common::root().join("data/default.csv"))
+        .unwrap()
         .lines()
         .map(|l| {
             let f: Vec<&str> = l.split(',').collect();

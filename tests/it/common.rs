@@ -80,11 +80,6 @@ pub fn col(h: &[String], name: &str) -> usize {
         .unwrap_or_else(|| panic!("missing column {name}: {h:?}"))
 }
 
-/// A table of tests/reference/ (docs/ACCURACY.md#reference-tables says how each was made).
-pub fn reference_table(name: &str) -> (Vec<String>, Vec<Vec<String>>) {
-    read_table(&root().join("tests").join("reference").join(name))
-}
-
 /// Asserts exit code `code` and that stderr holds every one of `must`.
 pub fn expect(out: &Output, code: i32, must: &[&str], what: &str) {
     let e = stderr(out);

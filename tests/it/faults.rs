@@ -491,26 +491,6 @@ fn a_report_is_written_whole_or_not_at_all() {
 }
 
 #[test]
-fn a_failed_group_of_renames_is_rolled_back() {
-    // Library level: a target that turns into a directory after the group was checked (a
-    // race) fails its rename; the file renamed before it is put back.
-    let dir = tmpdir();
-    let a = write(&dir, "a.csv", "old a\n");
-    let b = dir.path().join("b.csv");
-    let r = fitbead::io::write_atomic_all_then(&[(&a, b"new a\n"), (&b, b"new b\n")], || {
-        std::fs::create_dir(&b).unwrap()
-    });
-    assert!(r.is_err());
-    assert_eq!(std::fs::read_to_string(&a).unwrap(), "old a\n");
-    assert!(b.is_dir());
-    assert!(
-        leftovers(dir.path()).is_empty(),
-        "{:?}",
-        leftovers(dir.path())
-    );
-}
-
-#[test]
 fn an_output_that_is_an_input_or_another_output_is_refused() {
     let dir = tmpdir();
     let x = dir.path().join("x.csv");

@@ -1,4 +1,4 @@
-"""dv/dK of the steady rolling (stick) model at hard points, for tests/it/k_inversion.rs.
+"""dv/dK of the steady rolling (stick) model at hard points, for src/fit/suite/k_inversion.rs.
 
 v(K) = 2 sin(alpha) / tau(K), tau = int_{Theta0}^{Thetaf} dtheta / sqrt(A - B cos theta)
 (eqs 10-11), with B = 2/(1+rho), the steady launch speed from eq 19, and the integral by

@@ -26,7 +26,7 @@ pub struct KChoice {
 }
 
 /// The K estimate of one measurement (eq 69) under `model`, or under the model `auto`
-/// chooses for it ([`choose`]) when `auto` is given, with that choice.
+/// chooses for it (`choose`) when `auto` is given, with that choice.
 pub fn estimate_with(
     model: &Model,
     auto: Option<&Auto>,
@@ -44,7 +44,7 @@ pub fn estimate_with(
 }
 
 /// Chooses the model for inverting one point (ξ, δ, ρ, f of `scene`, measured `v`).
-pub fn choose(auto: &Auto, scene: &Scene, v: f64) -> KChoice {
+pub(crate) fn choose(auto: &Auto, scene: &Scene, v: f64) -> KChoice {
     let model_of = |c: Choice| match c {
         Choice::Stick => Model::Stick,
         Choice::StickSlip => Model::StickSlip,
@@ -80,7 +80,7 @@ pub fn choose(auto: &Auto, scene: &Scene, v: f64) -> KChoice {
 
 /// The most general model any of the points needs (contact over stickslip over stick), with
 /// the count of points per model: auto for fits that need one model for all points.
-pub fn most_general(choices: &[KChoice]) -> (Choice, [usize; 3]) {
+pub(crate) fn most_general(choices: &[KChoice]) -> (Choice, [usize; 3]) {
     let mut n = [0usize; 3];
     for c in choices {
         n[match c.choice {

@@ -12,7 +12,7 @@ use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// The models whose K can be inverted.
-pub fn invertible(model: &Model) -> bool {
+pub(crate) fn invertible(model: &Model) -> bool {
     matches!(
         model,
         Model::Stick
@@ -336,7 +336,7 @@ pub fn bracket(model: &Model, scene: &Scene) -> Result<KBracket, KFailure> {
 
 /// The points of `ds` that no K makes steady under any of `models` (regime A or C for every
 /// K), with why under the first model; none once `stop` is raised.
-pub fn unsteady_points(
+pub(crate) fn unsteady_points(
     models: &[Model],
     ds: &Dataset,
     stop: Option<&AtomicBool>,

@@ -589,7 +589,12 @@ enum End {
 
 /// [`super::estimate()`](super::estimate::estimate) by the launch speed, when this path applies (`None`: use the
 /// general search). Same outputs and statuses as the general path.
-pub fn estimate(model: &Model, scene: &Scene, v: f64, sigma_v: Option<f64>) -> Option<KEstimate> {
+pub(crate) fn estimate(
+    model: &Model,
+    scene: &Scene,
+    v: f64,
+    sigma_v: Option<f64>,
+) -> Option<KEstimate> {
     if !(v > 0.0 && v.is_finite()) {
         return None;
     }

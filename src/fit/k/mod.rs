@@ -33,7 +33,9 @@ pub mod launch;
 pub mod search;
 pub mod types;
 
-pub use bracket::{bracket, invertible, unsteady_points};
+pub use bracket::bracket;
+pub(crate) use bracket::unsteady_points;
 pub use estimate::estimate;
-pub use search::{dv_dk, estimate_in_k, solve};
+pub(crate) use search::dv_dk;
+pub use search::solve;
 pub use types::{KBracket, KEstimate, KFailure, KRoot, LowerLimit, UpperLimit};

@@ -10,7 +10,7 @@ use crate::special::root::brent;
 
 /// Solves v̄_th(K) = v (eq 69) on a bracket from [`bracket`]. Brent's method runs to full
 /// precision in s = ln(K − K_min), so |ΔK| ≈ 2ε |s| (K − K_min): about 1e-14 at most across
-/// the bracket (measured round trips: ≤ 3.4e-15, tests/it/k_inversion.rs). Where the bead crawls
+/// the bracket (measured round trips: ≤ 3.4e-15, src/fit/suite/k_inversion.rs). Where the bead crawls
 /// so slowly that no K distinguishable from K_min gives v, the first steady K above K_min is
 /// returned (within 1e-12 of the root).
 pub fn solve(model: &Model, scene: &Scene, br: &KBracket, v: f64) -> Result<KRoot, KFailure> {
@@ -128,7 +128,7 @@ pub fn solve(model: &Model, scene: &Scene, br: &KBracket, v: f64) -> Result<KRoo
 
 /// Relative tolerance on v at the ends of the steady range: the rounding of v̄ by the
 /// forward models there (measured up to 49 ε for stick-approx near its limit A = B,
-/// tests/it/k_edges.rs).
+/// src/fit/suite/k_edges.rs).
 const ROUNDING: f64 = 128.0 * f64::EPSILON;
 
 /// v is slower than the motion at `k`, the lowest steady K that double precision resolves
@@ -344,7 +344,12 @@ fn clamp_end(
 }
 
 /// [`estimate`](fn@super::estimate) by the general search in K: [`bracket`], then [`solve`] at v and v ± σ.
-pub fn estimate_in_k(model: &Model, scene: &Scene, v: f64, sigma_v: Option<f64>) -> KEstimate {
+pub(crate) fn estimate_in_k(
+    model: &Model,
+    scene: &Scene,
+    v: f64,
+    sigma_v: Option<f64>,
+) -> KEstimate {
     let br = match bracket(model, scene) {
         Ok(b) => b,
         Err(e) => {
@@ -416,10 +421,10 @@ fn slope(model: &Model, scene: &Scene, br: &KBracket, r: &KRoot) -> Option<f64> 
 /// derivative at `k0`, second-order accurate on any spacing). Near the bracket's top, where
 /// K_min + d e^h is out of range, the step is shrunk to fit and, failing that, the points are
 /// taken at s − h and s − 2h (one-sided, still second order); a first-order one-sided
-/// difference would be off by 5e-4 below lift-off (tests/it/k_inversion.rs, mpmath
+/// difference would be off by 5e-4 below lift-off (src/fit/suite/k_inversion.rs, mpmath
 /// references). Used by the K inversion (`dv_dK` of `fitbead k`) and by the K-law fits'
 /// Jacobian ([`crate::fit::klaw`]).
-pub fn dv_dk(
+pub(crate) fn dv_dk(
     br: &KBracket,
     k0: f64,
     v0: f64,

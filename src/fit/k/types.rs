@@ -53,7 +53,7 @@ pub struct KBracket {
     pub lo: f64,
     /// Highest K (inclusive: the forward model is steady there; for a stick/slip range ending
     /// at the map's saddle-node, the last K below it where the forward model finds the stable
-    /// fixed point — tested to within 1e-9 of the range in tests/it/k_inversion.rs).
+    /// fixed point — tested to within 1e-9 of the range in src/fit/suite/k_inversion.rs).
     pub hi: f64,
     /// v̄ at the lower end (0 when the bead crawls over the top).
     pub v_lo: f64,

@@ -3,7 +3,7 @@
 //! Layout: the draws of one scalar quantity are given as `&[Vec<f64>]`, one vector per chain
 //! (for an ensemble sampler, one chain per walker), all of the same length. The draws of a
 //! vector parameter are given as `&[Vec<Vec<f64>>]`, indexed `[chain][step][parameter]`;
-//! [`parameter_chains`] extracts one parameter from that layout.
+//! `parameter_chains` extracts one parameter from that layout.
 //!
 //! * [`integrated_time`] — the integrated autocorrelation time with Sokal's automatic window,
 //!   as in emcee's `integrated_time` (D. Foreman-Mackey, D. W. Hogg, D. Lang & J. Goodman,
@@ -14,8 +14,8 @@
 //!   "Rank-normalization, folding, and localization: an improved R̂ for assessing convergence
 //!   of MCMC", Bayesian Analysis 16, 2021, with Geyer's initial monotone sequence (C. J. Geyer,
 //!   "Practical Markov chain Monte Carlo", Statistical Science 7, 1992), as in Stan and the R
-//!   package `posterior`; [`convergence`] computes the three together, sharing their sorts;
-//! * [`summarise`] — all of the above plus mean, standard deviation and quantiles of the pooled
+//!   package `posterior`; `convergence` computes the three together, sharing their sorts;
+//! * `summarise` — all of the above plus mean, standard deviation and quantiles of the pooled
 //!   draws, per parameter.
 
 use realfft::num_complex::Complex;
@@ -23,10 +23,10 @@ use realfft::RealFftPlanner;
 use statrs::distribution::{ContinuousCDF, Normal};
 
 /// Sokal's window constant used by emcee: the window is the smallest M with M ≥ c·τ(M).
-pub const SOKAL_C: f64 = 5.0;
+pub(crate) const SOKAL_C: f64 = 5.0;
 
 /// Extracts parameter `k` from chains laid out `[chain][step][parameter]`.
-pub fn parameter_chains(chains: &[Vec<Vec<f64>>], k: usize) -> Vec<Vec<f64>> {
+pub(crate) fn parameter_chains(chains: &[Vec<Vec<f64>>], k: usize) -> Vec<Vec<f64>> {
     chains
         .iter()
         .map(|c| c.iter().map(|x| x[k]).collect())
@@ -80,7 +80,7 @@ pub fn autocovariance(x: &[f64]) -> Vec<f64> {
 }
 
 /// Normalised autocorrelation function ρ̂(t) = γ̂(t)/γ̂(0) (all zeros for a constant series).
-pub fn autocorrelation(x: &[f64]) -> Vec<f64> {
+pub(crate) fn autocorrelation(x: &[f64]) -> Vec<f64> {
     let mut acov = autocovariance(x);
     let v0 = acov.first().copied().unwrap_or(0.0);
     if v0 > 0.0 {
@@ -94,7 +94,7 @@ pub fn autocorrelation(x: &[f64]) -> Vec<f64> {
 /// Integrated autocorrelation time τ of one scalar quantity, in steps, as emcee's
 /// `integrated_time` (Foreman-Mackey et al. 2013): the autocorrelation functions of the chains
 /// are averaged, τ(M) = 1 + 2 Σ_{t=1}^{M} ρ̂(t), and the window M is the smallest with
-/// M ≥ c·τ(M) (Sokal 1997; `c` = [`SOKAL_C`] by default), or the last lag if none is.
+/// M ≥ c·τ(M) (Sokal 1997; `c` = `SOKAL_C` by default), or the last lag if none is.
 ///
 /// The estimate is reliable only for chains longer than about 50 τ (emcee's rule of thumb).
 /// Returns NaN for empty chains, and 1 for constant ones.
@@ -129,7 +129,7 @@ pub fn integrated_time(chains: &[Vec<f64>], c: f64) -> f64 {
 
 /// Integrated autocorrelation times of every parameter of chains laid out
 /// `[chain][step][parameter]` (see [`integrated_time`]).
-pub fn integrated_times(chains: &[Vec<Vec<f64>>], c: f64) -> Vec<f64> {
+pub(crate) fn integrated_times(chains: &[Vec<Vec<f64>>], c: f64) -> Vec<f64> {
     let dim = chains
         .first()
         .and_then(|c| c.first())
@@ -145,7 +145,7 @@ pub fn integrated_times(chains: &[Vec<Vec<f64>>], c: f64) -> Vec<f64> {
 
 /// Splits each chain in two halves (dropping the middle draw of odd-length chains), giving
 /// 2·M chains of length ⌊N/2⌋.
-pub fn split_chains(chains: &[Vec<f64>]) -> Vec<Vec<f64>> {
+pub(crate) fn split_chains(chains: &[Vec<f64>]) -> Vec<Vec<f64>> {
     let n = chains.iter().map(Vec::len).min().unwrap_or(0);
     let half = n / 2;
     let mut out = Vec::with_capacity(2 * chains.len());
@@ -266,7 +266,7 @@ pub struct Convergence {
 }
 
 /// [`Convergence`] of chains (one vector of draws per chain).
-pub fn convergence(chains: &[Vec<f64>]) -> Convergence {
+pub(crate) fn convergence(chains: &[Vec<f64>]) -> Convergence {
     let mut sorted: Vec<f64> = chains.iter().flatten().copied().collect();
     sorted.sort_by(f64::total_cmp);
     convergence_sorted(chains, &sorted)
@@ -293,7 +293,7 @@ fn convergence_sorted(chains: &[Vec<f64>], sorted: &[f64]) -> Convergence {
 /// Geyer's initial monotone sequence (Vehtari et al. 2021, §3.2; Stan's `ess`, including the
 /// `posterior` package's use of the last positive even lag and the 1/log₁₀(MN) floor on τ̂).
 /// NaN when the draws are constant or too few (N < 4).
-pub fn ess_basic(chains: &[Vec<f64>]) -> f64 {
+pub(crate) fn ess_basic(chains: &[Vec<f64>]) -> f64 {
     let m = chains.len();
     let n = chains.iter().map(Vec::len).min().unwrap_or(0);
     if m == 0 || n < 4 {
@@ -351,7 +351,7 @@ pub fn ess_basic(chains: &[Vec<f64>]) -> f64 {
     total / tau
 }
 
-/// Bulk effective sample size: [`ess_basic`] of the rank-normalised split chains
+/// Bulk effective sample size: `ess_basic` of the rank-normalised split chains
 /// (Vehtari et al. 2021, §4.3). Measures the efficiency of estimates of the centre of the
 /// distribution (mean, median).
 pub fn ess_bulk(chains: &[Vec<f64>]) -> f64 {
@@ -389,7 +389,7 @@ fn ess_tail_sorted(split: &[Vec<f64>], sorted: &[f64]) -> f64 {
         })
 }
 
-/// Effective sample size for the mean: [`ess_basic`] of the split chains on the original scale
+/// Effective sample size for the mean: `ess_basic` of the split chains on the original scale
 /// (no rank normalisation), as `posterior::ess_mean`. Use it for Monte-Carlo standard errors
 /// of means: MCSE = sd/√ESS.
 pub fn ess_mean(chains: &[Vec<f64>]) -> f64 {
@@ -402,7 +402,7 @@ pub fn ess_mean(chains: &[Vec<f64>]) -> f64 {
 
 /// Quantile of sorted data with linear interpolation between order statistics (Hyndman & Fan
 /// 1996, type 7, the default of R and NumPy). NaN for empty data.
-pub fn quantile_sorted(sorted: &[f64], p: f64) -> f64 {
+pub(crate) fn quantile_sorted(sorted: &[f64], p: f64) -> f64 {
     let n = sorted.len();
     if n == 0 {
         return f64::NAN;
@@ -427,7 +427,7 @@ pub struct ParameterDiagnostics {
     pub median: f64,
     /// 97.5 % quantile.
     pub q975: f64,
-    /// Central interval at the level asked of [`summarise`]: (quantile (1−level)/2,
+    /// Central interval at the level asked of `summarise`: (quantile (1−level)/2,
     /// quantile (1+level)/2).
     pub interval: (f64, f64),
     /// Integrated autocorrelation time (in steps of the chains given), see [`integrated_time`].
@@ -442,7 +442,7 @@ pub struct ParameterDiagnostics {
 
 /// Diagnostics of one scalar quantity given as one vector of draws per chain; `level` is the
 /// probability of the central interval (e.g. 0.95).
-pub fn summarise_scalar(chains: &[Vec<f64>], level: f64) -> ParameterDiagnostics {
+pub(crate) fn summarise_scalar(chains: &[Vec<f64>], level: f64) -> ParameterDiagnostics {
     let mut sorted: Vec<f64> = chains.iter().flatten().copied().collect();
     let s = sorted.len() as f64;
     let mean = sorted.iter().sum::<f64>() / s;
@@ -469,7 +469,7 @@ pub fn summarise_scalar(chains: &[Vec<f64>], level: f64) -> ParameterDiagnostics
 
 /// Diagnostics of every parameter of chains laid out `[chain][step][parameter]`; `level` is
 /// the probability of the central interval (e.g. 0.95).
-pub fn summarise(chains: &[Vec<Vec<f64>>], level: f64) -> Vec<ParameterDiagnostics> {
+pub(crate) fn summarise(chains: &[Vec<Vec<f64>>], level: f64) -> Vec<ParameterDiagnostics> {
     let dim = chains
         .first()
         .and_then(|c| c.first())

@@ -1,6 +1,6 @@
-//! The figures: SVG documents written by the crate's own engine ([`svg`] for the document
-//! and its text, [`plot`] for axes, legends and grids of panels), the corner plots of
-//! posteriors ([`corner`]), and the scatter figure of `fitbead k`. `png` (feature `png`)
+//! The figures: SVG documents written by the crate's own engine (`svg` for the document
+//! and its text, `plot` for axes, legends and grids of panels), the corner plots of
+//! posteriors (`corner`), and the scatter figure of `fitbead k`. `png` (feature `png`)
 //! renders any of them to PNG with resvg and the embedded font; feature `pdf` converts them to
 //! PDF (svg2pdf over the same tree, the font embedded).
 //!
@@ -11,26 +11,25 @@
 //! Every document names the font family list `FONT_FAMILY`, whose first member is the
 //! embedded DejaVu Sans (`assets/fonts/`), whose advance widths the layout measures text with.
 
-pub mod corner;
+pub(crate) mod corner;
 mod metrics;
 #[cfg(feature = "pdf")]
 mod pdf;
-pub mod plot;
+pub(crate) mod plot;
 #[cfg(feature = "png")]
-pub mod png;
-pub mod svg;
+pub(crate) mod png;
+pub(crate) mod svg;
 
 pub use corner::{corner_svg, CornerBlock};
-pub use plot::{
-    coincide, stack_svg, Axis, ErrPoint, Figure, Item, LegendEntry, Panel, Scale, Swatch, DASHES,
-    PALETTE,
+pub(crate) use plot::{
+    coincide, Axis, ErrPoint, Figure, Item, LegendEntry, Panel, DASHES, PALETTE,
 };
-pub use svg::{Anchor, Mark, Stroke, MARKS};
+pub(crate) use svg::{Anchor, Mark, Stroke, MARKS};
 
 /// One series of points with optional vertical error bars, and an optional horizontal
 /// reference line drawn in the same colour.
 #[derive(Debug, Clone, Default)]
-pub struct PointSeries {
+pub(crate) struct PointSeries {
     /// Legend label (markup).
     pub label: String,
     /// (x, y, y_low, y_high) per point; y_low/y_high equal y when there is no interval.
@@ -41,7 +40,7 @@ pub struct PointSeries {
 
 /// A scatter figure: title, axis labels, series.
 #[derive(Debug, Clone, Default)]
-pub struct Scatter {
+pub(crate) struct Scatter {
     /// Caption above the plot (markup).
     pub title: String,
     /// x-axis label (markup).
@@ -86,7 +85,7 @@ pub(crate) fn scatter_svg(fig: &Scatter) -> Result<String, String> {
 /// in mm. The figures are laid out for it (see
 /// [`Figure::print_width_mm`](plot::Figure::print_width_mm)): text never prints below 7 pt.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum FigureWidth {
+pub(crate) enum FigureWidth {
     /// One column: 86 mm (8.6 cm, as the Physical Review journals).
     Single,
     /// Both columns: 178 mm (17.8 cm, as the Physical Review journals).
@@ -129,7 +128,7 @@ impl std::str::FromStr for FigureWidth {
 
 /// The file formats of a report's figures.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum FigureFormat {
+pub(crate) enum FigureFormat {
     /// SVG only.
     #[default]
     Svg,

@@ -1099,10 +1099,10 @@ impl Figure {
             }
             g.plot.0
         };
-        while reflow && f.cols > 1 && shrunk(&f) < COMFORTABLE_PLOT.min(w0) {
+        while reflow && f.cols > 1 && shrunk(f) < COMFORTABLE_PLOT.min(w0) {
             f.cols -= 1;
         }
-        let w = shrunk(&f);
+        let w = shrunk(f);
         // The aspect kept, but never shorter than the longest y label needs.
         let y_label = f
             .panels

@@ -270,11 +270,6 @@ impl Svg {
         }
     }
 
-    /// Raw SVG appended to the body.
-    pub fn raw(&mut self, s: &str) {
-        self.body.push_str(s);
-    }
-
     /// Opens a group translated by (dx, dy); close it with [`Svg::end_group`].
     pub fn begin_translate(&mut self, dx: f64, dy: f64) {
         let _ = writeln!(

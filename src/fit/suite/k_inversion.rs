@@ -2,14 +2,15 @@
 //! bracket's ends against the forward models' own status, and v̄ increasing in K on it.
 //!
 //! Reference: the forward models themselves (held to 3e-13 against mpmath in
-//! tests/it/reference_models.rs); the inversion must return the K that produced v̄.
+//! src/models/suite/reference_models.rs); the inversion must return the K that produced v̄.
 
-use fitbead::fit::k::{bracket, estimate, estimate_in_k, solve, KFailure, LowerLimit, UpperLimit};
-use fitbead::{CollisionLaw, ForwardModel, Model, Scene};
+use crate::fit::k::search::estimate_in_k;
+use crate::fit::k::{bracket, estimate, solve, KFailure, LowerLimit, UpperLimit};
+use crate::{CollisionLaw, ForwardModel, Model, Scene};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use crate::common::reference_table;
+use super::reference_table;
 
 const MODELS: [Model; 5] = [
     Model::Stick,
@@ -265,8 +266,8 @@ fn stickslip_within_1e_9_of_the_saddle_node() {
 /// taken.
 #[test]
 fn launch_speed_path_agrees_with_the_search_in_k() {
-    use fitbead::fit::k::estimate_in_k;
-    use fitbead::fit::k::launch as klaunch;
+    use crate::fit::k::launch as klaunch;
+    use crate::fit::k::search::estimate_in_k;
     let mut rng = ChaCha8Rng::seed_from_u64(70);
     for m in [Model::Stick, Model::StickSlip] {
         let (mut taken, mut tried, mut worst, mut worst_slope) = (0, 0, 0.0f64, 0.0f64);

@@ -4,10 +4,10 @@
 //! (δ in radians as a double, K as a double). Regenerate with
 //! `python3 tests/reference/make_refs.py`.
 
-use fitbead::models::{stick, NotSteady, Regime};
-use fitbead::{CollisionLaw, ForwardModel, Model, Scene};
+use crate::models::{stick, NotSteady, Regime};
+use crate::{CollisionLaw, ForwardModel, Model, Scene};
 
-use crate::common::{col, reference_table};
+use super::{col, reference_table};
 
 struct Row {
     case: String,
@@ -237,7 +237,7 @@ fn slip_limit_case(r: &Row) -> bool {
 /// terms at 1e-9). The minimum comes from double-double, and the test also holds it against
 /// the reference's own minimum (`extra`, min_G2).
 /// v̄ to 1.2e-15 relative (measured 7.8e-16), the minimum to one ulp (measured: equal). Print
-/// with `cargo test --release --test it reference_models:: -- --nocapture`.
+/// with `cargo test --release --lib models::suite::reference_models:: -- --nocapture`.
 #[test]
 fn slip_near_its_limits() {
     const V_TOL: f64 = 1.2e-15;
@@ -256,7 +256,7 @@ fn slip_near_its_limits() {
         assert!(e <= V_TOL, "{}: {} vs {v}", r.case, s.mean_velocity);
         if r.model == "slip" && r.extra_name == "min_G2" {
             let want = r.extra.unwrap();
-            let (_, got) = fitbead::models::slip::speed_minimum(&r.scene).unwrap();
+            let (_, got) = crate::models::slip::speed_minimum(&r.scene).unwrap();
             let em = (got - want).abs() / want;
             line += &format!(", min speed² {got:.6e} rel {em:.2e}");
             worst_min = worst_min.max(em);
@@ -345,7 +345,7 @@ fn slip_deep_in_its_limits() {
 /// Relative error ≤ 4.6e-16, the figure docs/ACCURACY.md states.
 #[test]
 fn carlson_rf_matches_mpmath_at_hard_points() {
-    use fitbead::special::elliptic::rf;
+    use crate::special::elliptic::rf;
     let (_, records) = reference_table("elliptic_refs.csv");
     let (mut n, mut worst) = (0, 0.0f64);
     for rec in records {
@@ -382,8 +382,8 @@ fn carlson_rf_matches_mpmath_at_hard_points() {
 /// is infinite in both.
 #[test]
 fn legendre_f_matches_mpmath_from_zero_to_the_double_nearest_half_pi() {
-    use fitbead::special::elliptic::legendre_f;
-    use fitbead::special::SinCos;
+    use crate::special::elliptic::legendre_f;
+    use crate::special::SinCos;
     let (_, records) = reference_table("elliptic_refs.csv");
     let (mut n, mut worst) = (0, 0.0f64);
     for rec in records {
@@ -497,7 +497,7 @@ fn slip_approx_near_its_stop_limit_within_8_cond_u() {
 /// final-velocity map's slope is 0.993).
 #[test]
 fn named_laws_at_large_xi_within_1e_14() {
-    use fitbead::models::regimes;
+    use crate::models::regimes;
     let (mut n, mut worst) = (0, (0.0f64, String::new()));
     let mut failures = Vec::new();
     // Largest error per quantity (and model) and ξ, printed at the end.

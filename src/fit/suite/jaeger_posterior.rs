@@ -3,15 +3,15 @@
 //! against finite differences, and the posterior it gives against the one sampled in
 //! (ln a1, ln a2, ln a3) on the series where that sampler converges.
 
-use fitbead::fit::jaeger::{fit_jaeger_with, JaegerModel, JaegerX};
-use fitbead::fit::jaeger_coordinates::JaegerCoordinates;
-use fitbead::fit::posterior::{McmcSettings, Method, Prior};
-use fitbead::inverse::mcmc::diagnostics::{ess_basic, quantile_sorted, split_chains};
-use fitbead::inverse::mcmc::{EnsembleSampler, McmcOptions};
-use fitbead::inverse::posterior::Posterior;
-use fitbead::inverse::WeightedData;
-use fitbead::models::JaegerBranch;
-use fitbead::Dataset;
+use crate::fit::jaeger::{fit_jaeger_with, JaegerModel, JaegerX};
+use crate::fit::jaeger_coordinates::JaegerCoordinates;
+use crate::fit::posterior::{McmcSettings, Method, Prior};
+use crate::inverse::mcmc::diagnostics::{ess_basic, quantile_sorted, split_chains};
+use crate::inverse::mcmc::{EnsembleSampler, McmcOptions};
+use crate::inverse::posterior::Posterior;
+use crate::inverse::WeightedData;
+use crate::models::JaegerBranch;
+use crate::Dataset;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -170,13 +170,13 @@ fn coordinates_outside_the_domain_are_refused() {
     // a2 = 0 has no shape coordinate; a start lifts it to ln w = −3.
     let a = [0.1, 0.0, 0.7];
     assert!(c.to_coordinates(&a).is_none());
-    use fitbead::inverse::posterior::Reparameterisation;
+    use crate::inverse::posterior::Reparameterisation;
     let start = c.start(&a).unwrap();
     assert_eq!(start[2], -3.0);
     let (b, _) = c.to_params(&start).unwrap();
     // The lifted law keeps the level and slope at the mean slope.
     let root = |p: &[f64]| {
-        fitbead::models::jaeger::Jaeger::new(p[0], p[1], p[2], JaegerBranch::Upper)
+        crate::models::jaeger::Jaeger::new(p[0], p[1], p[2], JaegerBranch::Upper)
             .unwrap()
             .roots(t0)
             .upper

@@ -13,13 +13,13 @@
 //! The draws used for the ranks are 3 per walker, a third of the kept chain apart (the chain
 //! is at least 50 autocorrelation times long by the stopping rule, so they are nearly
 //! independent): L = 95 of them (3 × 32 − 1, so that the L + 1 = 96 rank values fill 8 bins
-//! evenly). Figures: `cargo test --release --test it sbc:: -- --nocapture`.
+//! evenly). Figures: `cargo test --release --lib fit::suite::sbc:: -- --nocapture`.
 
-use fitbead::fit::data::Dataset;
-use fitbead::fit::klaw::{fit_law_with, KLaw, KLawProblem};
-use fitbead::fit::posterior::{McmcSettings, Method, Prior};
-use fitbead::inverse::mcmc::McmcOptions;
-use fitbead::{CollisionLaw, ForwardModel, Model, Scene};
+use crate::fit::data::Dataset;
+use crate::fit::klaw::{fit_law_with, KLaw, KLawProblem};
+use crate::fit::posterior::{McmcSettings, Method, Prior};
+use crate::inverse::mcmc::McmcOptions;
+use crate::{CollisionLaw, ForwardModel, Model, Scene};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
@@ -38,7 +38,7 @@ fn design() -> Vec<(String, Scene)> {
     let mut out = Vec::new();
     for xi in [0.8, 1.2, 1.6] {
         let (lo, hi) =
-            fitbead::models::regimes::regime_b_interval(&Model::Stick, xi, 0.4, 0.1, law).unwrap();
+            crate::models::regimes::regime_b_interval(&Model::Stick, xi, 0.4, 0.1, law).unwrap();
         for j in 0..4 {
             let d = lo + (hi - lo) * (0.3 + 0.4 * j as f64 / 3.0);
             out.push((

@@ -1,8 +1,8 @@
 //! Property tests: no valid input panics or yields NaN; every invalid input is an error; the
 //! energy balance closes (eqs 70–72).
 
-use fitbead::models::{energy, regimes, stick, stickslip};
-use fitbead::{CollisionLaw, ForwardModel, Model, Scene};
+use crate::models::{energy, regimes, stick, stickslip};
+use crate::{CollisionLaw, ForwardModel, Model, Scene};
 use proptest::prelude::*;
 
 fn models() -> [Model; 5] {

@@ -4,9 +4,9 @@
 //! values (0.6215, 7.469°, 1.061, 1.159), which tests/reference/make_refs.py recomputes at 40
 //! digits by quadrature.
 
-use fitbead::models::regimes::{bulk_friction, critical_xi, delta_d, delta_m, theta_g};
-use fitbead::models::{stick, stickslip};
-use fitbead::{CollisionLaw, Scene};
+use crate::models::regimes::{bulk_friction, critical_xi, delta_d, delta_m, theta_g};
+use crate::models::{stick, stickslip};
+use crate::{CollisionLaw, Scene};
 
 #[test]
 fn critical_xi_of_the_fitted_law_is_0_6215() {

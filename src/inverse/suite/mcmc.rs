@@ -8,10 +8,10 @@
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
-use fitbead::inverse::mcmc::diagnostics::{
+use crate::inverse::mcmc::diagnostics::{
     autocovariance, ess_bulk, ess_mean, ess_tail, integrated_time, parameter_chains, rhat, SOKAL_C,
 };
-use fitbead::inverse::mcmc::{
+use crate::inverse::mcmc::{
     EnsembleSampler, LogDensity, McmcError, McmcOptions, McmcResult, StopReason,
 };
 use rand::SeedableRng;

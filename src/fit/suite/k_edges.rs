@@ -8,13 +8,14 @@
 //! (mpmath: the bracket ends from their closed forms, v̄ by quadrature at 40 digits, K_ref
 //! solving v̄(K_ref) = v exactly; every row rechecked at 60 digits by other routes).
 
-use fitbead::fit::k::{bracket, estimate, estimate_in_k, KFailure};
-use fitbead::{CollisionLaw, ForwardModel, Model, Scene};
+use crate::fit::k::search::estimate_in_k;
+use crate::fit::k::{bracket, estimate, KFailure};
+use crate::{CollisionLaw, ForwardModel, Model, Scene};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
-use crate::common::reference_table;
+use super::reference_table;
 
 fn model_of(name: &str) -> Model {
     match name {
@@ -27,7 +28,7 @@ fn model_of(name: &str) -> Model {
     }
 }
 
-fn is_jump(e: &fitbead::fit::k::KEstimate) -> bool {
+fn is_jump(e: &crate::fit::k::KEstimate) -> bool {
     let root_jump = matches!(&e.root, Err(KFailure::Invalid(m)) if m.contains("jumps"));
     root_jump || e.notes.iter().any(|n| n.contains("jumps"))
 }

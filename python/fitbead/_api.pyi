@@ -520,14 +520,15 @@ class Design:
     discrimination: tuple[float, float] | None
     points_needed: tuple[float, float] | None
     ranges: list[tuple[float, float]]
+    bayes: tuple[int, int] | None
     def __init__(self, raw: Mapping[str, Any]) -> None: ...
     def to_pandas(self):
         """The design as a DataFrame (series, xi, delta_deg, replicates; needs pandas)."""
     def to_csv(self, path: str) -> None:
         """Writes the design as ``fitbead design --output`` does (for ``simulate --design``)."""
 
-def design(fit: str = 'klaw', *, model: str | None = None, law: str = 'c=0.5', series: Sequence[float] = (0.8, 1.0, 1.6, 2.0), points: int = 9, noise: float | str = 0.02, delta_range: tuple[float, float] | None = None, criterion: str = 'd', target: str | None = None, vs: str | None = None, branch: str = 'upper', rho: float = 0.4, f: float = 0.1) -> Design:
-    '''Where to measure (``fitbead design``): locally optimal slopes for a fit\'s parameters,
+def design(fit: str = 'klaw', *, model: str | None = None, law: str = 'c=0.5', series: Sequence[float] = (0.8, 1.0, 1.6, 2.0), points: int = 9, noise: float | str = 0.02, delta_range: tuple[float, float] | None = None, criterion: str = 'd', target: str | None = None, vs: str | None = None, branch: str = 'upper', rho: float = 0.4, f: float = 0.1, prior: Mapping[str, str] | None = None, draws: int = 64, seed: int = 1, total: int | None = None) -> Design:
+    '''Where to measure (``fitbead design``): locally optimal slopes for a fit's parameters,
     or slopes that tell two models apart, from the Fisher information at a guess.
 
     Parameters
@@ -552,13 +553,27 @@ def design(fit: str = 'klaw', *, model: str | None = None, law: str = 'c=0.5', s
     criterion : {"d", "c", "t"}
         D-optimal, c-optimal for ``target``, or T-optimal against ``vs``.
     target : str, optional
-        The parameter of the c criterion.
+        The parameter of the c criterion; for ``klaw`` also the bulk friction μ of eq 79 at
+        the fitted K (``"mu"`` for one series, ``"mu of series 'xi=X'"`` for several), its
+        standard error by the delta method.
     vs : str, optional
-        The rival contact model of the T criterion.
+        The rival of the T criterion: a contact model for ``klaw``; ``"jan"`` for
+        ``jaeger`` (``jan`` against ``jaeger`` is refused: Jan's model is Jaeger's with
+        a2 = 0, so no design tells them apart when Jan's holds).
     branch : {"upper", "lower"}
-        Jaeger\'s root of eq 84.
+        Jaeger's root of eq 84.
     rho, f : float
         Gyration parameter and friction coefficient.
+    prior : mapping of str to str, optional
+        Priors by parameter name (``{"c": "normal(0.5,0.1)"}``; uniform, normal, lognormal or
+        halfnormal, as ``--prior``) for a Bayesian design: the criterion averaged over
+        ``draws`` draws; the other parameters stay at the guess.
+    draws : int
+        Prior draws of a Bayesian design.
+    seed : int
+        Seed of the prior draws.
+    total : int, optional
+        Points over all series, shared out by the design (replaces ``points``).
 
     Returns
     -------

@@ -3,6 +3,7 @@ parameter values bit for bit; data from CSV, arrays and DataFrames; errors as th
 line words them; posteriors to ArviZ; Ctrl-C stops an MCMC run."""
 
 import _thread
+import signal
 import threading
 import time
 
@@ -116,14 +117,20 @@ def test_mcmc_draws_and_arviz(data):
 
 
 def test_keyboard_interrupt_stops_mcmc(data):
-    timer = threading.Timer(0.3, _thread.interrupt_main)
-    t0 = time.perf_counter()
-    timer.start()
-    with pytest.raises(KeyboardInterrupt):
-        # A run that cannot converge (ESS 10⁹) and would take minutes: only the interrupt ends it.
-        fitbead.fit_jaeger(data, method="mcmc", min_ess=1e9, max_steps=1_000_000)
-    timer.cancel()
-    assert time.perf_counter() - t0 < 5.0
+    # Python's own SIGINT handler, also when the suite runs with SIGINT ignored (as a background
+    # job of a non-interactive shell): interrupt_main does nothing for an ignored signal.
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        timer = threading.Timer(0.3, _thread.interrupt_main)
+        t0 = time.perf_counter()
+        timer.start()
+        with pytest.raises(KeyboardInterrupt):
+            # A run that cannot converge (ESS 10⁹) and would take minutes: only the interrupt ends it.
+            fitbead.fit_jaeger(data, method="mcmc", min_ess=1e9, max_steps=1_000_000)
+        timer.cancel()
+        assert time.perf_counter() - t0 < 5.0
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def test_bad_input_raises_with_the_cli_message(cli, tmp_path):

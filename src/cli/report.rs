@@ -372,34 +372,38 @@ fn run_with(a: Args, r: Recipe) -> Result<(), CliError> {
     let (t, rows, ds) = io.read()?;
     let choice = io.method(&[])?;
     // A point that no contact model of the report can make steady is an error, as in klaw.
-    let unsteady = unsteady_points(&CONTACT_MODELS, &ds, Some(&super::stop_flag()));
+    // Per contact model, the points it cannot make steady at any K (`klaw`'s input check);
+    // a point in every model's list is steady under none of them.
+    let unsteady: Vec<Vec<(usize, String)>> = CONTACT_MODELS
+        .iter()
+        .map(|m| unsteady_points(std::slice::from_ref(m), &ds, Some(&super::stop_flag())))
+        .collect();
     if super::stop_requested() {
         return Err(CliError::Interrupted);
     }
-    if let Some((i, why)) = unsteady.first() {
+    let under_none: Vec<&(usize, String)> = unsteady[0]
+        .iter()
+        .filter(|(i, _)| unsteady[1..].iter().all(|u| u.iter().any(|(j, _)| j == i)))
+        .collect();
+    if let Some((i, why)) = under_none.first() {
         return Err(CliError::Other(format!(
             "{}: {why} (and {} more such point(s)); no K of the rolling or stick/slip model \
              makes this point steady: leave it out of the data",
             locate_point(&t, &ds, *i),
-            unsteady.len() - 1
+            under_none.len() - 1
         )));
     }
     let implausible = crate::io::measurements::plausibility(&t, &rows);
-    // The input checks of `klaw`, per contact model: points that model cannot make steady.
     let mut input_warnings = Vec::new();
-    for (model, name) in CONTACT_MODELS.iter().zip(CONTACT_NAMES) {
-        let unsteady = unsteady_points(std::slice::from_ref(model), &ds, Some(&super::stop_flag()));
-        if let Some((i, why)) = unsteady.first() {
+    for (u, name) in unsteady.iter().zip(CONTACT_NAMES) {
+        if let Some((i, why)) = u.first() {
             input_warnings.push(format!(
                 "{}: {why} (and {} more such point(s)); no K of the {name} model makes this \
                  point steady (the {name} fits leave such points out)",
                 locate_point(&t, &ds, *i),
-                unsteady.len() - 1
+                u.len() - 1
             ));
         }
-    }
-    if super::stop_requested() {
-        return Err(CliError::Interrupted);
     }
     refuse_unless_keep_going(a.keep_going, &input_warnings)?;
     let mut an = analyse(&ds, io.level.level(), &choice.method);

@@ -23,3 +23,4 @@ mod prior_sensitivity;
 mod recipes;
 mod report;
 mod report_mcmc;
+mod threads;

@@ -55,8 +55,8 @@
 //!
 //! What is hand-written instead, and the measurement that keeps it so, is said where it lives:
 //! the SVG figures (`report::figures::svg`: a plotting crate's backend rounds coordinates to
-//! whole pixels and cannot measure text), Carlson's R_F ([`special::elliptic::rf`]), the Brent root finder ([`special::root`]), the
-//! double-double arithmetic ([`special::dd`]) and the Levenberg–Marquardt iteration itself
+//! whole pixels and cannot measure text), Carlson's R_F (`special::elliptic::rf`), the Brent root finder (`special::root`), the
+//! double-double arithmetic (`special::dd`) and the Levenberg–Marquardt iteration itself
 //! (argmin has none; the NIST cross-checks in `docs/ACCURACY.md`).
 //!
 //! ## Quickstart
@@ -84,13 +84,16 @@ pub mod numfmt;
 pub mod progress;
 pub mod report;
 pub mod scene;
-pub mod special;
+pub(crate) mod special;
 
 pub mod io;
 pub mod prelude;
 
 #[cfg(feature = "cli")]
 pub mod cli;
+
+#[cfg(feature = "bench-internals")]
+pub mod bench_internals;
 
 pub use error::{Error, Result};
 pub use fit::data::Dataset;

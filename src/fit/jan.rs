@@ -17,13 +17,13 @@ use super::summary::{distinct_points, observed_norm, FitResult, ParamSpec, Solve
 use crate::inverse::{fit, CurveModel, Infeasible, LsqOptions, WeightedData};
 
 /// The paper's global values (λ0, λ1, μ0, μ1), eqs 75–76.
-pub const PAPER_GLOBAL: [f64; 4] = [0.063, 4.96, 0.0025, 7.46];
+pub(crate) const PAPER_GLOBAL: [f64; 4] = [0.063, 4.96, 0.0025, 7.46];
 
 /// What Jan's formula needs of a point: (sin α, sin δ, cos δ).
 pub type JanX = (f64, f64, f64);
 
 /// v̄ and (∂v̄/∂λ, ∂v̄/∂μ) at (λ, μ), or infeasible where sin δ − μ cos δ ≤ 0 or λ ≤ 0.
-pub fn velocity(x: &JanX, lambda: f64, mu: f64) -> Result<(f64, f64, f64), Infeasible> {
+pub(crate) fn velocity(x: &JanX, lambda: f64, mu: f64) -> Result<(f64, f64, f64), Infeasible> {
     let (sa, sd, cd) = *x;
     let drive = sd - mu * cd;
     if !(drive > 0.0 && lambda > 0.0) {
@@ -78,7 +78,7 @@ impl CurveModel<JanX> for JanGlobal {
 
 /// The fits of `fitbead jan`.
 #[derive(Debug, Clone, PartialEq)]
-pub struct JanFits {
+pub(crate) struct JanFits {
     /// Per series (λ, μ), in the dataset's series order; `None` where the series has fewer
     /// than 3 points (no degree of freedom left for the scatter).
     pub series: Vec<Option<FitResult>>,
@@ -126,13 +126,9 @@ fn line(x: &[f64], y: &[f64], sigma: &[f64]) -> Option<(f64, f64)> {
     (a.is_finite() && b.is_finite()).then_some((a, b))
 }
 
-/// Fits Jan's model per series and globally, with intervals at `level`.
-pub fn fit_jan(data: &Dataset, level: f64, profile: bool) -> JanFits {
-    fit_jan_with(data, level, &Method::lsq(profile))
-}
-
-/// As [`fit_jan`], with the parameters estimated by `method` (least squares, or a posterior
-/// run per fit started from its least-squares optimum; see [`super::posterior`]). The global
+/// Fits Jan's model per series and globally, with intervals at `level`, the parameters
+/// estimated by `method` (least squares, or a posterior run per fit started from its
+/// least-squares optimum; see [`super::posterior`]). The global
 /// fit starts from the per-series least-squares optima either way.
 pub(crate) fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFits {
     let mut notes = Vec::new();

@@ -782,7 +782,7 @@ fn fit_per_series(
 
 /// The fitted law with its reports.
 #[derive(Debug, Clone, PartialEq)]
-pub struct KLawFit {
+pub(crate) struct KLawFit {
     /// The law.
     pub law: KLaw,
     /// Parameter rows and statistics (for the impact law: no parameter rows, the statistics
@@ -794,7 +794,7 @@ pub struct KLawFit {
 
 /// Fits (or, for the impact law, scores) `law` under `model` on `data`, with covariance and
 /// (when `profile`) profile-likelihood intervals at `level`.
-pub fn fit_law(
+pub(crate) fn fit_law(
     model: Model,
     data: &Dataset,
     law: KLaw,
@@ -807,7 +807,7 @@ pub fn fit_law(
 /// As [`fit_law`], with the parameters estimated by `method` (least squares, or a posterior
 /// run started from the least-squares optimum; see [`super::posterior`]). The impact law has
 /// nothing to sample and is scored either way.
-pub fn fit_law_with(
+pub(crate) fn fit_law_with(
     model: Model,
     data: &Dataset,
     law: KLaw,

@@ -32,12 +32,12 @@ pub mod lm;
 mod lmpar;
 pub mod lsq;
 pub mod mcmc;
-pub mod observer;
+pub(crate) mod observer;
 pub mod posterior;
 pub mod problem;
 pub mod profile;
 mod qr;
-pub mod state;
+pub(crate) mod state;
 #[cfg(test)]
 mod suite;
 #[cfg(test)]
@@ -52,10 +52,8 @@ pub use mcmc::{
     EnsembleSampler, LogDensity, McmcError, McmcOptions, McmcResult, ParameterDiagnostics,
     StopReason,
 };
-pub use observer::ProgressObserver;
 pub use problem::{ArgminResiduals, LeastSquares};
 pub use profile::{
     confidence_intervals, ConfidenceIntervals, Interval, ProfileEnd, ProfileInterval, DEFAULT_LEVEL,
 };
 pub(crate) use profile::{covariance_intervals, profile_interval};
-pub use state::{LmStage, LmState};

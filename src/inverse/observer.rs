@@ -52,11 +52,6 @@ impl ProgressObserver {
         ProgressObserver { tally, reported: 0 }
     }
 
-    /// The tally it adds to.
-    pub fn tally(&self) -> &Tally {
-        &self.tally
-    }
-
     /// Adds the evaluations since the last report.
     fn advance(&mut self, state: &LmState) {
         let done = state.model_evals();

@@ -1456,18 +1456,8 @@ pub(crate) const MD_REFINE: usize = 7;
 pub(crate) const MD_NARROW: usize = 8;
 
 /// The slopes (degrees) where the md model is in regime B at this ξ: the longest run of the
-/// 0.5° scan (slopes in parallel), each end refined by bisection.
-pub fn regime_b_interval(
-    md: &Md,
-    xi: f64,
-    rho: f64,
-    tick: &(dyn Fn() + Sync),
-) -> std::result::Result<Option<(f64, f64)>, Error> {
-    regime_b_interval_until(md, xi, rho, tick, None)
-}
-
-/// As [`regime_b_interval`], its runs stopped early once `stop` is raised (the result is then
-/// meaningless: the caller checks the flag).
+/// 0.5° scan (slopes in parallel), each end refined by bisection; its runs stopped early once
+/// `stop` is raised (the result is then meaningless: the caller checks the flag).
 pub(crate) fn regime_b_interval_until(
     md: &Md,
     xi: f64,

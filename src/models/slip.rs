@@ -187,6 +187,7 @@ fn minimum_angle(ph: &SlipPhase, a: f64, b: f64) -> Result<(f64, f64, f64), NotS
 /// The least squared speed of the slip model's steady contact (§4.3) and where it lies:
 /// (θm, Θ̇²(θm)), in double-double (`SlipDd`) when θm is interior. It vanishes at the slip
 /// model's stop limit, like the squared top speed of rolling at δ_m.
+#[cfg(test)]
 pub fn speed_minimum(scene: &Scene) -> Result<(f64, f64), NotSteady> {
     let l2 = final_velocity_sq(scene)?;
     let ph = SlipPhase::new(scene.theta_0, scene.k * scene.k * l2, scene.f);

@@ -60,6 +60,7 @@ impl Default for QuadOptions {
 
 /// The value of an integral with its error estimate.
 #[derive(Debug, Clone, Copy)]
+#[cfg_attr(not(test), allow(dead_code))]
 pub struct QuadResult {
     /// The integral.
     pub value: f64,

@@ -354,7 +354,8 @@ fn bead_fits_cross_check() {
 
     let (x, y, s) = jan_points(None);
     let global = WeightedData::new(JanGlobal, x, y, Some(s)).unwrap();
-    let start = fitbead::fit::jan::PAPER_GLOBAL;
+    // The paper's global laws, eqs 75–76: λ = 0.063 e^{4.96 sin α}, μ = 0.0025 e^{7.46 sin α}.
+    let start = [0.063, 4.96, 0.0025, 7.46];
     let f = fit(&global, &start, &LsqOptions::default()).unwrap();
     let (g, n) = bead_case("jan global", global, &start, &f);
     assert!(g >= 8.0 && n >= 8.0, "LRE {g}, {n}");

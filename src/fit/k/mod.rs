@@ -27,15 +27,15 @@
 //! [`estimate`](mod@estimate) picks the path; [`auto`] picks the model per point.
 
 pub mod auto;
-pub mod bracket;
+pub(crate) mod bracket;
 pub mod estimate;
 pub mod launch;
-pub mod search;
+pub(crate) mod search;
 pub mod types;
 
-pub use bracket::bracket;
+pub(crate) use bracket::bracket;
 pub(crate) use bracket::unsteady_points;
 pub use estimate::estimate;
 pub(crate) use search::dv_dk;
-pub use search::solve;
+pub(crate) use search::solve;
 pub use types::{KBracket, KEstimate, KFailure, KRoot, LowerLimit, UpperLimit};

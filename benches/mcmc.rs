@@ -5,7 +5,7 @@
 //!
 //! Before timing, one run prints its smallest ESS, steps, walkers and log-density evaluations
 //! (deterministic for the seed), from which ESS/s = ESS / median time and evaluations per
-//! effective sample follow: `cargo bench --bench mcmc`.
+//! effective sample follow: `cargo bench --features bench-internals --bench mcmc`.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use fitbead::fit::builder::KLawFitter;

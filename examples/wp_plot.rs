@@ -1,7 +1,7 @@
 //! Re-plots a work-precision table written by `fitbead bench --output` without measuring
 //! again (the figure's look changes, the measurements stay):
 //!
-//!     cargo run --release --example wp_plot -- bench/wp.csv bench/wp.svg "Work-precision, 2000 scenes (seed 1)"
+//!     cargo run --release --features bench-internals --example wp_plot -- bench/wp.csv bench/wp.svg "Work-precision, 2000 scenes (seed 1)"
 
 use fitbead::bench_internals::replot;
 

@@ -23,7 +23,7 @@
 
 use super::data::Dataset;
 use super::jaeger_coordinates::JaegerCoordinates;
-pub use super::jaeger_coordinates::JaegerX;
+pub(crate) use super::jaeger_coordinates::JaegerX;
 use super::posterior::{summarise_reparameterised, summarise_with, Method, Prior};
 use super::summary::{distinct_points, observed_norm, FitResult, ParamSpec, Solved};
 use crate::inverse::{fit, CurveModel, Infeasible, LsqOptions, WeightedData};
@@ -48,7 +48,7 @@ pub(crate) fn paper_values(xi: f64) -> Option<[f64; 3]> {
 
 /// Jaeger's model on one branch, p = (a1, a2, a3).
 #[derive(Debug, Clone, Copy)]
-pub struct JaegerModel(pub JaegerBranch);
+pub(crate) struct JaegerModel(pub JaegerBranch);
 
 impl JaegerModel {
     fn root(&self, x: &JaegerX, p: &[f64]) -> Result<f64, Infeasible> {
@@ -134,7 +134,7 @@ fn chi2(model: &JaegerModel, x: &[JaegerX], y: &[f64], s: &[f64], p: &[f64]) -> 
 }
 
 /// The derived start (module docs).
-pub fn start(model: &JaegerModel, x: &[JaegerX], y: &[f64], s: &[f64]) -> Option<[f64; 3]> {
+pub(crate) fn start(model: &JaegerModel, x: &[JaegerX], y: &[f64], s: &[f64]) -> Option<[f64; 3]> {
     let xx: Vec<f64> = x
         .iter()
         .zip(y)

@@ -20,7 +20,7 @@ use crate::inverse::{fit, CurveModel, Infeasible, LsqOptions, WeightedData};
 pub(crate) const PAPER_GLOBAL: [f64; 4] = [0.063, 4.96, 0.0025, 7.46];
 
 /// What Jan's formula needs of a point: (sin α, sin δ, cos δ).
-pub type JanX = (f64, f64, f64);
+pub(crate) type JanX = (f64, f64, f64);
 
 /// v̄ and (∂v̄/∂λ, ∂v̄/∂μ) at (λ, μ), or infeasible where sin δ − μ cos δ ≤ 0 or λ ≤ 0.
 pub(crate) fn velocity(x: &JanX, lambda: f64, mu: f64) -> Result<(f64, f64, f64), Infeasible> {
@@ -35,7 +35,7 @@ pub(crate) fn velocity(x: &JanX, lambda: f64, mu: f64) -> Result<(f64, f64, f64)
 
 /// Per-series model: p = (λ, μ).
 #[derive(Debug, Clone, Copy)]
-pub struct JanSeries;
+pub(crate) struct JanSeries;
 
 impl CurveModel<JanX> for JanSeries {
     fn n_params(&self) -> usize {
@@ -54,7 +54,7 @@ impl CurveModel<JanX> for JanSeries {
 
 /// Global model: p = (λ0, λ1, μ0, μ1).
 #[derive(Debug, Clone, Copy)]
-pub struct JanGlobal;
+pub(crate) struct JanGlobal;
 
 impl CurveModel<JanX> for JanGlobal {
     fn n_params(&self) -> usize {

@@ -6,7 +6,7 @@
 //! (law c: a = cos 2α, b = sin²α sin 2α > 0, one group; free: a = 0, b = 1, one group per
 //! series). Hence:
 //! - the feasible box of each parameter is exact: point i stays in regime B for K in its
-//!   bracket (K_min, K_max] ([`crate::fit::k::bracket()`]), so p_j must lie in the intersection
+//!   bracket (K_min, K_max] (`fit::k::bracket`), so p_j must lie in the intersection
 //!   of ((K_min,i − a_i)/b_i, (K_max,i − a_i)/b_i] over the points of group j. An empty
 //!   intersection means no value of the law keeps every point steady, and the fit says so
 //!   instead of searching;
@@ -165,7 +165,7 @@ impl fmt::Display for KLawError {
 
 /// The residuals (v_i − v̄_th(K_i(p)))/σ_i of a law over a dataset.
 #[derive(Debug)]
-pub struct KLawProblem<'a> {
+pub(crate) struct KLawProblem<'a> {
     model: Model,
     data: &'a Dataset,
     law: KLaw,
@@ -194,6 +194,7 @@ pub(crate) const START_POINTS: usize = 255;
 
 impl<'a> KLawProblem<'a> {
     /// The problem for `law` under `model` (a contact model whose K can be inverted).
+    #[cfg(test)]
     pub fn new(model: Model, data: &'a Dataset, law: KLaw) -> Result<Self, KLawError> {
         Self::new_until(model, data, law, None)
     }
@@ -284,12 +285,6 @@ impl<'a> KLawProblem<'a> {
         }
     }
 
-    /// Reports the forward evaluations done (after each batch of them) to `progress`.
-    pub fn with_progress(mut self, progress: Option<Progress>) -> Self {
-        self.progress = progress;
-        self
-    }
-
     /// Cuts the per-point work short once `stop` is raised ([`KLawError::Interrupted`] from
     /// [`KLawProblem::start`], a rejected step from the Jacobian).
     pub fn with_stop(mut self, stop: Option<Arc<AtomicBool>>) -> Self {
@@ -301,11 +296,6 @@ impl<'a> KLawProblem<'a> {
         self.stop
             .as_ref()
             .is_some_and(|s| s.load(Ordering::Relaxed))
-    }
-
-    /// The law.
-    pub fn law(&self) -> KLaw {
-        self.law
     }
 
     /// Name of the parameters: `c`, or `K` (one per series).

@@ -25,7 +25,7 @@
 //! `max_steps`, or until a caller raises the stop flag. The chains, and the diagnostics on
 //! them, are of what the density records of each point ([`LogDensity::observe`]: the point
 //! itself unless the density is over transformed coordinates). The diagnostics are in
-//! [`diagnostics`] and work on any chains.
+//! `diagnostics` and work on any chains.
 
 pub(crate) mod diagnostics;
 pub(crate) mod sensitivity;

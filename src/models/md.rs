@@ -619,7 +619,7 @@ pub(crate) const MIN_RHO: f64 = 0.01;
 /// Largest factor by which the damping rates may shrink the time step below the contact-time
 /// step (`step_fraction` × contact time): beyond it the run's cost grows without bound as
 /// ρ → 0 or γ → ∞, and the scene is refused ([`Md::check_scene`]).
-pub const MAX_STEP_SHRINK: f64 = 100.0;
+pub(crate) const MAX_STEP_SHRINK: f64 = 100.0;
 
 /// Most time steps one md run may take. A run gives up after `max_time_per_bead` times
 /// (`beads` plus one) time units, so its step bounds its steps: `step_fraction` of the Hertz
@@ -1526,5 +1526,30 @@ mod tests {
         assert!((2.0 * impact_integral(1.5) - 2.9432).abs() < 1e-4);
         // Linear spring: ∫₀¹ du/√(1−u²) = π/2.
         assert!((impact_integral(1.0) - PI / 2.0).abs() < 1e-12);
+    }
+
+    /// A scene outside the md model's domain (ρ → 0) fails at once, its time step never shrunk
+    /// below the contact-time step over `MAX_STEP_SHRINK`.
+    #[test]
+    fn md_time_step_cannot_collapse() {
+        use std::time::{Duration, Instant};
+        let md = Md::ristow();
+        for rho in [1e-4, 1e-6, 1e-300] {
+            let sc = Scene::new(1.6, 6.0, rho, 0.1, CollisionLaw::Value(0.5)).unwrap();
+            assert!(md.check_scene(&sc).is_err(), "rho {rho}");
+            let t0 = Instant::now();
+            let r = md.simulate(&sc, 1.0, None);
+            assert_eq!(r.failure, Some(MdFailure::OutsideDomain), "rho {rho}");
+            assert!(t0.elapsed() < Duration::from_millis(100));
+            assert!(
+                r.dt >= md.config.step_fraction * r.contact_time / MAX_STEP_SHRINK * (1.0 - 1e-12),
+                "rho {rho}: dt {} contact time {}",
+                r.dt,
+                r.contact_time
+            );
+        }
+        // At Ristow's ρ = 0.4 the step is the contact-time step or the damping's, unchanged.
+        let sc = Scene::new(1.6, 6.0, 0.4, 0.1, CollisionLaw::Value(0.5)).unwrap();
+        assert!(md.check_scene(&sc).is_ok());
     }
 }

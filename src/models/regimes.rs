@@ -29,12 +29,12 @@ pub fn delta_m_law(alpha: f64, law: CollisionLaw, rho: f64) -> f64 {
     delta_m_of(alpha, law.k(alpha, rho), law.one_minus_k(alpha, rho))
 }
 
-/// [`delta_d`] for a collision law at α and ρ (1 − K as in [`delta_m_law`]).
+/// δ_d (eq 31) for a collision law at α and ρ (1 − K as in [`delta_m_law`]).
 pub fn delta_d_law(alpha: f64, law: CollisionLaw, rho: f64) -> f64 {
     delta_d_of(alpha, law.k(alpha, rho), law.one_minus_k(alpha, rho), rho)
 }
 
-/// [`bulk_friction`] (eq 79) for a collision law at α and ρ (1 − K as in [`delta_m_law`]).
+/// The bulk friction (eq 79) for a collision law at α and ρ (1 − K as in [`delta_m_law`]).
 pub fn bulk_friction_law(alpha: f64, law: CollisionLaw, rho: f64) -> f64 {
     bulk_friction_of(alpha, law.k(alpha, rho), law.one_minus_k(alpha, rho))
 }

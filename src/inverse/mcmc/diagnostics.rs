@@ -42,7 +42,7 @@ thread_local! {
 
 /// Biased autocovariance γ̂(t) = (1/n) Σ_{i<n−t} (xᵢ − x̄)(x_{i+t} − x̄), t = 0..n, by a real FFT
 /// (`realfft`) with zero padding to avoid circular wrap-around: O(n log n), where the direct sum
-/// is O(n²) (`cargo bench --bench mcmc -- autocovariance` times the three ways it has been done:
+/// is O(n²) (`cargo bench --features bench-internals --bench mcmc -- autocovariance` times the three ways it has been done:
 /// at n = 10⁴, 0.42 ms here, 3.17 ms by a hand-written radix-2 complex FFT, 61 ms by the direct
 /// sum; criterion medians, 2-core AMD EPYC, 2026-11-23).
 pub fn autocovariance(x: &[f64]) -> Vec<f64> {
@@ -434,13 +434,13 @@ pub struct ParameterDiagnostics {
     /// Central interval at the level asked of `summarise`: (quantile (1−level)/2,
     /// quantile (1+level)/2).
     pub interval: (f64, f64),
-    /// Integrated autocorrelation time (in steps of the chains given), see [`integrated_time`].
+    /// Integrated autocorrelation time (in steps of the chains given), see `integrated_time`.
     pub tau: f64,
-    /// Rank-normalised split-R̂, see [`rhat`].
+    /// Rank-normalised split-R̂, see `rhat`.
     pub rhat: f64,
-    /// Bulk effective sample size, see [`ess_bulk`].
+    /// Bulk effective sample size, see `ess_bulk`.
     pub ess_bulk: f64,
-    /// Tail effective sample size, see [`ess_tail`].
+    /// Tail effective sample size, see `ess_tail`.
     pub ess_tail: f64,
 }
 

@@ -134,7 +134,7 @@ pub(crate) fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFi
     let mut notes = Vec::new();
     let mut per = Vec::new();
     // (sin α, ln λ, weight σ of ln λ) and the same of μ, one per converged series fit.
-    let mut pts: (Vec<(f64, f64, f64)>, Vec<(f64, f64, f64)>) = (Vec::new(), Vec::new());
+    let mut pts: (LogPoints, LogPoints) = (Vec::new(), Vec::new());
     for (s, label) in data.labels.iter().enumerate() {
         per.push(fit_jan_series(
             data, s, label, level, method, &mut notes, &mut pts,
@@ -156,6 +156,9 @@ pub(crate) fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFi
     }
 }
 
+/// (sin α, ln x, σ of ln x) of a parameter x of each converged series fit.
+type LogPoints = Vec<(f64, f64, f64)>;
+
 /// Jan's λ and μ of series `s` (eq 74), or `None` with a note saying why not; a converged fit
 /// adds its (sin α, ln λ, σ of ln λ) and (sin α, ln μ, σ of ln μ) to `pts`.
 fn fit_jan_series(
@@ -165,7 +168,7 @@ fn fit_jan_series(
     level: f64,
     method: &Method,
     notes: &mut Vec<String>,
-    pts: &mut (Vec<(f64, f64, f64)>, Vec<(f64, f64, f64)>),
+    pts: &mut (LogPoints, LogPoints),
 ) -> Option<FitResult> {
     let (x, y, sg) = xs(data, Some(s));
     if x.len() < 3 {

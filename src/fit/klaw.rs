@@ -815,7 +815,7 @@ pub(crate) struct KLawContext {
     pub brackets: Option<Vec<KBracket>>,
     /// Where progress goes: a task labelled with the fit's name, of unknown total, whose
     /// positions count the model evaluations (residual vectors and Jacobians over the data) of
-    /// the least-squares fit and its profiles, from a [`crate::inverse::ProgressObserver`]
+    /// the least-squares fit and its profiles, from a `ProgressObserver`
     /// on their iterations.
     pub progress: Option<Progress>,
 }

@@ -9,7 +9,7 @@
 //!   problem as argmin's `Operator` + `Jacobian` (residuals) and `CostFunction` + `Gradient`
 //!   (χ²) on nalgebra vectors: [`fit`] runs under argmin's `Executor`, argmin's other solvers
 //!   run on fitbead's problems, and observers, timeouts and iteration limits apply to both;
-//!   the solver's state is `LmState` (argmin's `State` with λ, the trust radius, the scaling,
+//!   the solver's state is [`LmState`] (argmin's `State` with λ, the trust radius, the scaling,
 //!   the active set and the stage for observers), and `ProgressObserver` is the observer that
 //!   counts a fit's model evaluations for a progress bar;
 //! * [`ArgminResiduals`] — any argmin problem with residuals and their Jacobian
@@ -37,7 +37,7 @@ pub mod posterior;
 pub mod problem;
 pub mod profile;
 mod qr;
-pub(crate) mod state;
+pub mod state;
 #[cfg(test)]
 mod suite;
 #[cfg(test)]
@@ -54,6 +54,7 @@ pub use mcmc::{
 };
 pub use problem::{ArgminResiduals, LeastSquares};
 pub use profile::{
-    confidence_intervals, ConfidenceIntervals, Interval, ProfileEnd, ProfileInterval, DEFAULT_LEVEL,
+    confidence_intervals, ConfidenceIntervals, Interval, ProfileEnd, ProfileInterval,
 };
-pub(crate) use profile::{covariance_intervals, profile_interval};
+pub(crate) use profile::{covariance_intervals, profile_interval, DEFAULT_LEVEL};
+pub use state::{LmStage, LmState};

@@ -895,8 +895,8 @@ impl Md {
     }
 
     /// Checks that `scene` is inside the model's domain with these parameters: ρ ≥
-    /// `MIN_RHO`, and damping rates that shrink the time step by at most
-    /// [`MAX_STEP_SHRINK`] below the contact-time step (the normal rate γ_n m_eff/m and the
+    /// `MIN_RHO`, and damping rates that shrink the time step by at most a factor
+    /// `MAX_STEP_SHRINK` (100) below the contact-time step (the normal rate γ_n m_eff/m and the
     /// spin relaxation rate γ_s m_eff/m (1 + 1/ρ), in units sqrt(g/(R+r)), each times the
     /// step, at most 0.1). The error names the field to change.
     pub fn check_scene(&self, scene: &Scene) -> Result<()> {

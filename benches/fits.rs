@@ -3,9 +3,8 @@
 //! The data are made as in `tests/it/fits.rs` (whose simulation helpers this bench shares).
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use fitbead::fit::jaeger::fit_jaeger;
-use fitbead::fit::jan::fit_jan;
-use fitbead::fit::klaw::{fit_law, KLaw};
+use fitbead::fit::builder::{JaegerFitter, JanFitter, KLawFitter};
+use fitbead::fit::klaw::KLaw;
 use fitbead::models::JaegerBranch;
 use fitbead::{CollisionLaw, Model};
 
@@ -35,47 +34,30 @@ fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("fits");
     g.sample_size(30);
     g.bench_function("klaw stickslip c, 40 points, profile", |b| {
-        b.iter(|| {
-            fit_law(Model::StickSlip, black_box(&stickslip), KLaw::C, 0.95, true).map(|f| f.k)
-        })
+        let fitter = KLawFitter::new(Model::StickSlip, KLaw::C).least_squares(true);
+        b.iter(|| fitter.fit(black_box(&stickslip)).map(|f| f.stats.chi2))
     });
     g.bench_function("klaw stickslip c, 40 points, covariance only", |b| {
-        b.iter(|| {
-            fit_law(
-                Model::StickSlip,
-                black_box(&stickslip),
-                KLaw::C,
-                0.95,
-                false,
-            )
-            .map(|f| f.k)
-        })
+        let fitter = KLawFitter::new(Model::StickSlip, KLaw::C).least_squares(false);
+        b.iter(|| fitter.fit(black_box(&stickslip)).map(|f| f.stats.chi2))
     });
     g.bench_function("klaw stickslip free-per-series, 40 points, profile", |b| {
-        b.iter(|| {
-            fit_law(
-                Model::StickSlip,
-                black_box(&stickslip),
-                KLaw::FreePerSeries,
-                0.95,
-                true,
-            )
-            .map(|f| f.k)
-        })
+        let fitter = KLawFitter::new(Model::StickSlip, KLaw::FreePerSeries).least_squares(true);
+        b.iter(|| fitter.fit(black_box(&stickslip)).map(|f| f.stats.chi2))
     });
     g.bench_function("jan 4 series + global, 36 points, profile", |b| {
+        let fitter = JanFitter::new().least_squares(true);
         b.iter(|| {
-            fit_jan(black_box(&jan), 0.95, true)
-                .global
-                .map(|s| s.stats.chi2)
+            fitter
+                .fit(black_box(&jan))
+                .map(|s| s.get("jan-global", "all").map(|g| g.stats.chi2))
         })
     });
     g.bench_function("jaeger 4 series, 36 points, profile", |b| {
-        b.iter(|| {
-            fit_jaeger(black_box(&jaeger), JaegerBranch::Upper, 0.95, true)
-                .notes
-                .len()
-        })
+        let fitter = JaegerFitter::new()
+            .branch(JaegerBranch::Upper)
+            .least_squares(true);
+        b.iter(|| fitter.fit(black_box(&jaeger)).map(|s| s.notes.len()))
     });
     g.finish();
 }

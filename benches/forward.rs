@@ -1,9 +1,8 @@
 //! Forward-model benchmarks: one evaluation of each model on scenes across regime B.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use fitbead::models::{slip, stick, stickslip};
-use fitbead::special::elliptic::rf;
-use fitbead::{CollisionLaw, Scene};
+use fitbead::bench_internals::rf;
+use fitbead::{CollisionLaw, ForwardModel, Model, Scene};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -69,7 +68,10 @@ fn bench(c: &mut Criterion) {
                 .iter()
                 .map(|&(xi, d, k, rho)| {
                     let x = Scene::new(black_box(xi), d, rho, 0.1, CollisionLaw::Value(k)).unwrap();
-                    stick::steady(&x).map(|r| r.mean_velocity).unwrap_or(0.0)
+                    Model::Stick
+                        .evaluate(&x)
+                        .map(|r| r.mean_velocity)
+                        .unwrap_or(0.0)
                 })
                 .sum::<f64>()
         })
@@ -81,7 +83,8 @@ fn bench(c: &mut Criterion) {
         b.iter(|| {
             s.iter()
                 .map(|x| {
-                    stick::steady(black_box(x))
+                    Model::Stick
+                        .evaluate(black_box(x))
                         .map(|r| r.mean_velocity)
                         .unwrap_or(0.0)
                 })
@@ -92,7 +95,8 @@ fn bench(c: &mut Criterion) {
         b.iter(|| {
             s.iter()
                 .map(|x| {
-                    stick::steady_approx(black_box(x))
+                    Model::StickApprox
+                        .evaluate(black_box(x))
                         .map(|r| r.mean_velocity)
                         .unwrap_or(0.0)
                 })
@@ -103,7 +107,8 @@ fn bench(c: &mut Criterion) {
         b.iter(|| {
             s.iter()
                 .map(|x| {
-                    slip::steady(black_box(x))
+                    Model::Slip
+                        .evaluate(black_box(x))
                         .map(|r| r.mean_velocity)
                         .unwrap_or(0.0)
                 })
@@ -114,7 +119,8 @@ fn bench(c: &mut Criterion) {
         b.iter(|| {
             s.iter()
                 .map(|x| {
-                    slip::steady_approx(black_box(x))
+                    Model::SlipApprox
+                        .evaluate(black_box(x))
                         .map(|r| r.mean_velocity)
                         .unwrap_or(0.0)
                 })
@@ -125,7 +131,8 @@ fn bench(c: &mut Criterion) {
         b.iter(|| {
             s.iter()
                 .map(|x| {
-                    stickslip::steady(black_box(x))
+                    Model::StickSlip
+                        .evaluate(black_box(x))
                         .map(|r| r.mean_velocity)
                         .unwrap_or(0.0)
                 })

@@ -4,7 +4,8 @@
 //! launch-speed path that `estimate` takes for stick and stick/slip (src/fit/k/launch.rs).
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use fitbead::fit::k::{bracket, estimate, solve};
+use fitbead::bench_internals::{bracket, solve};
+use fitbead::fit::k::estimate;
 use fitbead::{CollisionLaw, Model, Scene};
 
 fn rows() -> Vec<(Scene, f64, f64)> {
@@ -92,7 +93,7 @@ fn roots(c: &mut Criterion) {
     use argmin::solver::brent::BrentRoot;
     let f = |e: f64| Kepler.cost(&e).unwrap();
     let (a, b) = (0.0, std::f64::consts::PI);
-    let ours = fitbead::special::root::brent(f, a, b, f(a), f(b), 1e-15, 200)
+    let ours = fitbead::bench_internals::brent(f, a, b, f(a), f(b), 1e-15, 200)
         .unwrap()
         .x;
     let theirs = *Executor::new(Kepler, BrentRoot::new(a, b, 1e-15))
@@ -108,7 +109,7 @@ fn roots(c: &mut Criterion) {
     g.bench_function("brent (fitbead)", |bn| {
         bn.iter(|| {
             let (a, b) = (black_box(a), black_box(b));
-            fitbead::special::root::brent(f, a, b, f(a), f(b), 1e-15, 200).map(|r| r.x)
+            fitbead::bench_internals::brent(f, a, b, f(a), f(b), 1e-15, 200).map(|r| r.x)
         })
     });
     g.bench_function("BrentRoot (argmin)", |bn| {
@@ -132,8 +133,7 @@ fn roots(c: &mut Criterion) {
 /// dτ/du side passes and the K_lo, K_hi searches); and a row's scene built alone against one
 /// that takes what depends on ξ alone from the row before.
 fn lanes(c: &mut Criterion) {
-    use fitbead::special::elliptic::{cos_integral, cos_integral_pair};
-    use fitbead::special::SinCos;
+    use fitbead::bench_internals::{cos_integral, cos_integral_pair, SinCos};
     let rows = rows();
     let args: Vec<(SinCos, SinCos, f64, f64, f64)> = rows
         .iter()

@@ -5,12 +5,13 @@
 //!
 //! Before timing, one run prints its smallest ESS, steps, walkers and log-density evaluations
 //! (deterministic for the seed), from which ESS/s = ESS / median time and evaluations per
-//! effective sample follow: `cargo bench --bench mcmc`.
+//! effective sample follow: `cargo bench --features bench-internals --bench mcmc`.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use fitbead::fit::klaw::{fit_law_with, KLaw};
-use fitbead::fit::posterior::{McmcSettings, Method};
+use fitbead::fit::builder::KLawFitter;
+use fitbead::fit::klaw::KLaw;
 use fitbead::inverse::mcmc::McmcOptions;
+use fitbead::inverse::posterior::McmcSettings;
 use fitbead::{CollisionLaw, Model};
 
 #[allow(dead_code, unused_imports)]
@@ -27,23 +28,20 @@ fn bench(c: &mut Criterion) {
         0.02,
         7,
     );
-    let method = Method::Mcmc(Box::new(McmcSettings {
+    let fitter = KLawFitter::new(Model::StickSlip, KLaw::C).mcmc(McmcSettings {
         options: McmcOptions {
             seed: 1,
             ..Default::default()
         },
         ..Default::default()
-    }));
+    });
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()
         .unwrap();
-    let run = || {
-        pool.install(|| fit_law_with(Model::StickSlip, black_box(&data), KLaw::C, 0.95, &method))
-            .unwrap()
-    };
+    let run = || pool.install(|| fitter.fit(black_box(&data))).unwrap();
     let once = run();
-    let s = &once.summary.stats;
+    let s = &once.stats;
     let m = s.mcmc.as_ref().unwrap();
     let evals = m.walkers * m.steps;
     eprintln!(
@@ -71,7 +69,7 @@ fn bench(c: &mut Criterion) {
 /// hand-written iterative radix-2 complex FFT (bit reversal, direct twiddle table), and the
 /// direct O(n²) sum, on AR(1) chains of 10⁴ and 10⁵ steps. The four agree to 1e-12 of γ(0).
 fn autocovariance(c: &mut Criterion) {
-    use fitbead::inverse::mcmc::diagnostics::autocovariance as ours;
+    use fitbead::bench_internals::autocovariance as ours;
     use realfft::RealFftPlanner;
     fn chain(n: usize) -> Vec<f64> {
         let mut x = vec![0.0; n];

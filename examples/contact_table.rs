@@ -5,8 +5,9 @@
 //!
 //!     cargo run --release --example contact_table
 
+use fitbead::fit::builder::KLawFitter;
 use fitbead::fit::data::Dataset;
-use fitbead::fit::klaw::{fit_law, KLaw};
+use fitbead::fit::klaw::KLaw;
 use fitbead::models::contact::Contact;
 use fitbead::models::{ForwardModel, Model};
 use fitbead::{CollisionLaw, Scene};
@@ -71,27 +72,39 @@ fn main() {
         ("stickslip", Model::StickSlip),
         ("contact", contact),
     ] {
-        let free = fit_law(m, &data, KLaw::FreePerSeries, 0.95, false).unwrap();
-        let law = fit_law(m, &data, KLaw::C, 0.95, false).unwrap();
+        let free = KLawFitter::new(m, KLaw::FreePerSeries)
+            .least_squares(false)
+            .fit(&data)
+            .unwrap();
+        let law = KLawFitter::new(m, KLaw::C)
+            .least_squares(false)
+            .fit(&data)
+            .unwrap();
         let ks: Vec<String> = free
-            .summary
             .params
             .iter()
             .map(|p| format!("{:.4} ± {:.4}", p.value, p.stderr.unwrap_or(f64::NAN)))
             .collect();
-        let c = &law.summary.params[0];
+        let c = &law.params[0];
         println!(
             "| {name} | {} | {:.4} ± {:.4} | {:.2} |",
             ks.join(" | "),
             c.value,
             c.stderr.unwrap_or(f64::NAN),
-            law.summary.stats.chi2
+            law.stats.chi2
         );
     }
     // Phase sequences of the contact model at each point's fitted law-c K.
-    let law = fit_law(contact, &data, KLaw::C, 0.95, false).unwrap();
+    let law = KLawFitter::new(contact, KLaw::C)
+        .least_squares(false)
+        .fit(&data)
+        .unwrap();
+    let c = law.params[0].value;
     let mut seqs: BTreeMap<(String, String), usize> = BTreeMap::new();
-    for (p, &k) in data.points.iter().zip(&law.k) {
+    for p in &data.points {
+        // Law c: K = cos 2α + c sin²α sin 2α.
+        let a = p.scene.alpha_rad();
+        let k = (2.0 * a).cos() + c * a.sin().powi(2) * (2.0 * a).sin();
         let sc = p.scene.with_k(k).unwrap();
         let seq = contact
             .evaluate(&sc)

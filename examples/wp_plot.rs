@@ -1,9 +1,9 @@
 //! Re-plots a work-precision table written by `fitbead bench --output` without measuring
 //! again (the figure's look changes, the measurements stay):
 //!
-//!     cargo run --release --example wp_plot -- bench/wp.csv bench/wp.svg "Work-precision, 2000 scenes (seed 1)"
+//!     cargo run --release --features bench-internals --example wp_plot -- bench/wp.csv bench/wp.svg "Work-precision, 2000 scenes (seed 1)"
 
-use fitbead::report::workprecision::{plot, read_rows};
+use fitbead::bench_internals::replot;
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -15,13 +15,9 @@ fn main() {
         eprintln!("{csv}: {e}");
         std::process::exit(2)
     });
-    let rows = read_rows(&bytes).unwrap_or_else(|e| {
+    let out = replot(&bytes, title).unwrap_or_else(|e| {
         eprintln!("{csv}: {e}");
         std::process::exit(2)
-    });
-    let out = plot(&rows, title).unwrap_or_else(|e| {
-        eprintln!("{e}");
-        std::process::exit(1)
     });
     if let Err(e) = std::fs::write(svg, out) {
         eprintln!("{svg}: {e}");

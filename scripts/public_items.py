@@ -4,7 +4,10 @@
 Counts what a user of the library can name: structs, enums, unions, traits, functions, type
 aliases, constants, statics and macros reachable from the crate root, each once (as rustdoc's
 `all.html` lists them; methods and fields belong to their type and are not counted). The
-command-line binary is not part of the library and is not counted.
+command-line binary is not part of the library and is not counted. The count is that of the
+default features; the non-default feature `bench-internals` (internals for the benchmarks, not
+part of the API) adds the names its one module `src/bench_internals.rs` makes public, printed
+apart and not counted.
 
     scripts/public_items.py                  # build the docs, print the list and the count
     scripts/public_items.py --max 150        # ... and exit 1 if the count is above 150
@@ -31,6 +34,27 @@ def items(all_html):
         for name in re.findall(r'<li><a href="[^"]+">([^<]+)</a></li>', body):
             out.append((kind, html.unescape(name)))
     return out
+
+
+def feature_items():
+    """The names the feature `bench-internals` adds: every name `src/bench_internals.rs` makes
+    public (`pub use` lists, renamed with `as`, and its own `pub` items)."""
+    path = os.path.join(ROOT, "src", "bench_internals.rs")
+    if not os.path.exists(path):
+        return []
+    with open(path, encoding="utf-8") as f:
+        text = re.sub(r"//[^\n]*", "", f.read())
+    names = []
+    for body in re.findall(r"\bpub use ([^;]+);", text):
+        body = re.sub(r"\s+", " ", body)
+        m = re.match(r"(.*?)::\{(.*)\}$", body.strip())
+        parts = [p.strip() for p in m.group(2).split(",")] if m else [body.rsplit("::", 1)[-1]]
+        for p in filter(None, parts):
+            names.append(p.split(" as ")[-1].strip())
+    names += re.findall(
+        r"^pub (?:fn|struct|enum|trait|type|const|static|union) (\w+)", text, re.M
+    )
+    return names
 
 
 def main():
@@ -60,6 +84,12 @@ def main():
                 print(f"{kind:10} {name}")
     summary = ", ".join(f"{len(v)} {k}" for k, v in sorted(by_kind.items()))
     print(f"public items of fitbead: {len(found)} ({summary})")
+    extra = feature_items()
+    if extra:
+        print(
+            f"not counted: the feature bench-internals (not part of the API) adds {len(extra)}: "
+            + ", ".join(f"bench_internals::{n}" for n in extra)
+        )
     if args.max is not None and len(found) > args.max:
         print(f"more than {args.max} public items", file=sys.stderr)
         sys.exit(1)

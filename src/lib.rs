@@ -43,7 +43,7 @@
 //!
 //! | crate | what it does here |
 //! |---|---|
-//! | argmin | the optimisation framework: the least-squares solver is an argmin `Solver` ([`inverse::LevenbergMarquardt`]) run by argmin's `Executor`, and every least-squares problem is an argmin problem ([`inverse::LeastSquares`]), so argmin's other solvers, observers and termination rules apply; the fits' progress comes from an argmin observer ([`inverse::ProgressObserver`]), and argmin problems fit with fitbead's solver ([`inverse::ArgminResiduals`]) |
+//! | argmin | the optimisation framework: the least-squares solver is an argmin `Solver` ([`inverse::LevenbergMarquardt`]) run by argmin's `Executor`, and every least-squares problem is an argmin problem ([`inverse::LeastSquares`]), so argmin's other solvers, observers and termination rules apply; the fits' progress comes from an argmin observer (`inverse::ProgressObserver`), and argmin problems fit with fitbead's solver ([`inverse::ArgminResiduals`]) |
 //! | nalgebra (with argmin-math's nalgebra backend) | the vectors and matrices of that argmin interface; fixed-size 2-D geometry: the molecular-dynamics bead's position, velocity and forces (`Vector2`) and the 2×2 Newton polish of the contact model's fixed point (`Matrix2`) |
 //! | faer | dense linear algebra inside the solver: the column-pivoted QR of each Levenberg–Marquardt iteration and the SVD behind every covariance |
 //! | statrs | Student-t and normal quantiles of the confidence intervals and the MCMC diagnostics; the priors' densities |
@@ -55,8 +55,8 @@
 //!
 //! What is hand-written instead, and the measurement that keeps it so, is said where it lives:
 //! the SVG figures (`report::figures::svg`: a plotting crate's backend rounds coordinates to
-//! whole pixels and cannot measure text), Carlson's R_F ([`special::elliptic::rf`]), the Brent root finder ([`special::root`]), the
-//! double-double arithmetic ([`special::dd`]) and the Levenberg–Marquardt iteration itself
+//! whole pixels and cannot measure text), Carlson's R_F (`special::elliptic::rf`), the Brent root finder (`special::root`), the
+//! double-double arithmetic (`special::dd`) and the Levenberg–Marquardt iteration itself
 //! (argmin has none; the NIST cross-checks in `docs/ACCURACY.md`).
 //!
 //! ## Quickstart
@@ -84,13 +84,16 @@ pub mod numfmt;
 pub mod progress;
 pub mod report;
 pub mod scene;
-pub mod special;
+pub(crate) mod special;
 
 pub mod io;
 pub mod prelude;
 
 #[cfg(feature = "cli")]
 pub mod cli;
+
+#[cfg(feature = "bench-internals")]
+pub mod bench_internals;
 
 pub use error::{Error, Result};
 pub use fit::data::Dataset;

@@ -2,7 +2,7 @@
 
 use crate::numfmt::{clip, ECHO_CHARS};
 use crate::special::dd::Dd;
-pub use crate::special::SinCos;
+pub(crate) use crate::special::SinCos;
 use std::f64::consts::FRAC_PI_2;
 use std::fmt;
 use std::str::FromStr;
@@ -42,7 +42,7 @@ pub enum ParameterError {
 }
 
 /// Result of the constructors and parsers that validate parameters.
-pub type ParameterResult<T> = std::result::Result<T, ParameterError>;
+pub(crate) type ParameterResult<T> = std::result::Result<T, ParameterError>;
 
 type Result<T> = ParameterResult<T>;
 

@@ -23,7 +23,7 @@
 
 use super::data::Dataset;
 use super::jaeger_coordinates::JaegerCoordinates;
-pub use super::jaeger_coordinates::JaegerX;
+pub(crate) use super::jaeger_coordinates::JaegerX;
 use super::posterior::{summarise_reparameterised, summarise_with, Method, Prior};
 use super::summary::{distinct_points, observed_norm, FitResult, ParamSpec, Solved};
 use crate::inverse::{fit, CurveModel, Infeasible, LsqOptions, WeightedData};
@@ -39,7 +39,7 @@ pub(crate) const PAPER_FIG9: [(f64, f64, f64, f64); 4] = [
 ];
 
 /// The paper's Fig. 9 values (a1, a2, a3) at ξ, if ξ is one of its four series.
-pub fn paper_values(xi: f64) -> Option<[f64; 3]> {
+pub(crate) fn paper_values(xi: f64) -> Option<[f64; 3]> {
     PAPER_FIG9
         .iter()
         .find(|r| (r.0 - xi).abs() < 1e-9)
@@ -48,7 +48,7 @@ pub fn paper_values(xi: f64) -> Option<[f64; 3]> {
 
 /// Jaeger's model on one branch, p = (a1, a2, a3).
 #[derive(Debug, Clone, Copy)]
-pub struct JaegerModel(pub JaegerBranch);
+pub(crate) struct JaegerModel(pub JaegerBranch);
 
 impl JaegerModel {
     fn root(&self, x: &JaegerX, p: &[f64]) -> Result<f64, Infeasible> {
@@ -102,7 +102,7 @@ impl CurveModel<JaegerX> for JaegerModel {
 
 /// One series' fit.
 #[derive(Debug, Clone, PartialEq)]
-pub struct JaegerFit {
+pub(crate) struct JaegerFit {
     /// Reports (parameter rows carry the paper's Fig. 9 values where ξ matches).
     pub summary: FitResult,
     /// Branch used.
@@ -115,7 +115,7 @@ pub struct JaegerFit {
 
 /// Jaeger's fits of every series.
 #[derive(Debug, Clone, PartialEq)]
-pub struct JaegerFits {
+pub(crate) struct JaegerFits {
     /// Per series, in the dataset's order (`None` with fewer than 4 points).
     pub series: Vec<Option<JaegerFit>>,
     /// Why a fit was not made.
@@ -134,7 +134,7 @@ fn chi2(model: &JaegerModel, x: &[JaegerX], y: &[f64], s: &[f64], p: &[f64]) -> 
 }
 
 /// The derived start (module docs).
-pub fn start(model: &JaegerModel, x: &[JaegerX], y: &[f64], s: &[f64]) -> Option<[f64; 3]> {
+pub(crate) fn start(model: &JaegerModel, x: &[JaegerX], y: &[f64], s: &[f64]) -> Option<[f64; 3]> {
     let xx: Vec<f64> = x
         .iter()
         .zip(y)
@@ -172,14 +172,9 @@ pub fn start(model: &JaegerModel, x: &[JaegerX], y: &[f64], s: &[f64]) -> Option
     best.map(|b| b.0)
 }
 
-/// Fits Jaeger's law to every series on `branch`, with intervals at `level`.
-pub fn fit_jaeger(data: &Dataset, branch: JaegerBranch, level: f64, profile: bool) -> JaegerFits {
-    fit_jaeger_with(data, branch, level, &Method::lsq(profile))
-}
-
-/// As [`fit_jaeger`], with the parameters estimated by `method` (least squares, or a
-/// posterior run per series started from its least-squares optimum; see
-/// [`super::posterior`]). The branch notes are those of the least-squares optimum.
+/// Fits Jaeger's law to every series on `branch`, with intervals at `level`, the parameters
+/// estimated by `method` (least squares, or a posterior run per series started from its
+/// least-squares optimum; see [`super::posterior`]). The branch notes are those of the least-squares optimum.
 pub(crate) fn fit_jaeger_with(
     data: &Dataset,
     branch: JaegerBranch,

@@ -17,13 +17,13 @@ use super::summary::{distinct_points, observed_norm, FitResult, ParamSpec, Solve
 use crate::inverse::{fit, CurveModel, Infeasible, LsqOptions, WeightedData};
 
 /// The paper's global values (λ0, λ1, μ0, μ1), eqs 75–76.
-pub const PAPER_GLOBAL: [f64; 4] = [0.063, 4.96, 0.0025, 7.46];
+pub(crate) const PAPER_GLOBAL: [f64; 4] = [0.063, 4.96, 0.0025, 7.46];
 
 /// What Jan's formula needs of a point: (sin α, sin δ, cos δ).
-pub type JanX = (f64, f64, f64);
+pub(crate) type JanX = (f64, f64, f64);
 
 /// v̄ and (∂v̄/∂λ, ∂v̄/∂μ) at (λ, μ), or infeasible where sin δ − μ cos δ ≤ 0 or λ ≤ 0.
-pub fn velocity(x: &JanX, lambda: f64, mu: f64) -> Result<(f64, f64, f64), Infeasible> {
+pub(crate) fn velocity(x: &JanX, lambda: f64, mu: f64) -> Result<(f64, f64, f64), Infeasible> {
     let (sa, sd, cd) = *x;
     let drive = sd - mu * cd;
     if !(drive > 0.0 && lambda > 0.0) {
@@ -35,7 +35,7 @@ pub fn velocity(x: &JanX, lambda: f64, mu: f64) -> Result<(f64, f64, f64), Infea
 
 /// Per-series model: p = (λ, μ).
 #[derive(Debug, Clone, Copy)]
-pub struct JanSeries;
+pub(crate) struct JanSeries;
 
 impl CurveModel<JanX> for JanSeries {
     fn n_params(&self) -> usize {
@@ -54,7 +54,7 @@ impl CurveModel<JanX> for JanSeries {
 
 /// Global model: p = (λ0, λ1, μ0, μ1).
 #[derive(Debug, Clone, Copy)]
-pub struct JanGlobal;
+pub(crate) struct JanGlobal;
 
 impl CurveModel<JanX> for JanGlobal {
     fn n_params(&self) -> usize {
@@ -78,7 +78,7 @@ impl CurveModel<JanX> for JanGlobal {
 
 /// The fits of `fitbead jan`.
 #[derive(Debug, Clone, PartialEq)]
-pub struct JanFits {
+pub(crate) struct JanFits {
     /// Per series (λ, μ), in the dataset's series order; `None` where the series has fewer
     /// than 3 points (no degree of freedom left for the scatter).
     pub series: Vec<Option<FitResult>>,
@@ -126,112 +126,19 @@ fn line(x: &[f64], y: &[f64], sigma: &[f64]) -> Option<(f64, f64)> {
     (a.is_finite() && b.is_finite()).then_some((a, b))
 }
 
-/// Fits Jan's model per series and globally, with intervals at `level`.
-pub fn fit_jan(data: &Dataset, level: f64, profile: bool) -> JanFits {
-    fit_jan_with(data, level, &Method::lsq(profile))
-}
-
-/// As [`fit_jan`], with the parameters estimated by `method` (least squares, or a posterior
-/// run per fit started from its least-squares optimum; see [`super::posterior`]). The global
+/// Fits Jan's model per series and globally, with intervals at `level`, the parameters
+/// estimated by `method` (least squares, or a posterior run per fit started from its
+/// least-squares optimum; see [`super::posterior`]). The global
 /// fit starts from the per-series least-squares optima either way.
 pub(crate) fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFits {
     let mut notes = Vec::new();
     let mut per = Vec::new();
-    let mut lam_pts: Vec<(f64, f64, f64)> = Vec::new(); // (sin α, ln λ, weight σ of ln λ)
-    let mut mu_pts: Vec<(f64, f64, f64)> = Vec::new();
+    // (sin α, ln λ, weight σ of ln λ) and the same of μ, one per converged series fit.
+    let mut pts: (LogPoints, LogPoints) = (Vec::new(), Vec::new());
     for (s, label) in data.labels.iter().enumerate() {
-        let (x, y, sg) = xs(data, Some(s));
-        if x.len() < 3 {
-            notes.push(format!(
-                "series '{label}': {} points, need at least 3 for λ and μ",
-                x.len()
-            ));
-            per.push(None);
-            continue;
-        }
-        let sa = x[0].0;
-        let tmin = x.iter().map(|p| p.1 / p.2).fold(f64::INFINITY, f64::min);
-        // Linearised start: v̄²/cos δ = A (tan δ − μ), σ of v̄²/cos δ = 2 v̄ σ / cos δ.
-        let lx: Vec<f64> = x.iter().map(|p| p.1 / p.2).collect();
-        let ly: Vec<f64> = x.iter().zip(&y).map(|(p, v)| v * v / p.2).collect();
-        let ls: Vec<f64> = x
-            .iter()
-            .zip(&y)
-            .zip(&sg)
-            .map(|((p, v), s)| 2.0 * v * s / p.2)
-            .collect();
-        let (lam0, mu0) = match line(&lx, &ly, &ls) {
-            Some((a, b)) if b > 0.0 => (2.0 * sa / b, (-a / b).clamp(0.0, 0.999 * tmin)),
-            _ => (crate::models::jan::Jan::paper_fit(sa.asin()).lambda, 0.0),
-        };
-        let distinct = distinct_points(x.iter().map(|p| [p.1, p.2]));
-        let norm = observed_norm(y.iter().zip(&sg));
-        let problem = match WeightedData::new(JanSeries, x, y, Some(sg)) {
-            Ok(p) => p,
-            Err(e) => {
-                notes.push(format!("series '{label}': {e}"));
-                per.push(None);
-                continue;
-            }
-        };
-        let opts = LsqOptions {
-            lower: Some(vec![0.0, 0.0]),
-            upper: Some(vec![f64::INFINITY, tmin]),
-            sigma: data.sigma,
-            stop: method.stop().cloned(),
-            progress: method.progress().cloned(),
-            ..Default::default()
-        };
-        let f = match fit(&problem, &[lam0, mu0], &opts) {
-            Ok(f) => f,
-            Err(e) => {
-                notes.push(format!("series '{label}': {e}"));
-                per.push(None);
-                continue;
-            }
-        };
-        let paper = crate::models::jan::Jan::paper_fit(sa.asin());
-        let specs = [
-            ParamSpec {
-                name: "lambda",
-                unit: "1",
-                paper_value: Some(paper.lambda),
-                paper_source: "paper eq 75 at this alpha",
-                default_prior: None,
-            },
-            ParamSpec {
-                name: "mu",
-                unit: "1",
-                paper_value: Some(paper.mu),
-                paper_source: "paper eq 76 at this alpha",
-                default_prior: None,
-            },
-        ];
-        let mut sum = summarise_with(
-            method,
-            Solved {
-                name: "jan-series",
-                series: label,
-                specs: &specs,
-                problem: &problem,
-                fit: &f,
-                level,
-                options: &opts,
-                distinct: Some(distinct),
-                observed_norm: Some(norm),
-            },
-        );
-        sum.attach_points(data, &data.series_index(s));
-        if f.converged() {
-            let se = f.std_errors().map(|s| s.to_vec()).unwrap_or(vec![1.0; 2]);
-            if f.params[0] > 0.0 {
-                lam_pts.push((sa, f.params[0].ln(), se[0] / f.params[0]));
-            }
-            if f.params[1] > 0.0 {
-                mu_pts.push((sa, f.params[1].ln(), se[1] / f.params[1]));
-            }
-        }
-        per.push(Some(sum));
+        per.push(fit_jan_series(
+            data, s, label, level, method, &mut notes, &mut pts,
+        ));
     }
     let mut alphas: Vec<f64> = data.points.iter().map(|p| p.scene.sin_alpha).collect();
     alphas.sort_by(|a, b| a.total_cmp(b));
@@ -240,110 +147,228 @@ pub(crate) fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFi
         notes.push("global laws need series at two or more contact angles".into());
         None
     } else {
-        let fit_line = |pts: &[(f64, f64, f64)], paper: (f64, f64)| {
-            let (x, y, s): (Vec<f64>, Vec<f64>, Vec<f64>) = (
-                pts.iter().map(|p| p.0).collect(),
-                pts.iter().map(|p| p.1).collect(),
-                pts.iter()
-                    .map(|p| {
-                        if p.2 > 0.0 && p.2.is_finite() {
-                            p.2
-                        } else {
-                            1.0
-                        }
-                    })
-                    .collect(),
-            );
-            match (pts.len() >= 2).then(|| line(&x, &y, &s)).flatten() {
-                Some((a, b)) => (a.exp(), b),
-                None => paper,
-            }
-        };
-        let (l0, l1) = fit_line(&lam_pts, (PAPER_GLOBAL[0], PAPER_GLOBAL[1]));
-        let (m0, m1) = fit_line(&mu_pts, (PAPER_GLOBAL[2], PAPER_GLOBAL[3]));
-        let (x, y, sg) = xs(data, None);
-        let norm = observed_norm(y.iter().zip(&sg));
-        let problem = WeightedData::new(JanGlobal, x.clone(), y, Some(sg)).ok();
-        let opts = LsqOptions {
-            lower: Some(vec![0.0, f64::NEG_INFINITY, 0.0, f64::NEG_INFINITY]),
-            sigma: data.sigma,
-            stop: method.stop().cloned(),
-            progress: method.progress().cloned(),
-            ..Default::default()
-        };
-        let feasible = |p: &[f64]| x.iter().all(|q| JanGlobal.value(q, p).is_ok());
-        // The start must keep μ(α) below every slope; shrink μ0 until it does.
-        let mut start = [l0, l1, m0, m1];
-        let mut tries = 0;
-        while !feasible(&start) && tries < 60 {
-            start[2] *= 0.5;
-            tries += 1;
-        }
-        let problem = problem.or_else(|| {
-            notes.push("global laws: the data cannot form a weighted problem".into());
-            None
-        });
-        problem.and_then(|problem| {
-            let f = match fit(&problem, &start, &opts) {
-                Ok(f) => f,
-                Err(e) => {
-                    notes.push(format!("global laws: {e}"));
-                    return None;
-                }
-            };
-            let src75 = "paper eq 75";
-            let src76 = "paper eq 76";
-            let specs = [
-                ParamSpec {
-                    name: "lambda0",
-                    unit: "1",
-                    paper_value: Some(PAPER_GLOBAL[0]),
-                    paper_source: src75,
-                    default_prior: None,
-                },
-                ParamSpec {
-                    name: "lambda1",
-                    unit: "1",
-                    paper_value: Some(PAPER_GLOBAL[1]),
-                    paper_source: src75,
-                    default_prior: None,
-                },
-                ParamSpec {
-                    name: "mu0",
-                    unit: "1",
-                    paper_value: Some(PAPER_GLOBAL[2]),
-                    paper_source: src76,
-                    default_prior: None,
-                },
-                ParamSpec {
-                    name: "mu1",
-                    unit: "1",
-                    paper_value: Some(PAPER_GLOBAL[3]),
-                    paper_source: src76,
-                    default_prior: None,
-                },
-            ];
-            let mut sum = summarise_with(
-                method,
-                Solved {
-                    name: "jan-global",
-                    series: "all",
-                    specs: &specs,
-                    problem: &problem,
-                    fit: &f,
-                    level,
-                    options: &opts,
-                    distinct: Some(distinct_points(x.iter().map(|p| [p.0, p.1, p.2]))),
-                    observed_norm: Some(norm),
-                },
-            );
-            sum.attach_points(data, &(0..data.points.len()).collect::<Vec<_>>());
-            Some(sum)
-        })
+        fit_jan_global(data, level, method, &pts.0, &pts.1, &mut notes)
     };
     JanFits {
         series: per,
         global,
         notes,
     }
+}
+
+/// (sin α, ln x, σ of ln x) of a parameter x of each converged series fit.
+type LogPoints = Vec<(f64, f64, f64)>;
+
+/// Jan's λ and μ of series `s` (eq 74), or `None` with a note saying why not; a converged fit
+/// adds its (sin α, ln λ, σ of ln λ) and (sin α, ln μ, σ of ln μ) to `pts`.
+fn fit_jan_series(
+    data: &Dataset,
+    s: usize,
+    label: &str,
+    level: f64,
+    method: &Method,
+    notes: &mut Vec<String>,
+    pts: &mut (LogPoints, LogPoints),
+) -> Option<FitResult> {
+    let (x, y, sg) = xs(data, Some(s));
+    if x.len() < 3 {
+        notes.push(format!(
+            "series '{label}': {} points, need at least 3 for λ and μ",
+            x.len()
+        ));
+        return None;
+    }
+    let sa = x[0].0;
+    let tmin = x.iter().map(|p| p.1 / p.2).fold(f64::INFINITY, f64::min);
+    // Linearised start: v̄²/cos δ = A (tan δ − μ), σ of v̄²/cos δ = 2 v̄ σ / cos δ.
+    let lx: Vec<f64> = x.iter().map(|p| p.1 / p.2).collect();
+    let ly: Vec<f64> = x.iter().zip(&y).map(|(p, v)| v * v / p.2).collect();
+    let ls: Vec<f64> = x
+        .iter()
+        .zip(&y)
+        .zip(&sg)
+        .map(|((p, v), s)| 2.0 * v * s / p.2)
+        .collect();
+    let (lam0, mu0) = match line(&lx, &ly, &ls) {
+        Some((a, b)) if b > 0.0 => (2.0 * sa / b, (-a / b).clamp(0.0, 0.999 * tmin)),
+        _ => (crate::models::jan::Jan::paper_fit(sa.asin()).lambda, 0.0),
+    };
+    let distinct = distinct_points(x.iter().map(|p| [p.1, p.2]));
+    let norm = observed_norm(y.iter().zip(&sg));
+    let problem = match WeightedData::new(JanSeries, x, y, Some(sg)) {
+        Ok(p) => p,
+        Err(e) => {
+            notes.push(format!("series '{label}': {e}"));
+            return None;
+        }
+    };
+    let opts = LsqOptions {
+        lower: Some(vec![0.0, 0.0]),
+        upper: Some(vec![f64::INFINITY, tmin]),
+        sigma: data.sigma,
+        stop: method.stop().cloned(),
+        progress: method.progress().cloned(),
+        ..Default::default()
+    };
+    let f = match fit(&problem, &[lam0, mu0], &opts) {
+        Ok(f) => f,
+        Err(e) => {
+            notes.push(format!("series '{label}': {e}"));
+            return None;
+        }
+    };
+    let paper = crate::models::jan::Jan::paper_fit(sa.asin());
+    let specs = [
+        ParamSpec {
+            name: "lambda",
+            unit: "1",
+            paper_value: Some(paper.lambda),
+            paper_source: "paper eq 75 at this alpha",
+            default_prior: None,
+        },
+        ParamSpec {
+            name: "mu",
+            unit: "1",
+            paper_value: Some(paper.mu),
+            paper_source: "paper eq 76 at this alpha",
+            default_prior: None,
+        },
+    ];
+    let mut sum = summarise_with(
+        method,
+        Solved {
+            name: "jan-series",
+            series: label,
+            specs: &specs,
+            problem: &problem,
+            fit: &f,
+            level,
+            options: &opts,
+            distinct: Some(distinct),
+            observed_norm: Some(norm),
+        },
+    );
+    sum.attach_points(data, &data.series_index(s));
+    if f.converged() {
+        let se = f.std_errors().map(|s| s.to_vec()).unwrap_or(vec![1.0; 2]);
+        if f.params[0] > 0.0 {
+            pts.0.push((sa, f.params[0].ln(), se[0] / f.params[0]));
+        }
+        if f.params[1] > 0.0 {
+            pts.1.push((sa, f.params[1].ln(), se[1] / f.params[1]));
+        }
+    }
+    Some(sum)
+}
+
+/// The global laws of eqs 75–76 fitted to every point, started from the lines through the
+/// series' ln λ and ln μ (`lam_pts`, `mu_pts`), or `None` with a note saying why not.
+fn fit_jan_global(
+    data: &Dataset,
+    level: f64,
+    method: &Method,
+    lam_pts: &[(f64, f64, f64)],
+    mu_pts: &[(f64, f64, f64)],
+    notes: &mut Vec<String>,
+) -> Option<FitResult> {
+    let fit_line = |pts: &[(f64, f64, f64)], paper: (f64, f64)| {
+        let (x, y, s): (Vec<f64>, Vec<f64>, Vec<f64>) = (
+            pts.iter().map(|p| p.0).collect(),
+            pts.iter().map(|p| p.1).collect(),
+            pts.iter()
+                .map(|p| {
+                    if p.2 > 0.0 && p.2.is_finite() {
+                        p.2
+                    } else {
+                        1.0
+                    }
+                })
+                .collect(),
+        );
+        match (pts.len() >= 2).then(|| line(&x, &y, &s)).flatten() {
+            Some((a, b)) => (a.exp(), b),
+            None => paper,
+        }
+    };
+    let (l0, l1) = fit_line(lam_pts, (PAPER_GLOBAL[0], PAPER_GLOBAL[1]));
+    let (m0, m1) = fit_line(mu_pts, (PAPER_GLOBAL[2], PAPER_GLOBAL[3]));
+    let (x, y, sg) = xs(data, None);
+    let norm = observed_norm(y.iter().zip(&sg));
+    let problem = WeightedData::new(JanGlobal, x.clone(), y, Some(sg)).ok();
+    let opts = LsqOptions {
+        lower: Some(vec![0.0, f64::NEG_INFINITY, 0.0, f64::NEG_INFINITY]),
+        sigma: data.sigma,
+        stop: method.stop().cloned(),
+        progress: method.progress().cloned(),
+        ..Default::default()
+    };
+    let feasible = |p: &[f64]| x.iter().all(|q| JanGlobal.value(q, p).is_ok());
+    // The start must keep μ(α) below every slope; shrink μ0 until it does.
+    let mut start = [l0, l1, m0, m1];
+    let mut tries = 0;
+    while !feasible(&start) && tries < 60 {
+        start[2] *= 0.5;
+        tries += 1;
+    }
+    let problem = problem.or_else(|| {
+        notes.push("global laws: the data cannot form a weighted problem".into());
+        None
+    });
+    problem.and_then(|problem| {
+        let f = match fit(&problem, &start, &opts) {
+            Ok(f) => f,
+            Err(e) => {
+                notes.push(format!("global laws: {e}"));
+                return None;
+            }
+        };
+        let src75 = "paper eq 75";
+        let src76 = "paper eq 76";
+        let specs = [
+            ParamSpec {
+                name: "lambda0",
+                unit: "1",
+                paper_value: Some(PAPER_GLOBAL[0]),
+                paper_source: src75,
+                default_prior: None,
+            },
+            ParamSpec {
+                name: "lambda1",
+                unit: "1",
+                paper_value: Some(PAPER_GLOBAL[1]),
+                paper_source: src75,
+                default_prior: None,
+            },
+            ParamSpec {
+                name: "mu0",
+                unit: "1",
+                paper_value: Some(PAPER_GLOBAL[2]),
+                paper_source: src76,
+                default_prior: None,
+            },
+            ParamSpec {
+                name: "mu1",
+                unit: "1",
+                paper_value: Some(PAPER_GLOBAL[3]),
+                paper_source: src76,
+                default_prior: None,
+            },
+        ];
+        let mut sum = summarise_with(
+            method,
+            Solved {
+                name: "jan-global",
+                series: "all",
+                specs: &specs,
+                problem: &problem,
+                fit: &f,
+                level,
+                options: &opts,
+                distinct: Some(distinct_points(x.iter().map(|p| [p.0, p.1, p.2]))),
+                observed_norm: Some(norm),
+            },
+        );
+        sum.attach_points(data, &(0..data.points.len()).collect::<Vec<_>>());
+        Some(sum)
+    })
 }

@@ -6,7 +6,7 @@
 //! (law c: a = cos 2α, b = sin²α sin 2α > 0, one group; free: a = 0, b = 1, one group per
 //! series). Hence:
 //! - the feasible box of each parameter is exact: point i stays in regime B for K in its
-//!   bracket (K_min, K_max] ([`crate::fit::k::bracket()`]), so p_j must lie in the intersection
+//!   bracket (K_min, K_max] (`fit::k::bracket`), so p_j must lie in the intersection
 //!   of ((K_min,i − a_i)/b_i, (K_max,i − a_i)/b_i] over the points of group j. An empty
 //!   intersection means no value of the law keeps every point steady, and the fit says so
 //!   instead of searching;
@@ -165,7 +165,7 @@ impl fmt::Display for KLawError {
 
 /// The residuals (v_i − v̄_th(K_i(p)))/σ_i of a law over a dataset.
 #[derive(Debug)]
-pub struct KLawProblem<'a> {
+pub(crate) struct KLawProblem<'a> {
     model: Model,
     data: &'a Dataset,
     law: KLaw,
@@ -194,6 +194,7 @@ pub(crate) const START_POINTS: usize = 255;
 
 impl<'a> KLawProblem<'a> {
     /// The problem for `law` under `model` (a contact model whose K can be inverted).
+    #[cfg(test)]
     pub fn new(model: Model, data: &'a Dataset, law: KLaw) -> Result<Self, KLawError> {
         Self::new_until(model, data, law, None)
     }
@@ -284,12 +285,6 @@ impl<'a> KLawProblem<'a> {
         }
     }
 
-    /// Reports the forward evaluations done (after each batch of them) to `progress`.
-    pub fn with_progress(mut self, progress: Option<Progress>) -> Self {
-        self.progress = progress;
-        self
-    }
-
     /// Cuts the per-point work short once `stop` is raised ([`KLawError::Interrupted`] from
     /// [`KLawProblem::start`], a rejected step from the Jacobian).
     pub fn with_stop(mut self, stop: Option<Arc<AtomicBool>>) -> Self {
@@ -301,11 +296,6 @@ impl<'a> KLawProblem<'a> {
         self.stop
             .as_ref()
             .is_some_and(|s| s.load(Ordering::Relaxed))
-    }
-
-    /// The law.
-    pub fn law(&self) -> KLaw {
-        self.law
     }
 
     /// Name of the parameters: `c`, or `K` (one per series).
@@ -782,7 +772,7 @@ fn fit_per_series(
 
 /// The fitted law with its reports.
 #[derive(Debug, Clone, PartialEq)]
-pub struct KLawFit {
+pub(crate) struct KLawFit {
     /// The law.
     pub law: KLaw,
     /// Parameter rows and statistics (for the impact law: no parameter rows, the statistics
@@ -794,7 +784,7 @@ pub struct KLawFit {
 
 /// Fits (or, for the impact law, scores) `law` under `model` on `data`, with covariance and
 /// (when `profile`) profile-likelihood intervals at `level`.
-pub fn fit_law(
+pub(crate) fn fit_law(
     model: Model,
     data: &Dataset,
     law: KLaw,
@@ -807,7 +797,7 @@ pub fn fit_law(
 /// As [`fit_law`], with the parameters estimated by `method` (least squares, or a posterior
 /// run started from the least-squares optimum; see [`super::posterior`]). The impact law has
 /// nothing to sample and is scored either way.
-pub fn fit_law_with(
+pub(crate) fn fit_law_with(
     model: Model,
     data: &Dataset,
     law: KLaw,
@@ -825,7 +815,7 @@ pub(crate) struct KLawContext {
     pub brackets: Option<Vec<KBracket>>,
     /// Where progress goes: a task labelled with the fit's name, of unknown total, whose
     /// positions count the model evaluations (residual vectors and Jacobians over the data) of
-    /// the least-squares fit and its profiles, from a [`crate::inverse::ProgressObserver`]
+    /// the least-squares fit and its profiles, from a `ProgressObserver`
     /// on their iterations.
     pub progress: Option<Progress>,
 }

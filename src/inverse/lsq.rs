@@ -255,7 +255,7 @@ pub struct LsqOptions {
     pub stop: Option<Arc<AtomicBool>>,
     /// Counts the model evaluations of the iterations — every residual vector and every
     /// analytic Jacobian, one each (a finite-difference Jacobian by its residual evaluations) —
-    /// as the position of the caller's task, through a [`super::ProgressObserver`] that
+    /// as the position of the caller's task, through a `ProgressObserver` that
     /// [`super::fit`] attaches to its executor (positions move once per iteration; the
     /// covariance's Jacobian at the end is not counted). Profiles pass it on to their
     /// constrained fits. The solver itself ignores it: a run built by hand under argmin's

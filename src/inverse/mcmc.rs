@@ -25,9 +25,9 @@
 //! `max_steps`, or until a caller raises the stop flag. The chains, and the diagnostics on
 //! them, are of what the density records of each point ([`LogDensity::observe`]: the point
 //! itself unless the density is over transformed coordinates). The diagnostics are in
-//! [`diagnostics`] and work on any chains.
+//! `diagnostics` and work on any chains.
 
-pub mod diagnostics;
+pub(crate) mod diagnostics;
 pub(crate) mod sensitivity;
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -39,9 +39,7 @@ use rand_distr::StandardNormal;
 use rayon::prelude::*;
 use thiserror::Error;
 
-pub use diagnostics::{
-    ess_bulk, ess_mean, ess_tail, integrated_time, rhat, Convergence, ParameterDiagnostics,
-};
+pub use diagnostics::ParameterDiagnostics;
 pub(crate) use diagnostics::{integrated_times, summarise};
 
 /// An unnormalised log probability density on ℝⁿ.

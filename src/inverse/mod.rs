@@ -10,7 +10,7 @@
 //!   (χ²) on nalgebra vectors: [`fit`] runs under argmin's `Executor`, argmin's other solvers
 //!   run on fitbead's problems, and observers, timeouts and iteration limits apply to both;
 //!   the solver's state is [`LmState`] (argmin's `State` with λ, the trust radius, the scaling,
-//!   the active set and the stage for observers), and [`ProgressObserver`] is the observer that
+//!   the active set and the stage for observers), and `ProgressObserver` is the observer that
 //!   counts a fit's model evaluations for a progress bar;
 //! * [`ArgminResiduals`] — any argmin problem with residuals and their Jacobian
 //!   (`Operator` + `Jacobian` on nalgebra vectors) fitted by fitbead's solver;
@@ -22,7 +22,7 @@
 //!   App. Math. Comp. Sci. 5, 2010; emcee's split-half parallel form, Foreman-Mackey et al.
 //!   2013), reproducible for a seed whatever the thread count, run until the rank-normalised
 //!   split-R̂ and bulk/tail effective sample sizes of Vehtari et al. (2021) meet their
-//!   thresholds; the diagnostics ([`mcmc::diagnostics`]) work on any chains.
+//!   thresholds; the diagnostics (`mcmc::diagnostics`) work on any chains.
 //!
 //! The solver is validated on the 27 nonlinear problems of the NIST Statistical Reference
 //! Datasets (StRD), from both starting points (`tests/it/nist.rs`).
@@ -32,7 +32,7 @@ pub mod lm;
 mod lmpar;
 pub mod lsq;
 pub mod mcmc;
-pub mod observer;
+pub(crate) mod observer;
 pub mod posterior;
 pub mod problem;
 pub mod profile;
@@ -52,10 +52,9 @@ pub use mcmc::{
     EnsembleSampler, LogDensity, McmcError, McmcOptions, McmcResult, ParameterDiagnostics,
     StopReason,
 };
-pub use observer::ProgressObserver;
 pub use problem::{ArgminResiduals, LeastSquares};
 pub use profile::{
-    confidence_intervals, ConfidenceIntervals, Interval, ProfileEnd, ProfileInterval, DEFAULT_LEVEL,
+    confidence_intervals, ConfidenceIntervals, Interval, ProfileEnd, ProfileInterval,
 };
-pub(crate) use profile::{covariance_intervals, profile_interval};
+pub(crate) use profile::{covariance_intervals, profile_interval, DEFAULT_LEVEL};
 pub use state::{LmStage, LmState};

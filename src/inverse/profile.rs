@@ -32,7 +32,7 @@ use super::lsq::{validate, Infeasible, LsqError, LsqOptions, Residuals, SigmaKin
 use crate::special::root::brent;
 
 /// The customary confidence level, 0.95.
-pub const DEFAULT_LEVEL: f64 = 0.95;
+pub(crate) const DEFAULT_LEVEL: f64 = 0.95;
 
 /// A closed interval [lower, upper].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -313,7 +313,7 @@ pub(crate) fn profile_interval<R: Residuals + ?Sized>(
 }
 
 /// Covariance and profile-likelihood intervals of every parameter at `level`
-/// ([`DEFAULT_LEVEL`] = 0.95 is the usual choice).
+/// (0.95 is the usual choice).
 ///
 /// ```
 /// use fitbead::inverse::{confidence_intervals, fit, Infeasible, LsqOptions, CurveModel, WeightedData};

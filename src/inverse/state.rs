@@ -229,7 +229,7 @@ impl LmState {
     }
 
     /// Model evaluations so far: every residual vector (finite-difference ones included) and
-    /// every analytic Jacobian, one each — the count [`super::ProgressObserver`] reports.
+    /// every analytic Jacobian, one each — the count `ProgressObserver` reports.
     pub fn model_evals(&self) -> usize {
         self.0.model_evals
     }

@@ -619,7 +619,7 @@ pub(crate) const MIN_RHO: f64 = 0.01;
 /// Largest factor by which the damping rates may shrink the time step below the contact-time
 /// step (`step_fraction` × contact time): beyond it the run's cost grows without bound as
 /// ρ → 0 or γ → ∞, and the scene is refused ([`Md::check_scene`]).
-pub const MAX_STEP_SHRINK: f64 = 100.0;
+pub(crate) const MAX_STEP_SHRINK: f64 = 100.0;
 
 /// Most time steps one md run may take. A run gives up after `max_time_per_bead` times
 /// (`beads` plus one) time units, so its step bounds its steps: `step_fraction` of the Hertz
@@ -895,8 +895,8 @@ impl Md {
     }
 
     /// Checks that `scene` is inside the model's domain with these parameters: ρ ≥
-    /// `MIN_RHO`, and damping rates that shrink the time step by at most
-    /// [`MAX_STEP_SHRINK`] below the contact-time step (the normal rate γ_n m_eff/m and the
+    /// `MIN_RHO`, and damping rates that shrink the time step by at most a factor
+    /// `MAX_STEP_SHRINK` (100) below the contact-time step (the normal rate γ_n m_eff/m and the
     /// spin relaxation rate γ_s m_eff/m (1 + 1/ρ), in units sqrt(g/(R+r)), each times the
     /// step, at most 0.1). The error names the field to change.
     pub fn check_scene(&self, scene: &Scene) -> Result<()> {
@@ -1456,18 +1456,8 @@ pub(crate) const MD_REFINE: usize = 7;
 pub(crate) const MD_NARROW: usize = 8;
 
 /// The slopes (degrees) where the md model is in regime B at this ξ: the longest run of the
-/// 0.5° scan (slopes in parallel), each end refined by bisection.
-pub fn regime_b_interval(
-    md: &Md,
-    xi: f64,
-    rho: f64,
-    tick: &(dyn Fn() + Sync),
-) -> std::result::Result<Option<(f64, f64)>, Error> {
-    regime_b_interval_until(md, xi, rho, tick, None)
-}
-
-/// As [`regime_b_interval`], its runs stopped early once `stop` is raised (the result is then
-/// meaningless: the caller checks the flag).
+/// 0.5° scan (slopes in parallel), each end refined by bisection; its runs stopped early once
+/// `stop` is raised (the result is then meaningless: the caller checks the flag).
 pub(crate) fn regime_b_interval_until(
     md: &Md,
     xi: f64,
@@ -1536,5 +1526,30 @@ mod tests {
         assert!((2.0 * impact_integral(1.5) - 2.9432).abs() < 1e-4);
         // Linear spring: ∫₀¹ du/√(1−u²) = π/2.
         assert!((impact_integral(1.0) - PI / 2.0).abs() < 1e-12);
+    }
+
+    /// A scene outside the md model's domain (ρ → 0) fails at once, its time step never shrunk
+    /// below the contact-time step over `MAX_STEP_SHRINK`.
+    #[test]
+    fn md_time_step_cannot_collapse() {
+        use std::time::{Duration, Instant};
+        let md = Md::ristow();
+        for rho in [1e-4, 1e-6, 1e-300] {
+            let sc = Scene::new(1.6, 6.0, rho, 0.1, CollisionLaw::Value(0.5)).unwrap();
+            assert!(md.check_scene(&sc).is_err(), "rho {rho}");
+            let t0 = Instant::now();
+            let r = md.simulate(&sc, 1.0, None);
+            assert_eq!(r.failure, Some(MdFailure::OutsideDomain), "rho {rho}");
+            assert!(t0.elapsed() < Duration::from_millis(100));
+            assert!(
+                r.dt >= md.config.step_fraction * r.contact_time / MAX_STEP_SHRINK * (1.0 - 1e-12),
+                "rho {rho}: dt {} contact time {}",
+                r.dt,
+                r.contact_time
+            );
+        }
+        // At Ristow's ρ = 0.4 the step is the contact-time step or the damping's, unchanged.
+        let sc = Scene::new(1.6, 6.0, 0.4, 0.1, CollisionLaw::Value(0.5)).unwrap();
+        assert!(md.check_scene(&sc).is_ok());
     }
 }

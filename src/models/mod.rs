@@ -11,11 +11,11 @@ pub mod jaeger;
 pub mod jan;
 pub mod md;
 pub mod regimes;
-pub mod sample;
-pub mod slip;
-pub mod stick;
-pub mod stickquad;
-pub mod stickslip;
+pub(crate) mod sample;
+pub(crate) mod slip;
+pub(crate) mod stick;
+pub(crate) mod stickquad;
+pub(crate) mod stickslip;
 #[cfg(test)]
 mod suite;
 

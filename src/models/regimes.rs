@@ -12,13 +12,13 @@ pub fn delta_m(alpha: f64, k: f64) -> f64 {
 
 /// Upper limit (lift-off at Θf), δ_d = atan((1+ρ)(1−K²) / (tan α (4 + (1+ρ)(1−K²)))) (eq 31),
 /// radians.
-pub fn delta_d(alpha: f64, k: f64, rho: f64) -> f64 {
+pub(crate) fn delta_d(alpha: f64, k: f64, rho: f64) -> f64 {
     delta_d_of(alpha, k, 1.0 - k, rho)
 }
 
 /// Bulk friction of the rolling model, μ = lim_{v→0} tan δ
 /// = (1 − K²) sin α / ((1 + K²) cos α + 2K) (eqs 78–79). Equals tan δ_m exactly.
-pub fn bulk_friction(alpha: f64, k: f64) -> f64 {
+pub(crate) fn bulk_friction(alpha: f64, k: f64) -> f64 {
     bulk_friction_of(alpha, k, 1.0 - k)
 }
 
@@ -29,12 +29,12 @@ pub fn delta_m_law(alpha: f64, law: CollisionLaw, rho: f64) -> f64 {
     delta_m_of(alpha, law.k(alpha, rho), law.one_minus_k(alpha, rho))
 }
 
-/// [`delta_d`] for a collision law at α and ρ (1 − K as in [`delta_m_law`]).
+/// δ_d (eq 31) for a collision law at α and ρ (1 − K as in [`delta_m_law`]).
 pub fn delta_d_law(alpha: f64, law: CollisionLaw, rho: f64) -> f64 {
     delta_d_of(alpha, law.k(alpha, rho), law.one_minus_k(alpha, rho), rho)
 }
 
-/// [`bulk_friction`] (eq 79) for a collision law at α and ρ (1 − K as in [`delta_m_law`]).
+/// The bulk friction (eq 79) for a collision law at α and ρ (1 − K as in [`delta_m_law`]).
 pub fn bulk_friction_law(alpha: f64, law: CollisionLaw, rho: f64) -> f64 {
     bulk_friction_of(alpha, law.k(alpha, rho), law.one_minus_k(alpha, rho))
 }
@@ -83,7 +83,7 @@ pub fn alpha_of_xi(xi: f64) -> f64 {
 
 /// δ_m and δ_d (radians) at radius ratio ξ for a collision law ([`delta_m_law`],
 /// [`delta_d_law`]).
-pub fn limits(xi: f64, law: CollisionLaw, rho: f64) -> (f64, f64) {
+pub(crate) fn limits(xi: f64, law: CollisionLaw, rho: f64) -> (f64, f64) {
     let a = alpha_of_xi(xi);
     (delta_m_law(a, law, rho), delta_d_law(a, law, rho))
 }
@@ -130,7 +130,7 @@ pub fn friction_demand(scene: &Scene, w0sq: f64, theta: f64) -> f64 {
 /// tan(Θ_G/2) = f (3+ρ−ϑ) / (ρ + sqrt(ρ² + f² ((3+ρ)² − ϑ²))) (docs/PHYSICS.md#friction-demand).
 /// `None` when no real Θ_G exists ((3+ρ)² < ϑ²: the normal force is negative everywhere), or
 /// when ρ = f = 0 (no friction is ever needed).
-pub fn theta_g(scene: &Scene, w0sq: f64) -> Option<f64> {
+pub(crate) fn theta_g(scene: &Scene, w0sq: f64) -> Option<f64> {
     theta_g_of(scene.rho, scene.f, vartheta(scene, w0sq))
 }
 

@@ -107,7 +107,7 @@ impl SlipPhase {
 /// in pairs θc ± t, and each pair shares one sin_cos and one exp_m1 through the addition
 /// formulas, with Θ̇² in the cancellation-free form of [`SlipPhase::speed_sq_offset`]: one
 /// panel where the adaptive 15-point rule takes three on the stick/slip scenes of
-/// `cargo bench --bench forward` (timings in docs/PERFORMANCE.md), with the same value to
+/// `cargo bench --features bench-internals --bench forward` (timings in docs/PERFORMANCE.md), with the same value to
 /// 1e-15.
 fn slip_time_panel(ph: &SlipPhase, a: f64, b: f64, ga: f64, tol: f64) -> Option<f64> {
     let m = ph.speed_sq(a);
@@ -187,6 +187,7 @@ fn minimum_angle(ph: &SlipPhase, a: f64, b: f64) -> Result<(f64, f64, f64), NotS
 /// The least squared speed of the slip model's steady contact (§4.3) and where it lies:
 /// (θm, Θ̇²(θm)), in double-double (`SlipDd`) when θm is interior. It vanishes at the slip
 /// model's stop limit, like the squared top speed of rolling at δ_m.
+#[cfg(test)]
 pub fn speed_minimum(scene: &Scene) -> Result<(f64, f64), NotSteady> {
     let l2 = final_velocity_sq(scene)?;
     let ph = SlipPhase::new(scene.theta_0, scene.k * scene.k * l2, scene.f);

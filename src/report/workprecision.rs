@@ -7,7 +7,7 @@
 use crate::fit::k::{bracket, solve};
 use crate::models::auto::Auto;
 use crate::models::contact::{Contact, PhaseKind, SpinRule};
-pub use crate::models::sample::{draw_scenes, Draw};
+pub(crate) use crate::models::sample::{draw_scenes, Draw};
 use crate::models::slip::SlipPhase;
 use crate::models::{slip, stick, stickquad, stickslip, Model, Outcome, Phases};
 use crate::numfmt::fmt_f64;
@@ -332,7 +332,7 @@ fn time_one(f: &dyn Fn(&Scene) -> Outcome, s: &Scene, first: Duration) -> f64 {
 
 /// One row of the work-precision table.
 #[derive(Debug, Clone, PartialEq)]
-pub struct WpRow {
+pub(crate) struct WpRow {
     /// Model name.
     pub model: String,
     /// Method name.
@@ -607,7 +607,7 @@ pub(crate) fn run_bench_until(
 }
 
 /// The CSV of the rows.
-pub fn render(rows: &[WpRow]) -> csv::Result<Vec<u8>> {
+pub(crate) fn render(rows: &[WpRow]) -> csv::Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
     w.write_record(COLUMNS)?;
     let opt = |x: Option<f64>| x.map(fmt_f64).unwrap_or_default();
@@ -641,7 +641,8 @@ pub fn render(rows: &[WpRow]) -> csv::Result<Vec<u8>> {
 
 /// Reads back the rows [`render`] wrote (a `bench --output` file), to re-plot measured rows
 /// without measuring again. An empty error cell reads as NaN, `inf` as infinity.
-pub fn read_rows(csv_bytes: &[u8]) -> Result<Vec<WpRow>, String> {
+#[cfg(any(test, feature = "bench-internals"))]
+pub(crate) fn read_rows(csv_bytes: &[u8]) -> Result<Vec<WpRow>, String> {
     let mut r = csv::Reader::from_reader(csv_bytes);
     let h = r.headers().map_err(|e| e.to_string())?.clone();
     if h.iter().collect::<Vec<_>>() != COLUMNS {
@@ -686,7 +687,7 @@ pub fn read_rows(csv_bytes: &[u8]) -> Result<Vec<WpRow>, String> {
 /// points, the legend outside the plot. A method that is invalid on some scenes (infinite
 /// maximum error) is drawn at its median error and says so in its label; errors below 1e-17
 /// are drawn at 1e-17.
-pub fn plot(rows: &[WpRow], title: &str) -> Result<String, String> {
+pub(crate) fn plot(rows: &[WpRow], title: &str) -> Result<String, String> {
     use super::figures::{series_style, Axis, Figure, LegendEntry, Panel, Stroke};
     let floor = 1e-17f64;
     // (row, error, time, drawn at the median error)
@@ -746,4 +747,21 @@ pub fn plot(rows: &[WpRow], title: &str) -> Result<String, String> {
     let mut f = Figure::new(title, 1, (640.0, 460.0), vec![panel]);
     f.legend = legend;
     Ok(f.to_svg())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{read_rows, render};
+
+    /// The committed work-precision table reads back into rows that render to the same bytes
+    /// (so `examples/wp_plot.rs` re-plots exactly the measured values).
+    #[test]
+    fn wp_table_reads_back_byte_for_byte() {
+        let bytes =
+            std::fs::read(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("bench/wp.csv"))
+                .unwrap();
+        let rows = read_rows(&bytes).unwrap();
+        assert!(rows.len() > 20);
+        assert_eq!(render(&rows).unwrap(), bytes);
+    }
 }

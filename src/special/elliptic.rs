@@ -102,6 +102,7 @@ fn rf_series([x, y, _]: [f64; 3], a0: f64, an: f64, f: f64) -> f64 {
 /// complementary parameter k'² = 1 − k² (which may be negative for k > 1), as
 /// F = sin φ · R_F(cos² φ, cos² φ + k'² sin² φ, 1). Passing cos φ and k'² computed without
 /// cancellation keeps full relative accuracy as k → 1 and φ → π/2.
+#[cfg(test)]
 pub fn legendre_f(sc: SinCos, kc2: f64) -> f64 {
     let (s, c) = (sc.s, sc.c);
     if s == 0.0 {

@@ -60,6 +60,8 @@ impl Default for QuadOptions {
 
 /// The value of an integral with its error estimate.
 #[derive(Debug, Clone, Copy)]
+// `error` and `evals` describe the integration when a call is debugged; no caller reads them.
+#[allow(dead_code)]
 pub struct QuadResult {
     /// The integral.
     pub value: f64,

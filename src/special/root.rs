@@ -2,7 +2,7 @@
 //!
 //! Written by hand rather than through argmin's `BrentRoot`: it is called inside every
 //! stick/slip evaluation and K inversion, where the executor's state and observer machinery cost
-//! more than the function it solves. Measured by `cargo bench --bench k -- root` on Kepler's
+//! more than the function it solves. Measured by `cargo bench --features bench-internals --bench k -- root` on Kepler's
 //! equation to 1e-15 (a function of a few flops, like the inner loops'): 400–402 ns here against
 //! 1.10–1.22 µs for `BrentRoot` under argmin's `Executor` (criterion medians of two runs, 2-core
 //! AMD EPYC, 2026-11-23). This version also allocates nothing and reports its evaluation

@@ -391,21 +391,6 @@ fn impact_rule_is_the_impact_law_when_rolling() {
     }
 }
 
-/// eq 69 with the contact model: forward at K, then `k` recovers K.
-#[test]
-fn k_round_trip() {
-    use fitbead::fit::k::{bracket, solve};
-    let m = Model::Contact(Contact::default());
-    for &(xi, d) in &[(1.0, 12.0), (2.0, 5.73), (1.6, 8.0)] {
-        let sc = scene(xi, d, 0.4, 0.1, CollisionLaw::Adjusted);
-        let v = m.evaluate(&sc).unwrap().mean_velocity;
-        let br = bracket(&m, &sc).unwrap();
-        let r = solve(&m, &sc, &br, v).unwrap();
-        println!("xi {xi} d {d}: K {} vs {} ({} evals)", r.k, sc.k(), r.evals);
-        assert!((r.k - sc.k()).abs() < 1e-11, "{} vs {}", r.k, sc.k());
-    }
-}
-
 /// `forward --model contact`: the phase columns and the energy closure on every row; a bad
 /// spin rule exits 2 naming the flag; `simulate --model contact --v0` writes one row per bead.
 #[test]

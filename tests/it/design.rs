@@ -609,7 +609,6 @@ fn validation_bayesian_jan_mu() {
 /// design than at evenly spaced slopes by more than 2 standard errors of the difference.
 #[test]
 fn discrimination_jaeger_vs_jan() {
-    use fitbead::fit::jaeger::paper_values;
     use fitbead::models::jaeger::Jaeger;
     use fitbead::models::JaegerBranch;
     use fitbead::prelude::JaegerFitter;
@@ -623,7 +622,8 @@ fn discrimination_jaeger_vs_jan() {
         ..DesignSettings::default()
     })
     .unwrap();
-    let [a1, a2, a3] = paper_values(1.0).unwrap();
+    // The paper's Fig. 9 values at ξ = 1.
+    let [a1, a2, a3] = [0.131, 18.57, 1.41];
     let jaeger = Jaeger::new(a1, a2, a3, JaegerBranch::Upper).unwrap();
     let truth = move |xi: f64, d: f64| {
         let sc = Scene::new(xi, d, 0.4, 0.1, CollisionLaw::Value(0.5)).unwrap();

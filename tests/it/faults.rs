@@ -155,30 +155,6 @@ fn md_outside_its_domain_is_refused_at_once() {
 }
 
 #[test]
-fn md_time_step_cannot_collapse() {
-    use fitbead::models::md::{Md, MdFailure, MAX_STEP_SHRINK};
-    use fitbead::scene::{CollisionLaw, Scene};
-    let md = Md::ristow();
-    for rho in [1e-4, 1e-6, 1e-300] {
-        let sc = Scene::new(1.6, 6.0, rho, 0.1, CollisionLaw::Value(0.5)).unwrap();
-        assert!(md.check_scene(&sc).is_err(), "rho {rho}");
-        let t0 = Instant::now();
-        let r = md.simulate(&sc, 1.0, None);
-        assert_eq!(r.failure, Some(MdFailure::OutsideDomain), "rho {rho}");
-        assert!(t0.elapsed() < Duration::from_millis(100));
-        assert!(
-            r.dt >= md.config.step_fraction * r.contact_time / MAX_STEP_SHRINK * (1.0 - 1e-12),
-            "rho {rho}: dt {} contact time {}",
-            r.dt,
-            r.contact_time
-        );
-    }
-    // At Ristow's ρ = 0.4 the step is the contact-time step or the damping's, unchanged.
-    let sc = Scene::new(1.6, 6.0, 0.4, 0.1, CollisionLaw::Value(0.5)).unwrap();
-    assert!(md.check_scene(&sc).is_ok());
-}
-
-#[test]
 fn huge_counts_are_refused_before_any_work() {
     let out = fb(&["simulate", "--points", "4294967296"]);
     expect(&out, 2, &["--points", "1000000"], "simulate --points");

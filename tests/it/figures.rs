@@ -473,14 +473,3 @@ fn overlap_check_sees_overlapping_text() {
     assert_eq!(overlapping_texts(&doc(40.0), 0.5).len(), 1);
     assert!(overlapping_texts(&doc(150.0), 0.5).is_empty());
 }
-
-/// The committed work-precision table reads back into rows that render to the same bytes
-/// (so `examples/wp_plot.rs` re-plots exactly the measured values).
-#[test]
-fn wp_table_reads_back_byte_for_byte() {
-    use fitbead::report::workprecision::{read_rows, render};
-    let bytes = std::fs::read(crate::common::root().join("bench/wp.csv")).unwrap();
-    let rows = read_rows(&bytes).unwrap();
-    assert!(rows.len() > 20);
-    assert_eq!(render(&rows).unwrap(), bytes);
-}

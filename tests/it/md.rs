@@ -3,7 +3,7 @@
 //! with the impact law, and the CLI contracts of `forward --model md`.
 
 use fitbead::models::md::{Md, MdParams, MdRunConfig, ReducedMass};
-use fitbead::models::{stick, ForwardModel, NotSteady, Regime};
+use fitbead::models::{ForwardModel, Model, NotSteady, Regime};
 use fitbead::{CollisionLaw, Scene};
 
 use crate::common::{bin, tmpdir, write};
@@ -14,7 +14,8 @@ fn scene(xi: f64, d: f64) -> Scene {
 }
 
 fn stick_v(xi: f64, d: f64, law: CollisionLaw) -> f64 {
-    stick::steady(&Scene::new(xi, d, 0.4, 0.1, law).unwrap())
+    Model::Stick
+        .evaluate(&Scene::new(xi, d, 0.4, 0.1, law).unwrap())
         .unwrap()
         .mean_velocity
 }

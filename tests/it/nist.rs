@@ -12,11 +12,11 @@
 
 use std::path::{Path, PathBuf};
 
+use dd::Dd;
 use faer::MatMut;
 use fitbead::inverse::{
     fit, CurveModel, Fit, Infeasible, LsqOptions, Residuals, SigmaKind, WeightedData,
 };
-use fitbead::special::dd::Dd;
 
 /// One StRD problem: data and certified values.
 #[derive(Debug, Clone)]
@@ -981,4 +981,106 @@ fn nist_profile_intervals() {
     // docs/ACCURACY.md: 240 of 240 found, 239 confirmed.
     assert_eq!(found, total);
     assert!(agree + 1 >= found, "{agree} of {found} confirmed");
+}
+
+/// Double-double arithmetic (about 32 significant digits) for the exact Lanczos1 references:
+/// the error-free transforms two-sum and FMA two-product (Dekker 1971; Hida, Li & Bailey,
+/// "Library for double-double and quad-double arithmetic", 2007), written here so that the
+/// reference values do not depend on the library's own double-double type.
+mod dd {
+    use std::ops::{Add, Div, Mul, Neg, Sub};
+
+    /// An unevaluated sum hi + lo with |lo| ≤ ulp(hi)/2.
+    #[derive(Debug, Clone, Copy, PartialEq, Default)]
+    pub struct Dd {
+        pub hi: f64,
+        pub lo: f64,
+    }
+
+    fn two_sum(a: f64, b: f64) -> (f64, f64) {
+        let s = a + b;
+        let bb = s - a;
+        (s, (a - (s - bb)) + (b - bb))
+    }
+
+    fn quick_two_sum(a: f64, b: f64) -> (f64, f64) {
+        let s = a + b;
+        (s, b - (s - a))
+    }
+
+    fn two_prod(a: f64, b: f64) -> (f64, f64) {
+        let p = a * b;
+        (p, a.mul_add(b, -p))
+    }
+
+    impl From<f64> for Dd {
+        fn from(x: f64) -> Self {
+            Dd { hi: x, lo: 0.0 }
+        }
+    }
+
+    impl Dd {
+        /// Rounded to the nearest double.
+        pub fn to_f64(self) -> f64 {
+            self.hi + self.lo
+        }
+
+        /// Multiplication by a double.
+        pub fn mul_f64(self, b: f64) -> Dd {
+            let (p, e) = two_prod(self.hi, b);
+            let (hi, lo) = quick_two_sum(p, e + self.lo * b);
+            Dd { hi, lo }
+        }
+    }
+
+    impl Neg for Dd {
+        type Output = Dd;
+        fn neg(self) -> Dd {
+            Dd {
+                hi: -self.hi,
+                lo: -self.lo,
+            }
+        }
+    }
+
+    impl Add for Dd {
+        type Output = Dd;
+        fn add(self, b: Dd) -> Dd {
+            let (s, e) = two_sum(self.hi, b.hi);
+            let (t, f) = two_sum(self.lo, b.lo);
+            let (s, e) = quick_two_sum(s, e + t);
+            let (hi, lo) = quick_two_sum(s, e + f);
+            Dd { hi, lo }
+        }
+    }
+
+    impl Sub for Dd {
+        type Output = Dd;
+        fn sub(self, b: Dd) -> Dd {
+            self + (-b)
+        }
+    }
+
+    impl Mul for Dd {
+        type Output = Dd;
+        fn mul(self, b: Dd) -> Dd {
+            let (p, e) = two_prod(self.hi, b.hi);
+            let e = e + (self.hi * b.lo + self.lo * b.hi);
+            let (hi, lo) = quick_two_sum(p, e);
+            Dd { hi, lo }
+        }
+    }
+
+    impl Div for Dd {
+        type Output = Dd;
+        fn div(self, b: Dd) -> Dd {
+            let q1 = self.hi / b.hi;
+            let r = self - b.mul_f64(q1);
+            let q2 = r.hi / b.hi;
+            let r = r - b.mul_f64(q2);
+            let q3 = r.hi / b.hi;
+            let (hi, lo) = quick_two_sum(q1, q2);
+            Dd { hi, lo } + Dd::from(q3)
+        }
+    }
 }

@@ -1,7 +1,7 @@
 //! The collisional parameter K of one measurement (eq 69): find K with v̄_th(K; α, δ, ρ, f) =
 //! v̄_exp for the rolling, slip and stick/slip models.
 //!
-//! The search runs on a bracket of K that is derived, not guessed ([`bracket`](mod@bracket)). Every contact
+//! The search runs on a bracket of K that is derived, not guessed (`bracket`). Every contact
 //! model maps the speed Θ̇0 just after a collision to the speed Θ̇f at the next one by a
 //! function Φ that does not involve K; K enters only through Θ̇0 = K Θ̇f. Hence:
 //! - the lowest K is K_min = w_c / Φ(w_c), where w_c is the smallest launch speed that still
@@ -22,20 +22,20 @@
 //! crawls over the top, v̄ has an infinite slope in K), so in s the function is close to a
 //! straight line and the solver converges superlinearly at either end instead of stalling.
 //!
-//! Layout: [`types`] holds what every path shares; [`bracket`](mod@bracket) derives the bracket of K;
-//! [`search`] solves eq 69 in K; [`launch`] solves it in the launch speed where that applies;
+//! Layout: [`types`] holds what every path shares; `bracket` derives the bracket of K;
+//! `search` solves eq 69 in K; [`launch`] solves it in the launch speed where that applies;
 //! [`estimate`](mod@estimate) picks the path; [`auto`] picks the model per point.
 
 pub mod auto;
-pub mod bracket;
+pub(crate) mod bracket;
 pub mod estimate;
 pub mod launch;
-pub mod search;
+pub(crate) mod search;
 pub mod types;
 
-pub use bracket::bracket;
+pub(crate) use bracket::bracket;
 pub(crate) use bracket::unsteady_points;
 pub use estimate::estimate;
 pub(crate) use search::dv_dk;
-pub use search::solve;
+pub(crate) use search::solve;
 pub use types::{KBracket, KEstimate, KFailure, KRoot, LowerLimit, UpperLimit};

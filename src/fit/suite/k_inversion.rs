@@ -427,3 +427,17 @@ fn dv_dk_matches_mpmath_at_hard_points() {
     println!("dv/dK at {n} points: max relative error {worst:.3e}, search in K {worst2:.3e}");
     assert_eq!(n, 9);
 }
+
+/// eq 69 with the contact model: forward at K, then `k` recovers K.
+#[test]
+fn contact_k_round_trip() {
+    let m = Model::Contact(crate::models::contact::Contact::default());
+    for &(xi, d) in &[(1.0, 12.0), (2.0, 5.73), (1.6, 8.0)] {
+        let sc = Scene::new(xi, d, 0.4, 0.1, CollisionLaw::Adjusted).unwrap();
+        let v = m.evaluate(&sc).unwrap().mean_velocity;
+        let br = bracket(&m, &sc).unwrap();
+        let r = solve(&m, &sc, &br, v).unwrap();
+        println!("xi {xi} d {d}: K {} vs {} ({} evals)", r.k, sc.k(), r.evals);
+        assert!((r.k - sc.k()).abs() < 1e-11, "{} vs {}", r.k, sc.k());
+    }
+}

@@ -2,6 +2,8 @@
 //! posteriors (calibration by simulation, Jaeger's reparameterisation): `cargo test --release --lib
 //! fit::suite`.
 
+mod cross_solvers;
+mod gradients;
 mod jaeger_posterior;
 mod k_edges;
 mod k_inversion;

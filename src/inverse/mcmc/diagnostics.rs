@@ -42,7 +42,7 @@ thread_local! {
 
 /// Biased autocovariance γ̂(t) = (1/n) Σ_{i<n−t} (xᵢ − x̄)(x_{i+t} − x̄), t = 0..n, by a real FFT
 /// (`realfft`) with zero padding to avoid circular wrap-around: O(n log n), where the direct sum
-/// is O(n²) (`cargo bench --bench mcmc -- autocovariance` times the three ways it has been done:
+/// is O(n²) (`cargo bench --features bench-internals --bench mcmc -- autocovariance` times the three ways it has been done:
 /// at n = 10⁴, 0.42 ms here, 3.17 ms by a hand-written radix-2 complex FFT, 61 ms by the direct
 /// sum; criterion medians, 2-core AMD EPYC, 2026-11-23).
 pub fn autocovariance(x: &[f64]) -> Vec<f64> {
@@ -226,6 +226,7 @@ fn rhat_basic(chains: &[Vec<f64>]) -> f64 {
 /// Rank-normalised split-R̂ (Vehtari et al. 2021, §4.2): the maximum of the bulk R̂ (split
 /// chains, rank-normalised) and the tail R̂ (the same on the folded draws |θ − median θ|).
 /// Values above ~1.01 flag chains that have not mixed. NaN for fewer than 4 draws per chain.
+#[cfg(test)]
 pub fn rhat(chains: &[Vec<f64>]) -> f64 {
     let split = split_chains(chains);
     if split.first().map_or(0, Vec::len) < 2 {
@@ -354,6 +355,7 @@ pub(crate) fn ess_basic(chains: &[Vec<f64>]) -> f64 {
 /// Bulk effective sample size: `ess_basic` of the rank-normalised split chains
 /// (Vehtari et al. 2021, §4.3). Measures the efficiency of estimates of the centre of the
 /// distribution (mean, median).
+#[cfg(test)]
 pub fn ess_bulk(chains: &[Vec<f64>]) -> f64 {
     ess_basic(&rank_normalise(&split_chains(chains)))
 }
@@ -361,6 +363,7 @@ pub fn ess_bulk(chains: &[Vec<f64>]) -> f64 {
 /// Tail effective sample size: the smaller of the split-chain ESS of the indicators
 /// I(θ ≤ q₀.₀₅) and I(θ ≤ q₀.₉₅) (Vehtari et al. 2021, §4.3), measuring the efficiency of the
 /// 5 % and 95 % quantile estimates.
+#[cfg(test)]
 pub fn ess_tail(chains: &[Vec<f64>]) -> f64 {
     let mut sorted: Vec<f64> = chains.iter().flatten().copied().collect();
     sorted.sort_by(f64::total_cmp);
@@ -392,6 +395,7 @@ fn ess_tail_sorted(split: &[Vec<f64>], sorted: &[f64]) -> f64 {
 /// Effective sample size for the mean: `ess_basic` of the split chains on the original scale
 /// (no rank normalisation), as `posterior::ess_mean`. Use it for Monte-Carlo standard errors
 /// of means: MCSE = sd/√ESS.
+#[cfg(test)]
 pub fn ess_mean(chains: &[Vec<f64>]) -> f64 {
     ess_basic(&split_chains(chains))
 }
@@ -430,13 +434,13 @@ pub struct ParameterDiagnostics {
     /// Central interval at the level asked of `summarise`: (quantile (1−level)/2,
     /// quantile (1+level)/2).
     pub interval: (f64, f64),
-    /// Integrated autocorrelation time (in steps of the chains given), see [`integrated_time`].
+    /// Integrated autocorrelation time (in steps of the chains given), see `integrated_time`.
     pub tau: f64,
-    /// Rank-normalised split-R̂, see [`rhat`].
+    /// Rank-normalised split-R̂, see `rhat`.
     pub rhat: f64,
-    /// Bulk effective sample size, see [`ess_bulk`].
+    /// Bulk effective sample size, see `ess_bulk`.
     pub ess_bulk: f64,
-    /// Tail effective sample size, see [`ess_tail`].
+    /// Tail effective sample size, see `ess_tail`.
     pub ess_tail: f64,
 }
 

@@ -363,7 +363,7 @@ fn run_with(a: Args, r: Recipe) -> Result<(), CliError> {
         rows,
         dataset,
     };
-    let mut settings = ReportSettings {
+    let settings = ReportSettings {
         level: io.level.level(),
         method: choice.method,
         format: format_text.unwrap_or_else(|| "svg".into()),
@@ -373,9 +373,8 @@ fn run_with(a: Args, r: Recipe) -> Result<(), CliError> {
         defaults: io.data.defaults()?,
         source: shown,
         stop: Some(super::stop_flag()),
-        ..ReportSettings::default()
+        method_name: Some(io.method.clone()),
     };
-    settings.method_text = Some(io.method.clone());
     let out = report(&data, &settings, Some(&out_dir))?;
     for s in &out.stats {
         if let Some(w) = s.absurd_misfit() {

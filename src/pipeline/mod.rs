@@ -1,5 +1,6 @@
-//! Whole runs of the command line as library calls: synthetic measurements ([`simulate`]) and
-//! the report of every model fitted to one data set ([`report`]). The command line parses its
+//! Whole runs of the command line as library calls: synthetic measurements ([`simulate`]),
+//! the report of every model fitted to one data set ([`report`]) and the work-precision table
+//! of the forward models ([`work_precision`]). The command line parses its
 //! flags into these settings, calls these functions and prints or writes what they return;
 //! the Python package calls the same functions.
 //!
@@ -7,9 +8,11 @@
 //! (`--points`, `--series`, …) in the column of the error, so that both front ends report it
 //! alike.
 
+mod bench;
 mod report;
 mod simulate;
 
+pub use bench::work_precision;
 pub use report::{report, ReportOutput, ReportSettings};
 pub use simulate::{simulate, SimulateSettings};
 

@@ -53,9 +53,9 @@ pub struct ReportSettings {
     /// Raised to stop the run: [`report`] then returns [`RunError::Interrupted`] (or, once a
     /// posterior run has been cut short, writes what it has, marked interrupted).
     pub stop: Option<Arc<AtomicBool>>,
-    /// The method as report.md names it (the command line's own spelling); `None`: `lsq` or
-    /// `mcmc`.
-    pub(crate) method_text: Option<String>,
+    /// The method as report.md names it (the command line gives its flag's text); `None`:
+    /// `lsq` or `mcmc`.
+    pub method_name: Option<String>,
 }
 
 impl Default for ReportSettings {
@@ -72,7 +72,7 @@ impl Default for ReportSettings {
             defaults: MeasurementDefaults::default(),
             source: None,
             stop: None,
-            method_text: None,
+            method_name: None,
         }
     }
 }
@@ -97,6 +97,20 @@ pub struct ReportOutput {
 impl ReportSettings {
     fn stopped(&self) -> bool {
         self.stop.as_ref().is_some_and(|s| s.load(Ordering::SeqCst))
+    }
+}
+
+impl MeasurementFile {
+    /// The cells of column `name` as the file holds them (trimmed), one per point in file
+    /// order; `None` when the file has no such column. The columns a data set does not keep
+    /// (`R_m`, `g`, `v_m_s`, `sigma_v_m_s`) are read this way.
+    pub fn column(&self, name: &str) -> Option<Vec<String>> {
+        let c = self.table.col(name)?;
+        Some(
+            (0..self.table.rows.len())
+                .map(|i| self.table.cell(i, c).trim().to_string())
+                .collect(),
+        )
     }
 }
 
@@ -348,7 +362,7 @@ pub fn report(
             .chain(absurd)
             .collect(),
     };
-    let method = s.method_text.clone().unwrap_or_else(|| {
+    let method = s.method_name.clone().unwrap_or_else(|| {
         match s.method {
             Method::Mcmc(_) => "mcmc",
             _ => "lsq",

@@ -195,8 +195,10 @@ def forward(
     ----------
     model : str
         ``stick`` (pure rolling), ``stick-approx``, ``slip``, ``slip-approx``, ``stickslip``,
-        ``contact`` (the general contact model), ``jan`` (eq 74), ``jaeger`` (eqs 80–84) or
-        ``auto`` (the simplest model meeting ``tol``).
+        ``contact`` (the general contact model), ``jan`` (eq 74), ``jaeger`` (eqs 80–84),
+        ``auto`` (the simplest model meeting ``tol``) or ``md`` (molecular dynamics, one run per
+        scene: seconds each; the columns of ``fitbead forward --model md``: the scene's ``xi``,
+        ``delta_deg``, ``rho``, ``f``, then the md run's).
     xi, delta_deg : array_like
         Radius ratio ξ = r/R (> 0) and slope δ in degrees; arrays broadcast together with
         every other array argument.
@@ -222,7 +224,8 @@ def forward(
     tol : float, default 1e-14
         The contact model's quadrature tolerance; the target tolerance of ``auto``.
     **params
-        ``lambda`` (Jan's λ), under the name the command line and the fit reports use.
+        ``lambda`` (Jan's λ), under the name the command line and the fit reports use;
+        ``md_preset`` (``ristow``, the default, or ``steel``) for ``md``.
 
     Returns
     -------
@@ -254,13 +257,14 @@ def forward(
         warnings.warn("forward: lam is now lambda (the command line's name)", DeprecationWarning, stacklevel=2)
         lam = params.pop("lam")
     params.pop("sigma_scale", None)
+    model = _model_name(model)
+    md_preset = params.pop("md_preset", "ristow")
     if params:
         raise TypeError(f"forward: unexpected arguments {sorted(params)}")
-    model = _model_name(model)
+    if model == "md":
+        return _forward_md(xi, delta_deg, rho, f, md_preset)
     if model not in MODELS:
-        if model == "md":
-            raise FitbeadError("model md is not vectorised; use the command line's `fitbead forward --model md`")
-        raise FitbeadError(f"model = {model!r}: expected one of {', '.join(MODELS)}")
+        raise FitbeadError(f"model = {model!r}: expected one of {', '.join(MODELS)}, md")
     k_arr = None
     law = "adjusted"
     if c is not None:
@@ -295,6 +299,20 @@ def forward(
     t["xi"] = a["xi"].reshape(shape).copy()  # type: ignore[union-attr]
     t["delta_deg"] = a["delta_deg"].reshape(shape).copy()  # type: ignore[union-attr]
     return _ordered(t, ["xi", "delta_deg", *_core.output_columns("forward", model)])
+
+
+def _forward_md(xi: ArrayLike, delta_deg: ArrayLike, rho: ArrayLike, f: ArrayLike, md_preset: str) -> Table:
+    """``forward("md", ...)``: one molecular-dynamics run per scene (``fitbead forward --model
+    md`` on the scenes written as its CSV input)."""
+    shape, a = _broadcast({"xi": xi, "delta_deg": delta_deg, "rho": rho, "f": f})
+    lines = ["xi,delta_deg,rho,f"]
+    for i in range(a["xi"].size):  # type: ignore[union-attr]
+        lines.append(",".join(repr(float(a[k][i])) for k in ("xi", "delta_deg", "rho", "f")))  # type: ignore[index]
+    t = _csv_table(_core.forward_md("\n".join(lines) + "\n", md_preset=str(md_preset)))
+    for k in t:
+        t[k] = t[k].reshape(shape)
+    t.shape = shape
+    return t
 
 
 def invert_k(

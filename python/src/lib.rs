@@ -537,7 +537,7 @@ fn forward<'py>(
         .map_err(|e| value_error(e.to_string()))?;
     if kind == ModelKind::Md {
         return Err(value_error(
-            "model md is not vectorised (it integrates each scene's bead row); use the command line's `forward --model md`",
+            "model md runs through forward_md (it integrates each scene's bead row)",
         ));
     }
     let [xi_s, d_s, rho_s, f_s] = slices_of([
@@ -1685,6 +1685,33 @@ fn report(
     Ok((out.files, out.warnings, out.interrupted, out.summary))
 }
 
+/// `fitbead forward --model md` on the CSV text of a scene table, under the md preset: the CSV
+/// text it writes.
+#[pyfunction]
+#[pyo3(signature = (table, rho=0.4, f=0.1, md_preset="ristow"))]
+fn forward_md(py: Python<'_>, table: &str, rho: f64, f: f64, md_preset: &str) -> PyResult<String> {
+    use fitbead::models::md::{Md, MdParams, MdRunConfig};
+    let params = match md_preset.to_ascii_lowercase().as_str() {
+        "ristow" => MdParams::ristow(),
+        "steel" => MdParams::steel(),
+        _ => {
+            return Err(value_error(format!(
+                "md_preset = '{md_preset}': expected ristow or steel"
+            )))
+        }
+    };
+    let md = Md {
+        params,
+        config: MdRunConfig::default(),
+    };
+    let stop = Arc::new(AtomicBool::new(false));
+    let r = interruptible(py, &stop, || {
+        fitbead::pipeline::forward_md(table.as_bytes(), "<arrays>", md, rho, f, Some(&stop))
+    })?;
+    let bytes = r.map_err(pipeline_error)?;
+    String::from_utf8(bytes).map_err(|e| value_error(e.to_string()))
+}
+
 /// The work-precision table of `fitbead bench` as the CSV text of its `--output`.
 #[pyfunction]
 #[pyo3(signature = (scenes=2000, seed=1))]
@@ -1725,6 +1752,7 @@ fn _fitbead(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(report, m)?)?;
     m.add_function(wrap_pyfunction!(work_precision, m)?)?;
+    m.add_function(wrap_pyfunction!(forward_md, m)?)?;
     m.add("FitbeadError", m.py().get_type::<FitbeadError>())?;
     m.add_function(wrap_pyfunction!(threads, m)?)?;
     m.add_class::<PyDataset>()?;

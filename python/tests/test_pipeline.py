@@ -153,3 +153,19 @@ def test_from_arrays_of_plausible_data_is_quiet():
         warnings.simplefilter("error", fitbead.FitbeadWarning)
         d = fitbead.Dataset.from_arrays(c["xi"], c["delta_deg"], c["v"], c["sigma_v"], series=c["series"])
     assert d.warnings == []
+
+
+def test_forward_md_equals_the_command_line(cli, tmp_path):
+    """md through forward: the command line's `forward --model md` rows, bit for bit."""
+    p = tmp_path / "scenes.csv"
+    p.write_text("xi,delta_deg\n1,20\n2,8\n")
+    _, text, _ = cli("forward", "--model", "md", p)
+    out = fitbead.forward("md", xi=[1.0, 2.0], delta_deg=[20.0, 8.0])
+    cols = read_csv_text(text)
+    # The scenes go in with their rho and f columns, which pass through.
+    assert [k for k in out if k not in ("rho", "f")] == header(text)
+    for k, cells in cols.items():
+        if out[k].dtype == object:
+            assert_text_equal(k, out[k], cells)
+        else:
+            assert_bits_equal(k, out[k], cells)

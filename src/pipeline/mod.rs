@@ -1,6 +1,7 @@
 //! Whole runs of the command line as library calls: synthetic measurements ([`simulate`]),
-//! the report of every model fitted to one data set ([`report`]) and the work-precision table
-//! of the forward models ([`work_precision`]). The command line parses its
+//! the report of every model fitted to one data set ([`report`]), the work-precision table
+//! of the forward models ([`work_precision`]) and the molecular-dynamics runs of a scene table
+//! ([`forward_md`]). The command line parses its
 //! flags into these settings, calls these functions and prints or writes what they return;
 //! the Python package calls the same functions.
 //!
@@ -12,14 +13,14 @@ mod bench;
 mod report;
 mod simulate;
 
-pub use bench::work_precision;
+pub use bench::{forward_md, work_precision};
 pub use report::{report, ReportOutput, ReportSettings};
 pub use simulate::{simulate, SimulateSettings};
 
 use crate::io::InputError;
 use std::fmt;
 
-/// Why a run of [`simulate`] or [`report`] failed.
+/// Why a run of this module failed.
 #[derive(Debug)]
 #[non_exhaustive]
 pub enum RunError {

@@ -935,8 +935,12 @@ impl PyDataset {
             }
             text.push('\n');
         }
-        let m = MeasurementFile::parse(ARRAYS_NAME, text.as_bytes(), &MeasurementDefaults::default())
-            .map_err(|e| value_error(e.to_string()))?;
+        let m = MeasurementFile::parse(
+            ARRAYS_NAME,
+            text.as_bytes(),
+            &MeasurementDefaults::default(),
+        )
+        .map_err(|e| value_error(e.to_string()))?;
         let warnings = m
             .plausibility()
             .iter()
@@ -1680,7 +1684,9 @@ fn report(
     };
     let file = &data.file;
     let dir = out_dir.as_deref();
-    let r = interruptible(py, &stop, || fitbead::pipeline::report(file, &settings, dir))?;
+    let r = interruptible(py, &stop, || {
+        fitbead::pipeline::report(file, &settings, dir)
+    })?;
     let out = r.map_err(pipeline_error)?;
     Ok((out.files, out.warnings, out.interrupted, out.summary))
 }

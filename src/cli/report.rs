@@ -383,7 +383,11 @@ fn run_with(a: Args, r: Recipe) -> Result<(), CliError> {
     }
     // Outside an interrupted run the exit-1 message names the fits that did not converge.
     if out.interrupted {
-        for s in out.stats.iter().filter(|s| s.mcmc.is_some() && !s.converged) {
+        for s in out
+            .stats
+            .iter()
+            .filter(|s| s.mcmc.is_some() && !s.converged)
+        {
             eprintln!("fitbead: warning: {} [{}]: {}", s.fit, s.series, s.note);
         }
     }

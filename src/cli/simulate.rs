@@ -190,7 +190,11 @@ pub fn run(a: Args) -> Result<(), CliError> {
                 a.jan.as_deref(),
                 "expected four numbers lambda0,lambda1,mu0,mu1",
             )?,
-            numbers::<3>("--jaeger", a.jaeger.as_deref(), "expected three numbers a1,a2,a3")?,
+            numbers::<3>(
+                "--jaeger",
+                a.jaeger.as_deref(),
+                "expected three numbers a1,a2,a3",
+            )?,
             super::jaeger_branch(&a.branch)?,
         )
     } else {

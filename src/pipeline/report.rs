@@ -390,9 +390,8 @@ pub fn report(
     }
     let shown_dir = out_dir.map(|d| d.display().to_string()).unwrap_or_default();
     if let Some(out_dir) = out_dir {
-        let created = create_dirs(out_dir).map_err(|e| {
-            RunError::Failed(format!("{}: cannot create: {e}", out_dir.display()))
-        })?;
+        let created = create_dirs(out_dir)
+            .map_err(|e| RunError::Failed(format!("{}: cannot create: {e}", out_dir.display())))?;
         if let Err(e) = crate::io::outdir::write_dir(out_dir, &files) {
             // All or nothing: directories made for this report go as well.
             for d in created.iter().rev() {

@@ -141,7 +141,9 @@ impl Default for SimulateSettings {
 
 impl SimulateSettings {
     fn stopped(&self) -> bool {
-        self.stop.as_ref().is_some_and(|s| s.load(Ordering::Relaxed))
+        self.stop
+            .as_ref()
+            .is_some_and(|s| s.load(Ordering::Relaxed))
     }
 }
 
@@ -332,11 +334,7 @@ pub fn simulate(a: &SimulateSettings) -> Result<Vec<u8>, RunError> {
                 .map_err(|e| RunError::Failed(e.to_string()))?;
             let v_true = match model.evaluate(&scene) {
                 Ok(s) => s.mean_velocity,
-                Err(e) => {
-                    return Err(RunError::Failed(format!(
-                        "xi {xi}, delta {d_deg} deg: {e}"
-                    )))
-                }
+                Err(e) => return Err(RunError::Failed(format!("xi {xi}, delta {d_deg} deg: {e}"))),
             };
             let z: f64 = StandardNormal.sample(&mut rng);
             let v = v_true * (1.0 + a.noise * z);

@@ -78,6 +78,7 @@ pub struct SimulateSettings {
     /// Progress of the md runs (label `md simulate`).
     pub progress: Option<Progress>,
     /// Called with each note of the run as it is made (md: a steady range narrowed).
+    #[allow(clippy::type_complexity)]
     pub notes: Option<Arc<dyn Fn(&str) + Send + Sync>>,
 }
 

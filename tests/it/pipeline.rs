@@ -112,7 +112,7 @@ fn report_from_the_library_writes_the_commands_directory() {
 }
 
 #[test]
-fn a_report_without_a_directory_writes_nothing() {
+fn a_bad_report_setting_is_named_by_its_flag_and_writes_nothing() {
     let dir = tmpdir();
     let data = root().join("data").join("default.csv");
     let file = MeasurementFile::read(&data, &MeasurementDefaults::default()).unwrap();

@@ -1667,12 +1667,13 @@ def report(
 
     Warns
     -----
-    FitbeadWarning
-        The command line's warnings: fits whose misfit is implausible for the σ given,
-        posterior runs that did not converge.
+    UnitWarning
+        A fit whose misfit is implausible for the σ given (the command line's warning).
+    ConvergenceWarning
+        A posterior run that did not converge, or was interrupted.
     """
     d = _dataset(data)
-    files, warns, interrupted, summary = _core.report(
+    files, unit_warnings, convergence_warnings, interrupted, summary = _core.report(
         d._core,
         out_dir=None if out_dir is None else str(out_dir),
         method=method,
@@ -1686,8 +1687,10 @@ def report(
         keep_going=bool(keep_going),
         g=float(g),
     )
-    for w in warns:
-        _warn(w, FitbeadWarning)
+    for w in unit_warnings:
+        _warn(w, UnitWarning)
+    for w in convergence_warnings:
+        _warn(w, ConvergenceWarning)
     if interrupted:
         _warn("a posterior run was interrupted: its tables hold the draws so far", ConvergenceWarning)
     out = Report()

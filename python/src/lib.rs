@@ -1602,7 +1602,8 @@ fn simulate(
 }
 
 /// The report (`fitbead report`) of `data`: every file (name, bytes) in the order written,
-/// the warnings of the run and whether a posterior run was cut short; the directory written
+/// the warnings of the run (implausible misfits, posterior runs that did not converge) and
+/// whether a posterior run was cut short; the directory written
 /// when `out_dir` is given (see the Python `fitbead.report`).
 #[pyfunction]
 #[pyo3(signature = (data, out_dir=None, method="lsq", format="svg", units="dimensionless", figure_width=None, level=0.95, seed=None, min_ess=None, max_steps=None, keep_going=false, g=9.81))]
@@ -1621,7 +1622,13 @@ fn report(
     max_steps: Option<usize>,
     keep_going: bool,
     g: f64,
-) -> PyResult<(Vec<(String, Vec<u8>)>, Vec<String>, bool, String)> {
+) -> PyResult<(
+    Vec<(String, Vec<u8>)>,
+    Vec<String>,
+    Vec<String>,
+    bool,
+    String,
+)> {
     use fitbead::inverse::posterior::Method;
     use fitbead::pipeline::ReportSettings;
     let stop = Arc::new(AtomicBool::new(false));
@@ -1688,7 +1695,23 @@ fn report(
         fitbead::pipeline::report(file, &settings, dir)
     })?;
     let out = r.map_err(pipeline_error)?;
-    Ok((out.files, out.warnings, out.interrupted, out.summary))
+    // The warnings by kind: implausible misfits (unit mistakes), posterior runs that did not
+    // converge.
+    let absurd: Vec<String> = out
+        .stats
+        .iter()
+        .filter_map(|s| {
+            s.absurd_misfit()
+                .map(|w| format!("{} [{}]: {w}", s.fit, s.series))
+        })
+        .collect();
+    let unconverged: Vec<String> = out
+        .warnings
+        .iter()
+        .filter(|w| !absurd.contains(w))
+        .cloned()
+        .collect();
+    Ok((out.files, absurd, unconverged, out.interrupted, out.summary))
 }
 
 /// `fitbead forward --model md` on the CSV text of a scene table, under the md preset: the CSV

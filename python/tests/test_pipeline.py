@@ -159,7 +159,7 @@ def test_forward_md_equals_the_command_line(cli, tmp_path):
     """md through forward: the command line's `forward --model md` rows, bit for bit."""
     p = tmp_path / "scenes.csv"
     p.write_text("xi,delta_deg\n1,20\n2,8\n")
-    _, text, _ = cli("forward", "--model", "md", p)
+    _, text, _ = cli("forward", "--model", "md", "--input", p)
     out = fitbead.forward("md", xi=[1.0, 2.0], delta_deg=[20.0, 8.0])
     cols = read_csv_text(text)
     # The scenes go in with their rho and f columns, which pass through.

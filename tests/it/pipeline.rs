@@ -59,7 +59,7 @@ fn a_bad_simulate_setting_is_named_by_its_flag() {
         ..SimulateSettings::default()
     })
     .unwrap_err();
-    let RunError::Input(ie) = e else {
+    let RunError::Input(ie) = &e else {
         panic!("expected an input error, got {e}")
     };
     assert_eq!(ie.column.as_deref(), Some("--points"));
@@ -86,7 +86,7 @@ fn report_from_the_library_writes_the_commands_directory() {
         .unwrap();
     let summary = stdout_ok(&out);
     let file = MeasurementFile::read(&data, &MeasurementDefaults::default()).unwrap();
-    let rep = report(&file, &ReportSettings::default(), Some(&lib_dir)).unwrap();
+    let rep = report(&file, &ReportSettings::default(), Some(lib_dir.as_path())).unwrap();
     assert_eq!(
         rep.summary.replace(&lib_dir.display().to_string(), "DIR"),
         summary.replace(&cli_dir.display().to_string(), "DIR")
@@ -122,10 +122,10 @@ fn a_bad_report_setting_is_named_by_its_flag_and_writes_nothing() {
             format: "gif".into(),
             ..ReportSettings::default()
         },
-        Some(&dir.path().join("never")),
+        Some(dir.path().join("never").as_path()),
     )
     .unwrap_err();
-    let RunError::Input(ie) = e else {
+    let RunError::Input(ie) = &e else {
         panic!("expected an input error, got {e}")
     };
     assert_eq!(ie.column.as_deref(), Some("--format"));

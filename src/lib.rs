@@ -18,6 +18,8 @@
 //! ## Layers
 //!
 //! ```text
+//!   pipeline ───── whole runs as library calls: synthetic data (simulate), the report
+//!                  directory (report)
 //!   io ─────────── CSV schemas, measurements with units (Dataset::from_csv), atomic files
 //!   report ─────── the paper's comparisons, figures, the work-precision engine
 //!   design ─────── optimal experimental design: the slopes to measure for a parameter
@@ -81,6 +83,7 @@ pub mod fit;
 pub mod inverse;
 pub mod models;
 pub mod numfmt;
+pub mod pipeline;
 pub mod progress;
 pub mod report;
 pub mod scene;

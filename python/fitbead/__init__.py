@@ -43,6 +43,7 @@ from ._api import (
     FitResult,
     FitSet,
     Param,
+    Report,
     Table,
     UnitWarning,
     __version__,
@@ -53,7 +54,10 @@ from ._api import (
     forward,
     invert_k,
     regimes,
+    report,
+    simulate,
     threads,
+    work_precision,
 )
 
 __all__ = [
@@ -68,6 +72,7 @@ __all__ = [
     "FitResult",
     "FitSet",
     "Param",
+    "Report",
     "Table",
     "UnitWarning",
     "__version__",
@@ -78,5 +83,8 @@ __all__ = [
     "forward",
     "invert_k",
     "regimes",
+    "report",
+    "simulate",
     "threads",
+    "work_precision",
 ]

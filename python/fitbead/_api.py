@@ -195,8 +195,10 @@ def forward(
     ----------
     model : str
         ``stick`` (pure rolling), ``stick-approx``, ``slip``, ``slip-approx``, ``stickslip``,
-        ``contact`` (the general contact model), ``jan`` (eq 74), ``jaeger`` (eqs 80–84) or
-        ``auto`` (the simplest model meeting ``tol``).
+        ``contact`` (the general contact model), ``jan`` (eq 74), ``jaeger`` (eqs 80–84),
+        ``auto`` (the simplest model meeting ``tol``) or ``md`` (molecular dynamics, one run per
+        scene: seconds each; the columns of ``fitbead forward --model md``: the scene's ``xi``,
+        ``delta_deg``, ``rho``, ``f``, then the md run's).
     xi, delta_deg : array_like
         Radius ratio ξ = r/R (> 0) and slope δ in degrees; arrays broadcast together with
         every other array argument.
@@ -222,7 +224,8 @@ def forward(
     tol : float, default 1e-14
         The contact model's quadrature tolerance; the target tolerance of ``auto``.
     **params
-        ``lambda`` (Jan's λ), under the name the command line and the fit reports use.
+        ``lambda`` (Jan's λ), under the name the command line and the fit reports use;
+        ``md_preset`` (``ristow``, the default, or ``steel``) for ``md``.
 
     Returns
     -------
@@ -254,13 +257,14 @@ def forward(
         warnings.warn("forward: lam is now lambda (the command line's name)", DeprecationWarning, stacklevel=2)
         lam = params.pop("lam")
     params.pop("sigma_scale", None)
+    model = _model_name(model)
+    md_preset = params.pop("md_preset", "ristow")
     if params:
         raise TypeError(f"forward: unexpected arguments {sorted(params)}")
-    model = _model_name(model)
+    if model == "md":
+        return _forward_md(xi, delta_deg, rho, f, md_preset)
     if model not in MODELS:
-        if model == "md":
-            raise FitbeadError("model md is not vectorised; use the command line's `fitbead forward --model md`")
-        raise FitbeadError(f"model = {model!r}: expected one of {', '.join(MODELS)}")
+        raise FitbeadError(f"model = {model!r}: expected one of {', '.join(MODELS)}, md")
     k_arr = None
     law = "adjusted"
     if c is not None:
@@ -295,6 +299,20 @@ def forward(
     t["xi"] = a["xi"].reshape(shape).copy()  # type: ignore[union-attr]
     t["delta_deg"] = a["delta_deg"].reshape(shape).copy()  # type: ignore[union-attr]
     return _ordered(t, ["xi", "delta_deg", *_core.output_columns("forward", model)])
+
+
+def _forward_md(xi: ArrayLike, delta_deg: ArrayLike, rho: ArrayLike, f: ArrayLike, md_preset: str) -> Table:
+    """``forward("md", ...)``: one molecular-dynamics run per scene (``fitbead forward --model
+    md`` on the scenes written as its CSV input)."""
+    shape, a = _broadcast({"xi": xi, "delta_deg": delta_deg, "rho": rho, "f": f})
+    lines = ["xi,delta_deg,rho,f"]
+    for i in range(a["xi"].size):  # type: ignore[union-attr]
+        lines.append(",".join(repr(float(a[k][i])) for k in ("xi", "delta_deg", "rho", "f")))  # type: ignore[index]
+    t = _csv_table(_core.forward_md("\n".join(lines) + "\n", md_preset=str(md_preset)))
+    for k in t:
+        t[k] = t[k].reshape(shape)
+    t.shape = shape
+    return t
 
 
 def invert_k(
@@ -435,7 +453,15 @@ class Dataset:
         f: ArrayLike = 0.1,
     ) -> "Dataset":
         """From arrays (broadcast together). ``series`` labels group the points (default:
-        grouped by ξ); without ``sigma_v`` the fits weight relatively."""
+        grouped by ξ); without ``sigma_v`` the fits weight relatively.
+
+        Warns
+        -----
+        UnitWarning
+            The command line's plausibility warnings, as for :meth:`read_csv` (slopes in
+            radians, velocities in m/s or mm/s); the data are named ``<arrays>`` and the point
+            at index ``i`` is "line" ``i + 2``, as if written to a CSV file.
+        """
         shape, a = _broadcast(
             {"xi": xi, "delta_deg": delta_deg, "v": v, "sigma_v": np.nan if sigma_v is None else sigma_v, "rho": rho, "f": f}
         )
@@ -479,14 +505,22 @@ class Dataset:
         c = dict(self._core.columns())
         labels = np.asarray(self.labels, dtype=object)
         c["series"] = labels[c["series_index"]]
+        c.update(self.file_columns())
         return c
 
+    def file_columns(self) -> Dict[str, np.ndarray]:
+        """The file's columns that the dimensionless data set converts away, as float64 (NaN
+        where a row leaves the cell empty): ``v_m_s``, ``sigma_v_m_s``, ``R_m`` and ``g``,
+        those the file has (none for data without SI velocities)."""
+        return {name: np.array([float(x) if x != "" else np.nan for x in cells], dtype=np.float64) for name, cells in self._core.file_columns()}
+
     def to_pandas(self):
-        """The points as a DataFrame (needs pandas)."""
+        """The points as a DataFrame (needs pandas): the columns of :meth:`columns` but
+        ``series_index``, the file's ``R_m`` and ``g`` (and ``v_m_s``, ``sigma_v_m_s``) kept."""
         import pandas as pd
 
         c = self.columns()
-        cols = ["series", "xi", "delta_deg", "v", "sigma_v", "rho", "f"]
+        cols = ["series", "xi", "delta_deg", "v", "sigma_v", "rho", "f", *self.file_columns()]
         return pd.DataFrame({k: c[k] for k in cols})
 
     def __repr__(self) -> str:
@@ -1416,3 +1450,274 @@ def design(
         total=None if total is None else int(total),
     )
     return Design(raw)
+
+
+def _csv_table(text: str) -> Table:
+    """A CSV text of the command line as a :class:`Table`: one column per header name, in
+    its order; a column whose every cell is a number or empty is float64 (NaN for empty),
+    any other, and ``series`` (labels, even those that read as numbers), an object array of
+    ``str``."""
+    import csv
+    import io
+
+    rows = list(csv.reader(io.StringIO(text)))
+    header, body = rows[0], rows[1:]
+    t = Table()
+    for j, name in enumerate(header):
+        cells = [r[j] if j < len(r) else "" for r in body]
+        col: Optional[np.ndarray] = None
+        if name != "series":
+            try:
+                col = np.array([float(c) if c != "" else np.nan for c in cells], dtype=np.float64)
+            except ValueError:
+                col = None
+        t[name] = col if col is not None else np.array(cells, dtype=object)
+    t.shape = (len(body),)
+    return t
+
+
+def simulate(
+    model: str = "stickslip",
+    *,
+    law: str = "adjusted",
+    series: Sequence[float] = (0.8, 1.0, 1.6, 2.0),
+    points: int = 9,
+    noise: float = 0.02,
+    seed: int = 1,
+    rho: float = 0.4,
+    f: float = 0.1,
+    jan: Optional[Sequence[float]] = None,
+    jaeger: Optional[Sequence[float]] = None,
+    branch: str = "upper",
+    delta_range: Optional[Tuple[float, float]] = None,
+    design: Optional[Any] = None,
+    v0: Optional[float] = None,
+    delta_deg: Optional[float] = None,
+    beads: Optional[int] = None,
+    spin: str = "roll",
+    md_preset: str = "ristow",
+) -> Table:
+    """Synthetic measurements inside regime B, reproducible from a seed (``fitbead simulate``).
+
+    The keyword arguments are the command line's flags (``--delta-range`` is
+    ``delta_range``); the rows are those it writes for the same settings, to the last bit.
+
+    Parameters
+    ----------
+    model : str, default "stickslip"
+        The forward model that makes the data: ``stick``, ``stick-approx``, ``slip``,
+        ``slip-approx``, ``stickslip``, ``contact`` (with ``v0``: the bead-by-bead transient
+        instead), ``jan``, ``jaeger`` or ``md`` (molecular dynamics: slow, minutes per
+        series).
+    law : str, default "adjusted"
+        Collision law: a number, ``cos2a``, ``adjusted``, ``impact`` or ``c=VALUE``.
+    series : sequence of float
+        Radius ratios ξ of the series, each once.
+    points : int, default 9
+        Points per series, spread over 5 %–95 % of the steady range.
+    noise : float, default 0.02
+        Relative noise: v = v_true (1 + noise · N(0,1)), σ = noise · v_true.
+    seed : int, default 1
+        Seed of the random stream (ChaCha8).
+    rho, f : float
+        Gyration parameter ρ and friction coefficient f.
+    jan : sequence of 4 float, optional
+        Jan's global laws λ0, λ1, μ0, μ1 for ``jan`` (default: the paper's eqs 75–76).
+    jaeger : sequence of 3 float, optional
+        Jaeger's a1, a2, a3 for ``jaeger``, every series (default: the paper's Fig. 9 values
+        of each ξ, for ξ = 0.8, 1, 1.6, 2).
+    branch : {"upper", "lower"}
+        Jaeger's root of eq 84.
+    delta_range : (float, float), optional
+        Slopes LO, HI in degrees, cut to the steady range.
+    design : str or path-like, optional
+        A design file (``series,xi,delta_deg,replicates``, as :meth:`Design.to_csv` writes
+        it): the data are made at its slopes.
+    v0, delta_deg, beads : optional
+        ``contact`` only: the launch speed, slope (degrees) and row beads (default 50) of the
+        bead-by-bead transient.
+    spin : str, default "roll"
+        The contact model's spin rule: ``roll``, ``keep``, ``impact`` or ``factor=L``.
+    md_preset : {"ristow", "steel"}
+        The md model's parameter set.
+
+    Returns
+    -------
+    Table
+        The command line's CSV columns in its order: ``series``, ``xi``, ``delta_deg``,
+        ``v``, ``sigma_v`` (NaN with no noise), ``v_true``; md adds ``v_md_stderr`` and
+        ``v_m_s``; the transient has the columns of ``simulate --v0``. ``to_pandas()`` gives
+        a DataFrame.
+
+    Raises
+    ------
+    FitbeadError
+        A setting that cannot be used, named by its command-line flag.
+
+    Examples
+    --------
+    >>> import fitbead
+    >>> sim = fitbead.simulate("stick", series=[1.0], points=3, seed=2)
+    >>> list(sim)
+    ['series', 'xi', 'delta_deg', 'v', 'sigma_v', 'v_true']
+    """
+    text = _core.simulate(
+        model=_model_name(model),
+        law=law,
+        series=[float(x) for x in series],
+        points=int(points),
+        noise=float(noise),
+        seed=int(seed),
+        rho=float(rho),
+        f=float(f),
+        jan=None if jan is None else [float(x) for x in jan],
+        jaeger=None if jaeger is None else [float(x) for x in jaeger],
+        branch=branch,
+        delta_range=None if delta_range is None else (float(delta_range[0]), float(delta_range[1])),
+        design=None if design is None else str(design),
+        v0=None if v0 is None else float(v0),
+        delta_deg=None if delta_deg is None else float(delta_deg),
+        beads=None if beads is None else int(beads),
+        spin=spin,
+        md_preset=md_preset,
+    )
+    return _csv_table(text)
+
+
+class Report(dict):
+    """The tables of a report (:func:`report`), by the name of their CSV file without
+    ``.csv`` (``params``, ``stats``, ``bulk_friction``, ...), each a :class:`Table` whose
+    columns are that file's header.
+
+    Attributes
+    ----------
+    markdown : str
+        The text of report.md.
+    files : dict of str to bytes
+        Every file of the report directory (tables, figures, report.md), by name.
+    summary : str
+        The summary the command line prints.
+    """
+
+    markdown: str = ""
+    files: Dict[str, bytes] = {}
+    summary: str = ""
+
+    def __repr__(self) -> str:
+        return f"Report(tables=[{', '.join(self)}])"
+
+
+def report(
+    data: Any = None,
+    out_dir: Optional[Any] = None,
+    method: str = "lsq",
+    *,
+    format: str = "svg",
+    units: str = "dimensionless",
+    figure_width: Optional[Union[str, float]] = None,
+    level: float = 0.95,
+    seed: Optional[int] = None,
+    min_ess: Optional[float] = None,
+    max_steps: Optional[int] = None,
+    keep_going: bool = False,
+    g: float = 9.81,
+) -> Report:
+    """Every model fitted to one data set and the paper's comparisons (``fitbead report``).
+
+    The tables are computed as the command line computes them; with ``out_dir`` the report
+    directory is written as the command line writes it (one unit: every file or none).
+
+    Parameters
+    ----------
+    data : Dataset, str, path-like or DataFrame, optional
+        The measurements (default: the shipped synthetic data set).
+    out_dir : str or path-like, optional
+        Directory for the tables, figures and report.md (created if missing); ``None`` writes
+        nothing.
+    method : {"lsq", "mcmc"}
+        Least squares, or posteriors for every fit (slow: minutes).
+    format : str, default "svg"
+        Figure files: ``svg``, ``png``, ``pdf``, ``both`` or ``all``.
+    units : {"dimensionless", "si"}
+        Velocities on the figures (``si`` needs data given as ``v_m_s`` with ``R_m``).
+    figure_width : str or float, optional
+        Print width of the figures: ``single``, ``double`` or a width in mm.
+    level : float, default 0.95
+        The level of every interval.
+    seed, min_ess, max_steps : optional
+        MCMC settings (``method="mcmc"`` only).
+    keep_going : bool, default False
+        Report data that fail a fit command's input check, leaving out what fails (else an
+        error).
+    g : float, default 9.81
+        Gravity (m/s²) of SI rows without a ``g`` column (for ``units="si"``).
+
+    Returns
+    -------
+    Report
+        A dict of :class:`Table` by CSV file name without ``.csv``: ``bulk_friction``,
+        ``energy``, ``regime_map``, ``points``, ``models``, ``models_by_series``,
+        ``params``, ``stats``, ``residuals``, ``correlations``; the columns are each file's
+        header. ``Report.files`` holds every file's bytes, ``Report.markdown`` report.md.
+
+    Raises
+    ------
+    FitbeadError
+        Data or settings the command line refuses, with its message.
+
+    Warns
+    -----
+    UnitWarning
+        A fit whose misfit is implausible for the σ given (the command line's warning).
+    ConvergenceWarning
+        A posterior run that did not converge, or was interrupted.
+    """
+    d = _dataset(data)
+    files, unit_warnings, convergence_warnings, interrupted, summary = _core.report(
+        d._core,
+        out_dir=None if out_dir is None else str(out_dir),
+        method=method,
+        format=format,
+        units=units,
+        figure_width=None if figure_width is None else str(figure_width),
+        level=float(level),
+        seed=None if seed is None else int(seed),
+        min_ess=None if min_ess is None else float(min_ess),
+        max_steps=None if max_steps is None else int(max_steps),
+        keep_going=bool(keep_going),
+        g=float(g),
+    )
+    for w in unit_warnings:
+        _warn(w, UnitWarning)
+    for w in convergence_warnings:
+        _warn(w, ConvergenceWarning)
+    if interrupted:
+        _warn("a posterior run was interrupted: its tables hold the draws so far", ConvergenceWarning)
+    out = Report()
+    out.files = {name: bytes(b) for name, b in files}
+    for name, b in out.files.items():
+        if name.endswith(".csv"):
+            out[name[: -len(".csv")]] = _csv_table(b.decode("utf-8"))
+    out.markdown = out.files.get("report.md", b"").decode("utf-8")
+    out.summary = summary
+    return out
+
+
+def work_precision(scenes: int = 2000, seed: int = 1) -> Table:
+    """The work-precision table (``fitbead bench --output``): error against time of every
+    model and method variant, and of ``auto``, over scenes drawn across regime B.
+
+    Parameters
+    ----------
+    scenes : int, default 2000
+        Scenes drawn (about 30 % of them a hard subset).
+    seed : int, default 1
+        Seed of the scene draw.
+
+    Returns
+    -------
+    Table
+        The columns of ``fitbead bench --output``, one row per variant. The errors depend on
+        the scenes only; the times are measured on this machine.
+    """
+    return _csv_table(_core.work_precision(scenes=int(scenes), seed=int(seed)))

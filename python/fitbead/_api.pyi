@@ -198,8 +198,13 @@ class Dataset:
         The data set holds δ in radians: ``delta_deg`` is converted back and may differ from
         the file's degrees in the last bit (:func:`invert_k` on a Dataset uses the radians
         themselves)."""
+    def file_columns(self) -> dict[str, np.ndarray]:
+        """The file's columns that the dimensionless data set converts away, as float64 (NaN
+        where a row leaves the cell empty): ``v_m_s``, ``sigma_v_m_s``, ``R_m`` and ``g``,
+        those the file has (none for data without SI velocities)."""
     def to_pandas(self):
-        """The points as a DataFrame (needs pandas)."""
+        """The points as a DataFrame (needs pandas): the columns of :meth:`columns` but
+        ``series_index``, the file's ``R_m`` and ``g`` (and ``v_m_s``, ``sigma_v_m_s``) kept."""
 
 @dataclass(frozen=True)
 class Param:
@@ -585,3 +590,21 @@ def design(fit: str = 'klaw', *, model: str | None = None, law: str = 'c=0.5', s
         A setting the design cannot work with (e.g. a series without a regime-B range),
         named as the command line names it.
     '''
+
+def simulate(model: str = 'stickslip', *, law: str = 'adjusted', series: Sequence[float] = (0.8, 1.0, 1.6, 2.0), points: int = 9, noise: float = 0.02, seed: int = 1, rho: float = 0.4, f: float = 0.1, jan: Sequence[float] | None = None, jaeger: Sequence[float] | None = None, branch: str = 'upper', delta_range: tuple[float, float] | None = None, design: Any | None = None, v0: float | None = None, delta_deg: float | None = None, beads: int | None = None, spin: str = 'roll', md_preset: str = 'ristow') -> Table:
+    """Synthetic measurements inside regime B, reproducible from a seed (``fitbead simulate``);
+    the keyword arguments are the command line's flags, the rows those it writes."""
+
+class Report(dict):
+    """The tables of a report (:func:`report`), by the name of their CSV file without
+    ``.csv``, each a :class:`Table` whose columns are that file's header."""
+    markdown: str
+    files: dict[str, bytes]
+    summary: str
+
+def report(data: Any = None, out_dir: Any | None = None, method: str = 'lsq', *, format: str = 'svg', units: str = 'dimensionless', figure_width: str | float | None = None, level: float = 0.95, seed: int | None = None, min_ess: float | None = None, max_steps: int | None = None, keep_going: bool = False, g: float = 9.81) -> Report:
+    """Every model fitted to one data set and the paper's comparisons (``fitbead report``): the
+    tables, and the report directory written when ``out_dir`` is given."""
+
+def work_precision(scenes: int = 2000, seed: int = 1) -> Table:
+    """The work-precision table (``fitbead bench --output``)."""

@@ -537,7 +537,7 @@ fn forward<'py>(
         .map_err(|e| value_error(e.to_string()))?;
     if kind == ModelKind::Md {
         return Err(value_error(
-            "model md is not vectorised (it integrates each scene's bead row); use the command line's `forward --model md`",
+            "model md runs through forward_md (it integrates each scene's bead row)",
         ));
     }
     let [xi_s, d_s, rho_s, f_s] = slices_of([
@@ -812,7 +812,16 @@ struct PyDataset {
     /// The command line's plausibility warnings on the data (unit mistakes), each prefixed
     /// with the data's source as the command line prints it.
     warnings: Vec<String>,
+    /// The measurement file the data were read from (its columns, line numbers and source,
+    /// which the report uses).
+    file: MeasurementFile,
 }
+
+/// The name the shipped data set goes by in messages and reports (the command line's).
+const DEFAULT_DATA_NAME: &str = "<embedded default data: data/default.csv>";
+
+/// The name data given as arrays go by in warnings and reports (a line N is element N - 2).
+const ARRAYS_NAME: &str = "<arrays>";
 
 impl PyDataset {
     fn of_file(m: MeasurementFile) -> Self {
@@ -822,8 +831,9 @@ impl PyDataset {
             .map(|w| format!("{}: {w}", m.source()))
             .collect();
         PyDataset {
-            inner: m.into_dataset(),
+            inner: m.dataset().clone(),
             warnings,
+            file: m,
         }
     }
 }
@@ -857,11 +867,18 @@ impl PyDataset {
 
     /// The shipped synthetic data set (data/default.csv).
     #[staticmethod]
-    fn default_data() -> Self {
-        PyDataset {
+    fn default_data() -> PyResult<Self> {
+        let m = MeasurementFile::parse(
+            DEFAULT_DATA_NAME,
+            include_bytes!("../../data/default.csv"),
+            &MeasurementDefaults::default(),
+        )
+        .map_err(|e| value_error(e.to_string()))?;
+        Ok(PyDataset {
             inner: RsDataset::default_data(),
             warnings: Vec::new(),
-        }
+            file: m,
+        })
     }
 
     /// From flat arrays; `sigma_v` NaN everywhere for no σ (then relative weights).
@@ -887,16 +904,52 @@ impl PyDataset {
             (&f, "f"),
         ])?;
         let mut rows = Vec::with_capacity(n);
-        for (i, label) in series.into_iter().enumerate() {
+        // The same points as a measurement file, for the command line's checks of the data
+        // (plausibility) and for the report: every number written in its shortest round-trip
+        // form, so that the file reads back the same doubles.
+        let sigma = ss.iter().any(|x| !x.is_nan());
+        let mut text = String::from("series,xi,delta_deg,v,rho,f");
+        if sigma {
+            text.push_str(",sigma_v");
+        }
+        text.push('\n');
+        for (i, label) in series.iter().enumerate() {
             let scene =
                 scene_of(i, xs, d, rs, fs, CollisionLaw::Value(0.5)).map_err(value_error)?;
             let (v, s) = measured(i, vs, ss).map_err(value_error)?;
-            rows.push((label, scene, v, s));
+            rows.push((label.clone(), scene, v, s));
         }
         let inner = RsDataset::new(rows).map_err(|e| value_error(e.to_string()))?;
+        for (i, label) in series.iter().enumerate() {
+            let quoted = format!("\"{}\"", label.replace('"', "\"\""));
+            text.push_str(&quoted);
+            for x in [xs[i], d[i], vs[i], rs[i], fs[i]] {
+                text.push(',');
+                text.push_str(&fitbead::numfmt::fmt_f64(x));
+            }
+            if sigma {
+                text.push(',');
+                if !ss[i].is_nan() {
+                    text.push_str(&fitbead::numfmt::fmt_f64(ss[i]));
+                }
+            }
+            text.push('\n');
+        }
+        let m = MeasurementFile::parse(
+            ARRAYS_NAME,
+            text.as_bytes(),
+            &MeasurementDefaults::default(),
+        )
+        .map_err(|e| value_error(e.to_string()))?;
+        let warnings = m
+            .plausibility()
+            .iter()
+            .map(|w| format!("{ARRAYS_NAME}: {w}"))
+            .collect();
         Ok(PyDataset {
             inner,
-            warnings: Vec::new(),
+            warnings,
+            file: m,
         })
     }
 
@@ -927,6 +980,15 @@ impl PyDataset {
         });
         r.map_err(value_error)?;
         cols.into_dict(py)
+    }
+
+    /// The columns of the file that the data set converts away, as text cells per point (one
+    /// list per column present): `v_m_s`, `sigma_v_m_s`, `R_m`, `g`.
+    fn file_columns(&self) -> Vec<(String, Vec<String>)> {
+        ["v_m_s", "sigma_v_m_s", "R_m", "g"]
+            .iter()
+            .filter_map(|c| self.file.column(c).map(|v| (c.to_string(), v)))
+            .collect()
     }
 
     /// Number of points.
@@ -1452,6 +1514,247 @@ fn design<'py>(
     Ok(d)
 }
 
+/// A run of the library's pipeline without the GIL, interruptibly; its errors as the
+/// command line words them.
+fn pipeline_error(e: fitbead::pipeline::RunError) -> PyErr {
+    match e {
+        fitbead::pipeline::RunError::Interrupted => {
+            PyKeyboardInterrupt::new_err("interrupted (the run stopped cleanly)")
+        }
+        e => value_error(e.to_string()),
+    }
+}
+
+/// Synthetic measurements (`fitbead simulate`): the settings as its flags, the result as the
+/// CSV text it writes (see the Python `fitbead.simulate`).
+#[pyfunction]
+#[pyo3(signature = (model="stickslip", law="adjusted", series=vec![0.8, 1.0, 1.6, 2.0], points=9, noise=0.02, seed=1, rho=0.4, f=0.1, jan=None, jaeger=None, branch="upper", delta_range=None, design=None, v0=None, delta_deg=None, beads=None, spin="roll", md_preset="ristow"))]
+#[allow(clippy::too_many_arguments)]
+fn simulate(
+    py: Python<'_>,
+    model: &str,
+    law: &str,
+    series: Vec<f64>,
+    points: usize,
+    noise: f64,
+    seed: u64,
+    rho: f64,
+    f: f64,
+    jan: Option<[f64; 4]>,
+    jaeger: Option<[f64; 3]>,
+    branch: &str,
+    delta_range: Option<(f64, f64)>,
+    design: Option<std::path::PathBuf>,
+    v0: Option<f64>,
+    delta_deg: Option<f64>,
+    beads: Option<usize>,
+    spin: &str,
+    md_preset: &str,
+) -> PyResult<String> {
+    use fitbead::models::md::{Md, MdParams, MdRunConfig};
+    use fitbead::pipeline::SimulateSettings;
+    let kind = model
+        .parse::<ModelKind>()
+        .map_err(|_| value_error(format!("model = '{model}': unknown model")))?;
+    let spin: SpinRule = spin.parse().map_err(|e: fitbead::scene::ParameterError| {
+        value_error(format!("spin = '{spin}': {e}"))
+    })?;
+    let params = match md_preset.to_ascii_lowercase().as_str() {
+        "ristow" => MdParams::ristow(),
+        "steel" => MdParams::steel(),
+        _ => {
+            return Err(value_error(format!(
+                "md_preset = '{md_preset}': expected ristow or steel"
+            )))
+        }
+    };
+    let stop = Arc::new(AtomicBool::new(false));
+    let settings = SimulateSettings {
+        model: kind,
+        law: parse_law(law)?,
+        series,
+        points,
+        noise,
+        seed,
+        rho,
+        f,
+        jan,
+        jaeger,
+        branch: branch
+            .parse()
+            .map_err(|e: String| value_error(format!("branch = '{branch}': {e}")))?,
+        delta_range,
+        design,
+        v0,
+        delta_deg,
+        beads,
+        spin,
+        md: Md {
+            params,
+            config: MdRunConfig::default(),
+        },
+        stop: Some(stop.clone()),
+        ..SimulateSettings::default()
+    };
+    let r = interruptible(py, &stop, || fitbead::pipeline::simulate(&settings))?;
+    let bytes = r.map_err(pipeline_error)?;
+    String::from_utf8(bytes).map_err(|e| value_error(e.to_string()))
+}
+
+/// The report (`fitbead report`) of `data`: every file (name, bytes) in the order written,
+/// the warnings of the run (implausible misfits, posterior runs that did not converge) and
+/// whether a posterior run was cut short; the directory written
+/// when `out_dir` is given (see the Python `fitbead.report`).
+#[pyfunction]
+#[pyo3(signature = (data, out_dir=None, method="lsq", format="svg", units="dimensionless", figure_width=None, level=0.95, seed=None, min_ess=None, max_steps=None, keep_going=false, g=9.81))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn report(
+    py: Python<'_>,
+    data: &PyDataset,
+    out_dir: Option<std::path::PathBuf>,
+    method: &str,
+    format: &str,
+    units: &str,
+    figure_width: Option<String>,
+    level: f64,
+    seed: Option<u64>,
+    min_ess: Option<f64>,
+    max_steps: Option<usize>,
+    keep_going: bool,
+    g: f64,
+) -> PyResult<(
+    Vec<(String, Vec<u8>)>,
+    Vec<String>,
+    Vec<String>,
+    bool,
+    String,
+)> {
+    use fitbead::inverse::posterior::Method;
+    use fitbead::pipeline::ReportSettings;
+    let stop = Arc::new(AtomicBool::new(false));
+    let m = match method.to_ascii_lowercase().as_str() {
+        "lsq" => {
+            if seed.is_some() || min_ess.is_some() || max_steps.is_some() {
+                return Err(value_error(
+                    "seed, min_ess and max_steps apply to method = 'mcmc' only",
+                ));
+            }
+            Method::Lsq {
+                profile: true,
+                stop: Some(stop.clone()),
+                progress: None,
+            }
+        }
+        "mcmc" => {
+            let mut s = McmcSettings::seeded(seed.unwrap_or(1));
+            if let Some(e) = min_ess {
+                s.options.min_ess = e;
+            }
+            if let Some(m) = max_steps {
+                s.options.max_steps = m;
+            }
+            s.options.check().map_err(|e| value_error(e.to_string()))?;
+            s.options.stop = Some(stop.clone());
+            Method::Mcmc(Box::new(s))
+        }
+        _ => {
+            return Err(value_error(format!(
+                "method = '{method}': expected lsq or mcmc"
+            )))
+        }
+    };
+    let si_units = match units.to_ascii_lowercase().as_str() {
+        "dimensionless" => false,
+        "si" => true,
+        _ => {
+            return Err(value_error(format!(
+                "units = '{units}': expected dimensionless or si"
+            )))
+        }
+    };
+    let defaults = MeasurementDefaults {
+        g,
+        ..MeasurementDefaults::default()
+    }
+    .checked()
+    .map_err(|e| value_error(e.to_string()))?;
+    let settings = ReportSettings {
+        level,
+        method: m,
+        format: format.to_string(),
+        si_units,
+        figure_width,
+        keep_going,
+        defaults,
+        stop: Some(stop.clone()),
+        ..ReportSettings::default()
+    };
+    let file = &data.file;
+    let dir = out_dir.as_deref();
+    let r = interruptible(py, &stop, || {
+        fitbead::pipeline::report(file, &settings, dir)
+    })?;
+    let out = r.map_err(pipeline_error)?;
+    // The warnings by kind: implausible misfits (unit mistakes), posterior runs that did not
+    // converge.
+    let absurd: Vec<String> = out
+        .stats
+        .iter()
+        .filter_map(|s| {
+            s.absurd_misfit()
+                .map(|w| format!("{} [{}]: {w}", s.fit, s.series))
+        })
+        .collect();
+    let unconverged: Vec<String> = out
+        .warnings
+        .iter()
+        .filter(|w| !absurd.contains(w))
+        .cloned()
+        .collect();
+    Ok((out.files, absurd, unconverged, out.interrupted, out.summary))
+}
+
+/// `fitbead forward --model md` on the CSV text of a scene table, under the md preset: the CSV
+/// text it writes.
+#[pyfunction]
+#[pyo3(signature = (table, rho=0.4, f=0.1, md_preset="ristow"))]
+fn forward_md(py: Python<'_>, table: &str, rho: f64, f: f64, md_preset: &str) -> PyResult<String> {
+    use fitbead::models::md::{Md, MdParams, MdRunConfig};
+    let params = match md_preset.to_ascii_lowercase().as_str() {
+        "ristow" => MdParams::ristow(),
+        "steel" => MdParams::steel(),
+        _ => {
+            return Err(value_error(format!(
+                "md_preset = '{md_preset}': expected ristow or steel"
+            )))
+        }
+    };
+    let md = Md {
+        params,
+        config: MdRunConfig::default(),
+    };
+    let stop = Arc::new(AtomicBool::new(false));
+    let r = interruptible(py, &stop, || {
+        fitbead::pipeline::forward_md(table.as_bytes(), "<arrays>", md, rho, f, Some(&stop))
+    })?;
+    let bytes = r.map_err(pipeline_error)?;
+    String::from_utf8(bytes).map_err(|e| value_error(e.to_string()))
+}
+
+/// The work-precision table of `fitbead bench` as the CSV text of its `--output`.
+#[pyfunction]
+#[pyo3(signature = (scenes=2000, seed=1))]
+fn work_precision(py: Python<'_>, scenes: usize, seed: u64) -> PyResult<String> {
+    let stop = Arc::new(AtomicBool::new(false));
+    let r = interruptible(py, &stop, || {
+        fitbead::pipeline::work_precision(scenes, seed, Some(&stop))
+    })?;
+    let rows = r.map_err(pipeline_error)?;
+    let bytes =
+        fitbead::report::workprecision::render(&rows).map_err(|e| value_error(e.to_string()))?;
+    String::from_utf8(bytes).map_err(|e| value_error(e.to_string()))
+}
+
 #[pyfunction]
 fn version() -> &'static str {
     env!("CARGO_PKG_VERSION")
@@ -1475,6 +1778,10 @@ fn _fitbead(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(record_columns, m)?)?;
     m.add_function(wrap_pyfunction!(output_columns, m)?)?;
     m.add_function(wrap_pyfunction!(design, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(report, m)?)?;
+    m.add_function(wrap_pyfunction!(work_precision, m)?)?;
+    m.add_function(wrap_pyfunction!(forward_md, m)?)?;
     m.add("FitbeadError", m.py().get_type::<FitbeadError>())?;
     m.add_function(wrap_pyfunction!(threads, m)?)?;
     m.add_class::<PyDataset>()?;

@@ -3,23 +3,11 @@
 //! as a directory of CSV tables, SVG figures and a `report.md` that links them.
 
 use super::args::{ContactArgs, DataArgs, LevelArgs, PlotArgs};
-use super::fitargs::{flag_absurd, not_converged, FitArgs, FitOutputArgs};
-use super::klaw::law_error;
+use super::fitargs::{not_converged, FitArgs, FitOutputArgs};
 use super::CliError;
-use crate::fit::k::unsteady_points;
-use crate::io::measurements::locate_point;
-use crate::io::measurements::{is_shipped_data, si_conversion};
-use crate::report::analysis::analyse;
+use crate::pipeline::{report, ReportSettings};
 use crate::report::figures::{FigureFormat, FigureWidth};
-use crate::report::text::{markdown, one_line, terminal_summary, ReportContext};
 use std::path::{Path, PathBuf};
-
-/// The contact models the report fits (a point must be steady under one of them).
-const CONTACT_MODELS: [crate::models::Model; 2] =
-    [crate::models::Model::Stick, crate::models::Model::StickSlip];
-
-/// [`CONTACT_MODELS`] in prose.
-const CONTACT_NAMES: [&str; 2] = ["rolling", "stick/slip"];
 
 /// Arguments of `fitbead report`.
 #[derive(Debug, clap::Args)]
@@ -302,13 +290,12 @@ fn run_with(a: Args, r: Recipe) -> Result<(), CliError> {
             .map_err(|e: String| super::flag_error("--format", f, e))?,
         None => FigureFormat::Svg,
     };
-    let figure_width: Option<FigureWidth> = match a.figure_width.clone().or(r.figure_width) {
-        Some(w) => Some(
-            w.parse()
-                .map_err(|e: String| super::flag_error("--figure-width", &w, e))?,
-        ),
-        None => None,
-    };
+    // Checked here, before the data are read; the library reads the text again.
+    let figure_width_text = a.figure_width.clone().or(r.figure_width);
+    if let Some(w) = &figure_width_text {
+        w.parse::<FigureWidth>()
+            .map_err(|e: String| super::flag_error("--figure-width", w, e))?;
+    }
     let out_dir = a
         .out_dir
         .clone()
@@ -369,266 +356,49 @@ fn run_with(a: Args, r: Recipe) -> Result<(), CliError> {
         ],
         &outputs,
     )?;
-    let (t, rows, ds) = io.read()?;
+    let (table, rows, dataset) = io.read()?;
     let choice = io.method(&[])?;
-    // A point that no contact model of the report can make steady is an error, as in klaw.
-    // Per contact model, the points it cannot make steady at any K (`klaw`'s input check);
-    // a point in every model's list is steady under none of them.
-    let unsteady: Vec<Vec<(usize, String)>> = CONTACT_MODELS
-        .iter()
-        .map(|m| unsteady_points(std::slice::from_ref(m), &ds, Some(&super::stop_flag())))
-        .collect();
-    if super::stop_requested() {
-        return Err(CliError::Interrupted);
-    }
-    let under_none: Vec<&(usize, String)> = unsteady[0]
-        .iter()
-        .filter(|(i, _)| unsteady[1..].iter().all(|u| u.iter().any(|(j, _)| j == i)))
-        .collect();
-    if let Some((i, why)) = under_none.first() {
-        return Err(CliError::Other(format!(
-            "{}: {why} (and {} more such point(s)); no K of the rolling or stick/slip model \
-             makes this point steady: leave it out of the data",
-            locate_point(&t, &ds, *i),
-            under_none.len() - 1
-        )));
-    }
-    let implausible = crate::io::measurements::plausibility(&t, &rows);
-    let mut input_warnings = Vec::new();
-    for (u, name) in unsteady.iter().zip(CONTACT_NAMES) {
-        if let Some((i, why)) = u.first() {
-            input_warnings.push(format!(
-                "{}: {why} (and {} more such point(s)); no K of the {name} model makes this \
-                 point steady (the {name} fits leave such points out)",
-                locate_point(&t, &ds, *i),
-                u.len() - 1
-            ));
-        }
-    }
-    refuse_unless_keep_going(a.keep_going, &input_warnings)?;
-    let mut an = analyse(&ds, io.level.level(), &choice.method);
-    an.print_width_mm = figure_width.map(FigureWidth::mm);
-    // The K(α) laws `klaw` would have refused to fit (on the points each model keeps).
-    let mut law_failures = Vec::new();
-    for (c, name) in an.contact.iter().zip(CONTACT_NAMES) {
-        for (law, e) in &c.law_failures {
-            let located = law_error(e, &|i| locate_point(&t, &ds, c.used[i]));
-            law_failures.push(format!("{name} law {}: {located}", law.name()));
-        }
-    }
-    if !super::stop_requested() {
-        refuse_unless_keep_going(a.keep_going, &law_failures)?;
-    }
-    input_warnings.extend(law_failures);
-    let interrupted = an
-        .posteriors()
-        .iter()
-        .any(|p| p.draws.as_ref().is_some_and(|d| d.interrupted));
-    if super::stop_requested() && !interrupted {
-        return Err(CliError::Interrupted);
-    }
-    let mut files: Vec<(String, Vec<u8>)> = Vec::new();
-    let csv_err = |e: csv::Error| CliError::Other(e.to_string());
-    files.push(("bulk_friction.csv".into(), an.mu_csv().map_err(csv_err)?));
-    files.push(("energy.csv".into(), an.energy_csv().map_err(csv_err)?));
-    files.push((
-        "regime_map.csv".into(),
-        an.regime_map_csv().map_err(csv_err)?,
-    ));
-    files.push(("points.csv".into(), an.points_csv().map_err(csv_err)?));
-    files.push(("models.csv".into(), an.models_csv().map_err(csv_err)?));
-    files.push((
-        "models_by_series.csv".into(),
-        an.models_by_series_csv().map_err(csv_err)?,
-    ));
-    // Under a posterior run: the bands of v̄(δ) and the posterior median at every point.
-    // A run whose sampling was interrupted has none (the bands of every fit's draws cost
-    // model evaluations by the million); a stop while they are drawn writes nothing.
-    let bands = if an.mcmc && !interrupted {
-        match crate::report::bands::posterior_bands_until(&an, &super::stop_flag()) {
-            Some(b) => Some(b),
-            None => return Err(CliError::Interrupted),
-        }
-    } else {
-        None
+    let data = crate::io::measurements::MeasurementFile {
+        table,
+        rows,
+        dataset,
     };
-    let fits = an.fit_results_at(bands.as_ref());
-    let params = an.params();
-    let stats: Vec<_> = fits.iter().map(|f| f.stats.clone()).collect();
-    let stats = flag_absurd(&stats);
-    files.push((
-        "params.csv".into(),
-        crate::io::reports::params_csv(&params).map_err(csv_err)?,
-    ));
-    files.push((
-        "stats.csv".into(),
-        crate::io::reports::stats_csv(&stats).map_err(csv_err)?,
-    ));
-    // Velocities in m/s on the figures (--units si): each series' unit sqrt(g R (1 + ξ)).
-    let si = si_conversion(&t, &io.data.defaults()?);
-    let units_m_s: Option<Vec<f64>> = match units {
-        Units::Dimensionless => None,
-        Units::Si => {
-            let si = si.as_ref().ok_or_else(|| {
-                super::flag_error(
-                    "--units",
-                    "si",
-                    "the velocities were given dimensionless (column v): figures in m/s need \
-                     v_m_s with R_m",
-                )
-            })?;
-            let mut u = Vec::new();
-            for label in &ds.labels {
-                let s = si.iter().find(|s| &s.series == label);
-                match s.and_then(|s| s.unit()) {
-                    Some(x) => u.push(x),
-                    None => {
-                        return Err(super::flag_error(
-                            "--units",
-                            "si",
-                            format!(
-                                "series {label} has rows of different R_m or g, so no one unit \
-                                 converts its velocities to m/s"
-                            ),
-                        ))
-                    }
-                }
-            }
-            Some(u)
-        }
+    let settings = ReportSettings {
+        level: io.level.level(),
+        method: choice.method,
+        format: format_text.unwrap_or_else(|| "svg".into()),
+        si_units: units == Units::Si,
+        figure_width: figure_width_text,
+        keep_going: a.keep_going,
+        defaults: io.data.defaults()?,
+        source: shown,
+        stop: Some(super::stop_flag()),
+        method_name: Some(io.method.clone()),
     };
-    let fit_refs: Vec<&crate::fit::summary::FitResult> = fits.iter().collect();
-    files.push((
-        "residuals.csv".into(),
-        crate::io::reports::residuals_csv(&fit_refs).map_err(csv_err)?,
-    ));
-    files.push((
-        "correlations.csv".into(),
-        crate::io::reports::correlations_csv(&fit_refs).map_err(csv_err)?,
-    ));
-    let fig = |name: &str, r: Result<String, String>| {
-        r.map(|s| (name.to_string(), s.into_bytes()))
-            .map_err(|e| CliError::Other(format!("figure {name}: {e}")))
-    };
-    files.push(fig(
-        "velocity.svg",
-        an.velocity_figure_with(bands.as_ref(), units_m_s.as_deref()),
-    )?);
-    files.push(fig("jan_linear.svg", an.jan_figure(units_m_s.as_deref()))?);
-    files.push(fig(
-        "k_final_velocity.svg",
-        an.k_figure(units_m_s.as_deref()),
-    )?);
-    files.push(fig("regime_map.svg", an.regime_figure())?);
-    files.push(fig("jaeger.svg", an.jaeger_figure())?);
-    files.push(fig("k_alpha.svg", an.k_alpha_figure())?);
-    files.push(fig("energy.svg", an.energy_figure())?);
-    files.push(fig("residuals.svg", an.residuals_figure_with(&fits))?);
-    let mut corner_files = Vec::new();
-    for (name, svg) in an.corner_figures() {
-        corner_files.push(name.clone());
-        files.push((name, svg.into_bytes()));
-    }
-    let warnings: Vec<String> = stats
-        .iter()
-        .filter(|s| s.mcmc.is_some() && !s.converged)
-        .map(|s| format!("{} [{}]: {}", s.fit, s.series, s.note))
-        .collect();
-    // Outside an interrupted run the exit-1 message names these fits ([`not_converged`]).
-    if interrupted {
-        for w in &warnings {
-            eprintln!("fitbead: warning: {w}");
+    let out = report(&data, &settings, Some(&out_dir))?;
+    for s in &out.stats {
+        if let Some(w) = s.absurd_misfit() {
+            eprintln!("fitbead: warning: {} [{}]: {w}", s.fit, s.series);
         }
     }
-    let absurd: Vec<String> = stats
-        .iter()
-        .filter_map(|s| {
-            s.absurd_misfit()
-                .map(|w| format!("{} [{}]: {w}", s.fit, s.series))
-        })
-        .collect();
-    let context = ReportContext {
-        source: shown.unwrap_or_else(|| t.source.clone()),
-        shipped_synthetic: is_shipped_data(&ds),
-        si,
-        figure_format: format,
-        corner_files,
-        input_warnings,
-        plausibility: implausible
+    // Outside an interrupted run the exit-1 message names the fits that did not converge.
+    if out.interrupted {
+        for s in out
+            .stats
             .iter()
-            .map(|w| w.to_string())
-            .chain(absurd)
-            .collect(),
-    };
-    let mut md = markdown(&an, &context, &io.method);
-    if !warnings.is_empty() {
-        md.push_str(
-            "
-## Posterior runs that did not converge
-
-",
-        );
-        for w in &warnings {
-            md.push_str(&format!("- {}\n", one_line(w)));
+            .filter(|s| s.mcmc.is_some() && !s.converged)
+        {
+            eprintln!("fitbead: warning: {} [{}]: {}", s.fit, s.series, s.note);
         }
-    }
-    files.push(("report.md".into(), md.into_bytes()));
-    let files = format.apply(files).map_err(CliError::Other)?;
-    // A stop that came while the tables and figures were drawn: nothing is written.
-    if super::stop_requested() && !interrupted {
-        return Err(CliError::Interrupted);
-    }
-    let created = create_dirs(&out_dir)
-        .map_err(|e| CliError::Other(format!("{}: cannot create: {e}", out_dir.display())))?;
-    if let Err(e) = crate::io::outdir::write_dir(&out_dir, &files) {
-        // All or nothing: directories made for this report go as well.
-        for d in created.iter().rev() {
-            let _ = std::fs::remove_dir(d);
-        }
-        return Err(CliError::Other(format!("cannot write: {e}")));
     }
     {
         // The summary only repeats the files: a closed or broken stdout does not fail the
         // report (print! would panic on a broken pipe).
         use std::io::Write;
-        let _ = std::io::stdout()
-            .write_all(terminal_summary(&an, &out_dir.display().to_string()).as_bytes());
+        let _ = std::io::stdout().write_all(out.summary.as_bytes());
     }
-    if interrupted {
+    if out.interrupted {
         return Err(CliError::InterruptedPartial);
     }
-    not_converged(&stats)
-}
-
-/// Exit 2 on `problems` (the input checks a fit command would have failed), unless
-/// `--keep-going`.
-fn refuse_unless_keep_going(keep_going: bool, problems: &[String]) -> Result<(), CliError> {
-    if keep_going || problems.is_empty() {
-        return Ok(());
-    }
-    Err(CliError::Other(format!(
-        "{}{}; nothing written (--keep-going writes the report without what these leave out, \
-         report.md opening with the warnings)",
-        problems[0],
-        match problems.len() {
-            1 => String::new(),
-            n => format!("; and {} more problem(s)", n - 1),
-        }
-    )))
-}
-
-/// Creates `dir` and its missing parents; returns the directories it made, outermost first.
-fn create_dirs(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
-    let mut missing = Vec::new();
-    let mut p = Some(dir);
-    while let Some(d) = p {
-        if d.as_os_str().is_empty() || d.exists() {
-            break;
-        }
-        missing.push(d.to_path_buf());
-        p = d.parent();
-    }
-    missing.reverse();
-    std::fs::create_dir_all(dir)?;
-    Ok(missing)
+    not_converged(&out.stats)
 }

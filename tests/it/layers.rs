@@ -11,8 +11,8 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// The layers, lowest first, as `src/lib.rs` lists them.
-const LAYERS: [&str; 8] = [
-    "special", "scene", "models", "inverse", "fit", "design", "report", "io",
+const LAYERS: [&str; 9] = [
+    "special", "scene", "models", "inverse", "fit", "design", "report", "io", "pipeline",
 ];
 /// Modules every layer may use and which themselves use none.
 const LEAVES: [&str; 2] = ["numfmt", "progress"];

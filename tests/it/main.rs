@@ -19,6 +19,7 @@ mod fits;
 mod layers;
 mod md;
 mod nist;
+mod pipeline;
 mod prior_sensitivity;
 mod recipes;
 mod report;

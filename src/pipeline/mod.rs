@@ -1,0 +1,64 @@
+//! Whole runs of the command line as library calls: synthetic measurements ([`simulate`]),
+//! the report of every model fitted to one data set ([`report`]), the work-precision table
+//! of the forward models ([`work_precision`]) and the molecular-dynamics runs of a scene table
+//! ([`forward_md`]). The command line parses its
+//! flags into these settings, calls these functions and prints or writes what they return;
+//! the Python package calls the same functions.
+//!
+//! A setting that cannot be used is an [`InputError`] named as the command line's flag
+//! (`--points`, `--series`, …) in the column of the error, so that both front ends report it
+//! alike.
+
+mod bench;
+mod report;
+mod simulate;
+
+pub use bench::{forward_md, work_precision};
+pub use report::{report, ReportOutput, ReportSettings};
+pub use simulate::{simulate, SimulateSettings};
+
+use crate::io::InputError;
+use std::fmt;
+
+/// Why a run of this module failed.
+#[derive(Debug)]
+#[non_exhaustive]
+pub enum RunError {
+    /// A bad setting (its flag in `column`) or a bad cell of an input file, located.
+    Input(InputError),
+    /// Any other failure (a model without a steady state where one is needed, a figure that
+    /// cannot be drawn, a directory that cannot be written), with its message.
+    Failed(String),
+    /// Stopped by the settings' stop flag before anything was written.
+    Interrupted,
+}
+
+impl fmt::Display for RunError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            RunError::Input(e) => write!(f, "{e}"),
+            RunError::Failed(s) => f.write_str(s),
+            RunError::Interrupted => f.write_str("interrupted: nothing written"),
+        }
+    }
+}
+
+impl std::error::Error for RunError {}
+
+impl From<InputError> for RunError {
+    fn from(e: InputError) -> Self {
+        RunError::Input(e)
+    }
+}
+
+/// An error about the setting `flag` (the command line's flag, e.g. `--points`) of value
+/// `value`.
+pub(crate) fn setting_error(flag: &str, value: &str, message: impl Into<String>) -> RunError {
+    RunError::Input(InputError {
+        file: crate::io::SETTINGS_ORIGIN.into(),
+        line: None,
+        column: Some(flag.to_string()),
+        value: Some(value.to_string()),
+        message: message.into(),
+    })
+}

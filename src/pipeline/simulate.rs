@@ -1,0 +1,773 @@
+//! Synthetic measurements spread inside regime B of each series, with multiplicative Gaussian
+//! noise, reproducible from the seed (ChaCha8 stream); or the bead-by-bead transient of the
+//! contact model from a launch speed.
+
+use super::{setting_error as flag_error, RunError};
+use crate::io::fmt_f64;
+use crate::models::contact::{Contact, SpinRule};
+use crate::models::jaeger::Jaeger;
+use crate::models::jan::Jan;
+use crate::models::md::{
+    regime_b_interval_until as md_regime_b_interval, Md, MdParams, MdRunConfig, MD_NARROW,
+    MD_REFINE, MD_SCAN_POINTS,
+};
+use crate::models::regimes::regime_b_interval;
+use crate::models::{ForwardModel, JaegerBranch, Model, ModelKind};
+use crate::progress::{Progress, ProgressEvent};
+use crate::scene::{CollisionLaw, Scene};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, StandardNormal};
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
+/// Most points per series (`points`).
+pub(crate) const MAX_POINTS: usize = 1_000_000;
+/// Most rows in all (series × points).
+pub(crate) const MAX_ROWS: usize = 10_000_000;
+/// Most series (`series`).
+pub(crate) const MAX_SERIES: usize = 10_000;
+
+/// What [`simulate`] makes: the settings of `fitbead simulate`, one field per flag (the
+/// defaults are the flags' defaults).
+#[derive(Clone)]
+pub struct SimulateSettings {
+    /// Forward model that makes the data (`--model`): a contact model, contact (with `v0`:
+    /// the transient instead), jan, jaeger or md.
+    pub model: ModelKind,
+    /// Collision law (`--law`).
+    pub law: CollisionLaw,
+    /// Radius ratios ξ of the series (`--series`), each once.
+    pub series: Vec<f64>,
+    /// Points per series (`--points`).
+    pub points: usize,
+    /// Relative noise (`--noise`): v = v_true (1 + noise · N(0,1)), σ = noise · v_true.
+    pub noise: f64,
+    /// Seed of the random stream (`--seed`).
+    pub seed: u64,
+    /// Gyration parameter ρ (`--rho`).
+    pub rho: f64,
+    /// Friction coefficient f (`--f`).
+    pub f: f64,
+    /// Jan's global laws λ0, λ1, μ0, μ1 (`--jan`; λ = λ0 e^{λ1 sin α}, μ = μ0 e^{μ1 sin α});
+    /// `None`: the paper's eqs 75–76.
+    pub jan: Option<[f64; 4]>,
+    /// Jaeger's a1, a2, a3 for every series (`--jaeger`, eq 81); `None`: the paper's Fig. 9
+    /// values of each series' ξ.
+    pub jaeger: Option<[f64; 3]>,
+    /// Branch of eq 84 for jaeger (`--branch`).
+    pub branch: JaegerBranch,
+    /// Slopes LO, HI in degrees (`--delta-range`), cut to the steady range.
+    pub delta_range: Option<(f64, f64)>,
+    /// A design file (`--design`: series,xi,delta_deg,replicates): the data are made at its
+    /// slopes instead.
+    pub design: Option<PathBuf>,
+    /// Launch speed of the contact model's transient (`--v0`).
+    pub v0: Option<f64>,
+    /// Slope of the transient, degrees (`--delta-deg`).
+    pub delta_deg: Option<f64>,
+    /// Row beads of the transient (`--beads`); `None`: 50.
+    pub beads: Option<usize>,
+    /// Spin rule of the contact model (`--spin`).
+    pub spin: SpinRule,
+    /// The molecular-dynamics model of `model` md (the md flags).
+    pub md: Md,
+    /// Raised to stop the run: [`simulate`] then returns [`RunError::Interrupted`].
+    pub stop: Option<Arc<AtomicBool>>,
+    /// Progress of the md runs (label `md simulate`).
+    pub progress: Option<Progress>,
+    /// Called with each note of the run as it is made (md: a steady range narrowed).
+    #[allow(clippy::type_complexity)]
+    pub notes: Option<Arc<dyn Fn(&str) + Send + Sync>>,
+}
+
+impl std::fmt::Debug for SimulateSettings {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SimulateSettings")
+            .field("model", &self.model)
+            .field("law", &self.law)
+            .field("series", &self.series)
+            .field("points", &self.points)
+            .field("noise", &self.noise)
+            .field("seed", &self.seed)
+            .field("rho", &self.rho)
+            .field("f", &self.f)
+            .field("jan", &self.jan)
+            .field("jaeger", &self.jaeger)
+            .field("branch", &self.branch)
+            .field("delta_range", &self.delta_range)
+            .field("design", &self.design)
+            .field("v0", &self.v0)
+            .field("delta_deg", &self.delta_deg)
+            .field("beads", &self.beads)
+            .field("spin", &self.spin)
+            .field("md", &self.md)
+            .finish_non_exhaustive()
+    }
+}
+
+impl Default for SimulateSettings {
+    /// The command line's defaults: stickslip under the adjusted law, ξ = 0.8, 1, 1.6, 2,
+    /// 9 points per series, 2 % noise, seed 1, ρ = 0.4, f = 0.1, md with the ristow preset.
+    fn default() -> Self {
+        SimulateSettings {
+            model: ModelKind::StickSlip,
+            law: CollisionLaw::Adjusted,
+            series: vec![0.8, 1.0, 1.6, 2.0],
+            points: 9,
+            noise: 0.02,
+            seed: 1,
+            rho: 0.4,
+            f: 0.1,
+            jan: None,
+            jaeger: None,
+            branch: JaegerBranch::Upper,
+            delta_range: None,
+            design: None,
+            v0: None,
+            delta_deg: None,
+            beads: None,
+            spin: SpinRule::Roll,
+            md: Md {
+                params: MdParams::ristow(),
+                config: MdRunConfig::default(),
+            },
+            stop: None,
+            progress: None,
+            notes: None,
+        }
+    }
+}
+
+impl SimulateSettings {
+    fn stopped(&self) -> bool {
+        self.stop
+            .as_ref()
+            .is_some_and(|s| s.load(Ordering::Relaxed))
+    }
+}
+
+/// Runs `fitbead simulate`: the CSV it writes (`series,xi,delta_deg,v,sigma_v,v_true`, md
+/// adding `v_md_stderr,v_m_s`; with `v0` the transient's columns).
+pub fn simulate(a: &SimulateSettings) -> Result<Vec<u8>, RunError> {
+    let kind = a.model;
+    let law = a.law;
+    if kind != ModelKind::Contact && a.spin != SpinRule::Roll {
+        return Err(flag_error(
+            "--spin",
+            &a.spin.to_string(),
+            "a spin rule applies to --model contact only",
+        ));
+    }
+    // The contact model under the spin rule (other models have none).
+    let contact = Contact {
+        spin: a.spin,
+        ..Contact::default()
+    };
+    let series = &a.series;
+    // Rows of a series are labelled by its ξ: two equal values would make one series.
+    for (j, x) in series.iter().enumerate() {
+        if let Some(i) = series[..j].iter().position(|y| y == x) {
+            return Err(flag_error(
+                "--series",
+                &fmt_f64(*x),
+                format!(
+                    "xi {} is given twice (values {} and {}): each series needs its own xi",
+                    fmt_f64(*x),
+                    i + 1,
+                    j + 1
+                ),
+            ));
+        }
+    }
+    if series.len() > MAX_SERIES {
+        return Err(flag_error(
+            "--series",
+            &format!("{} values", series.len()),
+            format!("expected at most {MAX_SERIES} series"),
+        ));
+    }
+    if let Some(v0) = a.v0 {
+        if kind != ModelKind::Contact {
+            return Err(flag_error(
+                "--v0",
+                &v0.to_string(),
+                "the bead-by-bead transient needs --model contact",
+            ));
+        }
+        return trace(a, law, series, v0, contact);
+    }
+    if a.points == 0 || a.points > MAX_POINTS {
+        return Err(flag_error(
+            "--points",
+            &a.points.to_string(),
+            format!("expected 1 to {MAX_POINTS} points per series"),
+        ));
+    }
+    if series.len().saturating_mul(a.points) > MAX_ROWS {
+        return Err(flag_error(
+            "--points",
+            &a.points.to_string(),
+            format!(
+                "{} series of {} points make more than {MAX_ROWS} rows",
+                series.len(),
+                a.points
+            ),
+        ));
+    }
+    if !(a.noise.is_finite() && (0.0..0.5).contains(&a.noise)) {
+        return Err(flag_error(
+            "--noise",
+            &a.noise.to_string(),
+            "must be in [0, 0.5)",
+        ));
+    }
+    if let Some((lo, hi)) = a.delta_range {
+        if !(lo < hi) {
+            return Err(flag_error(
+                "--delta-range",
+                &format!("{},{}", fmt_f64(lo), fmt_f64(hi)),
+                "expected LO,HI in degrees with LO < HI",
+            ));
+        }
+    }
+    if kind == ModelKind::Md {
+        if let Some(p) = &a.design {
+            return Err(flag_error(
+                "--design",
+                &p.display().to_string(),
+                "a design is simulated with the steady-state models, not --model md",
+            ));
+        }
+        return run_md(a, series);
+    }
+    let jan = a.jan;
+    let jaeger = a.jaeger;
+    let branch = a.branch;
+    let range = a.delta_range;
+    let mut rng = ChaCha8Rng::seed_from_u64(a.seed);
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let io = |e: csv::Error| RunError::Failed(e.to_string());
+    w.write_record(["series", "xi", "delta_deg", "v", "sigma_v", "v_true"])
+        .map_err(io)?;
+    let model_for = |xi: f64| -> Result<Model, RunError> {
+        let alpha = Scene::from_radians(xi, 0.1, a.rho, a.f, law)
+            .map_err(|e| flag_error("--series", &xi.to_string(), e.to_string()))?
+            .alpha_rad();
+        Ok(match (kind, kind.contact_model()) {
+            (ModelKind::Contact, _) => Model::Contact(contact),
+            (_, Some(m)) => m,
+            (ModelKind::Jan, None) => match &jan {
+                None => Model::Jan(Jan::paper_fit(alpha)),
+                Some(p) => {
+                    let s = alpha.sin();
+                    Model::Jan(
+                        Jan::new(p[0] * (p[1] * s).exp(), p[2] * (p[3] * s).exp())
+                            .map_err(|e| flag_error("--jan", "", e.to_string()))?,
+                    )
+                }
+            },
+            _ => {
+                let p = match &jaeger {
+                    Some(p) => [p[0], p[1], p[2]],
+                    None => crate::fit::jaeger::paper_values(xi).ok_or_else(|| {
+                        flag_error(
+                            "--series",
+                            &xi.to_string(),
+                            "the paper gives Jaeger's a1, a2, a3 for xi = 0.8, 1, 1.6, 2 only: \
+                             give --jaeger A1,A2,A3",
+                        )
+                    })?,
+                };
+                Model::Jaeger(
+                    Jaeger::new(p[0], p[1], p[2], branch)
+                        .map_err(|e| flag_error("--jaeger", "", e.to_string()))?,
+                )
+            }
+        })
+    };
+    if let Some(path) = a.design.as_deref() {
+        return simulate_design(a, path, law, &model_for, &mut rng);
+    }
+    for &xi in series {
+        let model = model_for(xi)?;
+        let Some((lo, hi)) = regime_b_interval(&model, xi, a.rho, a.f, law) else {
+            return Err(flag_error(
+                "--series",
+                &xi.to_string(),
+                "no steady regime for this xi under this model and law",
+            ));
+        };
+        let open_ended = matches!(kind, ModelKind::Jan | ModelKind::Jaeger);
+        let (lo, hi, f0, f1) = match range {
+            Some((l, h)) => {
+                let (l, h) = (l.to_radians().max(lo), h.to_radians().min(hi));
+                if !(l < h) {
+                    return Err(flag_error(
+                        "--delta-range",
+                        &range_text(range),
+                        format!(
+                            "no steady state in this range at xi = {xi} (steady from {} to {} deg)",
+                            fmt_f64(lo.to_degrees()),
+                            fmt_f64(hi.to_degrees())
+                        ),
+                    ));
+                }
+                (l, h, 0.05, 0.95)
+            }
+            None if open_ended => (lo, (lo + 12f64.to_radians()).min(hi), 0.05, 0.95),
+            None => (lo, hi, 0.05, 0.95),
+        };
+        for j in 0..a.points {
+            if a.stopped() {
+                return Err(RunError::Interrupted);
+            }
+            let frac = if a.points == 1 {
+                0.5
+            } else {
+                f0 + (f1 - f0) * j as f64 / (a.points - 1) as f64
+            };
+            let d = lo + (hi - lo) * frac;
+            // Round the slope to 1e-4 degree, as a measured slope would be written.
+            let d_deg = (d.to_degrees() * 1e4).round() / 1e4;
+            let scene = Scene::new(xi, d_deg, a.rho, a.f, law)
+                .map_err(|e| RunError::Failed(e.to_string()))?;
+            let v_true = match model.evaluate(&scene) {
+                Ok(s) => s.mean_velocity,
+                Err(e) => return Err(RunError::Failed(format!("xi {xi}, delta {d_deg} deg: {e}"))),
+            };
+            let z: f64 = StandardNormal.sample(&mut rng);
+            let v = v_true * (1.0 + a.noise * z);
+            w.write_record([
+                fmt_f64(xi),
+                fmt_f64(xi),
+                fmt_f64(d_deg),
+                fmt_f64(v),
+                sigma_cell(a.noise * v_true),
+                fmt_f64(v_true),
+            ])
+            .map_err(io)?;
+        }
+    }
+    w.into_inner().map_err(|e| RunError::Failed(e.to_string()))
+}
+
+/// The slope range as `LO,HI` (the command line shows its flag's own text instead).
+fn range_text(range: Option<(f64, f64)>) -> String {
+    range
+        .map(|(l, h)| format!("{},{}", fmt_f64(l), fmt_f64(h)))
+        .unwrap_or_default()
+}
+
+/// The bead-by-bead transient from a launch `v0`, one scene per ξ at `delta_deg`.
+fn trace(
+    a: &SimulateSettings,
+    law: CollisionLaw,
+    series: &[f64],
+    v0: f64,
+    model: Contact,
+) -> Result<Vec<u8>, RunError> {
+    use crate::io::reports::transient_csv;
+    if !(v0.is_finite() && v0 >= 0.0) {
+        return Err(flag_error(
+            "--v0",
+            &v0.to_string(),
+            "expected a finite launch speed >= 0",
+        ));
+    }
+    // The row beads travelled default to 50 for the transient.
+    let beads = a.beads.unwrap_or(50);
+    if beads == 0 || beads > 10_000_000 {
+        return Err(flag_error(
+            "--beads",
+            &beads.to_string(),
+            "expected 1 to 10000000 beads",
+        ));
+    }
+    let Some(d) = a.delta_deg else {
+        return Err(flag_error(
+            "--delta-deg",
+            "",
+            "--v0 needs the slope of the scene (--delta-deg)",
+        ));
+    };
+    let scenes = series
+        .iter()
+        .map(|&xi| {
+            Scene::new(xi, d, a.rho, a.f, law)
+                .map_err(|e| flag_error("--series/--delta-deg", &xi.to_string(), e.to_string()))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    transient_csv(&model, &scenes, d, v0, beads).map_err(|e| RunError::Failed(e.to_string()))
+}
+
+/// One row of a design file: its line, series label, ξ, slope (degrees) and replicates.
+struct DesignLine {
+    line: u64,
+    series: String,
+    xi: f64,
+    delta_deg: f64,
+    replicates: usize,
+}
+
+/// Reads a design file (series,xi,delta_deg,replicates; other columns ignored), every cell
+/// checked: a bad one is an error naming file, line, column and value.
+fn read_design(path: &std::path::Path) -> Result<Vec<DesignLine>, RunError> {
+    use crate::io::InputError;
+    let file = path.display().to_string();
+    let err = |line: Option<u64>, column: Option<&str>, value: Option<&str>, message: String| {
+        RunError::Input(InputError {
+            file: file.clone(),
+            line,
+            column: column.map(str::to_string),
+            value: value.map(|v| crate::io::clip(v, crate::io::ECHO_CHARS).into_owned()),
+            message,
+        })
+    };
+    let mut r = csv::ReaderBuilder::new()
+        .flexible(false)
+        .from_path(path)
+        .map_err(|e| err(None, None, None, format!("cannot read: {e}")))?;
+    let header = r
+        .headers()
+        .map_err(|e| err(Some(1), None, None, e.to_string()))?
+        .clone();
+    let col = |name: &str| -> Result<usize, RunError> {
+        header.iter().position(|h| h.trim() == name).ok_or_else(|| {
+            err(
+                Some(1),
+                Some(name),
+                None,
+                "missing column: a design has the columns series,xi,delta_deg,replicates".into(),
+            )
+        })
+    };
+    let (cs, cx, cd, cr) = (
+        col("series")?,
+        col("xi")?,
+        col("delta_deg")?,
+        col("replicates")?,
+    );
+    let mut out = Vec::new();
+    let mut total: usize = 0;
+    for rec in r.records() {
+        let rec = rec.map_err(|e| {
+            let line = e.position().map(|p| p.line());
+            err(line, None, None, e.to_string())
+        })?;
+        let line = rec.position().map_or(0, |p| p.line());
+        let cell = |c: usize| rec.get(c).unwrap_or("").trim();
+        let num = |c: usize, name: &str, ok: &dyn Fn(f64) -> bool, what: &str| {
+            cell(c)
+                .parse::<f64>()
+                .ok()
+                .filter(|v| ok(*v))
+                .ok_or_else(|| err(Some(line), Some(name), Some(cell(c)), what.to_string()))
+        };
+        let xi = num(
+            cx,
+            "xi",
+            &|v| v.is_finite() && v > 0.0,
+            "expected a radius ratio > 0",
+        )?;
+        let delta_deg = num(
+            cd,
+            "delta_deg",
+            &|v| v.is_finite() && v > 0.0 && v < 90.0,
+            "expected a slope in degrees in (0, 90)",
+        )?;
+        let replicates = cell(cr)
+            .parse::<usize>()
+            .ok()
+            .filter(|n| (1..=MAX_POINTS).contains(n))
+            .ok_or_else(|| {
+                err(
+                    Some(line),
+                    Some("replicates"),
+                    Some(cell(cr)),
+                    format!("expected a whole number of points from 1 to {MAX_POINTS}"),
+                )
+            })?;
+        total = total.saturating_add(replicates);
+        if total > MAX_ROWS {
+            return Err(err(
+                Some(line),
+                Some("replicates"),
+                Some(cell(cr)),
+                format!("the design asks for more than {MAX_ROWS} points in all"),
+            ));
+        }
+        let series = if cell(cs).is_empty() {
+            fmt_f64(xi)
+        } else {
+            cell(cs).to_string()
+        };
+        out.push(DesignLine {
+            line,
+            series,
+            xi,
+            delta_deg,
+            replicates,
+        });
+    }
+    if out.is_empty() {
+        return Err(err(None, None, None, "the design has no rows".into()));
+    }
+    Ok(out)
+}
+
+/// Synthetic points at exactly the design's slopes, `replicates` at each, noise drawn from
+/// the seed's stream in the file's order.
+fn simulate_design(
+    a: &SimulateSettings,
+    path: &std::path::Path,
+    law: CollisionLaw,
+    model_for: &dyn Fn(f64) -> Result<Model, RunError>,
+    rng: &mut ChaCha8Rng,
+) -> Result<Vec<u8>, RunError> {
+    let rows = read_design(path)?;
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let io = |e: csv::Error| RunError::Failed(e.to_string());
+    w.write_record(["series", "xi", "delta_deg", "v", "sigma_v", "v_true"])
+        .map_err(io)?;
+    for row in &rows {
+        if a.stopped() {
+            return Err(RunError::Interrupted);
+        }
+        let at = |message: String| {
+            RunError::Input(crate::io::InputError {
+                file: path.display().to_string(),
+                line: Some(row.line),
+                column: Some("delta_deg".into()),
+                value: Some(fmt_f64(row.delta_deg)),
+                message,
+            })
+        };
+        let model = model_for(row.xi)?;
+        let scene =
+            Scene::new(row.xi, row.delta_deg, a.rho, a.f, law).map_err(|e| at(e.to_string()))?;
+        let v_true = model
+            .evaluate(&scene)
+            .map_err(|e| at(format!("no steady state at xi {}: {e}", fmt_f64(row.xi))))?
+            .mean_velocity;
+        for _ in 0..row.replicates {
+            let z: f64 = StandardNormal.sample(rng);
+            let v = v_true * (1.0 + a.noise * z);
+            w.write_record([
+                row.series.clone(),
+                fmt_f64(row.xi),
+                fmt_f64(row.delta_deg),
+                fmt_f64(v),
+                sigma_cell(a.noise * v_true),
+                fmt_f64(v_true),
+            ])
+            .map_err(io)?;
+        }
+    }
+    w.into_inner().map_err(|e| RunError::Failed(e.to_string()))
+}
+
+/// The `sigma_v` cell of a synthetic point: empty when σ is 0 (noise 0), so that the file
+/// reads as noise-free data (unit weights) rather than as a refused σ = 0.
+fn sigma_cell(sigma: f64) -> String {
+    if sigma > 0.0 {
+        fmt_f64(sigma)
+    } else {
+        String::new()
+    }
+}
+
+/// Synthetic measurements of the molecular-dynamics model: regime B found per series by md
+/// runs, then one md run per point.
+fn run_md(a: &SimulateSettings, series: &[f64]) -> Result<Vec<u8>, RunError> {
+    use crate::models::md::MdResult;
+    use crate::models::Regime;
+    use rayon::prelude::*;
+    let md: Md = a.md;
+    if !(a.rho > 0.0) {
+        return Err(flag_error(
+            "--rho",
+            &fmt_f64(a.rho),
+            "md needs rho > 0 (the bead's moment of inertia)",
+        ));
+    }
+    let never = AtomicBool::new(false);
+    let stop: &AtomicBool = a.stop.as_deref().unwrap_or(&never);
+    let range = a.delta_range;
+    let per_series = (MD_SCAN_POINTS + 2 * MD_REFINE + a.points) as u64;
+    let tally = a.progress.as_ref().map(|p| {
+        p.report(ProgressEvent::Start {
+            label: "md simulate",
+            total: per_series * series.len() as u64,
+            check_every: 1,
+        });
+        crate::progress::Tally::new(p.clone())
+    });
+    let tick = || {
+        if let Some(t) = &tally {
+            t.add(1);
+        }
+    };
+    let note = |s: &str| {
+        if let Some(n) = &a.notes {
+            n(s);
+        }
+    };
+    let mut rng = ChaCha8Rng::seed_from_u64(a.seed);
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let io = |e: csv::Error| RunError::Failed(e.to_string());
+    w.write_record([
+        "series",
+        "xi",
+        "delta_deg",
+        "v",
+        "sigma_v",
+        "v_true",
+        "v_md_stderr",
+        "v_m_s",
+    ])
+    .map_err(io)?;
+    for &xi in series {
+        let sc = Scene::new(xi, 1.0, a.rho, 0.1, CollisionLaw::Value(0.5))
+            .map_err(|e| flag_error("--series", &xi.to_string(), e.to_string()))?;
+        md.check_scene(&sc).map_err(|e| md_error(a, xi, e))?;
+        let interval = md_regime_b_interval(&md, xi, a.rho, &tick, Some(stop))
+            .map_err(|e| flag_error("--series", &xi.to_string(), e.to_string()))?;
+        if stop.load(Ordering::Relaxed) {
+            return Err(RunError::Interrupted);
+        }
+        let Some((lo, hi)) = interval else {
+            return Err(flag_error(
+                "--series",
+                &xi.to_string(),
+                "md finds no steady regime (B) for this xi between 0.5 and 45 degrees",
+            ));
+        };
+        let (lo, hi) = match range {
+            Some((l, h)) => {
+                let (l, h) = (l.max(lo), h.min(hi));
+                if !(l < h) {
+                    return Err(flag_error(
+                        "--delta-range",
+                        &range_text(range),
+                        format!(
+                            "no steady state in this range at xi = {xi} (md steady from {} to {} deg)",
+                            fmt_f64(lo),
+                            fmt_f64(hi)
+                        ),
+                    ));
+                }
+                (l, h)
+            }
+            None => (lo, hi),
+        };
+        // Near the ends of regime B the md bead's bounces are chaotic and B can have holes: a
+        // point that is not in B narrows the range from its side and the points are redrawn.
+        let (mut lo, mut hi) = (lo, hi);
+        let mut runs: Vec<(f64, f64, f64, MdResult)> = Vec::new();
+        for attempt in 0..=MD_NARROW {
+            let slopes: Vec<f64> = (0..a.points)
+                .map(|j| {
+                    let frac = if a.points == 1 {
+                        0.5
+                    } else {
+                        0.05 + 0.9 * j as f64 / (a.points - 1) as f64
+                    };
+                    // Rounded to 1e-4 degree, as a measured slope would be written.
+                    ((lo + (hi - lo) * frac) * 1e4).round() / 1e4
+                })
+                .collect();
+            let done: Vec<(f64, f64, f64, MdResult)> = slopes
+                .par_iter()
+                .map(|&d| {
+                    let sc = Scene::new(xi, d, a.rho, 0.1, CollisionLaw::Value(0.5))
+                        .map_err(|e| RunError::Failed(e.to_string()))?;
+                    let r = md.simulate_until(&sc, 1.0, None, Some(stop));
+                    tick();
+                    Ok((d, lo, hi, r))
+                })
+                .collect::<Result<_, RunError>>()?;
+            if stop.load(Ordering::Relaxed) {
+                return Err(RunError::Interrupted);
+            }
+            let bad: Vec<f64> = done
+                .iter()
+                .filter(|x| x.3.regime != Some(Regime::B))
+                .map(|x| x.0)
+                .collect();
+            if bad.is_empty() {
+                runs = done;
+                break;
+            }
+            if attempt == MD_NARROW {
+                return Err(RunError::Failed(format!(
+                    "md: xi {xi}: slopes {bad:?} deg are not in regime B after narrowing the \
+                     steady range {MD_NARROW} times (now {} to {} deg); give --delta-range",
+                    fmt_f64(lo),
+                    fmt_f64(hi)
+                )));
+            }
+            let mid = 0.5 * (lo + hi);
+            let (old_lo, old_hi) = (lo, hi);
+            for &d in &bad {
+                if d >= mid {
+                    hi = hi.min(d - 0.01 * (old_hi - old_lo));
+                } else {
+                    lo = lo.max(d + 0.01 * (old_hi - old_lo));
+                }
+            }
+            note(&format!(
+                "md, xi {xi}: slopes {bad:?} deg are not in regime B; steady range narrowed \
+                 from [{}, {}] to [{}, {}] deg",
+                fmt_f64(old_lo),
+                fmt_f64(old_hi),
+                fmt_f64(lo),
+                fmt_f64(hi)
+            ));
+        }
+        for (d, _, _, r) in runs {
+            let (Some(v_true), Some(se)) = (r.mean_velocity, r.stderr) else {
+                return Err(RunError::Failed(format!(
+                    "md: xi {xi}, delta {d} deg: no mean velocity measured"
+                )));
+            };
+            let z: f64 = StandardNormal.sample(&mut rng);
+            let v = v_true * (1.0 + a.noise * z);
+            let sigma = (a.noise * v_true).hypot(se);
+            w.write_record([
+                fmt_f64(xi),
+                fmt_f64(xi),
+                fmt_f64(d),
+                fmt_f64(v),
+                sigma_cell(sigma),
+                fmt_f64(v_true),
+                fmt_f64(se),
+                r.mean_velocity_si.map(fmt_f64).unwrap_or_default(),
+            ])
+            .map_err(io)?;
+        }
+    }
+    if let Some(p) = &a.progress {
+        p.report(ProgressEvent::Finish);
+    }
+    w.into_inner().map_err(|e| RunError::Failed(e.to_string()))
+}
+
+/// A scene outside the md model's domain, as the setting to change.
+fn md_error(a: &SimulateSettings, xi: f64, e: crate::scene::ParameterError) -> RunError {
+    use crate::scene::ParameterError;
+    let (flag, value) = match &e {
+        ParameterError::InvalidParameter { field: "rho", .. } => ("--rho", fmt_f64(a.rho)),
+        ParameterError::InvalidParameter { field, value, .. } => (*field, value.clone()),
+        _ => ("--series", fmt_f64(xi)),
+    };
+    let flag = match flag {
+        "--rho" | "--series" => flag.to_string(),
+        f => match crate::models::md::MdSetting::from_column(f) {
+            Some(s) => format!("--{}", s.flag()),
+            None => format!("--{}", f.replace('_', "-")),
+        },
+    };
+    flag_error(&flag, &value, e.to_string())
+}

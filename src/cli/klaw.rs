@@ -12,29 +12,9 @@ use crate::fit::posterior::Method;
 use crate::io::fmt_f64;
 use crate::io::measurements::locate_point;
 use crate::models::Model;
+use crate::pipeline::law_error;
 use crate::report::bands::Curve;
 use rayon::prelude::*;
-
-/// Why a law cannot be fitted, in words, with the points an empty box names located by
-/// `locate` (given an index into the fitted data set).
-pub fn law_error(e: &KLawError, locate: &dyn Fn(usize) -> String) -> String {
-    match e {
-        KLawError::EmptyBox {
-            param,
-            lower,
-            upper,
-        } if lower.0.is_finite() && upper.0.is_finite() => format!(
-            "no value of {param} keeps every point in regime B: {} needs {param} > {} \
-             (below, the bead stops), while {} needs {param} <= {} (above, it lifts off or runs \
-             away)",
-            locate(lower.1),
-            fmt_f64(lower.0),
-            locate(upper.1),
-            fmt_f64(upper.0)
-        ),
-        e => e.to_string(),
-    }
-}
 
 /// Arguments of `fitbead klaw`.
 #[derive(Debug, clap::Args)]

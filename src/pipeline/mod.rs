@@ -14,6 +14,7 @@ mod report;
 mod simulate;
 
 pub use bench::{forward_md, work_precision};
+pub(crate) use report::law_error;
 pub use report::{report, ReportOutput, ReportSettings};
 pub use simulate::{simulate, SimulateSettings};
 

@@ -116,7 +116,7 @@ impl MeasurementFile {
 
 /// Why a law cannot be fitted, in words, with the points an empty box names located by
 /// `locate` (given an index into the fitted data set).
-fn law_error(e: &KLawError, locate: &dyn Fn(usize) -> String) -> String {
+pub(crate) fn law_error(e: &KLawError, locate: &dyn Fn(usize) -> String) -> String {
     match e {
         KLawError::EmptyBox {
             param,

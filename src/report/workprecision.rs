@@ -332,7 +332,7 @@ fn time_one(f: &dyn Fn(&Scene) -> Outcome, s: &Scene, first: Duration) -> f64 {
 
 /// One row of the work-precision table.
 #[derive(Debug, Clone, PartialEq)]
-pub(crate) struct WpRow {
+pub struct WpRow {
     /// Model name.
     pub model: String,
     /// Method name.
@@ -607,7 +607,7 @@ pub(crate) fn run_bench_until(
 }
 
 /// The CSV of the rows.
-pub(crate) fn render(rows: &[WpRow]) -> csv::Result<Vec<u8>> {
+pub fn render(rows: &[WpRow]) -> csv::Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
     w.write_record(COLUMNS)?;
     let opt = |x: Option<f64>| x.map(fmt_f64).unwrap_or_default();

@@ -20,7 +20,8 @@
 //! ```text
 //!   pipeline ───── whole runs as library calls: synthetic data (simulate), the report
 //!                  directory (report)
-//!   io ─────────── CSV schemas, measurements with units (Dataset::from_csv), atomic files
+//!   io ─────────── CSV schemas, measurements with units (Dataset::from_csv), atomic files;
+//!                  one typed record per output row (io::records: ForwardRecord, KRecord, …)
 //!   report ─────── the paper's comparisons, figures, the work-precision engine
 //!   design ─────── optimal experimental design: the slopes to measure for a parameter
 //!                  (D, c criteria) or to tell two models apart (T)
@@ -34,8 +35,8 @@
 //!   special ────── math with no beads in it: elliptic integrals, quadrature, roots, dd
 //! ```
 //!
-//! Each layer uses only the layers below it (`numfmt`, `progress` and `error` are leaves or
-//! the crate's top). The command line is the module `cli` (`src/cli/`, one module per
+//! Each layer uses only the layers below it (`numfmt`, `progress`, `record` and `error` are
+//! leaves or the crate's top). The command line is the module `cli` (`src/cli/`, one module per
 //! subcommand), compiled with the default feature `cli` and above every layer; its one public
 //! function, `cli::main`, is the whole of the binary `src/main.rs`. Without the feature
 //! (`default-features = false`) the library has no command-line module and no command-line
@@ -85,6 +86,7 @@ pub mod models;
 pub mod numfmt;
 pub mod pipeline;
 pub mod progress;
+pub(crate) mod record;
 pub mod report;
 pub mod scene;
 pub(crate) mod special;

@@ -378,17 +378,15 @@ def invert_k(
 def regimes(xi: ArrayLike = (0.8, 1.0, 1.6, 2.0), law: str = "adjusted", rho: float = 0.4) -> Table:
     """The regime limits of a collision law (``fitbead regimes``).
 
-    Returns ``xi``, ``alpha_deg``, ``K``, ``delta_m_deg`` (δ_m, eq 32: below it the bead
-    stops), ``delta_d_deg`` (δ_d, eq 31: above it the bead lifts off), ``mu_eq79`` (the bulk
-    friction of eq 79), ``steady_range`` (``yes`` where δ_m < δ_d); the table's attribute
-    ``critical_xi`` is the ξ below which no steady regime exists (None if there is none).
+    Returns the command line's columns: ``xi``, ``alpha_deg``, ``K``, ``delta_m_deg`` (δ_m,
+    eq 32: below it the bead stops), ``delta_d_deg`` (δ_d, eq 31: above it the bead lifts
+    off), ``mu_eq79`` (the bulk friction of eq 79), ``steady_range`` (``yes`` where δ_m <
+    δ_d) and ``critical_xi`` (the ξ below which no steady regime exists, NaN if there is
+    none); the table's attribute ``critical_xi`` holds it too (None if there is none).
     """
     x = _flat(np.atleast_1d(_as_f64("xi", xi)))
-    raw = dict(_core.regimes(x, law=law, rho=float(rho)))
-    crit = raw.pop("critical_xi")
-    t = _table(raw, x.shape)
-    t = Table({"xi": x.copy(), **t})
-    t.shape = x.shape
+    raw, crit = _core.regimes(x, law=law, rho=float(rho))
+    t = _ordered(_table(raw, x.shape), _core.record_columns("regimes"))
     t.critical_xi = crit  # type: ignore[attr-defined]
     return t
 

@@ -9,30 +9,27 @@
 
 use fitbead::fit::builder::{JaegerFitter, JanFitter, KLawFitter};
 use fitbead::fit::data::Dataset as RsDataset;
-use fitbead::fit::k::auto::estimate_with;
 use fitbead::fit::klaw::KLaw;
 use fitbead::fit::report::FitSet;
 use fitbead::fit::summary::FitResult as RsFitResult;
 use fitbead::inverse::posterior::McmcSettings;
 use fitbead::io::measurements::{MeasurementDefaults, MeasurementFile};
 use fitbead::io::records::{
-    cells, columns, Cell, CorrelationRecord, ParamRecord, ResidualRecord, StatsRecord,
+    columns, each_cell, AutoRecord, Cell, ContactRecord, CorrelationRecord, ForwardRecord, KRecord,
+    ParamRecord, RegimeRecord, ResidualRecord, StatsRecord,
 };
 use fitbead::models::auto::Auto;
 use fitbead::models::contact::{Contact, SpinRule};
 use fitbead::models::jaeger::Jaeger;
 use fitbead::models::jan::Jan;
-use fitbead::models::regimes::{
-    alpha_of_xi, bulk_friction_law, critical_xi, delta_d_law, delta_m_law,
-};
-use fitbead::models::{regime_of, Evaluation, JaegerBranch, Model, ModelKind, Phases, Regime};
+use fitbead::models::regimes::{alpha_of_xi, critical_xi};
+use fitbead::models::{JaegerBranch, Model, ModelKind};
 use fitbead::scene::{CollisionLaw, Scene};
 use numpy::{PyArray1, PyArray3, PyReadonlyArray1};
 use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;
-use std::borrow::Cow;
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Condvar, Mutex};
@@ -184,51 +181,56 @@ impl TextColumn {
     }
 }
 
-/// Columns being filled: numbers and texts, by name, in output order.
+/// Where a record's cell goes: a numeric column or a text column, by index.
+#[derive(Clone, Copy)]
+enum Slot {
+    Num(usize),
+    Text(usize),
+}
+
+/// The fields of record type `R` as (column, whether it is a number), in order. A record's
+/// text fields are never optional, so a field that is not text in the default record (a
+/// number, a count, or an empty `Option`) is a number.
+fn fields<R: serde::Serialize + Default>() -> Vec<(&'static str, bool)> {
+    let mut out = Vec::new();
+    each_cell(&R::default(), |k, c| {
+        out.push((k, !matches!(c, Cell::Text(_))))
+    });
+    out
+}
+
+/// Columns being filled from records: numbers and texts, by name.
 struct Columns {
     num_names: Vec<&'static str>,
-    num_idx: Vec<usize>,
     nums: Vec<Vec<f64>>,
     text_names: Vec<&'static str>,
-    text_idx: Vec<usize>,
     texts: Vec<TextColumn>,
+    /// Per field of a row's records, in order: its column.
+    slots: Vec<Slot>,
 }
 
 impl Columns {
-    /// Every field of the row records, in order.
-    fn new(num_names: &[&'static str], text_names: &[&'static str]) -> Self {
-        let (nn, tn) = (num_names.len(), text_names.len());
-        Columns::pick(num_names, (0..nn).collect(), text_names, (0..tn).collect())
-    }
-
-    /// The fields `num_idx` and `text_idx` of the row records (whose fields are named by
-    /// `num_names` and `text_names`).
-    fn pick(
-        num_names: &[&'static str],
-        num_idx: Vec<usize>,
-        text_names: &[&'static str],
-        text_idx: Vec<usize>,
-    ) -> Self {
-        Columns {
-            num_names: num_idx.iter().map(|&i| num_names[i]).collect(),
-            nums: num_idx.iter().map(|_| Vec::new()).collect(),
-            num_idx,
-            text_names: text_idx.iter().map(|&i| text_names[i]).collect(),
-            texts: text_idx
-                .iter()
-                .map(|&i| TextColumn::named(text_names[i]))
-                .collect(),
-            text_idx,
+    /// The columns of rows made of records with these fields ([`fields`]), in order.
+    fn of(fields: impl IntoIterator<Item = (&'static str, bool)>) -> Self {
+        let mut c = Columns {
+            num_names: Vec::new(),
+            nums: Vec::new(),
+            text_names: Vec::new(),
+            texts: Vec::new(),
+            slots: Vec::new(),
+        };
+        for (name, number) in fields {
+            if number {
+                c.slots.push(Slot::Num(c.num_names.len()));
+                c.num_names.push(name);
+                c.nums.push(Vec::new());
+            } else {
+                c.slots.push(Slot::Text(c.text_names.len()));
+                c.text_names.push(name);
+                c.texts.push(TextColumn::named(name));
+            }
         }
-    }
-
-    fn push(&mut self, nums: &[f64], texts: &[Cow<'_, str>]) {
-        for (c, &i) in self.nums.iter_mut().zip(&self.num_idx) {
-            c.push(nums[i]);
-        }
-        for (c, &i) in self.texts.iter_mut().zip(&self.text_idx) {
-            c.push(&texts[i]);
-        }
+        c
     }
 
     fn into_dict(self, py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
@@ -249,19 +251,51 @@ impl Columns {
     }
 }
 
+/// One row being written into a task's columns, record by record, field by field.
+struct RowSink<'a, 's> {
+    /// The row's index in the task.
+    j: usize,
+    /// The next field's index in the row.
+    slot: usize,
+    slots: &'a [Slot],
+    nums: &'a mut [&'s mut [f64]],
+    texts: &'a mut [TextColumn],
+}
+
+impl RowSink<'_, '_> {
+    /// Writes `record`'s fields as the row's next cells: a number (a count as a float, an
+    /// empty cell as NaN) or a text.
+    fn record<R: serde::Serialize>(&mut self, record: &R) {
+        each_cell(record, |_, c| {
+            match self.slots[self.slot] {
+                Slot::Num(i) => {
+                    self.nums[i][self.j] = match c {
+                        Cell::Number(x) => x,
+                        Cell::Count(n) => n as f64,
+                        Cell::Flag(b) => f64::from(u8::from(b)),
+                        Cell::Text(_) | Cell::Empty => f64::NAN,
+                    }
+                }
+                Slot::Text(i) => self.texts[i].push(match &c {
+                    Cell::Text(s) => s,
+                    _ => "",
+                }),
+            }
+            self.slot += 1;
+        });
+    }
+}
+
 /// Rows per parallel task of [`fill`].
 const TASK_ROWS: usize = 2048;
 
-/// Evaluates rows `0..n` in parallel tasks of [`TASK_ROWS`], each row giving fixed-size number
-/// and text records, and fills `cols` in row order: numbers written in place, texts coded per
-/// task and merged. The error of the lowest failing row is returned.
-fn fill<const NF: usize, const NT: usize, F>(
-    n: usize,
-    cols: &mut Columns,
-    row: F,
-) -> Result<(), String>
+/// Evaluates rows `0..n` in parallel tasks of [`TASK_ROWS`], each row writing its records
+/// into a [`RowSink`] (every field of `cols`, in order), and fills `cols` in row order:
+/// numbers written in place, texts coded per task and merged. The error of the lowest failing
+/// row is returned.
+fn fill<F>(n: usize, cols: &mut Columns, row: F) -> Result<(), String>
 where
-    F: Fn(usize) -> Result<([f64; NF], [Cow<'static, str>; NT]), String> + Sync,
+    F: Fn(usize, &mut RowSink<'_, '_>) -> Result<(), String> + Sync,
 {
     for c in cols.nums.iter_mut() {
         c.clear();
@@ -275,7 +309,7 @@ where
             slices[t].push(ch);
         }
     }
-    let (num_idx, text_idx, text_names) = (&cols.num_idx, &cols.text_idx, &cols.text_names);
+    let (slots, text_names) = (&cols.slots, &cols.text_names);
     let done: Vec<Result<Vec<TextColumn>, String>> = slices
         .into_par_iter()
         .enumerate()
@@ -285,15 +319,17 @@ where
                 .iter()
                 .map(|name| TextColumn::named(name))
                 .collect();
-            let len = out.first().map_or((n - start).min(TASK_ROWS), |s| s.len());
+            let len = (n - start).min(TASK_ROWS);
             for j in 0..len {
-                let (nums, tx) = row(start + j)?;
-                for (o, &i) in out.iter_mut().zip(num_idx) {
-                    o[j] = nums[i];
-                }
-                for (c, &i) in texts.iter_mut().zip(text_idx) {
-                    c.push(&tx[i]);
-                }
+                let mut sink = RowSink {
+                    j,
+                    slot: 0,
+                    slots,
+                    nums: &mut out,
+                    texts: &mut texts,
+                };
+                row(start + j, &mut sink)?;
+                debug_assert_eq!(sink.slot, slots.len(), "a row writes every field");
             }
             Ok(texts)
         })
@@ -314,16 +350,20 @@ fn opt(x: Option<f64>) -> f64 {
 /// empty cell.
 fn record_dict<'py, R: serde::Serialize>(py: Python<'py>, r: &R) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
-    for (k, c) in cells(r) {
-        match c {
-            Cell::Text(s) => d.set_item(k, s)?,
-            Cell::Number(x) => d.set_item(k, x)?,
-            Cell::Count(n) => d.set_item(k, n)?,
-            Cell::Flag(b) => d.set_item(k, b)?,
-            Cell::Empty => d.set_item(k, py.None())?,
+    let mut result = Ok(());
+    each_cell(r, |k, c| {
+        if result.is_err() {
+            return;
         }
-    }
-    Ok(d)
+        result = match c {
+            Cell::Text(s) => d.set_item(k, s.as_ref()),
+            Cell::Number(x) if x.is_finite() => d.set_item(k, x),
+            Cell::Count(n) => d.set_item(k, n),
+            Cell::Flag(b) => d.set_item(k, b),
+            Cell::Number(_) | Cell::Empty => d.set_item(k, py.None()),
+        };
+    });
+    result.map(|()| d)
 }
 
 /// The collision law of row `i`: a number from `k`, else the named law.
@@ -367,29 +407,6 @@ fn parse_law(law: &str) -> PyResult<CollisionLaw> {
         .map_err(|e: fitbead::scene::ParameterError| value_error(format!("K = '{law}': {e}")))
 }
 
-const FORWARD_NUMS: [&str; 8] = [
-    "v",
-    "K_used",
-    "final_velocity",
-    "initial_velocity",
-    "contact_time",
-    "theta_G_deg",
-    "map_slope",
-    "other_fixed_point",
-];
-const FORWARD_TEXTS: [&str; 4] = ["regime", "status", "phases", "message"];
-const CONTACT_NUMS: [&str; 7] = [
-    "initial_spin",
-    "final_spin",
-    "beads",
-    "collision_translation_frac",
-    "collision_spin_frac",
-    "friction_work_frac",
-    "energy_closure",
-];
-const CONTACT_TEXTS: [&str; 3] = ["phase_sequence", "phase_change_deg", "spin_rule"];
-const AUTO_TEXTS: [&str; 2] = ["model_used", "reason"];
-
 /// The per-row parameters of the phenomenological models and the contact model.
 struct ModelArgs<'a> {
     kind: ModelKind,
@@ -432,82 +449,6 @@ impl ModelArgs<'_> {
             }
         })
     }
-}
-
-type ForwardRow = ([f64; 15], [Cow<'static, str>; 9]);
-
-fn forward_row(scene: &Scene, model: &Model) -> ForwardRow {
-    let mut nums = [f64::NAN; 15];
-    let mut texts: [Cow<'static, str>; 9] = Default::default();
-    let Evaluation {
-        outcome: o,
-        contact,
-        auto,
-    } = model.evaluate_detailed(scene);
-    let auto = auto.map(|r| (r.choice, r.reason));
-    let has_k = !matches!(model, Model::Jan(_) | Model::Jaeger(_));
-    texts[0] = Cow::Borrowed(match regime_of(&o) {
-        Some(Regime::A) => "A",
-        Some(Regime::B) => "B",
-        Some(Regime::C) => "C",
-        None => "",
-    });
-    if has_k {
-        nums[1] = scene.k();
-    }
-    match &o {
-        Ok(s) => {
-            nums[0] = s.mean_velocity;
-            if has_k {
-                nums[2] = s.final_velocity;
-                nums[3] = s.initial_velocity;
-            }
-            nums[4] = s.contact_time;
-            nums[5] = opt(s.theta_g.map(f64::to_degrees));
-            nums[6] = opt(s.map_slope);
-            nums[7] = opt(s.other_fixed_point);
-            texts[1] = Cow::Borrowed("ok");
-            texts[2] = match s.phases {
-                Phases::Roll => Cow::Borrowed("roll"),
-                Phases::Slip => Cow::Borrowed("slip"),
-                Phases::RollSlip => Cow::Borrowed("roll>slip"),
-                Phases::None => Cow::Borrowed(""),
-                p => Cow::Owned(p.to_string()),
-            };
-            if s.other_fixed_point.is_some() {
-                texts[3] = Cow::Borrowed(if has_k {
-                    "bistable: another fixed point of the final-velocity map"
-                } else {
-                    "two positive roots (eq 84): bistable band"
-                });
-            }
-        }
-        Err(e) => {
-            texts[1] = Cow::Borrowed(e.status());
-            texts[3] = Cow::Owned(e.to_string());
-        }
-    }
-    if let Some((rule, steady)) = contact {
-        texts[8] = Cow::Owned(rule.to_string());
-        if let Some(s) = steady {
-            let e = s.energy(scene);
-            let p = e.potential_drop;
-            texts[6] = Cow::Owned(s.run.phases.to_string());
-            texts[7] = Cow::Owned(s.run.phases.changes_deg());
-            nums[8] = s.launch.spin;
-            nums[9] = s.final_spin;
-            nums[10] = s.beads as f64;
-            nums[11] = e.collision_translation / p;
-            nums[12] = e.collision_spin / p;
-            nums[13] = e.friction_work / p;
-            nums[14] = e.closure();
-        }
-    }
-    if let Some((choice, reason)) = auto {
-        texts[4] = Cow::Borrowed(choice.name());
-        texts[5] = Cow::Owned(reason.to_string());
-    }
-    (nums, texts)
 }
 
 /// Forward model over flat arrays (see the Python `fitbead.forward`).
@@ -576,52 +517,34 @@ fn forward<'py>(
     };
     let contact = kind == ModelKind::Contact;
     let auto = kind == ModelKind::Auto;
-    // Columns of the row records: FORWARD_NUMS then CONTACT_NUMS; FORWARD_TEXTS, AUTO_TEXTS,
-    // CONTACT_TEXTS. The model's own are kept.
-    let mut num_idx: Vec<usize> = (0..FORWARD_NUMS.len()).collect();
-    let mut text_idx: Vec<usize> = (0..FORWARD_TEXTS.len()).collect();
-    if auto {
-        text_idx.extend(4..6);
-    }
+    // The records' columns: every model's, then the contact model's or auto's.
+    let mut f = fields::<ForwardRecord>();
     if contact {
-        num_idx.extend(8..15);
-        text_idx.extend(6..9);
+        f.extend(fields::<ContactRecord>());
     }
-    let all_nums: Vec<&'static str> = FORWARD_NUMS.iter().chain(&CONTACT_NUMS).copied().collect();
-    let all_texts: Vec<&'static str> = FORWARD_TEXTS
-        .iter()
-        .chain(&AUTO_TEXTS)
-        .chain(&CONTACT_TEXTS)
-        .copied()
-        .collect();
-    let mut cols = Columns::pick(&all_nums, num_idx, &all_texts, text_idx);
+    if auto {
+        f.extend(fields::<AutoRecord>());
+    }
+    let mut cols = Columns::of(f);
     let r = py.detach(|| {
-        fill(n, &mut cols, |i| {
+        fill(n, &mut cols, |i, sink| {
             let law = law_of(k_s, base_law, i)?;
             let scene = scene_of(i, xi_s, d_s, rho_s, f_s, law)?;
             let m = args.model(i, &scene)?;
-            Ok(forward_row(&scene, &m))
+            let (common, c, a) = ForwardRecord::evaluate(&scene, &m);
+            sink.record(&common);
+            if contact {
+                sink.record(&c.unwrap_or_default());
+            }
+            if auto {
+                sink.record(&a.unwrap_or_default());
+            }
+            Ok(())
         })
     });
     r.map_err(value_error)?;
     cols.into_dict(py)
 }
-
-const K_NUMS: [&str; 11] = [
-    "K",
-    "K_lo",
-    "K_hi",
-    "dv_dK",
-    "final_velocity",
-    "theta_G_deg",
-    "K_cos2a",
-    "K_adjusted",
-    "K_impact",
-    "iterations",
-    "K_min",
-];
-const K_NUMS2: [&str; 1] = ["K_max"];
-const K_TEXTS: [&str; 5] = ["regime", "status", "lower_limit", "upper_limit", "message"];
 
 /// The model of `k`'s `--model` (the five contact models, contact, or auto).
 fn k_model(name: &str, tol: f64) -> PyResult<(Model, Option<Auto>)> {
@@ -671,17 +594,13 @@ fn invert_k<'py>(
         (&f, "f"),
     ])?;
     let n = xi_s.len();
-    let nums: Vec<&'static str> = K_NUMS.iter().chain(&K_NUMS2).copied().collect();
-    let mut texts: Vec<&'static str> = K_TEXTS.to_vec();
-    if auto.is_some() {
-        texts.extend(AUTO_TEXTS);
-    }
-    let mut cols = Columns::new(&nums, &texts);
+    let mut cols = k_columns(auto.is_some());
     let r = py.detach(|| {
-        fill(n, &mut cols, |i| -> Result<KRow, String> {
+        fill(n, &mut cols, |i, sink| {
             let scene = scene_of(i, xi_s, d_s, rho_s, f_s, CollisionLaw::Value(0.5))?;
             let (vi, sigma) = measured(i, v_s, s_s)?;
-            Ok(k_row(&model, auto.as_ref(), &scene, vi, sigma))
+            k_record(sink, &model, auto.as_ref(), &scene, vi, sigma);
+            Ok(())
         })
     });
     r.map_err(value_error)?;
@@ -711,50 +630,33 @@ fn measured(i: usize, v: &[f64], sigma_v: &[f64]) -> Result<(f64, Option<f64>), 
     Ok((vi, sigma))
 }
 
-type KRow = ([f64; 12], [Cow<'static, str>; 7]);
-
-/// One measurement's K estimate as the `k` command's columns.
-fn k_row(model: &Model, auto: Option<&Auto>, scene: &Scene, vi: f64, sigma: Option<f64>) -> KRow {
-    let (e, choice) = estimate_with(model, auto, scene, vi, sigma);
-    let (alpha, rho) = (scene.alpha_rad(), scene.rho());
-    let root = e.root.as_ref().ok();
-    let mut nums = [f64::NAN; 12];
-    nums[0] = opt(root.map(|r| r.k));
-    nums[1] = opt(e.k_lo);
-    nums[2] = opt(e.k_hi);
-    nums[3] = opt(e.dv_dk);
-    nums[4] = opt(root.map(|r| r.steady.final_velocity));
-    nums[5] = opt(e.theta_g.map(f64::to_degrees));
-    nums[6] = CollisionLaw::Cos2a.k(alpha, rho);
-    nums[7] = CollisionLaw::Adjusted.k(alpha, rho);
-    nums[8] = CollisionLaw::Impact.k(alpha, rho);
-    nums[9] = opt(root.map(|r| r.evals as f64));
-    let mut texts: [Cow<'static, str>; 7] = Default::default();
-    let (regime, status) = e.regime_status();
-    texts[0] = Cow::Borrowed(regime);
-    texts[1] = Cow::Borrowed(status);
-    if let Some(b) = &e.bracket {
-        nums[10] = b.lo;
-        nums[11] = b.hi;
-        texts[2] = Cow::Borrowed(b.lower.name());
-        texts[3] = Cow::Borrowed(b.upper.name());
+/// The columns of the K records, with auto's when `auto`.
+fn k_columns(auto: bool) -> Columns {
+    let mut f = fields::<KRecord>();
+    if auto {
+        f.extend(fields::<AutoRecord>());
     }
-    let mut message: Vec<String> = Vec::new();
-    if let Err(fail) = &e.root {
-        message.push(fail.to_string());
-    }
-    message.extend(e.notes.iter().cloned());
-    if !message.is_empty() {
-        texts[4] = Cow::Owned(message.join("; "));
-    }
-    if let Some(c) = choice {
-        texts[5] = Cow::Borrowed(c.choice.name());
-        texts[6] = Cow::Owned(c.reason);
-    }
-    (nums, texts)
+    Columns::of(f)
 }
 
-/// δ_m (eq 32), δ_d (eq 31), the bulk friction of eq 79 and the critical ξ of a law.
+/// One measurement's K records (eq 69) written into `sink`.
+fn k_record(
+    sink: &mut RowSink<'_, '_>,
+    model: &Model,
+    auto: Option<&Auto>,
+    scene: &Scene,
+    v: f64,
+    sigma_v: Option<f64>,
+) {
+    let (rec, choice) = KRecord::estimate(model, auto, scene, v, sigma_v);
+    sink.record(&rec);
+    if auto.is_some() {
+        sink.record(&choice.unwrap_or_default());
+    }
+}
+
+/// δ_m (eq 32), δ_d (eq 31), the bulk friction of eq 79 per ξ (the columns of `fitbead
+/// regimes`), and the critical ξ of the law.
 #[pyfunction]
 #[pyo3(signature = (xi, law="adjusted", rho=0.4))]
 fn regimes<'py>(
@@ -762,16 +664,12 @@ fn regimes<'py>(
     xi: PyReadonlyArray1<'py, f64>,
     law: &str,
     rho: f64,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<(Bound<'py, PyDict>, Option<f64>)> {
     let l = parse_law(law)?;
     if !(rho.is_finite() && rho >= 0.0) {
         return Err(value_error(format!("rho = {}: must be >= 0", show(rho))));
     }
     let xs = slice(&xi, "xi")?;
-    let mut cols = Columns::new(
-        &["alpha_deg", "K", "delta_m_deg", "delta_d_deg", "mu_eq79"],
-        &["steady_range"],
-    );
     for (i, &x) in xs.iter().enumerate() {
         if !(x.is_finite() && x > 0.0) {
             return Err(value_error(format!(
@@ -779,8 +677,7 @@ fn regimes<'py>(
                 show(x)
             )));
         }
-        let al = alpha_of_xi(x);
-        let k = l.k(al, rho);
+        let k = l.k(alpha_of_xi(x), rho);
         if !(k.is_finite() && k > 0.0) {
             return Err(value_error(format!(
                 "K = '{law}': K = {} at xi = {}: must be > 0",
@@ -788,21 +685,15 @@ fn regimes<'py>(
                 show(x)
             )));
         }
-        let (dm, dd) = (delta_m_law(al, l, rho), delta_d_law(al, l, rho));
-        cols.push(
-            &[
-                al.to_degrees(),
-                k,
-                dm.to_degrees(),
-                dd.to_degrees(),
-                bulk_friction_law(al, l, rho),
-            ],
-            &[Cow::Borrowed(if dm < dd { "yes" } else { "no" })],
-        );
     }
-    let d = cols.into_dict(py)?;
-    d.set_item("critical_xi", critical_xi(l, rho))?;
-    Ok(d)
+    let table = RegimeRecord::table(xs, l, rho);
+    let mut cols = Columns::of(fields::<RegimeRecord>());
+    fill(table.len(), &mut cols, |i, sink| {
+        sink.record(&table[i]);
+        Ok(())
+    })
+    .map_err(value_error)?;
+    Ok((cols.into_dict(py)?, critical_xi(l, rho)))
 }
 
 /// Measured mean velocities grouped in series (the library's `Dataset`).
@@ -963,19 +854,15 @@ impl PyDataset {
         tol: f64,
     ) -> PyResult<Bound<'py, PyDict>> {
         let (model, auto) = k_model(model, tol)?;
-        let mut texts: Vec<&'static str> = K_TEXTS.to_vec();
-        if auto.is_some() {
-            texts.extend(AUTO_TEXTS);
-        }
-        let nums: Vec<&'static str> = K_NUMS.iter().chain(&K_NUMS2).copied().collect();
         let p = &self.inner.points;
-        let mut cols = Columns::new(&nums, &texts);
+        let mut cols = k_columns(auto.is_some());
         let abs = self.has_sigma();
         let r: Result<(), String> = py.detach(|| {
-            fill(p.len(), &mut cols, |i| {
+            fill(p.len(), &mut cols, |i, sink| {
                 let q = &p[i];
                 let sigma = abs.then_some(q.sigma);
-                Ok(k_row(&model, auto.as_ref(), &q.scene, q.v, sigma))
+                k_record(sink, &model, auto.as_ref(), &q.scene, q.v, sigma);
+                Ok(())
             })
         });
         r.map_err(value_error)?;
@@ -1379,10 +1266,12 @@ fn record_columns(kind: &str) -> PyResult<Vec<String>> {
         "stats" => Ok(columns::<StatsRecord>()),
         "residuals" => Ok(columns::<ResidualRecord>()),
         "correlations" => Ok(columns::<CorrelationRecord>()),
+        "regimes" => Ok(columns::<RegimeRecord>()),
         _ => Err(value_error(format!(
-            "kind = {kind:?}: expected params, stats, residuals or correlations"
+            "kind = {kind:?}: expected params, stats, residuals, correlations or regimes"
         ))),
     }
+    .map(|c| c.into_iter().map(String::from).collect())
 }
 
 /// The column names of the command line's `forward` output under `model` (after the input's

@@ -155,7 +155,8 @@ def test_regimes_equal_cli(cli):
     _, text, _ = cli("regimes", "--law", "adjusted", "--xi", "0.8,1,1.6,2")
     cols = read_csv_text(text)
     t = fitbead.regimes([0.8, 1, 1.6, 2], law="adjusted")
-    for c in ["xi", "alpha_deg", "K", "delta_m_deg", "delta_d_deg", "mu_eq79"]:
+    assert list(t) == list(cols), "the command line's columns, in its order"
+    for c in ["xi", "alpha_deg", "K", "delta_m_deg", "delta_d_deg", "mu_eq79", "critical_xi"]:
         assert_bits_equal(c, t[c], cols[c])
     assert list(t["steady_range"]) == cols["steady_range"]
     assert_bits_equal("critical_xi", [t.critical_xi] * 4, cols["critical_xi"])

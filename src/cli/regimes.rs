@@ -3,10 +3,8 @@
 
 use super::args::OutputArgs;
 use super::{emit, CliError};
-use crate::io::fmt_f64;
-use crate::models::regimes::{
-    alpha_of_xi, bulk_friction_law, critical_xi, delta_d_law, delta_m_law,
-};
+use crate::io::records::{to_csv, RegimeRecord};
+use crate::models::regimes::alpha_of_xi;
 use crate::scene::CollisionLaw;
 
 /// Arguments of `fitbead regimes`.
@@ -38,20 +36,6 @@ pub fn run(a: Args) -> Result<(), CliError> {
             "must be >= 0",
         ));
     }
-    let xc = critical_xi(law, a.rho);
-    let mut w = csv::Writer::from_writer(Vec::new());
-    let io = |e: csv::Error| CliError::Other(e.to_string());
-    w.write_record([
-        "xi",
-        "alpha_deg",
-        "K",
-        "delta_m_deg",
-        "delta_d_deg",
-        "mu_eq79",
-        "steady_range",
-        "critical_xi",
-    ])
-    .map_err(io)?;
     for &xi in &a.xi {
         if !(xi.is_finite() && xi > 0.0) {
             return Err(super::flag_error(
@@ -60,8 +44,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
                 "radius ratio must be > 0",
             ));
         }
-        let al = alpha_of_xi(xi);
-        let k = law.k(al, a.rho);
+        let k = law.k(alpha_of_xi(xi), a.rho);
         if !(k.is_finite() && k > 0.0 && k < 1.0) {
             return Err(super::flag_error(
                 "--law",
@@ -74,19 +57,8 @@ pub fn run(a: Args) -> Result<(), CliError> {
                 ),
             ));
         }
-        let (dm, dd) = (delta_m_law(al, law, a.rho), delta_d_law(al, law, a.rho));
-        w.write_record([
-            fmt_f64(xi),
-            fmt_f64(al.to_degrees()),
-            fmt_f64(k),
-            fmt_f64(dm.to_degrees()),
-            fmt_f64(dd.to_degrees()),
-            fmt_f64(bulk_friction_law(al, law, a.rho)),
-            (if dm < dd { "yes" } else { "no" }).to_string(),
-            xc.map(fmt_f64).unwrap_or_default(),
-        ])
-        .map_err(io)?;
     }
-    let bytes = w.into_inner().map_err(|e| CliError::Other(e.to_string()))?;
+    let bytes = to_csv(RegimeRecord::table(&a.xi, law, a.rho))
+        .map_err(|e| CliError::Other(e.to_string()))?;
     emit(a.out.output.as_deref(), &bytes)
 }

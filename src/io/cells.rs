@@ -1,10 +1,14 @@
-//! Writing CSV records straight into a byte buffer, cell by cell, with the bytes of the `csv`
-//! crate's default writer (comma separators, quotes only where needed, `\n` after a record)
-//! and without allocating: numbers by [`push_f64`], text quoted by `push_csv_field`.
+//! Writing CSV records straight into a byte buffer, cell by cell or a whole record (a struct
+//! of [`crate::record`]) at once, with the bytes of the `csv` crate's default writer (comma
+//! separators, quotes only where needed, `\n` after a record) and without allocating: numbers
+//! by [`push_f64`], text quoted by `push_csv_field`.
 
 use super::push_csv_field;
+use super::records::columns;
 use crate::numfmt::push_f64;
-use std::io::Write;
+use crate::record::{not_flat, refuse, NotFlat};
+use serde::ser::{Impossible, SerializeStruct, Serializer};
+use serde::Serialize;
 
 /// The cells of one CSV record, appended to a byte buffer (the test below shows the calls).
 pub struct Cells<'b> {
@@ -18,6 +22,7 @@ impl<'b> Cells<'b> {
         Cells { out, first: true }
     }
 
+    #[inline]
     fn sep(&mut self) {
         if !self.first {
             self.out.push(b',');
@@ -26,18 +31,13 @@ impl<'b> Cells<'b> {
     }
 
     /// An empty cell.
+    #[inline]
     pub fn empty(&mut self) {
         self.sep();
     }
 
-    /// One or more cells already written as CSV (separated by commas, quoted where needed),
-    /// appended as they are.
-    pub fn raw(&mut self, cells: &[u8]) {
-        self.sep();
-        self.out.extend_from_slice(cells);
-    }
-
     /// A whole number (as [`Cells::num`] writes it).
+    #[inline]
     pub fn count(&mut self, n: u64) {
         self.sep();
         let mut digits = [0u8; 20];
@@ -55,6 +55,7 @@ impl<'b> Cells<'b> {
     }
 
     /// A text cell, quoted when it holds a comma, a quote, a carriage return or a newline.
+    #[inline]
     pub fn text(&mut self, s: &str) {
         self.sep();
         push_csv_field(self.out, s.as_bytes());
@@ -62,61 +63,38 @@ impl<'b> Cells<'b> {
 
     /// A number as [`crate::numfmt::fmt_f64`] writes it (never needs quotes; empty for
     /// inf and NaN).
+    #[inline]
     pub fn num(&mut self, x: f64) {
         self.sep();
         push_f64(self.out, x);
     }
 
-    /// A number, or an empty cell.
-    pub fn opt(&mut self, x: Option<f64>) {
-        self.sep();
-        if let Some(x) = x {
-            push_f64(self.out, x);
-        }
+    /// The cells of `record`, one per field in column order (the fields
+    /// [`crate::record::each_cell`] visits): numbers as [`Cells::num`], counts as
+    /// [`Cells::count`], text quoted where needed, `None` empty.
+    ///
+    /// # Panics
+    /// If `R` is not a record of flat fields (see [`crate::record::each_cell`]).
+    #[inline]
+    pub fn record<R: Serialize>(&mut self, record: &R) {
+        self.write_record(record, None);
     }
 
-    /// A cell with the `Display` text of `x`, quoted where needed.
-    pub fn show(&mut self, x: impl std::fmt::Display) {
-        self.sep();
-        let start = self.out.len();
-        // Writing into a Vec cannot fail.
-        let _ = write!(self.out, "{x}");
-        self.quote_from(start);
+    /// [`Cells::record`], reusing the text of the numbers `repeat` caches while they repeat
+    /// from the last record it saw.
+    #[inline]
+    pub fn record_repeating<R: Serialize>(&mut self, record: &R, repeat: &mut Repeat) {
+        self.write_record(record, Some(repeat));
     }
 
-    /// A cell holding `parts` joined by `sep`, quoted where needed.
-    pub fn joined<I>(&mut self, parts: I, sep: &str)
-    where
-        I: IntoIterator,
-        I::Item: std::fmt::Display,
-    {
-        self.sep();
-        let start = self.out.len();
-        for (i, p) in parts.into_iter().enumerate() {
-            if i > 0 {
-                self.out.extend_from_slice(sep.as_bytes());
-            }
-            let _ = write!(self.out, "{p}");
-        }
-        self.quote_from(start);
-    }
-
-    /// Quotes the cell that starts at `start` when it needs it.
-    fn quote_from(&mut self, start: usize) {
-        if self.out[start..]
-            .iter()
-            .any(|&b| matches!(b, b',' | b'"' | b'\r' | b'\n'))
-        {
-            let s = self.out.split_off(start);
-            push_csv_field(self.out, &s);
-        }
-    }
-
-    /// The `Display` text of `x`, or an empty cell.
-    pub fn opt_show(&mut self, x: Option<impl std::fmt::Display>) {
-        match x {
-            Some(x) => self.show(x),
-            None => self.empty(),
+    fn write_record<R: Serialize>(&mut self, record: &R, repeat: Option<&mut Repeat>) {
+        let mut w = RecordWriter {
+            cells: self,
+            repeat,
+            field: 0,
+        };
+        if let Err(e) = record.serialize(&mut w) {
+            panic!("not a record of flat fields: {e}");
         }
     }
 
@@ -126,19 +104,358 @@ impl<'b> Cells<'b> {
     }
 }
 
+/// Writes a record's fields straight into [`Cells`]: serde's walk of the record, one cell per
+/// field, with no intermediate value (the streaming commands' writer; the tests check it
+/// against [`crate::record::each_cell`] and the `csv` crate).
+struct RecordWriter<'w, 'b> {
+    cells: &'w mut Cells<'b>,
+    repeat: Option<&'w mut Repeat>,
+    /// The index of the field being written.
+    field: usize,
+}
+
+/// One field of a record being written by a [`RecordWriter`].
+struct FieldWriter<'f, 'w, 'b>(&'f mut RecordWriter<'w, 'b>);
+
+impl<'f, 'w, 'b> Serializer for &'f mut RecordWriter<'w, 'b> {
+    type Ok = ();
+    type Error = NotFlat;
+    type SerializeSeq = Impossible<(), NotFlat>;
+    type SerializeTuple = Impossible<(), NotFlat>;
+    type SerializeTupleStruct = Impossible<(), NotFlat>;
+    type SerializeTupleVariant = Impossible<(), NotFlat>;
+    type SerializeMap = Impossible<(), NotFlat>;
+    type SerializeStruct = Self;
+    type SerializeStructVariant = Impossible<(), NotFlat>;
+
+    fn serialize_struct(self, _: &'static str, _: usize) -> Result<Self, NotFlat> {
+        Ok(self)
+    }
+
+    fn serialize_newtype_struct<T: Serialize + ?Sized>(
+        self,
+        _: &'static str,
+        value: &T,
+    ) -> Result<(), NotFlat> {
+        value.serialize(self)
+    }
+
+    fn serialize_some<T: Serialize + ?Sized>(self, _: &T) -> Result<(), NotFlat> {
+        not_flat("an option")
+    }
+
+    fn serialize_newtype_variant<T: Serialize + ?Sized>(
+        self,
+        _: &'static str,
+        _: u32,
+        _: &'static str,
+        _: &T,
+    ) -> Result<(), NotFlat> {
+        not_flat("an enum")
+    }
+
+    refuse! {
+        serialize_bool(bool) -> ();
+        serialize_i8(i8) -> ();
+        serialize_i16(i16) -> ();
+        serialize_i32(i32) -> ();
+        serialize_i64(i64) -> ();
+        serialize_u8(u8) -> ();
+        serialize_u16(u16) -> ();
+        serialize_u32(u32) -> ();
+        serialize_u64(u64) -> ();
+        serialize_f32(f32) -> ();
+        serialize_f64(f64) -> ();
+        serialize_char(char) -> ();
+        serialize_str(&str) -> ();
+        serialize_bytes(&[u8]) -> ();
+        serialize_none() -> ();
+        serialize_unit() -> ();
+        serialize_unit_struct(&'static str) -> ();
+        serialize_unit_variant(&'static str, u32, &'static str) -> ();
+        serialize_seq(Option<usize>) -> Self::SerializeSeq;
+        serialize_tuple(usize) -> Self::SerializeTuple;
+        serialize_tuple_struct(&'static str, usize) -> Self::SerializeTupleStruct;
+        serialize_tuple_variant(&'static str, u32, &'static str, usize) -> Self::SerializeTupleVariant;
+        serialize_map(Option<usize>) -> Self::SerializeMap;
+        serialize_struct_variant(&'static str, u32, &'static str, usize) -> Self::SerializeStructVariant;
+    }
+}
+
+impl SerializeStruct for &mut RecordWriter<'_, '_> {
+    type Ok = ();
+    type Error = NotFlat;
+
+    #[inline]
+    fn serialize_field<T: Serialize + ?Sized>(
+        &mut self,
+        _: &'static str,
+        value: &T,
+    ) -> Result<(), NotFlat> {
+        value.serialize(FieldWriter(self))?;
+        self.field += 1;
+        Ok(())
+    }
+
+    fn end(self) -> Result<(), NotFlat> {
+        Ok(())
+    }
+}
+
+impl Serializer for FieldWriter<'_, '_, '_> {
+    type Ok = ();
+    type Error = NotFlat;
+    type SerializeSeq = Impossible<(), NotFlat>;
+    type SerializeTuple = Impossible<(), NotFlat>;
+    type SerializeTupleStruct = Impossible<(), NotFlat>;
+    type SerializeTupleVariant = Impossible<(), NotFlat>;
+    type SerializeMap = Impossible<(), NotFlat>;
+    type SerializeStruct = Impossible<(), NotFlat>;
+    type SerializeStructVariant = Impossible<(), NotFlat>;
+
+    fn serialize_bool(self, v: bool) -> Result<(), NotFlat> {
+        self.serialize_str(if v { "true" } else { "false" })
+    }
+    fn serialize_i8(self, v: i8) -> Result<(), NotFlat> {
+        self.serialize_i64(v.into())
+    }
+    fn serialize_i16(self, v: i16) -> Result<(), NotFlat> {
+        self.serialize_i64(v.into())
+    }
+    fn serialize_i32(self, v: i32) -> Result<(), NotFlat> {
+        self.serialize_i64(v.into())
+    }
+    fn serialize_i64(self, v: i64) -> Result<(), NotFlat> {
+        match u64::try_from(v) {
+            Ok(n) => self.serialize_u64(n),
+            Err(_) => self.serialize_f64(v as f64),
+        }
+    }
+    fn serialize_u8(self, v: u8) -> Result<(), NotFlat> {
+        self.serialize_u64(v.into())
+    }
+    fn serialize_u16(self, v: u16) -> Result<(), NotFlat> {
+        self.serialize_u64(v.into())
+    }
+    fn serialize_u32(self, v: u32) -> Result<(), NotFlat> {
+        self.serialize_u64(v.into())
+    }
+    #[inline]
+    fn serialize_u64(self, v: u64) -> Result<(), NotFlat> {
+        self.0.cells.count(v);
+        Ok(())
+    }
+    fn serialize_f32(self, v: f32) -> Result<(), NotFlat> {
+        self.serialize_f64(v.into())
+    }
+    #[inline]
+    fn serialize_f64(self, x: f64) -> Result<(), NotFlat> {
+        let w = self.0;
+        match &mut w.repeat {
+            Some(r) if r.cached[w.field] => {
+                w.cells.sep();
+                let (bits, text) = &mut r.last[w.field];
+                if *bits != Some(x.to_bits()) {
+                    *bits = Some(x.to_bits());
+                    text.clear();
+                    push_f64(text, x);
+                }
+                w.cells.out.extend_from_slice(text);
+            }
+            _ => w.cells.num(x),
+        }
+        Ok(())
+    }
+    fn serialize_char(self, v: char) -> Result<(), NotFlat> {
+        self.serialize_str(v.encode_utf8(&mut [0; 4]))
+    }
+    #[inline]
+    fn serialize_str(self, v: &str) -> Result<(), NotFlat> {
+        self.0.cells.text(v);
+        Ok(())
+    }
+    #[inline]
+    fn serialize_none(self) -> Result<(), NotFlat> {
+        self.0.cells.empty();
+        Ok(())
+    }
+    #[inline]
+    fn serialize_some<T: Serialize + ?Sized>(self, value: &T) -> Result<(), NotFlat> {
+        value.serialize(self)
+    }
+    fn serialize_unit(self) -> Result<(), NotFlat> {
+        self.serialize_none()
+    }
+    fn serialize_unit_variant(
+        self,
+        _: &'static str,
+        _: u32,
+        variant: &'static str,
+    ) -> Result<(), NotFlat> {
+        self.serialize_str(variant)
+    }
+    fn serialize_newtype_struct<T: Serialize + ?Sized>(
+        self,
+        _: &'static str,
+        value: &T,
+    ) -> Result<(), NotFlat> {
+        value.serialize(self)
+    }
+    fn serialize_newtype_variant<T: Serialize + ?Sized>(
+        self,
+        _: &'static str,
+        _: u32,
+        _: &'static str,
+        _: &T,
+    ) -> Result<(), NotFlat> {
+        not_flat("an enum with data")
+    }
+
+    refuse! {
+        serialize_bytes(&[u8]) -> ();
+        serialize_unit_struct(&'static str) -> ();
+        serialize_seq(Option<usize>) -> Self::SerializeSeq;
+        serialize_tuple(usize) -> Self::SerializeTuple;
+        serialize_tuple_struct(&'static str, usize) -> Self::SerializeTupleStruct;
+        serialize_tuple_variant(&'static str, u32, &'static str, usize) -> Self::SerializeTupleVariant;
+        serialize_map(Option<usize>) -> Self::SerializeMap;
+        serialize_struct(&'static str, usize) -> Self::SerializeStruct;
+        serialize_struct_variant(&'static str, u32, &'static str, usize) -> Self::SerializeStructVariant;
+    }
+}
+
+/// The text of chosen numeric fields of a record type as last written, for
+/// [`Cells::record_repeating`]: fields whose values consecutive rows share (ξ and the
+/// quantities of ξ alone, along a series) are formatted once per run of equal values.
+#[derive(Debug, Clone)]
+pub(crate) struct Repeat {
+    /// Per field of the record, in order: whether its text is kept.
+    cached: Vec<bool>,
+    /// Per field: the bits of its last value and that value's text.
+    last: Vec<(Option<u64>, Vec<u8>)>,
+}
+
+impl Repeat {
+    /// A cache for the fields `names` of record type `R`.
+    ///
+    /// # Panics
+    /// If a name is not a column of `R` (a programming error the tests catch).
+    pub fn new<R: Serialize + Default>(names: &[&str]) -> Self {
+        let columns = columns::<R>();
+        for n in names {
+            assert!(columns.contains(n), "{n} is not a column of the record");
+        }
+        Repeat {
+            cached: columns.iter().map(|c| names.contains(c)).collect(),
+            last: vec![(None, Vec::new()); columns.len()],
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
-    use super::Cells;
+    use super::{Cells, Repeat};
 
     #[test]
-    fn a_record_of_text_number_empty_and_shown_cells() {
+    fn a_record_of_text_number_empty_and_count_cells() {
         let mut out = Vec::new();
         let mut w = Cells::new(&mut out);
         w.text("a,b");
         w.num(0.5);
         w.empty();
-        w.show(3);
+        w.count(3);
+        w.num(f64::NAN);
         w.end();
-        assert_eq!(out, b"\"a,b\",0.5,,3\n");
+        assert_eq!(out, b"\"a,b\",0.5,,3,\n");
+    }
+
+    #[test]
+    fn repeated_numbers_are_written_as_their_first_text() {
+        #[derive(serde::Serialize, Default)]
+        struct R {
+            a: f64,
+            b: f64,
+            c: Option<f64>,
+        }
+        let mut repeat = Repeat::new::<R>(&["a", "c"]);
+        let (mut plain, mut reused) = (Vec::new(), Vec::new());
+        for r in [
+            R {
+                a: 0.1,
+                b: 1.0,
+                c: Some(2.5),
+            },
+            R {
+                a: 0.1,
+                b: 2.0,
+                c: Some(2.5),
+            },
+            R {
+                a: -0.0,
+                b: 3.0,
+                c: None,
+            },
+            R {
+                a: 0.0,
+                b: 3.0,
+                c: Some(f64::NAN),
+            },
+            R {
+                a: 0.0,
+                b: 4.0,
+                c: Some(2.5),
+            },
+        ] {
+            let mut w = Cells::new(&mut plain);
+            w.record(&r);
+            w.end();
+            let mut w = Cells::new(&mut reused);
+            w.record_repeating(&r, &mut repeat);
+            w.end();
+        }
+        assert_eq!(reused, plain);
+        assert_eq!(plain, b"0.1,1,2.5\n0.1,2,2.5\n-0,3,\n0,3,\n0,4,2.5\n");
+    }
+
+    #[test]
+    #[should_panic(expected = "d is not a column")]
+    fn a_repeat_cache_names_columns_of_its_record() {
+        #[derive(serde::Serialize, Default)]
+        struct R {
+            a: f64,
+        }
+        Repeat::new::<R>(&["d"]);
+    }
+
+    #[test]
+    fn a_record_is_written_field_by_field_as_the_csv_crate_writes_it() {
+        #[derive(serde::Serialize)]
+        struct R<'a> {
+            text: &'a str,
+            quoted: String,
+            number: f64,
+            none: Option<f64>,
+            count: Option<u64>,
+            flag: bool,
+            inf: f64,
+        }
+        let r = R {
+            text: "roll>slip",
+            quoted: "a \"b\", c".into(),
+            number: 1e-7,
+            none: None,
+            count: Some(12),
+            flag: false,
+            inf: f64::INFINITY,
+        };
+        let mut out = Vec::new();
+        let mut w = Cells::new(&mut out);
+        w.record(&r);
+        w.end();
+        // The csv crate's writer on the same cells (the reference for quoting).
+        let mut c = csv::Writer::from_writer(Vec::new());
+        c.write_record(["roll>slip", "a \"b\", c", "1e-7", "", "12", "false", ""])
+            .unwrap();
+        assert_eq!(out, c.into_inner().unwrap());
     }
 }

@@ -6,21 +6,22 @@
 //! Input columns `xi`, `delta_deg` (required), `K` (a number or a law name), `rho`, `f`,
 //! `lambda`, `mu` (Jan), `a1`, `a2`, `a3` (Jaeger) and `spin` (contact); an empty cell or an
 //! absent column takes the setting. Every input cell passes through (trimmed), an input column
-//! whose name is also an output column renamed `in_NAME` (see `pass_through_names`); then `OUTPUT_COLUMNS`, then
-//! `CONTACT_COLUMNS` (contact model) or `AUTO_COLUMNS` (auto).
+//! whose name is also an output column renamed `in_NAME` (see `pass_through_names`); then the
+//! records' columns ([`output_columns`]).
 //!
 //! Settings are named in messages as the command line's flags (`--rho` of
 //! `SETTINGS_ORIGIN`), since that is where they come from.
 
 use super::cells::Cells;
+use super::records::{columns, AutoRecord, ContactRecord, ForwardRecord};
 use super::scenes::{Row, TableReader};
 use super::stream::RowPlan;
 use super::InputError;
 use crate::models::auto::Auto;
-use crate::models::contact::{Contact, SpinRule, SteadyContact};
+use crate::models::contact::{Contact, SpinRule};
 use crate::models::jaeger::Jaeger;
 use crate::models::jan::Jan;
-use crate::models::{regime_of, Evaluation, JaegerBranch, Model, ModelKind};
+use crate::models::{JaegerBranch, Model, ModelKind};
 use crate::scene::ParameterError;
 use crate::scene::{CollisionLaw, Scene};
 use std::io::Read;
@@ -48,48 +49,16 @@ pub(crate) fn scene_columns() -> Vec<&'static str> {
     v
 }
 
-/// Columns added after [`OUTPUT_COLUMNS`] by the contact model.
-pub(crate) const CONTACT_COLUMNS: [&str; 10] = [
-    "phase_sequence",
-    "phase_change_deg",
-    "initial_spin",
-    "final_spin",
-    "beads",
-    "collision_translation_frac",
-    "collision_spin_frac",
-    "friction_work_frac",
-    "energy_closure",
-    "spin_rule",
-];
-
-/// Columns added after [`OUTPUT_COLUMNS`] by `auto`: the model used and why.
-pub(crate) const AUTO_COLUMNS: [&str; 2] = ["model_used", "reason"];
-
-/// Output columns added to each row.
-pub(crate) const OUTPUT_COLUMNS: [&str; 12] = [
-    "v",
-    "regime",
-    "status",
-    "K_used",
-    "final_velocity",
-    "initial_velocity",
-    "contact_time",
-    "theta_G_deg",
-    "map_slope",
-    "other_fixed_point",
-    "phases",
-    "message",
-];
-
-/// The columns `forward` adds after the input's own under a model of `kind`, in order:
-/// the columns every model adds (v, regime, status, …), then the contact model's or auto's own.
+/// The columns `forward` adds after the input's own under a model of `kind`, in order,
+/// generated from the records: [`ForwardRecord`]'s (every model), then [`ContactRecord`]'s
+/// (the contact model) or [`AutoRecord`]'s (auto).
 pub fn output_columns(kind: ModelKind) -> Vec<&'static str> {
-    let mut outputs = OUTPUT_COLUMNS.to_vec();
+    let mut outputs = columns::<ForwardRecord>();
     if kind == ModelKind::Contact {
-        outputs.extend(CONTACT_COLUMNS);
+        outputs.extend(columns::<ContactRecord>());
     }
     if kind == ModelKind::Auto {
-        outputs.extend(AUTO_COLUMNS);
+        outputs.extend(columns::<AutoRecord>());
     }
     outputs
 }
@@ -491,100 +460,19 @@ impl RowPlan for ForwardPlan {
     }
 
     fn write(&self, row: &Row<'_>, job: Job, _: &mut (), out: &mut Vec<u8>) {
-        let Evaluation {
-            outcome: o,
-            contact: d,
-            auto: au,
-        } = job.model.evaluate_detailed(&job.scene);
+        let (common, contact, auto) = ForwardRecord::evaluate(&job.scene, &job.model);
         let kind = self.settings.kind;
-        let general = kind == ModelKind::Contact;
-        let contact = !matches!(kind, ModelKind::Jan | ModelKind::Jaeger);
         let mut w = Cells::new(out);
         for i in 0..row.rec.len() {
             w.text(row.cell(i));
         }
-        let regime = regime_of(&o);
-        match &o {
-            Ok(s) => {
-                w.num(s.mean_velocity);
-                w.opt_show(regime);
-                w.text("ok");
-                if contact {
-                    w.num(job.scene.k());
-                    w.num(s.final_velocity);
-                    w.num(s.initial_velocity);
-                } else {
-                    w.empty();
-                    w.empty();
-                    w.empty();
-                }
-                w.num(s.contact_time);
-                w.opt(s.theta_g.map(f64::to_degrees));
-                w.opt(s.map_slope);
-                w.opt(s.other_fixed_point);
-                w.show(s.phases);
-                w.text(if s.other_fixed_point.is_some() {
-                    if contact {
-                        "bistable: another fixed point of the final-velocity map"
-                    } else {
-                        "two positive roots (eq 84): bistable band"
-                    }
-                } else {
-                    ""
-                });
-            }
-            Err(e) => {
-                w.empty();
-                w.opt_show(regime);
-                w.text(e.status());
-                if contact {
-                    w.num(job.scene.k());
-                } else {
-                    w.empty();
-                }
-                for _ in 0..7 {
-                    w.empty();
-                }
-                w.show(e);
-            }
-        }
-        if let (true, Some(d)) = (general, &d) {
-            contact_cells(&mut w, &job, d.0, &d.1);
+        w.record(&common);
+        if let (ModelKind::Contact, Some(c)) = (kind, &contact) {
+            w.record(c);
         }
         if kind == ModelKind::Auto {
-            match au {
-                Some(r) => {
-                    w.text(r.choice.name());
-                    w.show(r.reason);
-                }
-                None => {
-                    w.empty();
-                    w.empty();
-                }
-            }
+            w.record(&auto.unwrap_or_default());
         }
         w.end();
     }
-}
-
-fn contact_cells(w: &mut Cells, job: &Job, rule: SpinRule, steady: &Option<SteadyContact>) {
-    let Some(s) = steady else {
-        for _ in 0..CONTACT_COLUMNS.len() - 1 {
-            w.empty();
-        }
-        w.show(rule);
-        return;
-    };
-    let e = s.energy(&job.scene);
-    let p = e.potential_drop;
-    w.show(s.run.phases);
-    w.text(&s.run.phases.changes_deg());
-    w.num(s.launch.spin);
-    w.num(s.final_spin);
-    w.show(s.beads);
-    w.num(e.collision_translation / p);
-    w.num(e.collision_spin / p);
-    w.num(e.friction_work / p);
-    w.num(e.closure());
-    w.show(rule);
 }

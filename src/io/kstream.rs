@@ -5,11 +5,12 @@
 //! record of `COLUMNS`, `EXTRA_COLUMNS`, `AUTO_COLUMNS` (auto only), then the input's
 //! other columns (trimmed; a name clashing with an output column renamed `in_NAME`).
 
-use super::cells::Cells;
+use super::cells::{Cells, Repeat};
 use super::measurements::{
     Implausible, Measured, MeasurementColumns, MeasurementDefaults, Plausibility, PlausiblePoint,
     SeriesLedger,
 };
+use super::records::{columns, AutoRecord, KRecord};
 use super::scenes::{Header, Row};
 use super::stream::RowPlan;
 use super::InputError;
@@ -17,53 +18,32 @@ use crate::fit::k::auto::{self as kauto, KChoice};
 use crate::fit::k::KEstimate;
 use crate::models::auto::Auto;
 use crate::models::Model;
-use crate::numfmt::{fmt_f64, push_f64};
+use crate::numfmt::fmt_f64;
 use crate::report::figures::{scatter_svg, PointSeries, Scatter};
 use crate::scene::{CollisionLaw, Scene};
+use serde::Serialize;
 use std::collections::HashMap;
-use std::fmt::Display;
 
-/// The contract columns, in order.
-pub(crate) const COLUMNS: [&str; 18] = [
-    "series",
-    "xi",
-    "delta_deg",
-    "v",
-    "sigma_v",
-    "model",
-    "K",
-    "K_lo",
-    "K_hi",
-    "dv_dK",
-    "final_velocity",
-    "theta_G_deg",
-    "K_cos2a",
-    "K_adjusted",
-    "K_impact",
-    "regime",
-    "status",
-    "iterations",
-];
+/// The measurement's own columns, first in a K row: series, ξ, δ (as written), v, σ and the
+/// model's name.
+#[derive(Debug, Clone, Default, Serialize)]
+struct KInput<'a> {
+    series: &'a str,
+    xi: f64,
+    delta_deg: &'a str,
+    v: f64,
+    sigma_v: Option<f64>,
+    model: &'a str,
+}
 
-/// Columns added after the contract ones: the bracket of K, what sets its ends, and why a
-/// row has no K or how its interval was cut.
-pub(crate) const EXTRA_COLUMNS: [&str; 5] =
-    ["K_min", "K_max", "lower_limit", "upper_limit", "message"];
-
-/// Columns added after [`EXTRA_COLUMNS`] by auto: the model each row was inverted with, and
-/// why.
-pub(crate) const AUTO_COLUMNS: [&str; 2] = ["model_used", "reason"];
-
-/// The columns of a K row in order (input columns with their own output column included),
-/// with auto's two when `auto`: the input's other columns follow them.
+/// The columns of a K row in order, generated from the records: the measurement's own
+/// (`KInput`), [`KRecord`]'s, and [`AutoRecord`]'s when `auto`; the input's other columns
+/// follow them.
 pub fn output_columns(auto: bool) -> Vec<&'static str> {
-    let mut v: Vec<&'static str> = COLUMNS
-        .iter()
-        .chain(EXTRA_COLUMNS.iter())
-        .copied()
-        .collect();
+    let mut v = columns::<KInput>();
+    v.extend(columns::<KRecord>());
     if auto {
-        v.extend(AUTO_COLUMNS);
+        v.extend(columns::<AutoRecord>());
     }
     v
 }
@@ -102,17 +82,30 @@ pub(crate) struct KLedger {
 }
 
 /// What consecutive rows of one task share when they have the same ξ and ρ (rows of a
-/// series usually follow each other): ξ and the three named laws' K, formatted, and the last
-/// scene read (whose quantities of ξ alone the next row of the same ξ reuses).
-#[derive(Debug, Clone, Default)]
+/// series usually follow each other): the three named laws' K, the text of ξ and of those K,
+/// and the last scene read (whose quantities of ξ alone the next row of the same ξ reuses).
+#[derive(Debug, Clone)]
 pub(crate) struct KScratch {
     scene: Option<Scene>,
     key: Option<(u64, u64)>,
-    cos2a: f64,
-    /// ξ as a cell.
-    xi: Vec<u8>,
-    /// K_cos2a, K_adjusted, K_impact as cells.
-    laws: Vec<u8>,
+    /// K of cos 2α, the adjusted law and the impact law.
+    laws: [f64; 3],
+    /// The text of ξ.
+    input: Repeat,
+    /// The text of the three laws' K.
+    record: Repeat,
+}
+
+impl Default for KScratch {
+    fn default() -> Self {
+        KScratch {
+            scene: None,
+            key: None,
+            laws: [f64::NAN; 3],
+            input: Repeat::new::<KInput>(&["xi"]),
+            record: Repeat::new::<KRecord>(&["K_cos2a", "K_adjusted", "K_impact"]),
+        }
+    }
 }
 
 impl KScratch {
@@ -123,15 +116,12 @@ impl KScratch {
         }
         self.key = Some(key);
         let (alpha, rho) = (s.alpha_rad(), s.rho());
-        self.cos2a = CollisionLaw::Cos2a.k(alpha, rho);
-        self.xi.clear();
-        push_f64(&mut self.xi, s.xi());
-        self.laws.clear();
-        push_f64(&mut self.laws, self.cos2a);
-        self.laws.push(b',');
-        push_f64(&mut self.laws, CollisionLaw::Adjusted.k(alpha, rho));
-        self.laws.push(b',');
-        push_f64(&mut self.laws, CollisionLaw::Impact.k(alpha, rho));
+        self.laws = [
+            CollisionLaw::Cos2a,
+            CollisionLaw::Adjusted,
+            CollisionLaw::Impact,
+        ]
+        .map(|l| l.k(alpha, rho));
     }
 }
 
@@ -256,65 +246,28 @@ impl RowPlan for KPlan {
     fn write(&self, row: &Row<'_>, m: Measured, cache: &mut KScratch, out: &mut Vec<u8>) -> KNote {
         let (e, choice) = self.invert(&m);
         let s = &m.scene;
-        let mut w = Cells::new(out);
         cache.update(s);
-        w.text(self.cols.series(row));
-        w.raw(&cache.xi);
-        w.text(row.cell(self.cols.delta_deg()));
-        w.num(m.v);
-        w.opt(m.sigma_v);
-        w.text(&self.settings.model_name);
-        let root = e.root.as_ref().ok();
-        w.opt(root.map(|r| r.k));
-        w.opt(e.k_lo);
-        w.opt(e.k_hi);
-        w.opt(e.dv_dk);
-        w.opt(root.map(|r| r.steady.final_velocity));
-        w.opt(e.theta_g.map(f64::to_degrees));
-        w.raw(&cache.laws);
-        let (regime, status) = e.regime_status();
-        w.text(regime);
-        w.text(status);
-        match root {
-            Some(r) => w.count(r.evals as u64),
-            None => w.empty(),
-        }
-        match &e.bracket {
-            Some(b) => {
-                w.num(b.lo);
-                w.num(b.hi);
-                w.text(b.lower.name());
-                w.text(b.upper.name());
-            }
-            None => {
-                for _ in 0..4 {
-                    w.empty();
-                }
-            }
-        }
-        let failure = e.root.as_ref().err().map(|f| f as &dyn Display);
-        w.joined(
-            failure
-                .into_iter()
-                .chain(e.notes.iter().map(|n| n as &dyn Display)),
-            "; ",
+        let mut w = Cells::new(out);
+        w.record_repeating(
+            &KInput {
+                series: self.cols.series(row),
+                xi: s.xi(),
+                delta_deg: row.cell(self.cols.delta_deg()),
+                v: m.v,
+                sigma_v: m.sigma_v,
+                model: &self.settings.model_name,
+            },
+            &mut cache.input,
         );
+        w.record_repeating(&KRecord::new(&e, cache.laws), &mut cache.record);
         if self.settings.auto.is_some() {
-            match &choice {
-                Some(c) => {
-                    w.text(c.choice.name());
-                    w.text(&c.reason);
-                }
-                None => {
-                    w.empty();
-                    w.empty();
-                }
-            }
+            w.record(&choice.map(AutoRecord::of_choice).unwrap_or_default());
         }
         for &c in &self.pass {
             w.text(row.cell(c));
         }
         w.end();
+        let root = e.root.as_ref().ok();
         let plot = match (self.settings.plot, root) {
             (true, Some(r)) => Some(PlotNote {
                 point: (
@@ -323,7 +276,7 @@ impl RowPlan for KPlan {
                     e.k_lo.unwrap_or(r.k),
                     e.k_hi.unwrap_or(r.k),
                 ),
-                cos2a: cache.cos2a,
+                cos2a: cache.laws[0],
             }),
             _ => None,
         };

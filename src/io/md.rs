@@ -8,7 +8,7 @@ use super::forward::{check_scene_cells, scene_error, setting_error};
 use super::scenes::Table;
 use super::InputError;
 use crate::models::md::{Md, MdResult, MdSetting, MdSettings};
-use crate::models::{regime_of, Regime};
+use crate::models::Regime;
 use crate::numfmt::fmt_f64;
 use crate::scene::ParameterError as Error;
 use crate::scene::{CollisionLaw, Scene};
@@ -152,7 +152,7 @@ pub fn md_csv(
         } else {
             String::new()
         });
-        out.push(regime_of(&o).map(|g| g.to_string()).unwrap_or_default());
+        out.push(Regime::of(&o).map(|g| g.to_string()).unwrap_or_default());
         out.push(match &o {
             Ok(_) => "ok".into(),
             Err(e) => e.status().into(),

@@ -1,92 +1,28 @@
-//! One typed record per row of the fit reports: a parameter ([`ParamRecord`], params.csv and
-//! `--output`), the statistics of a fit ([`StatsRecord`], stats.csv and `--output-stats`), a
-//! point against its fit ([`ResidualRecord`], residuals.csv) and a pair of parameters
-//! ([`CorrelationRecord`], correlations.csv).
+//! One typed record per output row: a parameter ([`ParamRecord`], params.csv and `--output`),
+//! the statistics of a fit ([`StatsRecord`], stats.csv and `--output-stats`), a point against
+//! its fit ([`ResidualRecord`], residuals.csv), a pair of parameters ([`CorrelationRecord`],
+//! correlations.csv), a scene's steady state ([`ForwardRecord`], with [`ContactRecord`] and
+//! [`AutoRecord`]: `fitbead forward`), a measurement's K ([`KRecord`]: `fitbead k`) and a
+//! law's regime limits ([`RegimeRecord`]: `fitbead regimes`).
 //!
 //! Each record derives `serde::Serialize`; its columns are its fields, in order, with their
-//! serde names ([`columns`]). Every writer reads the record: the CSV files (`to_csv`) and the
-//! Python binding's dicts (through [`cells`]). A number is written as the shortest decimal
-//! that reads back as the same double ([`crate::numfmt::fmt_f64`]), an absent or non-finite
-//! number as an empty cell.
+//! serde names ([`columns`]). Every writer reads the record ([`each_cell`]): the CSV files,
+//! the streaming commands and the Python binding's columns and dicts. A number is written as
+//! the shortest decimal that reads back as the same double ([`crate::numfmt::fmt_f64`]), an
+//! absent or non-finite number as an empty cell.
 
+use crate::fit::k::auto::{estimate_with, KChoice};
+use crate::fit::k::KEstimate;
 use crate::fit::summary::{FitResult, ParamRow, PointFit, StatsRow};
 use crate::inverse::{ProfileEnd, SigmaKind};
-use crate::numfmt::fmt_f64;
+use crate::models::auto::Auto;
+use crate::models::contact::{SpinRule, SteadyContact};
+use crate::models::{Model, Outcome, Phases, Regime};
+pub(crate) use crate::record::to_csv;
+pub use crate::record::{columns, each_cell, Cell};
+use crate::scene::{CollisionLaw, Scene};
 use serde::Serialize;
-use serde_json::Value;
-
-/// One cell of a record: what a writer needs to know of a field's value.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Cell {
-    /// Text.
-    Text(String),
-    /// A finite number.
-    Number(f64),
-    /// A count.
-    Count(u64),
-    /// A flag.
-    Flag(bool),
-    /// No value (an absent or non-finite number).
-    Empty,
-}
-
-impl Cell {
-    /// The cell as the CSV files write it.
-    pub fn to_csv(&self) -> String {
-        match self {
-            Cell::Text(s) => s.clone(),
-            Cell::Number(x) => fmt_f64(*x),
-            Cell::Count(n) => n.to_string(),
-            Cell::Flag(b) => b.to_string(),
-            Cell::Empty => String::new(),
-        }
-    }
-}
-
-fn cell(v: Value) -> Cell {
-    match v {
-        Value::Null => Cell::Empty,
-        Value::Bool(b) => Cell::Flag(b),
-        Value::String(s) => Cell::Text(s),
-        Value::Number(n) => match n.as_u64() {
-            Some(k) if !n.is_f64() => Cell::Count(k),
-            _ => n
-                .as_f64()
-                .filter(|x| x.is_finite())
-                .map_or(Cell::Empty, Cell::Number),
-        },
-        // Records are flat: a nested value is written as JSON text.
-        other => Cell::Text(other.to_string()),
-    }
-}
-
-/// The record's (column, cell) pairs, in column order.
-///
-/// # Panics
-/// If `R` does not serialise as a flat struct, which the records of this module all do.
-pub fn cells<R: Serialize>(record: &R) -> Vec<(String, Cell)> {
-    match serde_json::to_value(record).expect("a record serialises") {
-        Value::Object(m) => m.into_iter().map(|(k, v)| (k, cell(v))).collect(),
-        other => panic!("a record serialises as a struct, not {other}"),
-    }
-}
-
-/// The columns of record type `R`, generated from its fields.
-pub fn columns<R: Serialize + Default>() -> Vec<String> {
-    cells(&R::default()).into_iter().map(|(k, _)| k).collect()
-}
-
-/// The records as CSV: the header from [`columns`], one row per record.
-pub(crate) fn to_csv<R: Serialize + Default>(
-    records: impl IntoIterator<Item = R>,
-) -> csv::Result<Vec<u8>> {
-    let mut w = csv::Writer::from_writer(Vec::new());
-    w.write_record(columns::<R>())?;
-    for r in records {
-        w.write_record(cells(&r).into_iter().map(|(_, c)| c.to_csv()))?;
-    }
-    w.into_inner().map_err(|e| e.into_error().into())
-}
+use std::borrow::Cow;
 
 /// One parameter of one fit: its estimate, standard error, reported interval and how it was
 /// found, the covariance and profile intervals, and, for a posterior run, the posterior summary.
@@ -415,23 +351,494 @@ impl CorrelationRecord {
     }
 }
 
+/// The columns every model adds to a `forward` row: the steady state (eq 68 for v̄), or why
+/// there is none. Velocities are in units of √(g (R + r)), angles in degrees.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct ForwardRecord {
+    /// Mean velocity v̄; empty without a steady state.
+    pub v: Option<f64>,
+    /// Regime `A`, `B` or `C`; empty where the model does not say.
+    pub regime: &'static str,
+    /// `ok`, or why there is no steady state.
+    pub status: &'static str,
+    /// The collision parameter K used (the contact models; empty for Jan and Jaeger).
+    #[serde(rename = "K_used")]
+    pub k_used: Option<f64>,
+    /// Final velocity of the steady contact (contact models).
+    pub final_velocity: Option<f64>,
+    /// Velocity just after the collision (contact models).
+    pub initial_velocity: Option<f64>,
+    /// Contact time, in units of √((R + r)/g).
+    pub contact_time: Option<f64>,
+    /// Θ_G (eq 36), where rolling gives way to slip.
+    #[serde(rename = "theta_G_deg")]
+    pub theta_g_deg: Option<f64>,
+    /// Slope of the final-velocity map at the fixed point.
+    pub map_slope: Option<f64>,
+    /// Another fixed point of the final-velocity map, where the scene is bistable.
+    pub other_fixed_point: Option<f64>,
+    /// The phases of the steady contact (`roll`, `slip`, `roll>slip`, or a sequence).
+    pub phases: Cow<'static, str>,
+    /// Why there is no steady state, or a warning about the one found.
+    pub message: Cow<'static, str>,
+}
+
+/// The columns the general contact model adds to a `forward` row: its phases, spins and
+/// energy partition (fractions of the potential drop).
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct ContactRecord {
+    /// The phase sequence of the steady contact.
+    pub phase_sequence: String,
+    /// The angles of its phase changes, degrees.
+    pub phase_change_deg: String,
+    /// Spin ω0/ε at the start of the contact.
+    pub initial_spin: Option<f64>,
+    /// Spin ωf/ε at its end.
+    pub final_spin: Option<f64>,
+    /// Contacts evaluated to find the fixed point.
+    pub beads: Option<u64>,
+    /// Translational energy lost at each collision.
+    pub collision_translation_frac: Option<f64>,
+    /// Spin energy lost at each collision.
+    pub collision_spin_frac: Option<f64>,
+    /// Work of friction over the contact.
+    pub friction_work_frac: Option<f64>,
+    /// The energy balance's closure (0 when the partition adds up).
+    pub energy_closure: Option<f64>,
+    /// The spin rule at each collision.
+    pub spin_rule: String,
+}
+
+/// The columns `auto` adds to a `forward` or `k` row: the model it used, and why.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct AutoRecord {
+    /// The model used.
+    pub model_used: &'static str,
+    /// Why.
+    pub reason: String,
+}
+
+/// The message of a steady state on two fixed points.
+fn bistable(contact: bool) -> &'static str {
+    if contact {
+        "bistable: another fixed point of the final-velocity map"
+    } else {
+        "two positive roots (eq 84): bistable band"
+    }
+}
+
+fn phases_text(p: Phases) -> Cow<'static, str> {
+    match p {
+        Phases::Roll => Cow::Borrowed("roll"),
+        Phases::Slip => Cow::Borrowed("slip"),
+        Phases::RollSlip => Cow::Borrowed("roll>slip"),
+        Phases::None => Cow::Borrowed(""),
+        p => Cow::Owned(p.to_string()),
+    }
+}
+
+impl ForwardRecord {
+    /// The records of `scene` under `model`: the columns every model adds, the contact
+    /// model's (that model only) and auto's (auto only).
+    pub fn evaluate(
+        scene: &Scene,
+        model: &Model,
+    ) -> (ForwardRecord, Option<ContactRecord>, Option<AutoRecord>) {
+        let ev = model.evaluate_detailed(scene);
+        let contact = ev
+            .contact
+            .as_ref()
+            .map(|(rule, steady)| ContactRecord::new(scene, *rule, steady.as_ref()));
+        let auto = ev.auto.as_ref().map(|a| AutoRecord {
+            model_used: a.choice.name(),
+            reason: a.reason.to_string(),
+        });
+        let uses_k = !matches!(model, Model::Jan(_) | Model::Jaeger(_));
+        (
+            ForwardRecord::new(scene, uses_k, &ev.outcome),
+            contact,
+            auto,
+        )
+    }
+
+    /// The record of `outcome` at `scene`, whose K is reported when `uses_k` (the models of
+    /// the contact, not Jan's or Jaeger's laws).
+    pub(crate) fn new(scene: &Scene, uses_k: bool, outcome: &Outcome) -> ForwardRecord {
+        let k_used = uses_k.then(|| scene.k());
+        let regime = Regime::of(outcome).map_or("", Regime::letter);
+        match outcome {
+            Ok(s) => ForwardRecord {
+                v: Some(s.mean_velocity),
+                regime,
+                status: "ok",
+                k_used,
+                final_velocity: uses_k.then_some(s.final_velocity),
+                initial_velocity: uses_k.then_some(s.initial_velocity),
+                contact_time: Some(s.contact_time),
+                theta_g_deg: s.theta_g.map(f64::to_degrees),
+                map_slope: s.map_slope,
+                other_fixed_point: s.other_fixed_point,
+                phases: phases_text(s.phases),
+                message: Cow::Borrowed(if s.other_fixed_point.is_some() {
+                    bistable(uses_k)
+                } else {
+                    ""
+                }),
+            },
+            Err(e) => ForwardRecord {
+                regime,
+                status: e.status(),
+                k_used,
+                message: Cow::Owned(e.to_string()),
+                ..ForwardRecord::default()
+            },
+        }
+    }
+}
+
+impl ContactRecord {
+    /// The record of the general contact model's steady state at `scene` (empty but for the
+    /// spin rule where there is none).
+    pub(crate) fn new(scene: &Scene, rule: SpinRule, steady: Option<&SteadyContact>) -> Self {
+        let Some(s) = steady else {
+            return ContactRecord {
+                spin_rule: rule.to_string(),
+                ..ContactRecord::default()
+            };
+        };
+        let e = s.energy(scene);
+        let p = e.potential_drop;
+        ContactRecord {
+            phase_sequence: s.run.phases.to_string(),
+            phase_change_deg: s.run.phases.changes_deg(),
+            initial_spin: Some(s.launch.spin),
+            final_spin: Some(s.final_spin),
+            beads: Some(s.beads as u64),
+            collision_translation_frac: Some(e.collision_translation / p),
+            collision_spin_frac: Some(e.collision_spin / p),
+            friction_work_frac: Some(e.friction_work / p),
+            energy_closure: Some(e.closure()),
+            spin_rule: rule.to_string(),
+        }
+    }
+}
+
+/// The K of one measurement (eq 69) as the columns `fitbead k` adds after the measurement's
+/// own: K, its interval for v ± σ, the bracket it was sought in, and the three named laws' K
+/// at the measurement's ξ for comparison.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct KRecord {
+    /// K at the measured v̄; empty where there is none (see `status`).
+    #[serde(rename = "K")]
+    pub k: Option<f64>,
+    /// K at v − σ.
+    #[serde(rename = "K_lo")]
+    pub k_lo: Option<f64>,
+    /// K at v + σ.
+    #[serde(rename = "K_hi")]
+    pub k_hi: Option<f64>,
+    /// dv̄/dK at K.
+    #[serde(rename = "dv_dK")]
+    pub dv_dk: Option<f64>,
+    /// Final velocity of the steady contact at K.
+    pub final_velocity: Option<f64>,
+    /// Θ_G (eq 36) at K, degrees.
+    #[serde(rename = "theta_G_deg")]
+    pub theta_g_deg: Option<f64>,
+    /// K = cos 2α at the measurement's ξ.
+    #[serde(rename = "K_cos2a")]
+    pub k_cos2a: f64,
+    /// The adjusted law's K.
+    #[serde(rename = "K_adjusted")]
+    pub k_adjusted: f64,
+    /// The impact law's K.
+    #[serde(rename = "K_impact")]
+    pub k_impact: f64,
+    /// `B` with a K, `A` below the steady range, `C` above it, empty when invalid.
+    pub regime: &'static str,
+    /// `ok`, `below-range`, `above-range` or `invalid`.
+    pub status: &'static str,
+    /// Model evaluations of the root search.
+    pub iterations: Option<u64>,
+    /// Lower end of the bracket of K.
+    #[serde(rename = "K_min")]
+    pub k_min: Option<f64>,
+    /// Upper end of the bracket.
+    #[serde(rename = "K_max")]
+    pub k_max: Option<f64>,
+    /// What sets the bracket's lower end.
+    pub lower_limit: &'static str,
+    /// What sets its upper end.
+    pub upper_limit: &'static str,
+    /// Why there is no K, and notes on the interval's ends, separated by `; `.
+    pub message: String,
+}
+
+impl KRecord {
+    /// The K of measurement `v` (± `sigma_v`) at `scene` under `model`, or under the model
+    /// `auto` chooses for it, with that choice (eq 69).
+    pub fn estimate(
+        model: &Model,
+        auto: Option<&Auto>,
+        scene: &Scene,
+        v: f64,
+        sigma_v: Option<f64>,
+    ) -> (KRecord, Option<AutoRecord>) {
+        let (e, choice) = estimate_with(model, auto, scene, v, sigma_v);
+        let (alpha, rho) = (scene.alpha_rad(), scene.rho());
+        let laws = [
+            CollisionLaw::Cos2a,
+            CollisionLaw::Adjusted,
+            CollisionLaw::Impact,
+        ]
+        .map(|l| l.k(alpha, rho));
+        (KRecord::new(&e, laws), choice.map(AutoRecord::of_choice))
+    }
+
+    /// The record of estimate `e`, with the three named laws' K (cos 2α, adjusted, impact).
+    pub(crate) fn new(e: &KEstimate, laws: [f64; 3]) -> KRecord {
+        let root = e.root.as_ref().ok();
+        let (regime, status) = e.regime_status();
+        let failure = e.root.as_ref().err().map(ToString::to_string);
+        let message = match (failure, e.notes.is_empty()) {
+            (None, true) => String::new(),
+            (f, _) => f
+                .into_iter()
+                .chain(e.notes.iter().cloned())
+                .collect::<Vec<_>>()
+                .join("; "),
+        };
+        let b = e.bracket.as_ref();
+        KRecord {
+            k: root.map(|r| r.k),
+            k_lo: e.k_lo,
+            k_hi: e.k_hi,
+            dv_dk: e.dv_dk,
+            final_velocity: root.map(|r| r.steady.final_velocity),
+            theta_g_deg: e.theta_g.map(f64::to_degrees),
+            k_cos2a: laws[0],
+            k_adjusted: laws[1],
+            k_impact: laws[2],
+            regime,
+            status,
+            iterations: root.map(|r| r.evals as u64),
+            k_min: b.map(|b| b.lo),
+            k_max: b.map(|b| b.hi),
+            lower_limit: b.map_or("", |b| b.lower.name()),
+            upper_limit: b.map_or("", |b| b.upper.name()),
+            message,
+        }
+    }
+}
+
+impl AutoRecord {
+    /// The record of auto's choice of a model to invert eq 69 with.
+    pub(crate) fn of_choice(c: KChoice) -> Self {
+        AutoRecord {
+            model_used: c.choice.name(),
+            reason: c.reason,
+        }
+    }
+}
+
+/// The regime limits of a collision law at one ξ (`fitbead regimes`): δ_m (eq 32), δ_d
+/// (eq 31), the bulk friction of eq 79, and the law's critical ξ (eq 32 = eq 31), below which
+/// no steady regime exists. Angles in degrees.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct RegimeRecord {
+    /// Radius ratio ξ = R/r.
+    pub xi: f64,
+    /// α (eq 2).
+    pub alpha_deg: f64,
+    /// The law's K at this α.
+    #[serde(rename = "K")]
+    pub k: f64,
+    /// δ_m: below it the bead stops (eq 32).
+    pub delta_m_deg: f64,
+    /// δ_d: above it the bead lifts off (eq 31).
+    pub delta_d_deg: f64,
+    /// Bulk friction μ of eq 79.
+    pub mu_eq79: f64,
+    /// `yes` where δ_m < δ_d (a steady regime exists), else `no`.
+    pub steady_range: &'static str,
+    /// The law's critical ξ; empty where there is none.
+    pub critical_xi: Option<f64>,
+}
+
+impl RegimeRecord {
+    /// The records of the ξ of `xi` under `law` with gyration parameter `rho`.
+    pub fn table(xi: &[f64], law: CollisionLaw, rho: f64) -> Vec<RegimeRecord> {
+        use crate::models::regimes::{
+            alpha_of_xi, bulk_friction_law, critical_xi, delta_d_law, delta_m_law,
+        };
+        let critical = critical_xi(law, rho);
+        xi.iter()
+            .map(|&xi| {
+                let alpha = alpha_of_xi(xi);
+                let (dm, dd) = (delta_m_law(alpha, law, rho), delta_d_law(alpha, law, rho));
+                RegimeRecord {
+                    xi,
+                    alpha_deg: alpha.to_degrees(),
+                    k: law.k(alpha, rho),
+                    delta_m_deg: dm.to_degrees(),
+                    delta_d_deg: dd.to_degrees(),
+                    mu_eq79: bulk_friction_law(alpha, law, rho),
+                    steady_range: if dm < dd { "yes" } else { "no" },
+                    critical_xi: critical,
+                }
+            })
+            .collect()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    /// The output columns of `forward` and `k` as the documentation gives them
+    /// (docs/GUIDE.md): a contract users' scripts read, here checked against the columns
+    /// generated from the records.
     #[test]
-    fn cells_follow_the_csv_rules() {
-        assert_eq!(cell(serde_json::json!(2.0)).to_csv(), "2");
-        assert_eq!(cell(serde_json::json!(0.1)).to_csv(), "0.1");
-        assert_eq!(cell(serde_json::json!(-0.0)).to_csv(), "-0");
-        assert_eq!(cell(serde_json::json!(7u64)).to_csv(), "7");
-        assert_eq!(cell(serde_json::json!(1e300)).to_csv(), "1e300");
-        assert_eq!(cell(serde_json::to_value(f64::NAN).unwrap()), Cell::Empty);
+    fn forward_and_k_columns_are_the_documented_contract() {
+        use crate::io::{forward, kstream};
+        use crate::models::ModelKind;
+        let common = [
+            "v",
+            "regime",
+            "status",
+            "K_used",
+            "final_velocity",
+            "initial_velocity",
+            "contact_time",
+            "theta_G_deg",
+            "map_slope",
+            "other_fixed_point",
+            "phases",
+            "message",
+        ];
+        let contact = [
+            "phase_sequence",
+            "phase_change_deg",
+            "initial_spin",
+            "final_spin",
+            "beads",
+            "collision_translation_frac",
+            "collision_spin_frac",
+            "friction_work_frac",
+            "energy_closure",
+            "spin_rule",
+        ];
+        let auto = ["model_used", "reason"];
+        assert_eq!(forward::output_columns(ModelKind::Stick), common);
+        assert_eq!(forward::output_columns(ModelKind::Jaeger), common);
         assert_eq!(
-            cell(serde_json::to_value(None::<f64>).unwrap()),
-            Cell::Empty
+            forward::output_columns(ModelKind::Contact),
+            [&common[..], &contact].concat()
         );
-        assert_eq!(cell(serde_json::json!(true)).to_csv(), "true");
+        assert_eq!(
+            forward::output_columns(ModelKind::Auto),
+            [&common[..], &auto].concat()
+        );
+        let k = [
+            "series",
+            "xi",
+            "delta_deg",
+            "v",
+            "sigma_v",
+            "model",
+            "K",
+            "K_lo",
+            "K_hi",
+            "dv_dK",
+            "final_velocity",
+            "theta_G_deg",
+            "K_cos2a",
+            "K_adjusted",
+            "K_impact",
+            "regime",
+            "status",
+            "iterations",
+            "K_min",
+            "K_max",
+            "lower_limit",
+            "upper_limit",
+            "message",
+        ];
+        assert_eq!(kstream::output_columns(false), k);
+        assert_eq!(kstream::output_columns(true), [&k[..], &auto].concat());
+    }
+
+    /// The streaming writer ([`crate::io::cells::Cells::record`]) writes a record's cells as
+    /// [`each_cell`] sees them, with the bytes the `csv` crate writes for those cells: checked
+    /// on the records of scenes across every model (steady, stopped, lifted off, bistable, the
+    /// contact model's phases and auto's reasons) and of K estimates.
+    #[test]
+    fn the_streaming_writer_writes_the_records_cells() {
+        use crate::io::cells::Cells;
+        use crate::models::{ForwardModel, ModelKind};
+        use crate::record::cells;
+        fn check<R: Serialize>(r: &R) {
+            let mut out = Vec::new();
+            let mut w = Cells::new(&mut out);
+            w.record(r);
+            w.end();
+            let mut c = csv::Writer::from_writer(Vec::new());
+            c.write_record(cells(r).into_iter().map(|(_, c)| c.to_csv()))
+                .unwrap();
+            let expected = c.into_inner().unwrap();
+            assert_eq!(
+                String::from_utf8_lossy(&out),
+                String::from_utf8_lossy(&expected)
+            );
+        }
+        let mut written = 0;
+        for kind in [
+            ModelKind::Stick,
+            ModelKind::StickSlip,
+            ModelKind::Contact,
+            ModelKind::Jan,
+            ModelKind::Auto,
+        ] {
+            for (xi, delta) in [
+                (1.0, 3.0),
+                (1.0, 20.0),
+                (2.0, 26.0),
+                (0.6, 40.0),
+                (1.6, 14.0),
+            ] {
+                let scene = Scene::new(xi, delta, 0.4, 0.1, CollisionLaw::Adjusted).unwrap();
+                let model = match kind {
+                    ModelKind::Jan => {
+                        Model::Jan(crate::models::jan::Jan::paper_fit(scene.alpha_rad()))
+                    }
+                    ModelKind::Contact => Model::Contact(crate::models::contact::Contact {
+                        spin: SpinRule::Roll,
+                        tol: 1e-10,
+                    }),
+                    ModelKind::Auto => Model::Auto(Auto { tol: 1e-10 }),
+                    k => k.contact_model().unwrap(),
+                };
+                let (f, c, a) = ForwardRecord::evaluate(&scene, &model);
+                check(&f);
+                written += 1;
+                if let Some(c) = c {
+                    check(&c);
+                }
+                if let Some(a) = a {
+                    check(&a);
+                }
+                if let Ok(v) = model.evaluate(&scene).map(|s| s.mean_velocity) {
+                    for dv in [0.5, 1.0, 2.0] {
+                        let (k, a) =
+                            KRecord::estimate(&Model::Stick, None, &scene, v * dv, Some(0.01));
+                        check(&k);
+                        check(&a.unwrap_or_default());
+                    }
+                }
+            }
+        }
+        assert_eq!(written, 25);
+        check(&RegimeRecord::table(&[0.5, 1.0], CollisionLaw::Cos2a, 0.4)[0]);
     }
 
     #[test]

@@ -35,14 +35,29 @@ pub enum Regime {
     C,
 }
 
-impl fmt::Display for Regime {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let s = match self {
+impl Regime {
+    /// The regime of an outcome: B when steady, else the one its failure implies (none for
+    /// a failure that says nothing about the regime).
+    pub fn of(o: &Outcome) -> Option<Regime> {
+        match o {
+            Ok(_) => Some(Regime::B),
+            Err(e) => e.regime(),
+        }
+    }
+
+    /// The regime's letter.
+    pub fn letter(self) -> &'static str {
+        match self {
             Regime::A => "A",
             Regime::B => "B",
             Regime::C => "C",
-        };
-        f.write_str(s)
+        }
+    }
+}
+
+impl fmt::Display for Regime {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.letter())
     }
 }
 
@@ -198,14 +213,6 @@ impl fmt::Display for NotSteady {
 
 /// Result of one forward evaluation.
 pub type Outcome = std::result::Result<Steady, NotSteady>;
-
-/// Regime of an outcome (B when steady).
-pub fn regime_of(o: &Outcome) -> Option<Regime> {
-    match o {
-        Ok(_) => Some(Regime::B),
-        Err(e) => e.regime(),
-    }
-}
 
 /// A forward model: scene → steady mean velocity or the reason there is none.
 pub trait ForwardModel: Sync {

@@ -5,8 +5,10 @@ use super::{ForwardModel, Model};
 use crate::scene::{CollisionLaw, Scene};
 use crate::special::root::brent;
 
-/// Lower limit of the steady regime, δ_m = 2 atan(tan(α/2) (1−K)/(1+K)) (eq 32), radians.
-pub fn delta_m(alpha: f64, k: f64) -> f64 {
+/// Lower limit of the steady regime, δ_m = 2 atan(tan(α/2) (1−K)/(1+K)) (eq 32), radians
+/// (the tests' form at a given K; [`delta_m_law`] is the library's).
+#[cfg(test)]
+pub(crate) fn delta_m(alpha: f64, k: f64) -> f64 {
     delta_m_of(alpha, k, 1.0 - k)
 }
 
@@ -22,7 +24,7 @@ pub(crate) fn bulk_friction(alpha: f64, k: f64) -> f64 {
     bulk_friction_of(alpha, k, 1.0 - k)
 }
 
-/// [`delta_m`] for a collision law at α and ρ, with 1 − K from
+/// δ_m (eq 32) for a collision law at α and ρ, with 1 − K from
 /// [`CollisionLaw::one_minus_k`]: for a named law it keeps its relative accuracy as ξ → ∞,
 /// where 1 − K ≈ 2 sin²α and the 1 − K of a double K would cost about u/(2 sin²α).
 pub fn delta_m_law(alpha: f64, law: CollisionLaw, rho: f64) -> f64 {
@@ -117,12 +119,6 @@ pub fn critical_xi(law: CollisionLaw, rho: f64) -> Option<f64> {
 #[inline]
 pub(crate) fn vartheta(scene: &Scene, w0sq: f64) -> f64 {
     2.0 * scene.sc_0.c + (1.0 + scene.rho) * w0sq
-}
-
-/// Friction demand H(Θ) = T/N = ρ sin Θ / ((3+ρ) cos Θ − ϑ) of rolling from Θ0 with squared
-/// speed `w0sq` (eq 35). Rolling holds while |H| ≤ f.
-pub fn friction_demand(scene: &Scene, w0sq: f64, theta: f64) -> f64 {
-    scene.rho * theta.sin() / ((3.0 + scene.rho) * theta.cos() - vartheta(scene, w0sq))
 }
 
 /// Θ_G: the angle where rolling from Θ0 with squared speed `w0sq` first needs more friction

@@ -12,29 +12,15 @@ use crate::fit::summary::{FitResult, ParamRow};
 use crate::inverse::{CurveModel as _, Residuals, SigmaKind};
 use crate::models::energy;
 use crate::models::regimes::{bulk_friction, critical_xi, delta_d_law, delta_m_law};
-use crate::models::{regime_of, ForwardModel, JaegerBranch, Model, Regime};
+use crate::models::{ForwardModel, JaegerBranch, Model, Regime};
 use crate::numfmt::fmt_f64;
 use crate::progress::{Progress, ProgressEvent};
+use crate::record::to_csv;
 use crate::scene::CollisionLaw;
 use rayon::prelude::*;
+use serde::Serialize;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
-
-/// The contract columns of the bulk-friction table, in order.
-pub(crate) const MU_COLUMNS: [&str; 12] = [
-    "series",
-    "xi",
-    "mu_jan",
-    "mu_jan_lo",
-    "mu_jan_hi",
-    "K_source",
-    "K",
-    "mu_eq79",
-    "mu_eq79_lo",
-    "mu_eq79_hi",
-    "rel_diff",
-    "intervals_overlap",
-];
 
 /// The two collision models whose K is fitted: pure rolling (the paper's stick model) and
 /// stick/slip.
@@ -321,10 +307,6 @@ fn num(x: f64) -> String {
     }
 }
 
-fn opt(x: Option<f64>) -> String {
-    x.filter(|v| v.is_finite()).map(fmt_f64).unwrap_or_default()
-}
-
 /// One row of the bulk-friction table.
 #[derive(Debug, Clone)]
 pub struct MuRow {
@@ -355,6 +337,94 @@ impl MuRow {
     pub fn overlap(&self) -> bool {
         self.mu_eq79.1 <= self.mu_jan.2 && self.mu_jan.1 <= self.mu_eq79.2
     }
+}
+
+/// One row of bulk_friction.csv: Jan's μ of a series against eq 79's μ at one fitted K, with
+/// their intervals, and the paper's eq 76.
+#[derive(Debug, Clone, Default, Serialize)]
+pub(crate) struct MuRecord {
+    series: String,
+    xi: f64,
+    mu_jan: f64,
+    mu_jan_lo: f64,
+    mu_jan_hi: f64,
+    #[serde(rename = "K_source")]
+    k_source: String,
+    #[serde(rename = "K")]
+    k: f64,
+    mu_eq79: f64,
+    mu_eq79_lo: f64,
+    mu_eq79_hi: f64,
+    rel_diff: f64,
+    intervals_overlap: bool,
+    alpha_deg: f64,
+    #[serde(rename = "K_lo")]
+    k_lo: f64,
+    #[serde(rename = "K_hi")]
+    k_hi: f64,
+    mu_eq76: f64,
+    rel_diff_eq76: f64,
+    level: f64,
+}
+
+impl MuRecord {
+    /// The record of `r`, whose intervals are at confidence `level`.
+    fn new(r: &MuRow, level: f64) -> Self {
+        MuRecord {
+            series: r.series.clone(),
+            xi: r.xi,
+            mu_jan: r.mu_jan.0,
+            mu_jan_lo: r.mu_jan.1,
+            mu_jan_hi: r.mu_jan.2,
+            k_source: r.k_source.clone(),
+            k: r.k.0,
+            mu_eq79: r.mu_eq79.0,
+            mu_eq79_lo: r.mu_eq79.1,
+            mu_eq79_hi: r.mu_eq79.2,
+            rel_diff: r.rel_diff(),
+            intervals_overlap: r.overlap(),
+            alpha_deg: r.alpha.to_degrees(),
+            k_lo: r.k.1,
+            k_hi: r.k.2,
+            mu_eq76: r.mu_eq76,
+            rel_diff_eq76: (r.mu_eq79.0 - r.mu_eq76) / r.mu_eq76,
+            level,
+        }
+    }
+}
+
+/// One row of energy.csv: a point's energy budget under a contact model at the K of its law-c
+/// fit (fractions of the potential drop 2 sin α sin δ), or Jan's eq 77 ratio.
+#[derive(Debug, Clone, Default, Serialize)]
+pub(crate) struct EnergyRecord {
+    series: String,
+    xi: f64,
+    delta_deg: f64,
+    v: f64,
+    model: String,
+    #[serde(rename = "K")]
+    k: Option<f64>,
+    potential_drop: Option<f64>,
+    collision_translation: Option<f64>,
+    collision_spin: Option<f64>,
+    collision: Option<f64>,
+    friction: Option<f64>,
+    closure: Option<f64>,
+    status: &'static str,
+}
+
+/// One row of regime_map.csv: δ_m (eq 32) and δ_d (eq 31) of a law at one ξ, and the law's
+/// critical ξ.
+#[derive(Debug, Clone, Default, Serialize)]
+pub(crate) struct RegimeMapRecord {
+    law: String,
+    xi: f64,
+    alpha_deg: f64,
+    #[serde(rename = "K")]
+    k: f64,
+    delta_m_deg: f64,
+    delta_d_deg: f64,
+    critical_xi: Option<f64>,
 }
 
 impl Analysis {
@@ -408,114 +478,56 @@ impl Analysis {
         out
     }
 
-    /// The bulk-friction table as CSV (`MU_COLUMNS`, then `alpha_deg,K_lo,K_hi,mu_eq76,
-    /// rel_diff_eq76,level`).
+    /// The bulk-friction table as CSV, one [`MuRecord`] per row.
     pub fn mu_csv(&self) -> csv::Result<Vec<u8>> {
-        let mut w = csv::Writer::from_writer(Vec::new());
-        let mut h: Vec<&str> = MU_COLUMNS.to_vec();
-        h.extend([
-            "alpha_deg",
-            "K_lo",
-            "K_hi",
-            "mu_eq76",
-            "rel_diff_eq76",
-            "level",
-        ]);
-        w.write_record(&h)?;
-        for r in self.mu_rows() {
-            w.write_record([
-                r.series.clone(),
-                fmt_f64(r.xi),
-                fmt_f64(r.mu_jan.0),
-                fmt_f64(r.mu_jan.1),
-                fmt_f64(r.mu_jan.2),
-                r.k_source.clone(),
-                fmt_f64(r.k.0),
-                fmt_f64(r.mu_eq79.0),
-                fmt_f64(r.mu_eq79.1),
-                fmt_f64(r.mu_eq79.2),
-                fmt_f64(r.rel_diff()),
-                r.overlap().to_string(),
-                fmt_f64(r.alpha.to_degrees()),
-                fmt_f64(r.k.1),
-                fmt_f64(r.k.2),
-                fmt_f64(r.mu_eq76),
-                fmt_f64((r.mu_eq79.0 - r.mu_eq76) / r.mu_eq76),
-                fmt_f64(self.level),
-            ])?;
-        }
-        w.into_inner().map_err(|e| e.into_error().into())
+        to_csv(self.mu_rows().iter().map(|r| MuRecord::new(r, self.level)))
     }
 
     /// Energy budget per point: rolling and stick/slip at the K of their law-c fits, and
     /// Jan's eq 77 ratio with the series' λ. Fractions of the potential drop 2 sin α sin δ.
     pub fn energy_csv(&self) -> csv::Result<Vec<u8>> {
-        let mut w = csv::Writer::from_writer(Vec::new());
-        w.write_record([
-            "series",
-            "xi",
-            "delta_deg",
-            "v",
-            "model",
-            "K",
-            "potential_drop",
-            "collision_translation",
-            "collision_spin",
-            "collision",
-            "friction",
-            "closure",
-            "status",
-        ])?;
+        let mut rows = Vec::new();
         for c in &self.contact {
             let Some(f) = &c.law_c else { continue };
             for ((p, &k), part) in c.data.points.iter().zip(&f.k).zip(&c.energy) {
-                let mut row = vec![
-                    c.data.labels[p.series].clone(),
-                    fmt_f64(p.scene.xi),
-                    fmt_f64(p.scene.delta_deg()),
-                    fmt_f64(p.v),
-                    c.name.to_string(),
-                    fmt_f64(k),
-                ];
-                match part {
-                    Some(e) => {
-                        let d = e.potential_drop;
-                        row.extend([
-                            fmt_f64(d),
-                            fmt_f64(e.collision_translation / d),
-                            fmt_f64(e.collision_spin / d),
-                            fmt_f64(e.collision_fraction()),
-                            fmt_f64(e.friction_work / d),
-                            fmt_f64(e.closure()),
-                            "ok".into(),
-                        ]);
-                    }
-                    None => {
-                        row.extend(vec![String::new(); 6]);
-                        row.push("not-steady".into());
-                    }
+                let mut r = EnergyRecord {
+                    series: c.data.labels[p.series].clone(),
+                    xi: p.scene.xi,
+                    delta_deg: p.scene.delta_deg(),
+                    v: p.v,
+                    model: c.name.to_string(),
+                    k: Some(k),
+                    status: "not-steady",
+                    ..EnergyRecord::default()
+                };
+                if let Some(e) = part {
+                    let d = e.potential_drop;
+                    r.potential_drop = Some(d);
+                    r.collision_translation = Some(e.collision_translation / d);
+                    r.collision_spin = Some(e.collision_spin / d);
+                    r.collision = Some(e.collision_fraction());
+                    r.friction = Some(e.friction_work / d);
+                    r.closure = Some(e.closure());
+                    r.status = "ok";
                 }
-                w.write_record(&row)?;
+                rows.push(r);
             }
         }
         for (s, p, d, ratio) in self.jan_eq77() {
-            w.write_record([
-                self.data.labels[s].clone(),
-                fmt_f64(p.scene.xi),
-                fmt_f64(p.scene.delta_deg()),
-                fmt_f64(p.v),
-                "jan-eq77".into(),
-                String::new(),
-                fmt_f64(d),
-                String::new(),
-                String::new(),
-                fmt_f64(ratio),
-                fmt_f64(1.0 - ratio),
-                String::new(),
-                "ok".into(),
-            ])?;
+            rows.push(EnergyRecord {
+                series: self.data.labels[s].clone(),
+                xi: p.scene.xi,
+                delta_deg: p.scene.delta_deg(),
+                v: p.v,
+                model: "jan-eq77".into(),
+                potential_drop: Some(d),
+                collision: Some(ratio),
+                friction: Some(1.0 - ratio),
+                status: "ok",
+                ..EnergyRecord::default()
+            });
         }
-        w.into_inner().map_err(|e| e.into_error().into())
+        to_csv(rows)
     }
 
     /// Jan's eq 77 per point of every fitted series: (series, point, potential drop
@@ -589,34 +601,24 @@ impl Analysis {
     /// the critical ξ of each law.
     pub fn regime_map_csv(&self) -> csv::Result<Vec<u8>> {
         let rho = self.rho();
-        let mut w = csv::Writer::from_writer(Vec::new());
-        w.write_record([
-            "law",
-            "xi",
-            "alpha_deg",
-            "K",
-            "delta_m_deg",
-            "delta_d_deg",
-            "critical_xi",
-        ])?;
+        let mut rows = Vec::new();
         for (name, law) in self.map_laws() {
             let crit = critical_xi(law, rho);
             for i in 0..=80 {
                 let xi = 0.5 * 40f64.powf(i as f64 / 80.0);
                 let a = crate::models::regimes::alpha_of_xi(xi);
-                let k = law.k(a, rho);
-                w.write_record([
-                    name.clone(),
-                    fmt_f64(xi),
-                    fmt_f64(a.to_degrees()),
-                    fmt_f64(k),
-                    fmt_f64(delta_m_law(a, law, rho).to_degrees()),
-                    fmt_f64(delta_d_law(a, law, rho).to_degrees()),
-                    opt(crit),
-                ])?;
+                rows.push(RegimeMapRecord {
+                    law: name.clone(),
+                    xi,
+                    alpha_deg: a.to_degrees(),
+                    k: law.k(a, rho),
+                    delta_m_deg: delta_m_law(a, law, rho).to_degrees(),
+                    delta_d_deg: delta_d_law(a, law, rho).to_degrees(),
+                    critical_xi: crit,
+                });
             }
         }
-        w.into_inner().map_err(|e| e.into_error().into())
+        to_csv(rows)
     }
 
     /// The regime each contact model (at its law-c fit) assigns to every data point.
@@ -638,7 +640,7 @@ impl Analysis {
                         };
                         let k = k_of_c(p.scene.alpha, cv);
                         match p.scene.with_k(k) {
-                            Ok(sc) => match regime_of(&c.model.evaluate(&sc)) {
+                            Ok(sc) => match Regime::of(&c.model.evaluate(&sc)) {
                                 Some(Regime::A) => "A".into(),
                                 Some(Regime::B) => "B".into(),
                                 Some(Regime::C) => "C".into(),

@@ -88,6 +88,69 @@ pub(crate) const REPORT_FILES: [&str; 19] = [
 
 #[cfg(test)]
 mod tests {
+    use super::analysis::{EnergyRecord, MuRecord, RegimeMapRecord};
+    use crate::record::columns;
+
+    /// The columns of the report's record tables, a contract users' scripts read (as
+    /// docs/GUIDE.md lists bulk_friction.csv's and the shipped fits/default/ has all three),
+    /// against the columns generated from the records.
+    #[test]
+    fn report_table_columns_are_the_documented_contract() {
+        assert_eq!(
+            columns::<MuRecord>(),
+            [
+                "series",
+                "xi",
+                "mu_jan",
+                "mu_jan_lo",
+                "mu_jan_hi",
+                "K_source",
+                "K",
+                "mu_eq79",
+                "mu_eq79_lo",
+                "mu_eq79_hi",
+                "rel_diff",
+                "intervals_overlap",
+                "alpha_deg",
+                "K_lo",
+                "K_hi",
+                "mu_eq76",
+                "rel_diff_eq76",
+                "level"
+            ]
+        );
+        assert_eq!(
+            columns::<EnergyRecord>(),
+            [
+                "series",
+                "xi",
+                "delta_deg",
+                "v",
+                "model",
+                "K",
+                "potential_drop",
+                "collision_translation",
+                "collision_spin",
+                "collision",
+                "friction",
+                "closure",
+                "status"
+            ]
+        );
+        assert_eq!(
+            columns::<RegimeMapRecord>(),
+            [
+                "law",
+                "xi",
+                "alpha_deg",
+                "K",
+                "delta_m_deg",
+                "delta_d_deg",
+                "critical_xi"
+            ]
+        );
+    }
+
     #[test]
     fn series_labels_become_safe_unique_file_names() {
         let labels: Vec<String> = ["../../x/evil", "a|b\nc", "0.8", "a_b_c", "a/b/c", "", ".."]

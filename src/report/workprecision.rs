@@ -10,26 +10,14 @@ use crate::models::contact::{Contact, PhaseKind, SpinRule};
 pub(crate) use crate::models::sample::{draw_scenes, Draw};
 use crate::models::slip::SlipPhase;
 use crate::models::{slip, stick, stickquad, stickslip, Model, Outcome, Phases};
-use crate::numfmt::fmt_f64;
 use crate::progress::Interrupted;
+use crate::record::to_csv;
 use crate::scene::Scene;
 use crate::special::quad::{integrate, QuadOptions};
+use serde::Serialize;
 use std::hint::black_box;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
-
-/// The contract columns of the CSV.
-pub(crate) const COLUMNS: [&str; 9] = [
-    "model",
-    "method",
-    "tolerance",
-    "scenes",
-    "err_median",
-    "err_p99",
-    "err_max",
-    "ns_median",
-    "ns_p99",
-];
 
 /// Tolerances of the quadrature variants.
 pub(crate) const TOLS: [f64; 6] = [1e-4, 1e-6, 1e-8, 1e-10, 1e-12, 1e-14];
@@ -330,27 +318,57 @@ fn time_one(f: &dyn Fn(&Scene) -> Outcome, s: &Scene, first: Duration) -> f64 {
     t0.elapsed().as_nanos() as f64 / reps as f64
 }
 
-/// One row of the work-precision table.
-#[derive(Debug, Clone, PartialEq)]
+/// One row of the work-precision table (`fitbead bench`): a method's relative errors against
+/// the reference and its time per evaluation. Errors are written with four significant
+/// digits, times in whole nanoseconds.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct WpRow {
     /// Model name.
     pub model: String,
     /// Method name.
     pub method: String,
     /// Tolerance (when the method has one).
+    #[serde(rename = "tolerance")]
     pub tol: Option<f64>,
     /// Scenes counted (the reference steady, or the variant steady).
     pub scenes: usize,
     /// Median relative error.
+    #[serde(serialize_with = "error_cell")]
     pub err_median: f64,
     /// 99th percentile of the relative error.
+    #[serde(serialize_with = "error_cell")]
     pub err_p99: f64,
     /// Maximum relative error.
+    #[serde(serialize_with = "error_cell")]
     pub err_max: f64,
     /// Median time per evaluation, ns.
+    #[serde(serialize_with = "ns_cell")]
     pub ns_median: Option<f64>,
     /// 99th percentile of the time per evaluation, ns.
+    #[serde(serialize_with = "ns_cell")]
     pub ns_p99: Option<f64>,
+}
+
+/// A relative error as its cell: four significant digits, `0`, `inf`, or empty for NaN.
+fn error_cell<S: serde::Serializer>(x: &f64, s: S) -> Result<S::Ok, S::Error> {
+    let x = *x;
+    if x.is_nan() {
+        s.serialize_none()
+    } else if x.is_infinite() {
+        s.serialize_str("inf")
+    } else if x == 0.0 {
+        s.serialize_str("0")
+    } else {
+        s.collect_str(&format_args!("{x:.3e}"))
+    }
+}
+
+/// A time as its cell: whole nanoseconds, or empty.
+fn ns_cell<S: serde::Serializer>(x: &Option<f64>, s: S) -> Result<S::Ok, S::Error> {
+    match x {
+        Some(t) => s.collect_str(&format_args!("{t:.0}")),
+        None => s.serialize_none(),
+    }
 }
 
 fn quantile(sorted: &[f64], q: f64) -> f64 {
@@ -606,37 +624,9 @@ pub(crate) fn run_bench_until(
     })
 }
 
-/// The CSV of the rows.
+/// The CSV of the rows (one [`WpRow`] record each).
 pub fn render(rows: &[WpRow]) -> csv::Result<Vec<u8>> {
-    let mut w = csv::Writer::from_writer(Vec::new());
-    w.write_record(COLUMNS)?;
-    let opt = |x: Option<f64>| x.map(fmt_f64).unwrap_or_default();
-    let e = |x: f64| {
-        if x.is_nan() {
-            String::new()
-        } else if x.is_infinite() {
-            "inf".to_string()
-        } else if x == 0.0 {
-            "0".to_string()
-        } else {
-            format!("{x:.3e}")
-        }
-    };
-    let ns = |x: Option<f64>| x.map(|t| format!("{t:.0}")).unwrap_or_default();
-    for r in rows {
-        w.write_record([
-            r.model.clone(),
-            r.method.clone(),
-            opt(r.tol),
-            r.scenes.to_string(),
-            e(r.err_median),
-            e(r.err_p99),
-            e(r.err_max),
-            ns(r.ns_median),
-            ns(r.ns_p99),
-        ])?;
-    }
-    w.into_inner().map_err(|e| csv::Error::from(e.into_error()))
+    to_csv(rows.iter().cloned())
 }
 
 /// Reads back the rows [`render`] wrote (a `bench --output` file), to re-plot measured rows
@@ -645,8 +635,9 @@ pub fn render(rows: &[WpRow]) -> csv::Result<Vec<u8>> {
 pub(crate) fn read_rows(csv_bytes: &[u8]) -> Result<Vec<WpRow>, String> {
     let mut r = csv::Reader::from_reader(csv_bytes);
     let h = r.headers().map_err(|e| e.to_string())?.clone();
-    if h.iter().collect::<Vec<_>>() != COLUMNS {
-        return Err(format!("expected the columns {}", COLUMNS.join(",")));
+    let columns = crate::record::columns::<WpRow>();
+    if h.iter().collect::<Vec<_>>() != columns {
+        return Err(format!("expected the columns {}", columns.join(",")));
     }
     let num = |s: &str| -> Result<f64, String> {
         match s {
@@ -751,7 +742,27 @@ pub(crate) fn plot(rows: &[WpRow], title: &str) -> Result<String, String> {
 
 #[cfg(test)]
 mod tests {
-    use super::{read_rows, render};
+    use super::{read_rows, render, WpRow};
+
+    /// The columns of `fitbead bench`'s table as docs/GUIDE.md lists them (a contract),
+    /// against the columns generated from the record.
+    #[test]
+    fn wp_columns_are_the_documented_contract() {
+        assert_eq!(
+            crate::record::columns::<WpRow>(),
+            [
+                "model",
+                "method",
+                "tolerance",
+                "scenes",
+                "err_median",
+                "err_p99",
+                "err_max",
+                "ns_median",
+                "ns_p99"
+            ]
+        );
+    }
 
     /// The committed work-precision table reads back into rows that render to the same bytes
     /// (so `examples/wp_plot.rs` re-plots exactly the measured values).

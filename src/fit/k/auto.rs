@@ -16,7 +16,7 @@ use crate::scene::Scene;
 
 /// The model auto uses to invert one point, and why.
 #[derive(Debug, Clone, PartialEq)]
-pub struct KChoice {
+pub(crate) struct KChoice {
     /// The model to invert eq 69 with.
     pub model: Model,
     /// Which model that is.
@@ -27,7 +27,7 @@ pub struct KChoice {
 
 /// The K estimate of one measurement (eq 69) under `model`, or under the model `auto`
 /// chooses for it (`choose`) when `auto` is given, with that choice.
-pub fn estimate_with(
+pub(crate) fn estimate_with(
     model: &Model,
     auto: Option<&Auto>,
     scene: &Scene,

@@ -1094,8 +1094,6 @@ impl SlipStick<'_> {
                 }
                 (pa, ga_, sa_) = (pb, gb_, sb_);
             }
-            t_known = pa;
-            g_known = ga_;
             let Some((d0, g0, s0, d1, g1, s1)) = found else {
                 t_known = d1;
                 g_known = ga_;

@@ -357,6 +357,10 @@ impl MuRow {
     }
 }
 
+/// One row of the per-series model table before its criteria: series, model, n_points,
+/// chi2, n_params, and whether the parameters are shared across series.
+type SeriesRecord = (String, String, usize, f64, usize, bool);
+
 impl Analysis {
     /// The bulk-friction comparison: per series with a Jan fit, per fitted K.
     pub fn mu_rows(&self) -> Vec<MuRow> {
@@ -850,14 +854,10 @@ impl Analysis {
         out
     }
 
-    /// χ², AIC and BIC per series of every candidate (at the least-squares optimum; ∞ where a
-    /// point of the series has no steady state under the candidate), as CSV: series, model,
-    /// n_points, chi2, then n_params (the parameters the series' fit uses), shared_params (yes
-    /// when they are fitted across all series, as law c and Jan's global laws: the per-series
-    /// AIC then charges each series the whole shared count, a conservative convention), aic,
-    /// bic, delta_aic, delta_bic and rank (by AIC) within the series.
-    pub fn models_by_series_csv(&self) -> csv::Result<Vec<u8>> {
-        let ns = self.data.labels.len();
+    /// χ² and points per series of every contact-model candidate (K = cos 2α, K = impact,
+    /// law c, free K per series), by candidate name; ∞ where a point of the series has no
+    /// steady state under the candidate.
+    fn contact_chi2_by_series(&self) -> Vec<(String, Vec<(usize, f64)>)> {
         let mut rows: Vec<(String, Vec<(usize, f64)>)> = Vec::new();
         let per_point = |c: &ContactFits, k: &(dyn Fn(usize) -> f64 + Sync)| -> Vec<(usize, f64)> {
             let r: Vec<(usize, f64)> = c
@@ -906,9 +906,16 @@ impl Analysis {
                 ));
             }
         }
+        rows
+    }
+
+    /// The records of [`Analysis::models_by_series_csv`], every candidate per series.
+    fn series_records(&self) -> Vec<SeriesRecord> {
+        let ns = self.data.labels.len();
+        let rows = self.contact_chi2_by_series();
         // Series labels of a contact model's subset map back to the full data by name.
         // (series, model, n_points, chi2, n_params, shared)
-        let mut recs: Vec<(String, String, usize, f64, usize, bool)> = Vec::new();
+        let mut recs: Vec<SeriesRecord> = Vec::new();
         for c in &self.contact {
             for (name, acc) in rows.iter().filter(|r| r.0.starts_with(c.name)) {
                 let (k, shared) = if name.ends_with("law c") {
@@ -965,6 +972,17 @@ impl Analysis {
                 ));
             }
         }
+        recs
+    }
+
+    /// χ², AIC and BIC per series of every candidate (at the least-squares optimum; ∞ where a
+    /// point of the series has no steady state under the candidate), as CSV: series, model,
+    /// n_points, chi2, then n_params (the parameters the series' fit uses), shared_params (yes
+    /// when they are fitted across all series, as law c and Jan's global laws: the per-series
+    /// AIC then charges each series the whole shared count, a conservative convention), aic,
+    /// bic, delta_aic, delta_bic and rank (by AIC) within the series.
+    pub fn models_by_series_csv(&self) -> csv::Result<Vec<u8>> {
+        let recs = self.series_records();
         let cands: Vec<Candidate> = recs
             .iter()
             .map(|r| Candidate::new(r.1.clone(), r.4, r.2, r.3, self.data.sigma, String::new()))

@@ -165,18 +165,7 @@ pub fn report(
     if s.stopped() {
         return Err(RunError::Interrupted);
     }
-    let under_none: Vec<&(usize, String)> = unsteady[0]
-        .iter()
-        .filter(|(i, _)| unsteady[1..].iter().all(|u| u.iter().any(|(j, _)| j == i)))
-        .collect();
-    if let Some((i, why)) = under_none.first() {
-        return Err(RunError::Failed(format!(
-            "{}: {why} (and {} more such point(s)); no K of the rolling or stick/slip model \
-             makes this point steady: leave it out of the data",
-            locate_point(t, ds, *i),
-            under_none.len() - 1
-        )));
-    }
+    refuse_unsteady_under_all(&unsteady, t, ds)?;
     let implausible = crate::io::measurements::plausibility(t, rows);
     let mut input_warnings = Vec::new();
     for (u, name) in unsteady.iter().zip(CONTACT_NAMES) {
@@ -319,6 +308,28 @@ fn figure_settings(s: &ReportSettings) -> Result<(FigureFormat, Option<FigureWid
         None => None,
     };
     Ok((format, figure_width))
+}
+
+/// An error naming the first point steady under none of the contact models (`unsteady`:
+/// per model, the points it cannot make steady, with why).
+fn refuse_unsteady_under_all(
+    unsteady: &[Vec<(usize, String)>],
+    t: &Table,
+    ds: &Dataset,
+) -> Result<(), RunError> {
+    let under_none: Vec<&(usize, String)> = unsteady[0]
+        .iter()
+        .filter(|(i, _)| unsteady[1..].iter().all(|u| u.iter().any(|(j, _)| j == i)))
+        .collect();
+    if let Some((i, why)) = under_none.first() {
+        return Err(RunError::Failed(format!(
+            "{}: {why} (and {} more such point(s)); no K of the rolling or stick/slip model \
+             makes this point steady: leave it out of the data",
+            locate_point(t, ds, *i),
+            under_none.len() - 1
+        )));
+    }
+    Ok(())
 }
 
 /// The K(α) laws `klaw` would have refused to fit (on the points each model keeps), in

@@ -353,20 +353,20 @@ fn csv_error(e: csv::Error) -> RunError {
 /// The tables of the analysis: bulk friction, energy, the regime map, the points and the
 /// model rankings.
 fn analysis_tables(an: &Analysis) -> Result<Vec<(String, Vec<u8>)>, RunError> {
-    let mut files: Vec<(String, Vec<u8>)> = Vec::new();
-    files.push(("bulk_friction.csv".into(), an.mu_csv().map_err(csv_error)?));
-    files.push(("energy.csv".into(), an.energy_csv().map_err(csv_error)?));
-    files.push((
-        "regime_map.csv".into(),
-        an.regime_map_csv().map_err(csv_error)?,
-    ));
-    files.push(("points.csv".into(), an.points_csv().map_err(csv_error)?));
-    files.push(("models.csv".into(), an.models_csv().map_err(csv_error)?));
-    files.push((
-        "models_by_series.csv".into(),
-        an.models_by_series_csv().map_err(csv_error)?,
-    ));
-    Ok(files)
+    Ok(vec![
+        ("bulk_friction.csv".into(), an.mu_csv().map_err(csv_error)?),
+        ("energy.csv".into(), an.energy_csv().map_err(csv_error)?),
+        (
+            "regime_map.csv".into(),
+            an.regime_map_csv().map_err(csv_error)?,
+        ),
+        ("points.csv".into(), an.points_csv().map_err(csv_error)?),
+        ("models.csv".into(), an.models_csv().map_err(csv_error)?),
+        (
+            "models_by_series.csv".into(),
+            an.models_by_series_csv().map_err(csv_error)?,
+        ),
+    ])
 }
 
 /// Every fit whose misfit is absurd for the σ given, flagged in its note and in `warnings`.

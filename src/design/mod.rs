@@ -297,37 +297,12 @@ enum Target {
     Mu(usize),
 }
 
-/// The optimal design for `s` (see the module docs for the method).
+/// The optimal design for `s` (see the module docs for the method), in stages: the problem
+/// and its candidate slopes, the draws the criterion is averaged over, the approximate
+/// design and its rounding to points, then the comparison with evenly spaced slopes.
 pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
     check(s)?;
-    let model = match (s.fit, s.model) {
-        (DesignFit::KLaw, m) => {
-            let kind = m.unwrap_or(ModelKind::StickSlip);
-            kind.contact_model().ok_or_else(|| {
-                DesignError::new(
-                    "model",
-                    &kind_name(kind),
-                    "the K-law fits need a contact model (stick, stick-approx, slip, \
-                     slip-approx, stickslip, contact or auto)",
-                )
-            })?
-        }
-        (DesignFit::Jan, None | Some(ModelKind::Jan))
-        | (DesignFit::Jaeger, None | Some(ModelKind::Jaeger)) => crate::models::Model::StickSlip,
-        (fit, Some(kind)) => {
-            return Err(DesignError::new(
-                "model",
-                &kind_name(kind),
-                format!(
-                    "the {} fit has its own model: leave --model out",
-                    match fit {
-                        DesignFit::Jan => "jan",
-                        _ => "jaeger",
-                    }
-                ),
-            ))
-        }
-    };
+    let model = design_model(s)?;
     let prob = problem::problem(s.fit, model, s.law, &s.series, s.rho, s.f, s.branch)?;
     let p = prob.names.len();
     let priors = prior_indices(s, &prob)?;
@@ -336,26 +311,7 @@ pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
         _ => None,
     };
     let ranges = ranges(s, &prob, rival_prob.as_ref())?;
-    // Candidates at the guess, series by series.
-    let mut cands = Vec::new();
-    let mut strata: Vec<Vec<usize>> = Vec::new();
-    for (k, &(lo, hi)) in ranges.iter().enumerate() {
-        let mut st = Vec::new();
-        for i in 0..s.grid {
-            let d = round_deg(lo + (hi - lo) * i as f64 / (s.grid - 1) as f64);
-            if let Some(c) = candidate(s, &prob, k, d) {
-                st.push(cands.len());
-                cands.push(c);
-            }
-        }
-        if st.is_empty() {
-            return Err(no_range(
-                s.series[k],
-                "no slope of its range has a steady state",
-            ));
-        }
-        strata.push(st);
-    }
+    let (cands, strata) = candidate_grid(s, &prob, &ranges)?;
     let n_series = s.series.len();
     // Points per series of the evenly spaced design (the budget shared out as evenly as it
     // goes under a total).
@@ -370,23 +326,7 @@ pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
         Criterion::C => Some(target_index(s, &prob)?),
         _ => None,
     };
-    // The evenly spaced comparison design.
-    let mut even_cands = Vec::new();
-    for (k, &(lo, hi)) in ranges.iter().enumerate() {
-        let m = even_counts[k];
-        for j in 0..m {
-            let frac = if m == 1 {
-                0.5
-            } else {
-                j as f64 / (m - 1) as f64
-            };
-            let d = round_deg(lo + (hi - lo) * frac);
-            let c = candidate(s, &prob, k, d).ok_or_else(|| {
-                no_range(s.series[k], "an evenly spaced slope has no steady state")
-            })?;
-            even_cands.push(c);
-        }
-    }
+    let even_cands = even_design(s, &prob, &ranges, &even_counts)?;
     let ones = vec![1.0; even_cands.len()];
     // The draws the criterion is averaged over: the guess alone, or draws from the priors.
     let target_c = |theta: &[f64]| -> Option<Vec<f64>> {
@@ -426,43 +366,13 @@ pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
         (d, e, Some((n, redrawn)))
     };
     let series_of: Vec<usize> = cands.iter().map(|c| c.series).collect();
-    let label = |k: Target| match k {
-        Target::Param(k) => prob.names[k].clone(),
-        Target::Mu(k) => prob.mu_names()[k].clone(),
-    };
-    let (approx, sens_label, rival, strata, alg) = match s.criterion {
-        Criterion::D => {
-            let alg = algorithm_strata(s, &strata);
-            (
-                optimal::multiplicative(&draws, &alg.0, &alg.1, p, Crit::D),
-                "standardised variance d/λ (D)".to_string(),
-                None,
-                strata,
-                alg,
-            )
-        }
-        Criterion::C => {
-            let k = target.expect("c has a target");
-            let alg = algorithm_strata(s, &strata);
-            (
-                optimal::multiplicative(&draws, &alg.0, &alg.1, p, Crit::C),
-                format!("information on {} ψ/λ (c)", label(k)),
-                None,
-                strata,
-                alg,
-            )
-        }
-        Criterion::T => {
-            let (a, rival, st, alg) = t_design(s, &prob, &cands, &strata)?;
-            (
-                a,
-                "squared distance to the rival ψ/λ (T)".to_string(),
-                Some(rival),
-                st,
-                alg,
-            )
-        }
-    };
+    let Approximate {
+        approx,
+        sens_label,
+        rival,
+        strata,
+        alg,
+    } = approximate(s, &prob, &draws, &cands, strata, target)?;
     let counts: Vec<usize> = alg.1.iter().map(|&n| n as usize).collect();
     let exact = optimal::round(&alg.0, &counts, &approx, &series_of);
     // A Bayesian design's exact slopes are improved on the averaged criterion itself.
@@ -471,99 +381,15 @@ pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
         (Some(_), Criterion::C) => optimal::exchange(&draws, &alg.0, &exact, p, Crit::C),
         _ => exact,
     };
-    let mut w = vec![0.0; cands.len()];
-    let mut rows = Vec::new();
-    for st in &exact {
-        for &(j, n) in st {
-            w[j] = n as f64;
-            let c = &cands[j];
-            rows.push(row(s.series[c.series], c.delta, n));
-        }
-    }
+    let (w, rows) = exact_rows(s, &cands, &exact);
     let even: Vec<DesignRow> = even_cands
         .iter()
         .map(|c| row(s.series[c.series], c.delta, 1))
         .collect();
-    let m_design: Vec<_> = draws.iter().map(|d| information(&d.cands, &w, p)).collect();
-    let m_even: Vec<_> = even_draws
-        .iter()
-        .map(|d| information(&d.cands, &ones, p))
-        .collect();
-    // Each variance averaged over the draws (the expected posterior variance of a Bayesian
-    // design); undetermined where any draw leaves it undetermined.
-    let mean_var = |ms: &[nalgebra::DMatrix<f64>],
-                    f: &dyn Fn(usize, &nalgebra::DMatrix<f64>) -> Option<f64>| {
-        let mut sum = 0.0;
-        for (i, m) in ms.iter().enumerate() {
-            sum += f(i, m)?;
-        }
-        Some(sum / ms.len() as f64)
-    };
-    let vd: Vec<Vec<Option<f64>>> = m_design.iter().map(variances).collect();
-    let ve: Vec<Vec<Option<f64>>> = m_even.iter().map(variances).collect();
-    let v_design: Vec<Option<f64>> = (0..p)
-        .map(|k| mean_var(&m_design, &|i, _| vd[i][k]))
-        .collect();
-    let v_even: Vec<Option<f64>> = (0..p)
-        .map(|k| mean_var(&m_even, &|i, _| ve[i][k]))
-        .collect();
-    let mut errors: Vec<PredictedError> = (0..p)
-        .map(|k| PredictedError {
-            name: prob.names[k].clone(),
-            guess: prob.guess[k],
-            design: v_design[k].map(f64::sqrt),
-            even: v_even[k].map(f64::sqrt),
-        })
-        .collect();
-    let mut mu_var = None;
-    if let Some(Target::Mu(k)) = target {
-        let vd = mean_var(&m_design, &|i, m| variance_of(m, &draws[i].c));
-        let ve = mean_var(&m_even, &|i, m| variance_of(m, &even_draws[i].c));
-        mu_var = Some((vd, ve));
-        errors.push(PredictedError {
-            name: label(Target::Mu(k)),
-            guess: prob.mu(k, &prob.guess).unwrap_or(f64::NAN),
-            design: vd.map(f64::sqrt),
-            even: ve.map(f64::sqrt),
-        });
-    }
+    let (cmp, errors) = Comparison::new(&prob, target, (&draws, &w), (&even_draws, &ones));
     let mut discrimination = None;
     let mut points_needed = None;
     let efficiency = match s.criterion {
-        Criterion::D if bayes.is_none() => {
-            let (a, b) = (m_even[0].determinant(), m_design[0].determinant());
-            if b > 0.0 {
-                (a.max(0.0) / b).powf(1.0 / p as f64)
-            } else {
-                f64::NAN
-            }
-        }
-        Criterion::D => {
-            // exp(E[log det M_even] − E[log det M])^{1/p}.
-            let mut sum = 0.0;
-            for (a, b) in m_even.iter().zip(&m_design) {
-                let (a, b) = (a.determinant(), b.determinant());
-                sum += if b > 0.0 && a > 0.0 {
-                    (a / b).ln()
-                } else if b > 0.0 {
-                    f64::NEG_INFINITY
-                } else {
-                    f64::NAN
-                };
-            }
-            (sum / (m_design.len() * p) as f64).exp()
-        }
-        Criterion::C => {
-            let (vd, ve) = match target.expect("c has a target") {
-                Target::Param(k) => (v_design[k], v_even[k]),
-                Target::Mu(_) => mu_var.expect("a μ target has its variances"),
-            };
-            match (vd, ve) {
-                (Some(a), Some(b)) => a / b,
-                (Some(_), None) => 0.0,
-                _ => f64::NAN,
-            }
-        }
         Criterion::T => {
             let rival = rival.expect("t has a rival");
             let pts: Vec<Cand> = exact
@@ -587,6 +413,8 @@ pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
             points_needed = Some((need(t_design), need(t_even)));
             t_even / t_design
         }
+        Criterion::D => cmp.d_efficiency(bayes.is_some(), p),
+        Criterion::C => cmp.c_efficiency(target.expect("c has a target")),
     };
     let sensitivity = strata
         .iter()
@@ -604,7 +432,7 @@ pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
             .map(|r| (r.0.to_degrees(), r.1.to_degrees()))
             .collect(),
         errors,
-        target: target.map(label),
+        target: target.map(|k| target_label(&prob, k)),
         efficiency,
         gap: approx.gap,
         discrimination,
@@ -613,6 +441,307 @@ pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
         sensitivity_label: sens_label,
         bayes,
     })
+}
+
+/// The forward model a design's fit is made with: the contact model `s.model` names for
+/// the K-law fits (stick-slip by default); Jan's and Jaeger's fits have their own.
+fn design_model(s: &DesignSettings) -> Result<crate::models::Model, DesignError> {
+    Ok(match (s.fit, s.model) {
+        (DesignFit::KLaw, m) => {
+            let kind = m.unwrap_or(ModelKind::StickSlip);
+            kind.contact_model().ok_or_else(|| {
+                DesignError::new(
+                    "model",
+                    &kind_name(kind),
+                    "the K-law fits need a contact model (stick, stick-approx, slip, \
+                     slip-approx, stickslip, contact or auto)",
+                )
+            })?
+        }
+        (DesignFit::Jan, None | Some(ModelKind::Jan))
+        | (DesignFit::Jaeger, None | Some(ModelKind::Jaeger)) => crate::models::Model::StickSlip,
+        (fit, Some(kind)) => {
+            return Err(DesignError::new(
+                "model",
+                &kind_name(kind),
+                format!(
+                    "the {} fit has its own model: leave --model out",
+                    match fit {
+                        DesignFit::Jan => "jan",
+                        _ => "jaeger",
+                    }
+                ),
+            ))
+        }
+    })
+}
+
+/// The candidate slopes at the guess: `s.grid` slopes evenly over each series' range, those
+/// with a steady state kept, and the strata (the candidates of each series, as indices).
+fn candidate_grid(
+    s: &DesignSettings,
+    prob: &Problem,
+    ranges: &[(f64, f64)],
+) -> Result<(Vec<Cand>, Vec<Vec<usize>>), DesignError> {
+    let mut cands = Vec::new();
+    let mut strata: Vec<Vec<usize>> = Vec::new();
+    for (k, &(lo, hi)) in ranges.iter().enumerate() {
+        let mut st = Vec::new();
+        for i in 0..s.grid {
+            let d = round_deg(lo + (hi - lo) * i as f64 / (s.grid - 1) as f64);
+            if let Some(c) = candidate(s, prob, k, d) {
+                st.push(cands.len());
+                cands.push(c);
+            }
+        }
+        if st.is_empty() {
+            return Err(no_range(
+                s.series[k],
+                "no slope of its range has a steady state",
+            ));
+        }
+        strata.push(st);
+    }
+    Ok((cands, strata))
+}
+
+/// The evenly spaced comparison design: `counts[k]` slopes evenly over series k's range
+/// (its middle for one), each of which must have a steady state.
+fn even_design(
+    s: &DesignSettings,
+    prob: &Problem,
+    ranges: &[(f64, f64)],
+    counts: &[usize],
+) -> Result<Vec<Cand>, DesignError> {
+    let mut even_cands = Vec::new();
+    for (k, &(lo, hi)) in ranges.iter().enumerate() {
+        let m = counts[k];
+        for j in 0..m {
+            let frac = if m == 1 {
+                0.5
+            } else {
+                j as f64 / (m - 1) as f64
+            };
+            let d = round_deg(lo + (hi - lo) * frac);
+            let c = candidate(s, prob, k, d).ok_or_else(|| {
+                no_range(s.series[k], "an evenly spaced slope has no steady state")
+            })?;
+            even_cands.push(c);
+        }
+    }
+    Ok(even_cands)
+}
+
+/// The name of a criterion's target: the parameter's, or μ's of its series.
+fn target_label(prob: &Problem, k: Target) -> String {
+    match k {
+        Target::Param(k) => prob.names[k].clone(),
+        Target::Mu(k) => prob.mu_names()[k].clone(),
+    }
+}
+
+/// An approximate design with what goes with it.
+struct Approximate {
+    /// The design.
+    approx: Approx,
+    /// What its sensitivity is.
+    sens_label: String,
+    /// The rival model of a T design.
+    rival: Option<Problem>,
+    /// The candidates of every series taking part.
+    strata: Vec<Vec<usize>>,
+    /// The strata and budgets of the algorithm (see [`algorithm_strata`]).
+    alg: (Vec<Vec<usize>>, Vec<f64>),
+}
+
+/// The approximate design of `s.criterion` on the candidates `cands` in `strata`.
+fn approximate(
+    s: &DesignSettings,
+    prob: &Problem,
+    draws: &[Draw],
+    cands: &[Cand],
+    strata: Vec<Vec<usize>>,
+    target: Option<Target>,
+) -> Result<Approximate, DesignError> {
+    let p = prob.names.len();
+    Ok(match s.criterion {
+        Criterion::D => {
+            let alg = algorithm_strata(s, &strata);
+            Approximate {
+                approx: optimal::multiplicative(draws, &alg.0, &alg.1, p, Crit::D),
+                sens_label: "standardised variance d/λ (D)".to_string(),
+                rival: None,
+                strata,
+                alg,
+            }
+        }
+        Criterion::C => {
+            let k = target.expect("c has a target");
+            let alg = algorithm_strata(s, &strata);
+            Approximate {
+                approx: optimal::multiplicative(draws, &alg.0, &alg.1, p, Crit::C),
+                sens_label: format!("information on {} ψ/λ (c)", target_label(prob, k)),
+                rival: None,
+                strata,
+                alg,
+            }
+        }
+        Criterion::T => {
+            let (a, rival, st, alg) = t_design(s, prob, cands, &strata)?;
+            Approximate {
+                approx: a,
+                sens_label: "squared distance to the rival ψ/λ (T)".to_string(),
+                rival: Some(rival),
+                strata: st,
+                alg,
+            }
+        }
+    })
+}
+
+/// The rows of an exact design (candidate, replicates per stratum) and its weights on the
+/// candidates.
+fn exact_rows(
+    s: &DesignSettings,
+    cands: &[Cand],
+    exact: &[Vec<(usize, usize)>],
+) -> (Vec<f64>, Vec<DesignRow>) {
+    let mut w = vec![0.0; cands.len()];
+    let mut rows = Vec::new();
+    for st in exact {
+        for &(j, n) in st {
+            w[j] = n as f64;
+            let c = &cands[j];
+            rows.push(row(s.series[c.series], c.delta, n));
+        }
+    }
+    (w, rows)
+}
+
+/// A variance averaged over the draws (the expected posterior variance of a Bayesian
+/// design): `f` of every draw's information matrix; undetermined where any draw leaves it
+/// undetermined.
+fn mean_var(
+    ms: &[nalgebra::DMatrix<f64>],
+    f: &dyn Fn(usize, &nalgebra::DMatrix<f64>) -> Option<f64>,
+) -> Option<f64> {
+    let mut sum = 0.0;
+    for (i, m) in ms.iter().enumerate() {
+        sum += f(i, m)?;
+    }
+    Some(sum / ms.len() as f64)
+}
+
+/// The design and the evenly spaced slopes compared: their information matrices at every
+/// draw and the variances they predict.
+struct Comparison {
+    /// The design's information matrix at every draw.
+    m_design: Vec<nalgebra::DMatrix<f64>>,
+    /// The evenly spaced slopes' information matrix at every draw.
+    m_even: Vec<nalgebra::DMatrix<f64>>,
+    /// Every parameter's variance at the design, averaged over the draws.
+    v_design: Vec<Option<f64>>,
+    /// Every parameter's variance at the evenly spaced slopes, averaged over the draws.
+    v_even: Vec<Option<f64>>,
+    /// A μ target's variance at the design and at the evenly spaced slopes.
+    mu_var: Option<(Option<f64>, Option<f64>)>,
+}
+
+impl Comparison {
+    /// The comparison of the design (its draws and weights on the candidates) with the
+    /// evenly spaced slopes (theirs), and the predicted standard errors of every parameter
+    /// and of a μ target.
+    fn new(
+        prob: &Problem,
+        target: Option<Target>,
+        (draws, w): (&[Draw], &[f64]),
+        (even_draws, ones): (&[Draw], &[f64]),
+    ) -> (Self, Vec<PredictedError>) {
+        let p = prob.names.len();
+        let m_design: Vec<_> = draws.iter().map(|d| information(&d.cands, w, p)).collect();
+        let m_even: Vec<_> = even_draws
+            .iter()
+            .map(|d| information(&d.cands, ones, p))
+            .collect();
+        let vd: Vec<Vec<Option<f64>>> = m_design.iter().map(variances).collect();
+        let ve: Vec<Vec<Option<f64>>> = m_even.iter().map(variances).collect();
+        let v_design: Vec<Option<f64>> = (0..p)
+            .map(|k| mean_var(&m_design, &|i, _| vd[i][k]))
+            .collect();
+        let v_even: Vec<Option<f64>> = (0..p)
+            .map(|k| mean_var(&m_even, &|i, _| ve[i][k]))
+            .collect();
+        let mut errors: Vec<PredictedError> = (0..p)
+            .map(|k| PredictedError {
+                name: prob.names[k].clone(),
+                guess: prob.guess[k],
+                design: v_design[k].map(f64::sqrt),
+                even: v_even[k].map(f64::sqrt),
+            })
+            .collect();
+        let mut mu_var = None;
+        if let Some(Target::Mu(k)) = target {
+            let vd = mean_var(&m_design, &|i, m| variance_of(m, &draws[i].c));
+            let ve = mean_var(&m_even, &|i, m| variance_of(m, &even_draws[i].c));
+            mu_var = Some((vd, ve));
+            errors.push(PredictedError {
+                name: target_label(prob, Target::Mu(k)),
+                guess: prob.mu(k, &prob.guess).unwrap_or(f64::NAN),
+                design: vd.map(f64::sqrt),
+                even: ve.map(f64::sqrt),
+            });
+        }
+        let cmp = Comparison {
+            m_design,
+            m_even,
+            v_design,
+            v_even,
+            mu_var,
+        };
+        (cmp, errors)
+    }
+
+    /// The D efficiency of the evenly spaced slopes relative to the design,
+    /// (det M_even/det M)^{1/p}; of a Bayesian design, exp(E[log det M_even] −
+    /// E[log det M])^{1/p}.
+    fn d_efficiency(&self, bayes: bool, p: usize) -> f64 {
+        let (m_design, m_even) = (&self.m_design, &self.m_even);
+        if !bayes {
+            let (a, b) = (m_even[0].determinant(), m_design[0].determinant());
+            if b > 0.0 {
+                (a.max(0.0) / b).powf(1.0 / p as f64)
+            } else {
+                f64::NAN
+            }
+        } else {
+            let mut sum = 0.0;
+            for (a, b) in m_even.iter().zip(m_design) {
+                let (a, b) = (a.determinant(), b.determinant());
+                sum += if b > 0.0 && a > 0.0 {
+                    (a / b).ln()
+                } else if b > 0.0 {
+                    f64::NEG_INFINITY
+                } else {
+                    f64::NAN
+                };
+            }
+            (sum / (m_design.len() * p) as f64).exp()
+        }
+    }
+
+    /// The c efficiency of the evenly spaced slopes relative to the design: the target's
+    /// Var/Var_even.
+    fn c_efficiency(&self, target: Target) -> f64 {
+        let (vd, ve) = match target {
+            Target::Param(k) => (self.v_design[k], self.v_even[k]),
+            Target::Mu(_) => self.mu_var.expect("a μ target has its variances"),
+        };
+        match (vd, ve) {
+            (Some(a), Some(b)) => a / b,
+            (Some(_), None) => 0.0,
+            _ => f64::NAN,
+        }
+    }
 }
 
 /// The strata and budgets of the approximate design: one stratum per series with `points`

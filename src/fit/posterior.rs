@@ -33,15 +33,16 @@
 //! optimum stays in `cov_low`/`cov_high` and the optimum in `lsq_value`.
 
 use super::summary::{
-    chi2_vanishes, summarise, FitResult, McmcFailure, McmcStats, ParamRow, PowerScaling, Solved,
+    chi2_vanishes, summarise, FitResult, McmcFailure, McmcStats, ParamRow, ParamSpec, PowerScaling,
+    Solved,
 };
 use crate::inverse::mcmc::sensitivity::sensitivity;
-use crate::inverse::mcmc::{EnsembleSampler, StopReason};
+use crate::inverse::mcmc::{EnsembleSampler, McmcError, McmcOptions, McmcResult, StopReason};
 use crate::inverse::posterior::Posterior;
 pub use crate::inverse::posterior::Reparameterisation;
 pub(crate) use crate::inverse::posterior::SCALE_NAME;
 pub use crate::inverse::posterior::{Draws, McmcSettings, Method, Prior};
-use crate::inverse::{Residuals, SigmaKind};
+use crate::inverse::{Fit, Residuals, SigmaKind};
 use crate::numfmt::{fmt_f64, fmt_sig};
 use crate::progress::ProgressEvent;
 use rayon::prelude::*;
@@ -87,6 +88,9 @@ pub(crate) fn summarise_reparameterised<R: Residuals + Sync + ?Sized>(
 /// (logarithms, dimensionless shapes), and the ensemble widens from a small ball by itself.
 const REPARAMETERISED_BALL: f64 = 1e-3;
 
+/// A posterior run started from the least-squares optimum of `solved` (module docs), in
+/// stages: the priors and their checks, the starting ball, the sampler's run, then the rows
+/// and the fit's statistics from the draws.
 fn sample<R: Residuals + Sync + ?Sized>(
     settings: &McmcSettings,
     solved: Solved<'_, R>,
@@ -107,16 +111,7 @@ fn sample<R: Residuals + Sync + ?Sized>(
     let n = specs.len();
     // The box of every parameter, as the least-squares summary read it from `opts`.
     let (lower, upper): (Vec<f64>, Vec<f64>) = out.params.iter().map(|r| r.bounds).unzip();
-    let priors: Vec<Prior> = specs
-        .iter()
-        .map(|s| {
-            settings
-                .prior(s.name)
-                .cloned()
-                .or_else(|| s.default_prior.clone())
-                .unwrap_or_else(Prior::flat)
-        })
-        .collect();
+    let priors = parameter_priors(settings, specs);
     let with_scale = f.sigma == SigmaKind::Relative || settings.fit_scatter;
     // With χ² = 0 (or rounding) the likelihood grows without bound as the scale goes to 0:
     // the posterior of the scale is improper and there is nothing to sample.
@@ -153,79 +148,19 @@ fn sample<R: Residuals + Sync + ?Sized>(
             1.0
         }
     };
-    // A prior whose support misses the feasible box leaves nothing to sample.
-    for (j, p) in priors.iter().enumerate() {
-        let (a, b) = p.support();
-        if !(a.max(lower[j]) < b.min(upper[j])) {
-            let failure = McmcFailure::PriorOutsideBox {
-                parameter: specs[j].name.to_string(),
-                prior: p.to_string(),
-                support: (a, b),
-                feasible: (lower[j], upper[j]),
-            };
-            return failed(out, failure);
-        }
+    if let Err(failure) = check_prior_supports(specs, &priors, scale_prior.as_ref(), &lower, &upper)
+    {
+        return failed(out, failure);
     }
-    if let Some(p) = &scale_prior {
-        let (a, b) = p.support();
-        if !(a.max(0.0) < b) {
-            let failure = McmcFailure::PriorOutsideBox {
-                parameter: SCALE_NAME.to_string(),
-                prior: p.to_string(),
-                support: (a, b),
-                feasible: (0.0, f64::INFINITY),
-            };
-            return failed(out, failure);
-        }
-    }
-    // The optimum may lie outside a prior's support (a prior narrower than the data): start
-    // then just inside the support, cut to the box.
-    let mut start: Vec<f64> = f
-        .params
-        .iter()
-        .zip(&priors)
-        .zip(lower.iter().zip(&upper))
-        .map(|((&x, p), (&l, &u))| {
-            let (a, b) = p.support();
-            let (a, b) = (a.max(l), b.min(u));
-            if x >= a && x <= b {
-                x
-            } else if a.is_finite() && b.is_finite() {
-                let w = b - a;
-                x.clamp(a + 1e-3 * w, b - 1e-3 * w)
-            } else if x < a {
-                a + 1e-3 * a.abs().max(1.0)
-            } else {
-                b - 1e-3 * b.abs().max(1.0)
-            }
-        })
-        .collect();
-    let mut se: Vec<Option<f64>> = (0..n)
-        .map(|j| {
-            f.std_errors()
-                .map(|s| s[j])
-                .filter(|s| *s > 0.0 && s.is_finite())
-        })
-        .collect();
-    if with_scale {
-        start.push(s0);
-        se.push(None);
-    }
-    // Coordinates sampled as ln x need x > 0: an optimum on the bound 0 starts just above it.
-    for (j, x) in start.iter_mut().enumerate() {
-        if target.is_log(j) && !(*x > 0.0) {
-            *x = se[j].map_or(1e-6, |s| 1e-2 * s);
-        }
-    }
-    let ball: Vec<f64> = (0..start.len())
-        .map(|j| match (target.is_log(j), se[j]) {
-            _ if j < n && transform.is_some() => REPARAMETERISED_BALL,
-            (true, Some(s)) => (1e-2 * s / start[j]).clamp(1e-4, 1e-1),
-            (true, None) => 1e-2,
-            (false, Some(s)) => 1e-2 * s,
-            (false, None) => 1e-4 * start[j].abs().max(1.0),
-        })
-        .collect();
+    let start = StartingBall {
+        fit: f,
+        priors: &priors,
+        lower: &lower,
+        upper: &upper,
+        scale: with_scale.then_some(s0),
+        reparameterised: transform.is_some(),
+    };
+    let (start, ball) = start.points(&target);
     let Some(start) = target.start_coordinates(&start) else {
         return failed(
             out,
@@ -243,7 +178,183 @@ fn sample<R: Residuals + Sync + ?Sized>(
     } else {
         "1 (multiplies sigma_v)"
     };
-    let run = EnsembleSampler::new(&target, options).and_then(|sampler| {
+    let run = run_sampler(&target, options, settings, fit_name, series, &start);
+    let (res, walkers) = match run {
+        Ok(r) => r,
+        Err(e) => return failed(out, McmcFailure::NotStarted(e.to_string())),
+    };
+    // The chains, and the diagnostics on them, are already in parameters
+    // (`Posterior` records them so).
+    // Rows: the parameters, then the scale.
+    if with_scale {
+        out.params
+            .push(scale_row(fit_name, series, s0, level, scale_unit));
+    }
+    let all_priors: Vec<&Prior> = priors.iter().chain(scale_prior.iter()).collect();
+    // What the least-squares run noted is about the optimum the chains start from.
+    if !out.stats.note.is_empty() {
+        out.stats.note = format!("least-squares start: {}", out.stats.note);
+    }
+    let ll = pointwise_log_likelihood(problem, n, &res.chains);
+    let scaling = power_scaling(&ll, &all_priors);
+    posterior_rows(&mut out.params, &res, scaling.as_deref(), &all_priors);
+    // Residuals at the posterior medians, and the correlations of the draws.
+    if res.diagnostics.len() >= n {
+        let median: Vec<f64> = res.diagnostics[..n].iter().map(|d| d.median).collect();
+        let mut r = vec![0.0; problem.n_residuals()];
+        if problem.residuals(&median, &mut r).is_ok() {
+            out.residuals = r;
+        }
+        out.correlation = draws_correlation(&res.chains);
+    }
+    let note = run_note(&mut out.params, &res, settings, thin);
+    out.stats.note = join(&out.stats.note, &note);
+    let waic = waic(&ll);
+    record_run(&mut out, res, walkers, thin, waic);
+    out
+}
+
+/// The prior of every parameter: the one `settings` name for it, else the parameter's
+/// default, else flat on its box.
+fn parameter_priors(settings: &McmcSettings, specs: &[ParamSpec]) -> Vec<Prior> {
+    specs
+        .iter()
+        .map(|s| {
+            settings
+                .prior(s.name)
+                .cloned()
+                .or_else(|| s.default_prior.clone())
+                .unwrap_or_else(Prior::flat)
+        })
+        .collect()
+}
+
+/// A prior whose support misses the feasible box (`lower`, `upper` for the parameters,
+/// (0, ∞) for the scale) leaves nothing to sample: the first such prior, as a failure.
+fn check_prior_supports(
+    specs: &[ParamSpec],
+    priors: &[Prior],
+    scale_prior: Option<&Prior>,
+    lower: &[f64],
+    upper: &[f64],
+) -> Result<(), McmcFailure> {
+    for (j, p) in priors.iter().enumerate() {
+        let (a, b) = p.support();
+        if !(a.max(lower[j]) < b.min(upper[j])) {
+            return Err(McmcFailure::PriorOutsideBox {
+                parameter: specs[j].name.to_string(),
+                prior: p.to_string(),
+                support: (a, b),
+                feasible: (lower[j], upper[j]),
+            });
+        }
+    }
+    if let Some(p) = scale_prior {
+        let (a, b) = p.support();
+        if !(a.max(0.0) < b) {
+            return Err(McmcFailure::PriorOutsideBox {
+                parameter: SCALE_NAME.to_string(),
+                prior: p.to_string(),
+                support: (a, b),
+                feasible: (0.0, f64::INFINITY),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// What the starting point of the walkers and the width of their initial ball are made of:
+/// the least-squares optimum and its standard errors, cut to the priors' supports and the
+/// box.
+struct StartingBall<'a> {
+    /// The least-squares optimum.
+    fit: &'a Fit,
+    /// The priors of the parameters.
+    priors: &'a [Prior],
+    /// The lower ends of the parameters' boxes.
+    lower: &'a [f64],
+    /// The upper ends of the parameters' boxes.
+    upper: &'a [f64],
+    /// The scale's starting value, when the scale is sampled.
+    scale: Option<f64>,
+    /// Whether the posterior samples the parameters in a [`Reparameterisation`]'s coordinates.
+    reparameterised: bool,
+}
+
+impl StartingBall<'_> {
+    /// The starting point in parameters (the scale last, when sampled) and the standard
+    /// deviation of the initial ball in every sampling coordinate.
+    fn points<R: Residuals + Sync + ?Sized>(
+        &self,
+        target: &Posterior<'_, R>,
+    ) -> (Vec<f64>, Vec<f64>) {
+        let f = self.fit;
+        let n = self.priors.len();
+        // The optimum may lie outside a prior's support (a prior narrower than the data):
+        // start then just inside the support, cut to the box.
+        let mut start: Vec<f64> = f
+            .params
+            .iter()
+            .zip(self.priors)
+            .zip(self.lower.iter().zip(self.upper))
+            .map(|((&x, p), (&l, &u))| {
+                let (a, b) = p.support();
+                let (a, b) = (a.max(l), b.min(u));
+                if x >= a && x <= b {
+                    x
+                } else if a.is_finite() && b.is_finite() {
+                    let w = b - a;
+                    x.clamp(a + 1e-3 * w, b - 1e-3 * w)
+                } else if x < a {
+                    a + 1e-3 * a.abs().max(1.0)
+                } else {
+                    b - 1e-3 * b.abs().max(1.0)
+                }
+            })
+            .collect();
+        let mut se: Vec<Option<f64>> = (0..n)
+            .map(|j| {
+                f.std_errors()
+                    .map(|s| s[j])
+                    .filter(|s| *s > 0.0 && s.is_finite())
+            })
+            .collect();
+        if let Some(s0) = self.scale {
+            start.push(s0);
+            se.push(None);
+        }
+        // Coordinates sampled as ln x need x > 0: an optimum on the bound 0 starts just above
+        // it.
+        for (j, x) in start.iter_mut().enumerate() {
+            if target.is_log(j) && !(*x > 0.0) {
+                *x = se[j].map_or(1e-6, |s| 1e-2 * s);
+            }
+        }
+        let ball: Vec<f64> = (0..start.len())
+            .map(|j| match (target.is_log(j), se[j]) {
+                _ if j < n && self.reparameterised => REPARAMETERISED_BALL,
+                (true, Some(s)) => (1e-2 * s / start[j]).clamp(1e-4, 1e-1),
+                (true, None) => 1e-2,
+                (false, Some(s)) => 1e-2 * s,
+                (false, None) => 1e-4 * start[j].abs().max(1.0),
+            })
+            .collect();
+        (start, ball)
+    }
+}
+
+/// Runs the ensemble sampler on `target` from `start` (sampling coordinates), reporting its
+/// progress to `settings.progress` under the label `fit [series]`; the result and the number
+/// of walkers.
+fn run_sampler<R: Residuals + Sync + ?Sized>(
+    target: &Posterior<'_, R>,
+    options: McmcOptions,
+    settings: &McmcSettings,
+    fit_name: &str,
+    series: &str,
+    start: &[f64],
+) -> Result<(McmcResult, usize), McmcError> {
+    EnsembleSampler::new(target, options).and_then(|sampler| {
         let bar = settings.progress.as_ref();
         if let Some(p) = bar {
             p.report(ProgressEvent::Start {
@@ -252,7 +363,7 @@ fn sample<R: Residuals + Sync + ?Sized>(
                 check_every: sampler.options().check_every as u64,
             });
         }
-        let r = sampler.run_with_progress(&start, |step, _| {
+        let r = sampler.run_with_progress(start, |step, _| {
             if let Some(p) = bar {
                 if step % 16 == 0 {
                     p.report(ProgressEvent::Position(step as u64));
@@ -263,45 +374,44 @@ fn sample<R: Residuals + Sync + ?Sized>(
             p.report(ProgressEvent::Finish);
         }
         r.map(|r| (r, sampler.walkers()))
-    });
-    let (res, walkers) = match run {
-        Ok(r) => r,
-        Err(e) => return failed(out, McmcFailure::NotStarted(e.to_string())),
-    };
-    // The chains, and the diagnostics on them, are already in parameters
-    // (`Posterior` records them so).
-    // Rows: the parameters, then the scale.
-    if with_scale {
-        out.params.push(ParamRow {
-            fit: fit_name.to_string(),
-            series: series.to_string(),
-            parameter: SCALE_NAME.to_string(),
-            value: s0,
-            stderr: None,
-            level,
-            cov: None,
-            profile: None,
-            unit: scale_unit,
-            at_bound: false,
-            paper_value: None,
-            paper_source: "",
-            note: String::new(),
-            bounds: (0.0, f64::INFINITY),
-            lsq_value: Some(s0),
-            posterior: None,
-            sensitivity: None,
-        });
+    })
+}
+
+/// The row of the scatter's scale, at its starting value `s0` (the posterior fills it in
+/// with the parameters' rows).
+fn scale_row(fit_name: &str, series: &str, s0: f64, level: f64, unit: &'static str) -> ParamRow {
+    ParamRow {
+        fit: fit_name.to_string(),
+        series: series.to_string(),
+        parameter: SCALE_NAME.to_string(),
+        value: s0,
+        stderr: None,
+        level,
+        cov: None,
+        profile: None,
+        unit,
+        at_bound: false,
+        paper_value: None,
+        paper_source: "",
+        note: String::new(),
+        bounds: (0.0, f64::INFINITY),
+        lsq_value: Some(s0),
+        posterior: None,
+        sensitivity: None,
     }
-    let all_priors: Vec<&Prior> = priors.iter().chain(scale_prior.iter()).collect();
-    // What the least-squares run noted is about the optimum the chains start from.
-    if !out.stats.note.is_empty() {
-        out.stats.note = format!("least-squares start: {}", out.stats.note);
-    }
-    let ll = pointwise_log_likelihood(problem, n, &res.chains);
-    let scaling = power_scaling(&ll, &all_priors);
-    // The rows report the posterior: their notes are the posterior's (the least-squares
-    // notes describe the optimum, kept in `lsq_value`, and are not repeated here).
-    for (j, row) in out.params.iter_mut().enumerate() {
+}
+
+/// Turns the least-squares rows into posterior rows: the optimum moves to `lsq_value`, the
+/// value, standard deviation and interval are the posterior's, and the notes name the prior
+/// and any sensitivity to it (the least-squares notes describe the optimum and are not
+/// repeated here).
+fn posterior_rows(
+    rows: &mut [ParamRow],
+    res: &McmcResult,
+    scaling: Option<&[PowerScaling]>,
+    all_priors: &[&Prior],
+) {
+    for (j, row) in rows.iter_mut().enumerate() {
         row.lsq_value = Some(row.value);
         row.profile = None;
         row.at_bound = false;
@@ -313,7 +423,7 @@ fn sample<R: Residuals + Sync + ?Sized>(
                 row.posterior = Some(d.clone());
                 row.at_bound = d.median <= row.bounds.0 || d.median >= row.bounds.1;
                 row.note = prior_note;
-                if let Some(ps) = scaling.as_ref().and_then(|v| v.get(j)).copied() {
+                if let Some(ps) = scaling.and_then(|v| v.get(j)).copied() {
                     row.sensitivity = Some(ps);
                     let what = match ps.diagnosis() {
                         "prior-driven" => Some(format!(
@@ -345,51 +455,29 @@ fn sample<R: Residuals + Sync + ?Sized>(
             }
         }
     }
-    // Residuals at the posterior medians, and the correlations of the draws.
-    if res.diagnostics.len() >= n {
-        let median: Vec<f64> = res.diagnostics[..n].iter().map(|d| d.median).collect();
-        let mut r = vec![0.0; problem.n_residuals()];
-        if problem.residuals(&median, &mut r).is_ok() {
-            out.residuals = r;
-        }
-        out.correlation = draws_correlation(&res.chains);
-    }
+}
+
+/// The fit's note on the run: interrupted (every row then says so too), not converged (and
+/// which parameter is furthest from the thresholds), and NaN evaluations.
+fn run_note(
+    rows: &mut [ParamRow],
+    res: &McmcResult,
+    settings: &McmcSettings,
+    thin: usize,
+) -> String {
     // Names for the messages; a name shared by several parameters (one K per series) gets
     // its row number in the report.
-    let names: Vec<String> = out
-        .params
+    let names: Vec<String> = rows
         .iter()
         .enumerate()
         .map(|(j, r)| {
-            if out
-                .params
-                .iter()
-                .filter(|q| q.parameter == r.parameter)
-                .count()
-                > 1
-            {
+            if rows.iter().filter(|q| q.parameter == r.parameter).count() > 1 {
                 format!("{} (row {} of this fit)", r.parameter, j + 1)
             } else {
                 r.parameter.clone()
             }
         })
         .collect();
-    let kept = res.chains.iter().map(Vec::len).sum::<usize>();
-    let rhat_max = res
-        .diagnostics
-        .iter()
-        .map(|d| d.rhat)
-        .fold(f64::NEG_INFINITY, f64::max);
-    let ess_min = res
-        .diagnostics
-        .iter()
-        .map(|d| d.ess_bulk.min(d.ess_tail))
-        .fold(f64::INFINITY, f64::min);
-    let status = match res.reason {
-        StopReason::Converged => "converged",
-        StopReason::MaxSteps => "max_steps",
-        StopReason::Interrupted => "interrupted",
-    };
     let mut note = String::new();
     if res.reason == StopReason::Interrupted {
         note = format!(
@@ -397,7 +485,7 @@ fn sample<R: Residuals + Sync + ?Sized>(
             res.steps
         );
         // Every row of an interrupted run says so.
-        for row in out.params.iter_mut() {
+        for row in rows.iter_mut() {
             row.note = join(INTERRUPTED_NOTE, &row.note);
         }
     } else if !res.converged {
@@ -433,7 +521,34 @@ fn sample<R: Residuals + Sync + ?Sized>(
             ),
         );
     }
-    out.stats.note = join(&out.stats.note, &note);
+    note
+}
+
+/// Records the run in the fit's statistics (convergence, steps, evaluations, the MCMC
+/// statistics with `waic`) and keeps its draws.
+fn record_run(
+    out: &mut FitResult,
+    res: McmcResult,
+    walkers: usize,
+    thin: usize,
+    waic: Option<(f64, f64, f64)>,
+) {
+    let kept = res.chains.iter().map(Vec::len).sum::<usize>();
+    let rhat_max = res
+        .diagnostics
+        .iter()
+        .map(|d| d.rhat)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let ess_min = res
+        .diagnostics
+        .iter()
+        .map(|d| d.ess_bulk.min(d.ess_tail))
+        .fold(f64::INFINITY, f64::min);
+    let status = match res.reason {
+        StopReason::Converged => "converged",
+        StopReason::MaxSteps => "max_steps",
+        StopReason::Interrupted => "interrupted",
+    };
     out.stats.converged = res.converged;
     out.stats.iterations = res.steps;
     out.stats.residual_evals += walkers * res.steps;
@@ -446,7 +561,7 @@ fn sample<R: Residuals + Sync + ?Sized>(
         acceptance: res.acceptance_overall,
         ess_min,
         rhat_max,
-        waic: waic(&ll),
+        waic,
         failure: None,
     });
     out.draws = Some(Draws {
@@ -456,7 +571,6 @@ fn sample<R: Residuals + Sync + ?Sized>(
         thin,
         interrupted: res.reason == StopReason::Interrupted,
     });
-    out
 }
 
 /// The note every parameter row of an interrupted posterior run starts with.

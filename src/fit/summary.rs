@@ -13,8 +13,8 @@
 use crate::inverse::mcmc::ParameterDiagnostics;
 pub use crate::inverse::posterior::Draws;
 use crate::inverse::{
-    confidence_intervals, Fit, LsqOptions, ProfileEnd, ProfileInterval, Residuals, SigmaKind,
-    Termination,
+    confidence_intervals, Covariance, Fit, LsqOptions, ProfileEnd, ProfileInterval, Residuals,
+    SigmaKind, Termination,
 };
 use crate::numfmt::{fmt_f64, fmt_sig};
 
@@ -628,28 +628,7 @@ pub(crate) fn summarise_with_profiles<R: Residuals + ?Sized>(
             "Jacobian rank deficient at the estimate: no covariance".into()
         };
     }
-    // With no σ given, −2 ln L = m ln(2π χ²/m) + m is unbounded below at χ² = 0.
-    // Within the rounding of the data χ² is 0 in all but its noise, and so are AIC and BIC.
-    let (aic, bic) = if f.aic == f64::NEG_INFINITY
-        || f.bic == f64::NEG_INFINITY
-        || scatter_vanishes(f, observed_norm)
-    {
-        let why = if f.chi2 == 0.0 {
-            "chi2 = 0: AIC and BIC undefined (the likelihood with the scatter estimated is \
-             unbounded)"
-        } else {
-            "chi2 is rounding: AIC and BIC undefined (the likelihood with the scatter estimated \
-             is unbounded)"
-        };
-        note = if note.is_empty() {
-            why.into()
-        } else {
-            format!("{note}; {why}")
-        };
-        (f64::NAN, f64::NAN)
-    } else {
-        (f.aic, f.bic)
-    };
+    let (aic, bic) = aic_bic(f, observed_norm, &mut note);
     let mut evals = f.residual_evals;
     let params = specs
         .iter()
@@ -678,28 +657,8 @@ pub(crate) fn summarise_with_profiles<R: Residuals + ?Sized>(
             if unknown.is_some() {
                 pnote.push_str("not determined by the data: no standard error or interval. ");
             }
-            if let Some((lo, hi)) = prof {
-                for (end, which) in [(lo, "lower"), (hi, "upper")] {
-                    match end {
-                        ProfileEnd::Found(_) => {}
-                        ProfileEnd::Bound(b) => pnote.push_str(&format!(
-                            "profile {which} end reaches the bound {}. ",
-                            fmt_f64(b)
-                        )),
-                        ProfileEnd::Edge(e) => pnote.push_str(&format!(
-                            "profile {which} end undetermined beyond {}: the constrained fits \
-                             there do not converge inside the model's feasible region. ",
-                            fmt_f64(e)
-                        )),
-                        ProfileEnd::NotFound => pnote.push_str(&format!(
-                            "profile {which} end not found: the likelihood does not fall by the \
-                             {} % threshold on that side within the search, so the data do not \
-                             bound {} there. ",
-                            fmt_sig(100.0 * level, 6),
-                            s.name
-                        )),
-                    }
-                }
+            if let Some(ends) = prof {
+                push_profile_notes(&mut pnote, ends, level, s.name);
             }
             ParamRow {
                 fit: fit_name.to_string(),
@@ -752,18 +711,79 @@ pub(crate) fn summarise_with_profiles<R: Residuals + ?Sized>(
             .covariance
             .as_ref()
             .filter(|_| unknown.is_none())
-            .map(|c| {
-                (0..c.correlation.nrows())
-                    .map(|i| {
-                        (0..c.correlation.ncols())
-                            .map(|j| c.correlation[(i, j)])
-                            .collect()
-                    })
-                    .collect()
-            }),
+            .map(correlation_rows),
         residuals: f.residuals.clone(),
         points: Vec::new(),
     }
+}
+
+/// AIC and BIC of the fit `f`, undefined (NaN, with why appended to `note`) where the
+/// likelihood is unbounded: with no σ given, −2 ln L = m ln(2π χ²/m) + m is unbounded below
+/// at χ² = 0, and within the rounding of the data (‖y/σ‖ = `observed_norm`) χ² is 0 in all
+/// but its noise, and so are AIC and BIC.
+fn aic_bic(f: &Fit, observed_norm: Option<f64>, note: &mut String) -> (f64, f64) {
+    if f.aic == f64::NEG_INFINITY
+        || f.bic == f64::NEG_INFINITY
+        || scatter_vanishes(f, observed_norm)
+    {
+        let why = if f.chi2 == 0.0 {
+            "chi2 = 0: AIC and BIC undefined (the likelihood with the scatter estimated is \
+             unbounded)"
+        } else {
+            "chi2 is rounding: AIC and BIC undefined (the likelihood with the scatter estimated \
+             is unbounded)"
+        };
+        *note = if note.is_empty() {
+            why.into()
+        } else {
+            format!("{note}; {why}")
+        };
+        (f64::NAN, f64::NAN)
+    } else {
+        (f.aic, f.bic)
+    }
+}
+
+/// Appends to `pnote` what the profile interval's ends (lower, upper) of the parameter
+/// `name` at `level` say when they are not found points.
+fn push_profile_notes(
+    pnote: &mut String,
+    (lo, hi): (ProfileEnd, ProfileEnd),
+    level: f64,
+    name: &str,
+) {
+    for (end, which) in [(lo, "lower"), (hi, "upper")] {
+        match end {
+            ProfileEnd::Found(_) => {}
+            ProfileEnd::Bound(b) => pnote.push_str(&format!(
+                "profile {which} end reaches the bound {}. ",
+                fmt_f64(b)
+            )),
+            ProfileEnd::Edge(e) => pnote.push_str(&format!(
+                "profile {which} end undetermined beyond {}: the constrained fits \
+                 there do not converge inside the model's feasible region. ",
+                fmt_f64(e)
+            )),
+            ProfileEnd::NotFound => pnote.push_str(&format!(
+                "profile {which} end not found: the likelihood does not fall by the \
+                 {} % threshold on that side within the search, so the data do not \
+                 bound {} there. ",
+                fmt_sig(100.0 * level, 6),
+                name
+            )),
+        }
+    }
+}
+
+/// The correlation matrix of a covariance, as rows.
+fn correlation_rows(c: &Covariance) -> Vec<Vec<f64>> {
+    (0..c.correlation.nrows())
+        .map(|i| {
+            (0..c.correlation.ncols())
+                .map(|j| c.correlation[(i, j)])
+                .collect()
+        })
+        .collect()
 }
 
 /// AIC and BIC of a parameter-free model with residuals `r` (conventions of [`Fit::aic`]).

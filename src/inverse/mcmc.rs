@@ -469,27 +469,7 @@ impl<'a, D: LogDensity + ?Sized> EnsembleSampler<'a, D> {
     ) -> Result<McmcResult, McmcError> {
         let dim = self.target.dim();
         let nw = self.walkers;
-        if ensemble.len() != nw {
-            return Err(McmcError::Length {
-                what: "initial ensemble",
-                got: ensemble.len(),
-                expected: nw,
-            });
-        }
-        for x in &ensemble {
-            if x.len() != dim {
-                return Err(McmcError::Length {
-                    what: "initial walker",
-                    got: x.len(),
-                    expected: dim,
-                });
-            }
-            if x.iter().any(|v| !v.is_finite()) {
-                return Err(McmcError::NotFinite {
-                    what: "initial walker",
-                });
-            }
-        }
+        self.check_ensemble(&ensemble)?;
         let nans = AtomicUsize::new(0);
         let mut pos = ensemble;
         let mut lp: Vec<f64> = pos.par_iter().map(|x| self.eval(x, &nans)).collect();
@@ -498,7 +478,6 @@ impl<'a, D: LogDensity + ?Sized> EnsembleSampler<'a, D> {
         }
         let o = &self.options;
         let half = nw / 2;
-        let a = o.stretch;
         let gamma0 = 2.38 / (2.0 * dim as f64).sqrt();
         let mut accepted = vec![0usize; nw];
         let mut chains: Vec<Vec<Vec<f64>>> = vec![Vec::new(); nw];
@@ -529,34 +508,7 @@ impl<'a, D: LogDensity + ?Sized> EnsembleSampler<'a, D> {
                         let mut rng = ChaCha8Rng::seed_from_u64(o.seed);
                         rng.set_stream(w as u64);
                         rng.set_word_pos(step * WORDS_PER_STEP);
-                        let x = &pos[w];
-                        let de = o.de_fraction > 0.0 && rng.random::<f64>() < o.de_fraction;
-                        let (y, log_jacobian) = if de {
-                            // Differential evolution (ter Braak 2006; emcee's DEMove):
-                            // y = x + γ (c_a − c_b), a ≠ b drawn from the complement,
-                            // γ = γ0 (1 + u/10), u uniform on [−1, 1], γ0 = 2.38/√(2 dim).
-                            // Symmetric (swap a and b), so no Jacobian term.
-                            let nc = complement.len();
-                            let ia = rng.random_range(0..nc);
-                            let ib = (ia + 1 + rng.random_range(0..nc - 1)) % nc;
-                            let g = gamma0 * (1.0 + 0.1 * (2.0 * rng.random::<f64>() - 1.0));
-                            let (ca, cb) = (&complement[ia], &complement[ib]);
-                            let y: Vec<f64> = x
-                                .iter()
-                                .zip(ca.iter().zip(cb))
-                                .map(|(xi, (p, q))| xi + g * (p - q))
-                                .collect();
-                            (y, 0.0)
-                        } else {
-                            let c = &complement[rng.random_range(0..complement.len())];
-                            let u: f64 = rng.random();
-                            // z ~ g(z) ∝ 1/√z on [1/a, a] by inversion (Goodman & Weare
-                            // 2010, eq. 9).
-                            let z = ((a - 1.0) * u + 1.0).powi(2) / a;
-                            let y: Vec<f64> =
-                                x.iter().zip(c).map(|(xi, ci)| ci + z * (xi - ci)).collect();
-                            (y, (dim as f64 - 1.0) * z.ln())
-                        };
+                        let (y, log_jacobian) = self.propose(&mut rng, &pos[w], complement, gamma0);
                         let lpy = self.eval(&y, &nans);
                         if lpy == f64::NEG_INFINITY {
                             return None;
@@ -646,6 +598,78 @@ impl<'a, D: LogDensity + ?Sized> EnsembleSampler<'a, D> {
             tau_max: assessment.tau_max * o.thin as f64,
             nan_evaluations: nans.load(Ordering::Relaxed),
         })
+    }
+
+    /// Checks an initial ensemble: one point per walker, each of the target's dimension and
+    /// finite.
+    fn check_ensemble(&self, ensemble: &[Vec<f64>]) -> Result<(), McmcError> {
+        let dim = self.target.dim();
+        let nw = self.walkers;
+        if ensemble.len() != nw {
+            return Err(McmcError::Length {
+                what: "initial ensemble",
+                got: ensemble.len(),
+                expected: nw,
+            });
+        }
+        for x in ensemble {
+            if x.len() != dim {
+                return Err(McmcError::Length {
+                    what: "initial walker",
+                    got: x.len(),
+                    expected: dim,
+                });
+            }
+            if x.iter().any(|v| !v.is_finite()) {
+                return Err(McmcError::NotFinite {
+                    what: "initial walker",
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The proposal for walker position `x` from the walkers of the other half,
+    /// `complement`, with the draws of `rng`: a differential-evolution move with probability
+    /// `de_fraction` (scale `gamma0`), else a stretch move; the proposed point and the log
+    /// of the move's Jacobian.
+    #[inline]
+    fn propose(
+        &self,
+        rng: &mut ChaCha8Rng,
+        x: &[f64],
+        complement: &[Vec<f64>],
+        gamma0: f64,
+    ) -> (Vec<f64>, f64) {
+        let o = &self.options;
+        // Every walker has the target's dimension (see `check_ensemble`).
+        let dim = x.len();
+        let a = o.stretch;
+        let de = o.de_fraction > 0.0 && rng.random::<f64>() < o.de_fraction;
+        if de {
+            // Differential evolution (ter Braak 2006; emcee's DEMove):
+            // y = x + γ (c_a − c_b), a ≠ b drawn from the complement,
+            // γ = γ0 (1 + u/10), u uniform on [−1, 1], γ0 = 2.38/√(2 dim).
+            // Symmetric (swap a and b), so no Jacobian term.
+            let nc = complement.len();
+            let ia = rng.random_range(0..nc);
+            let ib = (ia + 1 + rng.random_range(0..nc - 1)) % nc;
+            let g = gamma0 * (1.0 + 0.1 * (2.0 * rng.random::<f64>() - 1.0));
+            let (ca, cb) = (&complement[ia], &complement[ib]);
+            let y: Vec<f64> = x
+                .iter()
+                .zip(ca.iter().zip(cb))
+                .map(|(xi, (p, q))| xi + g * (p - q))
+                .collect();
+            (y, 0.0)
+        } else {
+            let c = &complement[rng.random_range(0..complement.len())];
+            let u: f64 = rng.random();
+            // z ~ g(z) ∝ 1/√z on [1/a, a] by inversion (Goodman & Weare 2010, eq. 9).
+            let z = ((a - 1.0) * u + 1.0).powi(2) / a;
+            let y: Vec<f64> = x.iter().zip(c).map(|(xi, ci)| ci + z * (xi - ci)).collect();
+            (y, (dim as f64 - 1.0) * z.ln())
+        }
     }
 
     /// Burn-in and convergence of the stored (thinned) chains; when `complete`, the failing

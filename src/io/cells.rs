@@ -251,8 +251,8 @@ impl Serializer for FieldWriter<'_, '_, '_> {
     #[inline]
     fn serialize_f64(self, x: f64) -> Result<(), NotFlat> {
         let w = self.0;
-        match &mut w.repeat {
-            Some(r) if r.cached[w.field] => {
+        if let Some(r) = &mut w.repeat {
+            if r.mask >> w.field & 1 == 1 {
                 w.cells.sep();
                 let (bits, text) = &mut r.last[w.field];
                 if *bits != Some(x.to_bits()) {
@@ -261,9 +261,10 @@ impl Serializer for FieldWriter<'_, '_, '_> {
                     push_f64(text, x);
                 }
                 w.cells.out.extend_from_slice(text);
+                return Ok(());
             }
-            _ => w.cells.num(x),
         }
+        w.cells.num(x);
         Ok(())
     }
     fn serialize_char(self, v: char) -> Result<(), NotFlat> {
@@ -329,8 +330,8 @@ impl Serializer for FieldWriter<'_, '_, '_> {
 /// quantities of ξ alone, along a series) are formatted once per run of equal values.
 #[derive(Debug, Clone)]
 pub(crate) struct Repeat {
-    /// Per field of the record, in order: whether its text is kept.
-    cached: Vec<bool>,
+    /// Bit i set: field i's text is kept (a record has at most 64 fields).
+    mask: u64,
     /// Per field: the bits of its last value and that value's text.
     last: Vec<(Option<u64>, Vec<u8>)>,
 }
@@ -339,14 +340,19 @@ impl Repeat {
     /// A cache for the fields `names` of record type `R`.
     ///
     /// # Panics
-    /// If a name is not a column of `R` (a programming error the tests catch).
+    /// If a name is not a column of `R`, or `R` has more than 64 fields (programming errors the
+    /// tests catch).
     pub fn new<R: Serialize + Default>(names: &[&str]) -> Self {
         let columns = columns::<R>();
+        assert!(columns.len() <= 64, "a record of more than 64 fields");
+        let mut mask = 0;
         for n in names {
-            assert!(columns.contains(n), "{n} is not a column of the record");
+            let i = columns.iter().position(|c| c == n);
+            let i = i.unwrap_or_else(|| panic!("{n} is not a column of the record"));
+            mask |= 1 << i;
         }
         Repeat {
-            cached: columns.iter().map(|c| names.contains(c)).collect(),
+            mask,
             last: vec![(None, Vec::new()); columns.len()],
         }
     }

@@ -474,162 +474,21 @@ impl Contact {
         // 3. Slip → stick (s = 0). ds/dθ has the sign of q(θ) = ρ sin θ/(1+ρ) − σ f N: s moves
         // towards 0 only where σ q < 0.
         let eps_f = sigma * f / rho;
-        let integrand = |t: f64| {
-            let (uu, _, c) = ph.speed_sq_sin_cos(t);
-            let uu = uu.max(f64::MIN_POSITIVE);
-            (c - uu) / uu.sqrt()
+        let stick = SlipStick {
+            ph: &ph,
+            ta,
+            wa,
+            sigma,
+            f,
+            rho,
+            eps_f,
+            tol: self.tol,
         };
-        let g_int = |a: f64, b: f64| -> f64 {
-            if b == a {
-                return 0.0;
-            }
-            integrate_smooth(integrand, a, b, self.tol)
+        let stick_at = if end > ta && f > 0.0 {
+            stick.first_stick(end)
+        } else {
+            None
         };
-        // σ q(θ): the sign of dσs/dθ = ((1+ρ)/ρ) σ q / Θ̇.
-        let sq = |t: f64| {
-            let (uu, sn, c) = ph.speed_sq_sin_cos(t);
-            sigma * (rho * sn / (1.0 + rho) - sigma * f * (c - uu))
-        };
-        // s relative to its sign: σ s(θ) = σ (Θ̇ − wa) − (f/ρ) G(θ).
-        let sig_s = |t: f64, g: f64| sigma * (u(t).max(0.0).sqrt() - wa) - eps_f * sigma * g;
-        let dsig_s = |t: f64| (1.0 + rho) / rho * sq(t) / u(t).max(f64::MIN_POSITIVE).sqrt();
-        let mut stick_at: Option<(f64, f64)> = None; // (angle, G there)
-        if end > ta && f > 0.0 {
-            // σs decreases exactly where σq < 0. Scan σq on 16 panels for the stretches
-            // [d0, d1] where it is negative (ends refined by Brent); on each, σs is monotone,
-            // so it has a zero there iff σs(d1) ≤ 0, found by safeguarded Newton with the
-            // closed-form derivative and the spin integral carried incrementally.
-            let n = 16;
-            let grid = |i: usize| ta + (end - ta) * i as f64 / n as f64;
-            let mut i = 0;
-            let mut qa = sq(ta);
-            let mut t_known = ta;
-            let mut g_known = 0.0;
-            while i < n && stick_at.is_none() {
-                // Next stretch start.
-                let d0 = if qa < 0.0 {
-                    grid(i)
-                } else {
-                    let mut found = None;
-                    while i < n {
-                        let (a, b) = (grid(i), grid(i + 1));
-                        let qb = sq(b);
-                        i += 1;
-                        if qb < 0.0 {
-                            found = Some(
-                                brent(sq, a, b, qa, qb, 1e-15, 200)
-                                    .map(|r| r.x)
-                                    .unwrap_or(a),
-                            );
-                            qa = qb;
-                            break;
-                        }
-                        qa = qb;
-                    }
-                    match found {
-                        Some(d) => d,
-                        None => break,
-                    }
-                };
-                // Stretch end: the first grid point where σq ≥ 0 again. It need not be
-                // refined: past the true end σs rises, so the first zero of σs after d0 is
-                // the same on [d0, d1].
-                let mut d1 = end;
-                while i < n {
-                    let b = grid(i + 1);
-                    let qb = sq(b);
-                    i += 1;
-                    qa = qb;
-                    if qb >= 0.0 {
-                        d1 = b;
-                        break;
-                    }
-                }
-                let g0 = g_known + g_int(t_known, d0);
-                let s0 = sig_s(d0, g0);
-                if d0 == ta && s0 <= 0.0 {
-                    // The slip starts at s = 0 exactly where σq = 0 (at Θ_G, or where a slip
-                    // reverses): the rounding of σq there says nothing, the mode decision
-                    // already chose σ. Look from the next stretch on.
-                    t_known = d0;
-                    g_known = g0;
-                    continue;
-                }
-                if s0 <= 0.0 {
-                    stick_at = Some((d0, g0));
-                    break;
-                }
-                // σs decreases on [d0, d1]: walk it in 8 panels (the spin integral carried
-                // from panel to panel) to the first panel where σs reaches 0.
-                let panels = 8;
-                let (mut pa, mut ga_, mut sa_) = (d0, g0, s0);
-                let mut found = None;
-                for k in 1..=panels {
-                    let pb = d0 + (d1 - d0) * k as f64 / panels as f64;
-                    let gb_ = ga_ + g_int(pa, pb);
-                    let sb_ = sig_s(pb, gb_);
-                    if sb_ <= 0.0 {
-                        found = Some((pa, ga_, sa_, pb, gb_, sb_));
-                        break;
-                    }
-                    (pa, ga_, sa_) = (pb, gb_, sb_);
-                }
-                t_known = pa;
-                g_known = ga_;
-                let Some((d0, g0, s0, d1, g1, s1)) = found else {
-                    t_known = d1;
-                    g_known = ga_;
-                    continue;
-                };
-                // G on that panel from one Chebyshev interpolant (every Newton iterate reads
-                // it), or by adaptive quadrature where the interpolant does not resolve it.
-                let cheb = ChebIntegral::new(integrand, d0, d1, self.tol);
-                let g_from = |lo: f64, glo: f64, x: f64| match &cheb {
-                    Some(c) => g0 + c.eval(x),
-                    None => glo + g_int(lo, x),
-                };
-                // Safeguarded Newton on [lo, hi] with σs(lo) > 0 ≥ σs(hi).
-                let (mut lo, mut glo) = (d0, g0);
-                let mut hi = d1;
-                let mut x = lo + (hi - lo) * s0 / (s0 - s1);
-                let mut last = (d1, g1);
-                for _ in 0..100 {
-                    if !(x > lo && x < hi) {
-                        x = 0.5 * (lo + hi);
-                    }
-                    let gx = g_from(lo, glo, x);
-                    let sx = sig_s(x, gx);
-                    last = (x, gx);
-                    if sx == 0.0 {
-                        break;
-                    }
-                    if sx > 0.0 {
-                        (lo, glo) = (x, gx);
-                    } else {
-                        hi = x;
-                    }
-                    let dx = dsig_s(x);
-                    let nx = x - sx / dx;
-                    let step = (nx - x).abs();
-                    // Newton within the bracket; otherwise bisect.
-                    x = if dx < 0.0 && nx > lo && nx < hi {
-                        nx
-                    } else {
-                        0.5 * (lo + hi)
-                    };
-                    if step <= 1e-10 * (1.0 + x.abs()) || hi - lo <= 1e-15 * (1.0 + x.abs()) {
-                        // Quadratic convergence: a Newton step below 1e-10 leaves the new
-                        // iterate within ~1e-20 of the zero, far below the rounding of σs
-                        // itself; take it as the event.
-                        if dx < 0.0 && nx > lo && nx < hi {
-                            last = (nx, g_from(lo, glo, nx));
-                        }
-                        break;
-                    }
-                }
-                stick_at = Some(last);
-            }
-        }
         let (end, g_stick, at_collision) = match stick_at {
             Some((t, g)) if t < end => (t, Some(g), false),
             _ => {
@@ -672,7 +531,7 @@ impl Contact {
             }
             (Some(g), true) => (g, integrate_smooth(inv_speed, ta, end, self.tol)),
             (g, false) => (
-                g.unwrap_or_else(|| g_int(ta, end)),
+                g.unwrap_or_else(|| stick.g_int(ta, end)),
                 slip_time(&ph, ta, end, self.tol)?,
             ),
         };
@@ -1090,6 +949,215 @@ impl Contact {
             collision_translation: translation,
             collision_spin: spin_loss,
         })
+    }
+}
+
+/// The slip → stick search of one slip phase with sgn(s) = σ from (Θa, Θ̇a², ωa/ε): the
+/// functions of θ it reads, with the phase's constants.
+struct SlipStick<'a> {
+    /// The phase's Θ̇²(θ).
+    ph: &'a SlipPhase,
+    /// Start angle Θa.
+    ta: f64,
+    /// Spin at the start, ωa/ε.
+    wa: f64,
+    /// sgn(s).
+    sigma: f64,
+    /// Friction coefficient.
+    f: f64,
+    /// ρ.
+    rho: f64,
+    /// σ f/ρ.
+    eps_f: f64,
+    /// Quadrature tolerance.
+    tol: f64,
+}
+
+impl SlipStick<'_> {
+    /// (cos θ − Θ̇²)/Θ̇, the integrand of the spin integral G.
+    #[inline]
+    fn integrand(&self, t: f64) -> f64 {
+        let (uu, _, c) = self.ph.speed_sq_sin_cos(t);
+        let uu = uu.max(f64::MIN_POSITIVE);
+        (c - uu) / uu.sqrt()
+    }
+
+    /// G from `a` to `b`.
+    #[inline]
+    fn g_int(&self, a: f64, b: f64) -> f64 {
+        if b == a {
+            return 0.0;
+        }
+        integrate_smooth(|t| self.integrand(t), a, b, self.tol)
+    }
+
+    /// σ q(θ): the sign of dσs/dθ = ((1+ρ)/ρ) σ q / Θ̇.
+    #[inline]
+    fn sq(&self, t: f64) -> f64 {
+        let (sigma, f, rho) = (self.sigma, self.f, self.rho);
+        let (uu, sn, c) = self.ph.speed_sq_sin_cos(t);
+        sigma * (rho * sn / (1.0 + rho) - sigma * f * (c - uu))
+    }
+
+    /// s relative to its sign: σ s(θ) = σ (Θ̇ − wa) − (f/ρ) G(θ), with G(θ) = `g`.
+    #[inline]
+    fn sig_s(&self, t: f64, g: f64) -> f64 {
+        let sigma = self.sigma;
+        sigma * (self.ph.speed_sq(t).max(0.0).sqrt() - self.wa) - self.eps_f * sigma * g
+    }
+
+    /// dσs/dθ.
+    #[inline]
+    fn dsig_s(&self, t: f64) -> f64 {
+        let rho = self.rho;
+        (1.0 + rho) / rho * self.sq(t) / self.ph.speed_sq(t).max(f64::MIN_POSITIVE).sqrt()
+    }
+
+    /// The first stick (s = 0) between Θa and `end`: its angle and G there.
+    fn first_stick(&self, end: f64) -> Option<(f64, f64)> {
+        // σs decreases exactly where σq < 0. Scan σq on 16 panels for the stretches
+        // [d0, d1] where it is negative (ends refined by Brent); on each, σs is monotone,
+        // so it has a zero there iff σs(d1) ≤ 0, found by safeguarded Newton with the
+        // closed-form derivative and the spin integral carried incrementally.
+        let n = 16;
+        let ta = self.ta;
+        let grid = |i: usize| ta + (end - ta) * i as f64 / n as f64;
+        let mut i = 0;
+        let mut qa = self.sq(ta);
+        let mut t_known = ta;
+        let mut g_known = 0.0;
+        while i < n {
+            // Next stretch start.
+            let d0 = if qa < 0.0 {
+                grid(i)
+            } else {
+                let mut found = None;
+                while i < n {
+                    let (a, b) = (grid(i), grid(i + 1));
+                    let qb = self.sq(b);
+                    i += 1;
+                    if qb < 0.0 {
+                        found = Some(
+                            brent(|t| self.sq(t), a, b, qa, qb, 1e-15, 200)
+                                .map(|r| r.x)
+                                .unwrap_or(a),
+                        );
+                        qa = qb;
+                        break;
+                    }
+                    qa = qb;
+                }
+                match found {
+                    Some(d) => d,
+                    None => break,
+                }
+            };
+            // Stretch end: the first grid point where σq ≥ 0 again. It need not be
+            // refined: past the true end σs rises, so the first zero of σs after d0 is
+            // the same on [d0, d1].
+            let mut d1 = end;
+            while i < n {
+                let b = grid(i + 1);
+                let qb = self.sq(b);
+                i += 1;
+                qa = qb;
+                if qb >= 0.0 {
+                    d1 = b;
+                    break;
+                }
+            }
+            let g0 = g_known + self.g_int(t_known, d0);
+            let s0 = self.sig_s(d0, g0);
+            if d0 == ta && s0 <= 0.0 {
+                // The slip starts at s = 0 exactly where σq = 0 (at Θ_G, or where a slip
+                // reverses): the rounding of σq there says nothing, the mode decision
+                // already chose σ. Look from the next stretch on.
+                t_known = d0;
+                g_known = g0;
+                continue;
+            }
+            if s0 <= 0.0 {
+                return Some((d0, g0));
+            }
+            // σs decreases on [d0, d1]: walk it in 8 panels (the spin integral carried
+            // from panel to panel) to the first panel where σs reaches 0.
+            let panels = 8;
+            let (mut pa, mut ga_, mut sa_) = (d0, g0, s0);
+            let mut found = None;
+            for k in 1..=panels {
+                let pb = d0 + (d1 - d0) * k as f64 / panels as f64;
+                let gb_ = ga_ + self.g_int(pa, pb);
+                let sb_ = self.sig_s(pb, gb_);
+                if sb_ <= 0.0 {
+                    found = Some((pa, ga_, sa_, pb, gb_, sb_));
+                    break;
+                }
+                (pa, ga_, sa_) = (pb, gb_, sb_);
+            }
+            let Some((d0, g0, s0, d1, g1, s1)) = found else {
+                t_known = d1;
+                g_known = ga_;
+                continue;
+            };
+            return Some(self.stick_in_panel((d0, g0, s0), (d1, g1, s1)));
+        }
+        None
+    }
+
+    /// The zero of σs on a panel [d0, d1] where it falls from s0 > 0 to s1 ≤ 0 (with G = g0
+    /// and g1 at the ends): its angle and G there.
+    fn stick_in_panel(
+        &self,
+        (d0, g0, s0): (f64, f64, f64),
+        (d1, g1, s1): (f64, f64, f64),
+    ) -> (f64, f64) {
+        // G on that panel from one Chebyshev interpolant (every Newton iterate reads
+        // it), or by adaptive quadrature where the interpolant does not resolve it.
+        let cheb = ChebIntegral::new(|t| self.integrand(t), d0, d1, self.tol);
+        let g_from = |lo: f64, glo: f64, x: f64| match &cheb {
+            Some(c) => g0 + c.eval(x),
+            None => glo + self.g_int(lo, x),
+        };
+        // Safeguarded Newton on [lo, hi] with σs(lo) > 0 ≥ σs(hi).
+        let (mut lo, mut glo) = (d0, g0);
+        let mut hi = d1;
+        let mut x = lo + (hi - lo) * s0 / (s0 - s1);
+        let mut last = (d1, g1);
+        for _ in 0..100 {
+            if !(x > lo && x < hi) {
+                x = 0.5 * (lo + hi);
+            }
+            let gx = g_from(lo, glo, x);
+            let sx = self.sig_s(x, gx);
+            last = (x, gx);
+            if sx == 0.0 {
+                break;
+            }
+            if sx > 0.0 {
+                (lo, glo) = (x, gx);
+            } else {
+                hi = x;
+            }
+            let dx = self.dsig_s(x);
+            let nx = x - sx / dx;
+            let step = (nx - x).abs();
+            // Newton within the bracket; otherwise bisect.
+            x = if dx < 0.0 && nx > lo && nx < hi {
+                nx
+            } else {
+                0.5 * (lo + hi)
+            };
+            if step <= 1e-10 * (1.0 + x.abs()) || hi - lo <= 1e-15 * (1.0 + x.abs()) {
+                // Quadratic convergence: a Newton step below 1e-10 leaves the new
+                // iterate within ~1e-20 of the zero, far below the rounding of σs
+                // itself; take it as the event.
+                if dx < 0.0 && nx > lo && nx < hi {
+                    last = (nx, g_from(lo, glo, nx));
+                }
+                break;
+            }
+        }
+        last
     }
 }
 

@@ -1153,6 +1153,9 @@ fn energy(nd: &Nd, xabs: f64, y: f64, v: Vector2<f64>, w: f64, u_el: f64) -> f64
 /// Steps between two looks at the stop flag.
 const STOP_POLL: u64 = 4096;
 
+/// One md run from the launch to the end of the measurement window (or a trap, a time
+/// limit or the stop flag), in two stages: the integration, then the measurement over the
+/// window; `res` receives both.
 fn run(
     nd: &Nd,
     c: &MdRunConfig,
@@ -1161,6 +1164,213 @@ fn run(
     progress: Option<&(dyn Fn(u64) + Sync)>,
     stop: Option<&AtomicBool>,
 ) {
+    let it = integrate(nd, c, scene, res, progress, stop);
+    res.time = it.t;
+    res.energy_error = if it.d_n + it.d_t > 0.0 {
+        it.err_max / (it.d_n + it.d_t)
+    } else {
+        it.err_max
+    };
+    if res.regime.is_some() || res.failure.is_some() {
+        return;
+    }
+    measure(nd, c, res, &it);
+}
+
+/// Where the integration of an md run ended, and what it recorded for the measurement.
+struct Integrated {
+    /// Time reached.
+    t: f64,
+    /// Absolute x of the centre reached.
+    xabs: f64,
+    /// Energy dissipated by normal damping.
+    d_n: f64,
+    /// Energy dissipated by tangential friction and damping.
+    d_t: f64,
+    /// Largest energy-balance error.
+    err_max: f64,
+    /// Crossing times of X = k s.
+    crossings: Vec<f64>,
+    /// (X, D_n, D_t) where the measurement window began, if it did.
+    win_start: Option<(f64, f64, f64)>,
+    /// The counts over the window.
+    win: Window,
+}
+
+/// The contact and flight bookkeeping of an md run: the row beads touched, the impact
+/// awaiting its speed after the first touch, the flight under way, and the counts over the
+/// measurement window.
+struct Bookkeeping {
+    /// Row spacing.
+    s: f64,
+    /// Slope.
+    delta: f64,
+    /// Time step.
+    dt: f64,
+    /// How long a contact lasts before leaving it counts as a lift-off.
+    sustained: f64,
+    max_touched: i64,
+    last_contact_start: f64,
+    last_lost: i64,
+    /// (new bead, speed at first touch).
+    pending: Option<(i64, f64)>,
+    in_flight: bool,
+    flight_x0: f64,
+    flight_liftoff: bool,
+    flight_angle: f64,
+    flight_hmax: f64,
+    /// The counts over the window.
+    win: Window,
+}
+
+impl Bookkeeping {
+    /// The bookkeeping at the launch, with the contacts `e` at the centre's absolute x `xabs`.
+    fn new(nd: &Nd, delta: f64, e: &Eval, xabs: f64) -> Self {
+        let mut max_touched: i64 = -1;
+        for &k in &e.idx[..e.n] {
+            max_touched = max_touched.max(k);
+        }
+        Bookkeeping {
+            s: nd.s,
+            delta,
+            dt: nd.dt,
+            sustained: 5.0 * nd.tc,
+            max_touched,
+            last_contact_start: -f64::INFINITY,
+            last_lost: 0,
+            pending: None,
+            in_flight: e.n == 0,
+            flight_x0: xabs,
+            flight_liftoff: false,
+            flight_angle: 0.0,
+            flight_hmax: 0.0,
+            win: Window::default(),
+        }
+    }
+
+    /// Contacts that began and ended in the step from `e` to `en` (at time `t`, velocity
+    /// `v`); whether the bead jumped a row bead onto a new one.
+    #[inline]
+    fn contacts(&mut self, e: &Eval, en: &Eval, t: f64, v: Vector2<f64>, in_window: bool) -> bool {
+        let win = &mut self.win;
+        let mut jumped = false;
+        if en.n > 0 || e.n > 0 {
+            for &k in &en.idx[..en.n] {
+                if !e.idx[..e.n].contains(&k) {
+                    self.last_contact_start = t;
+                    if in_window {
+                        win.episodes += 1;
+                    }
+                    if k > self.max_touched {
+                        if in_window {
+                            win.distinct += 1;
+                            jumped = k > self.max_touched + 1;
+                        }
+                        self.max_touched = k;
+                        self.pending = Some((k, v.norm()));
+                    }
+                }
+            }
+            for &k in &e.idx[..e.n] {
+                if !en.idx[..en.n].contains(&k) {
+                    self.last_lost = k;
+                }
+            }
+        }
+        jumped
+    }
+
+    /// The impact on a new row bead, once the bead stops approaching it: its speeds before
+    /// and after.
+    #[inline]
+    fn rebound(
+        &mut self,
+        en: &Eval,
+        xabs: f64,
+        pos: Vector2<f64>,
+        v: Vector2<f64>,
+        in_window: bool,
+    ) {
+        let (s, win) = (self.s, &mut self.win);
+        if let Some((k, vf)) = self.pending {
+            let old = en.idx[..en.n].iter().any(|&j| j < k);
+            let vapp = -v.dot(&Vector2::new(xabs - k as f64 * s, pos.y));
+            if !old && vapp <= 0.0 {
+                if in_window && vf > 0.0 {
+                    let vi = v.norm();
+                    win.vf_sum += vf;
+                    win.vi_sum += vi;
+                    win.k_sum += vi / vf;
+                    win.n_impacts += 1;
+                }
+                self.pending = None;
+            }
+        }
+    }
+
+    /// Flights: one begins when the last contact ends, and ends (counted as a jump, a
+    /// lift-off or neither) at the next contact.
+    #[inline]
+    fn flight(
+        &mut self,
+        en: &Eval,
+        t: f64,
+        xabs: f64,
+        pos: Vector2<f64>,
+        jumped: bool,
+        in_window: bool,
+    ) {
+        let (s, delta, dt) = (self.s, self.delta, self.dt);
+        let win = &mut self.win;
+        if en.n == 0 {
+            if !self.in_flight {
+                self.in_flight = true;
+                self.flight_x0 = xabs;
+                self.flight_hmax = 0.0;
+                let dx = xabs - self.last_lost as f64 * s;
+                self.flight_angle = dx.atan2(pos.y) + delta;
+                // Lift-off (eq 30a): leaving a sustained contact in the second half of its arc
+                // (Θ > (Θ0 + Θf)/2 = δ); a rebound leaves soon after an impact, near Θ0.
+                self.flight_liftoff =
+                    t - self.last_contact_start > self.sustained && self.flight_angle > delta;
+            }
+            let d0 = pos.norm();
+            let d1 = Vector2::new(pos.x - s, pos.y).norm();
+            self.flight_hmax = self.flight_hmax.max(d0.min(d1) - 1.0);
+            if in_window {
+                win.airborne_time += dt;
+            }
+        } else if self.in_flight {
+            self.in_flight = false;
+            if in_window {
+                let len = (xabs - self.flight_x0) / s;
+                win.height_max = win.height_max.max(self.flight_hmax);
+                win.len_max = win.len_max.max(len);
+                if jumped {
+                    win.jumps += 1;
+                    win.jump_angle_sum += self.flight_angle;
+                }
+                if self.flight_liftoff {
+                    win.lift_offs += 1;
+                    win.lift_angle_sum += self.flight_angle;
+                    win.lift_len_sum += len;
+                }
+            }
+        }
+    }
+}
+
+/// Integrates an md run by velocity Verlet from the launch until the bead has crossed the
+/// last row bead of the window, is trapped (regime A, recorded in `res`), runs past the
+/// time limit or sees the stop flag (recorded in `res.failure`).
+fn integrate(
+    nd: &Nd,
+    c: &MdRunConfig,
+    scene: &Scene,
+    res: &mut MdResult,
+    progress: Option<&(dyn Fn(u64) + Sync)>,
+    stop: Option<&AtomicBool>,
+) -> Integrated {
     let s = nd.s;
     let dt = nd.dt;
     let alpha = scene.alpha;
@@ -1187,22 +1397,9 @@ fn run(
     let mut crossings: Vec<f64> = Vec::with_capacity(nb + 1);
     let mut next_cross: i64 = 0; // next row index whose crossing is awaited
     let mut win_start: Option<(f64, f64, f64)> = None; // (X, D_n, D_t)
-    let mut win = Window::default();
 
     // Contact bookkeeping.
-    let mut max_touched: i64 = -1;
-    for &k in &e.idx[..e.n] {
-        max_touched = max_touched.max(k);
-    }
-    let mut last_contact_start = -f64::INFINITY;
-    let mut last_lost: i64 = 0;
-    let mut in_flight = e.n == 0;
-    let mut flight_x0 = xabs;
-    let mut flight_liftoff = false;
-    let mut flight_angle = 0.0;
-    let mut flight_hmax: f64 = 0.0;
-    let mut pending: Option<(i64, f64)> = None; // (new bead, speed at first touch)
-    let sustained = 5.0 * nd.tc;
+    let mut book = Bookkeeping::new(nd, delta, &e, xabs);
 
     // Trap test: only below δ = α is there a top to stop at.
     let depth = 1.0 - (delta - alpha).cos();
@@ -1241,80 +1438,10 @@ fn run(
         err_max = err_max.max((etot + d_n + d_t - e0).abs());
         let in_window = win_start.is_some();
 
-        // Contacts that began and ended in this step.
-        let mut jumped = false;
-        if en.n > 0 || e.n > 0 {
-            for &k in &en.idx[..en.n] {
-                if !e.idx[..e.n].contains(&k) {
-                    last_contact_start = t;
-                    if in_window {
-                        win.episodes += 1;
-                    }
-                    if k > max_touched {
-                        if in_window {
-                            win.distinct += 1;
-                            jumped = k > max_touched + 1;
-                        }
-                        max_touched = k;
-                        pending = Some((k, v.norm()));
-                    }
-                }
-            }
-            for &k in &e.idx[..e.n] {
-                if !en.idx[..en.n].contains(&k) {
-                    last_lost = k;
-                }
-            }
-        }
-        if let Some((k, vf)) = pending {
-            let old = en.idx[..en.n].iter().any(|&j| j < k);
-            let vapp = -v.dot(&Vector2::new(xabs - k as f64 * s, pos.y));
-            if !old && vapp <= 0.0 {
-                if in_window && vf > 0.0 {
-                    let vi = v.norm();
-                    win.vf_sum += vf;
-                    win.vi_sum += vi;
-                    win.k_sum += vi / vf;
-                    win.n_impacts += 1;
-                }
-                pending = None;
-            }
-        }
-        // Flights.
-        if en.n == 0 {
-            if !in_flight {
-                in_flight = true;
-                flight_x0 = xabs;
-                flight_hmax = 0.0;
-                let dx = xabs - last_lost as f64 * s;
-                flight_angle = dx.atan2(pos.y) + delta;
-                // Lift-off (eq 30a): leaving a sustained contact in the second half of its arc
-                // (Θ > (Θ0 + Θf)/2 = δ); a rebound leaves soon after an impact, near Θ0.
-                flight_liftoff = t - last_contact_start > sustained && flight_angle > delta;
-            }
-            let d0 = pos.norm();
-            let d1 = Vector2::new(pos.x - s, pos.y).norm();
-            flight_hmax = flight_hmax.max(d0.min(d1) - 1.0);
-            if in_window {
-                win.airborne_time += dt;
-            }
-        } else if in_flight {
-            in_flight = false;
-            if in_window {
-                let len = (xabs - flight_x0) / s;
-                win.height_max = win.height_max.max(flight_hmax);
-                win.len_max = win.len_max.max(len);
-                if jumped {
-                    win.jumps += 1;
-                    win.jump_angle_sum += flight_angle;
-                }
-                if flight_liftoff {
-                    win.lift_offs += 1;
-                    win.lift_angle_sum += flight_angle;
-                    win.lift_len_sum += len;
-                }
-            }
-        }
+        // Contacts that began and ended in this step, impacts and flights.
+        let jumped = book.contacts(&e, &en, t, v, in_window);
+        book.rebound(&en, xabs, pos, v, in_window);
+        book.flight(&en, t, xabs, pos, jumped, in_window);
 
         // Crossings of row-bead centres.
         if cell > cell_old && cell >= next_cross {
@@ -1373,17 +1500,28 @@ fn run(
             break;
         }
     }
-    res.time = t;
-    res.energy_error = if d_n + d_t > 0.0 {
-        err_max / (d_n + d_t)
-    } else {
-        err_max
-    };
-    if res.regime.is_some() || res.failure.is_some() {
-        return;
+    Integrated {
+        t,
+        xabs,
+        d_n,
+        d_t,
+        err_max,
+        crossings,
+        win_start,
+        win: book.win,
     }
+}
+
+/// The measurement over the window of a run that crossed it: the mean velocity and its
+/// standard error from blocks, the drift, the dissipation, and the contact and flight
+/// statistics; then the regime.
+fn measure(nd: &Nd, c: &MdRunConfig, res: &mut MdResult, it: &Integrated) {
+    let s = nd.s;
+    let nb = c.beads;
+    let (xabs, d_n, d_t, win) = (it.xabs, it.d_n, it.d_t, &it.win);
+    let crossings = &it.crossings;
     // Measurement over the window.
-    let Some((x_w0, dn0, dt0)) = win_start else {
+    let Some((x_w0, dn0, dt0)) = it.win_start else {
         res.failure = Some(MdFailure::TimeLimit);
         return;
     };

@@ -3,6 +3,7 @@
 //! — as CSV tables, figures and a `report.md` that links them, written as one directory.
 
 use super::{setting_error as flag_error, RunError};
+use crate::fit::data::{Dataset, SiSeries};
 use crate::fit::k::unsteady_points;
 use crate::fit::klaw::KLawError;
 use crate::fit::posterior::Method;
@@ -10,8 +11,10 @@ use crate::fit::summary::StatsRow;
 use crate::io::measurements::{
     is_shipped_data, locate_point, si_conversion, MeasurementDefaults, MeasurementFile,
 };
+use crate::io::scenes::Table;
 use crate::numfmt::fmt_f64;
-use crate::report::analysis::analyse;
+use crate::report::analysis::{analyse, Analysis};
+use crate::report::bands::PosteriorBands;
 use crate::report::figures::{FigureFormat, FigureWidth};
 use crate::report::text::{markdown, one_line, terminal_summary, ReportContext};
 use std::path::{Path, PathBuf};
@@ -139,30 +142,17 @@ pub(crate) fn law_error(e: &KLawError, locate: &dyn Fn(usize) -> String) -> Stri
 /// `out_dir` is given, the directory written as one unit (locked while written, every file or
 /// none, the run recorded in `.fitbead.manifest`; missing parents created and removed again
 /// on failure). The files are returned either way.
+///
+/// In stages: the flags checked, the input checked (points no contact model makes steady),
+/// the models fitted and their laws checked, then the tables, the figures and report.md
+/// drawn, and the directory written.
 pub fn report(
     data: &MeasurementFile,
     s: &ReportSettings,
     out_dir: Option<&Path>,
 ) -> Result<ReportOutput, RunError> {
     let (t, rows, ds) = (&data.table, &data.rows, &data.dataset);
-    if !(s.level > 0.0 && s.level < 1.0) {
-        return Err(flag_error(
-            "--level",
-            &s.level.to_string(),
-            "must be in (0, 1), e.g. 0.95",
-        ));
-    }
-    let format: FigureFormat = s
-        .format
-        .parse()
-        .map_err(|e: String| flag_error("--format", &s.format, e))?;
-    let figure_width: Option<FigureWidth> = match &s.figure_width {
-        Some(w) => Some(
-            w.parse()
-                .map_err(|e: String| flag_error("--figure-width", w, e))?,
-        ),
-        None => None,
-    };
+    let (format, figure_width) = figure_settings(s)?;
     let never = Arc::new(AtomicBool::new(false));
     let stop = s.stop.clone().unwrap_or(never);
     // A point that no contact model of the report can make steady is an error, as in klaw.
@@ -175,18 +165,7 @@ pub fn report(
     if s.stopped() {
         return Err(RunError::Interrupted);
     }
-    let under_none: Vec<&(usize, String)> = unsteady[0]
-        .iter()
-        .filter(|(i, _)| unsteady[1..].iter().all(|u| u.iter().any(|(j, _)| j == i)))
-        .collect();
-    if let Some((i, why)) = under_none.first() {
-        return Err(RunError::Failed(format!(
-            "{}: {why} (and {} more such point(s)); no K of the rolling or stick/slip model \
-             makes this point steady: leave it out of the data",
-            locate_point(t, ds, *i),
-            under_none.len() - 1
-        )));
-    }
+    refuse_unsteady_under_all(&unsteady, t, ds)?;
     let implausible = crate::io::measurements::plausibility(t, rows);
     let mut input_warnings = Vec::new();
     for (u, name) in unsteady.iter().zip(CONTACT_NAMES) {
@@ -202,14 +181,7 @@ pub fn report(
     refuse_unless_keep_going(s.keep_going, &input_warnings)?;
     let mut an = analyse(ds, s.level, &s.method);
     an.print_width_mm = figure_width.map(FigureWidth::mm);
-    // The K(α) laws `klaw` would have refused to fit (on the points each model keeps).
-    let mut law_failures = Vec::new();
-    for (c, name) in an.contact.iter().zip(CONTACT_NAMES) {
-        for (law, e) in &c.law_failures {
-            let located = law_error(e, &|i| locate_point(t, ds, c.used[i]));
-            law_failures.push(format!("{name} law {}: {located}", law.name()));
-        }
-    }
+    let law_failures = law_failures(&an, t, ds);
     if !s.stopped() {
         refuse_unless_keep_going(s.keep_going, &law_failures)?;
     }
@@ -221,20 +193,7 @@ pub fn report(
     if s.stopped() && !interrupted {
         return Err(RunError::Interrupted);
     }
-    let mut files: Vec<(String, Vec<u8>)> = Vec::new();
-    let csv_err = |e: csv::Error| RunError::Failed(e.to_string());
-    files.push(("bulk_friction.csv".into(), an.mu_csv().map_err(csv_err)?));
-    files.push(("energy.csv".into(), an.energy_csv().map_err(csv_err)?));
-    files.push((
-        "regime_map.csv".into(),
-        an.regime_map_csv().map_err(csv_err)?,
-    ));
-    files.push(("points.csv".into(), an.points_csv().map_err(csv_err)?));
-    files.push(("models.csv".into(), an.models_csv().map_err(csv_err)?));
-    files.push((
-        "models_by_series.csv".into(),
-        an.models_by_series_csv().map_err(csv_err)?,
-    ));
+    let mut files = analysis_tables(&an)?;
     // Under a posterior run: the bands of v̄(δ) and the posterior median at every point.
     // A run whose sampling was interrupted has none (the bands of every fit's draws cost
     // model evaluations by the million); a stop while they are drawn writes nothing.
@@ -250,93 +209,38 @@ pub fn report(
     let params = an.params();
     let stats: Vec<StatsRow> = fits.iter().map(|f| f.stats.clone()).collect();
     let mut warnings = Vec::new();
-    // Every fit whose misfit is absurd for the σ given, flagged in its note.
-    let stats: Vec<StatsRow> = stats
-        .into_iter()
-        .map(|mut s| {
-            if let Some(w) = s.absurd_misfit() {
-                warnings.push(format!("{} [{}]: {w}", s.fit, s.series));
-                s.note = if s.note.is_empty() {
-                    w
-                } else {
-                    format!("{}; {w}", s.note)
-                };
-            }
-            s
-        })
-        .collect();
+    let stats = flag_absurd_misfits(stats, &mut warnings);
     files.push((
         "params.csv".into(),
-        crate::io::reports::params_csv(&params).map_err(csv_err)?,
+        crate::io::reports::params_csv(&params).map_err(csv_error)?,
     ));
     files.push((
         "stats.csv".into(),
-        crate::io::reports::stats_csv(&stats).map_err(csv_err)?,
+        crate::io::reports::stats_csv(&stats).map_err(csv_error)?,
     ));
     // Velocities in m/s on the figures: each series' unit sqrt(g R (1 + ξ)).
     let si = si_conversion(t, &s.defaults);
-    let units_m_s: Option<Vec<f64>> = if s.si_units {
-        let si = si.as_ref().ok_or_else(|| {
-            flag_error(
-                "--units",
-                "si",
-                "the velocities were given dimensionless (column v): figures in m/s need \
-                 v_m_s with R_m",
-            )
-        })?;
-        let mut u = Vec::new();
-        for label in &ds.labels {
-            let series = si.iter().find(|s| &s.series == label);
-            match series.and_then(|s| s.unit()) {
-                Some(x) => u.push(x),
-                None => {
-                    return Err(flag_error(
-                        "--units",
-                        "si",
-                        format!(
-                            "series {label} has rows of different R_m or g, so no one unit \
-                             converts its velocities to m/s"
-                        ),
-                    ))
-                }
-            }
-        }
-        Some(u)
+    let units_m_s = if s.si_units {
+        Some(si_units(si.as_deref(), ds)?)
     } else {
         None
     };
     let fit_refs: Vec<&crate::fit::summary::FitResult> = fits.iter().collect();
     files.push((
         "residuals.csv".into(),
-        crate::io::reports::residuals_csv(&fit_refs).map_err(csv_err)?,
+        crate::io::reports::residuals_csv(&fit_refs).map_err(csv_error)?,
     ));
     files.push((
         "correlations.csv".into(),
-        crate::io::reports::correlations_csv(&fit_refs).map_err(csv_err)?,
+        crate::io::reports::correlations_csv(&fit_refs).map_err(csv_error)?,
     ));
-    let fig = |name: &str, r: Result<String, String>| {
-        r.map(|s| (name.to_string(), s.into_bytes()))
-            .map_err(|e| RunError::Failed(format!("figure {name}: {e}")))
+    let figures = Figures {
+        an: &an,
+        bands: bands.as_ref(),
+        units_m_s: units_m_s.as_deref(),
+        fits: &fits,
     };
-    files.push(fig(
-        "velocity.svg",
-        an.velocity_figure_with(bands.as_ref(), units_m_s.as_deref()),
-    )?);
-    files.push(fig("jan_linear.svg", an.jan_figure(units_m_s.as_deref()))?);
-    files.push(fig(
-        "k_final_velocity.svg",
-        an.k_figure(units_m_s.as_deref()),
-    )?);
-    files.push(fig("regime_map.svg", an.regime_figure())?);
-    files.push(fig("jaeger.svg", an.jaeger_figure())?);
-    files.push(fig("k_alpha.svg", an.k_alpha_figure())?);
-    files.push(fig("energy.svg", an.energy_figure())?);
-    files.push(fig("residuals.svg", an.residuals_figure_with(&fits))?);
-    let mut corner_files = Vec::new();
-    for (name, svg) in an.corner_figures() {
-        corner_files.push(name.clone());
-        files.push((name, svg.into_bytes()));
-    }
+    let corner_files = figures.draw(&mut files)?;
     let not_converged: Vec<String> = stats
         .iter()
         .filter(|s| s.mcmc.is_some() && !s.converged)
@@ -362,25 +266,7 @@ pub fn report(
             .chain(absurd)
             .collect(),
     };
-    let method = s.method_name.clone().unwrap_or_else(|| {
-        match s.method {
-            Method::Mcmc(_) => "mcmc",
-            _ => "lsq",
-        }
-        .to_string()
-    });
-    let mut md = markdown(&an, &context, &method);
-    if !not_converged.is_empty() {
-        md.push_str(
-            "
-## Posterior runs that did not converge
-
-",
-        );
-        for w in &not_converged {
-            md.push_str(&format!("- {}\n", one_line(w)));
-        }
-    }
+    let md = report_markdown(&an, &context, s, &not_converged);
     warnings.extend(not_converged);
     files.push(("report.md".into(), md.into_bytes()));
     let files = format.apply(files).map_err(RunError::Failed)?;
@@ -390,15 +276,7 @@ pub fn report(
     }
     let shown_dir = out_dir.map(|d| d.display().to_string()).unwrap_or_default();
     if let Some(out_dir) = out_dir {
-        let created = create_dirs(out_dir)
-            .map_err(|e| RunError::Failed(format!("{}: cannot create: {e}", out_dir.display())))?;
-        if let Err(e) = crate::io::outdir::write_dir(out_dir, &files) {
-            // All or nothing: directories made for this report go as well.
-            for d in created.iter().rev() {
-                let _ = std::fs::remove_dir(d);
-            }
-            return Err(RunError::Failed(format!("cannot write: {e}")));
-        }
+        write_report_dir(out_dir, &files)?;
     }
     Ok(ReportOutput {
         files,
@@ -407,6 +285,221 @@ pub fn report(
         warnings,
         interrupted,
     })
+}
+
+/// The figure settings of `s`, checked with its level: the format and the print width.
+fn figure_settings(s: &ReportSettings) -> Result<(FigureFormat, Option<FigureWidth>), RunError> {
+    if !(s.level > 0.0 && s.level < 1.0) {
+        return Err(flag_error(
+            "--level",
+            &s.level.to_string(),
+            "must be in (0, 1), e.g. 0.95",
+        ));
+    }
+    let format: FigureFormat = s
+        .format
+        .parse()
+        .map_err(|e: String| flag_error("--format", &s.format, e))?;
+    let figure_width: Option<FigureWidth> = match &s.figure_width {
+        Some(w) => Some(
+            w.parse()
+                .map_err(|e: String| flag_error("--figure-width", w, e))?,
+        ),
+        None => None,
+    };
+    Ok((format, figure_width))
+}
+
+/// An error naming the first point steady under none of the contact models (`unsteady`:
+/// per model, the points it cannot make steady, with why).
+fn refuse_unsteady_under_all(
+    unsteady: &[Vec<(usize, String)>],
+    t: &Table,
+    ds: &Dataset,
+) -> Result<(), RunError> {
+    let under_none: Vec<&(usize, String)> = unsteady[0]
+        .iter()
+        .filter(|(i, _)| unsteady[1..].iter().all(|u| u.iter().any(|(j, _)| j == i)))
+        .collect();
+    if let Some((i, why)) = under_none.first() {
+        return Err(RunError::Failed(format!(
+            "{}: {why} (and {} more such point(s)); no K of the rolling or stick/slip model \
+             makes this point steady: leave it out of the data",
+            locate_point(t, ds, *i),
+            under_none.len() - 1
+        )));
+    }
+    Ok(())
+}
+
+/// The K(α) laws `klaw` would have refused to fit (on the points each model keeps), in
+/// words.
+fn law_failures(an: &Analysis, t: &Table, ds: &Dataset) -> Vec<String> {
+    let mut law_failures = Vec::new();
+    for (c, name) in an.contact.iter().zip(CONTACT_NAMES) {
+        for (law, e) in &c.law_failures {
+            let located = law_error(e, &|i| locate_point(t, ds, c.used[i]));
+            law_failures.push(format!("{name} law {}: {located}", law.name()));
+        }
+    }
+    law_failures
+}
+
+/// A CSV writer's error as the run's.
+fn csv_error(e: csv::Error) -> RunError {
+    RunError::Failed(e.to_string())
+}
+
+/// The tables of the analysis: bulk friction, energy, the regime map, the points and the
+/// model rankings.
+fn analysis_tables(an: &Analysis) -> Result<Vec<(String, Vec<u8>)>, RunError> {
+    Ok(vec![
+        ("bulk_friction.csv".into(), an.mu_csv().map_err(csv_error)?),
+        ("energy.csv".into(), an.energy_csv().map_err(csv_error)?),
+        (
+            "regime_map.csv".into(),
+            an.regime_map_csv().map_err(csv_error)?,
+        ),
+        ("points.csv".into(), an.points_csv().map_err(csv_error)?),
+        ("models.csv".into(), an.models_csv().map_err(csv_error)?),
+        (
+            "models_by_series.csv".into(),
+            an.models_by_series_csv().map_err(csv_error)?,
+        ),
+    ])
+}
+
+/// Every fit whose misfit is absurd for the σ given, flagged in its note and in `warnings`.
+fn flag_absurd_misfits(stats: Vec<StatsRow>, warnings: &mut Vec<String>) -> Vec<StatsRow> {
+    stats
+        .into_iter()
+        .map(|mut s| {
+            if let Some(w) = s.absurd_misfit() {
+                warnings.push(format!("{} [{}]: {w}", s.fit, s.series));
+                s.note = if s.note.is_empty() {
+                    w
+                } else {
+                    format!("{}; {w}", s.note)
+                };
+            }
+            s
+        })
+        .collect()
+}
+
+/// Each series' velocity unit in m/s, for `--units si`: an error where the velocities were
+/// given dimensionless or a series mixes units.
+fn si_units(si: Option<&[SiSeries]>, ds: &Dataset) -> Result<Vec<f64>, RunError> {
+    let si = si.ok_or_else(|| {
+        flag_error(
+            "--units",
+            "si",
+            "the velocities were given dimensionless (column v): figures in m/s need \
+             v_m_s with R_m",
+        )
+    })?;
+    let mut u = Vec::new();
+    for label in &ds.labels {
+        let series = si.iter().find(|s| &s.series == label);
+        match series.and_then(|s| s.unit()) {
+            Some(x) => u.push(x),
+            None => {
+                return Err(flag_error(
+                    "--units",
+                    "si",
+                    format!(
+                        "series {label} has rows of different R_m or g, so no one unit \
+                         converts its velocities to m/s"
+                    ),
+                ))
+            }
+        }
+    }
+    Ok(u)
+}
+
+/// What the report's figures are drawn from.
+struct Figures<'a> {
+    /// The analysis.
+    an: &'a Analysis,
+    /// The posterior bands, under a posterior run.
+    bands: Option<&'a PosteriorBands>,
+    /// Each series' velocity unit in m/s, for figures in m/s.
+    units_m_s: Option<&'a [f64]>,
+    /// Every fit, at the posterior medians under a posterior run.
+    fits: &'a [crate::fit::summary::FitResult],
+}
+
+impl Figures<'_> {
+    /// Draws the figures and the corner plots onto `files`; the corner plots' names.
+    fn draw(&self, files: &mut Vec<(String, Vec<u8>)>) -> Result<Vec<String>, RunError> {
+        let (an, bands, units_m_s) = (self.an, self.bands, self.units_m_s);
+        let fig = |name: &str, r: Result<String, String>| {
+            r.map(|s| (name.to_string(), s.into_bytes()))
+                .map_err(|e| RunError::Failed(format!("figure {name}: {e}")))
+        };
+        files.push(fig(
+            "velocity.svg",
+            an.velocity_figure_with(bands, units_m_s),
+        )?);
+        files.push(fig("jan_linear.svg", an.jan_figure(units_m_s))?);
+        files.push(fig("k_final_velocity.svg", an.k_figure(units_m_s))?);
+        files.push(fig("regime_map.svg", an.regime_figure())?);
+        files.push(fig("jaeger.svg", an.jaeger_figure())?);
+        files.push(fig("k_alpha.svg", an.k_alpha_figure())?);
+        files.push(fig("energy.svg", an.energy_figure())?);
+        files.push(fig("residuals.svg", an.residuals_figure_with(self.fits))?);
+        let mut corner_files = Vec::new();
+        for (name, svg) in an.corner_figures() {
+            corner_files.push(name.clone());
+            files.push((name, svg.into_bytes()));
+        }
+        Ok(corner_files)
+    }
+}
+
+/// report.md: the analysis in words, then the posterior runs that did not converge.
+fn report_markdown(
+    an: &Analysis,
+    context: &ReportContext,
+    s: &ReportSettings,
+    not_converged: &[String],
+) -> String {
+    let method = s.method_name.clone().unwrap_or_else(|| {
+        match s.method {
+            Method::Mcmc(_) => "mcmc",
+            _ => "lsq",
+        }
+        .to_string()
+    });
+    let mut md = markdown(an, context, &method);
+    if !not_converged.is_empty() {
+        md.push_str(
+            "
+## Posterior runs that did not converge
+
+",
+        );
+        for w in not_converged {
+            md.push_str(&format!("- {}\n", one_line(w)));
+        }
+    }
+    md
+}
+
+/// Writes the report's `files` into `out_dir` as one unit, creating it and its missing
+/// parents; all or nothing: the directories made for it go again when the writing fails.
+fn write_report_dir(out_dir: &Path, files: &[(String, Vec<u8>)]) -> Result<(), RunError> {
+    let created = create_dirs(out_dir)
+        .map_err(|e| RunError::Failed(format!("{}: cannot create: {e}", out_dir.display())))?;
+    if let Err(e) = crate::io::outdir::write_dir(out_dir, files) {
+        // All or nothing: directories made for this report go as well.
+        for d in created.iter().rev() {
+            let _ = std::fs::remove_dir(d);
+        }
+        return Err(RunError::Failed(format!("cannot write: {e}")));
+    }
+    Ok(())
 }
 
 /// An error on `problems` (the input checks a fit command would have failed), unless

@@ -427,6 +427,40 @@ pub(crate) struct RegimeMapRecord {
     critical_xi: Option<f64>,
 }
 
+/// Δ AIC, Δ BIC and Δ WAIC of every candidate to the best of those fitted to all `n_all`
+/// points, and the candidates ranked by AIC, those fitted to fewer points last.
+fn rank_candidates(out: &mut [Candidate], n_all: usize) {
+    let best_aic = out
+        .iter()
+        .filter(|c| c.n == n_all)
+        .map(|c| c.aic)
+        .fold(f64::INFINITY, f64::min);
+    let best_bic = out
+        .iter()
+        .filter(|c| c.n == n_all)
+        .map(|c| c.bic)
+        .fold(f64::INFINITY, f64::min);
+    let best_waic = out
+        .iter()
+        .filter(|c| c.n == n_all)
+        .filter_map(|c| c.waic)
+        .fold(f64::INFINITY, f64::min);
+    for c in out.iter_mut() {
+        c.delta_aic = c.aic - best_aic;
+        c.delta_bic = c.bic - best_bic;
+        c.delta_waic = c.waic.map(|w| w - best_waic);
+    }
+    out.sort_by(|a, b| {
+        (a.n != n_all)
+            .cmp(&(b.n != n_all))
+            .then(a.aic.total_cmp(&b.aic))
+    });
+}
+
+/// One row of the per-series model table before its criteria: series, model, n_points,
+/// chi2, n_params, and whether the parameters are shared across series.
+type SeriesRecord = (String, String, usize, f64, usize, bool);
+
 impl Analysis {
     /// The bulk-friction comparison: per series with a Jan fit, per fitted K.
     pub fn mu_rows(&self) -> Vec<MuRow> {
@@ -695,6 +729,77 @@ impl Analysis {
     /// and rank by AIC.
     pub fn candidates(&self) -> Vec<Candidate> {
         let n_all = self.data.points.len();
+        let mut out = self.contact_candidates(n_all);
+        let sum_fits = |fits: Vec<&FitResult>, k_each: usize| {
+            let chi2: f64 = fits.iter().map(|f| f.stats.chi2).sum();
+            let n: usize = fits.iter().map(|f| f.stats.n_points).sum();
+            (chi2, k_each * fits.len(), n)
+        };
+        let jan_series: Vec<&FitResult> = self.jan.series.iter().flatten().collect();
+        if !jan_series.is_empty() {
+            let w = waic_sum(jan_series.iter().copied());
+            let (chi2, k, n) = sum_fits(jan_series, 2);
+            let note = if n < n_all {
+                format!("{n} of {n_all} points (series with < 3 points not fitted)")
+            } else {
+                String::new()
+            };
+            let mut cand = Candidate::new(
+                "jan lambda, mu per series".into(),
+                k,
+                n,
+                chi2,
+                self.data.sigma,
+                note,
+            );
+            cand.waic = w;
+            out.push(cand);
+        }
+        if let Some(g) = &self.jan.global {
+            let mut cand = Candidate::new(
+                "jan global laws (eqs 75-76 form)".into(),
+                4,
+                g.stats.n_points,
+                g.stats.chi2,
+                self.data.sigma,
+                String::new(),
+            );
+            cand.waic = waic_sum([g]);
+            out.push(cand);
+        }
+        let jaeger: Vec<&FitResult> = self
+            .jaeger
+            .series
+            .iter()
+            .flatten()
+            .map(|f| &f.summary)
+            .collect();
+        if !jaeger.is_empty() {
+            let w = waic_sum(jaeger.iter().copied());
+            let (chi2, k, n) = sum_fits(jaeger, 3);
+            let note = if n < n_all {
+                format!("{n} of {n_all} points (series with < 4 points not fitted)")
+            } else {
+                String::new()
+            };
+            let mut cand = Candidate::new(
+                "jaeger a1, a2, a3 per series".into(),
+                k,
+                n,
+                chi2,
+                self.data.sigma,
+                note,
+            );
+            cand.waic = w;
+            out.push(cand);
+        }
+        rank_candidates(&mut out, n_all);
+        out
+    }
+
+    /// The model-choice candidates of the contact models: K = cos 2α and K = impact (nothing
+    /// fitted), law c and free K per series, each on the points its model keeps of `n_all`.
+    fn contact_candidates(&self, n_all: usize) -> Vec<Candidate> {
         let mut out = Vec::new();
         for c in &self.contact {
             let n = c.data.points.len();
@@ -761,105 +866,13 @@ impl Analysis {
                 );
             }
         }
-        let sum_fits = |fits: Vec<&FitResult>, k_each: usize| {
-            let chi2: f64 = fits.iter().map(|f| f.stats.chi2).sum();
-            let n: usize = fits.iter().map(|f| f.stats.n_points).sum();
-            (chi2, k_each * fits.len(), n)
-        };
-        let jan_series: Vec<&FitResult> = self.jan.series.iter().flatten().collect();
-        if !jan_series.is_empty() {
-            let w = waic_sum(jan_series.iter().copied());
-            let (chi2, k, n) = sum_fits(jan_series, 2);
-            let note = if n < n_all {
-                format!("{n} of {n_all} points (series with < 3 points not fitted)")
-            } else {
-                String::new()
-            };
-            let mut cand = Candidate::new(
-                "jan lambda, mu per series".into(),
-                k,
-                n,
-                chi2,
-                self.data.sigma,
-                note,
-            );
-            cand.waic = w;
-            out.push(cand);
-        }
-        if let Some(g) = &self.jan.global {
-            let mut cand = Candidate::new(
-                "jan global laws (eqs 75-76 form)".into(),
-                4,
-                g.stats.n_points,
-                g.stats.chi2,
-                self.data.sigma,
-                String::new(),
-            );
-            cand.waic = waic_sum([g]);
-            out.push(cand);
-        }
-        let jaeger: Vec<&FitResult> = self
-            .jaeger
-            .series
-            .iter()
-            .flatten()
-            .map(|f| &f.summary)
-            .collect();
-        if !jaeger.is_empty() {
-            let w = waic_sum(jaeger.iter().copied());
-            let (chi2, k, n) = sum_fits(jaeger, 3);
-            let note = if n < n_all {
-                format!("{n} of {n_all} points (series with < 4 points not fitted)")
-            } else {
-                String::new()
-            };
-            let mut cand = Candidate::new(
-                "jaeger a1, a2, a3 per series".into(),
-                k,
-                n,
-                chi2,
-                self.data.sigma,
-                note,
-            );
-            cand.waic = w;
-            out.push(cand);
-        }
-        let best_aic = out
-            .iter()
-            .filter(|c| c.n == n_all)
-            .map(|c| c.aic)
-            .fold(f64::INFINITY, f64::min);
-        let best_bic = out
-            .iter()
-            .filter(|c| c.n == n_all)
-            .map(|c| c.bic)
-            .fold(f64::INFINITY, f64::min);
-        let best_waic = out
-            .iter()
-            .filter(|c| c.n == n_all)
-            .filter_map(|c| c.waic)
-            .fold(f64::INFINITY, f64::min);
-        for c in out.iter_mut() {
-            c.delta_aic = c.aic - best_aic;
-            c.delta_bic = c.bic - best_bic;
-            c.delta_waic = c.waic.map(|w| w - best_waic);
-        }
-        out.sort_by(|a, b| {
-            (a.n != n_all)
-                .cmp(&(b.n != n_all))
-                .then(a.aic.total_cmp(&b.aic))
-        });
         out
     }
 
-    /// χ², AIC and BIC per series of every candidate (at the least-squares optimum; ∞ where a
-    /// point of the series has no steady state under the candidate), as CSV: series, model,
-    /// n_points, chi2, then n_params (the parameters the series' fit uses), shared_params (yes
-    /// when they are fitted across all series, as law c and Jan's global laws: the per-series
-    /// AIC then charges each series the whole shared count, a conservative convention), aic,
-    /// bic, delta_aic, delta_bic and rank (by AIC) within the series.
-    pub fn models_by_series_csv(&self) -> csv::Result<Vec<u8>> {
-        let ns = self.data.labels.len();
+    /// χ² and points per series of every contact-model candidate (K = cos 2α, K = impact,
+    /// law c, free K per series), by candidate name; ∞ where a point of the series has no
+    /// steady state under the candidate.
+    fn contact_chi2_by_series(&self) -> Vec<(String, Vec<(usize, f64)>)> {
         let mut rows: Vec<(String, Vec<(usize, f64)>)> = Vec::new();
         let per_point = |c: &ContactFits, k: &(dyn Fn(usize) -> f64 + Sync)| -> Vec<(usize, f64)> {
             let r: Vec<(usize, f64)> = c
@@ -908,9 +921,16 @@ impl Analysis {
                 ));
             }
         }
+        rows
+    }
+
+    /// The records of [`Analysis::models_by_series_csv`], every candidate per series.
+    fn series_records(&self) -> Vec<SeriesRecord> {
+        let ns = self.data.labels.len();
+        let rows = self.contact_chi2_by_series();
         // Series labels of a contact model's subset map back to the full data by name.
         // (series, model, n_points, chi2, n_params, shared)
-        let mut recs: Vec<(String, String, usize, f64, usize, bool)> = Vec::new();
+        let mut recs: Vec<SeriesRecord> = Vec::new();
         for c in &self.contact {
             for (name, acc) in rows.iter().filter(|r| r.0.starts_with(c.name)) {
                 let (k, shared) = if name.ends_with("law c") {
@@ -967,6 +987,17 @@ impl Analysis {
                 ));
             }
         }
+        recs
+    }
+
+    /// χ², AIC and BIC per series of every candidate (at the least-squares optimum; ∞ where a
+    /// point of the series has no steady state under the candidate), as CSV: series, model,
+    /// n_points, chi2, then n_params (the parameters the series' fit uses), shared_params (yes
+    /// when they are fitted across all series, as law c and Jan's global laws: the per-series
+    /// AIC then charges each series the whole shared count, a conservative convention), aic,
+    /// bic, delta_aic, delta_bic and rank (by AIC) within the series.
+    pub fn models_by_series_csv(&self) -> csv::Result<Vec<u8>> {
+        let recs = self.series_records();
         let cands: Vec<Candidate> = recs
             .iter()
             .map(|r| Candidate::new(r.1.clone(), r.4, r.2, r.3, self.data.sigma, String::new()))

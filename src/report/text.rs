@@ -452,7 +452,19 @@ pub fn markdown(an: &Analysis, ctx: &ReportContext, method: &str) -> String {
     ));
     m.push_str(&si_units(ctx));
     m.push_str(&parameter_table(an));
-    // Bulk friction.
+    m.push_str(&bulk_friction_section(an));
+    m.push_str(&energy_section(an));
+    m.push_str(&regimes_section(an));
+    m.push_str(&jaeger_section(an));
+    m.push_str(&model_choice_section(an));
+    m.push_str(&figures_section(ctx));
+    m.push_str(&fit_reports(an));
+    m
+}
+
+/// report.md's bulk friction: Jan's μ against eq 79 per K source, and against eq 76.
+fn bulk_friction_section(an: &Analysis) -> String {
+    let mut m = String::new();
     let rows = an.mu_rows();
     m.push_str("## Bulk friction: Jan's μ against eq 79\n\n");
     m.push_str(
@@ -508,7 +520,12 @@ pub fn markdown(an: &Analysis, ctx: &ReportContext, method: &str) -> String {
         ));
     }
     m.push_str("\n\n");
-    // Energy.
+    m
+}
+
+/// report.md's energy budgets: collision loss and friction work per contact model.
+fn energy_section(an: &Analysis) -> String {
+    let mut m = String::new();
     m.push_str("## Energy budget\n\n");
     m.push_str(
         "Collision loss (translation and spin) and friction work as fractions of the potential \
@@ -528,7 +545,12 @@ pub fn markdown(an: &Analysis, ctx: &ReportContext, method: &str) -> String {
         "\nThe paper: 1 for rolling (eq 71), 0.74–0.94 for the translational loss under \
          stick/slip on Ristow's data, 0.24–0.78 for Jan's eq 77.\n\n",
     );
-    // Regimes.
+    m
+}
+
+/// report.md's regimes: the regime map and the regime of every point per contact model.
+fn regimes_section(an: &Analysis) -> String {
+    let mut m = String::new();
     m.push_str("## Regimes\n\n");
     m.push_str(
         "δ_m (eq 32) and δ_d (eq 31) against α for the reference and fitted laws, with the \
@@ -549,8 +571,12 @@ pub fn markdown(an: &Analysis, ctx: &ReportContext, method: &str) -> String {
         ));
     }
     m.push('\n');
-    m.push_str(&jaeger_section(an));
-    // Models.
+    m
+}
+
+/// report.md's model choice: the ranking by AIC, what the data support and the fits' notes.
+fn model_choice_section(an: &Analysis) -> String {
+    let mut m = String::new();
     m.push_str("## Model choice\n\n");
     m.push_str(
         "χ² at the least-squares optimum, AIC and BIC (with σ given: AIC = χ² + 2k, BIC = χ² + \
@@ -603,6 +629,12 @@ pub fn markdown(an: &Analysis, ctx: &ReportContext, method: &str) -> String {
             m.push_str(&format!("- {}\n", one_line(n)));
         }
     }
+    m
+}
+
+/// report.md's list of figures and tables.
+fn figures_section(ctx: &ReportContext) -> String {
+    let mut m = String::new();
     m.push_str("\n## Figures\n\n");
     for (name, what) in FIGURES {
         m.push_str(&format!("- {}: {what}\n", figure_link(ctx, name)));
@@ -624,6 +656,5 @@ pub fn markdown(an: &Analysis, ctx: &ReportContext, method: &str) -> String {
          [stats.csv](stats.csv); every point against every fit: [residuals.csv](residuals.csv); \
          every pair of parameters: [correlations.csv](correlations.csv).\n\n",
     );
-    m.push_str(&fit_reports(an));
     m
 }

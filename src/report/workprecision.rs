@@ -442,8 +442,30 @@ pub(crate) fn run_bench_until(
         check()?;
         refs.push(References::of(s));
     }
+    let mut rows = crosscheck_rows(&refs);
+    let vs_contact = variant_rows(scenes, &refs, &check, &mut rows)?;
+    let cheapest = cheapest_per_tolerance(&vs_contact);
+    let mut mix = (0, 0, 0);
+    for (s, _) in scenes {
+        check()?;
+        match (Auto { tol: 1e-10 }).choose(s).choice {
+            crate::models::auto::Choice::Stick => mix.0 += 1,
+            crate::models::auto::Choice::StickSlip => mix.1 += 1,
+            crate::models::auto::Choice::Contact => mix.2 += 1,
+        }
+    }
+    rows.extend(k_rows(scenes, &refs, &check)?);
+    Ok(BenchResult {
+        rows,
+        cheapest,
+        auto_mix: mix,
+    })
+}
+
+/// The cross-checks of the references: each reference against an independent method, one
+/// row per model.
+fn crosscheck_rows(refs: &[References]) -> Vec<WpRow> {
     let mut rows = Vec::new();
-    // Cross-checks of the references.
     let mut xs: Vec<(&str, &str, Vec<f64>)> = vec![
         ("stick", "crosscheck:elliptic-vs-quadrature-1e-15", vec![]),
         ("slip", "crosscheck:1e-14-vs-raw-quadrature-1e-15", vec![]),
@@ -458,7 +480,7 @@ pub(crate) fn run_bench_until(
             vec![],
         ),
     ];
-    for r in &refs {
+    for r in refs {
         if let Some(e) = error_of(&r.stick, v(&r.stick_x), r.stick_x.is_ok()) {
             xs[0].2.push(e);
         }
@@ -479,13 +501,27 @@ pub(crate) fn run_bench_until(
     for (m, meth, e) in xs {
         rows.push(row(m, meth, None, e, None));
     }
-    // Every variant.
-    let mut vs_contact: Vec<(String, f64, Option<f64>, f64)> = Vec::new();
+    rows
+}
+
+/// One variant's name, its largest error against the physics reference, its auto
+/// tolerance (auto variants) and its median time.
+type VsContact = (String, f64, Option<f64>, f64);
+
+/// Every variant on every scene, timed, its row pushed onto `rows`; each variant against the
+/// physics reference. `check` fails once the bench is stopped.
+fn variant_rows(
+    scenes: &[(Scene, Draw)],
+    refs: &[References],
+    check: &dyn Fn() -> Result<(), Interrupted>,
+    rows: &mut Vec<WpRow>,
+) -> Result<Vec<VsContact>, Interrupted> {
+    let mut vs_contact: Vec<VsContact> = Vec::new();
     for var in variants() {
         let mut errs = Vec::new();
         let mut errs_c = Vec::new();
         let mut ns = Vec::new();
-        for ((s, _), r) in scenes.iter().zip(&refs) {
+        for ((s, _), r) in scenes.iter().zip(refs) {
             check()?;
             let t0 = Instant::now();
             let o = (var.eval)(s);
@@ -522,6 +558,12 @@ pub(crate) fn run_bench_until(
         ));
         rows.push(rw);
     }
+    Ok(vs_contact)
+}
+
+/// Per auto tolerance, the cheapest single variant (by median time) that meets it on all
+/// scenes against the physics reference, with its median time.
+fn cheapest_per_tolerance(vs_contact: &[VsContact]) -> Vec<(f64, Option<(String, f64)>)> {
     // Auto against the cheapest single method meeting T on all scenes.
     let mut cheapest = Vec::new();
     for &t in &AUTO_TOLS {
@@ -534,17 +576,18 @@ pub(crate) fn run_bench_until(
             .map(|(name, _, _, ns)| (name.clone(), *ns));
         cheapest.push((t, best));
     }
-    let mut mix = (0, 0, 0);
-    for (s, _) in scenes {
-        check()?;
-        match (Auto { tol: 1e-10 }).choose(s).choice {
-            crate::models::auto::Choice::Stick => mix.0 += 1,
-            crate::models::auto::Choice::StickSlip => mix.1 += 1,
-            crate::models::auto::Choice::Contact => mix.2 += 1,
-        }
-    }
-    // K inversion (eq 69) with each model: v from the model's own reference at the scene's
-    // K; error |K̂ − K| / K.
+    cheapest
+}
+
+/// K inversion (eq 69) with each model: v from the model's own reference at the scene's
+/// K; error |K̂ − K| / K, on the first `K_SCENES` scenes. `check` fails once the bench is
+/// stopped.
+fn k_rows(
+    scenes: &[(Scene, Draw)],
+    refs: &[References],
+    check: &dyn Fn() -> Result<(), Interrupted>,
+) -> Result<Vec<WpRow>, Interrupted> {
+    let mut rows = Vec::new();
     let nk = scenes.len().min(K_SCENES);
     let mut kmodels: Vec<(&str, String, Option<f64>, Model)> = vec![
         ("k-stick", "brent-eq69".into(), None, Model::Stick),
@@ -592,7 +635,7 @@ pub(crate) fn run_bench_until(
         let mut errs = Vec::new();
         let mut ns = Vec::new();
         let by_estimate = method.starts_with("estimate");
-        for ((s, _), r) in scenes.iter().take(nk).zip(&refs) {
+        for ((s, _), r) in scenes.iter().take(nk).zip(refs) {
             check()?;
             let which = match model {
                 Model::Stick | Model::StickApprox => Ref::Stick,
@@ -617,11 +660,7 @@ pub(crate) fn run_bench_until(
         }
         rows.push(row(name, method, *tol, errs, Some(ns)));
     }
-    Ok(BenchResult {
-        rows,
-        cheapest,
-        auto_mix: mix,
-    })
+    Ok(rows)
 }
 
 /// The CSV of the rows (one [`WpRow`] record each).

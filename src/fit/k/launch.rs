@@ -599,37 +599,11 @@ pub(crate) fn estimate(
         return None;
     }
     let l = Launch::new(model, scene)?;
-    let mut evals = 0;
     let u_d = l.y_d.ln();
     let sin_alpha = scene.sin_alpha;
     let tau_star = 2.0 * sin_alpha / v;
-    // Rolling: the pass at the top of the range and the root search's first one (from the
-    // asinh start, which needs no pass) side by side; stick/slip takes them one by one, the
-    // second only when the root is searched.
-    let (top, first) = match l.mech {
-        Mechanics::Roll => {
-            let (u0, s0) = l.guess(tau_star);
-            let [top, first] = l.pass_pair(l.y_d, Secant::first_point(u0, u_d).exp());
-            evals += 1;
-            (top?, Some((u0, s0, first)))
-        }
-        Mechanics::RollSlip => (l.pass(l.y_d, &mut evals)?, None),
-    };
-    let br = KBracket {
-        lo: l.k_min,
-        hi: top.k(),
-        v_lo: 0.0,
-        v_hi: 2.0 * sin_alpha / top.tau,
-        tau_hi: top.tau,
-        lower: LowerLimit::Crawl,
-        upper: if l.saddle {
-            UpperLimit::Model
-        } else {
-            UpperLimit::LiftOff
-        },
-        evals,
-    };
-    let end = (u_d, top.tau);
+    let (br, first) = bracket(&l, tau_star, u_d)?;
+    let end = (u_d, br.tau_hi);
     let mut notes = Vec::new();
     // Near a saddle-node the range's end is where the forward model's status search puts it:
     // measurements within 1e-6 of the fastest stable motion, or whose v + σ passes it, are
@@ -669,74 +643,25 @@ pub(crate) fn estimate(
         },
     };
     let k = p.k();
-    // dτ/du and d²τ/du² by central differences, h = 1e-5 in u (one-sided at lift-off).
-    let h = 1e-5;
     let mut n_side = 2;
-    let [pm, pp] = if u + h <= u_d {
-        l.pass_pair((u - h).exp(), (u + h).exp())
-    } else {
-        l.pass_pair((u - 2.0 * h).exp(), (u - h).exp())
-    };
-    let (pm, pp) = (pm?, pp?);
-    let (d1, d2) = if u + h <= u_d {
-        (
-            (pp.tau - pm.tau) / (2.0 * h),
-            (pp.tau - 2.0 * p.tau + pm.tau) / (h * h),
-        )
-    } else {
-        (
-            (3.0 * p.tau - 4.0 * pp.tau + pm.tau) / (2.0 * h),
-            (p.tau - 2.0 * pp.tau + pm.tau) / (h * h),
-        )
-    };
+    let (d1, d2) = tau_derivatives(&l, u, u_d, &p)?;
     let (dk, map_slope) = l.dk_du(y, &p)?;
     // v̄ = 2 sin α / τ: dv̄/du = −v̄ τ'/τ.
     let dv_dk = -(2.0 * sin_alpha / p.tau) * d1 / p.tau / dk;
     // K at v ± σ: a second-order Taylor step in τ off the root, then the secant method (the
     // two searches side by side).
-    let plan_end = |vs: f64, name: &'static str, notes: &mut Vec<String>| -> Option<End> {
-        let side = if name == "K_lo" {
-            "v - sigma_v"
-        } else {
-            "v + sigma_v"
-        };
-        if vs <= 0.0 {
-            notes.push(format!("{name} is the bracket's lower end: {side} <= 0"));
-            return Some(End::At(br.lo));
-        }
-        if vs > br.v_hi {
-            notes.push(format!(
-                "{name} is the bracket's upper end: {side} is above the steady range"
-            ));
-            return Some(End::At(br.hi));
-        }
-        let t = 2.0 * sin_alpha / vs;
-        let dt = t - p.tau;
-        let du = dt / d1;
-        let du = du - 0.5 * d2 * du * du / d1;
-        Secant::new(t, u + du, d1 + d2 * du, end, Some(0.5 * d2 / d1)).map(End::Search)
-    };
-    let k_at = |r: Option<(f64, Option<Pass>)>| -> Option<f64> {
-        let (ue, pe) = r?;
-        match pe {
-            Some(pe) => Some(pe.k()),
-            None => l.k_of_launch(ue.exp()),
-        }
+    let ends = SigmaEnds {
+        l: &l,
+        br: &br,
+        sin_alpha,
+        end,
+        u,
+        tau: p.tau,
+        d1,
+        d2,
     };
     let (k_lo, k_hi) = match sigma_v {
-        Some(sg) => {
-            let lo = plan_end(v - sg, "K_lo", &mut notes)?;
-            let hi = plan_end(v + sg, "K_hi", &mut notes)?;
-            match (lo, hi) {
-                (End::Search(a), End::Search(b)) => {
-                    let [ra, rb] = l.solve_two((a, b), &mut n_side);
-                    (k_at(ra)?, k_at(rb)?)
-                }
-                (End::Search(a), End::At(kh)) => (k_at(l.solve(a, None, &mut n_side))?, kh),
-                (End::At(kl), End::Search(b)) => (kl, k_at(l.solve(b, None, &mut n_side))?),
-                (End::At(kl), End::At(kh)) => (kl, kh),
-            }
-        }
+        Some(sg) => ends.interval(v, sg, &mut notes, &mut n_side)?,
         None => (f64::NAN, f64::NAN),
     };
     if l.saddle {
@@ -772,4 +697,148 @@ pub(crate) fn estimate(
         theta_g,
         notes,
     })
+}
+
+/// The bracket of a launch-speed estimate: K from K_min to the top of the steady range,
+/// and, rolling, the root search's first pass (from the asinh start at τ* = `tau_star`,
+/// taken beside the top's) with its start.
+#[allow(clippy::type_complexity)]
+fn bracket(
+    l: &Launch<'_>,
+    tau_star: f64,
+    u_d: f64,
+) -> Option<(KBracket, Option<(f64, f64, Option<Pass>)>)> {
+    let mut evals = 0;
+    // Rolling: the pass at the top of the range and the root search's first one (from the
+    // asinh start, which needs no pass) side by side; stick/slip takes them one by one, the
+    // second only when the root is searched.
+    let (top, first) = match l.mech {
+        Mechanics::Roll => {
+            let (u0, s0) = l.guess(tau_star);
+            let [top, first] = l.pass_pair(l.y_d, Secant::first_point(u0, u_d).exp());
+            evals += 1;
+            (top?, Some((u0, s0, first)))
+        }
+        Mechanics::RollSlip => (l.pass(l.y_d, &mut evals)?, None),
+    };
+    let br = KBracket {
+        lo: l.k_min,
+        hi: top.k(),
+        v_lo: 0.0,
+        v_hi: 2.0 * l.scene.sin_alpha / top.tau,
+        tau_hi: top.tau,
+        lower: LowerLimit::Crawl,
+        upper: if l.saddle {
+            UpperLimit::Model
+        } else {
+            UpperLimit::LiftOff
+        },
+        evals,
+    };
+    Some((br, first))
+}
+
+/// dτ/du and d²τ/du² at the root `p` (u = ln y) by central differences, h = 1e-5 in u
+/// (one-sided at lift-off, u_d).
+fn tau_derivatives(l: &Launch<'_>, u: f64, u_d: f64, p: &Pass) -> Option<(f64, f64)> {
+    let h = 1e-5;
+    let [pm, pp] = if u + h <= u_d {
+        l.pass_pair((u - h).exp(), (u + h).exp())
+    } else {
+        l.pass_pair((u - 2.0 * h).exp(), (u - h).exp())
+    };
+    let (pm, pp) = (pm?, pp?);
+    Some(if u + h <= u_d {
+        (
+            (pp.tau - pm.tau) / (2.0 * h),
+            (pp.tau - 2.0 * p.tau + pm.tau) / (h * h),
+        )
+    } else {
+        (
+            (3.0 * p.tau - 4.0 * pp.tau + pm.tau) / (2.0 * h),
+            (p.tau - 2.0 * pp.tau + pm.tau) / (h * h),
+        )
+    })
+}
+
+/// K at v ± σ, from the root: a second-order Taylor step in τ off it, then the secant
+/// method.
+struct SigmaEnds<'a> {
+    /// The launch.
+    l: &'a Launch<'a>,
+    /// The bracket.
+    br: &'a KBracket,
+    /// sin α.
+    sin_alpha: f64,
+    /// The end of the root search's range, (u_d, τ there).
+    end: (f64, f64),
+    /// u = ln y at the root.
+    u: f64,
+    /// Contact time at the root.
+    tau: f64,
+    /// dτ/du at the root.
+    d1: f64,
+    /// d²τ/du² at the root.
+    d2: f64,
+}
+
+impl SigmaEnds<'_> {
+    /// How the end named `name` (`K_lo` or `K_hi`) at velocity `vs` is found: a bracket end
+    /// where `vs` is outside the steady range (noted in `notes`), else a search.
+    fn plan_end(&self, vs: f64, name: &'static str, notes: &mut Vec<String>) -> Option<End> {
+        let (br, sin_alpha, end, u) = (self.br, self.sin_alpha, self.end, self.u);
+        let (d1, d2) = (self.d1, self.d2);
+        let side = if name == "K_lo" {
+            "v - sigma_v"
+        } else {
+            "v + sigma_v"
+        };
+        if vs <= 0.0 {
+            notes.push(format!("{name} is the bracket's lower end: {side} <= 0"));
+            return Some(End::At(br.lo));
+        }
+        if vs > br.v_hi {
+            notes.push(format!(
+                "{name} is the bracket's upper end: {side} is above the steady range"
+            ));
+            return Some(End::At(br.hi));
+        }
+        let t = 2.0 * sin_alpha / vs;
+        let dt = t - self.tau;
+        let du = dt / d1;
+        let du = du - 0.5 * d2 * du * du / d1;
+        Secant::new(t, u + du, d1 + d2 * du, end, Some(0.5 * d2 / d1)).map(End::Search)
+    }
+
+    /// K of a search's result (its pass, or a launch at its u).
+    fn k_at(&self, r: Option<(f64, Option<Pass>)>) -> Option<f64> {
+        let (ue, pe) = r?;
+        match pe {
+            Some(pe) => Some(pe.k()),
+            None => self.l.k_of_launch(ue.exp()),
+        }
+    }
+
+    /// K_lo and K_hi at v ∓ `sg` (the two searches side by side), the searches' passes
+    /// counted in `n_side`.
+    fn interval(
+        &self,
+        v: f64,
+        sg: f64,
+        notes: &mut Vec<String>,
+        n_side: &mut usize,
+    ) -> Option<(f64, f64)> {
+        let l = self.l;
+        let lo = self.plan_end(v - sg, "K_lo", notes)?;
+        let hi = self.plan_end(v + sg, "K_hi", notes)?;
+        Some(match (lo, hi) {
+            (End::Search(a), End::Search(b)) => {
+                let [ra, rb] = l.solve_two((a, b), n_side);
+                (self.k_at(ra)?, self.k_at(rb)?)
+            }
+            (End::Search(a), End::At(kh)) => (self.k_at(l.solve(a, None, n_side))?, kh),
+            (End::At(kl), End::Search(b)) => (kl, self.k_at(l.solve(b, None, n_side))?),
+            (End::At(kl), End::At(kh)) => (kl, kh),
+        })
+    }
 }

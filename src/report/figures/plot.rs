@@ -762,7 +762,26 @@ impl Panel {
     /// Draws the panel with its plot area at (x0, y0), size w × h; `legend_out` is where an
     /// outside legend goes (left edge x, top y).
     fn draw(&self, svg: &mut Svg, lay: &Layout, f: Frame, legend_out: (f64, f64)) {
-        // Grid.
+        self.draw_grid(svg, lay, &f);
+        svg.begin_clip(f.x0, f.y0, f.w, f.h);
+        // Shading first, then lines, then points, then texts.
+        self.draw_shading(svg, &f);
+        self.draw_lines(svg, &f);
+        self.draw_marks(svg, &f);
+        svg.end_group();
+        self.draw_texts(svg, &f);
+        self.draw_axes(svg, lay, &f);
+        match self.legend_spot(&f) {
+            Some((x, y)) => draw_legend(svg, &self.legend, f.x0 + x, f.y0 + y),
+            None if !self.legend.is_empty() => {
+                draw_legend(svg, &self.legend, legend_out.0, legend_out.1)
+            }
+            None => {}
+        }
+    }
+
+    /// The grid lines at the ticks.
+    fn draw_grid(&self, svg: &mut Svg, lay: &Layout, f: &Frame) {
         let grid = Stroke::solid(GRID, 1.0);
         for (v, _) in &lay.xt {
             let x = f.x0 + (v - f.xr.0) / (f.xr.1 - f.xr.0) * f.w;
@@ -772,8 +791,10 @@ impl Panel {
             let y = f.y0 + f.h - (v - f.yr.0) / (f.yr.1 - f.yr.0) * f.h;
             svg.polyline(&[(f.x0, y), (f.x0 + f.w, y)], &grid);
         }
-        svg.begin_clip(f.x0, f.y0, f.w, f.h);
-        // Shading first, then lines, then points, then texts.
+    }
+
+    /// The shading: bands, fills and rectangles.
+    fn draw_shading(&self, svg: &mut Svg, f: &Frame) {
         for it in &self.items {
             match it {
                 Item::Band {
@@ -809,6 +830,10 @@ impl Panel {
                 _ => {}
             }
         }
+    }
+
+    /// The lines: curves, segments and horizontal and vertical lines.
+    fn draw_lines(&self, svg: &mut Svg, f: &Frame) {
         for it in &self.items {
             match it {
                 Item::Curve { pts, stroke } => {
@@ -840,6 +865,10 @@ impl Panel {
                 _ => {}
             }
         }
+    }
+
+    /// The marks: dots, then points with their error bars.
+    fn draw_marks(&self, svg: &mut Svg, f: &Frame) {
         for it in &self.items {
             if let Item::Dots {
                 pts,
@@ -883,7 +912,10 @@ impl Panel {
                 }
             }
         }
-        svg.end_group();
+    }
+
+    /// The texts placed in data coordinates.
+    fn draw_texts(&self, svg: &mut Svg, f: &Frame) {
         for it in &self.items {
             if let Item::Text {
                 at,
@@ -895,7 +927,10 @@ impl Panel {
                 svg.text(f.p(*at), text, TICK_SIZE, *anchor, false, colour);
             }
         }
-        // Frame, ticks, labels.
+    }
+
+    /// The frame, the ticks and their labels, the axis labels and the title.
+    fn draw_axes(&self, svg: &mut Svg, lay: &Layout, f: &Frame) {
         svg.rect(
             (f.x0, f.y0, f.w, f.h),
             "none",
@@ -957,13 +992,6 @@ impl Panel {
                 false,
                 INK,
             );
-        }
-        match self.legend_spot(&f) {
-            Some((x, y)) => draw_legend(svg, &self.legend, f.x0 + x, f.y0 + y),
-            None if !self.legend.is_empty() => {
-                draw_legend(svg, &self.legend, legend_out.0, legend_out.1)
-            }
-            None => {}
         }
     }
 }

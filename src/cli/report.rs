@@ -173,18 +173,16 @@ impl Recipe {
                 .and_then(|t| <FitMethod as clap::ValueEnum>::from_str(t.trim(), true).ok()),
         };
         let mcmc = method == Some(FitMethod::Mcmc);
-        let serde_json::Value::Object(map) =
-            serde_json::to_value(&keys).map_err(|e| CliError::Other(e.to_string()))?
+        let toml::Value::Table(map) =
+            toml::Value::try_from(&keys).map_err(|e| CliError::Other(e.to_string()))?
         else {
             return Ok(Some(r));
         };
         for (key, value) in map {
             let text = match value {
-                serde_json::Value::String(s) => s,
-                serde_json::Value::Number(n) if n.is_f64() => {
-                    crate::numfmt::echo_f64(n.as_f64().unwrap_or(f64::NAN))
-                }
-                serde_json::Value::Number(n) => n.to_string(),
+                toml::Value::String(s) => s,
+                toml::Value::Float(x) => crate::numfmt::echo_f64(x),
+                toml::Value::Integer(n) => n.to_string(),
                 _ => continue,
             };
             if given(&key) || (!mcmc && MCMC_KEYS.contains(&key.as_str())) {

@@ -2,7 +2,7 @@
 //! arguments: the measurements file with the defaults of the columns it may leave out, ρ and
 //! f, the output file, the figure and the interval level.
 
-use super::CliError;
+use super::{values, CliError};
 use crate::io::measurements::{MeasurementDefaults, MEASUREMENT_COLUMNS};
 use crate::io::scenes::{check_columns, Header};
 use crate::io::InputError;
@@ -13,10 +13,10 @@ use std::path::{Path, PathBuf};
 pub struct ContactArgs {
     /// Gyration parameter ρ (2/5 sphere, 1/2 cylinder) of rows without a rho column
     /// [default: 0.4]
-    #[arg(long)]
+    #[arg(long, value_parser = values::non_negative)]
     pub rho: Option<f64>,
     /// Coulomb friction coefficient f of rows without an f column [default: 0.1]
-    #[arg(long)]
+    #[arg(long, value_parser = values::non_negative)]
     pub f: Option<f64>,
 }
 
@@ -48,7 +48,7 @@ pub struct DataArgs {
     #[command(flatten)]
     pub contact: ContactArgs,
     /// Gravity g in m/s² of dimensional rows without a g column [default: 9.81]
-    #[arg(long)]
+    #[arg(long, value_parser = values::gravity)]
     pub g: Option<f64>,
     /// Refuse a column the measurements file has and fitbead does not read (without it, a
     /// column close to a known name gets a warning, others pass through)
@@ -138,7 +138,7 @@ impl PlotArgs {
 #[derive(Debug, Clone, Default, clap::Args)]
 pub struct LevelArgs {
     /// Confidence level of the intervals, in (0, 1) [default: 0.95]
-    #[arg(long)]
+    #[arg(long, value_parser = values::level)]
     pub level: Option<f64>,
 }
 

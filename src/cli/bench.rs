@@ -11,7 +11,7 @@ use crate::report::workprecision::{draw_scenes, plot, render, run_bench_until, X
 pub struct Args {
     /// Number of scenes drawn across regime B (about 30 % of them a hard subset: near δ_m,
     /// near Θ0 = 0, near the upper K limit).
-    #[arg(long, default_value_t = 2000)]
+    #[arg(long, default_value_t = 2000, value_parser = super::values::scenes)]
     pub scenes: usize,
     /// Seed of the scene draw.
     #[arg(long, default_value_t = 1)]
@@ -27,13 +27,6 @@ pub struct Args {
 
 /// Runs `fitbead bench`.
 pub fn run(a: Args) -> Result<(), CliError> {
-    if a.scenes == 0 || a.scenes > 1_000_000 {
-        return Err(super::flag_error(
-            "--scenes",
-            &a.scenes.to_string(),
-            "expected a number of scenes in 1..=1000000",
-        ));
-    }
     let scenes = draw_scenes(a.scenes, a.seed);
     if scenes.len() < a.scenes {
         return Err(CliError::Other(format!(

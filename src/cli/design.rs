@@ -3,11 +3,11 @@
 //! standard errors at the design and at evenly spaced slopes.
 
 use super::args::{ContactArgs, OutputArgs, PlotArgs};
-use super::{emit, parse_list, CliError};
+use super::values::{self, NamedPrior, Numbers, SlopeRange};
+use super::{emit, CliError};
 use crate::design::{design, Criterion, DesignError, DesignFit, DesignResult, DesignSettings};
 use crate::io::{fmt_f64, fmt_sig, AtomicFile};
-use crate::models::ModelKind;
-use crate::prelude::Prior;
+use crate::models::{JaegerBranch, ModelKind};
 use crate::report::figures::plot::{Axis, Figure, LegendEntry, Panel, PALETTE};
 use crate::report::figures::svg::{Mark, Stroke};
 use crate::scene::CollisionLaw;
@@ -18,20 +18,20 @@ use std::path::Path;
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// The fit the data are for: klaw (a K(α) law), jan (λ, μ) or jaeger (a1, a2, a3).
-    #[arg(long, default_value = "klaw")]
-    pub fit: String,
+    #[arg(long, default_value = "klaw", value_parser = values::choice::<DesignFit>())]
+    pub fit: DesignFit,
     /// The model the data follow: for --fit klaw a contact model (stick, stick-approx, slip,
     /// slip-approx, stickslip, contact, auto) [default: stickslip]; jan and jaeger have their
     /// own.
-    #[arg(long)]
-    pub model: Option<String>,
+    #[arg(long, value_parser = values::choice::<ModelKind>())]
+    pub model: Option<ModelKind>,
     /// For --fit klaw, the fitted law with the guess of its parameter: c=VALUE (law c) or a
     /// number K (one K per series, each guessed at K).
-    #[arg(long, default_value = "c=0.5")]
-    pub law: String,
+    #[arg(long, default_value = "c=0.5", value_parser = values::law)]
+    pub law: CollisionLaw,
     /// Radius ratios ξ of the series, comma-separated.
-    #[arg(long, default_value = "0.8,1,1.6,2")]
-    pub series: String,
+    #[arg(long, default_value = "0.8,1,1.6,2", value_parser = values::number_list)]
+    pub series: Numbers,
     /// Points per series.
     #[arg(long, default_value_t = 9)]
     pub points: usize,
@@ -41,16 +41,16 @@ pub struct Args {
     pub total: Option<usize>,
     /// Noise of v̄: relative (σ = noise · v̄, as `simulate --noise`), or abs=SIGMA for an
     /// absolute σ (dimensionless).
-    #[arg(long, default_value = "0.02")]
-    pub noise: String,
+    #[arg(long, default_value = "0.02", value_parser = values::design_noise)]
+    pub noise: (f64, bool),
     /// Slopes LO,HI in degrees, cut to regime B of the guess [default: regime B of the guess];
     /// the design keeps 5 % of the range's width from either end.
-    #[arg(long)]
-    pub delta_range: Option<String>,
+    #[arg(long, value_parser = values::slope_range)]
+    pub delta_range: Option<SlopeRange>,
     /// Criterion: d (D-optimal: all parameters), c (the smallest variance of --target) or t
     /// (model discrimination against --vs).
-    #[arg(long, default_value = "d")]
-    pub criterion: String,
+    #[arg(long, default_value = "d", value_parser = values::choice::<Criterion>())]
+    pub criterion: Criterion,
     /// The parameter of --criterion c (c, mu, a1, …; needed when the fit has several). For
     /// --fit klaw also the bulk friction μ (eq 79, dimensionless) at the fitted K: mu (one
     /// series) or "mu of series 'xi=X'", its standard error by the delta method.
@@ -59,15 +59,15 @@ pub struct Args {
     /// The rival model of --criterion t: for --fit klaw a contact model whose law's parameter
     /// is fitted; for --fit jaeger, jan (λ, μ, or the laws of eqs 75–76 across series). --fit
     /// jan has no rival: Jan's model is Jaeger's with a2 = 0.
-    #[arg(long)]
-    pub vs: Option<String>,
+    #[arg(long, value_parser = values::choice::<ModelKind>())]
+    pub vs: Option<ModelKind>,
     /// A prior of a parameter, NAME=DIST, repeatable, for a Bayesian design (the criterion
     /// averaged over --draws draws; parameters without a prior stay at the guess). DIST is
     /// uniform(a,b), normal(mean,sd), lognormal(mu,sigma) or halfnormal(scale), in the
     /// parameter's own units; quote it for the shell ('c=normal(0.5,0.1)'). Draws that leave
     /// a series no steady slope in its range are redrawn.
-    #[arg(long = "prior", value_name = "NAME=DIST")]
-    pub priors: Vec<String>,
+    #[arg(long = "prior", value_name = "NAME=DIST", value_parser = values::design_prior)]
+    pub priors: Vec<NamedPrior>,
     /// Prior draws the Bayesian criterion is averaged over (with --prior).
     #[arg(long, default_value_t = DesignSettings::default().draws)]
     pub draws: usize,
@@ -75,8 +75,8 @@ pub struct Args {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Branch of eq 84 for --fit jaeger: upper or lower.
-    #[arg(long, default_value = "upper")]
-    pub branch: String,
+    #[arg(long, default_value = "upper", value_parser = values::choice::<JaegerBranch>())]
+    pub branch: JaegerBranch,
     /// ρ and f of the scenes.
     #[command(flatten)]
     pub contact: ContactArgs,
@@ -139,86 +139,34 @@ fn design_error(e: DesignError) -> CliError {
 
 /// The library's settings from the flags.
 fn settings(a: &Args) -> Result<DesignSettings, CliError> {
-    let mut priors = Vec::new();
-    for p in &a.priors {
-        // The name may hold '=' (K of series 'xi=1'); the distribution never does.
-        let Some((name, dist)) = p.rsplit_once('=') else {
-            return Err(super::flag_error(
-                "--prior",
-                p,
-                "expected NAME=DIST, e.g. c=normal(0.5,0.1)",
-            ));
-        };
-        let prior: Prior = dist
-            .parse()
-            .map_err(|e: String| super::flag_error("--prior", p, e))?;
-        priors.push((name.trim().to_string(), prior));
-    }
-    let fit: DesignFit = a
-        .fit
-        .parse()
-        .map_err(|e: String| super::flag_error("--fit", &a.fit, e))?;
-    let kind = |flag: &str, s: &str| -> Result<ModelKind, CliError> {
-        s.parse()
-            .map_err(|_| super::flag_error(flag, s, "unknown model"))
-    };
-    let model = a.model.as_deref().map(|m| kind("--model", m)).transpose()?;
-    let vs = a.vs.as_deref().map(|m| kind("--vs", m)).transpose()?;
-    let law: CollisionLaw = a.law.parse().map_err(|e: crate::scene::ParameterError| {
-        super::flag_error("--law", &a.law, e.to_string())
-    })?;
-    let criterion: Criterion = a
-        .criterion
-        .parse()
-        .map_err(|e: String| super::flag_error("--criterion", &a.criterion, e))?;
-    let (noise, noise_absolute) = match a.noise.trim().strip_prefix("abs=") {
-        Some(v) => (parse_list("--noise", v)?, true),
-        None => (parse_list("--noise", &a.noise)?, false),
-    };
-    if noise.len() != 1 {
-        return Err(super::flag_error(
-            "--noise",
-            &a.noise,
-            "expected one number (relative) or abs=SIGMA",
-        ));
-    }
-    let delta_range = match a.delta_range.as_deref() {
-        None => None,
-        Some(t) => {
-            let r = parse_list("--delta-range", t)?;
-            if r.len() != 2 || !(r[0] < r[1]) {
-                return Err(super::flag_error(
-                    "--delta-range",
-                    t,
-                    "expected LO,HI in degrees with LO < HI",
-                ));
-            }
-            Some((r[0], r[1]))
-        }
-    };
-    if a.target.is_some() && criterion != Criterion::C {
+    if a.target.is_some() && a.criterion != Criterion::C {
         return Err(super::flag_error(
             "--target",
             a.target.as_deref().unwrap_or(""),
             "a target parameter goes with --criterion c",
         ));
     }
+    let (noise, noise_absolute) = a.noise;
     Ok(DesignSettings {
-        fit,
-        model,
-        law,
-        series: parse_list("--series", &a.series)?,
+        fit: a.fit,
+        model: a.model,
+        law: a.law,
+        series: a.series.0.clone(),
         rho: a.contact.rho(),
         f: a.contact.f(),
         points: a.points,
-        noise: noise[0],
+        noise,
         noise_absolute,
-        delta_range,
-        criterion,
+        delta_range: a.delta_range.as_ref().map(|r| (r.lo, r.hi)),
+        criterion: a.criterion,
         target: a.target.clone(),
-        vs,
-        branch: super::jaeger_branch(&a.branch)?,
-        priors,
+        vs: a.vs,
+        branch: a.branch,
+        priors: a
+            .priors
+            .iter()
+            .map(|p| (p.name.clone(), p.prior.clone()))
+            .collect(),
         draws: a.draws,
         seed: a.seed,
         total: a.total,

@@ -1,9 +1,10 @@
 //! Flags and I/O shared by the fit commands (`klaw`, `jan`, `jaeger`).
 
 use super::args::{DataArgs, LevelArgs, PlotArgs};
+use super::values::{self, FitMethod, NamedPrior};
 use super::{emit, read_input, CliError};
 use crate::fit::data::Dataset;
-use crate::fit::posterior::{McmcSettings, Method, Prior, SCALE_NAME};
+use crate::fit::posterior::{McmcSettings, Method, SCALE_NAME};
 use crate::fit::summary::{FitResult, McmcFailure, ParamRow, StatsRow};
 use crate::inverse::mcmc::McmcOptions;
 use crate::io::measurements::{dataset_of, read_measurements, Measurement};
@@ -63,25 +64,25 @@ pub struct FitArgs {
     /// Estimation method: lsq (least squares) or mcmc (posterior sampling by an affine-invariant
     /// ensemble sampler started from the least-squares optimum; value = posterior median,
     /// ci_low/ci_high = central posterior interval at --level, ci_method = posterior).
-    #[arg(long, default_value = "lsq")]
-    pub method: String,
+    #[arg(long, default_value = "lsq", value_parser = values::choice::<FitMethod>())]
+    pub method: FitMethod,
     /// MCMC: seed of every random stream; a run is bit-identical for a seed, whatever the number
     /// of threads [default: 1]
     #[arg(long)]
     pub seed: Option<u64>,
     /// MCMC: number of walkers, even [default: max(2·dim + 2, 32)]
-    #[arg(long)]
+    #[arg(long, value_parser = values::walkers)]
     pub walkers: Option<usize>,
     /// MCMC: run until every parameter's bulk and tail ESS reach this and its rank-normalised
     /// split-R̂ is ≤ 1.01 [default: 1000]
-    #[arg(long)]
+    #[arg(long, value_parser = values::non_negative)]
     pub min_ess: Option<f64>,
     /// MCMC: stop after this many steps even if not converged, with a warning naming the
     /// failing parameter [default: 100000]
-    #[arg(long)]
+    #[arg(long, value_parser = values::at_least_one)]
     pub max_steps: Option<usize>,
     /// MCMC: keep one step in THIN [default: 1]
-    #[arg(long)]
+    #[arg(long, value_parser = values::at_least_one)]
     pub thin: Option<usize>,
     /// MCMC: prior of a parameter, NAME=DIST, repeatable; DIST is flat, jeffreys,
     /// uniform(a,b), normal(mean,sd), lognormal(mu,sigma) or halfnormal(scale); quote it for
@@ -89,8 +90,8 @@ pub struct FitArgs {
     /// point in regime B), except Jaeger's a1, a2, a3: halfnormal(10), halfnormal(100),
     /// halfnormal(10); jeffreys for sigma_scale. The support is always cut to the feasible
     /// region.
-    #[arg(long = "prior", value_name = "NAME=DIST")]
-    pub priors: Vec<String>,
+    #[arg(long = "prior", value_name = "NAME=DIST", value_parser = values::fit_prior)]
+    pub priors: Vec<NamedPrior>,
     /// MCMC: also sample an error scale sigma_scale multiplying every sigma_v (for data whose
     /// sigma is underestimated). Always sampled when no sigma_v is given.
     #[arg(long)]
@@ -140,21 +141,17 @@ impl FitArgs {
             ("--fit-scatter", self.fit_scatter),
             ("--draws", self.draws.is_some()),
         ];
-        match self.method.to_ascii_lowercase().as_str() {
-            "lsq" => {
-                if let Some((flag, _)) = mcmc_flags.iter().find(|f| f.1) {
-                    return Err(super::flag_error(flag, "", "applies to --method mcmc only"));
-                }
-                return Ok(MethodChoice {
-                    method: Method::Lsq {
-                        profile: !self.no_profile,
-                        stop: Some(super::stop_flag()),
-                        progress: None,
-                    },
-                });
+        if self.method == FitMethod::Lsq {
+            if let Some((flag, _)) = mcmc_flags.iter().find(|f| f.1) {
+                return Err(super::flag_error(flag, "", "applies to --method mcmc only"));
             }
-            "mcmc" => {}
-            m => return Err(super::flag_error("--method", m, "expected lsq or mcmc")),
+            return Ok(MethodChoice {
+                method: Method::Lsq {
+                    profile: !self.no_profile,
+                    stop: Some(super::stop_flag()),
+                    progress: None,
+                },
+            });
         }
         let mut options = McmcOptions::default();
         if let Some(s) = self.seed {
@@ -180,29 +177,18 @@ impl FitArgs {
             )
         })?;
         let mut priors = Vec::new();
-        for p in &self.priors {
-            let Some((name, dist)) = p.split_once('=') else {
+        for NamedPrior { name, prior, text } in &self.priors {
+            if name != SCALE_NAME && !params.contains(&name.as_str()) {
                 return Err(super::flag_error(
                     "--prior",
-                    p,
-                    "expected NAME=DIST, e.g. c=normal(0.5,0.5)",
-                ));
-            };
-            let name = name.trim();
-            if name != SCALE_NAME && !params.contains(&name) {
-                return Err(super::flag_error(
-                    "--prior",
-                    p,
+                    text,
                     format!(
                         "no parameter '{name}' in this fit; expected one of {}, {SCALE_NAME}",
                         params.join(", ")
                     ),
                 ));
             }
-            let prior: Prior = dist
-                .parse()
-                .map_err(|e: String| super::flag_error("--prior", p, e))?;
-            priors.push((name.to_string(), prior));
+            priors.push((name.clone(), prior.clone()));
         }
         options.stop = Some(super::stop_flag());
         Ok(MethodChoice {
@@ -231,15 +217,8 @@ impl FitArgs {
         )
     }
 
-    /// Validates the flags and reads the measurements.
+    /// Reads the measurements.
     pub fn read(&self) -> Result<(Table, Vec<Measurement>, Dataset), CliError> {
-        if !(self.level.level() > 0.0 && self.level.level() < 1.0) {
-            return Err(super::flag_error(
-                "--level",
-                &self.level.level().to_string(),
-                "must be in (0, 1), e.g. 0.95",
-            ));
-        }
         let input = self.data.path();
         let (source, text) = read_input(input)?;
         let t = Table::parse(&source, &text)?;

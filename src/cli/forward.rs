@@ -3,6 +3,7 @@
 //! of `crate::io::forward`; md, whose runs are long and few, reads the whole table.
 
 use super::args::{ContactArgs, OutputArgs};
+use super::values::{self, MdPreset};
 use super::{emit, read_input, CliError};
 use crate::io::forward::{scene_columns, ForwardPlan, ForwardSettings, ForwardText};
 use crate::io::md::{md_csv, md_jobs, MdTable};
@@ -10,7 +11,7 @@ use crate::io::scenes::{check_columns, Header, Table, TableReader};
 use crate::io::stream::{stream, RowPlan, StreamError, StreamOptions, Streamed};
 use crate::io::{fmt_f64, AtomicFile, InputError};
 use crate::models::md::{Md, MdParams, MdResult, MdRunConfig, MdSetting, MdSettings, ReducedMass};
-use crate::models::{JaegerBranch, Model, ModelKind};
+use crate::models::{JaegerBranch, ModelKind};
 use rayon::prelude::*;
 use std::io::{Cursor, Read, Write};
 use std::path::{Path, PathBuf};
@@ -20,8 +21,8 @@ use std::path::{Path, PathBuf};
 pub struct Args {
     /// Forward model: stick, stick-approx, slip, slip-approx, stickslip, contact, jan, jaeger,
     /// md, or auto (per scene the cheapest model meeting --tol whose assumptions hold).
-    #[arg(long)]
-    pub model: String,
+    #[arg(long, value_parser = values::choice::<ModelKind>())]
+    pub model: ModelKind,
     /// Scenes CSV with columns xi,delta_deg[,K,rho,f] (K a number or a law name); extra columns
     /// pass through. Without --input and --xi: the embedded default data set.
     #[arg(long)]
@@ -30,14 +31,14 @@ pub struct Args {
     #[command(flatten)]
     pub out: OutputArgs,
     /// Radius ratio ξ = r/R of a single scene.
-    #[arg(long)]
+    #[arg(long, value_parser = values::finite)]
     pub xi: Option<f64>,
     /// Slope δ of a single scene, degrees.
-    #[arg(long = "delta-deg")]
+    #[arg(long = "delta-deg", value_parser = values::finite)]
     pub delta_deg: Option<f64>,
     /// Collisional parameter for rows without a K column: a number, cos2a, adjusted, impact or
     /// c=VALUE.
-    #[arg(long = "K", default_value = "adjusted")]
+    #[arg(long = "K", default_value = "adjusted", value_parser = values::law_text)]
     pub k: String,
     /// ρ and f of rows without those columns.
     #[command(flatten)]
@@ -58,17 +59,17 @@ pub struct Args {
     #[arg(long)]
     pub a3: Option<f64>,
     /// Jaeger root when there are two: upper or lower.
-    #[arg(long, default_value = "upper")]
-    pub branch: String,
+    #[arg(long, default_value = "upper", value_parser = values::choice::<JaegerBranch>())]
+    pub branch: JaegerBranch,
     /// Spin rule of the collision for --model contact: roll (rolling restarts, the paper's
     /// choice), keep (spin unchanged), factor=L (ω0 = L ωf, eq 63) or impact (no-slip impact
     /// conserving angular momentum about the new contact point; K is then not used). A `spin`
     /// column overrides it per row.
-    #[arg(long, default_value = "roll")]
+    #[arg(long, default_value = "roll", value_parser = values::spin_text)]
     pub spin: String,
     /// Relative tolerance of the contact model's quadratures (time and spin during slip); with
     /// --model auto, the target relative tolerance T on v.
-    #[arg(long, default_value = "1e-14")]
+    #[arg(long, default_value = "1e-14", value_parser = values::tolerance)]
     pub tol: f64,
     /// Molecular-dynamics settings (`--model md`).
     #[command(flatten)]
@@ -90,23 +91,7 @@ fn check_scene_columns(a: &Args, t: &impl Header) -> Result<(), CliError> {
 
 /// Runs `fitbead forward`.
 pub fn run(a: Args) -> Result<(), CliError> {
-    let kind: ModelKind = a.model.parse().map_err(|_| {
-        super::flag_error(
-            "--model",
-            &a.model,
-            format!("unknown model; expected one of {}", Model::NAMES.join(", ")),
-        )
-    })?;
-    let branch = super::jaeger_branch(&a.branch)?;
-    for (flag, x) in [("--xi", a.xi), ("--delta-deg", a.delta_deg)] {
-        if let Some(x) = x.filter(|x| !x.is_finite()) {
-            return Err(super::flag_error(
-                flag,
-                &crate::numfmt::echo_f64(x),
-                "not a finite number",
-            ));
-        }
-    }
+    let (kind, branch) = (a.model, a.branch);
     let single = if let (Some(xi), Some(d)) = (a.xi, a.delta_deg) {
         Some(format!("xi,delta_deg\n{},{}\n", fmt_f64(xi), fmt_f64(d)).into_bytes())
     } else if a.xi.is_some() || a.delta_deg.is_some() {
@@ -302,8 +287,8 @@ fn stream_error(e: StreamError, target: &str, file: bool) -> CliError {
 pub struct MdArgs {
     /// md parameter set: ristow (E = 1e7 Pa, gamma_n = 1000/s, gamma_s = 100/s, beta = 1.5,
     /// R = 2.5 mm, steel density) or steel (E = 2.1e11 Pa, the rest as ristow).
-    #[arg(long = "md-preset", default_value = "ristow")]
-    pub md_preset: String,
+    #[arg(long = "md-preset", default_value = "ristow", value_parser = values::choice::<MdPreset>())]
+    pub md_preset: MdPreset,
     /// md: radius R of the row beads, m [default: 2.5e-3]
     #[arg(long = "row-radius-m")]
     pub row_radius_m: Option<f64>,
@@ -332,8 +317,8 @@ pub struct MdArgs {
     #[arg(long = "md-g")]
     pub md_g: Option<f64>,
     /// md: reduced mass of eq 92: pair (m M/(m+M)) or mobile (m) [default: pair]
-    #[arg(long = "reduced-mass")]
-    pub reduced_mass: Option<String>,
+    #[arg(long = "reduced-mass", value_parser = values::choice::<ReducedMass>())]
+    pub reduced_mass: Option<ReducedMass>,
     /// Row beads travelled: by md, and by the contact transient of simulate --v0 [default: 400
     /// for md, 50 for the transient]
     #[arg(long)]
@@ -397,32 +382,12 @@ fn build_md(
     given: &MdSettings,
     err: &dyn Fn(MdSetting, String) -> CliError,
 ) -> Result<Md, CliError> {
-    let mut params = match a.md_preset.to_ascii_lowercase().as_str() {
-        "ristow" => MdParams::ristow(),
-        "steel" => MdParams::steel(),
-        _ => {
-            return Err(super::flag_error(
-                "--md-preset",
-                &a.md_preset,
-                "expected ristow or steel",
-            ))
-        }
+    let mut params = match a.md_preset {
+        MdPreset::Ristow => MdParams::ristow(),
+        MdPreset::Steel => MdParams::steel(),
     };
-    match a
-        .reduced_mass
-        .as_deref()
-        .map(str::to_ascii_lowercase)
-        .as_deref()
-    {
-        None | Some("pair") => {}
-        Some("mobile") => params.reduced_mass = ReducedMass::Mobile,
-        Some(_) => {
-            return Err(super::flag_error(
-                "--reduced-mass",
-                a.reduced_mass.as_deref().unwrap_or_default(),
-                "expected pair or mobile",
-            ))
-        }
+    if let Some(m) = a.reduced_mass {
+        params.reduced_mass = m;
     }
     let base = Md {
         params,

@@ -7,14 +7,15 @@ use crate::fit::jaeger::fit_jaeger_with;
 use crate::fit::jaeger::JaegerModel;
 use crate::fit::summary::FitResult;
 use crate::io::measurements::locate_note;
+use crate::models::JaegerBranch;
 use crate::report::bands::Curve;
 
 /// Arguments of `fitbead jaeger`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Root of eq 84 to fit where there are two: upper or lower.
-    #[arg(long, default_value = "upper")]
-    pub branch: String,
+    #[arg(long, default_value = "upper", value_parser = super::values::choice::<JaegerBranch>())]
+    pub branch: JaegerBranch,
     /// Input, output and interval flags.
     #[command(flatten)]
     pub io: FitArgs,
@@ -22,7 +23,7 @@ pub struct Args {
 
 /// Runs `fitbead jaeger`.
 pub fn run(a: Args) -> Result<(), CliError> {
-    let branch = super::jaeger_branch(&a.branch)?;
+    let branch = a.branch;
     let (t, _rows, ds) = a.io.read()?;
     let choice = a.io.method(&["a1", "a2", "a3"])?;
     let (method, task) = super::counted_fit("jaeger", choice.method);

@@ -3,13 +3,14 @@
 
 use super::args::{DataArgs, OutputArgs, PlotArgs};
 use super::forward::{open_input, stream_options, stream_to, Input};
+use super::values::{self, KModel};
 use super::CliError;
 use crate::io::kstream::{self, KLedger, KPlan, KSettings};
 use crate::io::scenes::TableReader;
 use crate::io::stream::StreamOptions;
 use crate::io::{AtomicFile, InputError};
 use crate::models::auto::Auto;
-use crate::models::{Model, ModelKind};
+use crate::models::Model;
 use std::io::Write;
 
 /// Arguments of `fitbead k`.
@@ -17,8 +18,8 @@ use std::io::Write;
 pub struct Args {
     /// Contact model: stick, stick-approx, slip, slip-approx, stickslip, contact, or auto (per
     /// row the model chosen at the stick K; see --tol).
-    #[arg(long)]
-    pub model: String,
+    #[arg(long, value_parser = values::choice::<KModel>())]
+    pub model: KModel,
     /// The measurements and the defaults of the columns they may leave out.
     #[command(flatten)]
     pub data: DataArgs,
@@ -30,69 +31,30 @@ pub struct Args {
     #[command(flatten)]
     pub plot: PlotArgs,
     /// With --model auto: the target relative tolerance T on v of the model chosen per row.
-    #[arg(long, default_value = "1e-10")]
+    #[arg(long, default_value = "1e-10", value_parser = values::tolerance)]
     pub tol: f64,
 }
 
-/// The model flag's name in prose for titles ("stick/slip" for `stickslip`); the flag as given
-/// when it names no model.
-pub fn prose_model_name(name: &str) -> String {
-    name.parse::<ModelKind>()
-        .map(|k| k.prose_name().to_string())
-        .unwrap_or_else(|_| name.to_string())
+/// The model's name in prose for titles ("stick/slip" for `stickslip`).
+pub fn prose_model_name(model: KModel) -> String {
+    model.kind().prose_name().to_string()
 }
 
-/// Parses the model flag of `k` (the five contact models).
-pub fn parse_model(name: &str) -> Result<Model, CliError> {
-    let err = || {
-        super::flag_error(
-            "--model",
-            name,
-            "expected one of stick, stick-approx, slip, slip-approx, stickslip, contact",
-        )
-    };
-    let kind: ModelKind = name.parse().map_err(|_| err())?;
-    if kind == ModelKind::Md {
-        return Err(super::flag_error(
-            "--model",
-            name,
-            "model md has no K inversion (its collisions come from the contact forces)",
-        ));
+/// The model of `--model` and, for `auto`, the auto model of `--tol` (k and klaw): the model
+/// is then stick until the data are read.
+pub fn model_of(model: KModel, tol: f64) -> (Model, Option<Auto>) {
+    if model == KModel::Auto {
+        return (Model::Stick, Some(Auto { tol }));
     }
-    if kind == ModelKind::Auto {
-        return Err(super::flag_error(
-            "--model",
-            name,
-            "model auto is chosen per row by k and klaw themselves (see --tol), not here",
-        ));
-    }
-    kind.contact_model().ok_or_else(err)
-}
-
-/// The auto model of `--model auto --tol T` (k and klaw), or `None` for any other model.
-pub fn parse_auto(name: &str, tol: f64) -> Result<Option<Auto>, CliError> {
-    if name != "auto" {
-        return Ok(None);
-    }
-    if !(tol > 0.0 && tol < 1.0) {
-        return Err(super::flag_error(
-            "--tol",
-            &tol.to_string(),
-            "expected a relative tolerance in (0, 1)",
-        ));
-    }
-    Ok(Some(Auto { tol }))
+    // Every other name is one of the five contact models.
+    (model.kind().contact_model().unwrap_or(Model::Stick), None)
 }
 
 /// Runs `fitbead k`: the rows stream through the library's engine with the K plan of
 /// `crate::io::kstream`; `--plot` keeps the inverted points for the figure.
 pub fn run(a: Args) -> Result<(), CliError> {
     // Per row, the model chosen at the stick K
-    let auto = parse_auto(&a.model, a.tol)?;
-    let model = match auto {
-        Some(_) => Model::Stick,
-        None => parse_model(&a.model)?,
-    };
+    let (model, auto) = model_of(a.model, a.tol);
     let input = a.data.path();
     let (source, input, size) = open_input(input)?;
     let reader = TableReader::new(&source, input)?;
@@ -103,7 +65,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let settings = KSettings {
         model,
         auto,
-        model_name: a.model.clone(),
+        model_name: a.model.name(),
         plot: a.plot.plot.is_some(),
     };
     let make = |r: &TableReader<Input>| -> Result<KPlan, InputError> {
@@ -137,7 +99,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
             let cannot =
                 |e: std::io::Error| CliError::Other(format!("{}: cannot write: {e}", p.display()));
             let svg = ledger
-                .plot_svg(&prose_model_name(&a.model))
+                .plot_svg(&prose_model_name(a.model))
                 .map_err(CliError::Other)?;
             let bytes = a.plot.bytes(svg)?;
             let mut f = file.map_err(cannot)?;

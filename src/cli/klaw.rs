@@ -2,8 +2,8 @@
 //! parameter-free impact law scored beside it.
 
 use super::fitargs::{FitArgs, LsqPlot};
-use super::k::parse_auto;
-use super::k::{parse_model, prose_model_name};
+use super::k::{model_of, prose_model_name};
+use super::values::{self, KModel};
 use super::CliError;
 use crate::fit::k::auto::{self as kauto, KChoice};
 use crate::fit::k::unsteady_points;
@@ -21,12 +21,12 @@ use rayon::prelude::*;
 pub struct Args {
     /// Contact model: stick, stick-approx, slip, slip-approx, stickslip, contact, or auto (the
     /// most general model any point needs at its stick K; see --tol).
-    #[arg(long)]
-    pub model: String,
+    #[arg(long, value_parser = values::choice::<KModel>())]
+    pub model: KModel,
     /// The law: c (K = cos 2α + c sin²α sin 2α), impact (K = (cos 2α + ρ)/(1 + ρ), scored
     /// only) or free-per-series (one K per series). The impact law is always scored as well.
-    #[arg(long, default_value = "c")]
-    pub law: String,
+    #[arg(long, default_value = "c", value_parser = values::choice::<KLaw>())]
+    pub law: KLaw,
     /// Leave out (and list on stderr) the points that no K can make steady under the model,
     /// instead of stopping with an error.
     #[arg(long)]
@@ -35,22 +35,15 @@ pub struct Args {
     #[command(flatten)]
     pub io: FitArgs,
     /// With --model auto: the target relative tolerance T on v.
-    #[arg(long, default_value = "1e-10")]
+    #[arg(long, default_value = "1e-10", value_parser = values::tolerance)]
     pub tol: f64,
 }
 
 /// Runs `fitbead klaw`.
 pub fn run(a: Args) -> Result<(), CliError> {
     // The model is chosen once the data are read
-    let auto = parse_auto(&a.model, a.tol)?;
-    let mut model = match auto {
-        Some(_) => Model::Stick,
-        None => parse_model(&a.model)?,
-    };
-    let law: KLaw = a
-        .law
-        .parse()
-        .map_err(|e: String| super::flag_error("--law", &a.law, e))?;
+    let (mut model, auto) = model_of(a.model, a.tol);
+    let law = a.law;
     // The handler goes in before the data are read: a signal while a large file is read and
     // checked raises the flag (polled from the first bracket on) instead of killing the
     // process with no exit code.
@@ -124,7 +117,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
              use another model, or --skip-unsteady to leave such points out",
             describe(*i, why),
             unsteady.len() - 1,
-            a.model
+            a.model.name()
         )));
     };
     if ds.points.is_empty() {
@@ -186,7 +179,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         .collect();
     let title = format!(
         "K(α) laws under the {} model, fitted on v\u{304}",
-        prose_model_name(&a.model)
+        prose_model_name(a.model)
     );
     let plot = LsqPlot {
         title: &title,

@@ -12,6 +12,7 @@ mod klaw;
 mod regimes;
 mod report;
 mod simulate;
+mod values;
 
 use crate::fit::posterior::Method;
 use crate::io::{clip, distinct_paths, write_atomic, InputError, ECHO_CHARS};
@@ -156,12 +157,12 @@ fn clip_message(message: &str) -> String {
     clip(&words.join(" "), MESSAGE_CHARS).into_owned()
 }
 
-/// Parses the command line as [`Cli::parse`] does, with negative numbers allowed as the
-/// values of every flag (`--xi -1` is the value −1 given to `--xi`, refused by its check, not
-/// an unknown flag `-1`), and any value starting with `-` taken by a flag that reads a number
-/// (`--delta-deg -inf` is the value −∞, refused by the flag's check, not a flag `-i`).
-pub(crate) fn parse() -> Cli {
-    use clap::{CommandFactory, FromArgMatches};
+/// The command line's parser: [`Cli`]'s, with negative numbers allowed as the values of every
+/// flag (`--xi -1` is the value −1 given to `--xi`, refused by its check, not an unknown flag
+/// `-1`), and any value starting with `-` taken by a flag that reads a number (`--delta-deg
+/// -inf` is the value −∞, refused by the flag's check, not a flag `-i`).
+fn command() -> clap::Command {
+    use clap::CommandFactory;
     let mut cmd = Cli::command();
     let names: Vec<String> = cmd
         .get_subcommands()
@@ -179,8 +180,70 @@ pub(crate) fn parse() -> Cli {
             })
         });
     }
-    let m = cmd.get_matches();
-    Cli::from_arg_matches(&m).unwrap_or_else(|e| e.exit())
+    cmd
+}
+
+/// Parses the command line. A value refused by its flag's parser is an error in the project's
+/// form ([`value_error`]); clap's other errors (an unknown flag, a missing value) and `--help`
+/// print and exit as clap does. A report's recipe gives the defaults of the flags named by its
+/// keys ([`report::Recipe`]).
+pub(crate) fn parse() -> Result<Cli, CliError> {
+    use clap::FromArgMatches;
+    let cmd = command();
+    let m = cmd.clone().try_get_matches().map_err(value_error)?;
+    let recipe = match m.subcommand() {
+        Some(("report", sub)) => report::Recipe::for_flags(sub)?,
+        _ => None,
+    };
+    let Some(recipe) = recipe else {
+        return Cli::from_arg_matches(&m).map_err(value_error);
+    };
+    let cmd = cmd.mut_subcommand("report", |s| recipe.defaults(s));
+    let m = cmd
+        .try_get_matches()
+        .map_err(|e| recipe.blame(value_error(e)))?;
+    let mut cli = Cli::from_arg_matches(&m).map_err(value_error)?;
+    if let Command::Report(a) = &mut cli.command {
+        a.recipe_used = Some(recipe);
+    }
+    Ok(cli)
+}
+
+/// A value refused by its flag's parser as the project's error (`<command line>, flag
+/// '--NAME', value 'V': message`, exit 2); any other error of clap is printed by clap, which
+/// exits.
+fn value_error(e: clap::Error) -> CliError {
+    use clap::error::{ContextKind, ContextValue, ErrorKind};
+    let text = |k: ContextKind| match e.get(k) {
+        Some(ContextValue::String(s)) => Some(s.clone()),
+        _ => None,
+    };
+    // `--NAME <VALUE>`: the flag is the first word.
+    let flag = text(ContextKind::InvalidArg)
+        .and_then(|a| a.split(' ').next().map(str::to_string))
+        .filter(|f| f.starts_with("--"));
+    let value = text(ContextKind::InvalidValue).filter(|v| !v.is_empty());
+    let (Some(flag), Some(value)) = (flag, value) else {
+        e.exit()
+    };
+    let (value, message) = match e.kind() {
+        ErrorKind::ValueValidation => {
+            let source = std::error::Error::source(&e);
+            match source.and_then(|s| s.downcast_ref::<values::Refusal>()) {
+                Some(r) => (r.part.clone().unwrap_or(value), r.message.clone()),
+                None => (value, source.map(|s| s.to_string()).unwrap_or_default()),
+            }
+        }
+        ErrorKind::InvalidValue => {
+            let expected = match e.get(ContextKind::ValidValue) {
+                Some(ContextValue::Strings(v)) => v.join(", "),
+                _ => String::new(),
+            };
+            (value, format!("expected one of {expected}"))
+        }
+        _ => e.exit(),
+    };
+    flag_error(&flag, &value, message)
 }
 
 /// Runs the parsed command line; returns the process exit code.
@@ -597,34 +660,6 @@ pub(crate) fn counted_fit(label: &str, method: Method) -> (Method, Task) {
     (method.with_progress(tally), Task(bar))
 }
 
-/// Parses a comma-separated list of numbers given on the command line.
-pub(crate) fn parse_list(flag: &str, s: &str) -> Result<Vec<f64>, CliError> {
-    s.split(',')
-        .map(|t| {
-            let t = t.trim();
-            t.parse::<f64>()
-                .ok()
-                .filter(|v| v.is_finite())
-                .ok_or_else(|| {
-                    CliError::Input(InputError {
-                        file: crate::io::SETTINGS_ORIGIN.into(),
-                        line: None,
-                        column: Some(flag.to_string()),
-                        value: Some(t.to_string()),
-                        message: "not a finite number".into(),
-                    })
-                })
-        })
-        .collect()
-}
-
-/// The Jaeger root of `--branch` (`upper`, the default, or `lower`; eqs 80–89).
-pub(crate) fn jaeger_branch(value: &str) -> Result<crate::models::JaegerBranch, CliError> {
-    value
-        .parse()
-        .map_err(|e: String| flag_error("--branch", value, e))
-}
-
 /// An error about a command-line flag value.
 pub(crate) fn flag_error(flag: &str, value: &str, message: impl Into<String>) -> CliError {
     CliError::Input(InputError {
@@ -640,5 +675,11 @@ pub(crate) fn flag_error(flag: &str, value: &str, message: impl Into<String>) ->
 /// exit code (0 done, 1 a fit that did not converge, 2 bad input or a failed read or write,
 /// 130 interrupted by a signal; `docs/GUIDE.md`, "Exit codes"). The binary is this call.
 pub fn main() -> i32 {
-    run(parse())
+    match parse() {
+        Ok(cli) => run(cli),
+        Err(e) => {
+            eprintln!("fitbead: error: {}", clip_message(&e.to_string()));
+            2
+        }
+    }
 }

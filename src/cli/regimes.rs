@@ -2,22 +2,23 @@
 //! critical ξ below which no steady regime exists.
 
 use super::args::OutputArgs;
-use super::{emit, CliError};
+use super::values::LawText;
+use super::{emit, values, CliError};
 use crate::io::records::{to_csv, RegimeRecord};
 use crate::models::regimes::alpha_of_xi;
-use crate::scene::CollisionLaw;
 
 /// Arguments of `fitbead regimes`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Collision law: a number, cos2a, adjusted, impact or c=VALUE.
-    #[arg(long, default_value = "adjusted")]
-    pub law: String,
+    #[arg(long, default_value = "adjusted", value_parser = values::law_with_text)]
+    pub law: LawText,
     /// Gyration parameter ρ.
-    #[arg(long, default_value_t = 0.4)]
+    #[arg(long, default_value_t = 0.4, value_parser = values::non_negative)]
     pub rho: f64,
     /// Radius ratios ξ (comma-separated, or the flag repeated).
-    #[arg(long, value_delimiter = ',', default_values_t = vec![0.8, 1.0, 1.6, 2.0])]
+    #[arg(long, value_delimiter = ',', default_values_t = vec![0.8, 1.0, 1.6, 2.0],
+          value_parser = values::radius_ratio)]
     pub xi: Vec<f64>,
     /// Where the result goes.
     #[command(flatten)]
@@ -26,29 +27,13 @@ pub struct Args {
 
 /// Runs `fitbead regimes`.
 pub fn run(a: Args) -> Result<(), CliError> {
-    let law: CollisionLaw = a.law.parse().map_err(|e: crate::scene::ParameterError| {
-        super::flag_error("--law", &a.law, e.to_string())
-    })?;
-    if !(a.rho.is_finite() && a.rho >= 0.0) {
-        return Err(super::flag_error(
-            "--rho",
-            &a.rho.to_string(),
-            "must be >= 0",
-        ));
-    }
+    let law = a.law.law;
     for &xi in &a.xi {
-        if !(xi.is_finite() && xi > 0.0) {
-            return Err(super::flag_error(
-                "--xi",
-                &xi.to_string(),
-                "radius ratio must be > 0",
-            ));
-        }
         let k = law.k(alpha_of_xi(xi), a.rho);
         if !(k.is_finite() && k > 0.0 && k < 1.0) {
             return Err(super::flag_error(
                 "--law",
-                &a.law,
+                &a.law.text,
                 format!(
                     "K = {} at xi = {}: a law's K must be in (0, 1) (a collision cannot return \
                      more velocity than it receives)",

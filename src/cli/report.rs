@@ -2,11 +2,13 @@
 //! friction μ of Jan's model against eq 79, energy budgets, the regime map, the model ranking —
 //! as a directory of CSV tables, SVG figures and a `report.md` that links them.
 
-use super::args::{ContactArgs, DataArgs, LevelArgs, PlotArgs};
+use super::args::{DataArgs, LevelArgs, PlotArgs};
 use super::fitargs::{not_converged, FitArgs, FitOutputArgs};
+use super::values::{self, FitMethod, Units};
 use super::CliError;
+use crate::io::InputError;
 use crate::pipeline::{report, ReportSettings};
-use crate::report::figures::{FigureFormat, FigureWidth};
+use crate::report::figures::FigureFormat;
 use std::path::{Path, PathBuf};
 
 /// Arguments of `fitbead report`.
@@ -23,22 +25,22 @@ pub struct Args {
     pub out_dir: Option<PathBuf>,
     /// lsq or mcmc (posteriors for every fit; adds one corner_<fit>_<series>.svg per
     /// posterior) [default: lsq]
-    #[arg(long)]
-    pub method: Option<String>,
+    #[arg(long, value_parser = values::choice::<FitMethod>())]
+    pub method: Option<FitMethod>,
     /// Figure files: svg, png (rendered from the SVG), pdf (vector, the font embedded, text
     /// selectable), both (svg and png) or all (svg, png and pdf) [default: svg]
-    #[arg(long)]
-    pub format: Option<String>,
+    #[arg(long, value_parser = values::choice::<FigureFormat>())]
+    pub format: Option<FigureFormat>,
     /// Velocities on the figures: dimensionless (units of sqrt(g (R + r))) or si (m/s, for
     /// data given in m/s with R_m; every velocity axis: velocity.svg, jan_linear.svg in
     /// m²/s², k_final_velocity.svg) [default: dimensionless]
-    #[arg(long)]
-    pub units: Option<String>,
+    #[arg(long, value_parser = values::choice::<Units>())]
+    pub units: Option<Units>,
     /// Print width of the figures: single (one journal column, 86 mm), double (two columns,
     /// 178 mm) or a width in mm (40-500); each figure is laid out for it (fewer columns,
     /// narrower panels, titles broken into lines) so that no text prints below 7 pt, sized in
     /// mm in SVG and PDF, PNG at 300 dpi [default: each figure's natural size]
-    #[arg(long)]
+    #[arg(long, value_parser = values::figure_width)]
     pub figure_width: Option<String>,
     /// The level of every interval.
     #[command(flatten)]
@@ -47,10 +49,10 @@ pub struct Args {
     #[arg(long)]
     pub seed: Option<u64>,
     /// MCMC: minimum bulk and tail ESS per parameter [default: 1000]
-    #[arg(long)]
+    #[arg(long, value_parser = values::non_negative)]
     pub min_ess: Option<f64>,
     /// MCMC: maximum steps per fit [default: 100000]
-    #[arg(long)]
+    #[arg(long, value_parser = values::at_least_one)]
     pub max_steps: Option<usize>,
     /// A TOML recipe with any of the keys input, out_dir, method, format, units, figure_width,
     /// rho, f, g,
@@ -65,69 +67,141 @@ pub struct Args {
     /// Without it such data exit 2 (as `klaw` does) and nothing is written
     #[arg(long)]
     pub keep_going: bool,
+    /// The recipe whose keys gave the defaults of the flags above (set by `super::parse`).
+    #[arg(skip)]
+    pub recipe_used: Option<Recipe>,
 }
 
-/// The keys of a recipe file.
-#[derive(Debug, Default, serde::Deserialize)]
+/// The keys of a recipe file: each is the flag of the same name (`out_dir` for `--out-dir`)
+/// and takes the same values, with the TOML types here.
+#[derive(Debug, Default, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Recipe {
+struct Keys {
     /// Measurements CSV.
-    pub input: Option<PathBuf>,
+    input: Option<PathBuf>,
     /// Output directory.
-    pub out_dir: Option<PathBuf>,
+    out_dir: Option<PathBuf>,
     /// lsq or mcmc.
-    pub method: Option<String>,
+    method: Option<String>,
     /// svg, png, pdf, both or all.
-    pub format: Option<String>,
+    format: Option<String>,
     /// dimensionless or si.
-    pub units: Option<String>,
+    units: Option<String>,
     /// single, double or a width in mm.
-    pub figure_width: Option<String>,
+    figure_width: Option<String>,
     /// ρ.
-    pub rho: Option<f64>,
+    rho: Option<f64>,
     /// f.
-    pub f: Option<f64>,
+    f: Option<f64>,
     /// g.
-    pub g: Option<f64>,
+    g: Option<f64>,
     /// Interval level.
-    pub level: Option<f64>,
+    level: Option<f64>,
     /// MCMC seed.
-    pub seed: Option<u64>,
+    seed: Option<u64>,
     /// MCMC minimum ESS.
-    pub min_ess: Option<f64>,
+    min_ess: Option<f64>,
     /// MCMC maximum steps.
-    pub max_steps: Option<usize>,
-    /// The input path as written in the recipe (shown in report.md, so that the report does
-    /// not depend on where the recipe was run from).
-    #[serde(skip)]
-    pub shown_input: Option<String>,
+    max_steps: Option<usize>,
 }
 
-/// The recipe's keys that a flag of the same meaning overrides, with that flag.
-const RECIPE_FLAGS: [(&str, &str); 13] = [
-    ("input", "--input"),
-    ("out_dir", "--out-dir"),
-    ("method", "--method"),
-    ("format", "--format"),
-    ("units", "--units"),
-    ("figure_width", "--figure-width"),
-    ("rho", "--rho"),
-    ("f", "--f"),
-    ("g", "--g"),
-    ("level", "--level"),
-    ("seed", "--seed"),
-    ("min_ess", "--min-ess"),
-    ("max_steps", "--max-steps"),
-];
+/// The keys that apply to a posterior run only: ignored under least squares.
+const MCMC_KEYS: [&str; 3] = ["seed", "min_ess", "max_steps"];
 
-/// A recipe as read: its keys, its file's name and text (to blame a bad value on its line).
-struct RecipeFile {
-    recipe: Recipe,
+/// A recipe as applied to a command line: each key not given as a flag is that flag's default
+/// value, so that clap's own parsing gives a flag over the recipe over the built-in default,
+/// and checks the recipe's values as it checks the flags'.
+#[derive(Debug, Clone)]
+pub(crate) struct Recipe {
+    /// The recipe file's name.
     name: String,
+    /// Its text (to blame a bad value on its line).
     text: String,
+    /// The keys applied, with their values as command-line text (paths relative to the
+    /// recipe's directory already joined to it).
+    keys: Vec<(String, String)>,
+    /// The input path as written in the recipe, when the input is the recipe's (shown in
+    /// report.md, so that the report does not depend on where the recipe was run from).
+    shown_input: Option<String>,
 }
 
-impl RecipeFile {
+impl Recipe {
+    /// The recipe of `--recipe`, read, with the keys that the flags of `m` (the report's
+    /// matches) do not give; `None` without `--recipe`.
+    pub fn for_flags(m: &clap::ArgMatches) -> Result<Option<Recipe>, CliError> {
+        use clap::parser::ValueSource;
+        let Some(path) = m.get_one::<PathBuf>("recipe") else {
+            return Ok(None);
+        };
+        let name = path.display().to_string();
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| InputError::file(&name, format!("cannot read: {e}")))?;
+        let mut keys: Keys = toml::from_str(&text)
+            .map_err(|e| InputError::file(&name, format!("not a valid recipe: {e}")))?;
+        let mut r = Recipe {
+            name,
+            text,
+            keys: Vec::new(),
+            shown_input: None,
+        };
+        // An empty path would be the recipe's own directory; the flags refuse it too.
+        for (key, p) in [("input", &keys.input), ("out_dir", &keys.out_dir)] {
+            if p.as_ref().is_some_and(|p| p.as_os_str().is_empty()) {
+                return Err(r.error(
+                    key,
+                    "",
+                    "an empty path: name a file or directory (\".\" for the recipe's own directory)",
+                ));
+            }
+        }
+        let dir = path.parent().unwrap_or(Path::new(""));
+        let given = |id: &str| m.value_source(id) == Some(ValueSource::CommandLine);
+        // The measurements given as a plain argument are the input as well.
+        if given("input") || given("data") {
+            keys.input = None;
+        }
+        r.shown_input = keys.input.as_ref().map(|p| p.display().to_string());
+        keys.input = keys.input.map(|p| dir.join(p));
+        keys.out_dir = keys.out_dir.map(|p| dir.join(p));
+        // The MCMC keys apply to a posterior run only; under least squares (the recipe's
+        // method or --method lsq, which wins) they are ignored, not an error.
+        let method = match m.get_one::<FitMethod>("method").filter(|_| given("method")) {
+            Some(m) => Some(*m),
+            None => keys
+                .method
+                .as_deref()
+                .and_then(|t| <FitMethod as clap::ValueEnum>::from_str(t.trim(), true).ok()),
+        };
+        let mcmc = method == Some(FitMethod::Mcmc);
+        let toml::Value::Table(map) =
+            toml::Value::try_from(&keys).map_err(|e| CliError::Other(e.to_string()))?
+        else {
+            return Ok(Some(r));
+        };
+        for (key, value) in map {
+            let text = match value {
+                toml::Value::String(s) => s,
+                toml::Value::Float(x) => crate::numfmt::echo_f64(x),
+                toml::Value::Integer(n) => n.to_string(),
+                _ => continue,
+            };
+            if given(&key) || (!mcmc && MCMC_KEYS.contains(&key.as_str())) {
+                continue;
+            }
+            r.keys.push((key, text));
+        }
+        Ok(Some(r))
+    }
+
+    /// The report's command with the recipe's keys as the defaults of their flags.
+    pub fn defaults(&self, cmd: clap::Command) -> clap::Command {
+        self.keys.iter().fold(cmd, |cmd, (key, value)| {
+            // The command is built once per run: its defaults live as long as the process.
+            let value: &'static str = value.clone().leak();
+            cmd.mut_arg(key.as_str(), |a| a.default_value(value))
+        })
+    }
+
     /// The 1-based line of `key = …` in the recipe, when it is written that way.
     fn line_of(&self, key: &str) -> Option<u64> {
         self.text
@@ -142,7 +216,7 @@ impl RecipeFile {
 
     /// An error about the recipe's `key`, located on its line.
     fn error(&self, key: &str, value: &str, message: impl Into<String>) -> CliError {
-        CliError::Input(crate::io::InputError {
+        CliError::Input(InputError {
             file: self.name.clone(),
             line: self.line_of(key),
             column: Some(key.to_string()),
@@ -150,183 +224,56 @@ impl RecipeFile {
             message: message.into(),
         })
     }
-}
 
-fn read_recipe(path: &Path) -> Result<RecipeFile, CliError> {
-    let name = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| {
-        CliError::Input(crate::io::InputError::file(
-            &name,
-            format!("cannot read: {e}"),
-        ))
-    })?;
-    let mut r: Recipe = toml::from_str(&text).map_err(|e| {
-        CliError::Input(crate::io::InputError::file(
-            &name,
-            format!("not a valid recipe: {e}"),
-        ))
-    })?;
-    let file = RecipeFile {
-        recipe: Recipe::default(),
-        name,
-        text,
-    };
-    // An empty path would be the recipe's own directory; the flags refuse it too.
-    for (key, p) in [("input", &r.input), ("out_dir", &r.out_dir)] {
-        if p.as_ref().is_some_and(|p| p.as_os_str().is_empty()) {
-            return Err(file.error(
-                key,
-                "",
-                "an empty path: name a file or directory (\".\" for the recipe's own directory)",
-            ));
+    /// `e` blamed on the recipe when it is about a flag whose value the recipe gave: the
+    /// recipe file, the key's line, the key.
+    pub fn blame(&self, e: CliError) -> CliError {
+        let CliError::Input(ie) = e else { return e };
+        let key = ie
+            .column
+            .as_deref()
+            .filter(|_| ie.file == crate::io::SETTINGS_ORIGIN)
+            .and_then(|c| c.strip_prefix("--"))
+            .map(|f| f.replace('-', "_"))
+            .filter(|k| self.keys.iter().any(|(key, _)| key == k));
+        match key {
+            Some(k) => CliError::Input(InputError {
+                file: self.name.clone(),
+                line: self.line_of(&k),
+                column: Some(k),
+                ..ie
+            }),
+            None => CliError::Input(ie),
         }
     }
-    let dir = path.parent().unwrap_or(Path::new(""));
-    r.shown_input = r.input.as_ref().map(|p| p.display().to_string());
-    r.input = r.input.map(|p| dir.join(p));
-    r.out_dir = r.out_dir.map(|p| dir.join(p));
-    Ok(RecipeFile { recipe: r, ..file })
-}
-
-/// Whether the recipe's `key` is the value used: set in the recipe and not given as a flag.
-fn from_recipe(a: &Args, r: &Recipe, key: &str) -> bool {
-    match key {
-        "input" => a.data.path().is_none() && r.input.is_some(),
-        "out_dir" => a.out_dir.is_none() && r.out_dir.is_some(),
-        "method" => a.method.is_none() && r.method.is_some(),
-        "format" => a.format.is_none() && r.format.is_some(),
-        "units" => a.units.is_none() && r.units.is_some(),
-        "figure_width" => a.figure_width.is_none() && r.figure_width.is_some(),
-        "rho" => a.data.contact.rho.is_none() && r.rho.is_some(),
-        "f" => a.data.contact.f.is_none() && r.f.is_some(),
-        "g" => a.data.g.is_none() && r.g.is_some(),
-        "level" => a.level.level.is_none() && r.level.is_some(),
-        "seed" => a.seed.is_none() && r.seed.is_some(),
-        "min_ess" => a.min_ess.is_none() && r.min_ess.is_some(),
-        "max_steps" => a.max_steps.is_none() && r.max_steps.is_some(),
-        _ => false,
-    }
-}
-
-/// `e` blamed on the recipe when it is about a setting whose value came from the recipe: the
-/// recipe file, the key's line, the key.
-fn blame_recipe(e: CliError, file: &RecipeFile, keys: &[&str]) -> CliError {
-    let CliError::Input(ie) = e else { return e };
-    if ie.file != crate::io::SETTINGS_ORIGIN {
-        return CliError::Input(ie);
-    }
-    let flag = ie.column.clone().unwrap_or_default();
-    let key = RECIPE_FLAGS
-        .iter()
-        .find(|(_, f)| *f == flag)
-        .map(|(k, _)| *k);
-    match key.filter(|k| keys.contains(k)) {
-        Some(k) => CliError::Input(crate::io::InputError {
-            file: file.name.clone(),
-            line: file.line_of(k),
-            column: Some(k.to_string()),
-            ..ie
-        }),
-        None => CliError::Input(ie),
-    }
-}
-
-/// The unit of the velocities on the report's figures (`--units`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Units {
-    /// Units of sqrt(g (R + r)).
-    Dimensionless,
-    /// m/s.
-    Si,
 }
 
 /// Runs `fitbead report`. An error about a setting taken from the recipe names the recipe
 /// file, the key's line and the key.
-pub fn run(a: Args) -> Result<(), CliError> {
-    let Some(path) = a.recipe.clone() else {
-        return run_with(a, Recipe::default());
-    };
-    let mut file = read_recipe(&path)?;
-    let mut r = std::mem::take(&mut file.recipe);
-    // The MCMC keys of a recipe apply to a posterior run only; under least squares (the
-    // recipe's method or --method lsq, which wins) they are ignored, not an error.
-    let method = a.method.clone().or(r.method.clone()).unwrap_or_default();
-    if !method.eq_ignore_ascii_case("mcmc") {
-        r.seed = None;
-        r.min_ess = None;
-        r.max_steps = None;
+pub fn run(mut a: Args) -> Result<(), CliError> {
+    match a.recipe_used.take() {
+        Some(r) => run_with(a, r.shown_input.clone()).map_err(|e| r.blame(e)),
+        None => run_with(a, None),
     }
-    let keys: Vec<&str> = RECIPE_FLAGS
-        .iter()
-        .map(|(k, _)| *k)
-        .filter(|k| from_recipe(&a, &r, k))
-        .collect();
-    run_with(a, r).map_err(|e| blame_recipe(e, &file, &keys))
 }
 
-fn run_with(a: Args, r: Recipe) -> Result<(), CliError> {
-    let from_flags = a.data.path().map(Path::to_path_buf);
-    let shown = match (&from_flags, &r.shown_input) {
-        (None, Some(s)) => Some(s.clone()),
-        _ => None,
-    };
-    let input = from_flags.or(r.input);
-    let units = match a.units.clone().or(r.units.clone()).as_deref() {
-        None => Units::Dimensionless,
-        Some(u) if u.eq_ignore_ascii_case("dimensionless") => Units::Dimensionless,
-        Some(u) if u.eq_ignore_ascii_case("si") => Units::Si,
-        Some(u) => {
-            return Err(super::flag_error(
-                "--units",
-                u,
-                "expected dimensionless or si",
-            ))
-        }
-    };
-    let format_text = a.format.clone().or(r.format);
-    let format: FigureFormat = match &format_text {
-        Some(f) => f
-            .parse()
-            .map_err(|e: String| super::flag_error("--format", f, e))?,
-        None => FigureFormat::Svg,
-    };
-    // Checked here, before the data are read; the library reads the text again.
-    let figure_width_text = a.figure_width.clone().or(r.figure_width);
-    if let Some(w) = &figure_width_text {
-        w.parse::<FigureWidth>()
-            .map_err(|e: String| super::flag_error("--figure-width", w, e))?;
-    }
-    let out_dir = a
-        .out_dir
-        .clone()
-        .or(r.out_dir)
-        .unwrap_or_else(|| PathBuf::from("report"));
+/// Runs the report of the flags `a` (the recipe's keys applied); `shown` is the input path as
+/// the recipe writes it.
+fn run_with(a: Args, shown: Option<String>) -> Result<(), CliError> {
+    let input = a.data.path().map(Path::to_path_buf);
+    let format = a.format.unwrap_or_default();
+    let out_dir = a.out_dir.clone().unwrap_or_else(|| PathBuf::from("report"));
     let io = FitArgs {
-        data: DataArgs {
-            input: input.clone(),
-            data: None,
-            contact: ContactArgs {
-                rho: a.data.contact.rho.or(r.rho),
-                f: a.data.contact.f.or(r.f),
-            },
-            g: a.data.g.or(r.g),
-            strict_columns: a.data.strict_columns,
-        },
-        level: LevelArgs {
-            level: a.level.level.or(r.level),
-        },
+        data: a.data.clone(),
+        level: a.level.clone(),
         no_profile: false,
         out: FitOutputArgs::default(),
         output_stats: None,
-        method: a
-            .method
-            .clone()
-            .or(r.method)
-            .unwrap_or_else(|| "lsq".into()),
-        seed: a.seed.or(r.seed),
+        method: a.method.unwrap_or_default(),
+        seed: a.seed,
         walkers: None,
-        min_ess: a.min_ess.or(r.min_ess),
-        max_steps: a.max_steps.or(r.max_steps),
+        min_ess: a.min_ess,
+        max_steps: a.max_steps,
         thin: None,
         priors: Vec::new(),
         fit_scatter: false,
@@ -366,14 +313,14 @@ fn run_with(a: Args, r: Recipe) -> Result<(), CliError> {
     let settings = ReportSettings {
         level: io.level.level(),
         method: choice.method,
-        format: format_text.unwrap_or_else(|| "svg".into()),
-        si_units: units == Units::Si,
-        figure_width: figure_width_text,
+        format: values::name_of(&format),
+        si_units: a.units == Some(Units::Si),
+        figure_width: a.figure_width.clone(),
         keep_going: a.keep_going,
         defaults: io.data.defaults()?,
         source: shown,
         stop: Some(super::stop_flag()),
-        method_name: Some(io.method.clone()),
+        method_name: Some(values::name_of(&io.method)),
     };
     let out = report(&data, &settings, Some(&out_dir))?;
     for s in &out.stats {

@@ -2,10 +2,10 @@
 //! that [`simulate`] makes written to `--output` or stdout.
 
 use super::args::{ContactArgs, OutputArgs};
-use super::{emit, parse_list, CliError};
-use crate::io::fmt_f64;
+use super::values::{self, Numbers, SlopeRange};
+use super::{emit, CliError};
 use crate::models::contact::SpinRule;
-use crate::models::ModelKind;
+use crate::models::{JaegerBranch, ModelKind};
 use crate::pipeline::{simulate, RunError, SimulateSettings};
 use crate::progress::{Progress, ProgressEvent};
 use crate::scene::CollisionLaw;
@@ -17,19 +17,19 @@ pub struct Args {
     /// Forward model that makes the data: stick, stick-approx, slip, slip-approx, stickslip,
     /// contact (with --v0: the bead-by-bead transient instead), jan (see --jan), jaeger (see
     /// --jaeger), md (molecular dynamics, see the md flags).
-    #[arg(long, default_value = "stickslip")]
-    pub model: String,
+    #[arg(long, default_value = "stickslip", value_parser = values::choice::<ModelKind>())]
+    pub model: ModelKind,
     /// Collision law: a number, cos2a, adjusted, impact or c=VALUE.
-    #[arg(long, default_value = "adjusted")]
-    pub law: String,
+    #[arg(long, default_value = "adjusted", value_parser = values::law)]
+    pub law: CollisionLaw,
     /// Radius ratios ξ of the series, comma-separated.
-    #[arg(long, default_value = "0.8,1,1.6,2")]
-    pub series: String,
+    #[arg(long, default_value = "0.8,1,1.6,2", value_parser = values::series)]
+    pub series: Numbers,
     /// Points per series.
-    #[arg(long, default_value_t = 9)]
+    #[arg(long, default_value_t = 9, value_parser = values::points)]
     pub points: usize,
     /// Relative noise: v = v_true (1 + noise · N(0,1)), sigma_v = noise · v_true.
-    #[arg(long, default_value_t = 0.02)]
+    #[arg(long, default_value_t = 0.02, value_parser = values::noise)]
     pub noise: f64,
     /// Seed of the random stream.
     #[arg(long, default_value_t = 1)]
@@ -39,20 +39,20 @@ pub struct Args {
     pub contact: ContactArgs,
     /// Jan's global laws λ0,λ1,μ0,μ1 (λ = λ0 e^{λ1 sin α}, μ = μ0 e^{μ1 sin α}) for
     /// --model jan [default: 0.063,4.96,0.0025,7.46, the paper's eqs 75–76]
-    #[arg(long)]
-    pub jan: Option<String>,
+    #[arg(long, value_parser = values::jan_laws)]
+    pub jan: Option<[f64; 4]>,
     /// Jaeger's a1,a2,a3 (Jaeger units, eq 81) for --model jaeger, used for every series
     /// [default: the paper's Fig. 9 values of the series' ξ, for ξ = 0.8, 1, 1.6 or 2]
-    #[arg(long)]
-    pub jaeger: Option<String>,
+    #[arg(long, value_parser = values::jaeger_values)]
+    pub jaeger: Option<[f64; 3]>,
     /// Branch of eq 84 for --model jaeger: upper or lower.
-    #[arg(long, default_value = "upper")]
-    pub branch: String,
+    #[arg(long, default_value = "upper", value_parser = values::choice::<JaegerBranch>())]
+    pub branch: JaegerBranch,
     /// Slopes LO,HI in degrees: the range is cut to the model's steady range and the points
     /// spread over 5 %–95 % of it [default: the steady range; for jan and jaeger, whose steady
     /// range has no upper end, the onset to the onset + 12°]
-    #[arg(long)]
-    pub delta_range: Option<String>,
+    #[arg(long, value_parser = values::slope_range)]
+    pub delta_range: Option<SlopeRange>,
     /// A design (CSV: series,xi,delta_deg,replicates, as `fitbead design` writes it): the
     /// data are made at exactly its slopes, `replicates` points at each, instead of spread
     /// over the steady range.
@@ -64,64 +64,17 @@ pub struct Args {
     /// --model contact only: launch speed Θ̇0 on the first bead (dimensionless, rolling
     /// launch). With it, simulate writes the bead-by-bead transient of one scene per ξ of
     /// --series at --delta-deg instead of synthetic measurements.
-    #[arg(long)]
+    #[arg(long, value_parser = values::launch_speed)]
     pub v0: Option<f64>,
     /// Slope of the --v0 transient, degrees.
     #[arg(long = "delta-deg")]
     pub delta_deg: Option<f64>,
     /// Spin rule of the collision for --model contact: roll, keep, factor=L or impact.
-    #[arg(long, default_value = "roll")]
-    pub spin: String,
+    #[arg(long, default_value = "roll", value_parser = values::spin)]
+    pub spin: SpinRule,
     /// Molecular-dynamics settings (`--model md`).
     #[command(flatten)]
     pub md: super::forward::MdArgs,
-}
-
-/// `--spin`: the contact model's spin rule. A rule other than the default `roll` is refused
-/// for the other models, which have no spin rule.
-fn spin_rule(a: &Args, kind: ModelKind) -> Result<SpinRule, CliError> {
-    let spin: SpinRule = a.spin.parse().map_err(|e: crate::scene::ParameterError| {
-        super::flag_error("--spin", &a.spin, e.to_string())
-    })?;
-    if kind != ModelKind::Contact && spin != SpinRule::Roll {
-        return Err(super::flag_error(
-            "--spin",
-            &a.spin,
-            "a spin rule applies to --model contact only",
-        ));
-    }
-    Ok(spin)
-}
-
-/// `--delta-range LO,HI` (degrees, LO < HI), when given.
-fn delta_range(flag: Option<&str>) -> Result<Option<(f64, f64)>, CliError> {
-    let Some(s) = flag else {
-        return Ok(None);
-    };
-    let r = parse_list("--delta-range", s)?;
-    if r.len() != 2 || !(r[0] < r[1]) {
-        return Err(super::flag_error(
-            "--delta-range",
-            s,
-            "expected LO,HI in degrees with LO < HI",
-        ));
-    }
-    Ok(Some((r[0], r[1])))
-}
-
-/// `--jan` or `--jaeger`: `N` comma-separated numbers, when given.
-fn numbers<const N: usize>(
-    flag: &str,
-    text: Option<&str>,
-    expected: &str,
-) -> Result<Option<[f64; N]>, CliError> {
-    let Some(s) = text else {
-        return Ok(None);
-    };
-    let p = parse_list(flag, s)?;
-    <[f64; N]>::try_from(p)
-        .map(Some)
-        .map_err(|_| super::flag_error(flag, s, expected))
 }
 
 /// The md runs' progress on a terminal's stderr (nothing elsewhere).
@@ -149,31 +102,7 @@ fn md_progress() -> Progress {
 
 /// Runs `fitbead simulate`.
 pub fn run(a: Args) -> Result<(), CliError> {
-    let kind: ModelKind = a
-        .model
-        .parse()
-        .map_err(|_| super::flag_error("--model", &a.model, "unknown model"))?;
-    let law: CollisionLaw = a.law.parse().map_err(|e: crate::scene::ParameterError| {
-        super::flag_error("--law", &a.law, e.to_string())
-    })?;
-    let spin = spin_rule(&a, kind)?;
-    let series = parse_list("--series", &a.series)?;
-    // Rows of a series are labelled by its ξ: two equal values would make one series.
-    for (j, x) in series.iter().enumerate() {
-        if let Some(i) = series[..j].iter().position(|y| y == x) {
-            let text: Vec<&str> = a.series.split(',').map(str::trim).collect();
-            return Err(super::flag_error(
-                "--series",
-                text[j],
-                format!(
-                    "xi {} is given twice (values {} and {}): each series needs its own xi",
-                    fmt_f64(*x),
-                    i + 1,
-                    j + 1
-                ),
-            ));
-        }
-    }
+    let kind = a.model;
     // The flags of one kind of run are read only for that run (the transient ignores the
     // steady-state flags, md the phenomenological models' flags).
     let steady = a.v0.is_none();
@@ -184,31 +113,15 @@ pub fn run(a: Args) -> Result<(), CliError> {
         SimulateSettings::default().md
     };
     let (jan, jaeger, branch) = if phenomenological {
-        (
-            numbers::<4>(
-                "--jan",
-                a.jan.as_deref(),
-                "expected four numbers lambda0,lambda1,mu0,mu1",
-            )?,
-            numbers::<3>(
-                "--jaeger",
-                a.jaeger.as_deref(),
-                "expected three numbers a1,a2,a3",
-            )?,
-            super::jaeger_branch(&a.branch)?,
-        )
+        (a.jan, a.jaeger, a.branch)
     } else {
-        (None, None, crate::models::JaegerBranch::Upper)
+        (None, None, JaegerBranch::Upper)
     };
-    let range = if steady {
-        delta_range(a.delta_range.as_deref())?
-    } else {
-        None
-    };
+    let range = a.delta_range.as_ref().filter(|_| steady);
     let settings = SimulateSettings {
         model: kind,
-        law,
-        series,
+        law: a.law,
+        series: a.series.0.clone(),
         points: a.points,
         noise: a.noise,
         seed: a.seed,
@@ -217,12 +130,12 @@ pub fn run(a: Args) -> Result<(), CliError> {
         jan,
         jaeger,
         branch,
-        delta_range: range,
+        delta_range: range.map(|r| (r.lo, r.hi)),
         design: a.design.clone(),
         v0: a.v0,
         delta_deg: a.delta_deg,
         beads: a.md.beads,
-        spin,
+        spin: a.spin,
         md,
         stop: Some(super::stop_flag()),
         progress: Some(md_progress()),
@@ -231,7 +144,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let bytes = simulate(&settings).map_err(|e| match e {
         // The range as given on the command line.
         RunError::Input(mut ie) if ie.column.as_deref() == Some("--delta-range") => {
-            ie.value = a.delta_range.clone();
+            ie.value = range.map(|r| r.text.clone());
             CliError::Input(ie)
         }
         e => CliError::from(e),

@@ -16,6 +16,7 @@ mod simulate;
 pub use bench::{forward_md, work_precision};
 pub(crate) use report::law_error;
 pub use report::{report, ReportOutput, ReportSettings};
+pub(crate) use simulate::MAX_POINTS;
 pub use simulate::{simulate, SimulateSettings};
 
 use crate::io::InputError;

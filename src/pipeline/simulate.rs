@@ -8,16 +8,17 @@ use crate::models::contact::{Contact, SpinRule};
 use crate::models::jaeger::Jaeger;
 use crate::models::jan::Jan;
 use crate::models::md::{
-    regime_b_interval_until as md_regime_b_interval, Md, MdParams, MdRunConfig, MD_NARROW,
-    MD_REFINE, MD_SCAN_POINTS,
+    regime_b_interval_until as md_regime_b_interval, Md, MdParams, MdResult, MdRunConfig,
+    MD_NARROW, MD_REFINE, MD_SCAN_POINTS,
 };
 use crate::models::regimes::regime_b_interval;
-use crate::models::{ForwardModel, JaegerBranch, Model, ModelKind};
+use crate::models::{ForwardModel, JaegerBranch, Model, ModelKind, Regime};
 use crate::progress::{Progress, ProgressEvent};
 use crate::scene::{CollisionLaw, Scene};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
+use rayon::prelude::*;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -151,20 +152,51 @@ impl SimulateSettings {
 /// Runs `fitbead simulate`: the CSV it writes (`series,xi,delta_deg,v,sigma_v,v_true`, md
 /// adding `v_md_stderr,v_m_s`; with `v0` the transient's columns).
 pub fn simulate(a: &SimulateSettings) -> Result<Vec<u8>, RunError> {
-    let kind = a.model;
-    let law = a.law;
-    if kind != ModelKind::Contact && a.spin != SpinRule::Roll {
+    check_series(a)?;
+    // The contact model under the spin rule (other models have none).
+    let contact = Contact {
+        spin: a.spin,
+        ..Contact::default()
+    };
+    if let Some(v0) = a.v0 {
+        if a.model != ModelKind::Contact {
+            return Err(flag_error(
+                "--v0",
+                &v0.to_string(),
+                "the bead-by-bead transient needs --model contact",
+            ));
+        }
+        return trace(a, a.law, &a.series, v0, contact);
+    }
+    check_steady(a)?;
+    if a.model == ModelKind::Md {
+        if let Some(p) = &a.design {
+            return Err(flag_error(
+                "--design",
+                &p.display().to_string(),
+                "a design is simulated with the steady-state models, not --model md",
+            ));
+        }
+        return run_md(a, &a.series);
+    }
+    let mut rng = ChaCha8Rng::seed_from_u64(a.seed);
+    let model_for = |xi: f64| model_for(a, contact, xi);
+    if let Some(path) = a.design.as_deref() {
+        return simulate_design(a, path, a.law, &model_for, &mut rng);
+    }
+    steady_points(a, &model_for, &mut rng)
+}
+
+/// The checks of every run: a spin rule only for the contact model, each series' ξ once, at
+/// most [`MAX_SERIES`] series.
+fn check_series(a: &SimulateSettings) -> Result<(), RunError> {
+    if a.model != ModelKind::Contact && a.spin != SpinRule::Roll {
         return Err(flag_error(
             "--spin",
             &a.spin.to_string(),
             "a spin rule applies to --model contact only",
         ));
     }
-    // The contact model under the spin rule (other models have none).
-    let contact = Contact {
-        spin: a.spin,
-        ..Contact::default()
-    };
     let series = &a.series;
     // Rows of a series are labelled by its ξ: two equal values would make one series.
     for (j, x) in series.iter().enumerate() {
@@ -188,16 +220,12 @@ pub fn simulate(a: &SimulateSettings) -> Result<Vec<u8>, RunError> {
             format!("expected at most {MAX_SERIES} series"),
         ));
     }
-    if let Some(v0) = a.v0 {
-        if kind != ModelKind::Contact {
-            return Err(flag_error(
-                "--v0",
-                &v0.to_string(),
-                "the bead-by-bead transient needs --model contact",
-            ));
-        }
-        return trace(a, law, series, v0, contact);
-    }
+    Ok(())
+}
+
+/// The checks of a steady-state run: 1 to [`MAX_POINTS`] points per series and at most
+/// [`MAX_ROWS`] rows, noise in [0, 0.5), a slope range with LO < HI.
+fn check_steady(a: &SimulateSettings) -> Result<(), RunError> {
     if a.points == 0 || a.points > MAX_POINTS {
         return Err(flag_error(
             "--points",
@@ -205,13 +233,13 @@ pub fn simulate(a: &SimulateSettings) -> Result<Vec<u8>, RunError> {
             format!("expected 1 to {MAX_POINTS} points per series"),
         ));
     }
-    if series.len().saturating_mul(a.points) > MAX_ROWS {
+    if a.series.len().saturating_mul(a.points) > MAX_ROWS {
         return Err(flag_error(
             "--points",
             &a.points.to_string(),
             format!(
                 "{} series of {} points make more than {MAX_ROWS} rows",
-                series.len(),
+                a.series.len(),
                 a.points
             ),
         ));
@@ -232,93 +260,100 @@ pub fn simulate(a: &SimulateSettings) -> Result<Vec<u8>, RunError> {
             ));
         }
     }
-    if kind == ModelKind::Md {
-        if let Some(p) = &a.design {
-            return Err(flag_error(
-                "--design",
-                &p.display().to_string(),
-                "a design is simulated with the steady-state models, not --model md",
-            ));
+    Ok(())
+}
+
+/// The model that makes the data of the series ξ: a contact model (`contact` for the
+/// contact model, with its spin rule), Jan's with the global laws or Jaeger's with the
+/// settings' parameters or the paper's.
+fn model_for(a: &SimulateSettings, contact: Contact, xi: f64) -> Result<Model, RunError> {
+    let alpha = Scene::from_radians(xi, 0.1, a.rho, a.f, a.law)
+        .map_err(|e| flag_error("--series", &xi.to_string(), e.to_string()))?
+        .alpha_rad();
+    Ok(match (a.model, a.model.contact_model()) {
+        (ModelKind::Contact, _) => Model::Contact(contact),
+        (_, Some(m)) => m,
+        (ModelKind::Jan, None) => match &a.jan {
+            None => Model::Jan(Jan::paper_fit(alpha)),
+            Some(p) => {
+                let s = alpha.sin();
+                Model::Jan(
+                    Jan::new(p[0] * (p[1] * s).exp(), p[2] * (p[3] * s).exp())
+                        .map_err(|e| flag_error("--jan", "", e.to_string()))?,
+                )
+            }
+        },
+        _ => {
+            let p = match &a.jaeger {
+                Some(p) => [p[0], p[1], p[2]],
+                None => crate::fit::jaeger::paper_values(xi).ok_or_else(|| {
+                    flag_error(
+                        "--series",
+                        &xi.to_string(),
+                        "the paper gives Jaeger's a1, a2, a3 for xi = 0.8, 1, 1.6, 2 only: \
+                         give --jaeger A1,A2,A3",
+                    )
+                })?,
+            };
+            Model::Jaeger(
+                Jaeger::new(p[0], p[1], p[2], a.branch)
+                    .map_err(|e| flag_error("--jaeger", "", e.to_string()))?,
+            )
         }
-        return run_md(a, series);
-    }
-    let jan = a.jan;
-    let jaeger = a.jaeger;
-    let branch = a.branch;
-    let range = a.delta_range;
-    let mut rng = ChaCha8Rng::seed_from_u64(a.seed);
+    })
+}
+
+/// The slopes of the series ξ under `model`, in radians: the steady range (for jan and
+/// jaeger, whose steady range has no upper end, the onset to the onset + 12°), cut to the
+/// settings' slope range, with the fractions of it that the points spread over.
+fn slope_span(
+    a: &SimulateSettings,
+    model: &Model,
+    xi: f64,
+) -> Result<(f64, f64, f64, f64), RunError> {
+    let Some((lo, hi)) = regime_b_interval(model, xi, a.rho, a.f, a.law) else {
+        return Err(flag_error(
+            "--series",
+            &xi.to_string(),
+            "no steady regime for this xi under this model and law",
+        ));
+    };
+    let open_ended = matches!(a.model, ModelKind::Jan | ModelKind::Jaeger);
+    Ok(match a.delta_range {
+        Some((l, h)) => {
+            let (l, h) = (l.to_radians().max(lo), h.to_radians().min(hi));
+            if !(l < h) {
+                return Err(flag_error(
+                    "--delta-range",
+                    &range_text(a.delta_range),
+                    format!(
+                        "no steady state in this range at xi = {xi} (steady from {} to {} deg)",
+                        fmt_f64(lo.to_degrees()),
+                        fmt_f64(hi.to_degrees())
+                    ),
+                ));
+            }
+            (l, h, 0.05, 0.95)
+        }
+        None if open_ended => (lo, (lo + 12f64.to_radians()).min(hi), 0.05, 0.95),
+        None => (lo, hi, 0.05, 0.95),
+    })
+}
+
+/// Synthetic points spread over the steady range of each series, noise drawn from `rng` in
+/// the order of the rows.
+fn steady_points(
+    a: &SimulateSettings,
+    model_for: &dyn Fn(f64) -> Result<Model, RunError>,
+    rng: &mut ChaCha8Rng,
+) -> Result<Vec<u8>, RunError> {
     let mut w = csv::Writer::from_writer(Vec::new());
     let io = |e: csv::Error| RunError::Failed(e.to_string());
     w.write_record(["series", "xi", "delta_deg", "v", "sigma_v", "v_true"])
         .map_err(io)?;
-    let model_for = |xi: f64| -> Result<Model, RunError> {
-        let alpha = Scene::from_radians(xi, 0.1, a.rho, a.f, law)
-            .map_err(|e| flag_error("--series", &xi.to_string(), e.to_string()))?
-            .alpha_rad();
-        Ok(match (kind, kind.contact_model()) {
-            (ModelKind::Contact, _) => Model::Contact(contact),
-            (_, Some(m)) => m,
-            (ModelKind::Jan, None) => match &jan {
-                None => Model::Jan(Jan::paper_fit(alpha)),
-                Some(p) => {
-                    let s = alpha.sin();
-                    Model::Jan(
-                        Jan::new(p[0] * (p[1] * s).exp(), p[2] * (p[3] * s).exp())
-                            .map_err(|e| flag_error("--jan", "", e.to_string()))?,
-                    )
-                }
-            },
-            _ => {
-                let p = match &jaeger {
-                    Some(p) => [p[0], p[1], p[2]],
-                    None => crate::fit::jaeger::paper_values(xi).ok_or_else(|| {
-                        flag_error(
-                            "--series",
-                            &xi.to_string(),
-                            "the paper gives Jaeger's a1, a2, a3 for xi = 0.8, 1, 1.6, 2 only: \
-                             give --jaeger A1,A2,A3",
-                        )
-                    })?,
-                };
-                Model::Jaeger(
-                    Jaeger::new(p[0], p[1], p[2], branch)
-                        .map_err(|e| flag_error("--jaeger", "", e.to_string()))?,
-                )
-            }
-        })
-    };
-    if let Some(path) = a.design.as_deref() {
-        return simulate_design(a, path, law, &model_for, &mut rng);
-    }
-    for &xi in series {
+    for &xi in &a.series {
         let model = model_for(xi)?;
-        let Some((lo, hi)) = regime_b_interval(&model, xi, a.rho, a.f, law) else {
-            return Err(flag_error(
-                "--series",
-                &xi.to_string(),
-                "no steady regime for this xi under this model and law",
-            ));
-        };
-        let open_ended = matches!(kind, ModelKind::Jan | ModelKind::Jaeger);
-        let (lo, hi, f0, f1) = match range {
-            Some((l, h)) => {
-                let (l, h) = (l.to_radians().max(lo), h.to_radians().min(hi));
-                if !(l < h) {
-                    return Err(flag_error(
-                        "--delta-range",
-                        &range_text(range),
-                        format!(
-                            "no steady state in this range at xi = {xi} (steady from {} to {} deg)",
-                            fmt_f64(lo.to_degrees()),
-                            fmt_f64(hi.to_degrees())
-                        ),
-                    ));
-                }
-                (l, h, 0.05, 0.95)
-            }
-            None if open_ended => (lo, (lo + 12f64.to_radians()).min(hi), 0.05, 0.95),
-            None => (lo, hi, 0.05, 0.95),
-        };
+        let (lo, hi, f0, f1) = slope_span(a, &model, xi)?;
         for j in 0..a.points {
             if a.stopped() {
                 return Err(RunError::Interrupted);
@@ -331,13 +366,13 @@ pub fn simulate(a: &SimulateSettings) -> Result<Vec<u8>, RunError> {
             let d = lo + (hi - lo) * frac;
             // Round the slope to 1e-4 degree, as a measured slope would be written.
             let d_deg = (d.to_degrees() * 1e4).round() / 1e4;
-            let scene = Scene::new(xi, d_deg, a.rho, a.f, law)
+            let scene = Scene::new(xi, d_deg, a.rho, a.f, a.law)
                 .map_err(|e| RunError::Failed(e.to_string()))?;
             let v_true = match model.evaluate(&scene) {
                 Ok(s) => s.mean_velocity,
                 Err(e) => return Err(RunError::Failed(format!("xi {xi}, delta {d_deg} deg: {e}"))),
             };
-            let z: f64 = StandardNormal.sample(&mut rng);
+            let z: f64 = StandardNormal.sample(rng);
             let v = v_true * (1.0 + a.noise * z);
             w.write_record([
                 fmt_f64(xi),
@@ -581,9 +616,6 @@ fn sigma_cell(sigma: f64) -> String {
 /// Synthetic measurements of the molecular-dynamics model: regime B found per series by md
 /// runs, then one md run per point.
 fn run_md(a: &SimulateSettings, series: &[f64]) -> Result<Vec<u8>, RunError> {
-    use crate::models::md::MdResult;
-    use crate::models::Regime;
-    use rayon::prelude::*;
     let md: Md = a.md;
     if !(a.rho > 0.0) {
         return Err(flag_error(
@@ -594,7 +626,6 @@ fn run_md(a: &SimulateSettings, series: &[f64]) -> Result<Vec<u8>, RunError> {
     }
     let never = AtomicBool::new(false);
     let stop: &AtomicBool = a.stop.as_deref().unwrap_or(&never);
-    let range = a.delta_range;
     let per_series = (MD_SCAN_POINTS + 2 * MD_REFINE + a.points) as u64;
     let tally = a.progress.as_ref().map(|p| {
         p.report(ProgressEvent::Start {
@@ -607,11 +638,6 @@ fn run_md(a: &SimulateSettings, series: &[f64]) -> Result<Vec<u8>, RunError> {
     let tick = || {
         if let Some(t) = &tally {
             t.add(1);
-        }
-    };
-    let note = |s: &str| {
-        if let Some(n) = &a.notes {
-            n(s);
         }
     };
     let mut rng = ChaCha8Rng::seed_from_u64(a.seed);
@@ -629,104 +655,8 @@ fn run_md(a: &SimulateSettings, series: &[f64]) -> Result<Vec<u8>, RunError> {
     ])
     .map_err(io)?;
     for &xi in series {
-        let sc = Scene::new(xi, 1.0, a.rho, 0.1, CollisionLaw::Value(0.5))
-            .map_err(|e| flag_error("--series", &xi.to_string(), e.to_string()))?;
-        md.check_scene(&sc).map_err(|e| md_error(a, xi, e))?;
-        let interval = md_regime_b_interval(&md, xi, a.rho, &tick, Some(stop))
-            .map_err(|e| flag_error("--series", &xi.to_string(), e.to_string()))?;
-        if stop.load(Ordering::Relaxed) {
-            return Err(RunError::Interrupted);
-        }
-        let Some((lo, hi)) = interval else {
-            return Err(flag_error(
-                "--series",
-                &xi.to_string(),
-                "md finds no steady regime (B) for this xi between 0.5 and 45 degrees",
-            ));
-        };
-        let (lo, hi) = match range {
-            Some((l, h)) => {
-                let (l, h) = (l.max(lo), h.min(hi));
-                if !(l < h) {
-                    return Err(flag_error(
-                        "--delta-range",
-                        &range_text(range),
-                        format!(
-                            "no steady state in this range at xi = {xi} (md steady from {} to {} deg)",
-                            fmt_f64(lo),
-                            fmt_f64(hi)
-                        ),
-                    ));
-                }
-                (l, h)
-            }
-            None => (lo, hi),
-        };
-        // Near the ends of regime B the md bead's bounces are chaotic and B can have holes: a
-        // point that is not in B narrows the range from its side and the points are redrawn.
-        let (mut lo, mut hi) = (lo, hi);
-        let mut runs: Vec<(f64, f64, f64, MdResult)> = Vec::new();
-        for attempt in 0..=MD_NARROW {
-            let slopes: Vec<f64> = (0..a.points)
-                .map(|j| {
-                    let frac = if a.points == 1 {
-                        0.5
-                    } else {
-                        0.05 + 0.9 * j as f64 / (a.points - 1) as f64
-                    };
-                    // Rounded to 1e-4 degree, as a measured slope would be written.
-                    ((lo + (hi - lo) * frac) * 1e4).round() / 1e4
-                })
-                .collect();
-            let done: Vec<(f64, f64, f64, MdResult)> = slopes
-                .par_iter()
-                .map(|&d| {
-                    let sc = Scene::new(xi, d, a.rho, 0.1, CollisionLaw::Value(0.5))
-                        .map_err(|e| RunError::Failed(e.to_string()))?;
-                    let r = md.simulate_until(&sc, 1.0, None, Some(stop));
-                    tick();
-                    Ok((d, lo, hi, r))
-                })
-                .collect::<Result<_, RunError>>()?;
-            if stop.load(Ordering::Relaxed) {
-                return Err(RunError::Interrupted);
-            }
-            let bad: Vec<f64> = done
-                .iter()
-                .filter(|x| x.3.regime != Some(Regime::B))
-                .map(|x| x.0)
-                .collect();
-            if bad.is_empty() {
-                runs = done;
-                break;
-            }
-            if attempt == MD_NARROW {
-                return Err(RunError::Failed(format!(
-                    "md: xi {xi}: slopes {bad:?} deg are not in regime B after narrowing the \
-                     steady range {MD_NARROW} times (now {} to {} deg); give --delta-range",
-                    fmt_f64(lo),
-                    fmt_f64(hi)
-                )));
-            }
-            let mid = 0.5 * (lo + hi);
-            let (old_lo, old_hi) = (lo, hi);
-            for &d in &bad {
-                if d >= mid {
-                    hi = hi.min(d - 0.01 * (old_hi - old_lo));
-                } else {
-                    lo = lo.max(d + 0.01 * (old_hi - old_lo));
-                }
-            }
-            note(&format!(
-                "md, xi {xi}: slopes {bad:?} deg are not in regime B; steady range narrowed \
-                 from [{}, {}] to [{}, {}] deg",
-                fmt_f64(old_lo),
-                fmt_f64(old_hi),
-                fmt_f64(lo),
-                fmt_f64(hi)
-            ));
-        }
-        for (d, _, _, r) in runs {
+        let (lo, hi) = md_steady_range(a, &md, xi, &tick, stop)?;
+        for (d, r) in md_points(a, &md, xi, (lo, hi), &tick, stop)? {
             let (Some(v_true), Some(se)) = (r.mean_velocity, r.stderr) else {
                 return Err(RunError::Failed(format!(
                     "md: xi {xi}, delta {d} deg: no mean velocity measured"
@@ -752,6 +682,131 @@ fn run_md(a: &SimulateSettings, series: &[f64]) -> Result<Vec<u8>, RunError> {
         p.report(ProgressEvent::Finish);
     }
     w.into_inner().map_err(|e| RunError::Failed(e.to_string()))
+}
+
+/// The steady range (regime B) of the series ξ found by md runs, in degrees, cut to the
+/// settings' slope range.
+fn md_steady_range(
+    a: &SimulateSettings,
+    md: &Md,
+    xi: f64,
+    tick: &(dyn Fn() + Sync),
+    stop: &AtomicBool,
+) -> Result<(f64, f64), RunError> {
+    let sc = Scene::new(xi, 1.0, a.rho, 0.1, CollisionLaw::Value(0.5))
+        .map_err(|e| flag_error("--series", &xi.to_string(), e.to_string()))?;
+    md.check_scene(&sc).map_err(|e| md_error(a, xi, e))?;
+    let interval = md_regime_b_interval(md, xi, a.rho, tick, Some(stop))
+        .map_err(|e| flag_error("--series", &xi.to_string(), e.to_string()))?;
+    if stop.load(Ordering::Relaxed) {
+        return Err(RunError::Interrupted);
+    }
+    let Some((lo, hi)) = interval else {
+        return Err(flag_error(
+            "--series",
+            &xi.to_string(),
+            "md finds no steady regime (B) for this xi between 0.5 and 45 degrees",
+        ));
+    };
+    let range = a.delta_range;
+    Ok(match range {
+        Some((l, h)) => {
+            let (l, h) = (l.max(lo), h.min(hi));
+            if !(l < h) {
+                return Err(flag_error(
+                    "--delta-range",
+                    &range_text(range),
+                    format!(
+                        "no steady state in this range at xi = {xi} (md steady from {} to {} deg)",
+                        fmt_f64(lo),
+                        fmt_f64(hi)
+                    ),
+                ));
+            }
+            (l, h)
+        }
+        None => (lo, hi),
+    })
+}
+
+/// The md runs of the points of the series ξ over `range` (degrees), each slope with its
+/// result. Near the ends of regime B the md bead's bounces are chaotic and B can have holes:
+/// a point that is not in B narrows the range from its side and the points are redrawn, at
+/// most [`MD_NARROW`] times.
+fn md_points(
+    a: &SimulateSettings,
+    md: &Md,
+    xi: f64,
+    range: (f64, f64),
+    tick: &(dyn Fn() + Sync),
+    stop: &AtomicBool,
+) -> Result<Vec<(f64, MdResult)>, RunError> {
+    let note = |s: &str| {
+        if let Some(n) = &a.notes {
+            n(s);
+        }
+    };
+    let (mut lo, mut hi) = range;
+    for attempt in 0..=MD_NARROW {
+        let slopes: Vec<f64> = (0..a.points)
+            .map(|j| {
+                let frac = if a.points == 1 {
+                    0.5
+                } else {
+                    0.05 + 0.9 * j as f64 / (a.points - 1) as f64
+                };
+                // Rounded to 1e-4 degree, as a measured slope would be written.
+                ((lo + (hi - lo) * frac) * 1e4).round() / 1e4
+            })
+            .collect();
+        let done: Vec<(f64, MdResult)> = slopes
+            .par_iter()
+            .map(|&d| {
+                let sc = Scene::new(xi, d, a.rho, 0.1, CollisionLaw::Value(0.5))
+                    .map_err(|e| RunError::Failed(e.to_string()))?;
+                let r = md.simulate_until(&sc, 1.0, None, Some(stop));
+                tick();
+                Ok((d, r))
+            })
+            .collect::<Result<_, RunError>>()?;
+        if stop.load(Ordering::Relaxed) {
+            return Err(RunError::Interrupted);
+        }
+        let bad: Vec<f64> = done
+            .iter()
+            .filter(|x| x.1.regime != Some(Regime::B))
+            .map(|x| x.0)
+            .collect();
+        if bad.is_empty() {
+            return Ok(done);
+        }
+        if attempt == MD_NARROW {
+            return Err(RunError::Failed(format!(
+                "md: xi {xi}: slopes {bad:?} deg are not in regime B after narrowing the \
+                 steady range {MD_NARROW} times (now {} to {} deg); give --delta-range",
+                fmt_f64(lo),
+                fmt_f64(hi)
+            )));
+        }
+        let mid = 0.5 * (lo + hi);
+        let (old_lo, old_hi) = (lo, hi);
+        for &d in &bad {
+            if d >= mid {
+                hi = hi.min(d - 0.01 * (old_hi - old_lo));
+            } else {
+                lo = lo.max(d + 0.01 * (old_hi - old_lo));
+            }
+        }
+        note(&format!(
+            "md, xi {xi}: slopes {bad:?} deg are not in regime B; steady range narrowed \
+             from [{}, {}] to [{}, {}] deg",
+            fmt_f64(old_lo),
+            fmt_f64(old_hi),
+            fmt_f64(lo),
+            fmt_f64(hi)
+        ));
+    }
+    Ok(Vec::new())
 }
 
 /// A scene outside the md model's domain, as the setting to change.

@@ -810,3 +810,88 @@ fn klaw_draws_its_progress_bar_on_a_terminal_only() {
         "no bar on a terminal: {shown:?}"
     );
 }
+
+/// Runs fitbead with `args`: the exit code, stdout and stderr.
+fn run_cli(args: &[&str]) -> (Option<i32>, String, String) {
+    let out = bin().args(args).output().unwrap();
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// A choice is a whole name in any case, spaces around it ignored: the same output as the
+/// name as listed.
+#[test]
+fn choices_are_whole_names_in_any_case() {
+    let scene = ["--xi", "1", "--delta-deg", "12"];
+    let (code, want, _) = run_cli(&[&["forward", "--model", "stickslip"][..], &scene].concat());
+    assert_eq!(code, Some(0));
+    let (code, got, err) = run_cli(&[&["forward", "--model", " StickSlip "][..], &scene].concat());
+    assert_eq!(code, Some(0), "{err}");
+    assert_eq!(got, want);
+    // The k table names the model as listed, whatever its spelling on the command line.
+    let (code, got, err) = run_cli(&["k", "--model", "STICK"]);
+    assert_eq!(code, Some(0), "{err}");
+    let (h, rows) = table(&got);
+    let m = h.iter().position(|c| c == "model").unwrap();
+    assert!(rows.iter().all(|r| r[m] == "stick"), "{:?}", rows[0]);
+}
+
+/// A refused value is one line in the flag form, exit 2, before any work: a choice with the
+/// list of its names, a number out of its range or not a number, an item of a list by itself.
+/// A bad value of a flag the run would not use is refused as well.
+#[test]
+fn refused_values_name_the_flag_and_the_value() {
+    let cases: [(&[&str], &str); 7] = [
+        (
+            &["simulate", "--model", "foo"],
+            "fitbead: error: <command line>, flag '--model', value 'foo': unknown model; \
+             expected one of stick, stick-approx, slip, slip-approx, stickslip, jan, jaeger, \
+             contact, md, auto\n",
+        ),
+        (
+            &["k", "--model", "jan"],
+            "fitbead: error: <command line>, flag '--model', value 'jan': expected one of \
+             stick, stick-approx, slip, slip-approx, stickslip, contact, auto\n",
+        ),
+        (
+            &["klaw", "--model", "stick", "--level", "abc"],
+            "fitbead: error: <command line>, flag '--level', value 'abc': must be in (0, 1), \
+             e.g. 0.95\n",
+        ),
+        (
+            &["regimes", "--rho", "-1"],
+            "fitbead: error: <command line>, flag '--rho', value '-1': must be a finite number \
+             >= 0\n",
+        ),
+        (
+            &["simulate", "--jan", "1, x,3,4"],
+            "fitbead: error: <command line>, flag '--jan', value 'x': not a finite number\n",
+        ),
+        (
+            &["simulate", "--model", "stick", "--branch", "sideways"],
+            "fitbead: error: <command line>, flag '--branch', value 'sideways': expected upper \
+             or lower\n",
+        ),
+        (
+            &["report", "--format", "gif"],
+            "fitbead: error: <command line>, flag '--format', value 'gif': must be svg, png, \
+             pdf, both (svg and png) or all\n",
+        ),
+    ];
+    for (args, want) in cases {
+        let (code, out, err) = run_cli(args);
+        assert_eq!(code, Some(2), "{args:?}: {err}");
+        assert_eq!(err, want, "{args:?}");
+        assert!(out.is_empty(), "{args:?}: {out}");
+    }
+    // The help lists every choice's names.
+    let (code, out, _) = run_cli(&["simulate", "--help"]);
+    assert_eq!(code, Some(0));
+    assert!(
+        out.contains("[possible values: stick, stick-approx, slip, slip-approx, stickslip"),
+        "{out}"
+    );
+}

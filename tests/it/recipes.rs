@@ -198,3 +198,32 @@ fn per_series_information_criteria() {
         );
     }
 }
+
+/// A recipe's keys are the defaults of their flags: a choice in any case, a flag given on the
+/// command line over the recipe, a key left out at the flag's own default.
+#[test]
+fn recipe_keys_are_flag_defaults() {
+    let tmp = tmpdir();
+    std::fs::copy(root().join("data/default.csv"), tmp.path().join("d.csv")).unwrap();
+    let recipe = write(
+        &tmp,
+        "r.toml",
+        "input = \"d.csv\"\nout_dir = \"o\"\nformat = \" PNG \"\nlevel = 0.9\n",
+    );
+    let out = bin()
+        .args(["report", "--recipe"])
+        .arg(&recipe)
+        .args(["--level", "0.8"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let o = tmp.path().join("o");
+    assert!(o.join("velocity.png").exists() && !o.join("velocity.svg").exists());
+    let (h, rows) = read_table(&o.join("bulk_friction.csv"));
+    let level = h.iter().position(|c| c == "level").unwrap();
+    assert!(rows.iter().all(|r| r[level] == "0.8"), "{:?}", rows[0]);
+}

@@ -1,0 +1,723 @@
+//! The values of the flags, parsed by clap: every flag whose value is one of fixed names is a
+//! [`clap::ValueEnum`] read by [`choice`] (whole names, any case, surrounding spaces ignored),
+//! and every number with a range of its own, list or text with a grammar has a value parser
+//! here that refuses a bad value before any work. A refusal is a [`Refusal`]; `super::parse`
+//! renders it in the project's form (`<command line>, flag '--NAME', value 'V': message`).
+
+use crate::design::{Criterion, DesignFit};
+use crate::fit::klaw::KLaw;
+use crate::inverse::posterior::Prior;
+use crate::models::contact::SpinRule;
+use crate::models::md::ReducedMass;
+use crate::models::{JaegerBranch, Model, ModelKind};
+use crate::report::figures::{FigureFormat, FigureWidth};
+use crate::scene::CollisionLaw;
+use clap::builder::{PossibleValue, TypedValueParser};
+use clap::ValueEnum;
+use std::marker::PhantomData;
+
+/// Why a flag's value is refused: the message, and the part of the value it is about when
+/// that is not the whole value (one number of a list), shown as the value.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Refusal {
+    /// The part of the value refused; `None`: the whole value.
+    pub part: Option<String>,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl Refusal {
+    /// A refusal of the whole value.
+    pub fn new(message: impl Into<String>) -> Self {
+        Refusal {
+            part: None,
+            message: message.into(),
+        }
+    }
+
+    /// A refusal of `part` of the value.
+    fn of(part: &str, message: impl Into<String>) -> Self {
+        Refusal {
+            part: Some(part.to_string()),
+            message: message.into(),
+        }
+    }
+}
+
+impl std::fmt::Display for Refusal {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for Refusal {}
+
+/// A flag's fixed names: a [`ValueEnum`] with the message for a name that is none of them.
+pub(crate) trait Choice: ValueEnum + Clone + Send + Sync + 'static {
+    /// The message for `name`, which is none of the names.
+    fn unknown(name: &str) -> String;
+}
+
+/// The value parser of a [`Choice`]: a whole name in any case, spaces around it ignored; the
+/// names are the flag's possible values in its help.
+pub(crate) struct ChoiceParser<E>(PhantomData<fn() -> E>);
+
+impl<E> Clone for ChoiceParser<E> {
+    fn clone(&self) -> Self {
+        ChoiceParser(PhantomData)
+    }
+}
+
+/// The value parser of the choice `E`.
+pub(crate) fn choice<E: Choice>() -> ChoiceParser<E> {
+    ChoiceParser(PhantomData)
+}
+
+impl<E: Choice> TypedValueParser for ChoiceParser<E> {
+    type Value = E;
+
+    fn parse_ref(
+        &self,
+        cmd: &clap::Command,
+        arg: Option<&clap::Arg>,
+        value: &std::ffi::OsStr,
+    ) -> Result<E, clap::Error> {
+        let named = |s: &str| E::from_str(s.trim(), true).map_err(|_| Refusal::new(E::unknown(s)));
+        named.parse_ref(cmd, arg, value)
+    }
+
+    fn possible_values(&self) -> Option<Box<dyn Iterator<Item = PossibleValue> + '_>> {
+        Some(Box::new(
+            E::value_variants()
+                .iter()
+                .filter_map(ValueEnum::to_possible_value),
+        ))
+    }
+}
+
+/// The names of `E`, joined by `, `.
+fn names<E: ValueEnum>() -> String {
+    E::value_variants()
+        .iter()
+        .filter_map(|v| v.to_possible_value())
+        .map(|p| p.get_name().to_string())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The command-line name of `value`.
+pub(crate) fn name_of<E: ValueEnum>(value: &E) -> String {
+    value
+        .to_possible_value()
+        .map(|p| p.get_name().to_string())
+        .unwrap_or_default()
+}
+
+impl ValueEnum for ModelKind {
+    fn value_variants<'a>() -> &'a [Self] {
+        // The order of `Model::NAMES`.
+        &[
+            ModelKind::Stick,
+            ModelKind::StickApprox,
+            ModelKind::Slip,
+            ModelKind::SlipApprox,
+            ModelKind::StickSlip,
+            ModelKind::Jan,
+            ModelKind::Jaeger,
+            ModelKind::Contact,
+            ModelKind::Md,
+            ModelKind::Auto,
+        ]
+    }
+
+    fn to_possible_value(&self) -> Option<PossibleValue> {
+        let i = Self::value_variants().iter().position(|k| k == self)?;
+        Some(PossibleValue::new(Model::NAMES[i]))
+    }
+}
+
+impl Choice for ModelKind {
+    fn unknown(_: &str) -> String {
+        format!("unknown model; expected one of {}", Model::NAMES.join(", "))
+    }
+}
+
+/// The models that `k` and `klaw` invert for K: the five contact models, and auto (chosen per
+/// point among them).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub(crate) enum KModel {
+    // Pure rolling.
+    Stick,
+    // Pure rolling, approximated.
+    StickApprox,
+    // Slip.
+    Slip,
+    // Slip, approximated.
+    SlipApprox,
+    // Roll then slip.
+    #[value(name = "stickslip")]
+    StickSlip,
+    // The general contact model.
+    Contact,
+    // Chosen per point.
+    Auto,
+}
+
+impl KModel {
+    /// The model kind.
+    pub fn kind(self) -> ModelKind {
+        match self {
+            KModel::Stick => ModelKind::Stick,
+            KModel::StickApprox => ModelKind::StickApprox,
+            KModel::Slip => ModelKind::Slip,
+            KModel::SlipApprox => ModelKind::SlipApprox,
+            KModel::StickSlip => ModelKind::StickSlip,
+            KModel::Contact => ModelKind::Contact,
+            KModel::Auto => ModelKind::Auto,
+        }
+    }
+
+    /// The command-line name.
+    pub fn name(self) -> String {
+        name_of(&self)
+    }
+}
+
+impl Choice for KModel {
+    fn unknown(name: &str) -> String {
+        match name.parse::<ModelKind>() {
+            Ok(ModelKind::Md) => {
+                "model md has no K inversion (its collisions come from the contact forces)".into()
+            }
+            _ => format!("expected one of {}", names::<KModel>()),
+        }
+    }
+}
+
+impl ValueEnum for JaegerBranch {
+    fn value_variants<'a>() -> &'a [Self] {
+        &[JaegerBranch::Upper, JaegerBranch::Lower]
+    }
+
+    fn to_possible_value(&self) -> Option<PossibleValue> {
+        Some(PossibleValue::new(match self {
+            JaegerBranch::Upper => "upper",
+            JaegerBranch::Lower => "lower",
+        }))
+    }
+}
+
+impl Choice for JaegerBranch {
+    fn unknown(_: &str) -> String {
+        "expected upper or lower".into()
+    }
+}
+
+impl ValueEnum for KLaw {
+    fn value_variants<'a>() -> &'a [Self] {
+        &[KLaw::C, KLaw::Impact, KLaw::FreePerSeries]
+    }
+
+    fn to_possible_value(&self) -> Option<PossibleValue> {
+        Some(PossibleValue::new(self.name()))
+    }
+}
+
+impl Choice for KLaw {
+    fn unknown(name: &str) -> String {
+        name.parse::<KLaw>().err().unwrap_or_default()
+    }
+}
+
+impl ValueEnum for DesignFit {
+    fn value_variants<'a>() -> &'a [Self] {
+        &[DesignFit::KLaw, DesignFit::Jan, DesignFit::Jaeger]
+    }
+
+    fn to_possible_value(&self) -> Option<PossibleValue> {
+        Some(PossibleValue::new(match self {
+            DesignFit::KLaw => "klaw",
+            DesignFit::Jan => "jan",
+            DesignFit::Jaeger => "jaeger",
+        }))
+    }
+}
+
+impl Choice for DesignFit {
+    fn unknown(name: &str) -> String {
+        name.parse::<DesignFit>().err().unwrap_or_default()
+    }
+}
+
+impl ValueEnum for Criterion {
+    fn value_variants<'a>() -> &'a [Self] {
+        &[Criterion::D, Criterion::C, Criterion::T]
+    }
+
+    fn to_possible_value(&self) -> Option<PossibleValue> {
+        Some(PossibleValue::new(match self {
+            Criterion::D => "d",
+            Criterion::C => "c",
+            Criterion::T => "t",
+        }))
+    }
+}
+
+impl Choice for Criterion {
+    fn unknown(name: &str) -> String {
+        name.parse::<Criterion>().err().unwrap_or_default()
+    }
+}
+
+impl ValueEnum for FigureFormat {
+    fn value_variants<'a>() -> &'a [Self] {
+        &[
+            FigureFormat::Svg,
+            FigureFormat::Png,
+            FigureFormat::Pdf,
+            FigureFormat::Both,
+            FigureFormat::All,
+        ]
+    }
+
+    fn to_possible_value(&self) -> Option<PossibleValue> {
+        Some(PossibleValue::new(match self {
+            FigureFormat::Svg => "svg",
+            FigureFormat::Png => "png",
+            FigureFormat::Pdf => "pdf",
+            FigureFormat::Both => "both",
+            FigureFormat::All => "all",
+        }))
+    }
+}
+
+impl Choice for FigureFormat {
+    fn unknown(name: &str) -> String {
+        name.parse::<FigureFormat>().err().unwrap_or_default()
+    }
+}
+
+impl ValueEnum for ReducedMass {
+    fn value_variants<'a>() -> &'a [Self] {
+        &[ReducedMass::Pair, ReducedMass::Mobile]
+    }
+
+    fn to_possible_value(&self) -> Option<PossibleValue> {
+        Some(PossibleValue::new(match self {
+            ReducedMass::Pair => "pair",
+            ReducedMass::Mobile => "mobile",
+        }))
+    }
+}
+
+impl Choice for ReducedMass {
+    fn unknown(_: &str) -> String {
+        "expected pair or mobile".into()
+    }
+}
+
+/// The estimation method of the fit commands (`--method`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
+pub(crate) enum FitMethod {
+    // Least squares.
+    #[default]
+    Lsq,
+    // Posterior sampling.
+    Mcmc,
+}
+
+impl Choice for FitMethod {
+    fn unknown(_: &str) -> String {
+        "expected lsq or mcmc".into()
+    }
+}
+
+/// The unit of the velocities on the report's figures (`--units`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
+pub(crate) enum Units {
+    // Units of sqrt(g (R + r)).
+    #[default]
+    Dimensionless,
+    // m/s.
+    Si,
+}
+
+impl Choice for Units {
+    fn unknown(_: &str) -> String {
+        "expected dimensionless or si".into()
+    }
+}
+
+/// The md parameter set (`--md-preset`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
+pub(crate) enum MdPreset {
+    // Ristow's set.
+    #[default]
+    Ristow,
+    // Steel.
+    Steel,
+}
+
+impl Choice for MdPreset {
+    fn unknown(_: &str) -> String {
+        "expected ristow or steel".into()
+    }
+}
+
+/// `s` as a number, or a refusal saying `message`.
+fn number(s: &str, ok: impl Fn(f64) -> bool, message: &str) -> Result<f64, Refusal> {
+    s.trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|x| ok(*x))
+        .ok_or_else(|| Refusal::new(message))
+}
+
+/// `s` as a whole number, or a refusal saying `message`.
+fn count(s: &str, ok: impl Fn(usize) -> bool, message: &str) -> Result<usize, Refusal> {
+    s.trim()
+        .parse::<usize>()
+        .ok()
+        .filter(|n| ok(*n))
+        .ok_or_else(|| Refusal::new(message))
+}
+
+/// A finite number.
+pub(crate) fn finite(s: &str) -> Result<f64, Refusal> {
+    number(s, f64::is_finite, "not a finite number")
+}
+
+/// A finite number ≥ 0 (ρ, f, the minimum ESS).
+pub(crate) fn non_negative(s: &str) -> Result<f64, Refusal> {
+    number(
+        s,
+        |x| x.is_finite() && x >= 0.0,
+        "must be a finite number >= 0",
+    )
+}
+
+/// Gravity g > 0, m/s².
+pub(crate) fn gravity(s: &str) -> Result<f64, Refusal> {
+    number(s, |x| x.is_finite() && x > 0.0, "g must be > 0")
+}
+
+/// The level of the intervals, in (0, 1).
+pub(crate) fn level(s: &str) -> Result<f64, Refusal> {
+    number(s, |x| x > 0.0 && x < 1.0, "must be in (0, 1), e.g. 0.95")
+}
+
+/// A relative tolerance, in (0, 1).
+pub(crate) fn tolerance(s: &str) -> Result<f64, Refusal> {
+    number(
+        s,
+        |x| x > 0.0 && x < 1.0,
+        "expected a relative tolerance in (0, 1)",
+    )
+}
+
+/// A radius ratio ξ > 0.
+pub(crate) fn radius_ratio(s: &str) -> Result<f64, Refusal> {
+    number(s, |x| x.is_finite() && x > 0.0, "radius ratio must be > 0")
+}
+
+/// The relative noise of simulated data, in [0, 0.5).
+pub(crate) fn noise(s: &str) -> Result<f64, Refusal> {
+    number(
+        s,
+        |x| x.is_finite() && (0.0..0.5).contains(&x),
+        "must be in [0, 0.5)",
+    )
+}
+
+/// The launch speed of a transient, finite and ≥ 0.
+pub(crate) fn launch_speed(s: &str) -> Result<f64, Refusal> {
+    number(
+        s,
+        |x| x.is_finite() && x >= 0.0,
+        "expected a finite launch speed >= 0",
+    )
+}
+
+/// A count ≥ 1 (MCMC steps, thinning).
+pub(crate) fn at_least_one(s: &str) -> Result<usize, Refusal> {
+    count(s, |n| n >= 1, "must be >= 1")
+}
+
+/// The MCMC walkers: even, at least 4 and at most the sampler's limit (that there are more
+/// walkers than parameters is checked with the fit).
+pub(crate) fn walkers(s: &str) -> Result<usize, Refusal> {
+    use crate::inverse::mcmc::MAX_WALKERS;
+    count(
+        s,
+        |w| w >= 4 && w % 2 == 0 && w <= MAX_WALKERS,
+        &format!(
+            "must be even, at least 4 (and more than the parameters) and at most {MAX_WALKERS}"
+        ),
+    )
+}
+
+/// The points per series of a simulation.
+pub(crate) fn points(s: &str) -> Result<usize, Refusal> {
+    use crate::pipeline::MAX_POINTS;
+    count(
+        s,
+        |n| (1..=MAX_POINTS).contains(&n),
+        &format!("expected 1 to {MAX_POINTS} points per series"),
+    )
+}
+
+/// The scenes of the work-precision report.
+pub(crate) fn scenes(s: &str) -> Result<usize, Refusal> {
+    count(
+        s,
+        |n| (1..=1_000_000).contains(&n),
+        "expected a number of scenes in 1..=1000000",
+    )
+}
+
+/// A comma-separated list of finite numbers; a bad one is refused by itself.
+pub(crate) fn numbers(s: &str) -> Result<Vec<f64>, Refusal> {
+    s.split(',')
+        .map(|t| {
+            let t = t.trim();
+            t.parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| Refusal::of(t, "not a finite number"))
+        })
+        .collect()
+}
+
+/// A list of numbers given as one value (`1,2,3`).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Numbers(pub Vec<f64>);
+
+/// A comma-separated list of finite numbers, as one value ([`numbers`]).
+pub(crate) fn number_list(s: &str) -> Result<Numbers, Refusal> {
+    numbers(s).map(Numbers)
+}
+
+/// The radius ratios of a simulation's series: a list of numbers, each once (the rows of a
+/// series are labelled by its ξ).
+pub(crate) fn series(s: &str) -> Result<Numbers, Refusal> {
+    let xs = numbers(s)?;
+    for (j, x) in xs.iter().enumerate() {
+        if let Some(i) = xs[..j].iter().position(|y| y == x) {
+            let text = s.split(',').nth(j).unwrap_or_default().trim();
+            return Err(Refusal::of(
+                text,
+                format!(
+                    "xi {} is given twice (values {} and {}): each series needs its own xi",
+                    crate::io::fmt_f64(*x),
+                    i + 1,
+                    j + 1
+                ),
+            ));
+        }
+    }
+    Ok(Numbers(xs))
+}
+
+/// Jan's global laws λ0,λ1,μ0,μ1.
+pub(crate) fn jan_laws(s: &str) -> Result<[f64; 4], Refusal> {
+    <[f64; 4]>::try_from(numbers(s)?)
+        .map_err(|_| Refusal::new("expected four numbers lambda0,lambda1,mu0,mu1"))
+}
+
+/// Jaeger's a1,a2,a3.
+pub(crate) fn jaeger_values(s: &str) -> Result<[f64; 3], Refusal> {
+    <[f64; 3]>::try_from(numbers(s)?).map_err(|_| Refusal::new("expected three numbers a1,a2,a3"))
+}
+
+/// A range of slopes `LO,HI` in degrees, with its text as given.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct SlopeRange {
+    /// Lower end, degrees.
+    pub lo: f64,
+    /// Upper end, degrees.
+    pub hi: f64,
+    /// The flag's text.
+    pub text: String,
+}
+
+/// `LO,HI` in degrees with LO < HI.
+pub(crate) fn slope_range(s: &str) -> Result<SlopeRange, Refusal> {
+    match numbers(s)?[..] {
+        [lo, hi] if lo < hi => Ok(SlopeRange {
+            lo,
+            hi,
+            text: s.to_string(),
+        }),
+        _ => Err(Refusal::new("expected LO,HI in degrees with LO < HI")),
+    }
+}
+
+/// The noise of a design: a relative noise, or `abs=SIGMA` (absolute); the value and whether
+/// it is absolute.
+pub(crate) fn design_noise(s: &str) -> Result<(f64, bool), Refusal> {
+    let (text, absolute) = match s.trim().strip_prefix("abs=") {
+        Some(v) => (v, true),
+        None => (s, false),
+    };
+    match numbers(text)?[..] {
+        [x] => Ok((x, absolute)),
+        _ => Err(Refusal::new("expected one number (relative) or abs=SIGMA")),
+    }
+}
+
+/// A collision law: a number, cos2a, adjusted, impact or c=VALUE.
+pub(crate) fn law(s: &str) -> Result<CollisionLaw, Refusal> {
+    s.parse()
+        .map_err(|e: crate::scene::ParameterError| Refusal::new(e.to_string()))
+}
+
+/// A collision law with its text as given.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct LawText {
+    /// The law.
+    pub law: CollisionLaw,
+    /// The flag's text.
+    pub text: String,
+}
+
+/// A collision law ([`law`]) with its text.
+pub(crate) fn law_with_text(s: &str) -> Result<LawText, Refusal> {
+    law(s).map(|law| LawText {
+        law,
+        text: s.to_string(),
+    })
+}
+
+/// A collision law, kept as its text (checked as [`law`]).
+pub(crate) fn law_text(s: &str) -> Result<String, Refusal> {
+    law(s).map(|_| s.to_string())
+}
+
+/// A spin rule: roll, keep, factor=L or impact.
+pub(crate) fn spin(s: &str) -> Result<SpinRule, Refusal> {
+    s.parse()
+        .map_err(|e: crate::scene::ParameterError| Refusal::new(e.to_string()))
+}
+
+/// A spin rule, kept as its text (checked as [`spin`]).
+pub(crate) fn spin_text(s: &str) -> Result<String, Refusal> {
+    spin(s).map(|_| s.to_string())
+}
+
+/// A figure width (single, double or a width in mm), kept as its text.
+pub(crate) fn figure_width(s: &str) -> Result<String, Refusal> {
+    s.parse::<FigureWidth>()
+        .map(|_| s.to_string())
+        .map_err(Refusal::new)
+}
+
+/// A prior of a parameter named on the command line, with the flag's text.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct NamedPrior {
+    /// The parameter's name.
+    pub name: String,
+    /// The prior.
+    pub prior: Prior,
+    /// The flag's text.
+    pub text: String,
+}
+
+/// `NAME=DIST` split at `at` (the position of the `=`).
+fn named_prior(s: &str, at: Option<usize>, example: &str) -> Result<NamedPrior, Refusal> {
+    let at = at.ok_or_else(|| Refusal::new(format!("expected NAME=DIST, e.g. {example}")))?;
+    let prior: Prior = s[at + 1..].parse().map_err(Refusal::new)?;
+    Ok(NamedPrior {
+        name: s[..at].trim().to_string(),
+        prior,
+        text: s.to_string(),
+    })
+}
+
+/// A prior of a fit's parameter, `NAME=DIST` (the name before the first `=`); the name is
+/// checked against the fit's parameters by the command.
+pub(crate) fn fit_prior(s: &str) -> Result<NamedPrior, Refusal> {
+    named_prior(s, s.find('='), "c=normal(0.5,0.5)")
+}
+
+/// A prior of a design's parameter, `NAME=DIST`: the name may hold `=` (K of series 'xi=1'),
+/// the distribution never does.
+pub(crate) fn design_prior(s: &str) -> Result<NamedPrior, Refusal> {
+    named_prior(s, s.rfind('='), "c=normal(0.5,0.1)")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn choices_take_whole_names_in_any_case_and_spacing() {
+        for (text, want) in [
+            ("stick", ModelKind::Stick),
+            (" Stick-Approx ", ModelKind::StickApprox),
+            ("STICKSLIP", ModelKind::StickSlip),
+            ("md", ModelKind::Md),
+        ] {
+            let got = ModelKind::from_str(text.trim(), true).unwrap();
+            assert_eq!(got, want, "{text}");
+            // The library reads the same names.
+            assert_eq!(text.parse::<ModelKind>().unwrap(), want, "{text}");
+        }
+        assert!(ModelKind::from_str("stic", true).is_err());
+        // Every name of the library's list is a possible value, in its order.
+        let names: Vec<String> = ModelKind::value_variants().iter().map(name_of).collect();
+        assert_eq!(names, Model::NAMES);
+    }
+
+    #[test]
+    fn every_choice_reads_back_the_library_names() {
+        for k in KLaw::value_variants() {
+            assert_eq!(name_of(k).parse::<KLaw>().unwrap(), *k);
+        }
+        for k in DesignFit::value_variants() {
+            assert_eq!(name_of(k).parse::<DesignFit>().unwrap(), *k);
+        }
+        for k in Criterion::value_variants() {
+            assert_eq!(name_of(k).parse::<Criterion>().unwrap(), *k);
+        }
+        for k in FigureFormat::value_variants() {
+            assert_eq!(name_of(k).parse::<FigureFormat>().unwrap(), *k);
+        }
+        for k in JaegerBranch::value_variants() {
+            assert_eq!(name_of(k).parse::<JaegerBranch>().unwrap(), *k);
+        }
+        for k in KModel::value_variants() {
+            assert_eq!(name_of(k).parse::<ModelKind>().unwrap(), k.kind());
+        }
+    }
+
+    #[test]
+    fn ranges_refuse_their_ends() {
+        assert!(level("0").is_err() && level("1").is_err() && level("0.5").is_ok());
+        assert!(tolerance("1").is_err() && tolerance("1e-10").is_ok());
+        assert!(non_negative("-0.1").is_err() && non_negative("0").is_ok());
+        assert!(non_negative("inf").is_err() && non_negative("NaN").is_err());
+        assert!(gravity("0").is_err() && gravity("9.81").is_ok());
+        assert!(noise("0.5").is_err() && noise("0").is_ok());
+        assert!(points("0").is_err() && points("1000001").is_err() && points("1").is_ok());
+        assert!(walkers("5").is_err() && walkers("2").is_err() && walkers("6").is_ok());
+        assert!(scenes("0").is_err() && scenes("1000000").is_ok());
+        assert!(at_least_one("0").is_err() && at_least_one("1").is_ok());
+    }
+
+    #[test]
+    fn lists_refuse_the_bad_item_by_itself() {
+        assert_eq!(
+            numbers("1, x ,3"),
+            Err(Refusal::of("x", "not a finite number"))
+        );
+        let e = series("1,2,1.0").unwrap_err();
+        assert_eq!(e.part.as_deref(), Some("1.0"));
+        assert!(e.message.contains("given twice (values 1 and 3)"), "{e}");
+        assert!(jan_laws("1,2,3").is_err() && jan_laws("1,2,3,4").is_ok());
+        assert!(slope_range("5,5").is_err());
+        assert_eq!(slope_range(" 5,10").unwrap().text, " 5,10");
+        assert_eq!(design_noise("abs=0.01"), Ok((0.01, true)));
+        assert_eq!(design_noise("0.02"), Ok((0.02, false)));
+        assert!(design_noise("1,2").is_err());
+    }
+}

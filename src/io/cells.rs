@@ -4,8 +4,8 @@
 //! by [`push_f64`], text quoted by `push_csv_field`.
 
 use super::push_csv_field;
-use super::records::columns;
 use crate::numfmt::push_f64;
+use crate::record::columns;
 use crate::record::{not_flat, refuse, NotFlat};
 use serde::ser::{Impossible, SerializeStruct, Serializer};
 use serde::Serialize;
@@ -463,5 +463,82 @@ mod tests {
         c.write_record(["roll>slip", "a \"b\", c", "1e-7", "", "12", "false", ""])
             .unwrap();
         assert_eq!(out, c.into_inner().unwrap());
+    }
+
+    /// The streaming writer ([`Cells::record`]) writes a record's cells as
+    /// [`each_cell`] sees them, with the bytes the `csv` crate writes for those cells: checked
+    /// on the records of scenes across every model (steady, stopped, lifted off, bistable, the
+    /// contact model's phases and auto's reasons) and of K estimates.
+    #[test]
+    fn the_streaming_writer_writes_the_records_cells() {
+        use crate::io::records::{ForwardRecord, KRecord, RegimeRecord};
+        use crate::models::auto::Auto;
+        use crate::models::contact::SpinRule;
+        use crate::models::{ForwardModel, Model, ModelKind};
+        use crate::record::cells;
+        use crate::scene::{CollisionLaw, Scene};
+        use serde::Serialize;
+        fn check<R: Serialize>(r: &R) {
+            let mut out = Vec::new();
+            let mut w = Cells::new(&mut out);
+            w.record(r);
+            w.end();
+            let mut c = csv::Writer::from_writer(Vec::new());
+            c.write_record(cells(r).into_iter().map(|(_, c)| c.to_csv()))
+                .unwrap();
+            let expected = c.into_inner().unwrap();
+            assert_eq!(
+                String::from_utf8_lossy(&out),
+                String::from_utf8_lossy(&expected)
+            );
+        }
+        let mut written = 0;
+        for kind in [
+            ModelKind::Stick,
+            ModelKind::StickSlip,
+            ModelKind::Contact,
+            ModelKind::Jan,
+            ModelKind::Auto,
+        ] {
+            for (xi, delta) in [
+                (1.0, 3.0),
+                (1.0, 20.0),
+                (2.0, 26.0),
+                (0.6, 40.0),
+                (1.6, 14.0),
+            ] {
+                let scene = Scene::new(xi, delta, 0.4, 0.1, CollisionLaw::Adjusted).unwrap();
+                let model = match kind {
+                    ModelKind::Jan => {
+                        Model::Jan(crate::models::jan::Jan::paper_fit(scene.alpha_rad()))
+                    }
+                    ModelKind::Contact => Model::Contact(crate::models::contact::Contact {
+                        spin: SpinRule::Roll,
+                        tol: 1e-10,
+                    }),
+                    ModelKind::Auto => Model::Auto(Auto { tol: 1e-10 }),
+                    k => k.contact_model().unwrap(),
+                };
+                let (f, c, a) = ForwardRecord::evaluate(&scene, &model);
+                check(&f);
+                written += 1;
+                if let Some(c) = c {
+                    check(&c);
+                }
+                if let Some(a) = a {
+                    check(&a);
+                }
+                if let Ok(v) = model.evaluate(&scene).map(|s| s.mean_velocity) {
+                    for dv in [0.5, 1.0, 2.0] {
+                        let (k, a) =
+                            KRecord::estimate(&Model::Stick, None, &scene, v * dv, Some(0.01));
+                        check(&k);
+                        check(&a.unwrap_or_default());
+                    }
+                }
+            }
+        }
+        assert_eq!(written, 25);
+        check(&RegimeRecord::table(&[0.5, 1.0], CollisionLaw::Cos2a, 0.4)[0]);
     }
 }

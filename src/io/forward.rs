@@ -476,3 +476,53 @@ impl RowPlan for ForwardPlan {
         w.end();
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::output_columns;
+    use crate::models::ModelKind;
+
+    /// The output columns of `forward` as the documentation gives them
+    /// (docs/GUIDE.md): a contract users' scripts read, here checked against the columns
+    /// generated from the records.
+    #[test]
+    fn forward_columns_are_the_documented_contract() {
+        let common = [
+            "v",
+            "regime",
+            "status",
+            "K_used",
+            "final_velocity",
+            "initial_velocity",
+            "contact_time",
+            "theta_G_deg",
+            "map_slope",
+            "other_fixed_point",
+            "phases",
+            "message",
+        ];
+        let contact = [
+            "phase_sequence",
+            "phase_change_deg",
+            "initial_spin",
+            "final_spin",
+            "beads",
+            "collision_translation_frac",
+            "collision_spin_frac",
+            "friction_work_frac",
+            "energy_closure",
+            "spin_rule",
+        ];
+        let auto = ["model_used", "reason"];
+        assert_eq!(output_columns(ModelKind::Stick), common);
+        assert_eq!(output_columns(ModelKind::Jaeger), common);
+        assert_eq!(
+            output_columns(ModelKind::Contact),
+            [&common[..], &contact].concat()
+        );
+        assert_eq!(
+            output_columns(ModelKind::Auto),
+            [&common[..], &auto].concat()
+        );
+    }
+}

@@ -317,3 +317,42 @@ impl RowPlan for KPlan {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::output_columns;
+
+    /// The output columns of `k` as the documentation gives them (docs/GUIDE.md): a contract
+    /// users' scripts read, here checked against the columns generated from the records.
+    #[test]
+    fn k_columns_are_the_documented_contract() {
+        let auto = ["model_used", "reason"];
+        let k = [
+            "series",
+            "xi",
+            "delta_deg",
+            "v",
+            "sigma_v",
+            "model",
+            "K",
+            "K_lo",
+            "K_hi",
+            "dv_dK",
+            "final_velocity",
+            "theta_G_deg",
+            "K_cos2a",
+            "K_adjusted",
+            "K_impact",
+            "regime",
+            "status",
+            "iterations",
+            "K_min",
+            "K_max",
+            "lower_limit",
+            "upper_limit",
+            "message",
+        ];
+        assert_eq!(output_columns(false), k);
+        assert_eq!(output_columns(true), [&k[..], &auto].concat());
+    }
+}

@@ -10,6 +10,9 @@
 #   WORK=DIR       where inputs and outputs go (default: a fresh temporary directory,
 #                  removed at the end)
 #   SMALL=1        inputs 100 times smaller (to try the script itself)
+#   ONLY=0,1       run only these commands (their indices in the table, from 0)
+#   SINK=null      the streaming commands write to standard output, discarded, instead of
+#                  --output out.csv (the report always writes its directory)
 set -u
 bin=$(cd "$(dirname "$1")" && pwd)/$(basename "$1")
 shift
@@ -56,11 +59,15 @@ cmds=(
   "klaw --model stickslip --input klaw_stickslip.csv --output out.csv"
   "report --method mcmc --out-dir report_out"
 )
+if [ "${SINK:-file}" = null ]; then
+  for i in "${!cmds[@]}"; do cmds[$i]=${cmds[$i]% --output out.csv}; done
+fi
 have_time=0
 [ -x /usr/bin/time ] && have_time=1
 results=$work/results.tsv
 : > "$results"
 for i in "${!cmds[@]}"; do
+  if [ -n "${ONLY:-}" ] && [[ ",$ONLY," != *",$i,"* ]]; then continue; fi
   for t in "${threads[@]}"; do
     for r in $(seq "$reps"); do
       # shellcheck disable=SC2086

@@ -198,6 +198,22 @@ pub struct Scene {
     pub(crate) tan_half_alpha: Dd,
     /// B = 2/(1+ρ) (eq 9).
     pub(crate) b: f64,
+    /// tan(δ/2) in double-double precision, where a caller that evaluates the scene at many K
+    /// has computed it ([`Scene::with_tan_half_delta`]); the δ_m cancellation of the rolling
+    /// models computes it otherwise.
+    pub(crate) tan_half_delta: Derived<Dd>,
+}
+
+/// A value derived from the other fields of the struct that holds it, kept once computed.
+/// It takes no part in comparisons: two structs equal in every other field are equal, kept
+/// value or not.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Derived<T>(pub(crate) Option<T>);
+
+impl<T> PartialEq for Derived<T> {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
 }
 
 fn check(field: &'static str, value: f64, ok: bool, reason: &'static str) -> Result<()> {
@@ -487,7 +503,18 @@ impl Scene {
             sc_f,
             tan_half_alpha: of_xi.tan_half_alpha,
             b: 2.0 / (1.0 + rho),
+            tan_half_delta: Derived(None),
         })
+    }
+
+    /// The same scene with tan(δ/2) in double-double precision kept, for callers that
+    /// evaluate it at many K (the K searches): the rolling models need it near δ_m, where the
+    /// factor of the top speed cancels ([`crate::models::stick`]). The same bits as computed
+    /// there.
+    pub(crate) fn with_tan_half_delta(&self) -> Self {
+        let mut s = *self;
+        s.tan_half_delta = Derived(Some(Dd::tan_half(self.delta)));
+        s
     }
 
     /// The same scene with another collisional parameter K (a number).

@@ -187,7 +187,7 @@ fn ends_record(buf: &[u8], i: usize) -> bool {
 
 /// Newlines in `bytes`.
 fn newlines(bytes: &[u8]) -> u64 {
-    bytes.iter().filter(|&&b| b == b'\n').count() as u64
+    memchr::memchr_iter(b'\n', bytes).count() as u64
 }
 
 impl<R: Read> Ranges<R> {
@@ -345,28 +345,13 @@ impl<R: Read> Ranges<R> {
         let mut cuts = vec![0];
         let (end, quoting, opened);
         if buf.contains(&b'"') {
-            // Byte by byte, following the quoting of the `csv` reader and of the watch.
-            let mut csv = Csv::RecordStart;
-            let (mut q, mut line, mut op) = (self.quoting, self.line, self.opened);
-            let mut last = None;
-            for (i, &b) in buf.iter().enumerate() {
-                if b == b'\n' {
-                    line += 1;
-                }
-                q = q.step(b, line, &mut op);
-                let (next, ended) = csv.step(b);
-                csv = next;
-                if ended {
-                    last = Some((i + 1, q, op));
-                    if i + 1 - cuts[cuts.len() - 1] >= step {
-                        cuts.push(i + 1);
-                    }
-                }
-            }
+            // Following the quoting of the `csv` reader and of the watch.
+            let sc = scan_quoted(buf, step, self.quoting, self.line, self.opened);
+            cuts = sc.cuts;
             if eof {
-                (end, quoting, opened) = (buf.len(), q, op);
+                (end, quoting, opened) = (buf.len(), sc.quoting, sc.opened);
             } else {
-                (end, quoting, opened) = last?;
+                (end, quoting, opened) = sc.last?;
             }
         } else {
             // No quote: a record ends at every line end that follows a byte of its line.
@@ -445,6 +430,77 @@ impl<R: Read> Ranges<R> {
     }
 }
 
+/// What [`scan_quoted`] finds in a block.
+#[derive(Debug, PartialEq)]
+struct Scan {
+    /// 0 and the record ends at which ranges of at least `step` bytes end.
+    cuts: Vec<usize>,
+    /// The last record end, with the watch's state and opening line there.
+    last: Option<(usize, Quoting, u64)>,
+    /// The watch's state and opening line after the block.
+    quoting: Quoting,
+    opened: u64,
+}
+
+/// The record ends of a block that holds a quote, by the `csv` reader's state machine
+/// ([`Csv`]) and the watch's ([`Quoting`]), the block starting before a record with the
+/// watch at `quoting` (its quoted cell opened on line `opened`) on line `line`.
+///
+/// Only quotes and line ends can change where the machines go next: outside a quoted cell a
+/// run of other bytes (commas included) leaves both machines in the state its last byte
+/// gives, whatever the state before (a comma: field start; any other byte: unquoted cell),
+/// and inside one only a quote ends it. So the scan jumps from one quote or line end to the
+/// next (`memchr`) and steps the machines byte by byte only there, with the results of a
+/// step through every byte (`scan_bytes` in the tests, against which it is checked).
+fn scan_quoted(buf: &[u8], step: usize, quoting: Quoting, line: u64, opened: u64) -> Scan {
+    let (mut csv, mut q, mut line, mut op) = (Csv::RecordStart, quoting, line, opened);
+    let mut cuts = vec![0];
+    let mut last = None;
+    let n = buf.len();
+    let mut i = 0;
+    while i < n {
+        let plain = matches!(csv, Csv::RecordStart | Csv::FieldStart | Csv::Unquoted)
+            && matches!(q, Quoting::FieldStart | Quoting::Unquoted);
+        if plain {
+            let j = memchr::memchr3(b'"', b'\n', b'\r', &buf[i..]).map_or(n, |k| i + k);
+            if j > i {
+                // A comma or another byte, neither of which ends a record.
+                let b = buf[j - 1];
+                csv = csv.step(b).0;
+                q = q.step(b, line, &mut op);
+            }
+            i = j;
+        } else if csv == Csv::Quoted && q == Quoting::Quoted {
+            let j = memchr::memchr(b'"', &buf[i..]).map_or(n, |k| i + k);
+            line += memchr::memchr_iter(b'\n', &buf[i..j]).count() as u64;
+            i = j;
+        }
+        if i == n {
+            break;
+        }
+        let b = buf[i];
+        if b == b'\n' {
+            line += 1;
+        }
+        q = q.step(b, line, &mut op);
+        let (next, ended) = csv.step(b);
+        csv = next;
+        i += 1;
+        if ended {
+            last = Some((i, q, op));
+            if i - cuts[cuts.len() - 1] >= step {
+                cuts.push(i);
+            }
+        }
+    }
+    Scan {
+        cuts,
+        last,
+        quoting: q,
+        opened: op,
+    }
+}
+
 /// A range's bytes read with the first byte alone: the `csv` reader drops a byte order mark
 /// only when its first read holds one whole, which a range's first read then never does.
 struct FirstByteAlone<'a>(&'a [u8], bool);
@@ -520,5 +576,83 @@ pub(crate) fn parse(
         rows,
         records: rdr.position().record(),
         failure,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// The scan of [`scan_quoted`] one byte at a time: both machines stepped through every
+    /// byte.
+    fn scan_bytes(buf: &[u8], step: usize, quoting: Quoting, line: u64, opened: u64) -> Scan {
+        let mut csv = Csv::RecordStart;
+        let (mut q, mut line, mut op) = (quoting, line, opened);
+        let mut cuts = vec![0];
+        let mut last = None;
+        for (i, &b) in buf.iter().enumerate() {
+            if b == b'\n' {
+                line += 1;
+            }
+            q = q.step(b, line, &mut op);
+            let (next, ended) = csv.step(b);
+            csv = next;
+            if ended {
+                last = Some((i + 1, q, op));
+                if i + 1 - cuts[cuts.len() - 1] >= step {
+                    cuts.push(i + 1);
+                }
+            }
+        }
+        Scan {
+            cuts,
+            last,
+            quoting: q,
+            opened: op,
+        }
+    }
+
+    #[test]
+    fn the_jumping_scan_finds_what_the_byte_scan_finds() {
+        let mut rng = ChaCha8Rng::seed_from_u64(35);
+        // Bytes that steer the machines, and two that do not.
+        let alphabet = b"\",\n\rab";
+        let starts = [
+            Quoting::FieldStart,
+            Quoting::Unquoted,
+            Quoting::Quoted,
+            Quoting::QuoteInQuoted,
+        ];
+        let mut quoted_ends = 0;
+        for case in 0..20_000 {
+            let len = rng.random_range(0..64);
+            // Runs of one byte, so that long plain and quoted stretches occur.
+            let mut buf = Vec::with_capacity(len);
+            while buf.len() < len {
+                let b = alphabet[rng.random_range(0..alphabet.len())];
+                let run = if rng.random_bool(0.3) {
+                    rng.random_range(1..12)
+                } else {
+                    1
+                };
+                buf.extend(std::iter::repeat_n(b, run));
+            }
+            let step = rng.random_range(1..16);
+            let q = starts[case % starts.len()];
+            let (line, opened) = (rng.random_range(1..5), rng.random_range(0..5));
+            let want = scan_bytes(&buf, step, q, line, opened);
+            let got = scan_quoted(&buf, step, q, line, opened);
+            assert_eq!(
+                got,
+                want,
+                "{:?}, step {step}, from {q:?}",
+                String::from_utf8_lossy(&buf)
+            );
+            quoted_ends += usize::from(want.quoting == Quoting::Quoted);
+        }
+        // The cases reach every kind of ending, a quoted cell still open among them.
+        assert!(quoted_ends > 1000, "{quoted_ends}");
     }
 }

@@ -35,7 +35,10 @@ pub(crate) fn lower_limit_factor(scene: &Scene) -> f64 {
 #[cold]
 #[inline(never)]
 fn lower_limit_bracket_dd(scene: &Scene, omk: f64) -> f64 {
-    let (s, c) = Dd::sin_cos(0.5 * scene.delta);
+    let tan_half_delta = match scene.tan_half_delta.0 {
+        Some(t) => t,
+        None => Dd::tan_half(scene.delta),
+    };
     let one = Dd::from(1.0);
     let kd = Dd::from(scene.k);
     let omk = if scene.law.is_value() {
@@ -43,7 +46,7 @@ fn lower_limit_bracket_dd(scene: &Scene, omk: f64) -> f64 {
     } else {
         Dd::from(omk)
     };
-    ((one + kd) * (s / c) - omk * scene.tan_half_alpha).to_f64()
+    ((one + kd) * tan_half_delta - omk * scene.tan_half_alpha).to_f64()
 }
 
 /// Squared velocity at the top Θ = 0 in the steady rolling state:

@@ -498,9 +498,18 @@ pub(crate) fn steady_lean(scene: &Scene) -> Outcome {
     steady_with(scene, 1e-14, false)
 }
 
-fn steady_with(scene: &Scene, tol: f64, diagnostics: bool) -> Outcome {
+/// Where [`settle`] ends: the rolling steady state (no slip at it, or ρ = 0), complete with
+/// its contact time, or the fixed point of the final-velocity map with the map's step there.
+enum Settled {
+    Rolling(Steady),
+    Fixed { xs: f64, step: MapStep },
+}
+
+/// The steady state's final velocity without the slip phase's contact time: the rolling
+/// steady state when it needs no slip, else the fixed point of the map followed from it.
+fn settle(scene: &Scene) -> Result<Settled, NotSteady> {
     if scene.rho == 0.0 {
-        return rolling_without_friction(scene);
+        return rolling_without_friction(scene).map(Settled::Rolling);
     }
     let x_hi = scene.sc_f.c.max(0.0).sqrt();
     // Start from the rolling steady state when it exists (its contact time, an elliptic
@@ -514,7 +523,7 @@ fn steady_with(scene: &Scene, tol: f64, diagnostics: bool) -> Outcome {
                     // and the two models agree exactly.
                     let mut out = stick::steady(scene)?;
                     out.theta_g = Some(tg);
-                    return Ok(out);
+                    return Ok(Settled::Rolling(out));
                 }
             }
             l
@@ -525,6 +534,22 @@ fn steady_with(scene: &Scene, tol: f64, diagnostics: bool) -> Outcome {
     };
     let xs = fixed_point_from(scene, x0.min(x_hi))?;
     let step = map(scene, xs)?;
+    Ok(Settled::Fixed { xs, step })
+}
+
+/// Whether [`steady_lean`] finds a steady state here, up to its contact time: `Ok` where the
+/// fixed point exists, even if the slip phase's quadrature were then to fail (the caller
+/// checks the point it keeps with [`steady_lean`]). A fixed point costs a fraction of the
+/// slip time's quadrature: this is the test the bracket's status bisection repeats.
+pub(crate) fn steady_status(scene: &Scene) -> Result<(), NotSteady> {
+    settle(scene).map(|_| ())
+}
+
+fn steady_with(scene: &Scene, tol: f64, diagnostics: bool) -> Outcome {
+    let (xs, step) = match settle(scene)? {
+        Settled::Rolling(s) => return Ok(s),
+        Settled::Fixed { xs, step } => (xs, step),
+    };
     let slope = if diagnostics {
         slope_at(scene, xs)
     } else {

@@ -163,6 +163,12 @@ impl Dd {
         Self::sin_cos_series(Dd::from(x))
     }
 
+    /// tan(x/2) of a double argument |x| ≤ 2, as sin / cos of [`Dd::sin_cos`].
+    pub fn tan_half(x: f64) -> Dd {
+        let (s, c) = Self::sin_cos(0.5 * x);
+        s / c
+    }
+
     fn sin_cos_series(xd: Dd) -> (Dd, Dd) {
         let x2 = xd * xd;
         // sin: x − x³/3! + …, cos: 1 − x²/2! + …; |x| ≤ 1 so 28 terms reach 1e-33.

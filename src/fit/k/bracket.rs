@@ -173,17 +173,45 @@ fn slip_contact_sq_at(scene: &Scene, w0sq: f64, theta: f64) -> f64 {
     SlipPhase::new(scene.theta_0, w0sq, scene.f).speed_sq(theta)
 }
 
+/// Whether `model` is steady at this scene with K = `k` (as [`eval`] says), counting the
+/// evaluation in `evals`: stick/slip without the slip phase's contact time
+/// ([`stickslip::steady_status`]).
+fn steady_at(model: &Model, scene: &Scene, k: f64, evals: &mut usize) -> bool {
+    if matches!(model, Model::StickSlip) && k.is_finite() {
+        *evals += 1;
+        return scene
+            .with_k(k)
+            .is_ok_and(|s| stickslip::steady_status(&s).is_ok());
+    }
+    eval(model, scene, k, evals).is_ok()
+}
+
 /// The steady K closest to `bad` between `good` (steady) and `bad` (not steady): the largest
 /// steady K at an upper end, the smallest at a lower end; bisection on the model's status to
-/// |ΔK| ≤ 1e-15 + 2 ulp.
+/// |ΔK| ≤ 1e-15 + 2 ulp. The bisection asks [`steady_at`]; the point it ends on is then
+/// evaluated in full, and where that fails (a contact time that [`steady_at`] does not
+/// compute), the bisection is redone on full evaluations, as [`eval`] decides.
 fn status_boundary(
     model: &Model,
     scene: &Scene,
-    mut good: f64,
-    mut bad: f64,
+    good: f64,
+    bad: f64,
     evals: &mut usize,
 ) -> (f64, Steady) {
-    let mut best = None;
+    let k = bisect_status(good, bad, |k| steady_at(model, scene, k, evals));
+    if let Ok(s) = eval(model, scene, k, evals) {
+        return (k, s);
+    }
+    let k = bisect_status(good, bad, |k| eval(model, scene, k, evals).is_ok());
+    match eval(model, scene, k, evals) {
+        Ok(s) => (k, s),
+        Err(_) => (k, unreachable_steady()),
+    }
+}
+
+/// Bisection between `good` (steady) and `bad` on `steady`, to |ΔK| ≤ 1e-15 + 2 ulp: the last
+/// steady point.
+fn bisect_status(mut good: f64, mut bad: f64, mut steady: impl FnMut(f64) -> bool) -> f64 {
     for _ in 0..80 {
         let mid = 0.5 * (good + bad);
         if (good - bad).abs() <= 1e-15 + 2.0 * f64::EPSILON * good.abs()
@@ -192,22 +220,13 @@ fn status_boundary(
         {
             break;
         }
-        match eval(model, scene, mid, evals) {
-            Ok(s) => {
-                good = mid;
-                best = Some(s);
-            }
-            Err(_) => bad = mid,
+        if steady(mid) {
+            good = mid;
+        } else {
+            bad = mid;
         }
     }
-    let s = match best {
-        Some(s) => s,
-        None => match eval(model, scene, good, evals) {
-            Ok(s) => s,
-            Err(_) => unreachable_steady(),
-        },
-    };
-    (good, s)
+    good
 }
 
 // `good` was verified steady before the bisection started; re-evaluating it cannot fail, but a

@@ -350,6 +350,17 @@ pub(crate) fn estimate_in_k(
     v: f64,
     sigma_v: Option<f64>,
 ) -> KEstimate {
+    // The rolling models need tan(δ/2) in double-double near δ_m, at every K the search
+    // tries there: computed once for the row where the bead crawls over the top at K_min
+    // (Θ0 < 0), the end of the range where the factor of the top speed vanishes.
+    let kept;
+    let rolling = matches!(model, Model::Stick | Model::StickApprox | Model::StickSlip);
+    let scene = if rolling && scene.theta_0 < 0.0 {
+        kept = scene.with_tan_half_delta();
+        &kept
+    } else {
+        scene
+    };
     let br = match bracket(model, scene) {
         Ok(b) => b,
         Err(e) => {

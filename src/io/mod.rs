@@ -146,21 +146,13 @@ pub(crate) fn pass_through_names<'a>(
     names
 }
 
-/// The bytes that make a field quoted: a comma, a quote, a carriage return, a newline (a
-/// table, so that the scan of a field costs one load per byte).
-static NEEDS_QUOTES: [bool; 256] = {
-    let mut t = [false; 256];
-    t[b',' as usize] = true;
-    t[b'"' as usize] = true;
-    t[b'\r' as usize] = true;
-    t[b'\n' as usize] = true;
-    t
-};
-
 /// Appends one CSV field to `out` as the `csv` crate's default writer does: quoted (with
 /// quotes doubled) when it holds a comma, a quote, a carriage return or a newline.
 pub(crate) fn push_csv_field(out: &mut Vec<u8>, field: &[u8]) {
-    if field.iter().any(|&b| NEEDS_QUOTES[usize::from(b)]) {
+    if field
+        .iter()
+        .any(|&b| matches!(b, b',' | b'"' | b'\r' | b'\n'))
+    {
         out.push(b'"');
         for &b in field {
             if b == b'"' {

@@ -283,6 +283,66 @@ pub struct AtomicFile {
     sink: Sink,
     /// The path as given, for messages.
     path: PathBuf,
+    /// The temporary file's data synced to disk in the background while it is written.
+    early: EarlySync,
+}
+
+/// Bytes written to a temporary file between two background syncs of its data (64 KiB in the
+/// unit tests, so that a small file goes through several).
+const EARLY_SYNC_BYTES: u64 = if cfg!(test) { 64 << 10 } else { 64 << 20 };
+
+/// Syncs a temporary file's data to disk on a thread of its own each [`EARLY_SYNC_BYTES`]
+/// written, so that [`AtomicFile::commit`]'s final sync has only the last of them to wait for
+/// (on the project machine the final sync of `forward`'s 200 MB output took 0.16 s of a 1.4 s
+/// run; docs/PERFORMANCE.md). One sync at a time; the first error is kept for the commit,
+/// since a failed sync may not fail again on the next.
+#[derive(Default)]
+struct EarlySync {
+    /// Bytes written since the last sync started.
+    since: u64,
+    /// The sync in flight.
+    running: Option<std::thread::JoinHandle<std::io::Result<()>>>,
+    /// The first error of a finished sync.
+    failed: Option<std::io::Error>,
+    /// Syncs started.
+    started: u32,
+}
+
+impl EarlySync {
+    /// Counts `n` bytes written to `file`, and starts a sync of its data when enough have
+    /// been since the last one and that one has finished.
+    fn wrote(&mut self, file: &File, n: usize) {
+        self.since += n as u64;
+        if self.since < EARLY_SYNC_BYTES || self.running.as_ref().is_some_and(|h| !h.is_finished())
+        {
+            return;
+        }
+        self.join();
+        self.since = 0;
+        // Without a second descriptor the final sync does it all.
+        if let Ok(f) = file.try_clone() {
+            self.running = Some(std::thread::spawn(move || f.sync_data()));
+            self.started += 1;
+        }
+    }
+
+    /// Waits for the sync in flight, keeping its error.
+    fn join(&mut self) {
+        if let Some(h) = self.running.take() {
+            let r = h
+                .join()
+                .unwrap_or_else(|_| Err(std::io::Error::other("background sync panicked")));
+            if let Err(e) = r {
+                self.failed.get_or_insert(e);
+            }
+        }
+    }
+
+    /// Waits for the sync in flight; the first error of any.
+    fn finish(&mut self) -> std::io::Result<()> {
+        self.join();
+        self.failed.take().map_or(Ok(()), Err)
+    }
 }
 
 impl AtomicFile {
@@ -324,6 +384,7 @@ impl AtomicFile {
         Ok(AtomicFile {
             sink,
             path: path.to_path_buf(),
+            early: EarlySync::default(),
         })
     }
 
@@ -336,7 +397,7 @@ impl AtomicFile {
 
     fn sync(&mut self) -> std::io::Result<()> {
         match &mut self.sink {
-            Sink::Temp { tmp, .. } => tmp.as_file().sync_all(),
+            Sink::Temp { tmp, .. } => self.early.finish().and_then(|()| tmp.as_file().sync_all()),
             Sink::Direct(f) => f.flush(),
         }
         .map_err(|e| with_path(&self.path, e))
@@ -574,14 +635,22 @@ fn temp_in(
 impl Write for AtomicFile {
     fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
         match &mut self.sink {
-            Sink::Temp { tmp, .. } => tmp.write(buf),
+            Sink::Temp { tmp, .. } => {
+                let n = tmp.write(buf)?;
+                self.early.wrote(tmp.as_file(), n);
+                Ok(n)
+            }
             Sink::Direct(f) => f.write(buf),
         }
     }
 
     fn write_all(&mut self, buf: &[u8]) -> std::io::Result<()> {
         match &mut self.sink {
-            Sink::Temp { tmp, .. } => tmp.write_all(buf),
+            Sink::Temp { tmp, .. } => {
+                tmp.write_all(buf)?;
+                self.early.wrote(tmp.as_file(), buf.len());
+                Ok(())
+            }
             Sink::Direct(f) => f.write_all(buf),
         }
     }
@@ -757,7 +826,28 @@ pub fn distinct_paths(
 
 #[cfg(test)]
 mod tests {
+    use std::io::Write;
     use std::path::{Path, PathBuf};
+
+    #[test]
+    fn a_file_synced_in_the_background_while_written_commits_whole() {
+        let d = tmpdir();
+        let p = write(&d, "out.csv", "old\n");
+        let mut f = super::AtomicFile::create(&p).unwrap();
+        let mut want = Vec::new();
+        for i in 0..3000u32 {
+            let line = format!("{i},{}\n", "x".repeat((i % 97) as usize));
+            f.write_all(line.as_bytes()).unwrap();
+            want.extend_from_slice(line.as_bytes());
+        }
+        // A background sync started along the way (one at a time, each 64 KiB in the tests),
+        // and the target is untouched until the commit.
+        assert!(f.early.started >= 1, "{} syncs", f.early.started);
+        assert_eq!(std::fs::read(&p).unwrap(), b"old\n");
+        f.commit().unwrap();
+        assert_eq!(std::fs::read(&p).unwrap(), want);
+        assert!(leftovers(d.path()).is_empty());
+    }
 
     fn tmpdir() -> tempfile::TempDir {
         tempfile::tempdir().unwrap()

@@ -173,24 +173,12 @@ fn slip_contact_sq_at(scene: &Scene, w0sq: f64, theta: f64) -> f64 {
     SlipPhase::new(scene.theta_0, w0sq, scene.f).speed_sq(theta)
 }
 
-/// Whether `model` is steady at this scene with K = `k` (as [`eval`] says), counting the
-/// evaluation in `evals`: stick/slip without the slip phase's contact time
-/// ([`stickslip::steady_status`]).
-fn steady_at(model: &Model, scene: &Scene, k: f64, evals: &mut usize) -> bool {
-    if matches!(model, Model::StickSlip) && k.is_finite() {
-        *evals += 1;
-        return scene
-            .with_k(k)
-            .is_ok_and(|s| stickslip::steady_status(&s).is_ok());
-    }
-    eval(model, scene, k, evals).is_ok()
-}
-
 /// The steady K closest to `bad` between `good` (steady) and `bad` (not steady): the largest
 /// steady K at an upper end, the smallest at a lower end; bisection on the model's status to
-/// |ΔK| ≤ 1e-15 + 2 ulp. The bisection asks [`steady_at`]; the point it ends on is then
-/// evaluated in full, and where that fails (a contact time that [`steady_at`] does not
-/// compute), the bisection is redone on full evaluations, as [`eval`] decides.
+/// |ΔK| ≤ 1e-15 + 2 ulp. Stick/slip's bisection asks only whether the fixed point exists
+/// ([`stickslip::steady_status`], without the slip phase's contact time), and the point it
+/// ends on is then evaluated in full; where that fails, the bisection is redone on full
+/// evaluations, as [`eval`] decides. The other models bisect on [`eval`] itself.
 fn status_boundary(
     model: &Model,
     scene: &Scene,
@@ -198,15 +186,28 @@ fn status_boundary(
     bad: f64,
     evals: &mut usize,
 ) -> (f64, Steady) {
-    let k = bisect_status(good, bad, |k| steady_at(model, scene, k, evals));
-    if let Ok(s) = eval(model, scene, k, evals) {
-        return (k, s);
+    if matches!(model, Model::StickSlip) {
+        let k = bisect_status(good, bad, |k| {
+            *evals += 1;
+            k.is_finite()
+                && scene
+                    .with_k(k)
+                    .is_ok_and(|s| stickslip::steady_status(&s).is_ok())
+        });
+        if let Ok(s) = eval(model, scene, k, evals) {
+            return (k, s);
+        }
     }
-    let k = bisect_status(good, bad, |k| eval(model, scene, k, evals).is_ok());
-    match eval(model, scene, k, evals) {
-        Ok(s) => (k, s),
-        Err(_) => (k, unreachable_steady()),
-    }
+    // Bisection on full evaluations: the steady state of the point it ends on is that of the
+    // last steady point it tried, or, when none was, of `good` itself.
+    let mut at_good = None;
+    let k = bisect_status(good, bad, |k| {
+        eval(model, scene, k, evals)
+            .map(|s| at_good = Some(s))
+            .is_ok()
+    });
+    let s = at_good.map_or_else(|| eval(model, scene, k, evals), Ok);
+    (k, s.unwrap_or_else(|_| unreachable_steady()))
 }
 
 /// Bisection between `good` (steady) and `bad` on `steady`, to |ΔK| ≤ 1e-15 + 2 ulp: the last

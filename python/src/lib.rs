@@ -113,10 +113,17 @@ struct TextColumn {
     names: Vec<String>,
     index: HashMap<String, u32>,
     last: Option<u32>,
+    /// Codes of `'static` texts by address and length (at most [`STATIC_CODES`]): a static
+    /// text's bytes never change, so an equal address and length is an equal text.
+    statics: Vec<(usize, usize, u32)>,
     sparse: bool,
     rows: usize,
     at: Vec<u64>,
 }
+
+/// Static texts a [`TextColumn`] recognises by address (the values of a status, a regime or a
+/// phase column are a handful of constants).
+const STATIC_CODES: usize = 16;
 
 impl TextColumn {
     fn named(name: &str) -> Self {
@@ -163,6 +170,27 @@ impl TextColumn {
             let c = self.code(s);
             self.codes.push(c);
         }
+        self.rows += 1;
+    }
+
+    /// [`TextColumn::push`] of a static text, coded by its address where it was seen before.
+    #[inline]
+    fn push_static(&mut self, s: &'static str) {
+        if self.sparse {
+            return self.push(s);
+        }
+        let key = (s.as_ptr() as usize, s.len());
+        let c = match self.statics.iter().find(|e| (e.0, e.1) == key) {
+            Some(e) => e.2,
+            None => {
+                let c = self.code(s);
+                if self.statics.len() < STATIC_CODES {
+                    self.statics.push((key.0, key.1, c));
+                }
+                c
+            }
+        };
+        self.codes.push(c);
         self.rows += 1;
     }
 
@@ -283,6 +311,96 @@ impl RowSink<'_, '_> {
             }
             self.slot += 1;
         });
+    }
+}
+
+/// Receives a record's fields in column order, by name: a number (`None` for an empty cell)
+/// or a text.
+trait FieldVisit {
+    fn num(&mut self, name: &'static str, x: Option<f64>);
+    fn text(&mut self, name: &'static str, s: &str);
+    /// A text known to be static (a constant of the crate).
+    fn text_static(&mut self, name: &'static str, s: &'static str) {
+        self.text(name, s);
+    }
+    /// A text that is static where borrowed (the `Cow` itself, not its `&str`, since its
+    /// variant says which).
+    #[allow(clippy::ptr_arg)]
+    fn text_cow(&mut self, name: &'static str, s: &std::borrow::Cow<'static, str>) {
+        match s {
+            std::borrow::Cow::Borrowed(b) => self.text_static(name, b),
+            std::borrow::Cow::Owned(o) => self.text(name, o),
+        }
+    }
+}
+
+/// [`ForwardRecord`]'s fields, each by its column name, in the order of its `Serialize`: the
+/// row writer of the forward models, without serde's per-cell dispatch (which cost about 1,000
+/// instructions a row, as much as the stick model itself). [`forward_fields_checked`] holds
+/// the names and kinds against the record's serde fields before any row is written.
+fn visit_forward(r: &ForwardRecord, v: &mut impl FieldVisit) {
+    v.num("v", r.v);
+    v.text_static("regime", r.regime);
+    v.text_static("status", r.status);
+    v.num("K_used", r.k_used);
+    v.num("final_velocity", r.final_velocity);
+    v.num("initial_velocity", r.initial_velocity);
+    v.num("contact_time", r.contact_time);
+    v.num("theta_G_deg", r.theta_g_deg);
+    v.num("map_slope", r.map_slope);
+    v.num("other_fixed_point", r.other_fixed_point);
+    v.text_cow("phases", &r.phases);
+    v.text_cow("message", &r.message);
+}
+
+/// Whether [`visit_forward`] names [`ForwardRecord`]'s serde fields, in order, each with its
+/// kind (number or text); an error naming the first difference otherwise.
+fn forward_fields_checked() -> Result<(), String> {
+    struct Names(Vec<(&'static str, bool)>);
+    impl FieldVisit for Names {
+        fn num(&mut self, name: &'static str, _: Option<f64>) {
+            self.0.push((name, true));
+        }
+        fn text(&mut self, name: &'static str, _: &str) {
+            self.0.push((name, false));
+        }
+    }
+    let mut typed = Names(Vec::new());
+    visit_forward(&ForwardRecord::default(), &mut typed);
+    let serde = fields::<ForwardRecord>();
+    if typed.0 == serde {
+        Ok(())
+    } else {
+        Err(format!(
+            "internal error: the forward row writer's fields {:?} are not the record's {:?}",
+            typed.0, serde
+        ))
+    }
+}
+
+impl FieldVisit for RowSink<'_, '_> {
+    #[inline]
+    fn num(&mut self, _: &'static str, x: Option<f64>) {
+        if let Slot::Num(i) = self.slots[self.slot] {
+            self.nums[i][self.j] = x.unwrap_or(f64::NAN);
+        }
+        self.slot += 1;
+    }
+
+    #[inline]
+    fn text(&mut self, _: &'static str, s: &str) {
+        if let Slot::Text(i) = self.slots[self.slot] {
+            self.texts[i].push(s);
+        }
+        self.slot += 1;
+    }
+
+    #[inline]
+    fn text_static(&mut self, _: &'static str, s: &'static str) {
+        if let Slot::Text(i) = self.slots[self.slot] {
+            self.texts[i].push_static(s);
+        }
+        self.slot += 1;
     }
 }
 
@@ -526,13 +644,14 @@ fn forward<'py>(
         f.extend(fields::<AutoRecord>());
     }
     let mut cols = Columns::of(f);
+    forward_fields_checked().map_err(PyRuntimeError::new_err)?;
     let r = py.detach(|| {
         fill(n, &mut cols, |i, sink| {
             let law = law_of(k_s, base_law, i)?;
             let scene = scene_of(i, xi_s, d_s, rho_s, f_s, law)?;
             let m = args.model(i, &scene)?;
             let (common, c, a) = ForwardRecord::evaluate(&scene, &m);
-            sink.record(&common);
+            visit_forward(&common, sink);
             if contact {
                 sink.record(&c.unwrap_or_default());
             }

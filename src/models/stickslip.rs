@@ -223,6 +223,57 @@ pub(crate) fn fixed_point_from(scene: &Scene, x0: f64) -> Result<f64, NotSteady>
 /// launch speed x0 the bead starts from is below the saddle-node's (so that the bead, following
 /// the map, settles on this fixed point).
 fn stable_branch_fixed_point(scene: &Scene, x0: f64) -> Option<f64> {
+    let sn = saddle_node(scene)?;
+    if !(scene.k <= sn.k && scene.k > sn.k_low && x0 <= sn.x) {
+        return None;
+    }
+    let g = |y: f64| sn.k_at(scene, y).map_or(f64::NAN, |p| p.0 - scene.k);
+    let root = brent(
+        g,
+        sn.y_low,
+        sn.y,
+        sn.k_low - scene.k,
+        sn.k - scene.k,
+        0.0,
+        200,
+    )?;
+    let (_, x) = sn.k_at(scene, root.x)?;
+    // A true fixed point of the map at this K.
+    let back = map(scene, x).ok()?.final_velocity;
+    ((back - x).abs() <= 1e-10 * x).then_some(x)
+}
+
+/// The saddle-node of the final-velocity map in launch space (see
+/// [`stable_branch_fixed_point`]): the maximum K_sn of K(y) = Θ̇0/Φ(Θ̇0) over the launches y,
+/// which does not depend on the scene's own K.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct SaddleNode {
+    /// K_sn, the largest K with a fixed point of the map on this branch.
+    pub(crate) k: f64,
+    /// The launch speed Θ̇0 there.
+    pub(crate) x: f64,
+    /// y at the saddle-node (the squared top speed for Θ0 < 0, else Θ̇0²).
+    y: f64,
+    /// The lowest y of the grid, and K(y) there.
+    y_low: f64,
+    k_low: f64,
+    /// 2B sin²(Θ0/2) for Θ0 < 0 (Θ̇0² = y + wc2), else 0.
+    wc2: f64,
+}
+
+impl SaddleNode {
+    /// K(y) and Φ at the launch y.
+    fn k_at(&self, scene: &Scene, y: f64) -> Option<(f64, f64)> {
+        launch(scene, y + self.wc2, y)
+            .ok()
+            .map(|m| ((y + self.wc2).sqrt() / m.final_velocity, m.final_velocity))
+    }
+}
+
+/// [`SaddleNode`] of the scene's map: `None` unless (for Θ0 < 0) the slip starts after the top
+/// at the crawl, and the maximum of K(y) is bracketed on a 56-point grid (40 log-spaced, 16
+/// crowding towards lift-off) and refined by golden section.
+pub(crate) fn saddle_node(scene: &Scene) -> Option<SaddleNode> {
     // With Θ0 < 0, y is the squared top speed (y = Θ̇0² − 2B sin²(Θ0/2)); else y = Θ̇0².
     let s0 = scene.sc_half_0.s;
     let wc2 = if s0 < 0.0 {
@@ -233,10 +284,13 @@ fn stable_branch_fixed_point(scene: &Scene, x0: f64) -> Option<f64> {
     if s0 < 0.0 && !theta_g(scene, wc2).is_some_and(|t| t > 0.0) {
         return None;
     }
-    let k_of = |y: f64| {
-        launch(scene, y + wc2, y)
-            .ok()
-            .map(|m| ((y + wc2).sqrt() / m.final_velocity, m.final_velocity))
+    let mut sn = SaddleNode {
+        k: f64::NAN,
+        x: f64::NAN,
+        y: f64::NAN,
+        y_low: f64::NAN,
+        k_low: f64::NAN,
+        wc2,
     };
     // Launches up to lift-off at Θf: Θ̇0² ≤ cos Θf.
     let y_top = scene.sc_f.c - wc2;
@@ -251,7 +305,9 @@ fn stable_branch_fixed_point(scene: &Scene, x0: f64) -> Option<f64> {
     let mut prev = (f64::NEG_INFINITY, 0usize);
     let mut peak = None;
     for (i, &y) in grid.iter().enumerate() {
-        let Some((k, _)) = k_of(y) else { break };
+        let Some((k, _)) = sn.k_at(scene, y) else {
+            break;
+        };
         if k <= prev.0 {
             peak = Some(i);
             break;
@@ -262,21 +318,14 @@ fn stable_branch_fixed_point(scene: &Scene, x0: f64) -> Option<f64> {
     if i < 2 {
         return None;
     }
-    let f = |u: f64| k_of(u.exp()).map_or(f64::NEG_INFINITY, |p| p.0);
+    let f = |u: f64| sn.k_at(scene, u.exp()).map_or(f64::NEG_INFINITY, |p| p.0);
     let (a, b) = (grid[i - 2].ln(), grid[i].ln());
     let a = golden_max(f, a, b, 1e-12 * (b - a), 100);
-    let y_sn = a.exp();
-    let (k_sn, x_sn) = k_of(y_sn)?;
-    let (k_lo, _) = k_of(grid[0])?;
-    if !(scene.k <= k_sn && scene.k > k_lo && x0 <= x_sn) {
-        return None;
-    }
-    let g = |y: f64| k_of(y).map_or(f64::NAN, |p| p.0 - scene.k);
-    let root = brent(g, grid[0], y_sn, k_lo - scene.k, k_sn - scene.k, 0.0, 200)?;
-    let (_, x) = k_of(root.x)?;
-    // A true fixed point of the map at this K.
-    let back = map(scene, x).ok()?.final_velocity;
-    ((back - x).abs() <= 1e-10 * x).then_some(x)
+    sn.y = a.exp();
+    (sn.k, sn.x) = sn.k_at(scene, sn.y)?;
+    sn.y_low = grid[0];
+    (sn.k_low, _) = sn.k_at(scene, grid[0])?;
+    Some(sn)
 }
 
 /// The secant method on g(x) = H(x) − x from x0 and x0 + g(x0) (one step of the map): about

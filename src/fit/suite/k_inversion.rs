@@ -123,7 +123,14 @@ fn v_increases_with_k_across_the_bracket() {
             let Ok(br) = bracket(&m, &s) else { continue };
             let mut prev = br.v_lo;
             for j in 1..=40 {
-                let k = br.lo + (br.hi - br.lo) * j as f64 / 40.0;
+                // The last point is the top itself: (hi − lo)·40/40 + lo may round an ulp
+                // away from it, which moves v̄ by ~1e-9 next to a saddle-node (v̄ − v̄_sn ∝
+                // √(K_sn − K)).
+                let k = if j == 40 {
+                    br.hi
+                } else {
+                    br.lo + (br.hi - br.lo) * j as f64 / 40.0
+                };
                 let v = m.evaluate(&with_k(&s, k)).unwrap().mean_velocity;
                 assert!(
                     v > prev,

@@ -260,18 +260,7 @@ fn stickslip_status_end(scene: &Scene, good: f64, bad: f64, evals: &mut usize) -
             }
         }
     }
-    while steps < BISECTION_STEPS {
-        let Some(mid) = bisect_mid(good, bad) else {
-            break;
-        };
-        steps += 1;
-        if status(mid) {
-            good = mid;
-        } else {
-            bad = mid;
-        }
-    }
-    good
+    bisect_steps(good, bad, BISECTION_STEPS - steps, &mut status)
 }
 
 /// The status end next to the saddle-node `k_sn`, inside (`good`, `bad`): not steady at
@@ -319,8 +308,18 @@ fn bisect_mid(good: f64, bad: f64) -> Option<f64> {
 
 /// Bisection between `good` (steady) and `bad` on `steady`, to |ΔK| ≤ 1e-15 + 2 ulp: the last
 /// steady point.
-fn bisect_status(mut good: f64, mut bad: f64, mut steady: impl FnMut(f64) -> bool) -> f64 {
-    for _ in 0..BISECTION_STEPS {
+fn bisect_status(good: f64, bad: f64, steady: impl FnMut(f64) -> bool) -> f64 {
+    bisect_steps(good, bad, BISECTION_STEPS, steady)
+}
+
+/// [`bisect_status`] in at most `steps` steps.
+fn bisect_steps(
+    mut good: f64,
+    mut bad: f64,
+    steps: usize,
+    mut steady: impl FnMut(f64) -> bool,
+) -> f64 {
+    for _ in 0..steps {
         let Some(mid) = bisect_mid(good, bad) else {
             break;
         };

@@ -264,10 +264,15 @@ pub(crate) struct SaddleNode {
 impl SaddleNode {
     /// K(y) and Φ at the launch y.
     fn k_at(&self, scene: &Scene, y: f64) -> Option<(f64, f64)> {
-        launch(scene, y + self.wc2, y)
-            .ok()
-            .map(|m| ((y + self.wc2).sqrt() / m.final_velocity, m.final_velocity))
+        k_of_launch(scene, self.wc2, y)
     }
+}
+
+/// K(y) = Θ̇0/Φ(Θ̇0) and Φ for the launch y, with Θ̇0² = y + `wc2` (see [`SaddleNode`]).
+fn k_of_launch(scene: &Scene, wc2: f64, y: f64) -> Option<(f64, f64)> {
+    launch(scene, y + wc2, y)
+        .ok()
+        .map(|m| ((y + wc2).sqrt() / m.final_velocity, m.final_velocity))
 }
 
 /// [`SaddleNode`] of the scene's map: `None` unless (for Θ0 < 0) the slip starts after the top
@@ -284,14 +289,7 @@ pub(crate) fn saddle_node(scene: &Scene) -> Option<SaddleNode> {
     if s0 < 0.0 && !theta_g(scene, wc2).is_some_and(|t| t > 0.0) {
         return None;
     }
-    let mut sn = SaddleNode {
-        k: f64::NAN,
-        x: f64::NAN,
-        y: f64::NAN,
-        y_low: f64::NAN,
-        k_low: f64::NAN,
-        wc2,
-    };
+    let k_at = |y: f64| k_of_launch(scene, wc2, y);
     // Launches up to lift-off at Θf: Θ̇0² ≤ cos Θf.
     let y_top = scene.sc_f.c - wc2;
     if !(y_top > 0.0) {
@@ -305,7 +303,7 @@ pub(crate) fn saddle_node(scene: &Scene) -> Option<SaddleNode> {
     let mut prev = (f64::NEG_INFINITY, 0usize);
     let mut peak = None;
     for (i, &y) in grid.iter().enumerate() {
-        let Some((k, _)) = sn.k_at(scene, y) else {
+        let Some((k, _)) = k_at(y) else {
             break;
         };
         if k <= prev.0 {
@@ -318,14 +316,20 @@ pub(crate) fn saddle_node(scene: &Scene) -> Option<SaddleNode> {
     if i < 2 {
         return None;
     }
-    let f = |u: f64| sn.k_at(scene, u.exp()).map_or(f64::NEG_INFINITY, |p| p.0);
+    let f = |u: f64| k_at(u.exp()).map_or(f64::NEG_INFINITY, |p| p.0);
     let (a, b) = (grid[i - 2].ln(), grid[i].ln());
     let a = golden_max(f, a, b, 1e-12 * (b - a), 100);
-    sn.y = a.exp();
-    (sn.k, sn.x) = sn.k_at(scene, sn.y)?;
-    sn.y_low = grid[0];
-    (sn.k_low, _) = sn.k_at(scene, grid[0])?;
-    Some(sn)
+    let y = a.exp();
+    let (k, x) = k_at(y)?;
+    let (k_low, _) = k_at(grid[0])?;
+    Some(SaddleNode {
+        k,
+        x,
+        y,
+        y_low: grid[0],
+        k_low,
+        wc2,
+    })
 }
 
 /// The secant method on g(x) = H(x) − x from x0 and x0 + g(x0) (one step of the map): about

@@ -25,6 +25,28 @@ pub struct Root {
 /// absolute tolerance `xtol` plus 2 ulp. Returns `None` when the bracket is not a bracket or a
 /// value is NaN.
 pub fn brent<F: FnMut(f64) -> f64>(
+    f: F,
+    a: f64,
+    b: f64,
+    fa: f64,
+    fb: f64,
+    xtol: f64,
+    max_evals: usize,
+) -> Option<Root> {
+    brent_until(f, a, b, fa, fb, xtol, max_evals, |_, _| false)
+}
+
+/// [`brent`] that also ends as soon as `resolved(b, c)` holds for its best point b and the
+/// other end c of its bracket, and |f(b)| < |f(c)| strictly. For a function that is constant
+/// on cells of x (the cells a computation resolves, such as the doubles of K = K_min + eˢ
+/// when x = s), once b and c lie in adjacent cells every later iterate lies in one of the two,
+/// and after each step b is the end with the smaller |f|: with the two values of |f| unequal,
+/// [`brent`] ends in b's cell. This returns b then, without the steps that only shrink the
+/// bracket inside the two cells (about 40 near the crawl end of the K inversion, where one
+/// double of K spans 1e-2 in s). Where |f| is equal in both cells (f = ±one rounding step, say)
+/// it goes on as [`brent`] does, whose end then depends on its path.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn brent_until<F: FnMut(f64) -> f64>(
     mut f: F,
     a: f64,
     b: f64,
@@ -32,6 +54,7 @@ pub fn brent<F: FnMut(f64) -> f64>(
     fb: f64,
     xtol: f64,
     max_evals: usize,
+    mut resolved: impl FnMut(f64, f64) -> bool,
 ) -> Option<Root> {
     let (mut a, mut b, mut fa, mut fb) = (a, b, fa, fb);
     if fa.is_nan() || fb.is_nan() || fa * fb > 0.0 {
@@ -73,7 +96,11 @@ pub fn brent<F: FnMut(f64) -> f64>(
         }
         let tol = 2.0 * f64::EPSILON * b.abs() + 0.5 * xtol;
         let m = 0.5 * (c - b);
-        if m.abs() <= tol || fb == 0.0 || evals >= max_evals {
+        if m.abs() <= tol
+            || fb == 0.0
+            || evals >= max_evals
+            || (fb.abs() < fc.abs() && resolved(b, c))
+        {
             return Some(Root {
                 x: b,
                 fx: fb,

@@ -6,7 +6,7 @@ use super::types::{KBracket, KEstimate, KFailure, KRoot};
 use crate::models::regimes::theta_g;
 use crate::models::{Model, NotSteady, Steady};
 use crate::scene::Scene;
-use crate::special::root::brent;
+use crate::special::root::brent_until;
 
 /// Solves v̄_th(K) = v (eq 69) on a bracket from [`bracket`]. Brent's method runs to full
 /// precision in s = ln(K − K_min), so |ΔK| ≈ 2ε |s| (K − K_min): about 1e-14 at most across
@@ -102,7 +102,13 @@ pub fn solve(model: &Model, scene: &Scene, br: &KBracket, v: f64) -> Result<KRoo
         g_up = 0.0;
     }
     let mut inner = 0;
-    let r = brent(
+    // g depends on s only through the double K = k_of(s): once the bracket's ends give
+    // adjacent doubles of K, the root's K is decided (`brent_until`).
+    let adjacent_k = |a: f64, b: f64| {
+        let (ka, kb) = (k_of(a).min(br.hi), k_of(b).min(br.hi));
+        ka.max(kb) <= ka.min(kb).next_up()
+    };
+    let r = brent_until(
         |s| g(s, &mut inner, &mut last),
         s_lo,
         s_up,
@@ -110,6 +116,7 @@ pub fn solve(model: &Model, scene: &Scene, br: &KBracket, v: f64) -> Result<KRoo
         g_up,
         0.0,
         200,
+        adjacent_k,
     )
     .ok_or_else(|| KFailure::Invalid("K bracket lost".into()))?;
     evals += inner;

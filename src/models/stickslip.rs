@@ -9,8 +9,9 @@ use super::regimes::theta_g;
 use super::slip::{slip_time, SlipPhase};
 use super::stick;
 use super::{NotSteady, Outcome, Phases, Steady};
-use crate::scene::Scene;
+use crate::scene::{CollisionLaw, Scene};
 use crate::special::root::{brent, golden_max};
+use std::cell::Cell;
 
 /// Which phases one contact goes through under the stick/slip model.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -216,12 +217,12 @@ pub(crate) fn fixed_point_from(scene: &Scene, x0: f64) -> Result<f64, NotSteady>
 /// src/fit/k/launch.rs): a launch at Θ0 with squared top speed y is the fixed point of
 /// K(y) = Θ̇0/Φ(Θ̇0), and K(y) rises from the crawl to a maximum K_sn at the saddle-node; the
 /// stable fixed point for K ≤ K_sn solves K(y) = K below that maximum, where K(y) is monotone
-/// (Brent). Within ~1e-9 of the saddle-node the map's slope is so close to 1 that following it
-/// does not settle and the grid of [`scan`] misses the pair of fixed points (3e-5 apart); this
-/// finds them. `None` unless (for Θ0 < 0) the slip starts after the top at the crawl, the maximum of
-/// K(y) is bracketed on a 56-point grid (40 log-spaced, 16 crowding towards lift-off) and refined (golden section), K ≤ K_sn, and the
-/// launch speed x0 the bead starts from is below the saddle-node's (so that the bead, following
-/// the map, settles on this fixed point).
+/// (Brent). Near the saddle-node the map's slope is so close to 1 that following it does not
+/// settle and the grid of [`scan`] misses the pair of fixed points (3e-5 apart within ~1e-9 of
+/// it; where the saddle-node lies just below lift-off, up to ~4e-7 below it on the random
+/// measured file of `scripts/gen_measurements.py`); this finds them. `None` unless
+/// [`saddle_node`] finds the maximum, K ≤ K_sn, and the launch speed x0 the bead starts from is
+/// below the saddle-node's (so that the bead, following the map, settles on this fixed point).
 fn stable_branch_fixed_point(scene: &Scene, x0: f64) -> Option<f64> {
     let sn = saddle_node(scene)?;
     if !(scene.k <= sn.k && scene.k > sn.k_low && x0 <= sn.x) {
@@ -277,8 +278,35 @@ fn k_of_launch(scene: &Scene, wc2: f64, y: f64) -> Option<(f64, f64)> {
 
 /// [`SaddleNode`] of the scene's map: `None` unless (for Θ0 < 0) the slip starts after the top
 /// at the crawl, and the maximum of K(y) is bracketed on a 56-point grid (40 log-spaced, 16
-/// crowding towards lift-off) and refined by golden section.
+/// crowding towards lift-off) and refined by golden section. Where the first launch of the
+/// grid that fails comes before K(y) is seen to fall, the launches that pass end (the bead
+/// lifts off at Θf, say) between two grid points, and the maximum can lie just below that end:
+/// the end is found by bisection on whether the launch passes (to 1e-13 relative), and 16 more
+/// points crowd towards it from the last grid point that passed; the scan for the fall goes on
+/// over them.
+///
+/// It does not depend on the scene's K, which is all that changes between the evaluations of
+/// one K inversion (every status test near the top of stick/slip's bracket asks for it, at
+/// ~1e5 instructions each): the last scene's result is kept per thread and returned for a
+/// scene equal to it apart from K.
 pub(crate) fn saddle_node(scene: &Scene) -> Option<SaddleNode> {
+    thread_local! {
+        static LAST: Cell<Option<(Scene, Option<SaddleNode>)>> = const { Cell::new(None) };
+    }
+    let mut key = *scene;
+    key.k = 1.0;
+    key.law = CollisionLaw::Value(1.0);
+    if let Some((last, sn)) = LAST.get() {
+        if last == key {
+            return sn;
+        }
+    }
+    let sn = saddle_node_of(scene);
+    LAST.set(Some((key, sn)));
+    sn
+}
+
+fn saddle_node_of(scene: &Scene) -> Option<SaddleNode> {
     // With Θ0 < 0, y is the squared top speed (y = Θ̇0² − 2B sin²(Θ0/2)); else y = Θ̇0².
     let s0 = scene.sc_half_0.s;
     let wc2 = if s0 < 0.0 {
@@ -300,17 +328,40 @@ pub(crate) fn saddle_node(scene: &Scene) -> Option<SaddleNode> {
         .collect();
     grid.extend((1..=16).map(|j| y_top * (1.0 - 0.6 * 0.75f64.powi(j))));
     grid.sort_by(f64::total_cmp);
-    let mut prev = (f64::NEG_INFINITY, 0usize);
+    let mut prev = f64::NEG_INFINITY;
     let mut peak = None;
-    for (i, &y) in grid.iter().enumerate() {
-        let Some((k, _)) = k_at(y) else {
-            break;
+    let mut refined = false;
+    let mut i = 0;
+    while i < grid.len() {
+        let Some((k, _)) = k_at(grid[i]) else {
+            if refined || i < 2 {
+                break;
+            }
+            // The last launch that passes, between the last grid point that did and this one;
+            // the grid goes on from the former towards it.
+            refined = true;
+            let y0 = grid[i - 1];
+            let mut ok = y0;
+            let mut bad = grid[i];
+            while bad - ok > 1e-13 * bad {
+                let mid = 0.5 * (ok + bad);
+                if k_at(mid).is_some() {
+                    ok = mid;
+                } else {
+                    bad = mid;
+                }
+            }
+            grid.truncate(i);
+            grid.extend((1..=16).map(|j| ok - (ok - y0) * 0.75f64.powi(j)));
+            grid.push(ok);
+            continue;
         };
-        if k <= prev.0 {
+        if k <= prev {
             peak = Some(i);
             break;
         }
-        prev = (k, i);
+        prev = k;
+        i += 1;
     }
     let i = peak?;
     if i < 2 {

@@ -227,6 +227,11 @@ fn stickslip_status_end(scene: &Scene, good: f64, bad: f64, evals: &mut usize) -
                 .with_k(k)
                 .is_ok_and(|s| stickslip::steady_status(&s).is_ok())
     };
+    if good > bad {
+        if let Some(k) = lower_end_chain(good, bad, &mut status) {
+            return k;
+        }
+    }
     let (mut good, mut bad) = (good, bad);
     let mut steps = 0;
     let k_sn = if good < bad {
@@ -261,6 +266,38 @@ fn stickslip_status_end(scene: &Scene, good: f64, bad: f64, evals: &mut usize) -
         }
     }
     bisect_steps(good, bad, BISECTION_STEPS - steps, &mut status)
+}
+
+/// Every [`LOWER_CHAIN_SAMPLE`]-th point of the lower-end chain is tested ([`lower_end_chain`]).
+const LOWER_CHAIN_SAMPLE: usize = 8;
+
+/// A lower end of stick/slip's status bisection (`good` > `bad`) where the bisection would
+/// find every point steady: each point then halves the distance to `bad`, and the end is the
+/// last of that chain (for Θ0 ≥ 0, where the steady state is the same down to K ~ 1e-100
+/// and `bad` is K = 2⁻¹⁰²², this walks down ~50 steps to ~1e-15). The chain's last point and
+/// every [`LOWER_CHAIN_SAMPLE`]-th one are tested; `None` (the caller bisects as before)
+/// unless all are steady. The result is the plain bisection's wherever the untested points of
+/// the chain are steady too (on the 100,000-row random measured file of
+/// `scripts/gen_measurements.py`, every row's bracket is byte-identical).
+fn lower_end_chain(good: f64, bad: f64, status: &mut impl FnMut(f64) -> bool) -> Option<f64> {
+    let mut chain = Vec::new();
+    let mut g = good;
+    while chain.len() < BISECTION_STEPS {
+        let Some(mid) = bisect_mid(g, bad) else {
+            break;
+        };
+        chain.push(mid);
+        g = mid;
+    }
+    let (&last, rest) = chain.split_last()?;
+    if !status(last) {
+        return None;
+    }
+    rest.iter()
+        .skip(LOWER_CHAIN_SAMPLE - 1)
+        .step_by(LOWER_CHAIN_SAMPLE)
+        .all(|&k| status(k))
+        .then_some(last)
 }
 
 /// The status end next to the saddle-node `k_sn`, inside (`good`, `bad`): not steady at

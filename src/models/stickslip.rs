@@ -151,7 +151,12 @@ fn check_slip_positive(ph: &SlipPhase, end: f64) -> Result<(), NotSteady> {
 /// g(x) = H(x) − x with the map's failures mapped to the side they belong to: a bead that
 /// stops is "slower than any fixed point", one that lifts off "faster".
 fn excess(scene: &Scene, x: f64) -> f64 {
-    match map(scene, x) {
+    excess_of(&map(scene, x), x)
+}
+
+/// [`excess`] from the map's step at x, for callers that need the step too.
+fn excess_of(step: &Result<MapStep, NotSteady>, x: f64) -> f64 {
+    match step {
         Ok(m) => m.final_velocity - x,
         Err(NotSteady::Stops { .. }) => -x.max(1e-300),
         Err(_) => f64::INFINITY,
@@ -469,12 +474,13 @@ fn follow(scene: &Scene, x0: f64) -> Result<f64, NotSteady> {
             return Ok(x);
         }
         let x1 = x + gx;
-        let g1 = excess(scene, x1);
+        let step_1 = map(scene, x1);
+        let g1 = excess_of(&step_1, x1);
         if (g1 > 0.0) != up || g1 == 0.0 {
             return refine(scene, x, x1, gx, g1);
         }
         if !g1.is_finite() || x1 > x_hi {
-            return Err(map(scene, x1).err().unwrap_or(NotSteady::Runaway));
+            return Err(step_1.err().unwrap_or(NotSteady::Runaway));
         }
         if x1 <= 0.0 {
             return Err(map(scene, x1.max(1e-300))
@@ -493,15 +499,17 @@ fn follow(scene: &Scene, x0: f64) -> Result<f64, NotSteady> {
         if !(xe.is_finite()) || xe <= 0.0 {
             xe = x2;
         }
-        if let Err(fail) = map(scene, xe) {
+        let step_e = map(scene, xe);
+        if let Err(fail) = step_e {
             // The extrapolation overshot into launch speeds from which the bead stops (going
             // down) or lifts off (going up). The fixed point, if any, lies between x2 and the
             // boundary of that region: find the boundary and look at the map just inside it.
-            let g2 = excess(scene, x2);
+            let step_2 = map(scene, x2);
+            let g2 = excess_of(&step_2, x2);
             if (g2 > 0.0) != up || g2 == 0.0 {
                 return refine(scene, x1, x2, g1, g2);
             }
-            map(scene, x2)?;
+            step_2?;
             let (xb, bad) = failure_boundary(scene, x2, xe);
             let gb = excess(scene, xb);
             if (gb > 0.0) != up || gb == 0.0 {
@@ -509,7 +517,7 @@ fn follow(scene: &Scene, x0: f64) -> Result<f64, NotSteady> {
             }
             return Err(map(scene, bad).err().unwrap_or(fail));
         }
-        let ge = excess(scene, xe);
+        let ge = excess_of(&step_e, xe);
         if (ge > 0.0) != up || ge == 0.0 {
             // Bracket between the last same-side point and the estimate.
             let g2 = excess(scene, x2);
@@ -521,7 +529,7 @@ fn follow(scene: &Scene, x0: f64) -> Result<f64, NotSteady> {
         x = xe;
         gx = ge;
         if !gx.is_finite() || x > x_hi {
-            return Err(map(scene, x).err().unwrap_or(NotSteady::Runaway));
+            return Err(step_e.err().unwrap_or(NotSteady::Runaway));
         }
     }
     Err(NotSteady::Runaway)

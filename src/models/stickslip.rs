@@ -224,7 +224,7 @@ pub(crate) fn fixed_point_from(scene: &Scene, x0: f64) -> Result<f64, NotSteady>
 /// stable fixed point for K ≤ K_sn solves K(y) = K below that maximum, where K(y) is monotone
 /// (Brent). Near the saddle-node the map's slope is so close to 1 that following it does not
 /// settle and the grid of [`scan`] misses the pair of fixed points (3e-5 apart within ~1e-9 of
-/// it; where the saddle-node lies just below lift-off, up to ~4e-7 below it on the random
+/// it; where the saddle-node lies just below lift-off, up to 5.1e-7 below it on the random
 /// measured file of `scripts/gen_measurements.py`); this finds them. `None` unless
 /// [`saddle_node`] finds the maximum, K ≤ K_sn, and the launch speed x0 the bead starts from is
 /// below the saddle-node's (so that the bead, following the map, settles on this fixed point).

@@ -108,9 +108,9 @@ fn stickslip_equals_stick_exactly_when_friction_prevents_slip() {
 /// of launches lifts off before K(y) is seen to fall), a bead launched from the rolling state
 /// settles on the stable fixed point at every K up to the saddle-node. Checked here against
 /// the map itself, iterated from the rolling state until it moves by less than 1e-15 x (the
-/// map's slope is 1 − O(1e-3) there, so that takes thousands of steps): an independent method
+/// map's slope is about 1 − 5e-4 there, so that takes thousands of steps): an independent method
 /// from the launch-space search the model uses so close to the saddle-node. The scene is row
-/// 810 of `scripts/gen_measurements.py 100000 1` (ξ, δ, ρ, f as written there); K lies 3.6e-7
+/// 810 of `scripts/gen_measurements.py 100000 1` (ξ, δ, ρ, f as written there); K lies 2.1e-7
 /// and 1.8e-7 below its saddle-node (K_sn = 0.92771206233), where the model used to report a
 /// runaway.
 #[test]

@@ -91,6 +91,13 @@ impl SlipPhase {
     /// d(Θ̇²)/dθ = 2 Θ̈ = 2 (sin θ − f (cos θ − Θ̇²)) (eq 37).
     #[inline]
     pub fn speed_sq_slope(&self, theta: f64) -> f64 {
+        if theta.to_bits() == self.theta_s.to_bits() {
+            // At Θs itself (where every slip phase is first asked for its slope): sin Θs and
+            // cos Θs as `new` computed them, and Θ̇² = Θ̇s² exactly, since every offset term of
+            // `speed_sq_offset(0)` vanishes. The same bits as below, without its three
+            // sin_cos and one exp_m1.
+            return 2.0 * (self.sin_s - self.f * (self.cos_s - self.ws_sq));
+        }
         let (s, c) = theta.sin_cos();
         2.0 * (s - self.f * (c - self.speed_sq(theta)))
     }

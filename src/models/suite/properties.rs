@@ -149,3 +149,36 @@ fn stickslip_settles_up_to_a_saddle_node_just_below_lift_off() {
         );
     }
 }
+
+/// The slope of a slip phase's squared speed at its own start, which `speed_sq_slope` takes
+/// from the phase's stored sin Θs, cos Θs and Θ̇s², is bit for bit the general expression
+/// 2 (sin θ − f (cos θ − Θ̇²(θ))) at θ = Θs (eq 37), on 100,000 random phases (Θs in ±1.6,
+/// Θ̇s² in [0, 2] with exact zeros, f in [0, 3] with exact zeros).
+#[test]
+fn slip_slope_at_the_start_is_the_general_expression_bit_for_bit() {
+    use crate::models::slip::SlipPhase;
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+    for i in 0..100_000 {
+        let theta_s: f64 = rng.random_range(-1.6..1.6);
+        let ws_sq = if i % 10 == 0 {
+            0.0
+        } else {
+            rng.random_range(0.0..2.0)
+        };
+        let f = if i % 7 == 0 {
+            0.0
+        } else {
+            rng.random_range(0.0..3.0)
+        };
+        let ph = SlipPhase::new(theta_s, ws_sq, f);
+        let (s, c) = theta_s.sin_cos();
+        let general = 2.0 * (s - f * (c - ph.speed_sq(theta_s)));
+        let fast = ph.speed_sq_slope(theta_s);
+        assert_eq!(
+            fast.to_bits(),
+            general.to_bits(),
+            "Θs {theta_s}, Θ̇s² {ws_sq}, f {f}: {fast} vs {general}"
+        );
+    }
+}

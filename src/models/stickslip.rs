@@ -348,8 +348,13 @@ fn saddle_node_of(scene: &Scene) -> Option<SaddleNode> {
             let y0 = grid[i - 1];
             let mut ok = y0;
             let mut bad = grid[i];
-            while bad - ok > 1e-13 * bad {
+            // At most 64 halvings (1e-13 of the gap is ~43): the bound also ends it where the
+            // two are adjacent doubles wider apart than 1e-13 (subnormal y).
+            for _ in 0..64 {
                 let mid = 0.5 * (ok + bad);
+                if !(bad - ok > 1e-13 * bad) || mid == ok || mid == bad {
+                    break;
+                }
                 if k_at(mid).is_some() {
                     ok = mid;
                 } else {

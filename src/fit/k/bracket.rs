@@ -176,8 +176,9 @@ fn slip_contact_sq_at(scene: &Scene, w0sq: f64, theta: f64) -> f64 {
 /// The steady K closest to `bad` between `good` (steady) and `bad` (not steady): the largest
 /// steady K at an upper end, the smallest at a lower end; bisection on the model's status to
 /// |ΔK| ≤ 1e-15 + 2 ulp. Stick/slip's bisection asks only whether the fixed point exists
-/// ([`stickslip::steady_status`], without the slip phase's contact time) and, at an upper end,
-/// is shortened next to the saddle-node ([`stickslip_status_end`]); the point it ends on is
+/// ([`stickslip::steady_status`], without the slip phase's contact time) and is shortened
+/// next to the saddle-node at an upper end, along a tested chain at a lower end
+/// ([`stickslip_status_end`]); the point it ends on is
 /// then evaluated in full, and where that fails, the bisection is redone on full evaluations,
 /// as [`eval`] decides. The other models bisect on [`eval`] itself.
 fn status_boundary(
@@ -218,7 +219,8 @@ const CHECKED_STEPS: usize = 8;
 /// monotone) or no end is found next to K_sn, the bisection goes on from where it is, so its
 /// result is then exactly the plain bisection's. On the random measured file of
 /// `scripts/gen_measurements.py` the end lies within 1.3e-15 relative below K_sn wherever the
-/// saddle-node is found.
+/// saddle-node is found. A lower end (`good` > `bad`) is first tried along the chain of
+/// [`lower_end_chain`].
 fn stickslip_status_end(scene: &Scene, good: f64, bad: f64, evals: &mut usize) -> f64 {
     let mut status = |k: f64| {
         *evals += 1;

@@ -8,7 +8,7 @@
 use super::cells::{Cells, Repeat};
 use super::measurements::{
     Implausible, Measured, MeasurementColumns, MeasurementDefaults, Plausibility, PlausiblePoint,
-    SeriesLedger,
+    SeriesLedger, StopSlopes,
 };
 use super::records::{columns, AutoRecord, KRecord};
 use super::scenes::{Header, Row};
@@ -23,6 +23,8 @@ use crate::report::figures::{scatter_svg, PointSeries, Scatter};
 use crate::scene::{CollisionLaw, Scene};
 use serde::Serialize;
 use std::collections::HashMap;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 /// The measurement's own columns, first in a K row: series, ξ, δ (as written), v, σ and the
 /// model's name.
@@ -94,6 +96,8 @@ pub(crate) struct KScratch {
     input: Repeat,
     /// The text of the three laws' K.
     record: Repeat,
+    /// The plausibility checks' slope limits of the last ξ and ρ.
+    slopes: StopSlopes,
 }
 
 impl Default for KScratch {
@@ -104,6 +108,7 @@ impl Default for KScratch {
             laws: [f64::NAN; 3],
             input: Repeat::new::<KInput>(&["xi"]),
             record: Repeat::new::<KRecord>(&["K_cos2a", "K_adjusted", "K_impact"]),
+            slopes: StopSlopes::default(),
         }
     }
 }
@@ -179,6 +184,10 @@ pub(crate) struct KPlan {
     headers: Vec<String>,
     /// Input columns passed through, in order.
     pass: Vec<usize>,
+    /// The plausibility checks have the velocity ratios they take: the rows need not compute
+    /// the rolling model's v̄ for them (raised in input order by [`RowPlan::record`]; a row
+    /// that computes it before it sees the flag only spends the time).
+    ratios_full: Arc<AtomicBool>,
 }
 
 impl KPlan {
@@ -199,6 +208,7 @@ impl KPlan {
             cols,
             headers,
             pass,
+            ratios_full: Arc::default(),
         })
     }
 
@@ -281,7 +291,11 @@ impl RowPlan for KPlan {
             _ => None,
         };
         KNote {
-            point: PlausiblePoint::from(&m),
+            point: PlausiblePoint::new(
+                &m,
+                &mut cache.slopes,
+                !self.ratios_full.load(Ordering::Relaxed),
+            ),
             plot,
         }
     }
@@ -291,6 +305,9 @@ impl RowPlan for KPlan {
             .check_series(&mut ledger.series, row, note.point.xi)?;
         if let Some(p) = &mut ledger.plausibility {
             p.add_point(row, &note.point);
+            if p.has_all_ratios() {
+                self.ratios_full.store(true, Ordering::Relaxed);
+            }
         }
         let Some(n) = note.plot else { return Ok(()) };
         let series = self.cols.series(row);

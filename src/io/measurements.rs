@@ -18,7 +18,6 @@ pub(crate) use crate::fit::data::SiSeries;
 use crate::fit::data::{DataError, Dataset};
 use crate::numfmt::fmt_f64;
 use crate::scene::{CollisionLaw, Scene};
-use std::collections::HashMap;
 use std::path::Path;
 
 /// The shipped default data set (synthetic; provenance in data/README.md).
@@ -152,7 +151,9 @@ pub(crate) struct Measured {
 /// mix ξ values). Its size grows with the number of series, not of rows.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct SeriesLedger {
-    first_xi: HashMap<String, (f64, u64)>,
+    /// The first ξ of each series and its line. Hashed with FxHash, not SipHash: it is looked
+    /// up once per row in input order, where every instruction holds up the other threads.
+    first_xi: rustc_hash::FxHashMap<String, (f64, u64)>,
     /// The last series checked, with its first ξ and line.
     last: Option<(String, f64, u64)>,
 }
@@ -655,8 +656,10 @@ pub(crate) fn plausibility(t: &Table, rows: &[Measurement]) -> Vec<Implausible> 
     p.warnings()
 }
 
-/// What the checks of [`Plausibility`] need of one validated row: its scene's ξ, δ (radians),
-/// ρ, f and α, and its dimensionless v.
+/// What the checks of [`Plausibility`] need of one validated row: its scene's ξ, δ (radians)
+/// and ρ, its dimensionless v, the stop and lift-off slopes of its ξ and ρ, and the rolling
+/// model's v̄ on its slope when that was computed with the row ([`PlausiblePoint::new`]), as
+/// a streamed row's is, in parallel with the other rows.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct PlausiblePoint {
     /// Radius ratio ξ.
@@ -667,23 +670,70 @@ pub(crate) struct PlausiblePoint {
     pub rho: f64,
     /// Friction coefficient f.
     pub f: f64,
-    /// α = asin(1/(1+ξ)) (eq 2).
-    pub alpha: f64,
     /// Dimensionless mean velocity.
     pub v: f64,
+    /// δ_m and δ_d (degrees) at the paper's law (eqs 31–32).
+    pub limits: (f64, f64),
+    /// The rolling model's v̄ at the paper's law on this slope, when computed with the row:
+    /// `Some(None)` where it has no steady state or the slope is outside (δ_m, δ_d).
+    pub paper_v: Option<Option<f64>>,
 }
 
-impl From<&Measured> for PlausiblePoint {
-    fn from(m: &Measured) -> Self {
+/// δ_m and δ_d (degrees) at the paper's law for the last (ξ, ρ) seen, which the next row of
+/// the same pair reuses (rows of a series usually follow each other).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct StopSlopes(Option<((u64, u64), f64, f64)>);
+
+impl StopSlopes {
+    fn of(&mut self, xi: f64, alpha: f64, rho: f64) -> (f64, f64) {
+        use crate::models::regimes::{delta_d_law, delta_m_law};
+        let key = (xi.to_bits(), rho.to_bits());
+        match self.0 {
+            Some((k, dm, dd)) if k == key => (dm, dd),
+            _ => {
+                let law = CollisionLaw::Adjusted;
+                let dm = delta_m_law(alpha, law, rho).to_degrees();
+                let dd = delta_d_law(alpha, law, rho).to_degrees();
+                self.0 = Some((key, dm, dd));
+                (dm, dd)
+            }
+        }
+    }
+}
+
+impl PlausiblePoint {
+    /// The point of `m`, its slopes' limits through `slopes`; with `paper_v`, also the
+    /// rolling model's v̄ where the slope is between them (what the velocity check needs).
+    pub fn new(m: &Measured, slopes: &mut StopSlopes, paper_v: bool) -> Self {
         let s = &m.scene;
-        PlausiblePoint {
+        let limits = slopes.of(s.xi(), s.alpha_rad(), s.rho());
+        let mut p = PlausiblePoint {
             xi: s.xi(),
             delta: s.delta_rad(),
             rho: s.rho(),
             f: s.f(),
-            alpha: s.alpha_rad(),
             v: m.v,
+            limits,
+            paper_v: None,
+        };
+        if paper_v {
+            p.paper_v = Some(p.rolling_v());
         }
+        p
+    }
+
+    /// The rolling model's v̄ at the paper's law, where the slope is inside (δ_m, δ_d).
+    fn rolling_v(&self) -> Option<f64> {
+        use crate::models::ForwardModel;
+        let d = self.delta.to_degrees();
+        let (dm, dd) = self.limits;
+        if !(d > dm && d < dd) {
+            return None;
+        }
+        Scene::new(self.xi, d, self.rho, self.f, CollisionLaw::Adjusted)
+            .ok()
+            .and_then(|sc| crate::models::Model::Stick.evaluate(&sc).ok())
+            .map(|o| o.mean_velocity)
     }
 }
 
@@ -704,8 +754,8 @@ pub(crate) struct Plausibility {
     ratios: Vec<f64>,
     /// The largest `R_m` and its line.
     largest_radius: Option<(f64, u64)>,
-    /// δ_m and δ_d (degrees) of the last (ξ, ρ) seen.
-    limits: Option<((u64, u64), f64, f64)>,
+    /// δ_m and δ_d of the last (ξ, ρ) seen by [`Plausibility::add`].
+    limits: StopSlopes,
 }
 
 impl Plausibility {
@@ -723,46 +773,30 @@ impl Plausibility {
             largest: None,
             ratios: Vec::new(),
             largest_radius: None,
-            limits: None,
+            limits: StopSlopes::default(),
         }
     }
 
     /// Takes one validated row (`m` read from `r`).
     pub fn add(&mut self, r: &Row<'_>, m: &Measured) {
-        self.add_point(r, &PlausiblePoint::from(m));
+        let p = PlausiblePoint::new(m, &mut self.limits, false);
+        self.add_point(r, &p);
     }
 
     /// Takes one validated row (read from `r`) by what the checks need of it.
-    pub fn add_point(&mut self, r: &Row<'_>, m: &PlausiblePoint) {
-        use crate::models::regimes::{delta_d_law, delta_m_law};
-        use crate::models::ForwardModel;
-        let law = CollisionLaw::Adjusted;
-        let s = m;
-        let key = (s.xi.to_bits(), s.rho.to_bits());
-        let (dm, dd) = match self.limits {
-            Some((k, dm, dd)) if k == key => (dm, dd),
-            _ => {
-                let (a, rho) = (s.alpha, s.rho);
-                let dm = delta_m_law(a, law, rho).to_degrees();
-                let dd = delta_d_law(a, law, rho).to_degrees();
-                self.limits = Some((key, dm, dd));
-                (dm, dd)
-            }
-        };
+    pub fn add_point(&mut self, r: &Row<'_>, p: &PlausiblePoint) {
+        let (dm, dd) = p.limits;
         self.rows += 1;
-        let d = s.delta.to_degrees();
+        let d = p.delta.to_degrees();
         self.all_low &= d < SLOPE_FRACTION * dm;
         self.all_below_half_pi &= d < std::f64::consts::FRAC_PI_2;
         if self.largest.is_none_or(|l| d >= l.0) {
-            self.largest = Some((d, r.line, dm, s.xi));
+            self.largest = Some((d, r.line, dm, p.xi));
         }
         if self.ratios.len() < MAX_RATIOS && d > dm && d < dd {
-            let v = Scene::new(s.xi, d, s.rho, s.f, law)
-                .ok()
-                .and_then(|sc| crate::models::Model::Stick.evaluate(&sc).ok())
-                .map(|o| o.mean_velocity);
+            let v = p.paper_v.unwrap_or_else(|| p.rolling_v());
             if let Some(v) = v.filter(|&v| v > 0.0) {
-                self.ratios.push(m.v / v);
+                self.ratios.push(p.v / v);
             }
         }
         if let Some(x) = self.r_m.and_then(|c| r.cell(c).parse::<f64>().ok()) {
@@ -770,6 +804,12 @@ impl Plausibility {
                 self.largest_radius = Some((x, r.line));
             }
         }
+    }
+
+    /// Whether the velocity check has all the rows it takes (`MAX_RATIOS`): a later row's
+    /// [`PlausiblePoint::paper_v`] is not needed.
+    pub fn has_all_ratios(&self) -> bool {
+        self.ratios.len() >= MAX_RATIOS
     }
 
     /// The warnings so far, in the order slopes, velocities, radii, columns.

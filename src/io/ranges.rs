@@ -1,19 +1,19 @@
 //! A CSV table's rows cut into byte ranges that can be parsed in parallel: one thread reads
 //! the raw bytes and cuts them at record boundaries into ranges ([`Ranges::next_block`]);
-//! each range is parsed by its own `csv` reader ([`parse`]), with the line numbers, byte
+//! each range is parsed by a `csv` reader in the state of a new one ([`parse`]: the thread's
+//! reader, kept between ranges and reset to the range's start), with the line numbers, byte
 //! offsets, checks and messages of [`TableReader`](super::scenes::TableReader) reading the
 //! same input alone.
 //!
-//! A boundary is the position right after the byte that ends a record (`\n`, or the `\r` of
-//! `\r\n` or of a lone `\r`), where the `csv` reader begins the next record: a range that
-//! starts there is read by a fresh reader exactly as the one reader of the whole input reads
-//! it, and its positions are the whole input's less the range's start. The scan that finds
-//! boundaries follows the quoting as the `csv` reader does (a quote opens a cell only at the
-//! start of a field; `""` inside one is a quote), so a newline inside a quoted cell never
-//! cuts a record; it runs byte by byte only over a block of input that holds a quote, and
-//! otherwise looks only at line ends. A range's reader gets its first byte alone, so that it
-//! keeps the bytes of a UTF-8 byte order mark at the range's start, as the one reader does
-//! after the header.
+//! A boundary is the position right after the byte that ends a record (`\n`, or the `\r` of `\r\n`
+//! or of a lone `\r`), where the `csv` reader begins the next record: a range that starts there is
+//! read by a new (or reset) reader exactly as the one reader of the whole input reads it, and its
+//! positions are the whole input's less the range's start. The scan that finds boundaries follows
+//! the quoting as the `csv` reader does (a quote opens a cell only at the start of a field; `""`
+//! inside one is a quote), so a newline inside a quoted cell never cuts a record; it runs byte by
+//! byte only over a block of input that holds a quote, and otherwise looks only at line ends. A
+//! range's reader gets its first byte alone, so that it keeps the bytes of a UTF-8 byte order mark
+//! at the range's start, as the one reader does after the header.
 //!
 //! Errors keep their order once the ranges' results are taken in input order: a range stops
 //! at its first malformed row (a row whose field count differs from the header's, or with
@@ -23,7 +23,9 @@
 use super::csvsyntax::{csv_error, ragged_row, unterminated_quote, utf8_error, Quoting};
 use super::InputError;
 use rayon::prelude::*;
-use std::io::Read;
+use std::cell::RefCell;
+use std::io::{Read, Seek, SeekFrom};
+use std::sync::Arc;
 
 /// The fewest bytes read ahead at once.
 const MIN_BLOCK: usize = 64 * 1024;
@@ -300,9 +302,10 @@ impl<R: Read> Ranges<R> {
                 Next::End(None) => break,
             };
             let (source, width) = (self.source.as_str(), self.width);
+            let block = Arc::new(block);
             let parsed: Vec<Parsed> = spans
                 .par_iter()
-                .map(|s| parse(source, &block[s.start..s.end], *s, width, Vec::new()))
+                .map(|s| parse(source, &block, *s, width, Vec::new()))
                 .collect();
             for p in parsed {
                 rows += p.rows.len() as u64;
@@ -311,7 +314,7 @@ impl<R: Read> Ranges<R> {
                 }
                 records += p.records;
             }
-            bytes = block;
+            bytes = Arc::into_inner(block).unwrap_or_default();
         }
         (rows == 0).then(|| self.no_rows())
     }
@@ -501,36 +504,105 @@ fn scan_quoted(buf: &[u8], step: usize, quoting: Quoting, line: u64, opened: u64
     }
 }
 
-/// A range's bytes read with the first byte alone: the `csv` reader drops a byte order mark
-/// only when its first read holds one whole, which a range's first read then never does.
-struct FirstByteAlone<'a>(&'a [u8], bool);
+/// A range of a block of input as a reader: its first byte alone, so that the `csv` reader,
+/// which drops a UTF-8 byte order mark only when its first read holds one whole, keeps one at
+/// a range's start (as the one reader of the whole input does after the header).
+#[derive(Default)]
+struct RangeBytes {
+    block: Option<Arc<Vec<u8>>>,
+    at: usize,
+    end: usize,
+    first: bool,
+}
 
-impl Read for FirstByteAlone<'_> {
+impl Read for RangeBytes {
     fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
-        let n = if std::mem::take(&mut self.1) {
-            buf.len().min(1)
-        } else {
-            buf.len()
+        let Some(block) = &self.block else {
+            return Ok(0);
         };
-        self.0.read(&mut buf[..n])
+        let left = self.end - self.at;
+        let n = if std::mem::take(&mut self.first) {
+            buf.len().min(left).min(1)
+        } else {
+            buf.len().min(left)
+        };
+        buf[..n].copy_from_slice(&block[self.at..self.at + n]);
+        self.at += n;
+        Ok(n)
     }
 }
 
-/// Parses one range (`bytes`, at `at`'s offset and line of the input `source`) under a
+/// A new range is put in place before [`csv::Reader::seek_raw`] asks to go to its start, so
+/// the seek itself moves nothing.
+impl Seek for RangeBytes {
+    fn seek(&mut self, _: SeekFrom) -> std::io::Result<u64> {
+        Ok(0)
+    }
+}
+
+thread_local! {
+    /// This thread's `csv` reader of ranges, kept from one range to the next: building one
+    /// costs about 270,000 instructions (its state machine) and zeroes its buffer, as much as
+    /// parsing 250 rows (`valgrind --tool=callgrind`, `fitbead forward`, 512-row ranges).
+    static RANGE_READER: RefCell<Option<csv::Reader<RangeBytes>>> = const { RefCell::new(None) };
+}
+
+/// A reader at the start of a range of `block`, in the state of a new one: line 1, byte 0,
+/// record 0, no header, its byte order mark rule as on a new input.
+fn range_reader<'r>(
+    kept: &'r mut Option<csv::Reader<RangeBytes>>,
+    block: &Arc<Vec<u8>>,
+    start: usize,
+    end: usize,
+) -> &'r mut csv::Reader<RangeBytes> {
+    let rdr = kept.get_or_insert_with(|| {
+        let mut r = csv::ReaderBuilder::new()
+            .has_headers(false)
+            .flexible(true)
+            .buffer_capacity(1 << 16)
+            .from_reader(RangeBytes::default());
+        // With headers set, `seek_raw` reads none.
+        r.set_byte_headers(csv::ByteRecord::new());
+        r
+    });
+    *rdr.get_mut() = RangeBytes {
+        block: Some(Arc::clone(block)),
+        at: start,
+        end,
+        first: true,
+    };
+    // Cannot fail: the headers are set and the seek is `RangeBytes`'s.
+    let _ = rdr.seek_raw(SeekFrom::Start(0), csv::Position::new());
+    rdr
+}
+
+/// Parses one range (`span` of `block`, at its offset and line of the input `source`) under a
 /// header of `width` fields, reusing the records of `spare` (whatever their contents).
 pub(crate) fn parse(
     source: &str,
-    bytes: &[u8],
+    block: &Arc<Vec<u8>>,
+    at: Span,
+    width: usize,
+    spare: Vec<csv::StringRecord>,
+) -> Parsed {
+    RANGE_READER.with(|kept| {
+        let mut kept = kept.borrow_mut();
+        let rdr = range_reader(&mut kept, block, at.start, at.end);
+        let parsed = parse_with(rdr, source, at, width, spare);
+        // Let go of the block, which goes back to the stream's pool once every range is read.
+        rdr.get_mut().block = None;
+        parsed
+    })
+}
+
+fn parse_with(
+    rdr: &mut csv::Reader<RangeBytes>,
+    source: &str,
     at: Span,
     width: usize,
     mut spare: Vec<csv::StringRecord>,
 ) -> Parsed {
     let (byte, line) = (at.byte, at.line);
-    let mut rdr = csv::ReaderBuilder::new()
-        .has_headers(false)
-        .flexible(true)
-        .buffer_capacity((bytes.len() + 1).clamp(1 << 10, 1 << 16))
-        .from_reader(FirstByteAlone(bytes, true));
     let mut rows = Vec::with_capacity(spare.len());
     let mut rec = spare.pop().unwrap_or_default();
     let mut failure = None;

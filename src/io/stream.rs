@@ -3,8 +3,8 @@
 //!
 //! The engine is a pipeline of rayon tasks. One reading task at a time takes the next block
 //! of raw input and cuts it into ranges at record boundaries (a scan that follows the CSV
-//! quoting, so a quoted cell may hold newlines); each range becomes a task
-//! that parses it with its own `csv` reader, then checks, computes and formats its rows into
+//! quoting, so a quoted cell may hold newlines); each range becomes a task that parses it
+//! with a `csv` reader reset to its start, then checks, computes and formats its rows into
 //! its own byte buffer; whichever task finishes the range that is next in input order takes
 //! the finished ranges in order, keeps what the plan keeps across rows
 //! ([`RowPlan::record`]) and writes their bytes. Ranges of many blocks are in flight at once:
@@ -554,13 +554,7 @@ impl<R: Read + Send, P: RowPlan> Pipe<'_, R, P> {
                         failure: None,
                     }
                 } else {
-                    parse(
-                        &self.ctx.source,
-                        &block[span.start..span.end],
-                        span,
-                        self.width,
-                        spare,
-                    )
+                    parse(&self.ctx.source, &block, span, self.width, spare)
                 };
                 let end_byte = span.byte + (span.end - span.start) as u64;
                 if let Some(b) = Arc::into_inner(block) {

@@ -168,8 +168,15 @@ impl SceneColumns {
         ]
     }
 
-    /// The scene and model of one row, or the row's first bad value.
-    pub fn read(&self, r: &Row<'_>, s: &ForwardSettings) -> Result<(Scene, Model), InputError> {
+    /// The scene and model of one row, or the row's first bad value; what depends on ξ alone
+    /// is taken from `like` when it has the row's ξ ([`Scene::new_like`]: the same scene to
+    /// the last bit).
+    pub fn read(
+        &self,
+        r: &Row<'_>,
+        s: &ForwardSettings,
+        like: Option<&Scene>,
+    ) -> Result<(Scene, Model), InputError> {
         let xi = r.number(self.xi)?;
         let d = r.number(self.delta_deg)?;
         let law = match self.k {
@@ -187,7 +194,8 @@ impl SceneColumns {
         let rho = r.opt_number(self.rho)?.unwrap_or(s.rho);
         let f = r.opt_number(self.f)?.unwrap_or(s.f);
         let named = self.named();
-        let scene = Scene::new(xi, d, rho, f, law).map_err(|e| scene_error(r, e, &named))?;
+        let scene =
+            Scene::new_like(like, xi, d, rho, f, law).map_err(|e| scene_error(r, e, &named))?;
         let model = match (s.kind, s.kind.contact_model()) {
             (ModelKind::Auto, _) => Model::Auto(Auto { tol: s.tol }),
             (ModelKind::Contact, _) => {
@@ -439,7 +447,8 @@ impl RowPlan for ForwardPlan {
     type Ready = Job;
     type Ledger = ();
     type Note = ();
-    type Scratch = ();
+    /// The last scene read, whose quantities of ξ alone the next row of the same ξ reuses.
+    type Scratch = Option<Scene>;
 
     fn header(&self, out: &mut Vec<u8>) {
         let mut w = Cells::new(out);
@@ -454,12 +463,13 @@ impl RowPlan for ForwardPlan {
         w.end();
     }
 
-    fn prepare(&self, row: &Row<'_>, _: &mut ()) -> Result<Job, InputError> {
-        let (scene, model) = self.cols.read(row, &self.settings)?;
+    fn prepare(&self, row: &Row<'_>, last: &mut Option<Scene>) -> Result<Job, InputError> {
+        let (scene, model) = self.cols.read(row, &self.settings, last.as_ref())?;
+        *last = Some(scene);
         Ok(Job { scene, model })
     }
 
-    fn write(&self, row: &Row<'_>, job: Job, _: &mut (), out: &mut Vec<u8>) {
+    fn write(&self, row: &Row<'_>, job: Job, _: &mut Option<Scene>, out: &mut Vec<u8>) {
         let (common, contact, auto) = ForwardRecord::evaluate(&job.scene, &job.model);
         let kind = self.settings.kind;
         let mut w = Cells::new(out);

@@ -111,7 +111,7 @@ impl Default for ForwardSettings {
 }
 
 /// Where the scene columns are in a table.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub(crate) struct SceneColumns {
     /// `xi`.
     pub xi: usize,
@@ -131,8 +131,9 @@ pub(crate) struct SceneColumns {
     pub a: [Option<usize>; 3],
     /// `spin`.
     pub spin: Option<usize>,
-    /// The columns of `SCENE_CELL_COLUMNS`, in its order (checked on every row).
-    pub cells: [Option<usize>; 23],
+    /// The columns of `SCENE_CELL_COLUMNS` that the table has, with their names, in that
+    /// order (checked on every row).
+    pub cells: Vec<(&'static str, usize)>,
 }
 
 impl SceneColumns {
@@ -148,7 +149,10 @@ impl SceneColumns {
             mu: reader.col("mu"),
             a: [reader.col("a1"), reader.col("a2"), reader.col("a3")],
             spin: reader.col("spin"),
-            cells: SCENE_CELL_COLUMNS.map(|n| reader.col(n)),
+            cells: SCENE_CELL_COLUMNS
+                .into_iter()
+                .filter_map(|n| reader.col(n).map(|c| (n, c)))
+                .collect(),
         })
     }
 
@@ -238,7 +242,7 @@ impl SceneColumns {
                 )
             }
         };
-        check_cells(r, SCENE_CELL_COLUMNS.into_iter().zip(self.cells))?;
+        check_cells(r, self.cells.iter().map(|&(n, c)| (n, Some(c))))?;
         Ok((scene, model))
     }
 }

@@ -152,7 +152,7 @@ pub(crate) struct Measured {
 #[derive(Debug, Clone, Default)]
 pub(crate) struct SeriesLedger {
     /// The first ξ of each series and its line. Hashed with FxHash, not SipHash: it is looked
-    /// up once per row in input order, where every instruction holds up the other threads.
+    /// up once per row on the ordered side of the stream, one thread at a time.
     first_xi: rustc_hash::FxHashMap<String, (f64, u64)>,
     /// The last series checked, with its first ξ and line.
     last: Option<(String, f64, u64)>,

@@ -288,8 +288,9 @@ pub struct AtomicFile {
 }
 
 /// Bytes written to a temporary file between two background syncs of its data (64 KiB in the
-/// unit tests, so that a small file goes through several).
-const EARLY_SYNC_BYTES: u64 = if cfg!(test) { 64 << 10 } else { 64 << 20 };
+/// unit tests, so that a small file goes through several); the size was chosen by
+/// whole-process timings against 2 and 64 MiB (docs/PERFORMANCE.md, "Thread scaling").
+const EARLY_SYNC_BYTES: u64 = if cfg!(test) { 64 << 10 } else { 8 << 20 };
 
 /// Syncs a temporary file's data to disk on a thread of its own each [`EARLY_SYNC_BYTES`]
 /// written, so that [`AtomicFile::commit`]'s final sync has only the last of them to wait for

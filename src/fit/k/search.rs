@@ -39,9 +39,8 @@ impl Seed {
         let s0 = s_of(k0);
         let (a1, a2) = (s_of(pts[0].0) - s0, s_of(pts[1].0) - s0);
         let (f0, f1, f2) = (v0, pts[0].1, pts[1].1);
-        // First and second derivatives at s0 of the quadratic through the three points.
-        let d1 =
-            -f0 * (a1 + a2) / (a1 * a2) + f1 * a2 / (a1 * (a2 - a1)) - f2 * a1 / (a2 * (a2 - a1));
+        let d1 = quadratic_slope((f0, f1, f2), a1, a2);
+        // The second derivative of the same quadratic.
         let d2 = 2.0 * (f0 / (a1 * a2) + f1 / (a1 * (a1 - a2)) + f2 / (a2 * (a2 - a1)));
         let step1 = (v - v0) / d1;
         let step2 = step1 - 0.5 * d2 * step1 * step1 / d1;
@@ -536,6 +535,12 @@ pub(crate) fn estimate_in_k(
     }
 }
 
+/// f′(x0) of the quadratic through (x0, f0), (x0 + a1, f1) and (x0 + a2, f2): the three-point
+/// Lagrange derivative on any spacing.
+fn quadratic_slope((f0, f1, f2): (f64, f64, f64), a1: f64, a2: f64) -> f64 {
+    -f0 * (a1 + a2) / (a1 * a2) + f1 * a2 / (a1 * (a2 - a1)) - f2 * a1 / (a2 * (a2 - a1))
+}
+
 /// dv̄/dK at K = `k0` inside the bracket `br`, where v̄ = `v0`, from `v_at` (v̄ at a K, or
 /// `None` where there is no steady state) at K_min + d e^{±h}, d = K − K_min, h = 1e-5
 /// (steps uniform in s = ln(K − K_min), which keeps their size right where the slope in K is
@@ -572,9 +577,8 @@ pub(crate) fn dv_dk(
         return None;
     }
     let (v1, v2) = (v_at(k1)?, v_at(k2)?);
-    // f'(x0) of the quadratic through (x0, f0), (x1, f1), (x2, f2).
     let (a1, a2) = (k1 - k0, k2 - k0);
-    let dv = -v0 * (a1 + a2) / (a1 * a2) + v1 * a2 / (a1 * (a2 - a1)) - v2 * a1 / (a2 * (a2 - a1));
+    let dv = quadratic_slope((v0, v1, v2), a1, a2);
     dv.is_finite().then_some(dv)
 }
 

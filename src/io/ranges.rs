@@ -465,11 +465,22 @@ fn scan_quoted(buf: &[u8], step: usize, quoting: Quoting, line: u64, opened: u64
         let plain = matches!(csv, Csv::RecordStart | Csv::FieldStart | Csv::Unquoted)
             && matches!(q, Quoting::FieldStart | Quoting::Unquoted);
         if plain {
-            let j = memchr::memchr3(b'"', b'\n', b'\r', &buf[i..]).map_or(n, |k| i + k);
+            // Up to the next quote, line ends are the only bytes that end records: the
+            // stretch is taken whole (`plain_stretch`).
+            let j = memchr::memchr(b'"', &buf[i..]).map_or(n, |k| i + k);
             if j > i {
-                // A comma or another byte, neither of which ends a record.
+                let st = plain_stretch(buf, i, j, csv, step, &mut cuts);
+                line += st.lines;
+                if let Some(end) = st.last_end {
+                    last = Some((end, Quoting::FieldStart, op));
+                }
+                // The last byte sets both machines' states, whatever came before it.
                 let b = buf[j - 1];
-                csv = csv.step(b).0;
+                csv = if is_end(b) {
+                    Csv::RecordStart
+                } else {
+                    csv.step(b).0
+                };
                 q = q.step(b, line, &mut op);
             }
             i = j;
@@ -501,6 +512,71 @@ fn scan_quoted(buf: &[u8], step: usize, quoting: Quoting, line: u64, opened: u64
         last,
         quoting: q,
         opened: op,
+    }
+}
+
+/// What [`plain_stretch`] finds.
+struct Stretch {
+    /// Newlines in the stretch.
+    lines: u64,
+    /// The position after the stretch's last record end.
+    last_end: Option<usize>,
+}
+
+/// The record ends of `buf[i..j]`, a stretch with no quote in which the `csv` reader is
+/// outside a quoted cell, starting in state `csv`: a line end ends a record unless the reader
+/// is before a record there, i.e. unless it is the stretch's first byte with `csv` at a
+/// record's start, or follows another line end. Pushes onto `cuts` each record end at least
+/// `step` bytes after the last cut, as the byte-by-byte scan does, looking only near those
+/// positions; counts the newlines.
+fn plain_stretch(
+    buf: &[u8],
+    i: usize,
+    j: usize,
+    csv: Csv,
+    step: usize,
+    cuts: &mut Vec<usize>,
+) -> Stretch {
+    let ends = |p: usize| {
+        if p == i {
+            csv != Csv::RecordStart
+        } else {
+            !is_end(buf[p - 1])
+        }
+    };
+    // The first record end at or after `from`, before j.
+    let next_end = |mut from: usize| {
+        while let Some(k) = buf
+            .get(from..j)
+            .and_then(|b| memchr::memchr2(b'\n', b'\r', b))
+        {
+            let p = from + k;
+            if ends(p) {
+                return Some(p);
+            }
+            from = p + 1;
+        }
+        None
+    };
+    loop {
+        let want = cuts[cuts.len() - 1] + step;
+        // A record end at p gives a cut at p + 1 >= want.
+        match next_end(want.saturating_sub(1).max(i)) {
+            Some(p) => cuts.push(p + 1),
+            None => break,
+        }
+    }
+    let mut hi = j;
+    let last_end = loop {
+        match memchr::memrchr2(b'\n', b'\r', &buf[i..hi]) {
+            Some(k) if ends(i + k) => break Some(i + k + 1),
+            Some(k) => hi = i + k,
+            None => break None,
+        }
+    };
+    Stretch {
+        lines: newlines(&buf[i..j]),
+        last_end,
     }
 }
 
@@ -686,17 +762,57 @@ mod tests {
         }
     }
 
-    #[test]
-    fn the_jumping_scan_finds_what_the_byte_scan_finds() {
-        let mut rng = ChaCha8Rng::seed_from_u64(35);
-        // Bytes that steer the machines, and two that do not.
-        let alphabet = b"\",\n\rab";
+    /// [`scan_quoted`] of `buf` against [`scan_bytes`], from a start state and lines drawn
+    /// from `rng` (the start state cycling with `case`); the byte scan's result.
+    fn scan_as_bytes(rng: &mut ChaCha8Rng, buf: &[u8], step: usize, case: usize) -> Scan {
         let starts = [
             Quoting::FieldStart,
             Quoting::Unquoted,
             Quoting::Quoted,
             Quoting::QuoteInQuoted,
         ];
+        let q = starts[case % starts.len()];
+        let (line, opened) = (rng.random_range(1..5), rng.random_range(0..5));
+        let want = scan_bytes(buf, step, q, line, opened);
+        let got = scan_quoted(buf, step, q, line, opened);
+        assert_eq!(
+            got,
+            want,
+            "{:?}, step {step}, from {q:?}",
+            String::from_utf8_lossy(buf)
+        );
+        want
+    }
+
+    /// Long quote-free stretches of many lines (a quote every ~150 bytes), the shape of a
+    /// table with an occasional quoted cell: [`plain_stretch`] takes them whole.
+    #[test]
+    fn the_scan_of_long_plain_stretches_is_the_byte_scan() {
+        let mut rng = ChaCha8Rng::seed_from_u64(36);
+        let mut cuts = 0;
+        for case in 0..5_000 {
+            let len = rng.random_range(0..600);
+            let buf: Vec<u8> = (0..len)
+                .map(|_| match rng.random_range(0..300) {
+                    0 | 1 => b'"',
+                    2..=19 => b'\n',
+                    20..=23 => b'\r',
+                    24..=79 => b',',
+                    _ => b'7',
+                })
+                .collect();
+            let step = rng.random_range(1..80);
+            cuts += scan_as_bytes(&mut rng, &buf, step, case).cuts.len();
+        }
+        // Most cases cut their stretches several times.
+        assert!(cuts > 20_000, "{cuts}");
+    }
+
+    #[test]
+    fn the_jumping_scan_finds_what_the_byte_scan_finds() {
+        let mut rng = ChaCha8Rng::seed_from_u64(35);
+        // Bytes that steer the machines, and two that do not.
+        let alphabet = b"\",\n\rab";
         let mut quoted_ends = 0;
         for case in 0..20_000 {
             let len = rng.random_range(0..64);
@@ -712,16 +828,7 @@ mod tests {
                 buf.extend(std::iter::repeat_n(b, run));
             }
             let step = rng.random_range(1..16);
-            let q = starts[case % starts.len()];
-            let (line, opened) = (rng.random_range(1..5), rng.random_range(0..5));
-            let want = scan_bytes(&buf, step, q, line, opened);
-            let got = scan_quoted(&buf, step, q, line, opened);
-            assert_eq!(
-                got,
-                want,
-                "{:?}, step {step}, from {q:?}",
-                String::from_utf8_lossy(&buf)
-            );
+            let want = scan_as_bytes(&mut rng, &buf, step, case);
             quoted_ends += usize::from(want.quoting == Quoting::Quoted);
         }
         // The cases reach every kind of ending, a quoted cell still open among them.

@@ -347,7 +347,7 @@ impl<R: Read> Ranges<R> {
         let eof = self.eof && self.read_error.is_none();
         let mut cuts = vec![0];
         let (end, quoting, opened);
-        if buf.contains(&b'"') {
+        if memchr::memchr(b'"', buf).is_some() {
             // Following the quoting of the `csv` reader and of the watch.
             let sc = scan_quoted(buf, step, self.quoting, self.line, self.opened);
             cuts = sc.cuts;

@@ -1,10 +1,8 @@
 //! Forward-model benchmarks: one evaluation of each model on scenes across regime B.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use fitbead::bench_internals::rf;
+use fitbead::bench_internals::{python_bench_scenes, rf, rf_lanes};
 use fitbead::{CollisionLaw, ForwardModel, Model, Scene};
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
 
 fn scenes() -> Vec<Scene> {
     let mut v = Vec::new();
@@ -22,43 +20,12 @@ fn scenes() -> Vec<Scene> {
     v
 }
 
-/// `n` random scenes as python/bench/bench_forward.py draws them (ξ in [0.8, 3], the adjusted
-/// law's K as a number, ρ = 0.4 on half of them and in [0.2, 0.7] on the others, f = 0.1; δ 90 %
-/// in (δ_m, δ_d), 5 % below δ_m, 5 % above δ_d): (ξ, δ in degrees, K, ρ).
-fn random_scenes(n: usize) -> Vec<(f64, f64, f64, f64)> {
-    let mut rng = ChaCha8Rng::seed_from_u64(20251125);
-    (0..n)
-        .map(|_| {
-            let xi: f64 = rng.random_range(0.8..3.0);
-            let rho = if rng.random::<f64>() < 0.5 {
-                0.4
-            } else {
-                rng.random_range(0.2..0.7f64)
-            };
-            let a = (1.0 / (1.0 + xi)).asin();
-            let k = (2.0 * a).cos() + 0.5 * a.sin().powi(2) * (2.0 * a).sin();
-            let dm = 2.0 * ((a / 2.0).tan() * (1.0 - k) / (1.0 + k)).atan();
-            let c = (1.0 + rho) * (1.0 - k * k);
-            let dd = (c / (a.tan() * (4.0 + c))).atan();
-            let (u, class) = (rng.random::<f64>(), rng.random::<f64>());
-            let d = if class < 0.9 {
-                dm + u * (dd - dm)
-            } else if class < 0.95 {
-                dm * (0.5 + 0.5 * u)
-            } else {
-                dd + u * ((1.5 * dd).min(89f64.to_radians()) - dd)
-            };
-            (xi, d.to_degrees(), k, rho)
-        })
-        .collect()
-}
-
 fn bench(c: &mut Criterion) {
     let s = scenes();
     let n = s.len() as u64;
     // The stick model with its scene built per row from (ξ, δ°, K, ρ, f) as `forward` and the
     // Python binding build it: the exact per-scene work without reading or writing anything.
-    let random = random_scenes(100_000);
+    let random = python_bench_scenes(100_000);
     let mut g = c.benchmark_group("random scenes");
     g.throughput(criterion::Throughput::Elements(random.len() as u64));
     g.sample_size(20);
@@ -184,6 +151,20 @@ fn bench(c: &mut Criterion) {
     c.bench_function("carlson-rf", |b| {
         b.iter(|| rf(black_box(0.3), black_box(1.2), black_box(0.7)))
     });
+    // Four independent R_F (arguments of the size the stick model's across-the-top halves
+    // take), one after the other and side by side: what `rf_lanes` overlaps.
+    let four = [
+        [0.3, 1.2, 0.7],
+        [0.05, 0.9, 1.4],
+        [0.6, 0.4, 2.1],
+        [0.2, 1.7, 0.35],
+    ];
+    let mut g = c.benchmark_group("carlson-rf x4");
+    g.bench_function("one at a time", |b| {
+        b.iter(|| black_box(four).map(|[x, y, z]| rf(x, y, z)))
+    });
+    g.bench_function("rf_lanes", |b| b.iter(|| rf_lanes(black_box(four))));
+    g.finish();
 }
 
 criterion_group!(benches, bench);

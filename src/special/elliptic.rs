@@ -177,7 +177,7 @@ pub fn cos_integral_pair(h0: SinCos, h1: SinCos, a: [f64; 3], b: [f64; 3], den: 
 /// 1.3 times one, four about 1.4 times two; docs/PERFORMANCE.md); elsewhere `N` calls of
 /// [`rf`].
 #[inline]
-pub(crate) fn rf_lanes<const N: usize>(a: [[f64; 3]; N]) -> [f64; N] {
+pub fn rf_lanes<const N: usize>(a: [[f64; 3]; N]) -> [f64; N] {
     if !a.iter().all(|t| in_range(*t)) {
         return a.map(|[x, y, z]| rf(x, y, z));
     }

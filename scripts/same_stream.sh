@@ -5,6 +5,10 @@
 #
 # Usage: scripts/same_stream.sh OLD_BINARY NEW_BINARY [WORKDIR] [--big]
 #   REUSE=1 keeps the outputs of an earlier run in WORKDIR (of binaries of the same names).
+#   The new binary's outputs of a case that does not differ are removed (they are the old
+#   binary's, byte for byte; the old binary's stay for REUSE): KEEP=1 keeps them too. The
+#   outputs take several GB (about 3 GB a binary without --big); the last line gives their
+#   size.
 #   --big adds the large inputs (k stick on 5,000,000 simulated rows, forward stick on
 #   1,000,000), minutes of work.
 # Prints one line per differing case and a count; exits 1 when any case differs.
@@ -127,7 +131,11 @@ case_() { # name args... (a literal OUT is replaced by an --output path)
     local d=""
     for s in stdout stderr rc; do cmp -s "$po.$s" "$pn.$s" || d="$d $s"; done
     if [ -f "$po.file" ] || [ -f "$pn.file" ]; then cmp -s "$po.file" "$pn.file" 2>/dev/null || d="$d file"; fi
-    if [ -n "$d" ]; then bad=$((bad + 1)); echo "DIFFERS: $name threads=$t:$d"; fi
+    if [ -n "$d" ]; then
+      bad=$((bad + 1)); echo "DIFFERS: $name threads=$t:$d"
+    elif [ "${KEEP:-0}" != 1 ]; then
+      rm -f "$pn.stdout" "$pn.stderr" "$pn.rc" "$pn.file"
+    fi
   done
 }
 [ "$(basename "$old")" = "$(basename "$new")" ] && { echo "give the binaries different names"; exit 2; }
@@ -162,4 +170,5 @@ if [ $big = 1 ]; then
   case_ f1m_stick forward --model stick --input "$in/f1m.csv" OUT
 fi
 echo "$n cases, $bad differ"
+echo "outputs kept in $work/out: $(du -sh "$work/out" | cut -f1) (remove the directory when done)"
 [ $bad = 0 ]

@@ -181,8 +181,9 @@ fn is_end(b: u8) -> bool {
     b == b'\n' || b == b'\r'
 }
 
-/// In a block that starts before a record and holds no quote: whether the line end at `i`
-/// ends a record (the byte before it is on the same, non-blank line).
+/// In a stretch of input with no quote, outside a quoted cell: whether the line end at `i`,
+/// not the stretch's first byte, ends a record (the byte before it is on the same, non-blank
+/// line).
 fn ends_record(buf: &[u8], i: usize) -> bool {
     i >= 1 && is_end(buf[i]) && !is_end(buf[i - 1])
 }
@@ -357,22 +358,9 @@ impl<R: Read> Ranges<R> {
                 (end, quoting, opened) = sc.last?;
             }
         } else {
-            // No quote: a record ends at every line end that follows a byte of its line.
-            let last = if eof {
-                Some(buf.len())
-            } else {
-                let mut hi = buf.len();
-                loop {
-                    let Some(i) = buf[..hi].iter().rposition(|&b| is_end(b)) else {
-                        break None;
-                    };
-                    if ends_record(buf, i) {
-                        break Some(i + 1);
-                    }
-                    hi = i;
-                }
-            };
-            end = last?;
+            // No quote: the block is one quote-free stretch from a record's start.
+            let last = plain_stretch(buf, 0, buf.len(), Csv::RecordStart, step, &mut cuts);
+            end = if eof { buf.len() } else { last? };
             // The watch sees no quote either: a quoted cell open before stays open.
             quoting = match (self.quoting, end.checked_sub(1).map(|i| buf[i])) {
                 (Quoting::Quoted, _) => Quoting::Quoted,
@@ -381,22 +369,6 @@ impl<R: Read> Ranges<R> {
                 (_, Some(_)) => Quoting::Unquoted,
             };
             opened = self.opened;
-            let mut at = step;
-            while at < end {
-                let next = buf[at..end]
-                    .iter()
-                    .enumerate()
-                    .filter(|&(_, &b)| is_end(b))
-                    .map(|(k, _)| at + k)
-                    .find(|&i| ends_record(buf, i));
-                match next {
-                    Some(i) if i + 1 < end => {
-                        cuts.push(i + 1);
-                        at = i + 1 + step;
-                    }
-                    _ => break,
-                }
-            }
         }
         if end == 0 {
             return eof.then_some(Cut {
@@ -469,11 +441,10 @@ fn scan_quoted(buf: &[u8], step: usize, quoting: Quoting, line: u64, opened: u64
             // stretch is taken whole (`plain_stretch`).
             let j = memchr::memchr(b'"', &buf[i..]).map_or(n, |k| i + k);
             if j > i {
-                let st = plain_stretch(buf, i, j, csv, step, &mut cuts);
-                line += st.lines;
-                if let Some(end) = st.last_end {
+                if let Some(end) = plain_stretch(buf, i, j, csv, step, &mut cuts) {
                     last = Some((end, Quoting::FieldStart, op));
                 }
+                line += newlines(&buf[i..j]);
                 // The last byte sets both machines' states, whatever came before it.
                 let b = buf[j - 1];
                 csv = if is_end(b) {
@@ -515,20 +486,13 @@ fn scan_quoted(buf: &[u8], step: usize, quoting: Quoting, line: u64, opened: u64
     }
 }
 
-/// What [`plain_stretch`] finds.
-struct Stretch {
-    /// Newlines in the stretch.
-    lines: u64,
-    /// The position after the stretch's last record end.
-    last_end: Option<usize>,
-}
-
 /// The record ends of `buf[i..j]`, a stretch with no quote in which the `csv` reader is
 /// outside a quoted cell, starting in state `csv`: a line end ends a record unless the reader
 /// is before a record there, i.e. unless it is the stretch's first byte with `csv` at a
-/// record's start, or follows another line end. Pushes onto `cuts` each record end at least
-/// `step` bytes after the last cut, as the byte-by-byte scan does, looking only near those
-/// positions; counts the newlines.
+/// record's start, or follows another line end ([`ends_record`]). Pushes onto `cuts` each
+/// record end at least `step` bytes after the last cut, as the byte-by-byte scan does,
+/// looking only near those positions; returns the position after the stretch's last record
+/// end.
 fn plain_stretch(
     buf: &[u8],
     i: usize,
@@ -536,12 +500,12 @@ fn plain_stretch(
     csv: Csv,
     step: usize,
     cuts: &mut Vec<usize>,
-) -> Stretch {
+) -> Option<usize> {
     let ends = |p: usize| {
         if p == i {
             csv != Csv::RecordStart
         } else {
-            !is_end(buf[p - 1])
+            ends_record(buf, p)
         }
     };
     // The first record end at or after `from`, before j.
@@ -558,25 +522,17 @@ fn plain_stretch(
         }
         None
     };
-    loop {
-        let want = cuts[cuts.len() - 1] + step;
-        // A record end at p gives a cut at p + 1 >= want.
-        match next_end(want.saturating_sub(1).max(i)) {
-            Some(p) => cuts.push(p + 1),
-            None => break,
-        }
+    // A record end at p gives a cut at p + 1 >= the last cut + step.
+    while let Some(p) = next_end((cuts[cuts.len() - 1] + step).saturating_sub(1).max(i)) {
+        cuts.push(p + 1);
     }
     let mut hi = j;
-    let last_end = loop {
+    loop {
         match memchr::memrchr2(b'\n', b'\r', &buf[i..hi]) {
-            Some(k) if ends(i + k) => break Some(i + k + 1),
+            Some(k) if ends(i + k) => return Some(i + k + 1),
             Some(k) => hi = i + k,
-            None => break None,
+            None => return None,
         }
-    };
-    Stretch {
-        lines: newlines(&buf[i..j]),
-        last_end,
     }
 }
 

@@ -21,7 +21,8 @@ pub fn replot(csv_bytes: &[u8], title: &str) -> Result<String, String> {
 
 /// `n` random scenes as python/bench/bench_forward.py draws them (ξ in [0.8, 3], the adjusted
 /// law's K as a number, ρ = 0.4 on half of them and in [0.2, 0.7] on the others, f = 0.1; δ 90 %
-/// in (δ_m, δ_d), 5 % below δ_m, 5 % above δ_d): (ξ, δ in degrees, K, ρ).
+/// in (δ_m, δ_d), 5 % below δ_m, 5 % above δ_d, with δ_m of eq 32 and δ_d of eq 31): (ξ, δ in
+/// degrees, K, ρ).
 pub fn python_bench_scenes(n: usize) -> Vec<(f64, f64, f64, f64)> {
     use rand::{Rng, SeedableRng};
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(20251125);

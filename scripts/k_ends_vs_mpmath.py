@@ -1,13 +1,14 @@
 #!/usr/bin/env python3
-"""K_lo and K_hi of two `fitbead k --model stick` outputs of the same input, held against
-mpmath: for the cells where the two differ, the root of v̄(K) = v ∓ σ solved at 40 digits with
+"""K, K_lo and K_hi of two `fitbead k --model stick` outputs of the same input, held against
+mpmath: for the cells where the two differ, the root of v̄(K) = v (K) or v ∓ σ solved at 40 digits with
 the reference stick model of tests/reference/make_refs.py (its tanh-sinh quadrature of the
 contact time), and the relative error of each output.
 
-Usage: scripts/k_ends_vs_mpmath.py OLD.csv NEW.csv [N]
+Usage: scripts/k_ends_vs_mpmath.py OLD.csv NEW.csv [N] [COLUMNS]
   Takes the N cells that differ most (default 12) and N more spread over the rest; prints one
   line per cell and, at the end, the largest error of each output and how often each is the
-  closer. Needs mpmath. Run from the crate root.
+  closer. COLUMNS, comma-separated, are the outputs compared (default K_lo,K_hi; K is the root
+  at v itself). Needs mpmath. Run from the crate root.
 
 The root is bisected at 40 digits in [K (1 - 1e-8), K (1 + 1e-8)] around the old value (a
 cell whose root is not there is reported and skipped); v and σ are the doubles of the input,
@@ -54,6 +55,7 @@ def main():
     if len(sys.argv) < 3:
         sys.exit(__doc__)
     n = int(sys.argv[3]) if len(sys.argv) > 3 else 12
+    columns = sys.argv[4].split(",") if len(sys.argv) > 4 else ["K_lo", "K_hi"]
     old = list(csv.DictReader(open(sys.argv[1])))
     new = list(csv.DictReader(open(sys.argv[2])))
     if len(old) != len(new):
@@ -62,7 +64,7 @@ def main():
     for ro, rn in zip(old, new):
         if ro.get("model") != "stick":
             continue
-        for c in ("K_lo", "K_hi"):
+        for c in columns:
             if ro[c] != rn[c] and ro[c] and rn[c]:
                 x, y = float(ro[c]), float(rn[c])
                 cells.append((abs(x - y) / max(abs(x), abs(y)), c, ro, rn))
@@ -75,8 +77,8 @@ def main():
     for change, c, ro, rn in pick:
         # An empty (or absent) rho is the command's default, 0.4 (a run without --rho).
         xi, dd, rho = float(ro["xi"]), float(ro["delta_deg"]), float(ro.get("rho") or 0.4)
-        v, s = float(ro["v"]), float(ro["sigma_v"])
-        target = v - s if c == "K_lo" else v + s
+        v, s = float(ro["v"]), float(ro["sigma_v"] or "nan")
+        target = {"K": v, "K_lo": v - s, "K_hi": v + s}[c]
         ref = root(xi, dd * (math.pi / 180), rho, target, float(ro[c]))
         if ref is None:
             print(f"{c} {ro[c]}: no root within 1e-8 of it")

@@ -67,6 +67,13 @@ fn slip_contact_sq(scene: &Scene, w0sq: f64) -> f64 {
     slip_contact_sq_at(scene, w0sq, scene.theta_f)
 }
 
+/// Whether a rolling model's analytic bracket (closed form, eqs 30a and 32) is empty, so
+/// that [`bracket`] fails before any forward evaluation; `false` for the other models.
+pub(crate) fn empty_rolling_bracket(model: &Model, scene: &Scene) -> bool {
+    matches!(model, Model::Stick | Model::StickApprox)
+        && !candidate(model, scene).is_some_and(|(lo, hi, _)| lo < hi)
+}
+
 /// Analytic candidate bracket (lo, hi, lower kind); `None` when it is empty.
 fn candidate(model: &Model, scene: &Scene) -> Option<(f64, f64, LowerLimit)> {
     let s0 = scene.sc_half_0.s;

@@ -2,7 +2,7 @@
 //! elsewhere.
 
 use super::launch;
-use super::search::estimate_in_k;
+use super::search::estimate_in_k_or;
 use super::types::KEstimate;
 use crate::models::Model;
 use crate::scene::Scene;
@@ -13,5 +13,8 @@ pub fn estimate(model: &Model, scene: &Scene, v: f64, sigma_v: Option<f64>) -> K
     if let Some(e) = launch::estimate(model, scene, v, sigma_v) {
         return e;
     }
-    estimate_in_k(model, scene, v, sigma_v)
+    // Stick with Θ0 > 0: the same in w0², on the general search's bracket.
+    estimate_in_k_or(model, scene, v, sigma_v, |scene, br| {
+        launch::estimate_past_top(model, scene, br, v, sigma_v)
+    })
 }

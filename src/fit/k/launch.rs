@@ -23,9 +23,17 @@
 //! (`UpperLimit::Model`), each root is checked against the forward model (it must settle on the
 //! stable fixed point found here), and measurements within 1e-6 of the fastest stable motion
 //! are left to the general search, where the forward model's own fixed-point search gives out.
+//! Rolling rows above the steady range are reported here too: no root, K_lo and K_hi by the
+//! rule of every row.
+//!
+//! For stick with Θ0 > 0 (δ > α) the contact starts past the top: every w0 ≥ 0 reaches Θf, K
+//! runs from 0 (w0 = 0, a finite contact time τ0) to lift-off, and τ is smooth in u = ln w0²,
+//! tending to τ0 as u → −∞ (`estimate_past_top`). The same secant runs there, from τ linear in
+//! w0 between τ0 and lift-off, on the general search's bracket (whose statuses and ends it
+//! keeps); measurements within 1e-6 of either end of the range are left to that search.
 //! Elsewhere [`super::estimate()`](super::estimate::estimate) uses its general bracketing search in K.
 
-use super::types::{KBracket, KEstimate, KRoot, LowerLimit, UpperLimit};
+use super::types::{KBracket, KEstimate, KFailure, KRoot, LowerLimit, UpperLimit};
 use crate::models::regimes::theta_g;
 use crate::models::stickslip::{self, Branch};
 use crate::models::{Model, NotSteady, Phases, Steady};
@@ -72,6 +80,9 @@ struct Launch<'a> {
     /// K(w0) rises to a maximum below lift-off (a saddle-node of the final-velocity map):
     /// `y_d` is that maximum, the end of the stable branch.
     saddle: bool,
+    /// Rolling with Θ0 > 0 ([`Launch::past_top`]): y is w0² itself, K_min = 0, and the range
+    /// is the general search's bracket, whose ends this path leaves to that search.
+    past_top: bool,
 }
 
 /// The contact time in the asinh approximation (eq 29) as a function of y:
@@ -116,6 +127,7 @@ impl<'a> Launch<'a> {
             y_d: 0.0,
             k_min: -s0 / scene.sc_half_f.s,
             saddle: false,
+            past_top: false,
         };
         match mech {
             Mechanics::Roll => {
@@ -202,6 +214,27 @@ impl<'a> Launch<'a> {
             }
         }
         (l.y_d > 0.0 && l.k_min < l.k_of_launch(l.y_d)?).then_some(l)
+    }
+
+    /// Rolling launches when the contact starts past the top (Θ0 > 0): every w0 ≥ 0 carries the
+    /// bead to Θf, so the unknown is y = w0² (no crawl: `wc2` = 0) from K_min = 0 (w0 = 0,
+    /// where the contact time is finite) to lift-off, y_d = cos Θf − 2B sin δ sin α (eq 30a).
+    fn past_top(scene: &'a Scene) -> Option<Self> {
+        if !(scene.sc_half_0.s > 0.0) {
+            return None;
+        }
+        let drop = 2.0 * scene.b * scene.sin_delta_sin_alpha();
+        let y_d = scene.sc_f.c - drop;
+        (y_d > 0.0).then_some(Launch {
+            scene,
+            mech: Mechanics::Roll,
+            wc2: 0.0,
+            drop,
+            y_d,
+            k_min: 0.0,
+            saddle: false,
+            past_top: true,
+        })
     }
 
     /// Launch and final speeds without the contact time.
@@ -456,6 +489,10 @@ struct Secant {
     tau_star: f64,
     slope0: f64,
     curv: Option<f64>,
+    /// Where |τ − τ*| falls to the rounding of τ: return the secant step from the last two
+    /// iterates (unevaluated), not the iterate itself. Where τ is flat in u (launches from
+    /// rest at small K) that step is closer to the root than the iterate's rounding band.
+    refine: bool,
     /// Bracket: g = τ − τ* > 0 below the root (slower), < 0 above.
     lo: f64,
     hi: f64,
@@ -486,6 +523,7 @@ impl Secant {
             tau_star,
             slope0,
             curv,
+            refine: false,
             lo: f64::NEG_INFINITY,
             hi: u_d,
             x,
@@ -516,6 +554,12 @@ impl Secant {
         let gx = p.tau - tau_star;
         // |τ − τ*| at the rounding level of τ itself: no iterate can do better.
         if gx.abs() <= 4.0 * f64::EPSILON * tau_star {
+            if let Some((xp, gp)) = self.prev.filter(|&(_, gp)| self.refine && gp != gx) {
+                let next = x - gx * (x - xp) / (gx - gp);
+                if next > self.lo && next < self.hi && next != x {
+                    return Step::Done(Some((next, None)));
+                }
+            }
             return Step::Done(Some((x, Some(p))));
         }
         if gx > 0.0 {
@@ -566,9 +610,9 @@ impl Secant {
 }
 
 /// The steady state of a launch, as the forward model reports it.
-fn steady_of(scene: &Scene, p: &Pass, y: f64, map_slope: f64) -> Steady {
+fn steady_of(scene: &Scene, p: &Pass, top_sq: f64, map_slope: f64) -> Steady {
     let mut s = Steady::basic(2.0 * scene.sin_alpha / p.tau, p.wf, p.w0, p.tau);
-    s.top_velocity_sq = Some(y);
+    s.top_velocity_sq = Some(top_sq);
     s.map_slope = Some(map_slope);
     s.theta_g = p.theta_g;
     s.phases = match p.branch {
@@ -604,17 +648,14 @@ pub(crate) fn estimate(
     let tau_star = 2.0 * sin_alpha / v;
     let (br, first) = bracket(&l, tau_star, u_d)?;
     let end = (u_d, br.tau_hi);
-    let mut notes = Vec::new();
     // Near a saddle-node the range's end is where the forward model's status search puts it:
     // measurements within 1e-6 of the fastest stable motion, or whose v + σ passes it, are
     // left to the general search, whose bracket (and so whose statuses there) is that one.
     if l.saddle && v + sigma_v.unwrap_or(0.0) > br.v_hi * (1.0 - 1e-6) {
         return None;
     }
-    // Above the range: the general search reports it, with K_lo and K_hi at v ∓ σ by the
-    // same rule as every other row (module docs of [`super`]).
     if v > br.v_hi {
-        return None;
+        return above_range(&l, &br, v, sigma_v);
     }
     // The root.
     let mut n_root = 0;
@@ -633,70 +674,205 @@ pub(crate) fn estimate(
     if y < 1e-12 * l.wc2 {
         return None;
     }
-    // An unevaluated root is the secant step from evaluated neighbours with a predicted error
-    // below one ulp of u: its contact time is τ* and its speeds need no quadrature.
-    let p = match p {
-        Some(p) => p,
-        None => Pass {
-            tau: tau_star,
-            ..l.launch(y)?
-        },
-    };
-    let k = p.k();
-    let mut n_side = 2;
-    let (d1, d2) = tau_derivatives(&l, u, u_d, &p)?;
-    let (dk, map_slope) = l.dk_du(y, &p)?;
-    // v̄ = 2 sin α / τ: dv̄/du = −v̄ τ'/τ.
-    let dv_dk = -(2.0 * sin_alpha / p.tau) * d1 / p.tau / dk;
-    // K at v ± σ: a second-order Taylor step in τ off the root, then the secant method (the
-    // two searches side by side).
-    let ends = SigmaEnds {
-        l: &l,
-        br: &br,
-        sin_alpha,
-        end,
-        u,
-        tau: p.tau,
-        d1,
-        d2,
-    };
-    let (k_lo, k_hi) = match sigma_v {
-        Some(sg) => ends.interval(v, sg, &mut notes, &mut n_side)?,
-        None => (f64::NAN, f64::NAN),
-    };
-    if l.saddle {
-        // Two fixed points per K here: the forward model must settle on this one, the stable
-        // one below the saddle-node.
-        let st = stickslip::steady_lean(&scene.with_k(k).ok()?).ok()?;
-        n_root += 1;
-        if (st.contact_time - p.tau).abs() > 1e-9 * p.tau {
+    l.conclude(&br, tau_star, (v, sigma_v), (u, p), n_root)
+}
+
+/// [`super::estimate()`](super::estimate::estimate) of a stick row whose contact starts past
+/// the top (Θ0 > 0, K_min = 0), on the general search's bracket `br`, whose statuses and ends
+/// it keeps: the secant method in u = ln w0² from an interpolated start ([`Launch::past_top`]),
+/// then K_lo and K_hi as on the crawl path. `None` (use the general search) for other rows, and
+/// where v or v ± σ lies within [`END_BAND`] of either end of the steady range.
+pub(crate) fn estimate_past_top(
+    model: &Model,
+    scene: &Scene,
+    br: &KBracket,
+    v: f64,
+    sigma_v: Option<f64>,
+) -> Option<KEstimate> {
+    if !matches!(model, Model::Stick)
+        || br.lower != LowerLimit::Zero
+        || br.upper != UpperLimit::LiftOff
+        || !(v > br.v_lo && v < br.v_hi)
+        || near_an_end(v, br)
+    {
+        return None;
+    }
+    let l = Launch::past_top(scene)?;
+    let u_d = l.y_d.ln();
+    let tau_star = 2.0 * scene.sin_alpha / v;
+    // The start: τ linear in w0 between w0 = 0 (τ0 at v_lo) and lift-off (τ_hi), whose
+    // slope in u = ln w0² is −(τ0 − τ)/2.
+    let tau_0 = 2.0 * scene.sin_alpha / br.v_lo;
+    let t = (tau_0 - tau_star) / (tau_0 - br.tau_hi);
+    let u0 = u_d + 2.0 * t.ln();
+    let slope0 = -0.5 * (tau_0 - tau_star);
+    let mut secant = Secant::new(tau_star, u0, slope0, (u_d, br.tau_hi), None)?;
+    secant.refine = true;
+    let mut n_root = 0;
+    let root = l.solve(secant, None, &mut n_root)?;
+    l.conclude(br, tau_star, (v, sigma_v), root, n_root)
+}
+
+/// A rolling row above the steady range (v faster than lift-off): no root; K_lo and K_hi at
+/// v ∓ σ by the rule of every other row, the bracket's top where v ∓ σ is above the range
+/// (noted) and otherwise the secant method from the asinh start. `None` (the general search
+/// reports the row) for stick/slip, within [`END_BAND`] of the top, and at the crawl end.
+fn above_range(l: &Launch<'_>, br: &KBracket, v: f64, sigma_v: Option<f64>) -> Option<KEstimate> {
+    if l.mech != Mechanics::Roll || near_an_end(v, br) {
+        return None;
+    }
+    let mut notes = Vec::new();
+    let mut end_at = |vs: f64, name: &str, side: &str| -> Option<f64> {
+        if vs <= 0.0 {
+            notes.push(format!("{name} is the bracket's lower end: {side} <= 0"));
+            return Some(br.lo);
+        }
+        if near_an_end(vs, br) {
             return None;
         }
-    }
-    let steady = steady_of(scene, &p, y, map_slope);
-    let theta_g = match l.mech {
-        // Θ_G does not involve K: the scene's own serves (K checked as `Scene::with_k` would).
-        Mechanics::Roll => (k.is_finite() && k > 0.0)
-            .then_some(())
-            .and_then(|()| theta_g(scene, p.w0 * p.w0)),
-        Mechanics::RollSlip => steady.theta_g,
+        if vs > br.v_hi {
+            notes.push(format!(
+                "{name} is the bracket's upper end: {side} is above the steady range"
+            ));
+            return Some(br.hi);
+        }
+        let t = 2.0 * l.scene.sin_alpha / vs;
+        let (u0, s0) = l.guess(t);
+        let secant = Secant::new(t, u0, s0, (l.y_d.ln(), br.tau_hi), None)?;
+        let (u, p) = l.solve(secant, None, &mut 0)?;
+        let y = u.exp();
+        if y < 1e-12 * l.wc2 {
+            return None;
+        }
+        match p {
+            Some(p) => Some(p.k()),
+            None => l.k_of_launch(y),
+        }
+    };
+    let (k_lo, k_hi) = match sigma_v {
+        Some(sg) => (
+            Some(end_at(v - sg, "K_lo", "v - sigma_v")?),
+            Some(end_at(v + sg, "K_hi", "v + sigma_v")?),
+        ),
+        None => (None, None),
     };
     Some(KEstimate {
-        bracket: Some(KBracket {
-            evals: br.evals,
-            ..br
-        }),
-        root: Ok(KRoot {
-            k,
-            steady,
-            evals: n_root,
-        }),
-        k_lo: sigma_v.map(|_| k_lo),
-        k_hi: sigma_v.map(|_| k_hi),
-        dv_dk: Some(dv_dk),
-        theta_g,
+        bracket: Some(*br),
+        root: Err(KFailure::AboveRange),
+        k_lo,
+        k_hi,
+        dv_dk: None,
+        theta_g: None,
         notes,
     })
+}
+
+/// Relative distance from the ends of the steady range (v̄ at K_min = 0 and at the top) within
+/// which [`estimate_past_top`] leaves a row to the general search, which resolves K there to
+/// the rounding of v̄ (its `ROUNDING` band and the lowest resolved K).
+const END_BAND: f64 = 1e-6;
+
+/// Whether `v` lies within [`END_BAND`] of either end of the bracket's steady range.
+fn near_an_end(v: f64, br: &KBracket) -> bool {
+    (v - br.v_lo).abs() <= END_BAND * br.v_lo || (v - br.v_hi).abs() <= END_BAND * br.v_hi
+}
+
+impl Launch<'_> {
+    /// The estimate from the root (u, its pass if evaluated) of τ = τ* = `tau_star` on the
+    /// bracket `br`, found in `n_root` passes: dv̄/dK, K_lo and K_hi at v ∓ σ, the steady state.
+    fn conclude(
+        &self,
+        br: &KBracket,
+        tau_star: f64,
+        (v, sigma_v): (f64, Option<f64>),
+        (u, p): (f64, Option<Pass>),
+        mut n_root: usize,
+    ) -> Option<KEstimate> {
+        let (l, scene) = (self, self.scene);
+        let sin_alpha = scene.sin_alpha;
+        let u_d = l.y_d.ln();
+        let end = (u_d, br.tau_hi);
+        let mut notes = Vec::new();
+        let y = u.exp();
+        // An unevaluated root is the secant step from evaluated neighbours with a predicted error
+        // below one ulp of u: its contact time is τ* and its speeds need no quadrature.
+        let p = match p {
+            Some(p) => p,
+            None => Pass {
+                tau: tau_star,
+                ..l.launch(y)?
+            },
+        };
+        let k = p.k();
+        let mut n_side = 2;
+        // The differences' step in u: 1e-5, wider from rest past the top, where τ is flat in u
+        // as K → 0 (τ' ≈ (τ − τ0)/2, τ0 the time from rest): there the step balances the
+        // rounding of the central difference, ε τ/(h |τ'|), against its truncation,
+        // h² |τ'''/τ'|/6 with τ'''/τ' ≈ 1/4, at h³ = 12 ε τ/|τ'|.
+        let h = if l.past_top {
+            let tau_0 = 2.0 * sin_alpha / br.v_lo;
+            let r = 0.5 * (tau_0 - p.tau) / p.tau;
+            (12.0 * f64::EPSILON / r).cbrt().max(1e-5)
+        } else {
+            1e-5
+        };
+        let (d1, d2) = tau_derivatives(l, (u, h), u_d, &p)?;
+        let (dk, map_slope) = l.dk_du(y, &p)?;
+        // v̄ = 2 sin α / τ: dv̄/du = −v̄ τ'/τ.
+        let dv_dk = -(2.0 * sin_alpha / p.tau) * d1 / p.tau / dk;
+        // K at v ± σ: a second-order Taylor step in τ off the root, then the secant method (the
+        // two searches side by side).
+        let ends = SigmaEnds {
+            l,
+            br,
+            sin_alpha,
+            end,
+            u,
+            tau: p.tau,
+            d1,
+            d2,
+        };
+        let (k_lo, k_hi) = match sigma_v {
+            Some(sg) => ends.interval(v, sg, &mut notes, &mut n_side)?,
+            None => (f64::NAN, f64::NAN),
+        };
+        if l.saddle {
+            // Two fixed points per K here: the forward model must settle on this one, the stable
+            // one below the saddle-node.
+            let st = stickslip::steady_lean(&scene.with_k(k).ok()?).ok()?;
+            n_root += 1;
+            if (st.contact_time - p.tau).abs() > 1e-9 * p.tau {
+                return None;
+            }
+        }
+        // The squared speed at the top, w0² − 2B sin²(Θ0/2): y itself on the crawl path.
+        let top_sq = if l.past_top {
+            y - 2.0 * scene.b * scene.sc_half_0.s * scene.sc_half_0.s
+        } else {
+            y
+        };
+        let steady = steady_of(scene, &p, top_sq, map_slope);
+        let theta_g = match l.mech {
+            // Θ_G does not involve K: the scene's own serves (K checked as `Scene::with_k` would).
+            Mechanics::Roll => (k.is_finite() && k > 0.0)
+                .then_some(())
+                .and_then(|()| theta_g(scene, p.w0 * p.w0)),
+            Mechanics::RollSlip => steady.theta_g,
+        };
+        Some(KEstimate {
+            bracket: Some(*br),
+            root: Ok(KRoot {
+                k,
+                steady,
+                evals: n_root,
+            }),
+            k_lo: sigma_v.map(|_| k_lo),
+            k_hi: sigma_v.map(|_| k_hi),
+            dv_dk: Some(dv_dk),
+            theta_g,
+            notes,
+        })
+    }
 }
 
 /// The bracket of a launch-speed estimate: K from K_min to the top of the steady range,
@@ -738,10 +914,9 @@ fn bracket(
     Some((br, first))
 }
 
-/// dτ/du and d²τ/du² at the root `p` (u = ln y) by central differences, h = 1e-5 in u
+/// dτ/du and d²τ/du² at the root `p` (u = ln y) by central differences with step `h` in u
 /// (one-sided at lift-off, u_d).
-fn tau_derivatives(l: &Launch<'_>, u: f64, u_d: f64, p: &Pass) -> Option<(f64, f64)> {
-    let h = 1e-5;
+fn tau_derivatives(l: &Launch<'_>, (u, h): (f64, f64), u_d: f64, p: &Pass) -> Option<(f64, f64)> {
     let [pm, pp] = if u + h <= u_d {
         l.pass_pair((u - h).exp(), (u + h).exp())
     } else {
@@ -797,6 +972,17 @@ impl SigmaEnds<'_> {
             notes.push(format!("{name} is the bracket's lower end: {side} <= 0"));
             return Some(End::At(br.lo));
         }
+        if self.l.past_top {
+            if near_an_end(vs, br) {
+                return None;
+            }
+            if vs < br.v_lo {
+                notes.push(format!(
+                    "{name} is the bracket's lower end: {side} is below the steady range"
+                ));
+                return Some(End::At(br.lo));
+            }
+        }
         if vs > br.v_hi {
             notes.push(format!(
                 "{name} is the bracket's upper end: {side} is above the steady range"
@@ -807,7 +993,10 @@ impl SigmaEnds<'_> {
         let dt = t - self.tau;
         let du = dt / d1;
         let du = du - 0.5 * d2 * du * du / d1;
-        Secant::new(t, u + du, d1 + d2 * du, end, Some(0.5 * d2 / d1)).map(End::Search)
+        Secant::new(t, u + du, d1 + d2 * du, end, Some(0.5 * d2 / d1)).map(|mut sc| {
+            sc.refine = self.l.past_top;
+            End::Search(sc)
+        })
     }
 
     /// K of a search's result (its pass, or a launch at its u).

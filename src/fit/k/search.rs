@@ -3,7 +3,7 @@
 //! searches for K_lo and K_hi start next to the K that the quadratic through the root and
 //! dv̄/dK's stencil predicts ([`Seed`]): about 6 evaluations each instead of 8 or 9.
 
-use super::bracket::{bracket, eval, lowest_steady};
+use super::bracket::{bracket, empty_rolling_bracket, eval, lowest_steady};
 use super::types::{KBracket, KEstimate, KFailure, KRoot};
 use crate::models::regimes::theta_g;
 use crate::models::{Model, NotSteady, Steady};
@@ -231,7 +231,7 @@ fn seeded_bracket(
 /// Relative tolerance on v at the ends of the steady range: the rounding of v̄ by the
 /// forward models there (measured up to 49 ε for stick-approx near its limit A = B,
 /// src/fit/suite/k_edges.rs).
-const ROUNDING: f64 = 128.0 * f64::EPSILON;
+pub(crate) const ROUNDING: f64 = 128.0 * f64::EPSILON;
 
 /// v is slower than the motion at `k`, the lowest steady K that double precision resolves
 /// above K_min. Either by rounding only, and then `k` is the root; or near a crawl end, where
@@ -446,18 +446,32 @@ fn clamp_end(
 }
 
 /// [`estimate`](fn@super::estimate) by the general search in K: [`bracket`], then [`solve`] at v and v ± σ.
+#[cfg(test)]
 pub(crate) fn estimate_in_k(
     model: &Model,
     scene: &Scene,
     v: f64,
     sigma_v: Option<f64>,
 ) -> KEstimate {
+    estimate_in_k_or(model, scene, v, sigma_v, |_, _| None)
+}
+
+/// [`estimate_in_k`], unless `on_bracket`, given the bracket and the scene the search would
+/// use, returns the estimate itself.
+pub(crate) fn estimate_in_k_or(
+    model: &Model,
+    scene: &Scene,
+    v: f64,
+    sigma_v: Option<f64>,
+    on_bracket: impl FnOnce(&Scene, &KBracket) -> Option<KEstimate>,
+) -> KEstimate {
     // The rolling models need tan(δ/2) in double-double near δ_m, at every K the search
     // tries there: computed once for the row where the bead crawls over the top at K_min
-    // (Θ0 < 0), the end of the range where the factor of the top speed vanishes.
+    // (Θ0 < 0), the end of the range where the factor of the top speed vanishes; not where
+    // the analytic bracket is already empty, which no evaluation follows.
     let kept;
     let rolling = matches!(model, Model::Stick | Model::StickApprox | Model::StickSlip);
-    let scene = if rolling && scene.theta_0 < 0.0 {
+    let scene = if rolling && scene.theta_0 < 0.0 && !empty_rolling_bracket(model, scene) {
         kept = scene.with_tan_half_delta();
         &kept
     } else {
@@ -477,6 +491,9 @@ pub(crate) fn estimate_in_k(
             }
         }
     };
+    if let Some(e) = on_bracket(scene, &br) {
+        return e;
+    }
     let root = solve(model, scene, &br, v);
     let mut notes = Vec::new();
     if root == Err(KFailure::BelowRange) && v >= br.v_lo {

@@ -266,7 +266,8 @@ fn stickslip_within_1e_9_of_the_saddle_node() {
     assert!(r.is_ok(), "K = {k}: {r:?}");
 }
 
-/// The launch-speed path of `estimate` (src/fit/k/launch.rs) against the general search in K
+/// The launch-speed paths of `estimate` (src/fit/k/launch.rs: from the crawl, and from rest past
+/// the top for stick) against the general search in K
 /// (`estimate_in_k`, the path of every test above) and against the forward models: K, K_lo,
 /// K_hi to 1e-12 (or, where v̄ is flat in K, v̄ reproduced to 8 ulp), the same notes; dv̄/dK to
 /// 1e-6 of an extrapolated difference of the forward model; and the path must actually be
@@ -294,7 +295,9 @@ fn launch_speed_path_agrees_with_the_search_in_k() {
                 let sigma = rng.random_range(0.005..0.1) * v;
                 let sg = Some(sigma);
                 tried += 1;
-                let Some(fast) = klaunch::estimate(&m, &s, v, sg) else {
+                let fast = klaunch::estimate(&m, &s, v, sg)
+                    .or_else(|| klaunch::estimate_past_top(&m, &s, &br, v, sg));
+                let Some(fast) = fast else {
                     continue;
                 };
                 taken += 1;
@@ -382,10 +385,12 @@ fn launch_speed_path_agrees_with_the_search_in_k() {
              max dv/dK rel. error {worst_slope:.1e}",
             m.name()
         );
-        // Θ0 ≥ 0 (half of these scenes) and, for stick/slip, K(w0) not monotone (a saddle-node
-        // of the map below lift-off, common with f up to 0.5) go to the search in K.
+        // Stick: every row but those within 1e-6 of an end of a K_min = 0 range (the first
+        // of the three above, v̄ flat in K there). Stick/slip: Θ0 ≥ 0 (half of these scenes)
+        // and K(w0) not monotone (a saddle-node of the map below lift-off, common with f up
+        // to 0.5) go to the search in K.
         let need = if matches!(m, Model::Stick) {
-            tried / 2
+            tried * 3 / 4
         } else {
             60
         };
@@ -397,11 +402,15 @@ fn launch_speed_path_agrees_with_the_search_in_k() {
 /// mpmath (tests/reference/dvdk_refs.csv, made by tests/reference/dvdk_refs.py: direct
 /// quadrature at 50 digits, central difference with h = 1e-20, at exactly the double K of each
 /// row). Relative error: launch path ≤ 3e-10 (measured 1.8e-10), search in K ≤ 1e-9 (measured
-/// 7.8e-10).
+/// 7.8e-10); except at K = 1e-4 K_d of the scene that starts past the top, where v̄ depends on
+/// K only through a difference of 6e-5 of itself: the launch path ≤ 2e-9 (measured 9.8e-10),
+/// the search in K (which no longer serves such rows) ≤ 1e-7 (measured 6.6e-8).
 #[test]
 fn dv_dk_matches_mpmath_at_hard_points() {
     const DV_DK_TOL: f64 = 3e-10;
     const SEARCH_DV_DK_TOL: f64 = 1e-9;
+    const FLAT_DV_DK_TOL: f64 = 2e-9;
+    const FLAT_SEARCH_DV_DK_TOL: f64 = 1e-7;
     let (_, records) = reference_table("dvdk_refs.csv");
     let mut n = 0;
     let (mut worst, mut worst2) = (0.0f64, 0.0f64);
@@ -421,18 +430,24 @@ fn dv_dk_matches_mpmath_at_hard_points() {
         println!("xi {xi} K {k}: dv/dK {dv} vs {reference} ({err:.1e}); search in K {err2:.1e}");
         worst = worst.max(err);
         worst2 = worst2.max(err2);
+        let flat = s.theta_0 > 0.0 && k < 1e-3;
+        let (tol, tol2) = if flat {
+            (FLAT_DV_DK_TOL, FLAT_SEARCH_DV_DK_TOL)
+        } else {
+            (DV_DK_TOL, SEARCH_DV_DK_TOL)
+        };
         assert!(
-            err < DV_DK_TOL,
+            err < tol,
             "xi {xi}, K {k}: dv/dK {dv} vs mpmath {reference}"
         );
         assert!(
-            err2 < SEARCH_DV_DK_TOL,
+            err2 < tol2,
             "xi {xi}, K {k}: search in K dv/dK {dv2} vs mpmath {reference}"
         );
         n += 1;
     }
     println!("dv/dK at {n} points: max relative error {worst:.3e}, search in K {worst2:.3e}");
-    assert_eq!(n, 9);
+    assert_eq!(n, 12);
 }
 
 /// eq 69 with the contact model: forward at K, then `k` recovers K.

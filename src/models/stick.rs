@@ -3,7 +3,7 @@
 use super::{NotSteady, Outcome, Phases, Steady};
 use crate::scene::Scene;
 use crate::special::dd::Dd;
-use crate::special::elliptic::cos_integral;
+use crate::special::elliptic::{cos_integral, cos_integral_pair};
 
 /// Steady final velocity squared L² = 4 sin δ sin α / ((1+ρ)(1−K²)) (eq 19).
 #[inline]
@@ -112,6 +112,30 @@ pub fn steady(scene: &Scene) -> Outcome {
         st.wtsq,
         scene.sin_delta_sin_alpha(),
     );
+    rolled(scene, &st, tau)
+}
+
+/// [`steady`] at two scenes that differ only in K (copies of one scene by
+/// [`Scene::with_k`]), each to the last bit: the R_F of their contact times run side by side
+/// ([`cos_integral_pair`]).
+pub(crate) fn steady_pair(a: &Scene, b: &Scene) -> [Outcome; 2] {
+    match (rolling_state(a), rolling_state(b)) {
+        (Ok(sa), Ok(sb)) => {
+            let tau = cos_integral_pair(
+                a.sc_half_0,
+                a.sc_half_f,
+                [sa.w0sq, sa.l2, sa.wtsq],
+                [sb.w0sq, sb.l2, sb.wtsq],
+                a.sin_delta_sin_alpha(),
+            );
+            [rolled(a, &sa, tau[0]), rolled(b, &sb, tau[1])]
+        }
+        _ => [steady(a), steady(b)],
+    }
+}
+
+/// The steady state of the rolling state `st` with contact time `tau`.
+fn rolled(scene: &Scene, st: &RollingState, tau: f64) -> Outcome {
     if !(tau.is_finite() && tau > 0.0) {
         return Err(NotSteady::Invalid {
             reason: "rolling time not finite",

@@ -155,9 +155,17 @@ fn across_top(h0: SinCos, h1: SinCos, [w0sq, w1sq, wt2]: [f64; 3]) -> [[f64; 3];
 
 /// [`cos_integral`] of two motions between the same angles (`h0`, `h1`, `den`) with the squared
 /// speeds `a` and `b` (each `[w0sq, w1sq, wtsq]`), each to the last bit; across the top their
-/// four R_F run side by side (`rf_lanes`).
+/// four R_F run side by side (`rf_lanes`), past it their two.
 #[inline]
 pub fn cos_integral_pair(h0: SinCos, h1: SinCos, a: [f64; 3], b: [f64; 3], den: f64) -> [f64; 2] {
+    if h1.s > 0.0 && h0.s >= 0.0 {
+        if let (Some(ra), Some(rb)) = (
+            same_side_args(h0, h1, a[0], a[1], den),
+            same_side_args(h0, h1, b[0], b[1], den),
+        ) {
+            return rf_lanes([ra, rb]).map(|r| 2.0 * r);
+        }
+    }
     if !(h1.s > 0.0 && h0.s < 0.0) {
         return [a, b].map(|[w0sq, w1sq, wtsq]| cos_integral(h0, h1, w0sq, w1sq, wtsq, den));
     }
@@ -235,15 +243,25 @@ fn in_range([x, y, z]: [f64; 3]) -> bool {
 
 #[inline]
 fn same_side(h0: SinCos, h1: SinCos, w0sq: f64, w1sq: f64, den: f64) -> f64 {
+    match same_side_args(h0, h1, w0sq, w1sq, den) {
+        Some([x, y, z]) => 2.0 * rf(x, y, z),
+        None => 0.0,
+    }
+}
+
+/// The R_F arguments of [`same_side`] (whose value is 2 R_F of them); `None` where `den` ≤ 0
+/// (no motion between the angles: the time is 0).
+#[inline(always)]
+fn same_side_args(h0: SinCos, h1: SinCos, w0sq: f64, w1sq: f64, den: f64) -> Option<[f64; 3]> {
     if den <= 0.0 {
-        return 0.0;
+        return None;
     }
     let w0 = w0sq.max(0.0).sqrt();
     let w1 = w1sq.max(0.0).sqrt();
     let u12 = (h1.s * h1.c * w0 + h0.s * h0.c * w1) / den;
     let u13 = (h1.s * h0.c * w1 + h0.s * h1.c * w0) / den;
     let u23 = (h0.s * h1.c * w1 + h1.s * h0.c * w0) / den;
-    2.0 * rf(u12 * u12, u13 * u13, u23 * u23)
+    Some([u12 * u12, u13 * u13, u23 * u23])
 }
 
 #[cfg(test)]
@@ -384,9 +402,22 @@ mod tests {
     }
 
     /// `cos_integral_pair` is two calls of `cos_integral`, to the last bit: across the top
-    /// (four R_F side by side) with top speeds from 1e-14 to 1, and on one side (two calls).
+    /// (four R_F side by side) with top speeds from 1e-14 to 1, past it (two R_F side by
+    /// side), from rest past it, and before it (two calls).
     #[test]
     fn cos_integral_pair_is_two_calls_to_the_bit() {
+        // From rest past the top (w0 = 0) beside launches from 1e-14 to 1.
+        let (p0, p1) = (0.03, 0.26);
+        let (h0, h1) = (SinCos::of(0.5 * p0), SinCos::of(0.5 * p1));
+        let den = (0.5 * (p1 + p0)).sin() * (0.5 * (p1 - p0)).sin();
+        let drop = f64::cos(p0) - f64::cos(p1);
+        for i in 0..=14 {
+            let w0 = 10f64.powi(-i);
+            let (a, b) = ([0.0, drop, -1.0], [w0, w0 + drop, -1.0]);
+            let one = |[w0, w1, wt]: [f64; 3]| cos_integral(h0, h1, w0, w1, wt, den);
+            let pair = cos_integral_pair(h0, h1, a, b, den);
+            assert_eq!(pair.map(f64::to_bits), [one(a).to_bits(), one(b).to_bits()]);
+        }
         for &(p0, p1) in &[(-0.3, 0.8), (-1.2, 0.05), (0.2, 0.8), (-0.9, -0.1)] {
             let (h0, h1) = (SinCos::of(0.5 * p0), SinCos::of(0.5 * p1));
             let den = (0.5 * (p1 + p0)).sin() * (0.5 * (p1 - p0)).sin();

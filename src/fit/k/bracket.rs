@@ -5,7 +5,7 @@ use super::types::{KBracket, KFailure, LowerLimit, UpperLimit};
 use crate::fit::data::Dataset;
 use crate::models::regimes::theta_g;
 use crate::models::slip::SlipPhase;
-use crate::models::{stickslip, ForwardModel, Model, NotSteady, Steady};
+use crate::models::{stick, stickslip, ForwardModel, Model, NotSteady, Steady};
 use crate::scene::Scene;
 use crate::special::root::brent;
 use rayon::prelude::*;
@@ -43,6 +43,23 @@ pub(crate) fn eval(
             reason: "K out of range",
         }),
     }
+}
+
+/// [`eval`] at two K, with the same results: stick evaluates them side by side
+/// ([`stick::steady_pair`]).
+fn eval_pair(
+    model: &Model,
+    scene: &Scene,
+    [ka, kb]: [f64; 2],
+    evals: &mut usize,
+) -> [Result<Steady, NotSteady>; 2] {
+    if matches!(model, Model::Stick) && ka.is_finite() && kb.is_finite() {
+        if let (Ok(a), Ok(b)) = (scene.with_k(ka), scene.with_k(kb)) {
+            *evals += 2;
+            return stick::steady_pair(&a, &b);
+        }
+    }
+    [eval(model, scene, ka, evals), eval(model, scene, kb, evals)]
 }
 
 /// The lowest K above `lo` (and not above `limit`) at which `model` is steady, among the K that
@@ -418,8 +435,7 @@ pub fn bracket(model: &Model, scene: &Scene) -> Result<KBracket, KFailure> {
     } else {
         lo + tiny
     };
-    let r_lo = eval(model, scene, lo_test, &mut evals);
-    let r_hi = eval(model, scene, hi_in, &mut evals);
+    let [r_lo, r_hi] = eval_pair(model, scene, [lo_test, hi_in], &mut evals);
     let mut upper = UpperLimit::LiftOff;
     // A steady point inside the bracket, to bisect from where an end fails.
     let good = match (&r_lo, &r_hi) {

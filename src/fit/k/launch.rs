@@ -28,12 +28,13 @@
 //!
 //! For stick with Θ0 > 0 (δ > α) the contact starts past the top: every w0 ≥ 0 reaches Θf, K
 //! runs from 0 (w0 = 0, a finite contact time τ0) to lift-off, and τ is smooth in u = ln w0²,
-//! tending to τ0 as u → −∞ (`estimate_past_top`). The same secant runs there, from τ linear in
-//! w0 between τ0 and lift-off, on the general search's bracket (whose statuses and ends it
-//! keeps); measurements within 1e-6 of either end of the range are left to that search.
+//! tending to τ0 as u → −∞ (`estimate_past_top`). The same secant runs there, from the time
+//! on a slope of constant pitch matched to τ0 and to lift-off, on the general search's bracket
+//! (whose statuses and ends it keeps); measurements within 1e-6 of either end of the range
+//! are left to that search.
 //! Elsewhere [`super::estimate()`](super::estimate::estimate) uses its general bracketing search in K.
 
-use super::types::{KBracket, KEstimate, KFailure, KRoot, LowerLimit, UpperLimit};
+use super::types::{end_note, AtEnd, KBracket, KEstimate, KFailure, KRoot, LowerLimit, UpperLimit};
 use crate::models::regimes::theta_g;
 use crate::models::stickslip::{self, Branch};
 use crate::models::{Model, NotSteady, Phases, Steady};
@@ -700,12 +701,15 @@ pub(crate) fn estimate_past_top(
     let l = Launch::past_top(scene)?;
     let u_d = l.y_d.ln();
     let tau_star = 2.0 * scene.sin_alpha / v;
-    // The start: τ linear in w0 between w0 = 0 (τ0 at v_lo) and lift-off (τ_hi), whose
-    // slope in u = ln w0² is −(τ0 − τ)/2.
+    // The start: the time of a bead on a slope of constant pitch, τ/τ0 = sqrt(z² + 1) − z
+    // with z ∝ w0 (finite from rest, L/w0 when fast), matched to the time from rest (τ0, at
+    // v_lo) and at lift-off (τ_hi): z(ρ) = (1 − ρ²)/(2ρ) at ρ = τ/τ0.
     let tau_0 = 2.0 * scene.sin_alpha / br.v_lo;
-    let t = (tau_0 - tau_star) / (tau_0 - br.tau_hi);
-    let u0 = u_d + 2.0 * t.ln();
-    let slope0 = -0.5 * (tau_0 - tau_star);
+    let z_of = |rho: f64| (1.0 - rho * rho) / (2.0 * rho);
+    let z = z_of(tau_star / tau_0);
+    let u0 = u_d + 2.0 * (z / z_of(br.tau_hi / tau_0)).ln();
+    // dτ/du = τ0 (z/sqrt(z² + 1) − 1) z/2 (u = ln w0², z ∝ e^{u/2}).
+    let slope0 = tau_0 * (z / z.hypot(1.0) - 1.0) * 0.5 * z;
     let mut secant = Secant::new(tau_star, u0, slope0, (u_d, br.tau_hi), None)?;
     secant.refine = true;
     let mut n_root = 0;
@@ -724,16 +728,14 @@ fn above_range(l: &Launch<'_>, br: &KBracket, v: f64, sigma_v: Option<f64>) -> O
     let mut notes = Vec::new();
     let mut end_at = |vs: f64, name: &str, side: &str| -> Option<f64> {
         if vs <= 0.0 {
-            notes.push(format!("{name} is the bracket's lower end: {side} <= 0"));
+            notes.push(end_note(name, side, AtEnd::NotPositive));
             return Some(br.lo);
         }
         if near_an_end(vs, br) {
             return None;
         }
         if vs > br.v_hi {
-            notes.push(format!(
-                "{name} is the bracket's upper end: {side} is above the steady range"
-            ));
+            notes.push(end_note(name, side, AtEnd::Above));
             return Some(br.hi);
         }
         let t = 2.0 * l.scene.sin_alpha / vs;
@@ -969,7 +971,7 @@ impl SigmaEnds<'_> {
             "v + sigma_v"
         };
         if vs <= 0.0 {
-            notes.push(format!("{name} is the bracket's lower end: {side} <= 0"));
+            notes.push(end_note(name, side, AtEnd::NotPositive));
             return Some(End::At(br.lo));
         }
         if self.l.past_top {
@@ -977,16 +979,12 @@ impl SigmaEnds<'_> {
                 return None;
             }
             if vs < br.v_lo {
-                notes.push(format!(
-                    "{name} is the bracket's lower end: {side} is below the steady range"
-                ));
+                notes.push(end_note(name, side, AtEnd::Below));
                 return Some(End::At(br.lo));
             }
         }
         if vs > br.v_hi {
-            notes.push(format!(
-                "{name} is the bracket's upper end: {side} is above the steady range"
-            ));
+            notes.push(end_note(name, side, AtEnd::Above));
             return Some(End::At(br.hi));
         }
         let t = 2.0 * sin_alpha / vs;

@@ -4,7 +4,7 @@
 //! dv̄/dK's stencil predicts ([`Seed`]): about 6 evaluations each instead of 8 or 9.
 
 use super::bracket::{bracket, empty_rolling_bracket, eval, lowest_steady};
-use super::types::{KBracket, KEstimate, KFailure, KRoot};
+use super::types::{end_note, AtEnd, KBracket, KEstimate, KFailure, KRoot};
 use crate::models::regimes::theta_g;
 use crate::models::{Model, NotSteady, Steady};
 use crate::scene::Scene;
@@ -423,19 +423,15 @@ fn clamp_end(
     match solve_with(model, scene, br, v, seed) {
         Ok(r) => Some(r.k),
         Err(KFailure::BelowRange) => {
-            notes.push(format!(
-                "{end} is the bracket's lower end: {side} is below the steady range"
-            ));
+            notes.push(end_note(end, side, AtEnd::Below));
             Some(br.lo)
         }
         Err(KFailure::AboveRange) => {
-            notes.push(format!(
-                "{end} is the bracket's upper end: {side} is above the steady range"
-            ));
+            notes.push(end_note(end, side, AtEnd::Above));
             Some(br.hi)
         }
         Err(KFailure::Invalid(_)) if v <= 0.0 => {
-            notes.push(format!("{end} is the bracket's lower end: {side} <= 0"));
+            notes.push(end_note(end, side, AtEnd::NotPositive));
             Some(br.lo)
         }
         Err(KFailure::Invalid(why)) => {

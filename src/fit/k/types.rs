@@ -154,3 +154,25 @@ pub struct KEstimate {
     /// Notes on the interval ends.
     pub notes: Vec<String>,
 }
+
+/// Why an end of the interval at v ± σ is an end of the bracket ([`end_note`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum AtEnd {
+    /// v ∓ σ ≤ 0: the lower end.
+    NotPositive,
+    /// v ∓ σ is below the steady range: the lower end.
+    Below,
+    /// v ∓ σ is above the steady range: the upper end.
+    Above,
+}
+
+/// The note of an interval end `end` (`K_lo` or `K_hi`, at `side`, `v - sigma_v` or
+/// `v + sigma_v`) that is an end of the bracket, for the reason `why`.
+pub(crate) fn end_note(end: &str, side: &str, why: AtEnd) -> String {
+    let (which, reason) = match why {
+        AtEnd::NotPositive => ("lower", " <= 0"),
+        AtEnd::Below => ("lower", " is below the steady range"),
+        AtEnd::Above => ("upper", " is above the steady range"),
+    };
+    [end, " is the bracket's ", which, " end: ", side, reason].concat()
+}

@@ -155,9 +155,21 @@ fn across_top(h0: SinCos, h1: SinCos, [w0sq, w1sq, wt2]: [f64; 3]) -> [[f64; 3];
 
 /// [`cos_integral`] of two motions between the same angles (`h0`, `h1`, `den`) with the squared
 /// speeds `a` and `b` (each `[w0sq, w1sq, wtsq]`), each to the last bit; across the top their
-/// four R_F run side by side (`rf_lanes`), past it their two.
-#[inline]
+/// four R_F run side by side (`rf_lanes`), past it their two. Always inlined, as is
+/// [`rf_lanes`]: out of line, with its arrays passed through memory, the crawl rows of
+/// `fitbead k --model stick` took 4 % longer and `fitbead forward --model stick` 5 %
+/// (docs/PERFORMANCE.md).
+#[inline(always)]
 pub fn cos_integral_pair(h0: SinCos, h1: SinCos, a: [f64; 3], b: [f64; 3], den: f64) -> [f64; 2] {
+    if h1.s > 0.0 && h0.s < 0.0 {
+        let [a1, a0] = across_top(h0, h1, a);
+        let [b1, b0] = across_top(h0, h1, b);
+        let [ra1, ra0, rb1, rb0] = rf_lanes([a1, a0, b1, b0]);
+        return [
+            2.0 * (h1.s.abs() * ra1 + h0.s.abs() * ra0),
+            2.0 * (h1.s.abs() * rb1 + h0.s.abs() * rb0),
+        ];
+    }
     if h1.s > 0.0 && h0.s >= 0.0 {
         if let (Some(ra), Some(rb)) = (
             same_side_args(h0, h1, a[0], a[1], den),
@@ -166,16 +178,7 @@ pub fn cos_integral_pair(h0: SinCos, h1: SinCos, a: [f64; 3], b: [f64; 3], den: 
             return rf_lanes([ra, rb]).map(|r| 2.0 * r);
         }
     }
-    if !(h1.s > 0.0 && h0.s < 0.0) {
-        return [a, b].map(|[w0sq, w1sq, wtsq]| cos_integral(h0, h1, w0sq, w1sq, wtsq, den));
-    }
-    let [a1, a0] = across_top(h0, h1, a);
-    let [b1, b0] = across_top(h0, h1, b);
-    let [ra1, ra0, rb1, rb0] = rf_lanes([a1, a0, b1, b0]);
-    [
-        2.0 * (h1.s.abs() * ra1 + h0.s.abs() * ra0),
-        2.0 * (h1.s.abs() * rb1 + h0.s.abs() * rb0),
-    ]
+    [a, b].map(|[w0sq, w1sq, wtsq]| cos_integral(h0, h1, w0sq, w1sq, wtsq, den))
 }
 
 /// [`rf`] of `N` argument triples, each to the last bit: where all are in the range of the
@@ -184,7 +187,7 @@ pub fn cos_integral_pair(h0: SinCos, h1: SinCos, a: [f64; 3], b: [f64; 3], den: 
 /// dependent square roots (one R_F is bound by their latency: two side by side cost about
 /// 1.3 times one, four about 1.4 times two; docs/PERFORMANCE.md); elsewhere `N` calls of
 /// [`rf`].
-#[inline]
+#[inline(always)]
 pub fn rf_lanes<const N: usize>(a: [[f64; 3]; N]) -> [f64; N] {
     if !a.iter().all(|t| in_range(*t)) {
         return a.map(|[x, y, z]| rf(x, y, z));

@@ -680,9 +680,10 @@ pub(crate) fn estimate(
 
 /// [`super::estimate()`](super::estimate::estimate) of a stick row whose contact starts past
 /// the top (Θ0 > 0, K_min = 0), on the general search's bracket `br`, whose statuses and ends
-/// it keeps: the secant method in u = ln w0² from an interpolated start ([`Launch::past_top`]),
-/// then K_lo and K_hi as on the crawl path. `None` (use the general search) for other rows, and
-/// where v or v ± σ lies within [`END_BAND`] of either end of the steady range.
+/// it keeps: the secant method in u = ln w0² ([`Launch::past_top`]) from the time on a slope
+/// of constant pitch, then K_lo and K_hi as on the crawl path. `None` (use the general search)
+/// for other rows, and where v or v ± σ lies within [`END_BAND`] of either end of the steady
+/// range.
 pub(crate) fn estimate_past_top(
     model: &Model,
     scene: &Scene,
@@ -726,17 +727,9 @@ fn above_range(l: &Launch<'_>, br: &KBracket, v: f64, sigma_v: Option<f64>) -> O
         return None;
     }
     let mut notes = Vec::new();
-    let mut end_at = |vs: f64, name: &str, side: &str| -> Option<f64> {
-        if vs <= 0.0 {
-            notes.push(end_note(name, side, AtEnd::NotPositive));
-            return Some(br.lo);
-        }
-        if near_an_end(vs, br) {
-            return None;
-        }
-        if vs > br.v_hi {
-            notes.push(end_note(name, side, AtEnd::Above));
-            return Some(br.hi);
+    let mut end_at = |vs: f64, name: &str| -> Option<f64> {
+        if let Some(k) = bracket_end(vs, br, true, name, &mut notes)? {
+            return Some(k);
         }
         let t = 2.0 * l.scene.sin_alpha / vs;
         let (u0, s0) = l.guess(t);
@@ -752,10 +745,7 @@ fn above_range(l: &Launch<'_>, br: &KBracket, v: f64, sigma_v: Option<f64>) -> O
         }
     };
     let (k_lo, k_hi) = match sigma_v {
-        Some(sg) => (
-            Some(end_at(v - sg, "K_lo", "v - sigma_v")?),
-            Some(end_at(v + sg, "K_hi", "v + sigma_v")?),
-        ),
+        Some(sg) => (Some(end_at(v - sg, "K_lo")?), Some(end_at(v + sg, "K_hi")?)),
         None => (None, None),
     };
     Some(KEstimate {
@@ -770,9 +760,43 @@ fn above_range(l: &Launch<'_>, br: &KBracket, v: f64, sigma_v: Option<f64>) -> O
 }
 
 /// Relative distance from the ends of the steady range (v̄ at K_min = 0 and at the top) within
-/// which [`estimate_past_top`] leaves a row to the general search, which resolves K there to
-/// the rounding of v̄ (its `ROUNDING` band and the lowest resolved K).
+/// which [`estimate_past_top`] and [`above_range`] leave a row to the general search, which
+/// resolves K there to the rounding of v̄ (its `ROUNDING` band and the lowest resolved K).
 const END_BAND: f64 = 1e-6;
+
+/// Where the interval end `name` (`K_lo` or `K_hi`) at v ∓ σ = `vs` is an end of the bracket
+/// `br`, with no search: `Some(Some(K))`, noted in `notes`, where `vs` ≤ 0 or lies outside the
+/// steady range; `Some(None)` where a search must find it; `None` (the general search's) where
+/// `guard` is set and `vs` lies within [`END_BAND`] of either end of the range.
+fn bracket_end(
+    vs: f64,
+    br: &KBracket,
+    guard: bool,
+    name: &str,
+    notes: &mut Vec<String>,
+) -> Option<Option<f64>> {
+    let side = if name == "K_lo" {
+        "v - sigma_v"
+    } else {
+        "v + sigma_v"
+    };
+    if vs <= 0.0 {
+        notes.push(end_note(name, side, AtEnd::NotPositive));
+        return Some(Some(br.lo));
+    }
+    if guard && near_an_end(vs, br) {
+        return None;
+    }
+    if vs < br.v_lo {
+        notes.push(end_note(name, side, AtEnd::Below));
+        return Some(Some(br.lo));
+    }
+    if vs > br.v_hi {
+        notes.push(end_note(name, side, AtEnd::Above));
+        return Some(Some(br.hi));
+    }
+    Some(None)
+}
 
 /// Whether `v` lies within [`END_BAND`] of either end of the bracket's steady range.
 fn near_an_end(v: f64, br: &KBracket) -> bool {
@@ -965,27 +989,8 @@ impl SigmaEnds<'_> {
     fn plan_end(&self, vs: f64, name: &'static str, notes: &mut Vec<String>) -> Option<End> {
         let (br, sin_alpha, end, u) = (self.br, self.sin_alpha, self.end, self.u);
         let (d1, d2) = (self.d1, self.d2);
-        let side = if name == "K_lo" {
-            "v - sigma_v"
-        } else {
-            "v + sigma_v"
-        };
-        if vs <= 0.0 {
-            notes.push(end_note(name, side, AtEnd::NotPositive));
-            return Some(End::At(br.lo));
-        }
-        if self.l.past_top {
-            if near_an_end(vs, br) {
-                return None;
-            }
-            if vs < br.v_lo {
-                notes.push(end_note(name, side, AtEnd::Below));
-                return Some(End::At(br.lo));
-            }
-        }
-        if vs > br.v_hi {
-            notes.push(end_note(name, side, AtEnd::Above));
-            return Some(End::At(br.hi));
+        if let Some(k) = bracket_end(vs, br, self.l.past_top, name, notes)? {
+            return Some(End::At(k));
         }
         let t = 2.0 * sin_alpha / vs;
         let dt = t - self.tau;

@@ -231,7 +231,7 @@ fn seeded_bracket(
 /// Relative tolerance on v at the ends of the steady range: the rounding of v̄ by the
 /// forward models there (measured up to 49 ε for stick-approx near its limit A = B,
 /// src/fit/suite/k_edges.rs).
-pub(crate) const ROUNDING: f64 = 128.0 * f64::EPSILON;
+const ROUNDING: f64 = 128.0 * f64::EPSILON;
 
 /// v is slower than the motion at `k`, the lowest steady K that double precision resolves
 /// above K_min. Either by rounding only, and then `k` is the root; or near a crawl end, where

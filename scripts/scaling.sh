@@ -8,9 +8,10 @@
 # Usage: scripts/scaling.sh BINARY [THREADS...]        (default threads: 1 2 4 8 16)
 #   REPS=3         runs per cell (the median is reported)
 #   WORK=DIR       where inputs and outputs go (default: a fresh temporary directory,
-#                  removed at the end)
+#                  removed at the end); inputs already there are used as they are
 #   SMALL=1        inputs 100 times smaller (to try the script itself)
 #   ONLY=0,1       run only these commands (their indices in the table, from 0)
+#   NO_TIME=1      time with python3 even where /usr/bin/time exists
 #   SINK=null      the streaming commands write to standard output, discarded, instead of
 #                  --output out.csv (the report always writes its directory)
 set -u
@@ -32,15 +33,15 @@ cd "$work" || exit 2
 
 # --- inputs (the same for every binary: fixed seeds) ----------------------------------
 series20=$(python3 -c "print(','.join(f'{0.8 + 0.11 * k:.2f}' for k in range(20)))")
-"$bin" simulate --model stick --series "$series20" --points $((250000 / div)) --seed 1 \
+[ -f k_stick.csv ] || "$bin" simulate --model stick --series "$series20" --points $((250000 / div)) --seed 1 \
   --output k_stick.csv || exit 2
-"$bin" simulate --model stick --series 0.8,1,1.6,2 --points $((250000 / div)) --seed 2 \
+[ -f forward_stick.csv ] || "$bin" simulate --model stick --series 0.8,1,1.6,2 --points $((250000 / div)) --seed 2 \
   --output forward_stick.csv || exit 2
-"$bin" simulate --model stickslip --series "$series20" --points $((5000 / div)) --seed 3 \
+[ -f k_stickslip.csv ] || "$bin" simulate --model stickslip --series "$series20" --points $((5000 / div)) --seed 3 \
   --output k_stickslip.csv || exit 2
-"$bin" simulate --model stick --series 0.8,1,1.6,2 --points $((25000 / div)) --seed 4 \
+[ -f forward_contact.csv ] || "$bin" simulate --model stick --series 0.8,1,1.6,2 --points $((25000 / div)) --seed 4 \
   --output forward_contact.csv || exit 2
-cp k_stickslip.csv klaw_stickslip.csv
+[ -f klaw_stickslip.csv ] || cp k_stickslip.csv klaw_stickslip.csv
 
 # --- runs -----------------------------------------------------------------------------
 names=(
@@ -63,7 +64,7 @@ if [ "${SINK:-file}" = null ]; then
   for i in "${!cmds[@]}"; do cmds[$i]=${cmds[$i]% --output out.csv}; done
 fi
 have_time=0
-[ -x /usr/bin/time ] && have_time=1
+[ -x /usr/bin/time ] && [ "${NO_TIME:-0}" != 1 ] && have_time=1
 results=$work/results.tsv
 : > "$results"
 for i in "${!cmds[@]}"; do
@@ -75,10 +76,14 @@ for i in "${!cmds[@]}"; do
         m=$(RAYON_NUM_THREADS=$t /usr/bin/time -f "%e %M" "$bin" ${cmds[$i]} 2>&1 >/dev/null |
           tail -n 1)
       else
-        s=$(date +%s.%N)
-        RAYON_NUM_THREADS=$t "$bin" ${cmds[$i]} >/dev/null 2>&1
-        e=$(date +%s.%N)
-        m="$(python3 -c "print(f'{$e - $s:.3f}')") -"
+        # No /usr/bin/time: python3 times the child and reads its peak RSS (KiB on Linux).
+        m=$(RAYON_NUM_THREADS=$t python3 -c '
+import resource, subprocess, sys, time
+s = time.perf_counter()
+subprocess.run(sys.argv[1:], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+e = time.perf_counter()
+print(f"{e - s:.2f} {resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss}")
+' "$bin" ${cmds[$i]})
       fi
       echo "$i	$t	$r	$m" >> "$results"
       echo "  ${names[$i]}, $t threads, run $r: $m" >&2

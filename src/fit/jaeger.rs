@@ -24,11 +24,12 @@
 use super::data::Dataset;
 use super::jaeger_coordinates::JaegerCoordinates;
 pub(crate) use super::jaeger_coordinates::JaegerX;
-use super::posterior::{summarise_reparameterised, summarise_with, Method, Prior};
+use super::posterior::{summarise_reparameterised, summarise_with, Method, Prior, SharedProgress};
 use super::summary::{distinct_points, observed_norm, FitResult, ParamSpec, Solved};
 use crate::inverse::{fit, CurveModel, Infeasible, LsqOptions, WeightedData};
 use crate::models::jaeger::Jaeger;
 use crate::models::JaegerBranch;
+use rayon::prelude::*;
 
 /// The paper's Fig. 9 values (ξ, a1, a2, a3), Jaeger units.
 pub(crate) const PAPER_FIG9: [(f64, f64, f64, f64); 4] = [
@@ -182,129 +183,145 @@ pub(crate) fn fit_jaeger_with(
     method: &Method,
 ) -> JaegerFits {
     let model = JaegerModel(branch);
+    // The series are independent fits (each sampler's streams depend on the seed alone), so
+    // they run side by side; their results and notes keep the series' order, and only the
+    // series holding the progress sink reaches it.
+    let shared = SharedProgress::of(method);
+    let fits: Vec<Result<JaegerFit, String>> = data
+        .labels
+        .par_iter()
+        .enumerate()
+        .map(|(s, label)| fit_jaeger_series(data, s, label, model, level, &shared.method()))
+        .collect();
     let mut notes = Vec::new();
-    let mut out = Vec::new();
-    for (s, label) in data.labels.iter().enumerate() {
-        let pts: Vec<_> = data.series(s).collect();
-        if pts.len() < 4 {
-            notes.push(format!(
-                "series '{label}': {} points, need at least 4 for a1, a2, a3",
-                pts.len()
-            ));
-            out.push(None);
-            continue;
-        }
-        let x: Vec<JaegerX> = pts
-            .iter()
-            .map(|p| {
-                let (sd, cd) = p.scene.delta.sin_cos();
-                (sd / cd, cd, p.scene.eps)
-            })
-            .collect();
-        let y: Vec<f64> = pts.iter().map(|p| p.v).collect();
-        let sg: Vec<f64> = pts.iter().map(|p| p.sigma).collect();
-        let norm = observed_norm(y.iter().zip(&sg));
-        let Some(p0) = start(&model, &x, &y, &sg) else {
-            notes.push(format!(
-                "series '{label}': no start with every point on the {} branch",
-                branch_name(branch)
-            ));
-            out.push(None);
-            continue;
-        };
-        let problem = match WeightedData::new(model, x.clone(), y, Some(sg)) {
-            Ok(p) => p,
-            Err(e) => {
-                notes.push(format!("series '{label}': {e}"));
-                out.push(None);
-                continue;
-            }
-        };
-        let opts = LsqOptions {
-            lower: Some(vec![0.0, 0.0, 0.0]),
-            sigma: data.sigma,
-            stop: method.stop().cloned(),
-            progress: method.progress().cloned(),
-            ..Default::default()
-        };
-        let f = match fit(&problem, &p0, &opts) {
-            Ok(f) => f,
-            Err(e) => {
-                notes.push(format!("series '{label}': {e}"));
-                out.push(None);
-                continue;
-            }
-        };
-        let paper = paper_values(pts[0].scene.xi);
-        let src = if paper.is_some() { "paper Fig. 9" } else { "" };
-        let specs = [("a1", 10.0), ("a2", 100.0), ("a3", 10.0)].map(|(name, scale)| ParamSpec {
-            name,
-            unit: "1 (Jaeger units, eq 81)",
-            paper_value: None,
-            paper_source: src,
-            default_prior: Some(Prior::half_normal(scale)),
-        });
-        let mut specs = specs;
-        if let Some(pv) = paper {
-            for k in 0..3 {
-                specs[k].paper_value = Some(pv[k]);
-            }
-        }
-        let solved = Solved {
-            name: "jaeger",
-            series: label,
-            specs: &specs,
-            problem: &problem,
-            fit: &f,
-            level,
-            options: &opts,
-            distinct: Some(distinct_points(x.iter().map(|q| [q.0, q.1, q.2]))),
-            observed_norm: Some(norm),
-        };
-        let mut summary = match JaegerCoordinates::for_series(&x, branch) {
-            Some(c) => summarise_reparameterised(method, solved, &c),
-            None => summarise_with(method, solved),
-        };
-        summary.attach_points(data, &data.series_index(s));
-        // The notes describe the values reported: the optimum, or the posterior medians.
-        let value = |k: usize| summary.params.get(k).map_or(f.params[k], |r| r.value);
-        let m = Jaeger {
-            a1: value(0),
-            a2: value(1),
-            a3: value(2),
-            branch,
-        };
-        let bistable_points = x.iter().filter(|q| m.bistable(q.0)).count();
-        let has_minimum = m.a1 * m.a2 > m.a3;
-        let mut extra = format!("branch {}", branch_name(branch));
-        if bistable_points > 0 {
-            extra.push_str(&format!(
-                "; {bistable_points} point(s) in the bistable band of eq 90"
-            ));
-        }
-        if !has_minimum {
-            extra.push_str("; a1 a2 <= a3: no minimum of the resistance (eq 82)");
-        }
-        for row in summary.params.iter_mut() {
-            row.note = if row.note.is_empty() {
-                extra.clone()
-            } else {
-                format!("{} {extra}", row.note)
-            };
-        }
-        summary.stats.note = if summary.stats.note.is_empty() {
-            extra
-        } else {
-            format!("{}; {extra}", summary.stats.note)
-        };
-        out.push(Some(JaegerFit {
-            summary,
-            branch,
-            bistable_points,
-            has_minimum,
-        }));
+    let series = fits
+        .into_iter()
+        .map(|r| r.map_err(|e| notes.push(e)).ok())
+        .collect();
+    JaegerFits { series, notes }
+}
+
+/// Jaeger's law fitted to series `s` (labelled `label`) of `data` on `model`'s branch, or the
+/// note saying why not.
+fn fit_jaeger_series(
+    data: &Dataset,
+    s: usize,
+    label: &str,
+    model: JaegerModel,
+    level: f64,
+    method: &Method,
+) -> Result<JaegerFit, String> {
+    let branch = model.0;
+    let pts: Vec<_> = data.series(s).collect();
+    if pts.len() < 4 {
+        return Err(format!(
+            "series '{label}': {} points, need at least 4 for a1, a2, a3",
+            pts.len()
+        ));
     }
-    JaegerFits { series: out, notes }
+    let x: Vec<JaegerX> = pts
+        .iter()
+        .map(|p| {
+            let (sd, cd) = p.scene.delta.sin_cos();
+            (sd / cd, cd, p.scene.eps)
+        })
+        .collect();
+    let y: Vec<f64> = pts.iter().map(|p| p.v).collect();
+    let sg: Vec<f64> = pts.iter().map(|p| p.sigma).collect();
+    let norm = observed_norm(y.iter().zip(&sg));
+    let Some(p0) = start(&model, &x, &y, &sg) else {
+        return Err(format!(
+            "series '{label}': no start with every point on the {} branch",
+            branch_name(branch)
+        ));
+    };
+    let problem = match WeightedData::new(model, x.clone(), y, Some(sg)) {
+        Ok(p) => p,
+        Err(e) => {
+            return Err(format!("series '{label}': {e}"));
+        }
+    };
+    let opts = LsqOptions {
+        lower: Some(vec![0.0, 0.0, 0.0]),
+        sigma: data.sigma,
+        stop: method.stop().cloned(),
+        progress: method.progress().cloned(),
+        ..Default::default()
+    };
+    let f = match fit(&problem, &p0, &opts) {
+        Ok(f) => f,
+        Err(e) => {
+            return Err(format!("series '{label}': {e}"));
+        }
+    };
+    let paper = paper_values(pts[0].scene.xi);
+    let src = if paper.is_some() { "paper Fig. 9" } else { "" };
+    let specs = [("a1", 10.0), ("a2", 100.0), ("a3", 10.0)].map(|(name, scale)| ParamSpec {
+        name,
+        unit: "1 (Jaeger units, eq 81)",
+        paper_value: None,
+        paper_source: src,
+        default_prior: Some(Prior::half_normal(scale)),
+    });
+    let mut specs = specs;
+    if let Some(pv) = paper {
+        for k in 0..3 {
+            specs[k].paper_value = Some(pv[k]);
+        }
+    }
+    let solved = Solved {
+        name: "jaeger",
+        series: label,
+        specs: &specs,
+        problem: &problem,
+        fit: &f,
+        level,
+        options: &opts,
+        distinct: Some(distinct_points(x.iter().map(|q| [q.0, q.1, q.2]))),
+        observed_norm: Some(norm),
+    };
+    let mut summary = match JaegerCoordinates::for_series(&x, branch) {
+        Some(c) => summarise_reparameterised(method, solved, &c),
+        None => summarise_with(method, solved),
+    };
+    summary.attach_points(data, &data.series_index(s));
+    // The notes describe the values reported: the optimum, or the posterior medians.
+    let value = |k: usize| summary.params.get(k).map_or(f.params[k], |r| r.value);
+    let m = Jaeger {
+        a1: value(0),
+        a2: value(1),
+        a3: value(2),
+        branch,
+    };
+    let bistable_points = x.iter().filter(|q| m.bistable(q.0)).count();
+    let has_minimum = m.a1 * m.a2 > m.a3;
+    let mut extra = format!("branch {}", branch_name(branch));
+    if bistable_points > 0 {
+        extra.push_str(&format!(
+            "; {bistable_points} point(s) in the bistable band of eq 90"
+        ));
+    }
+    if !has_minimum {
+        extra.push_str("; a1 a2 <= a3: no minimum of the resistance (eq 82)");
+    }
+    for row in summary.params.iter_mut() {
+        row.note = if row.note.is_empty() {
+            extra.clone()
+        } else {
+            format!("{} {extra}", row.note)
+        };
+    }
+    summary.stats.note = if summary.stats.note.is_empty() {
+        extra
+    } else {
+        format!("{}; {extra}", summary.stats.note)
+    };
+    Ok(JaegerFit {
+        summary,
+        branch,
+        bistable_points,
+        has_minimum,
+    })
 }
 
 /// `upper` or `lower`.

@@ -12,9 +12,10 @@
 //! ln μ against sin α through the per-series fits (the paper's values where those fail).
 
 use super::data::Dataset;
-use super::posterior::{summarise_with, Method};
+use super::posterior::{summarise_with, Method, SharedProgress};
 use super::summary::{distinct_points, observed_norm, FitResult, ParamSpec, Solved};
 use crate::inverse::{fit, CurveModel, Infeasible, LsqOptions, WeightedData};
+use rayon::prelude::*;
 
 /// The paper's global values (λ0, λ1, μ0, μ1), eqs 75–76.
 pub(crate) const PAPER_GLOBAL: [f64; 4] = [0.063, 4.96, 0.0025, 7.46];
@@ -131,14 +132,38 @@ fn line(x: &[f64], y: &[f64], sigma: &[f64]) -> Option<(f64, f64)> {
 /// least-squares optimum; see [`super::posterior`]). The global
 /// fit starts from the per-series least-squares optima either way.
 pub(crate) fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFits {
+    // The series are independent fits (each sampler's streams depend on the seed alone), so
+    // they run side by side; their results, notes and points keep the series' order, and only
+    // the series holding the progress sink reaches it.
+    let shared = SharedProgress::of(method);
+    let fits: Vec<_> = data
+        .labels
+        .par_iter()
+        .enumerate()
+        .map(|(s, label)| {
+            let mut notes = Vec::new();
+            let mut pts: (LogPoints, LogPoints) = (Vec::new(), Vec::new());
+            let fit = fit_jan_series(
+                data,
+                s,
+                label,
+                level,
+                &shared.method(),
+                &mut notes,
+                &mut pts,
+            );
+            (fit, notes, pts)
+        })
+        .collect();
     let mut notes = Vec::new();
     let mut per = Vec::new();
     // (sin α, ln λ, weight σ of ln λ) and the same of μ, one per converged series fit.
     let mut pts: (LogPoints, LogPoints) = (Vec::new(), Vec::new());
-    for (s, label) in data.labels.iter().enumerate() {
-        per.push(fit_jan_series(
-            data, s, label, level, method, &mut notes, &mut pts,
-        ));
+    for (fit, n, p) in fits {
+        per.push(fit);
+        notes.extend(n);
+        pts.0.extend(p.0);
+        pts.1.extend(p.1);
     }
     let mut alphas: Vec<f64> = data.points.iter().map(|p| p.scene.sin_alpha).collect();
     alphas.sort_by(|a, b| a.total_cmp(b));

@@ -14,12 +14,12 @@
 use super::mcmc::{LogDensity, McmcOptions};
 use super::Residuals;
 use crate::numfmt::fmt_f64;
-use crate::progress::{Progress, Tally};
+use crate::progress::{Progress, ProgressEvent, Tally};
 use statrs::distribution::{Continuous, LogNormal, Normal, Uniform};
 use std::fmt;
 use std::str::FromStr;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
 
 /// Name of the error-scale parameter.
 pub(crate) const SCALE_NAME: &str = "sigma_scale";
@@ -567,5 +567,53 @@ impl<R: Residuals + Sync + ?Sized> LogDensity for Posterior<'_, R> {
     /// The parameters (and the scale) at y: what the draws record.
     fn observe(&self, y: &[f64]) -> Vec<f64> {
         self.to_params(y)
+    }
+}
+
+/// A progress sink shared by fits that run concurrently: each fit gets its own sink
+/// ([`Self::method`]), and only the fit holding the shared one (the first to start while it
+/// is free, until it finishes) reaches it.
+pub(crate) struct SharedProgress<'a> {
+    method: &'a Method,
+    holder: Arc<Mutex<Option<usize>>>,
+    next: AtomicUsize,
+}
+
+impl<'a> SharedProgress<'a> {
+    pub(crate) fn of(method: &'a Method) -> Self {
+        SharedProgress {
+            method,
+            holder: Arc::new(Mutex::new(None)),
+            next: AtomicUsize::new(0),
+        }
+    }
+
+    /// The method for one more fit: `method` itself, with its own sink under MCMC.
+    pub(crate) fn method(&self) -> Method {
+        let Method::Mcmc(settings) = self.method else {
+            return self.method.clone();
+        };
+        let Some(outer) = settings.progress.clone() else {
+            return self.method.clone();
+        };
+        let id = self.next.fetch_add(1, Ordering::Relaxed);
+        let holder = Arc::clone(&self.holder);
+        let mut s = settings.clone();
+        s.progress = Some(Progress::new(move |e| {
+            let Ok(mut h) = holder.lock() else { return };
+            match (e, *h) {
+                (ProgressEvent::Start { .. }, None) => {
+                    *h = Some(id);
+                    outer.report(e);
+                }
+                (ProgressEvent::Finish, Some(k)) if k == id => {
+                    *h = None;
+                    outer.report(e);
+                }
+                (ProgressEvent::Position(_), Some(k)) if k == id => outer.report(e),
+                _ => {}
+            }
+        }));
+        Method::Mcmc(s)
     }
 }

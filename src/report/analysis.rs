@@ -7,20 +7,17 @@ use crate::fit::jaeger::{fit_jaeger_with, JaegerFits};
 use crate::fit::jan::{fit_jan_with, JanFits};
 use crate::fit::k::bracket;
 use crate::fit::klaw::{fit_law_with, KLaw, KLawError, KLawFit, KLawProblem};
-use crate::fit::posterior::Method;
+use crate::fit::posterior::{Method, SharedProgress};
 use crate::fit::summary::{FitResult, ParamRow};
 use crate::inverse::{CurveModel as _, Residuals, SigmaKind};
 use crate::models::energy;
 use crate::models::regimes::{bulk_friction, critical_xi, delta_d_law, delta_m_law};
 use crate::models::{ForwardModel, JaegerBranch, Model, Regime};
 use crate::numfmt::fmt_f64;
-use crate::progress::{Progress, ProgressEvent};
 use crate::record::to_csv;
 use crate::scene::CollisionLaw;
 use rayon::prelude::*;
 use serde::Serialize;
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::{Arc, Mutex};
 
 /// The two collision models whose K is fitted: pure rolling (the paper's stick model) and
 /// stick/slip.
@@ -231,54 +228,6 @@ fn contact_fits(
         energy,
         notes,
         law_failures,
-    }
-}
-
-/// A progress sink shared by fits that run concurrently: each fit gets its own sink
-/// ([`Self::method`]), and only the fit holding the shared one (the first to start while it
-/// is free, until it finishes) reaches it.
-struct SharedProgress<'a> {
-    method: &'a Method,
-    holder: Arc<Mutex<Option<usize>>>,
-    next: AtomicUsize,
-}
-
-impl<'a> SharedProgress<'a> {
-    fn of(method: &'a Method) -> Self {
-        SharedProgress {
-            method,
-            holder: Arc::new(Mutex::new(None)),
-            next: AtomicUsize::new(0),
-        }
-    }
-
-    /// The method for one more fit: `method` itself, with its own sink under MCMC.
-    fn method(&self) -> Method {
-        let Method::Mcmc(settings) = self.method else {
-            return self.method.clone();
-        };
-        let Some(outer) = settings.progress.clone() else {
-            return self.method.clone();
-        };
-        let id = self.next.fetch_add(1, Ordering::Relaxed);
-        let holder = Arc::clone(&self.holder);
-        let mut s = settings.clone();
-        s.progress = Some(Progress::new(move |e| {
-            let Ok(mut h) = holder.lock() else { return };
-            match (e, *h) {
-                (ProgressEvent::Start { .. }, None) => {
-                    *h = Some(id);
-                    outer.report(e);
-                }
-                (ProgressEvent::Finish, Some(k)) if k == id => {
-                    *h = None;
-                    outer.report(e);
-                }
-                (ProgressEvent::Position(_), Some(k)) if k == id => outer.report(e),
-                _ => {}
-            }
-        }));
-        Method::Mcmc(s)
     }
 }
 

@@ -1,6 +1,7 @@
 //! The fits give the same bytes on any number of threads: their parallel loops (the K-law
-//! Jacobian, the profile refits, the walkers' log densities) each write their own slot and
-//! combine in a fixed order, so rayon's pool size (`RAYON_NUM_THREADS`) changes only the time.
+//! Jacobian, the profile refits, the walkers' log densities, the per-series fits, the
+//! diagnostics of each parameter) each write their own slot and combine in a fixed order, so
+//! rayon's pool size (`RAYON_NUM_THREADS`) changes only the time.
 
 use std::path::Path;
 
@@ -45,9 +46,12 @@ fn outputs(dir: &Path, threads: usize, args: &[&str], mcmc: bool) -> Vec<String>
 
 #[test]
 fn fits_are_byte_identical_on_one_and_three_threads() {
-    let cases: [(&[&str], bool); 3] = [
+    let cases: [(&[&str], bool); 5] = [
         (&["klaw", "--model", "stickslip"], false),
         (&["jaeger"], false),
+        // The per-series fits of Jaeger and Jan run side by side.
+        (&["jaeger", "--method", "mcmc", "--seed", "3"], true),
+        (&["jan", "--method", "mcmc", "--seed", "5"], true),
         (
             &[
                 "klaw",

@@ -18,6 +18,7 @@
 //! * `summarise` — all of the above plus mean, standard deviation and quantiles of the pooled
 //!   draws, per parameter.
 
+use rayon::prelude::*;
 use realfft::num_complex::Complex;
 use realfft::RealFftPlanner;
 use statrs::distribution::{ContinuousCDF, Normal};
@@ -135,6 +136,7 @@ pub(crate) fn integrated_times(chains: &[Vec<Vec<f64>>], c: f64) -> Vec<f64> {
         .and_then(|c| c.first())
         .map_or(0, |x| x.len());
     (0..dim)
+        .into_par_iter()
         .map(|k| integrated_time(&parameter_chains(chains, k), c))
         .collect()
 }
@@ -452,7 +454,10 @@ pub(crate) fn summarise_scalar(chains: &[Vec<f64>], level: f64) -> ParameterDiag
     let mean = sorted.iter().sum::<f64>() / s;
     let sd = (sorted.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (s - 1.0)).sqrt();
     sorted.sort_by(f64::total_cmp);
-    let c = convergence_sorted(chains, &sorted);
+    let (c, tau) = rayon::join(
+        || convergence_sorted(chains, &sorted),
+        || integrated_time(chains, SOKAL_C),
+    );
     let alpha = 0.5 * (1.0 - level);
     ParameterDiagnostics {
         mean,
@@ -464,7 +469,7 @@ pub(crate) fn summarise_scalar(chains: &[Vec<f64>], level: f64) -> ParameterDiag
             quantile_sorted(&sorted, alpha),
             quantile_sorted(&sorted, 1.0 - alpha),
         ),
-        tau: integrated_time(chains, SOKAL_C),
+        tau,
         rhat: c.rhat,
         ess_bulk: c.ess_bulk,
         ess_tail: c.ess_tail,
@@ -479,6 +484,7 @@ pub(crate) fn summarise(chains: &[Vec<Vec<f64>>], level: f64) -> Vec<ParameterDi
         .and_then(|c| c.first())
         .map_or(0, |x| x.len());
     (0..dim)
+        .into_par_iter()
         .map(|k| summarise_scalar(&parameter_chains(chains, k), level))
         .collect()
 }

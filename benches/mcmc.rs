@@ -202,5 +202,44 @@ fn autocovariance(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench, autocovariance);
+/// One convergence check of one parameter (R̂, bulk and tail ESS; what a check during a
+/// one-parameter run computes, with no other work for the threads): 32 AR(1) chains of 4,000
+/// steps, on rayon pools of one and two threads. Its three parts and the rank transform run
+/// side by side; the result is the same on either pool.
+fn convergence(c: &mut Criterion) {
+    use fitbead::bench_internals::convergence as check;
+    let chains: Vec<Vec<f64>> = (0..32u64)
+        .map(|w| {
+            let mut x = vec![0.0; 4000];
+            let mut s = 0x9e37_79b9_7f4a_7c15u64.wrapping_mul(w + 1);
+            for i in 1..x.len() {
+                s ^= s << 13;
+                s ^= s >> 7;
+                s ^= s << 17;
+                let u = (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+                x[i] = 0.9 * x[i - 1] + u;
+            }
+            x
+        })
+        .collect();
+    let mut g = c.benchmark_group("convergence check");
+    g.sample_size(20);
+    let mut seen = Vec::new();
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        seen.push(pool.install(|| check(&chains)));
+        g.bench_function(
+            format!("32 chains x 4000 steps, {threads} thread(s)"),
+            |b| b.iter(|| pool.install(|| check(black_box(&chains)))),
+        );
+    }
+    let bits = |r: &(f64, f64, f64)| [r.0.to_bits(), r.1.to_bits(), r.2.to_bits()];
+    assert_eq!(bits(&seen[0]), bits(&seen[1]), "1 and 2 threads differ");
+    g.finish();
+}
+
+criterion_group!(benches, bench, autocovariance, convergence);
 criterion_main!(benches);

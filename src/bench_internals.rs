@@ -5,6 +5,12 @@
 pub use crate::fit::k::bracket::bracket;
 pub use crate::fit::k::search::solve;
 pub use crate::inverse::mcmc::diagnostics::autocovariance;
+
+/// R̂, bulk and tail ESS of one parameter's chains, as one convergence check computes them.
+pub fn convergence(chains: &[Vec<f64>]) -> (f64, f64, f64) {
+    let c = crate::inverse::mcmc::diagnostics::convergence(chains);
+    (c.rhat, c.ess_bulk, c.ess_tail)
+}
 pub use crate::models::sample::{draw_scenes, Draw};
 pub use crate::models::slip::steady_tol as slip_steady_tol;
 pub use crate::models::stickquad::steady_quad as stick_steady_quad;

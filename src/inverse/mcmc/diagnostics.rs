@@ -183,16 +183,20 @@ pub(crate) fn rank_normalise(chains: &[Vec<f64>]) -> Vec<Vec<f64>> {
     }
     let normal = Normal::standard();
     let denom = s as f64 + 0.25;
-    let mut k = 0;
+    // Each chain's draws start at its offset in the pooled order.
+    let starts = chains.iter().scan(0, |next, c| {
+        let at = *next;
+        *next += c.len();
+        Some(at)
+    });
+    let starts: Vec<usize> = starts.collect();
     chains
-        .iter()
-        .map(|c| {
-            c.iter()
-                .map(|_| {
-                    let z = normal.inverse_cdf((ranks[k] - 0.375) / denom);
-                    k += 1;
-                    z
-                })
+        .par_iter()
+        .zip(starts)
+        .map(|(c, at)| {
+            ranks[at..at + c.len()]
+                .iter()
+                .map(|r| normal.inverse_cdf((r - 0.375) / denom))
                 .collect()
         })
         .collect()
@@ -245,14 +249,18 @@ pub fn rhat(chains: &[Vec<f64>]) -> f64 {
 
 /// [`rhat`] from the split chains, their rank normalisation and the median of the pooled
 /// draws.
+#[cfg(test)]
 fn rhat_ranked(split: &[Vec<f64>], ranked: &[Vec<f64>], med: f64) -> f64 {
-    let bulk = rhat_basic(ranked);
+    rhat_basic(ranked).max(rhat_tail(split, med))
+}
+
+/// The tail R̂: [`rhat_basic`] of the rank-normalised folded draws |θ − `med`|.
+fn rhat_tail(split: &[Vec<f64>], med: f64) -> f64 {
     let folded: Vec<Vec<f64>> = split
         .iter()
         .map(|c| c.iter().map(|v| (v - med).abs()).collect())
         .collect();
-    let tail = rhat_basic(&rank_normalise(&folded));
-    bulk.max(tail)
+    rhat_basic(&rank_normalise(&folded))
 }
 
 /// [`rhat`], [`ess_bulk`] and [`ess_tail`] of one scalar quantity, computed together: the
@@ -276,18 +284,40 @@ pub(crate) fn convergence(chains: &[Vec<f64>]) -> Convergence {
 }
 
 /// [`convergence`] given the pooled draws already sorted.
+///
+/// Its three independent parts (the rank-normalised draws with the bulk R̂ and ESS, the tail
+/// R̂, the tail ESS) run side by side: a check during a one-parameter run has no other work
+/// for the threads.
 fn convergence_sorted(chains: &[Vec<f64>], sorted: &[f64]) -> Convergence {
     let split = split_chains(chains);
-    let ranked = rank_normalise(&split);
-    let rhat = if split.first().map_or(0, Vec::len) < 2 {
-        f64::NAN
-    } else {
-        rhat_ranked(&split, &ranked, quantile_sorted(sorted, 0.5))
-    };
+    let enough = split.first().map_or(0, Vec::len) >= 2;
+    let ((bulk, ess_bulk), (tail, ess_tail)) = rayon::join(
+        || {
+            let ranked = rank_normalise(&split);
+            let bulk = if enough {
+                rhat_basic(&ranked)
+            } else {
+                f64::NAN
+            };
+            (bulk, ess_basic(&ranked))
+        },
+        || {
+            rayon::join(
+                || {
+                    if enough {
+                        rhat_tail(&split, quantile_sorted(sorted, 0.5))
+                    } else {
+                        f64::NAN
+                    }
+                },
+                || ess_tail_sorted(&split, sorted),
+            )
+        },
+    );
     Convergence {
-        rhat,
-        ess_bulk: ess_basic(&ranked),
-        ess_tail: ess_tail_sorted(&split, sorted),
+        rhat: if enough { bulk.max(tail) } else { f64::NAN },
+        ess_bulk,
+        ess_tail,
     }
 }
 

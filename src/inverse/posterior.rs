@@ -571,8 +571,9 @@ impl<R: Residuals + Sync + ?Sized> LogDensity for Posterior<'_, R> {
 }
 
 /// A progress sink shared by fits that run concurrently: each fit gets its own sink
-/// ([`Self::method`]), and only the fit holding the shared one (the first to start while it
-/// is free, until it finishes) reaches it.
+/// ([`Self::method`]), and only the fit holding the shared one reaches it. A fit that starts
+/// while the sink is free takes it; once its holder finishes, the next fit still running to
+/// report takes it over, its start repeated first.
 pub(crate) struct SharedProgress<'a> {
     method: &'a Method,
     holder: Arc<Mutex<Option<usize>>>,
@@ -598,22 +599,104 @@ impl<'a> SharedProgress<'a> {
         };
         let id = self.next.fetch_add(1, Ordering::Relaxed);
         let holder = Arc::clone(&self.holder);
+        // This fit's start (label, total, check interval) while it runs, to repeat on a
+        // take-over.
+        let started: Mutex<Option<(String, u64, u64)>> = Mutex::new(None);
         let mut s = settings.clone();
         s.progress = Some(Progress::new(move |e| {
             let Ok(mut h) = holder.lock() else { return };
-            match (e, *h) {
-                (ProgressEvent::Start { .. }, None) => {
-                    *h = Some(id);
-                    outer.report(e);
+            let Ok(mut mine) = started.lock() else { return };
+            match e {
+                ProgressEvent::Start {
+                    label,
+                    total,
+                    check_every,
+                } => {
+                    *mine = Some((label.to_string(), total, check_every));
+                    if h.is_none() {
+                        *h = Some(id);
+                        outer.report(e);
+                    }
                 }
-                (ProgressEvent::Finish, Some(k)) if k == id => {
-                    *h = None;
-                    outer.report(e);
+                ProgressEvent::Position(_) => {
+                    if h.is_none() {
+                        if let Some((label, total, check_every)) = mine.as_ref() {
+                            *h = Some(id);
+                            outer.report(ProgressEvent::Start {
+                                label,
+                                total: *total,
+                                check_every: *check_every,
+                            });
+                        }
+                    }
+                    if *h == Some(id) {
+                        outer.report(e);
+                    }
                 }
-                (ProgressEvent::Position(_), Some(k)) if k == id => outer.report(e),
-                _ => {}
+                ProgressEvent::Finish => {
+                    *mine = None;
+                    if *h == Some(id) {
+                        *h = None;
+                        outer.report(e);
+                    }
+                }
             }
         }));
         Method::Mcmc(s)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two fits share one sink: the first to start holds it; the second, started meanwhile,
+    /// takes it over at its next position once the first has finished, its start repeated.
+    #[test]
+    fn a_shared_sink_passes_to_the_next_running_fit() {
+        let seen = Arc::new(Mutex::new(Vec::<String>::new()));
+        let log = Arc::clone(&seen);
+        let mut settings = McmcSettings::seeded(1);
+        settings.progress = Some(Progress::new(move |e| {
+            let line = match e {
+                ProgressEvent::Start { label, total, .. } => format!("start {label} {total}"),
+                ProgressEvent::Position(p) => format!("at {p}"),
+                ProgressEvent::Finish => "finish".to_string(),
+            };
+            log.lock().unwrap().push(line);
+        }));
+        let method = Method::Mcmc(Box::new(settings));
+        let shared = SharedProgress::of(&method);
+        let sink = |m: &Method| match m {
+            Method::Mcmc(s) => s.progress.clone().unwrap(),
+            Method::Lsq { .. } => unreachable!(),
+        };
+        let (a, b) = (sink(&shared.method()), sink(&shared.method()));
+        let start = |p: &Progress, label: &str| {
+            p.report(ProgressEvent::Start {
+                label,
+                total: 100,
+                check_every: 10,
+            })
+        };
+        start(&a, "a");
+        start(&b, "b");
+        a.report(ProgressEvent::Position(5));
+        b.report(ProgressEvent::Position(7));
+        a.report(ProgressEvent::Finish);
+        b.report(ProgressEvent::Position(9));
+        b.report(ProgressEvent::Finish);
+        a.report(ProgressEvent::Position(11));
+        assert_eq!(
+            *seen.lock().unwrap(),
+            [
+                "start a 100",
+                "at 5",
+                "finish",
+                "start b 100",
+                "at 9",
+                "finish"
+            ]
+        );
     }
 }

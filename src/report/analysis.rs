@@ -96,8 +96,8 @@ pub const REPORT_DRAWS: usize = 10_000;
 /// The fits are independent and run concurrently (rayon); each is reproducible on its own
 /// (the sampler's streams depend on the seed only), so the analysis is the same whatever the
 /// number of threads. Under MCMC a progress sink receives the events of one fit at a time
-/// (the first to start holds it until it finishes; the others run unseen), and each
-/// posterior keeps at most [`REPORT_DRAWS`] draws.
+/// (the first to start holds it until it finishes, then the next fit still running to report
+/// takes it over), and each posterior keeps at most [`REPORT_DRAWS`] draws.
 pub fn analyse(data: &Dataset, level: f64, method: &Method) -> Analysis {
     let shared = SharedProgress::of(method);
     let (contact, (jan, jaeger)) = rayon::join(

@@ -24,12 +24,11 @@
 use super::data::Dataset;
 use super::jaeger_coordinates::JaegerCoordinates;
 pub(crate) use super::jaeger_coordinates::JaegerX;
-use super::posterior::{summarise_reparameterised, summarise_with, Method, Prior, SharedProgress};
+use super::posterior::{per_series, summarise_reparameterised, summarise_with, Method, Prior};
 use super::summary::{distinct_points, observed_norm, FitResult, ParamSpec, Solved};
 use crate::inverse::{fit, CurveModel, Infeasible, LsqOptions, WeightedData};
 use crate::models::jaeger::Jaeger;
 use crate::models::JaegerBranch;
-use rayon::prelude::*;
 
 /// The paper's Fig. 9 values (ξ, a1, a2, a3), Jaeger units.
 pub(crate) const PAPER_FIG9: [(f64, f64, f64, f64); 4] = [
@@ -183,21 +182,20 @@ pub(crate) fn fit_jaeger_with(
     method: &Method,
 ) -> JaegerFits {
     let model = JaegerModel(branch);
-    // The series are independent fits (each sampler's streams depend on the seed alone), so
-    // they run side by side; their results and notes keep the series' order, and only the
-    // series holding the progress sink reaches it.
-    let shared = SharedProgress::of(method);
-    let fits: Vec<Result<JaegerFit, String>> = data
-        .labels
-        .par_iter()
-        .enumerate()
-        .map(|(s, label)| fit_jaeger_series(data, s, label, model, level, &shared.method()))
-        .collect();
+    let fits = per_series(data, method, |s, label, method| {
+        fit_jaeger_series(data, s, label, model, level, method)
+    });
     let mut notes = Vec::new();
-    let series = fits
-        .into_iter()
-        .map(|r| r.map_err(|e| notes.push(e)).ok())
-        .collect();
+    let mut series = Vec::with_capacity(fits.len());
+    for r in fits {
+        match r {
+            Ok(f) => series.push(Some(f)),
+            Err(note) => {
+                notes.push(note);
+                series.push(None);
+            }
+        }
+    }
     JaegerFits { series, notes }
 }
 

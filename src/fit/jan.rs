@@ -12,10 +12,9 @@
 //! ln μ against sin α through the per-series fits (the paper's values where those fail).
 
 use super::data::Dataset;
-use super::posterior::{summarise_with, Method, SharedProgress};
+use super::posterior::{per_series, summarise_with, Method};
 use super::summary::{distinct_points, observed_norm, FitResult, ParamSpec, Solved};
 use crate::inverse::{fit, CurveModel, Infeasible, LsqOptions, WeightedData};
-use rayon::prelude::*;
 
 /// The paper's global values (λ0, λ1, μ0, μ1), eqs 75–76.
 pub(crate) const PAPER_GLOBAL: [f64; 4] = [0.063, 4.96, 0.0025, 7.46];
@@ -132,29 +131,12 @@ fn line(x: &[f64], y: &[f64], sigma: &[f64]) -> Option<(f64, f64)> {
 /// least-squares optimum; see [`super::posterior`]). The global
 /// fit starts from the per-series least-squares optima either way.
 pub(crate) fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFits {
-    // The series are independent fits (each sampler's streams depend on the seed alone), so
-    // they run side by side; their results, notes and points keep the series' order, and only
-    // the series holding the progress sink reaches it.
-    let shared = SharedProgress::of(method);
-    let fits: Vec<_> = data
-        .labels
-        .par_iter()
-        .enumerate()
-        .map(|(s, label)| {
-            let mut notes = Vec::new();
-            let mut pts: (LogPoints, LogPoints) = (Vec::new(), Vec::new());
-            let fit = fit_jan_series(
-                data,
-                s,
-                label,
-                level,
-                &shared.method(),
-                &mut notes,
-                &mut pts,
-            );
-            (fit, notes, pts)
-        })
-        .collect();
+    let fits = per_series(data, method, |s, label, method| {
+        let mut notes = Vec::new();
+        let mut pts: (LogPoints, LogPoints) = (Vec::new(), Vec::new());
+        let fit = fit_jan_series(data, s, label, level, method, &mut notes, &mut pts);
+        (fit, notes, pts)
+    });
     let mut notes = Vec::new();
     let mut per = Vec::new();
     // (sin α, ln λ, weight σ of ln λ) and the same of μ, one per converged series fit.

@@ -32,6 +32,7 @@
 //! the level asked (`ci_method = posterior`); the covariance interval of the least-squares
 //! optimum stays in `cov_low`/`cov_high` and the optimum in `lsq_value`.
 
+use super::data::Dataset;
 use super::summary::{
     chi2_vanishes, summarise, FitResult, McmcFailure, McmcStats, ParamRow, ParamSpec, PowerScaling,
     Solved,
@@ -46,6 +47,24 @@ use crate::inverse::{Fit, Residuals, SigmaKind};
 use crate::numfmt::{fmt_f64, fmt_sig};
 use crate::progress::ProgressEvent;
 use rayon::prelude::*;
+
+/// `fit` applied to every series of `data` (its index and label, and the method to fit it
+/// by), the series side by side, the results in the series' order. The series are
+/// independent fits whose sampler streams depend on the seed alone, so the results are those
+/// of one series after the other; under MCMC the series share `method`'s progress sink
+/// ([`SharedProgress`]).
+pub(crate) fn per_series<T: Send>(
+    data: &Dataset,
+    method: &Method,
+    fit: impl Fn(usize, &str, &Method) -> T + Sync,
+) -> Vec<T> {
+    let shared = SharedProgress::of(method);
+    data.labels
+        .par_iter()
+        .enumerate()
+        .map(|(s, label)| fit(s, label, &shared.method()))
+        .collect()
+}
 
 /// The column naming a parameter in the draws file: its name, with the series appended where
 /// a fit across series has one parameter per series (`K[series]`).

@@ -184,12 +184,14 @@ pub(crate) fn rank_normalise(chains: &[Vec<f64>]) -> Vec<Vec<f64>> {
     let normal = Normal::standard();
     let denom = s as f64 + 0.25;
     // Each chain's draws start at its offset in the pooled order.
-    let starts = chains.iter().scan(0, |next, c| {
-        let at = *next;
-        *next += c.len();
-        Some(at)
-    });
-    let starts: Vec<usize> = starts.collect();
+    let starts: Vec<usize> = chains
+        .iter()
+        .scan(0, |next, c| {
+            let at = *next;
+            *next += c.len();
+            Some(at)
+        })
+        .collect();
     chains
         .par_iter()
         .zip(starts)
@@ -294,12 +296,7 @@ fn convergence_sorted(chains: &[Vec<f64>], sorted: &[f64]) -> Convergence {
     let ((bulk, ess_bulk), (tail, ess_tail)) = rayon::join(
         || {
             let ranked = rank_normalise(&split);
-            let bulk = if enough {
-                rhat_basic(&ranked)
-            } else {
-                f64::NAN
-            };
-            (bulk, ess_basic(&ranked))
+            (rhat_basic(&ranked), ess_basic(&ranked))
         },
         || {
             rayon::join(

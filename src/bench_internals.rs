@@ -19,6 +19,17 @@ pub use crate::special::elliptic::{cos_integral, cos_integral_pair, rf, rf_lanes
 pub use crate::special::root::{brent, Root};
 pub use crate::special::SinCos;
 
+/// Numbers as the streaming commands write a row's number cells: each of `xs` as the shortest
+/// decimal that reads back as it ([`crate::numfmt::fmt_f64`]), comma-separated, then the
+/// record's newline, appended to `out`.
+pub fn push_number_cells(out: &mut Vec<u8>, xs: &[f64]) {
+    let mut c = crate::io::cells::Cells::new(out);
+    for &x in xs {
+        c.num(x);
+    }
+    c.end();
+}
+
 /// A work-precision table written by `fitbead bench --output`, re-plotted as the bench
 /// command's SVG figure under `title`.
 pub fn replot(csv_bytes: &[u8], title: &str) -> Result<String, String> {

@@ -236,9 +236,15 @@ where
             let cannot =
                 |e: std::io::Error| CliError::Other(format!("{}: cannot write: {e}", p.display()));
             let mut file = AtomicFile::create(p);
+            // Unless the target is written in place (a device or FIFO), nothing written is
+            // seen before the commit.
+            let opts = StreamOptions {
+                atomic_output: file.as_ref().map_or(true, |f| !f.is_direct()),
+                ..opts.clone()
+            };
             let r = match &mut file {
-                Ok(f) => stream(reader, make, ledger, f, opts),
-                Err(_) => stream(reader, make, ledger, &mut std::io::sink(), opts),
+                Ok(f) => stream(reader, make, ledger, f, &opts),
+                Err(_) => stream(reader, make, ledger, &mut std::io::sink(), &opts),
             };
             match r {
                 Ok(done) => {

@@ -404,7 +404,9 @@ impl AtomicFile {
         .map_err(|e| with_path(&self.path, e))
     }
 
-    fn is_direct(&self) -> bool {
+    /// Whether the bytes go straight to the target (a device or FIFO), seen as they are
+    /// written, rather than to a temporary file that replaces the target on commit.
+    pub(crate) fn is_direct(&self) -> bool {
         matches!(self.sink, Sink::Direct(_))
     }
 

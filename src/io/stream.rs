@@ -31,7 +31,9 @@
 //! chunk `j` leaves chunks `0..j` written, a malformed row in chunk `j` chunks `0..j-1`, so
 //! an input whose first [`CHUNK_ROWS`] rows hold the bad one leaves even a stream such as
 //! standard output empty; a file given as `--output` is written atomically and stays
-//! untouched.
+//! untouched. Where a failed stream's output is discarded anyway
+//! ([`StreamOptions::atomic_output`], as for such a file), the rule has nothing to decide: rows
+//! are written as soon as they are in input order.
 //! It reports its progress in input bytes to a [`Progress`] sink and stops between tasks when
 //! the caller's stop flag is raised.
 
@@ -127,10 +129,15 @@ pub struct StreamOptions {
     pub label: String,
     /// Size of the input in bytes, when known (for progress only).
     pub input_bytes: Option<u64>,
+    /// The output is seen only if the stream succeeds (the caller discards it otherwise, as
+    /// a temporary file renamed over its target on success is): rows are then written as
+    /// soon as they are in input order, none held back by the chunk rule, which only decides
+    /// what a failed stream leaves written.
+    pub atomic_output: bool,
 }
 
 impl Default for StreamOptions {
-    /// [`CHUNK_ROWS`], [`TASK_ROWS`], no stop flag, no progress.
+    /// [`CHUNK_ROWS`], [`TASK_ROWS`], no stop flag, no progress, an output seen as written.
     fn default() -> Self {
         StreamOptions {
             chunk_rows: CHUNK_ROWS,
@@ -139,6 +146,7 @@ impl Default for StreamOptions {
             progress: None,
             label: String::new(),
             input_bytes: None,
+            atomic_output: false,
         }
     }
 }
@@ -733,8 +741,14 @@ impl<R: Read + Send, P: RowPlan> Pipe<'_, R, P> {
         }
         w.records += d.records;
         if w.bad.is_none() {
-            // A chunk goes out once the chunk after it has been read whole.
-            self.release(w, (w.parsed / self.chunk).saturating_sub(1) * self.chunk);
+            // A chunk goes out once the chunk after it has been read whole (an output seen
+            // only on success takes every row as it comes).
+            let upto = if self.opts.atomic_output {
+                w.parsed
+            } else {
+                (w.parsed / self.chunk).saturating_sub(1) * self.chunk
+            };
+            self.release(w, upto);
         }
         if let Some(p) = &self.opts.progress {
             if d.end_byte >= w.reported + PROGRESS_BYTES {

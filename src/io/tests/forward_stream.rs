@@ -50,12 +50,18 @@ fn args(flags: &[&str]) -> Flags {
     }
 }
 
-fn new(a: &Flags, text: &[u8], chunk: usize, task: usize) -> Result<Vec<u8>, String> {
+fn new(
+    a: &Flags,
+    text: &[u8],
+    (chunk, task): (usize, usize),
+    atomic_output: bool,
+) -> Result<Vec<u8>, String> {
     let reader = TableReader::new("in.csv", text).map_err(|e| e.to_string())?;
     let mut out = Vec::new();
     let opts = StreamOptions {
         chunk_rows: chunk,
         task_rows: task,
+        atomic_output,
         ..StreamOptions::default()
     };
     let t = ForwardText {
@@ -78,11 +84,12 @@ fn new(a: &Flags, text: &[u8], chunk: usize, task: usize) -> Result<Vec<u8>, Str
 
 const SIZES: [(usize, usize); 4] = [(1, 1), (7, 3), (64, 5), (CHUNK_ROWS, TASK_ROWS)];
 
-/// The streaming output of `text` under `flags` equals `want` at every chunk size.
+/// The streaming output of `text` under `flags` equals `want` at every chunk size, held back
+/// by chunks or written as it comes (an atomic output).
 fn same(flags: &[&str], text: &[u8], want: &[u8]) {
     let a = args(flags);
-    for (chunk, task) in SIZES {
-        let got = new(&a, text, chunk, task)
+    for ((chunk, task), atomic) in SIZES.into_iter().flat_map(|s| [(s, false), (s, true)]) {
+        let got = new(&a, text, (chunk, task), atomic)
             .unwrap_or_else(|e| panic!("{flags:?}, chunks of {chunk}: {e}"));
         assert!(
             want == got,
@@ -283,8 +290,8 @@ fn same_error_as_the_golden_messages() {
     for ((flags, bytes), want) in cases.into_iter().zip(want) {
         let a = args(flags);
         let text = String::from_utf8_lossy(&bytes);
-        for (chunk, task) in SIZES {
-            match new(&a, &bytes, chunk, task) {
+        for ((chunk, task), atomic) in SIZES.into_iter().flat_map(|s| [(s, false), (s, true)]) {
+            match new(&a, &bytes, (chunk, task), atomic) {
                 Ok(_) => panic!("{flags:?} {text:?}, chunks of {chunk}: should fail"),
                 Err(e) => assert_eq!(
                     format!("{e:?}"),

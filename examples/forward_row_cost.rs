@@ -15,19 +15,12 @@ use fitbead::bench_internals::python_bench_scenes;
 use fitbead::io::records::ForwardRecord;
 use fitbead::{CollisionLaw, ForwardModel, Model, Scene};
 use std::hint::black_box;
-use std::time::Instant;
+
+mod common;
 
 /// The best of three runs of `f` over every row, in ns per row.
-fn best_ns(n: usize, mut f: impl FnMut()) -> f64 {
-    (0..3)
-        .map(|_| {
-            let t = Instant::now();
-            f();
-            t.elapsed().as_secs_f64()
-        })
-        .fold(f64::INFINITY, f64::min)
-        * 1e9
-        / n as f64
+fn best_ns(n: usize, f: impl FnMut()) -> f64 {
+    common::best_of_three(f) * 1e9 / n as f64
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

@@ -1,23 +1,33 @@
 //! Wall time of the K inversion alone (eq 69: bracket, K, K_lo, K_hi, dv̄/dK; no CSV), per row
 //! of a measured file, by class of row: what the estimate costs inside `fitbead k`, whose
-//! whole-process time adds reading, checking and writing the rows.
+//! whole-process time adds reading, checking and writing the rows. Then the row's floor: the
+//! work no way of streaming the rows can avoid, each part timed alone over all the rows —
+//! parsing the six numeric cells (ξ, δ, v, σ_v, ρ, f) from their text, building the scene
+//! (`Scene::new`), the inversion, and writing the numbers of the output row (ξ, v, σ_v, K,
+//! K_lo, K_hi, dv̄/dK, Θ̇f, Θ_G, the three laws' K, K_min, K_max: those the row has) as the
+//! shortest decimals that read back as them, as `fitbead k` writes them. Their sum is what a
+//! row would cost if splitting the CSV, checking cells, the text cells, the series and
+//! plausibility checks and the pipeline cost nothing.
 //!
 //! Usage: cargo run --release --features bench-internals --example k_row_cost -- FILE [MODEL]
 //!   FILE: a measured table with columns series, xi, delta_deg, v, sigma_v and optionally rho
-//!   and f (e.g. `python3 scripts/gen_measurements.py 100000 1`); rows that do not parse or
-//!   make no scene are skipped. MODEL: stick (default) or stickslip.
+//!   and f (e.g. `python3 scripts/gen_measurements.py 100000 1`; an empty or absent ρ or f is
+//!   its default, 0.4 or 0.1); rows that do not parse or make no scene are skipped. MODEL:
+//!   stick (default) or stickslip.
 //!
-//! Each class (the `status` and `lower_limit` that `fitbead k` would print) is timed as a
-//! whole, three times over, on one thread; the best of the three is printed, in µs per row, with
-//! its share of the total.
+//! Each class (the `status` and `lower_limit` that `fitbead k` would print) and each part of
+//! the floor is timed as a whole, three times over, on one thread; the best of the three is
+//! printed, in µs per row, with its share of the total.
 
-use fitbead::fit::k::{estimate, KFailure, LowerLimit};
+use fitbead::bench_internals::push_number_cells;
+use fitbead::fit::k::{estimate, KEstimate, KFailure, LowerLimit};
 use fitbead::{CollisionLaw, Model, Scene};
 use std::collections::BTreeMap;
-use std::time::Instant;
+use std::hint::black_box;
 
-fn class(model: &Model, sc: &Scene, v: f64, sigma: Option<f64>) -> String {
-    let e = estimate(model, sc, v, sigma);
+mod common;
+
+fn class(e: &KEstimate) -> String {
     let lower = e.bracket.as_ref().map_or("none", |b| match b.lower {
         LowerLimit::Crawl => "crawl-over-top",
         LowerLimit::Zero => "K=0",
@@ -32,6 +42,57 @@ fn class(model: &Model, sc: &Scene, v: f64, sigma: Option<f64>) -> String {
     format!("{status:11} {lower}")
 }
 
+/// The numbers of the row `fitbead k` writes for estimate `e` of the measurement (`sc`, v, σ).
+fn row_numbers(sc: &Scene, v: f64, sigma: Option<f64>, e: &KEstimate) -> Vec<f64> {
+    let root = e.root.as_ref().ok();
+    let laws = [
+        CollisionLaw::Cos2a,
+        CollisionLaw::Adjusted,
+        CollisionLaw::Impact,
+    ]
+    .map(|l| l.k(sc.alpha_rad(), sc.rho()));
+    let b = e.bracket.as_ref();
+    [
+        Some(sc.xi()),
+        Some(v),
+        sigma,
+        root.map(|r| r.k),
+        e.k_lo,
+        e.k_hi,
+        e.dv_dk,
+        root.map(|r| r.steady.final_velocity),
+        e.theta_g.map(f64::to_degrees),
+        Some(laws[0]),
+        Some(laws[1]),
+        Some(laws[2]),
+        b.map(|b| b.lo),
+        b.map(|b| b.hi),
+    ]
+    .into_iter()
+    .flatten()
+    .collect()
+}
+
+/// One measured row: its six numeric cells as text (ρ and f possibly empty), its scene, v
+/// and σ.
+struct Measured {
+    /// The row's place in the file.
+    line: usize,
+    cells: [String; 6],
+    scene: Scene,
+    v: f64,
+    sigma: Option<f64>,
+}
+
+/// The six cells parsed (an empty ρ or f its default, any other empty cell NaN).
+fn parse(c: &[String; 6]) -> [f64; 6] {
+    let defaults = [f64::NAN, f64::NAN, f64::NAN, f64::NAN, 0.4, 0.1];
+    std::array::from_fn(|i| match c[i].as_str() {
+        "" => defaults[i],
+        x => x.parse::<f64>().unwrap_or(f64::NAN),
+    })
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let path = std::env::args()
         .nth(1)
@@ -44,37 +105,39 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut rdr = csv::Reader::from_path(&path)?;
     let h = rdr.headers()?.clone();
     let col = |n: &str| h.iter().position(|x| x == n);
-    let (xi, d, v, s) = (col("xi"), col("delta_deg"), col("v"), col("sigma_v"));
-    let (rho, f) = (col("rho"), col("f"));
-    let mut rows: BTreeMap<String, Vec<(Scene, f64, Option<f64>)>> = BTreeMap::new();
-    for r in rdr.records() {
+    let cols = ["xi", "delta_deg", "v", "sigma_v", "rho", "f"].map(col);
+    let mut rows: BTreeMap<String, Vec<Measured>> = BTreeMap::new();
+    for (line, r) in rdr.records().enumerate() {
         let r = r?;
-        let num = |c: Option<usize>| c.and_then(|c| r.get(c)).and_then(|x| x.parse::<f64>().ok());
-        let (Some(xi), Some(d), Some(v)) = (num(xi), num(d), num(v)) else {
-            continue;
-        };
+        let cells: [String; 6] =
+            std::array::from_fn(|i| cols[i].and_then(|c| r.get(c)).unwrap_or("").to_string());
+        let [xi, d, v, s, rho, f] = parse(&cells);
         let law = CollisionLaw::Adjusted;
-        let Ok(sc) = Scene::new(xi, d, num(rho).unwrap_or(0.4), num(f).unwrap_or(0.1), law) else {
+        let Ok(scene) = Scene::new(xi, d, rho, f, law) else {
             continue;
         };
-        let sigma = num(s);
-        rows.entry(class(&model, &sc, v, sigma))
-            .or_default()
-            .push((sc, v, sigma));
+        if !v.is_finite() {
+            continue;
+        }
+        let sigma = s.is_finite().then_some(s);
+        let e = estimate(&model, &scene, v, sigma);
+        rows.entry(class(&e)).or_default().push(Measured {
+            line,
+            cells,
+            scene,
+            v,
+            sigma,
+        });
     }
     let n: usize = rows.values().map(Vec::len).sum();
     let mut total = 0.0;
     let mut lines = Vec::new();
     for (name, rs) in &rows {
-        let best = (0..3)
-            .map(|_| {
-                let t = Instant::now();
-                for (sc, v, sigma) in rs {
-                    std::hint::black_box(estimate(&model, sc, *v, *sigma));
-                }
-                t.elapsed().as_secs_f64()
-            })
-            .fold(f64::INFINITY, f64::min);
+        let best = common::best_of_three(|| {
+            for m in rs {
+                black_box(estimate(&model, &m.scene, m.v, m.sigma));
+            }
+        });
         total += best;
         lines.push((name, rs.len(), best));
     }
@@ -87,5 +150,62 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
     }
     println!("all {:>40} {:8.3} µs/row", n, 1e6 * total / n as f64);
+
+    // The floor.
+    let mut in_order: Vec<&Measured> = rows.values().flatten().collect();
+    in_order.sort_by_key(|m| m.line);
+    let numbers: Vec<Vec<f64>> = in_order
+        .iter()
+        .map(|m| {
+            let e = estimate(&model, &m.scene, m.v, m.sigma);
+            row_numbers(&m.scene, m.v, m.sigma, &e)
+        })
+        .collect();
+    // The cells and the scenes' parameters in arrays of their own, in file order, as a
+    // stream holds them (not scattered among the classes' rows).
+    let cells: Vec<[String; 6]> = in_order.iter().map(|m| m.cells.clone()).collect();
+    let params: Vec<[f64; 4]> = in_order
+        .iter()
+        .map(|m| {
+            let s = &m.scene;
+            [s.xi(), s.delta_deg(), s.rho(), s.f()]
+        })
+        .collect();
+    let us = |t: f64| 1e6 * t / n as f64;
+    let t_parse = us(common::best_of_three(|| {
+        for c in &cells {
+            black_box(parse(black_box(c)));
+        }
+    }));
+    let law = CollisionLaw::Adjusted;
+    let t_scene = us(common::best_of_three(|| {
+        for &[xi, d, rho, f] in &params {
+            black_box(Scene::new(xi, d, rho, f, law).ok());
+        }
+    }));
+    let mut out = Vec::with_capacity(1 << 20);
+    let t_write = us(common::best_of_three(|| {
+        for xs in &numbers {
+            if out.len() > (1 << 20) - 1024 {
+                out.clear();
+            }
+            push_number_cells(&mut out, black_box(xs));
+        }
+    }));
+    let t_estimate = us(common::best_of_three(|| {
+        for m in &in_order {
+            black_box(estimate(&model, &m.scene, m.v, m.sigma));
+        }
+    }));
+    let per_row = numbers.iter().map(Vec::len).sum::<usize>() as f64 / n as f64;
+    println!("the row's floor, µs/row:");
+    println!("  parse six numeric cells       {t_parse:8.3}");
+    println!("  Scene::new                    {t_scene:8.3}");
+    println!("  K inversion, rows in file order {t_estimate:6.3}");
+    println!("  write {per_row:4.1} numbers            {t_write:8.3}");
+    println!(
+        "  sum                           {:8.3}",
+        t_parse + t_scene + t_estimate + t_write
+    );
     Ok(())
 }

@@ -39,15 +39,23 @@ pub(crate) fn push_f64(out: &mut Vec<u8>, x: f64) {
     }
     let mut b = zmij::Buffer::new();
     let s = b.format_finite(x).as_bytes();
-    // zmij writes a positive exponent with its sign (`1e+300`), ryu without (`1e300`); the
-    // sign is among the last five bytes (`e+308`) when there is one.
-    let tail = s.len().saturating_sub(5);
-    match s[tail..].iter().position(|&c| c == b'+') {
-        Some(i) => {
-            out.extend_from_slice(&s[..tail + i]);
-            out.extend_from_slice(&s[tail + i + 1..]);
+    let n = s.len();
+    // zmij writes a positive exponent with its sign (`1e+300`), ryu without (`1e300`): the
+    // sign, when there is one, is 2 to 4 bytes from the end (`e+5` to `e+308`), and a text
+    // with one is at least 4 bytes long. A whole number ends in `.0`, which ryu's layout
+    // drops.
+    let plus = if n >= 4 {
+        [2, 3, 4].into_iter().find(|&k| s[n - k] == b'+')
+    } else {
+        None
+    };
+    match plus {
+        Some(k) => {
+            out.extend_from_slice(&s[..n - k]);
+            out.extend_from_slice(&s[n - k + 1..]);
         }
-        None => out.extend_from_slice(s.strip_suffix(b".0").unwrap_or(s)),
+        None if n >= 2 && s[n - 2..] == *b".0" => out.extend_from_slice(&s[..n - 2]),
+        None => out.extend_from_slice(s),
     }
 }
 

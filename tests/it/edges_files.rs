@@ -175,6 +175,56 @@ fn replacing_an_existing_output_leaves_no_backup_behind() {
     );
 }
 
+/// A bad row after many good ones, with `--output` over an existing file: the rows before it
+/// went to the temporary file as they came (not held back by chunks, since nobody sees that
+/// file), and the error still leaves the target as it was and no temporary behind. For
+/// `forward` past its first chunk of 32,768 rows, and `k` past four of its 8,192.
+#[test]
+fn a_late_bad_row_leaves_an_existing_output_as_it_was() {
+    let dir = tmpdir();
+    let o = write(&dir, "o.csv", "precious\n");
+    let forward_rows = "1,12\n".repeat(40_000);
+    let k_rows = "a,1,12,0.3,0.01\n".repeat(40_000);
+    let cases = [
+        (
+            "forward",
+            format!("xi,delta_deg\n{forward_rows}1,abc\n"),
+            "line 40002",
+        ),
+        (
+            "k",
+            format!("series,xi,delta_deg,v,sigma_v\n{k_rows}a,1,12,-0.3,0.01\n"),
+            "line 40002",
+        ),
+    ];
+    for (command, text, line) in cases {
+        let input = write(&dir, "in.csv", &text);
+        let out = bin()
+            .args([
+                command,
+                "--model",
+                "stick",
+                "--input",
+                s(&input),
+                "--output",
+                s(&o),
+            ])
+            .output()
+            .unwrap();
+        expect(&out, 2, &["in.csv", line], command);
+        assert_eq!(
+            std::fs::read_to_string(&o).unwrap(),
+            "precious\n",
+            "{command}"
+        );
+        assert!(
+            leftovers(dir.path()).is_empty(),
+            "{command}: {:?}",
+            leftovers(dir.path())
+        );
+    }
+}
+
 #[test]
 fn stale_temporaries_of_gone_runs_are_removed_and_live_ones_kept() {
     let dir = tmpdir();

@@ -79,6 +79,8 @@ struct Measured {
     /// The row's place in the file.
     line: usize,
     cells: [String; 6],
+    /// The numbers of its output row ([`row_numbers`]).
+    numbers: Vec<f64>,
     scene: Scene,
     v: f64,
     sigma: Option<f64>,
@@ -106,13 +108,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let h = rdr.headers()?.clone();
     let col = |n: &str| h.iter().position(|x| x == n);
     let cols = ["xi", "delta_deg", "v", "sigma_v", "rho", "f"].map(col);
+    let law = CollisionLaw::Adjusted;
     let mut rows: BTreeMap<String, Vec<Measured>> = BTreeMap::new();
     for (line, r) in rdr.records().enumerate() {
         let r = r?;
         let cells: [String; 6] =
             std::array::from_fn(|i| cols[i].and_then(|c| r.get(c)).unwrap_or("").to_string());
         let [xi, d, v, s, rho, f] = parse(&cells);
-        let law = CollisionLaw::Adjusted;
         let Ok(scene) = Scene::new(xi, d, rho, f, law) else {
             continue;
         };
@@ -124,6 +126,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         rows.entry(class(&e)).or_default().push(Measured {
             line,
             cells,
+            numbers: row_numbers(&scene, v, sigma, &e),
             scene,
             v,
             sigma,
@@ -154,16 +157,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // The floor.
     let mut in_order: Vec<&Measured> = rows.values().flatten().collect();
     in_order.sort_by_key(|m| m.line);
-    let numbers: Vec<Vec<f64>> = in_order
-        .iter()
-        .map(|m| {
-            let e = estimate(&model, &m.scene, m.v, m.sigma);
-            row_numbers(&m.scene, m.v, m.sigma, &e)
-        })
-        .collect();
-    // The cells and the scenes' parameters in arrays of their own, in file order, as a
+    // The cells, the scenes' parameters and the output numbers in arrays of their own, in file order, as a
     // stream holds them (not scattered among the classes' rows).
     let cells: Vec<[String; 6]> = in_order.iter().map(|m| m.cells.clone()).collect();
+    let numbers: Vec<Vec<f64>> = in_order.iter().map(|m| m.numbers.clone()).collect();
     let params: Vec<[f64; 4]> = in_order
         .iter()
         .map(|m| {
@@ -177,7 +174,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             black_box(parse(black_box(c)));
         }
     }));
-    let law = CollisionLaw::Adjusted;
     let t_scene = us(common::best_of_three(|| {
         for &[xi, d, rho, f] in &params {
             black_box(Scene::new(xi, d, rho, f, law).ok());

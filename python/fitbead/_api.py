@@ -42,6 +42,12 @@ class UnitWarning(FitbeadWarning):
     given."""
 
 
+class MisfitWarning(FitbeadWarning):
+    """A fit with σ given does not describe the data within their σ: the χ² tail probability
+    P(χ²_dof ≥ χ²) is below 0.001, so its intervals, which assume the model holds, are too
+    narrow."""
+
+
 class ConvergenceWarning(FitbeadWarning):
     """A fit stopped without converging (least squares: its termination; MCMC: R̂ or ESS
     short of the target, or the run cut short)."""
@@ -712,6 +718,10 @@ class FitResult:
         label = f"{self.name} [{self.series}]"
         if absurd:
             _warn(f"{label}: {absurd}", UnitWarning)
+        else:
+            misfit = self._core.misfit_warning()
+            if misfit:
+                _warn(f"{label}: {misfit}", MisfitWarning)
         if not self.stats.get("converged", True):
             why = self.stats.get("note") or self.stats.get("termination")
             _warn(f"{label}: not converged: {why}", ConvergenceWarning)
@@ -1670,11 +1680,13 @@ def report(
     -----
     UnitWarning
         A fit whose misfit is implausible for the σ given (the command line's warning).
+    MisfitWarning
+        A fit whose χ² tail probability is below 0.001 with σ given.
     ConvergenceWarning
         A posterior run that did not converge, or was interrupted.
     """
     d = _dataset(data)
-    files, unit_warnings, convergence_warnings, interrupted, summary = _core.report(
+    files, unit_warnings, misfit_warnings, convergence_warnings, interrupted, summary = _core.report(
         d._core,
         out_dir=None if out_dir is None else str(out_dir),
         method=method,
@@ -1690,6 +1702,8 @@ def report(
     )
     for w in unit_warnings:
         _warn(w, UnitWarning)
+    for w in misfit_warnings:
+        _warn(w, MisfitWarning)
     for w in convergence_warnings:
         _warn(w, ConvergenceWarning)
     if interrupted:

@@ -1117,6 +1117,18 @@ impl PyFitResult {
         self.inner.stats.absurd_misfit()
     }
 
+    /// The warning the command line prints when the misfit is absurd (a unit mistake) or
+    /// improbable for the σ given (χ² tail probability below 0.001), or None.
+    fn misfit_warning(&self) -> Option<String> {
+        self.inner.stats.misfit_warning()
+    }
+
+    /// The χ² tail probability P(χ²_dof ≥ χ²) with σ given, or None (unit weights, no degree
+    /// of freedom).
+    fn chi2_p_value(&self) -> Option<f64> {
+        self.inner.stats.chi2_p_value()
+    }
+
     /// The correlation matrix of the parameters (rows in the order of `params`), or None.
     fn correlation(&self) -> Option<Vec<Vec<f64>>> {
         self.inner.correlation.clone()
@@ -1634,6 +1646,7 @@ fn report(
     Vec<(String, Vec<u8>)>,
     Vec<String>,
     Vec<String>,
+    Vec<String>,
     bool,
     String,
 )> {
@@ -1713,13 +1726,29 @@ fn report(
                 .map(|w| format!("{} [{}]: {w}", s.fit, s.series))
         })
         .collect();
+    let misfits: Vec<String> = out
+        .stats
+        .iter()
+        .filter(|s| s.absurd_misfit().is_none())
+        .filter_map(|s| {
+            s.misfit_warning()
+                .map(|w| format!("{} [{}]: {w}", s.fit, s.series))
+        })
+        .collect();
     let unconverged: Vec<String> = out
         .warnings
         .iter()
-        .filter(|w| !absurd.contains(w))
+        .filter(|w| !absurd.contains(w) && !misfits.contains(w))
         .cloned()
         .collect();
-    Ok((out.files, absurd, unconverged, out.interrupted, out.summary))
+    Ok((
+        out.files,
+        absurd,
+        misfits,
+        unconverged,
+        out.interrupted,
+        out.summary,
+    ))
 }
 
 /// `fitbead forward --model md` on the CSV text of a scene table, under the md preset: the CSV

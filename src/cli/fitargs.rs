@@ -423,14 +423,14 @@ pub fn not_converged(stats: &[StatsRow]) -> Result<(), CliError> {
     }
 }
 
-/// `stats` with every fit whose misfit is absurd for the σ given flagged in its note and on
-/// stderr ([`StatsRow::absurd_misfit`]).
+/// `stats` with every fit whose misfit is absurd or improbable for the σ given flagged in its
+/// note and on stderr ([`StatsRow::misfit_warning`]).
 pub fn flag_absurd(stats: &[StatsRow]) -> Vec<StatsRow> {
     stats
         .iter()
         .map(|s| {
             let mut s = s.clone();
-            if let Some(w) = s.absurd_misfit() {
+            if let Some(w) = s.misfit_warning() {
                 eprintln!("fitbead: warning: {} [{}]: {w}", s.fit, s.series);
                 s.note = if s.note.is_empty() {
                     w

@@ -159,8 +159,9 @@ fn clip_message(message: &str) -> String {
 
 /// The command line's parser: [`Cli`]'s, with negative numbers allowed as the values of every
 /// flag (`--xi -1` is the value −1 given to `--xi`, refused by its check, not an unknown flag
-/// `-1`), and any value starting with `-` taken by a flag that reads a number (`--delta-deg
-/// -inf` is the value −∞, refused by the flag's check, not a flag `-i`).
+/// `-1`), and any value starting with `-` taken by a flag that reads a number or a list of
+/// them (`--delta-deg -inf` is the value −∞, refused by the flag's check, not a flag `-i`;
+/// `--delta-range -5,10` and `--series -1,2` reach their flags' checks).
 fn command() -> clap::Command {
     use clap::CommandFactory;
     let mut cmd = Cli::command();
@@ -172,7 +173,16 @@ fn command() -> clap::Command {
     for n in names {
         cmd = cmd.mut_subcommand(n, |s| {
             s.allow_negative_numbers(true).mut_args(|a| {
-                if a.get_value_parser().type_id() == number {
+                let takes_value = a.get_action().takes_values();
+                let parser = a.get_value_parser().type_id();
+                let text = [
+                    std::any::TypeId::of::<String>(),
+                    std::any::TypeId::of::<PathBuf>(),
+                    std::any::TypeId::of::<std::ffi::OsString>(),
+                ];
+                if parser == number
+                    || (takes_value && !text.iter().any(|t| parser == *t) && !a.is_positional())
+                {
                     a.allow_hyphen_values(true)
                 } else {
                     a

@@ -324,7 +324,7 @@ fn run_with(a: Args, shown: Option<String>) -> Result<(), CliError> {
     };
     let out = report(&data, &settings, Some(&out_dir))?;
     for s in &out.stats {
-        if let Some(w) = s.absurd_misfit() {
+        if let Some(w) = s.misfit_warning() {
             eprintln!("fitbead: warning: {} [{}]: {w}", s.fit, s.series);
         }
     }

@@ -28,7 +28,8 @@ pub struct Args {
     /// Points per series.
     #[arg(long, default_value_t = 9, value_parser = values::points)]
     pub points: usize,
-    /// Relative noise: v = v_true (1 + noise · N(0,1)), sigma_v = noise · v_true.
+    /// Relative noise: v = v_true (1 + noise · z), sigma_v = noise · v_true, z standard normal
+    /// truncated to v > 0 (drawn again until the velocity is positive).
     #[arg(long, default_value_t = 0.02, value_parser = values::noise)]
     pub noise: f64,
     /// Seed of the random stream.

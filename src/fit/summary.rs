@@ -2,13 +2,15 @@
 //! interval and how it was obtained) and one row of fit statistics, and their CSV forms.
 //!
 //! The interval in `ci_low`/`ci_high` is the profile-likelihood one when both of its ends were
-//! determined (`ci_method = profile`): an end is where Δχ² reaches its threshold (`found`) or
-//! the bound of the parameter's box (`bound`: no value beyond is admissible). An end marked
-//! `edge` is where the constrained fits stop converging inside the feasible region (their
-//! optimum lies against the region's edge, or the warm start left the region); the profile
-//! there is not determined, so the covariance (Wald) interval is reported instead
-//! (`ci_method = covariance`), with the profile's state in the extra columns and the note; with
-//! neither, the cells are empty and `ci_method = none`.
+//! determined (`ci_method = profile`): an end is where Δχ² reaches its threshold (`found`), the
+//! bound of the parameter's box (`bound`: no value beyond is admissible), or the edge of the
+//! region where the constrained fits converge (`edge`: their optimum lies against the edge of
+//! the model's feasible region, or the warm start left it), where Δχ² is still below its
+//! threshold, so that the interval reaches at least that far; the note says so. An end the
+//! profile search could not close (`not_found`) leaves the covariance (Wald) interval in the
+//! cells (`ci_method = covariance`), widened to hold the other end where the profile found it,
+//! with the profile's state in the extra columns and the note; with neither, the cells are
+//! empty and `ci_method = none`.
 
 use crate::inverse::mcmc::ParameterDiagnostics;
 pub use crate::inverse::posterior::Draws;
@@ -85,24 +87,29 @@ impl PowerScaling {
 }
 
 impl ParamRow {
-    /// The reported interval and its method: profile when both ends were determined, else
-    /// covariance, else none (module docs).
+    /// The reported interval and its method: profile when both ends were determined (found,
+    /// bound or edge), else covariance widened to hold the profile end that was determined,
+    /// else none (module docs).
     pub fn interval(&self) -> (Option<(f64, f64)>, &'static str) {
         if let Some(d) = &self.posterior {
             return (Some(d.interval), "posterior");
         }
-        if let Some((lo, hi)) = self.profile {
-            if let (Some(a), Some(b)) = (closed_end(lo), closed_end(hi)) {
-                return (Some((a, b)), "profile");
-            }
+        let profile = self
+            .profile
+            .map(|(lo, hi)| (closed_end(lo), closed_end(hi)));
+        if let Some((Some(a), Some(b))) = profile {
+            return (Some((a, b)), "profile");
         }
-        match self.cov {
-            Some((a, b)) => (
-                Some((a.max(self.bounds.0), b.min(self.bounds.1))),
-                "covariance",
-            ),
-            None => (None, "none"),
+        let Some((a, b)) = self.cov else {
+            return (None, "none");
+        };
+        let (mut a, mut b) = (a.max(self.bounds.0), b.min(self.bounds.1));
+        // An end the profile did determine stays inside the reported interval.
+        if let Some((lo, hi)) = profile {
+            a = lo.map_or(a, |x| a.min(x));
+            b = hi.map_or(b, |x| b.max(x));
         }
+        (Some((a, b)), "covariance")
     }
 }
 
@@ -151,7 +158,60 @@ pub struct StatsRow {
 /// velocities or their σ are more likely in the wrong unit than the model wrong.
 pub(crate) const ABSURD_REDUCED_CHI2: f64 = 1000.0;
 
+/// A fit with σ given whose χ² tail probability, P(χ²_dof ≥ χ²), is below this is flagged as
+/// a misfit ([`StatsRow::misfit_warning`]): with the model and σ right, one fit in a thousand.
+pub(crate) const MISFIT_P_VALUE: f64 = 1e-3;
+
 impl StatsRow {
+    /// The χ² tail probability P(χ²_dof ≥ χ²): the chance of a misfit at least this large if
+    /// the model holds and σ is right. `None` without σ given (unit weights), with no degree of
+    /// freedom, or where χ² is not a number; 0 where χ² is infinite.
+    pub fn chi2_p_value(&self) -> Option<f64> {
+        use statrs::distribution::{ChiSquared, ContinuousCDF};
+        if self.sigma != SigmaKind::Absolute || self.dof == 0 || self.chi2.is_nan() {
+            return None;
+        }
+        if self.chi2 == f64::INFINITY {
+            return Some(0.0);
+        }
+        ChiSquared::new(self.dof as f64)
+            .ok()
+            .map(|d| d.sf(self.chi2.max(0.0)))
+    }
+
+    /// Why this fit's misfit should make the user doubt its intervals, if it should: the
+    /// implausible misfit of [`StatsRow::absurd_misfit`] (a unit mistake), else a χ² tail
+    /// probability below [`MISFIT_P_VALUE`] with σ given (the model does not describe the data
+    /// within their σ, and every interval assumes it does). A law whose χ² is infinite
+    /// because some points have no steady state under it (termination `infeasible`) is not
+    /// flagged again: its note says so.
+    pub fn misfit_warning(&self) -> Option<String> {
+        if let Some(w) = self.absurd_misfit() {
+            return Some(w);
+        }
+        if self.termination == "infeasible" {
+            return None;
+        }
+        let p = self.chi2_p_value()?;
+        (p < MISFIT_P_VALUE).then(|| {
+            let p_text = if p == 0.0 {
+                "p < 1e-300".to_string()
+            } else {
+                format!("p = {}", fmt_sig(p, 2))
+            };
+            format!(
+                "misfit: chi2 = {} on {} degrees of freedom (reduced chi2 {}), chi2 tail \
+                 probability {p_text}, below {}: the model does not describe these data within \
+                 their sigma_v, and the intervals, which assume it does, are too narrow (check \
+                 the model, the law and sigma_v)",
+                fmt_sig(self.chi2, 5),
+                self.dof,
+                fmt_sig(self.reduced_chi2, 4),
+                fmt_f64(MISFIT_P_VALUE)
+            )
+        })
+    }
+
     /// Why this fit's misfit is implausible for the σ given, if it is: reduced χ² above
     /// `ABSURD_REDUCED_CHI2` with σ given (with unit weights χ² is in the units of v̄ and
     /// says nothing of units); `None` for a law scored without fitting.
@@ -760,8 +820,9 @@ fn push_profile_notes(
                 fmt_f64(b)
             )),
             ProfileEnd::Edge(e) => pnote.push_str(&format!(
-                "profile {which} end undetermined beyond {}: the constrained fits \
-                 there do not converge inside the model's feasible region. ",
+                "profile {which} end reaches the edge of the model's feasible region at {} \
+                 (the constrained fits beyond it do not converge; the interval reaches at \
+                 least there). ",
                 fmt_f64(e)
             )),
             ProfileEnd::NotFound => pnote.push_str(&format!(
@@ -799,10 +860,12 @@ pub(crate) fn information_criteria(r: &[f64], sigma: SigmaKind) -> (f64, f64) {
     }
 }
 
-/// An end that closes the profile interval: Δχ² reached its threshold, or the box ends there.
+/// An end that closes the profile interval: Δχ² reached its threshold, the box ends there,
+/// or the constrained fits stop there with Δχ² still below it (the interval reaches at least
+/// that far).
 fn closed_end(e: ProfileEnd) -> Option<f64> {
     match e {
-        ProfileEnd::Found(v) | ProfileEnd::Bound(v) => Some(v),
-        _ => None,
+        ProfileEnd::Found(v) | ProfileEnd::Bound(v) | ProfileEnd::Edge(v) => Some(v),
+        ProfileEnd::NotFound => None,
     }
 }

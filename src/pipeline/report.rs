@@ -253,6 +253,14 @@ pub fn report(
                 .map(|w| format!("{} [{}]: {w}", s.fit, s.series))
         })
         .collect();
+    let misfits: Vec<String> = stats
+        .iter()
+        .filter(|s| s.absurd_misfit().is_none())
+        .filter_map(|s| {
+            s.misfit_warning()
+                .map(|w| format!("{} [{}]: {w}", s.fit, s.series))
+        })
+        .collect();
     let context = ReportContext {
         source: s.source.clone().unwrap_or_else(|| t.source.clone()),
         shipped_synthetic: is_shipped_data(ds),
@@ -265,6 +273,7 @@ pub fn report(
             .map(|w| w.to_string())
             .chain(absurd)
             .collect(),
+        misfits,
     };
     let md = report_markdown(&an, &context, s, &not_converged);
     warnings.extend(not_converged);
@@ -369,12 +378,13 @@ fn analysis_tables(an: &Analysis) -> Result<Vec<(String, Vec<u8>)>, RunError> {
     ])
 }
 
-/// Every fit whose misfit is absurd for the σ given, flagged in its note and in `warnings`.
+/// Every fit whose misfit is absurd for the σ given or improbable (χ² tail probability below
+/// 0.001), flagged in its note and in `warnings`.
 fn flag_absurd_misfits(stats: Vec<StatsRow>, warnings: &mut Vec<String>) -> Vec<StatsRow> {
     stats
         .into_iter()
         .map(|mut s| {
-            if let Some(w) = s.absurd_misfit() {
+            if let Some(w) = s.misfit_warning() {
                 warnings.push(format!("{} [{}]: {w}", s.fit, s.series));
                 s.note = if s.note.is_empty() {
                     w

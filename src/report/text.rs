@@ -28,12 +28,15 @@ pub struct ReportContext {
     /// Unit mistakes the data look like, and fits whose misfit is absurd: report.md opens
     /// with them too.
     pub plausibility: Vec<String>,
+    /// Fits whose χ² tail probability is below 0.001 with σ given
+    /// ([`crate::fit::StatsRow::misfit_warning`]): named in the same section.
+    pub misfits: Vec<String>,
 }
 
-/// The section report.md opens with when the data failed an input check (`--keep-going`) or
-/// look like a unit mistake; empty otherwise.
+/// The section report.md opens with when the data failed an input check (`--keep-going`),
+/// look like a unit mistake, or are not described by a fit within their σ; empty otherwise.
 fn warnings_section(ctx: &ReportContext) -> String {
-    if ctx.input_warnings.is_empty() && ctx.plausibility.is_empty() {
+    if ctx.input_warnings.is_empty() && ctx.plausibility.is_empty() && ctx.misfits.is_empty() {
         return String::new();
     }
     let mut m = String::from("## Warnings\n\n");
@@ -53,6 +56,16 @@ fn warnings_section(ctx: &ReportContext) -> String {
              \"Plausibility checks\"):\n\n",
         );
         for w in &ctx.plausibility {
+            m.push_str(&format!("- {}\n", one_line(w)));
+        }
+        m.push('\n');
+    }
+    if !ctx.misfits.is_empty() {
+        m.push_str(
+            "These fits do not describe the data within their sigma_v (chi2 tail probability \
+             below 0.001): their intervals assume the model holds and are too narrow:\n\n",
+        );
+        for w in &ctx.misfits {
             m.push_str(&format!("- {}\n", one_line(w)));
         }
         m.push('\n');

@@ -24,4 +24,5 @@ mod prior_sensitivity;
 mod recipes;
 mod report;
 mod report_mcmc;
+mod stress;
 mod threads;

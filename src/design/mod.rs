@@ -402,10 +402,11 @@ pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
             let t_even = t_value(s, &prob, &rival, &even_cands, &ones).unwrap_or(f64::NAN);
             discrimination = Some((t_design, t_even));
             let total = total_points as f64;
+            // t is in units of the noise ([`sigma`]): the points needed scale as its square.
             let need = |t: f64| {
                 let per_point = t / total;
                 if per_point > 0.0 {
-                    (noncentrality(0.05, 0.8) / per_point).ceil()
+                    (noncentrality(0.05, 0.8) / per_point * s.noise * s.noise).ceil()
                 } else {
                     f64::INFINITY
                 }
@@ -424,7 +425,7 @@ pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
                 .collect()
         })
         .collect();
-    Ok(DesignResult {
+    let mut result = DesignResult {
         rows,
         even,
         ranges: ranges
@@ -440,7 +441,9 @@ pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
         sensitivity,
         sensitivity_label: sens_label,
         bayes,
-    })
+    };
+    scale_to_noise(s, &mut result);
+    Ok(result)
 }
 
 /// The forward model a design's fit is made with: the contact model `s.model` names for
@@ -1058,13 +1061,28 @@ fn row(xi: f64, delta: f64, n: usize) -> DesignRow {
     }
 }
 
-/// σ of v̄ at a point.
+/// σ of v̄ at a point in units of the noise: 1 (absolute noise) or v̄ (relative). The design
+/// does not depend on the noise's size, which only scales what it predicts; working in its
+/// units keeps the information matrices in range for any noise (an absolute σ of 1e-160
+/// would square to 0 in them), and [`scale_to_noise`] brings the predictions back to σ.
 fn sigma(s: &DesignSettings, v: f64) -> f64 {
     if s.noise_absolute {
-        s.noise
+        1.0
     } else {
-        s.noise * v
+        v
     }
+}
+
+/// The predictions of a design made in units of the noise ([`sigma`]) for the noise of `s`:
+/// standard errors times the noise, the discrimination over its square (the points needed
+/// are scaled where they are counted).
+fn scale_to_noise(s: &DesignSettings, r: &mut DesignResult) {
+    let n = s.noise;
+    for e in &mut r.errors {
+        e.design = e.design.map(|x| x * n);
+        e.even = e.even.map(|x| x * n);
+    }
+    r.discrimination = r.discrimination.map(|(a, b)| (a / n / n, b / n / n));
 }
 
 /// The candidate of series `k` at slope `d` (radians), if the model at and around the guess

@@ -484,14 +484,13 @@ fn run_note(
     settings: &McmcSettings,
     thin: usize,
 ) -> String {
-    // Names for the messages; a name shared by several parameters (one K per series) gets
-    // its row number in the report.
+    // Names for the messages, as the draws file's columns name them: a name shared by several
+    // parameters (one K per series) gets its series (`K[1]`).
     let names: Vec<String> = rows
         .iter()
-        .enumerate()
-        .map(|(j, r)| {
+        .map(|r| {
             if rows.iter().filter(|q| q.parameter == r.parameter).count() > 1 {
-                format!("{} (row {} of this fit)", r.parameter, j + 1)
+                format!("{}[{}]", r.parameter, r.series)
             } else {
                 r.parameter.clone()
             }
@@ -508,6 +507,15 @@ fn run_note(
             row.note = join(INTERRUPTED_NOTE, &row.note);
         }
     } else if !res.converged {
+        // Every row of a run cut off at the step cap says so: its sd and interval come from
+        // chains that have not mixed.
+        if res.reason == StopReason::MaxSteps {
+            let plural = if res.steps == 1 { "" } else { "s" };
+            let row_note = format!("{MAX_STEPS_NOTE} ({} step{plural})", res.steps);
+            for row in rows.iter_mut() {
+                row.note = join(&row_note, &row.note);
+            }
+        }
         note = match res.failing_parameter {
             Some(k) => match res.diagnostics.get(k) {
                 Some(d) => format!(
@@ -591,6 +599,12 @@ fn record_run(
         interrupted: res.reason == StopReason::Interrupted,
     });
 }
+
+/// The note every parameter row of a posterior run stopped at the step cap (`--max-steps`)
+/// before converging starts with (the step count follows).
+pub(crate) const MAX_STEPS_NOTE: &str =
+    "stopped at the step cap, not converged: posterior from the draws so far, its sd and \
+     interval unreliable";
 
 /// The note every parameter row of an interrupted posterior run starts with.
 pub(crate) const INTERRUPTED_NOTE: &str =

@@ -277,7 +277,13 @@ impl MeasurementColumns {
             Some(c) => {
                 let v = positive(r, c, "v")?;
                 let s = match given(self.sigma_v) {
-                    Some(cs) => Some(positive(r, cs, "sigma_v")?),
+                    Some(cs) => Some(resolvable(
+                        r,
+                        cs,
+                        "sigma_v",
+                        positive(r, cs, "sigma_v")?,
+                        v,
+                    )?),
                     None => None,
                 };
                 (v, s)
@@ -292,7 +298,10 @@ impl MeasurementColumns {
                 };
                 let scale = (gg * radius * (1.0 + xi)).sqrt();
                 let s = match given(self.sigma_v_m_s) {
-                    Some(cs) => Some(positive(r, cs, "sigma_v_m_s")? / scale),
+                    Some(cs) => {
+                        let sms = positive(r, cs, "sigma_v_m_s")?;
+                        Some(resolvable(r, cs, "sigma_v_m_s", sms, vms)? / scale)
+                    }
                     None => None,
                 };
                 (vms / scale, s)
@@ -359,6 +368,29 @@ impl MeasurementColumns {
             ));
         }
         Ok(())
+    }
+}
+
+/// The smallest σ of a velocity, relative to the velocity, that a fit can resolve: below it σ
+/// is finer than the rounding of v and of any model value in double precision (2⁻⁵² ≈
+/// 2.2e-16), and χ² would measure rounding alone, or overflow.
+pub(crate) const MIN_RELATIVE_SIGMA: f64 = 1e-15;
+
+/// `sigma` (cell `c`, named `what`) if it is at least [`MIN_RELATIVE_SIGMA`] of the velocity
+/// `v` it belongs to.
+fn resolvable(r: &Row<'_>, c: usize, what: &str, sigma: f64, v: f64) -> Result<f64, InputError> {
+    if sigma >= MIN_RELATIVE_SIGMA * v {
+        Ok(sigma)
+    } else {
+        Err(r.err(
+            c,
+            format!(
+                "{what} is below 1e-15 of the velocity it belongs to ({}): finer than the \
+                 rounding of any computed velocity, so no fit can resolve it; give the \
+                 measurement's real uncertainty",
+                fmt_f64(v)
+            ),
+        ))
     }
 }
 

@@ -346,7 +346,7 @@ impl ForwardModel for Model {
     }
 
     fn evaluate(&self, scene: &Scene) -> Outcome {
-        match self {
+        let out = match self {
             Model::Stick => stick::steady(scene),
             Model::StickApprox => stick::steady_approx(scene),
             Model::Slip => slip::steady(scene),
@@ -357,6 +357,18 @@ impl ForwardModel for Model {
             Model::Contact(m) => m.evaluate(scene),
             Model::Md(m) => m.evaluate(scene),
             Model::Auto(m) => m.evaluate(scene),
+        };
+        // A steady state whose mean velocity is not a positive number is arithmetic that
+        // left the range of doubles (ξ near 0 or 1e300, f past 1e150), not a physical result.
+        match out {
+            Ok(s) if !(s.mean_velocity > 0.0 && s.mean_velocity.is_finite()) => {
+                Err(NotSteady::Invalid {
+                    reason: "the mean velocity is not a positive finite number at these \
+                             settings: they lie outside the range where the model's \
+                             arithmetic holds in double precision",
+                })
+            }
+            out => out,
         }
     }
 }

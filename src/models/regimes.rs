@@ -139,6 +139,13 @@ pub(crate) fn theta_g_of(rho: f64, f: f64, th: f64) -> Option<f64> {
     if disc < 0.0 || p - th < 0.0 {
         return None;
     }
+    // Beyond f = 1e150 f² overflows: divided through by f > 0, the tangent is
+    // (p − ϑ)/(ρ/f + √((p − ϑ)(p + ϑ) + (ρ/f)²)).
+    if f > 1e150 {
+        let r = rho / f;
+        let den = r + ((p - th) * (p + th) + r * r).sqrt();
+        return (den != 0.0).then(|| 2.0 * ((p - th) / den).atan());
+    }
     let den = rho + disc.sqrt();
     if den == 0.0 {
         return None;

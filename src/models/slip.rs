@@ -10,9 +10,15 @@ use crate::special::root::brent;
 use crate::special::SinCos;
 
 /// Coefficients of the slip first integral Θ̇² = a e^{2fΘ} + b sin Θ + c cos Θ (eq 39):
-/// b = −6f/(1+4f²), c = (4f² − 2)/(1+4f²).
+/// b = −6f/(1+4f²), c = (4f² − 2)/(1+4f²); beyond f = 1e150, where f² would overflow, in
+/// the form divided through by f², b = −6g/(g² + 4), c = (4 − 2g²)/(g² + 4) with g = 1/f.
 #[inline]
 pub(crate) fn slip_coefficients(f: f64) -> (f64, f64) {
+    if f.abs() > 1e150 {
+        let g = 1.0 / f;
+        let d = g * g + 4.0;
+        return (-6.0 * g / d, (4.0 - 2.0 * g * g) / d);
+    }
     let d = 1.0 + 4.0 * f * f;
     (-6.0 * f / d, (4.0 * f * f - 2.0) / d)
 }

@@ -608,6 +608,9 @@ pub enum MdFailure {
     OutsideDomain,
     /// The caller's stop flag was raised.
     Interrupted,
+    /// One time step carried the bead past more than a row bead, or its position left the
+    /// finite numbers: the step is too long for the speeds reached.
+    StepTooLong,
 }
 
 /// Smallest gyration parameter ρ the md model accepts. A bead's moment of inertia is ρ m r²
@@ -910,36 +913,95 @@ impl Md {
                          ever smaller time step)",
             });
         }
-        let p = &self.params;
         let xi = scene.xi;
-        let tu = p.time_unit(xi);
-        let mu = p.reduced_mass_ratio(xi);
-        let (gn, gs) = (p.gamma_n * tu * mu, p.gamma_s * tu * mu);
-        let nd = Nd::new(p, &self.config, scene, 1.0);
-        let dt_contact = self.config.step_fraction * nd.tc;
-        if !(dt_contact > 0.0 && dt_contact.is_finite()) {
-            return Err(invalid(
-                "young_pa",
-                p.young,
+        // Each check names the setting that, put back to its default value alone, passes
+        // it (the first in the order given), so that the message blames what the user set.
+        let blame = |order: &[MdSetting], ok: &dyn Fn(&Md) -> bool, reason: &'static str| {
+            let (field, value) = self.culprit(order, ok);
+            Err(invalid(field.column(), value, reason))
+        };
+        let material = [
+            MdSetting::Young,
+            MdSetting::RowRadius,
+            MdSetting::Density,
+            MdSetting::Gravity,
+            MdSetting::Poisson,
+            MdSetting::Beta,
+            MdSetting::StepFraction,
+        ];
+        let contact_ok = |m: &Md| {
+            let nd = Nd::new(&m.params, &m.config, scene, 1.0);
+            let dt = m.config.step_fraction * nd.tc;
+            dt > 0.0 && dt.is_finite() && nd.static_overlap.is_finite()
+        };
+        if !contact_ok(self) {
+            return blame(
+                &material,
+                &contact_ok,
                 "md: the contact time is not a positive number at these parameters",
-            ));
+            );
         }
-        if gn * dt_contact > 0.1 * MAX_STEP_SHRINK {
-            return Err(invalid(
-                "gamma_n",
-                p.gamma_n,
+        // Gravity must not press the bead into the row by a sizeable part of its radius: the
+        // Hertz contact would no longer hold it up, and the run would sink or race through
+        // the row.
+        let overlap_ok = |m: &Md| Nd::new(&m.params, &m.config, scene, 1.0).static_overlap < 0.5;
+        if !overlap_ok(self) {
+            return blame(
+                &material,
+                &overlap_ok,
+                "md: under its own weight the bead would sink into the row by half of R + r or \
+                 more (the contact is too soft for the gravity, the beads' size and density): \
+                 bring this setting closer to its default",
+            );
+        }
+        let damping = |m: &Md| {
+            let p = &m.params;
+            let nd = Nd::new(p, &m.config, scene, 1.0);
+            let dt_contact = m.config.step_fraction * nd.tc;
+            let tu = p.time_unit(xi);
+            let mu = p.reduced_mass_ratio(xi);
+            (
+                p.gamma_n * tu * mu * dt_contact,
+                p.gamma_s * tu * mu * dt_contact,
+            )
+        };
+        let normal_ok = |m: &Md| damping(m).0 <= 0.1 * MAX_STEP_SHRINK;
+        if !normal_ok(self) {
+            let mut order = vec![MdSetting::GammaN];
+            order.extend(material);
+            return blame(
+                &order,
+                &normal_ok,
                 "md: the normal damping is so fast that it needs a time step over 100 times \
                  smaller than the contact time's: lower gamma_n",
-            ));
+            );
         }
-        if gs * (1.0 + 1.0 / rho) * dt_contact > 0.1 * MAX_STEP_SHRINK {
-            return Err(invalid(
-                "gamma_s",
-                p.gamma_s,
+        let spin_ok = |m: &Md| damping(m).1 * (1.0 + 1.0 / rho) <= 0.1 * MAX_STEP_SHRINK;
+        if !spin_ok(self) {
+            let mut order = vec![MdSetting::GammaS];
+            order.extend(material);
+            return blame(
+                &order,
+                &spin_ok,
                 "md: the spin relaxation rate gamma_s (1 + 1/rho) is so fast that it needs a \
                  time step over 100 times smaller than the contact time's: lower gamma_s or \
                  raise rho",
-            ));
+            );
+        }
+        // The launch must not carry the bead past a row bead in one step.
+        let launch_ok = |m: &Md| {
+            let nd = Nd::new(&m.params, &m.config, scene, 1.0);
+            m.config.launch_velocity * nd.dt <= 0.1 * nd.s
+        };
+        if !launch_ok(self) {
+            let mut order = vec![MdSetting::LaunchVelocity];
+            order.extend(material);
+            return blame(
+                &order,
+                &launch_ok,
+                "md: the launch speed would carry the bead over more than a tenth of a row \
+                 bead in one time step: lower launch_velocity",
+            );
         }
         if !(self.step_bound(scene) <= MAX_MD_STEPS) {
             let (field, value) = self.costliest_setting(scene);
@@ -953,6 +1015,69 @@ impl Md {
     pub fn step_bound(&self, scene: &Scene) -> f64 {
         let nd = Nd::new(&self.params, &self.config, scene, 1.0);
         self.config.max_time_per_bead * (self.config.beads as f64 + 1.0) / nd.dt
+    }
+
+    /// These settings with `s` put back to its value in [`Md::default`].
+    fn with_default(&self, s: MdSetting) -> Md {
+        let (d, mut m) = (Md::default(), *self);
+        match s {
+            MdSetting::RowRadius => m.params.row_radius = d.params.row_radius,
+            MdSetting::Young => m.params.young = d.params.young,
+            MdSetting::Poisson => m.params.poisson = d.params.poisson,
+            MdSetting::Density => m.params.density = d.params.density,
+            MdSetting::Beta => m.params.beta = d.params.beta,
+            MdSetting::GammaN => m.params.gamma_n = d.params.gamma_n,
+            MdSetting::GammaS => m.params.gamma_s = d.params.gamma_s,
+            MdSetting::Coulomb => m.params.coulomb = d.params.coulomb,
+            MdSetting::Gravity => m.params.g = d.params.g,
+            MdSetting::Beads => m.config.beads = d.config.beads,
+            MdSetting::Transient => m.config.transient = d.config.transient,
+            MdSetting::Blocks => m.config.blocks = d.config.blocks,
+            MdSetting::LaunchVelocity => m.config.launch_velocity = d.config.launch_velocity,
+            MdSetting::StepFraction => m.config.step_fraction = d.config.step_fraction,
+        }
+        m
+    }
+
+    /// The value of setting `s` here.
+    fn value_of(&self, s: MdSetting) -> f64 {
+        let (p, c) = (&self.params, &self.config);
+        match s {
+            MdSetting::RowRadius => p.row_radius,
+            MdSetting::Young => p.young,
+            MdSetting::Poisson => p.poisson,
+            MdSetting::Density => p.density,
+            MdSetting::Beta => p.beta,
+            MdSetting::GammaN => p.gamma_n,
+            MdSetting::GammaS => p.gamma_s,
+            MdSetting::Coulomb => p.coulomb.unwrap_or(f64::INFINITY),
+            MdSetting::Gravity => p.g,
+            MdSetting::Beads => c.beads as f64,
+            MdSetting::Transient => c.transient as f64,
+            MdSetting::Blocks => c.blocks as f64,
+            MdSetting::LaunchVelocity => c.launch_velocity,
+            MdSetting::StepFraction => c.step_fraction,
+        }
+    }
+
+    /// The first setting of `order` that, put back to its value in [`Md::default`] alone,
+    /// makes `ok` hold, with its value here; else the first of `order` that differs from its
+    /// default (else the first of `order`).
+    fn culprit(&self, order: &[MdSetting], ok: &dyn Fn(&Md) -> bool) -> (MdSetting, f64) {
+        let d = Md::default();
+        let first = order.first().copied().unwrap_or(MdSetting::Young);
+        let s = order
+            .iter()
+            .copied()
+            .find(|&s| ok(&self.with_default(s)))
+            .or_else(|| {
+                order
+                    .iter()
+                    .copied()
+                    .find(|&s| self.value_of(s).to_bits() != d.value_of(s).to_bits())
+            })
+            .unwrap_or(first);
+        (s, self.value_of(s))
     }
 
     /// The setting that, put back to its value in [`Md::default`], lowers
@@ -1095,6 +1220,10 @@ impl Md {
             }),
             (_, Some(MdFailure::Interrupted)) => Err(NotSteady::Invalid {
                 reason: "md: interrupted",
+            }),
+            (_, Some(MdFailure::StepTooLong)) => Err(NotSteady::Invalid {
+                reason: "md: one time step carried the bead past more than a row bead (the \
+                         speeds reached outrun the step; lower step_fraction)",
             }),
             (Some(Regime::A), _) => Err(NotSteady::Stops {
                 angle: r.stop.map(|s| s.angle).unwrap_or(scene.theta_0),
@@ -1416,6 +1545,12 @@ fn integrate(
         let h = v + e.a * (0.5 * dt);
         let hw = w + 0.5 * dt * e.aw;
         pos += h * dt;
+        // A step that carries the bead past more than a row bead (or out of the numbers) is
+        // beyond the integration: the run ends there instead of walking the cells one by one.
+        if !(pos.x.abs() < 2.0 * s && pos.y.is_finite()) {
+            res.failure = Some(MdFailure::StepTooLong);
+            break;
+        }
         while pos.x >= s {
             pos.x -= s;
             cell += 1;

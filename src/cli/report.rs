@@ -292,8 +292,12 @@ fn run_with(a: Args, shown: Option<String>) -> Result<(), CliError> {
         })
         .map(|f| out_dir.join(f))
         .collect();
+    crate::io::outdir::check_dir(&out_dir)
+        .map_err(|e| super::flag_error("--out-dir", &out_dir.display().to_string(), e))?;
+    // A directory still to be made holds no input.
     let outputs: Vec<(&str, Option<&Path>)> = targets
         .iter()
+        .filter(|_| out_dir.is_dir())
         .map(|p| ("--out-dir", Some(p.as_path())))
         .collect();
     crate::io::distinct_paths(

@@ -187,6 +187,25 @@ fn dir_of(target: &Path) -> PathBuf {
     }
 }
 
+/// Refuses an output path (named by `flag`) whose directory does not exist or is not a
+/// directory: the run would fail only when it writes, after all its work.
+fn ready_directory(flag: &str, p: &Path) -> Result<(), InputError> {
+    let dir = dir_of(p);
+    match std::fs::metadata(&dir) {
+        Ok(m) if m.is_dir() => Ok(()),
+        Ok(_) => Err(setting_error(
+            flag.trim_start_matches("--"),
+            &p.display().to_string(),
+            format!("cannot be created: {} is not a directory", dir.display()),
+        )),
+        Err(e) => Err(setting_error(
+            flag.trim_start_matches("--"),
+            &p.display().to_string(),
+            format!("cannot be created in {}: {e}", dir.display()),
+        )),
+    }
+}
+
 /// Whether `a` and `b` name the same file once symbolic links are followed: the same device
 /// and inode when both exist, else the same path (its directory made absolute). A path that
 /// cannot be resolved is not the same as any other. Two standard streams (`-`,
@@ -766,9 +785,10 @@ fn is_char_device(p: &Path) -> bool {
     }
 }
 
-/// Refuses, before any work, an output that is a directory, that is one of the `inputs`
-/// (after following symbolic links; `-`, standard input, is none) or that is another of the
-/// `outputs` (a character device such as `/dev/null` excepted). An output `-` is standard
+/// Refuses, before any work, an output that is a directory, whose directory does not exist,
+/// that is one of the `inputs` (after following symbolic links; `-`, standard input, when it
+/// is redirected from that file) or that is another of the `outputs` (a character device such
+/// as `/dev/null` excepted). An output `-` is standard
 /// output; two outputs to the same standard stream or descriptor (`-` and `/dev/stdout`, say)
 /// are refused as well: their bytes would be mixed. Paths are named by the flag that gives
 /// them (absent ones skipped); the error names the flag.
@@ -789,8 +809,17 @@ pub fn distinct_paths(
                 "is a directory",
             ));
         }
+        if stream.is_none() {
+            ready_directory(flag, p)?;
+        }
         for (iflag, q) in inputs.iter().filter_map(|(n, q)| q.map(|q| (*n, q))) {
-            if q != Path::new("-") && same_file(p, q) {
+            // `-` is standard input: the same file as the output when it is redirected from it.
+            let q = if q == Path::new("-") {
+                Path::new("/dev/stdin")
+            } else {
+                q
+            };
+            if same_file(p, q) {
                 return Err(setting_error(
                     flag.trim_start_matches("--"),
                     &p.display().to_string(),

@@ -22,6 +22,33 @@
 use super::{remove_stale_temporaries, write_atomic, write_atomic_all};
 use std::path::Path;
 
+/// Whether `dir` can take the output files before any work is done: an existing directory,
+/// or a path whose nearest existing ancestor is a directory (the missing ones are made when
+/// the files are written). The error says what stands in the way (without naming `dir`).
+pub(crate) fn check_dir(dir: &Path) -> Result<(), String> {
+    let mut p = Some(dir);
+    while let Some(d) = p {
+        let d = if d.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            d
+        };
+        match std::fs::metadata(d) {
+            Ok(m) if m.is_dir() => return Ok(()),
+            Ok(_) if d == dir => return Err("is not a directory".into()),
+            Ok(_) => {
+                return Err(format!(
+                    "cannot be created: {} is not a directory",
+                    d.display()
+                ))
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => p = d.parent(),
+            Err(e) => return Err(format!("cannot be created: {}: {e}", d.display())),
+        }
+    }
+    Ok(())
+}
+
 /// The manifest's name in the directory. It does not start with `.fitbead-`, the prefix of
 /// temporary files.
 pub(crate) const MANIFEST: &str = ".fitbead.manifest";

@@ -153,6 +153,11 @@ pub fn report(
 ) -> Result<ReportOutput, RunError> {
     let (t, rows, ds) = (&data.table, &data.rows, &data.dataset);
     let (format, figure_width) = figure_settings(s)?;
+    // The output directory is checked before the fits, not found wanting after them.
+    if let Some(d) = out_dir {
+        crate::io::outdir::check_dir(d)
+            .map_err(|e| RunError::Failed(format!("{}: {e}", d.display())))?;
+    }
     let never = Arc::new(AtomicBool::new(false));
     let stop = s.stop.clone().unwrap_or(never);
     // A point that no contact model of the report can make steady is an error, as in klaw.

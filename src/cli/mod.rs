@@ -262,6 +262,14 @@ pub(crate) fn run(cli: Cli) -> i32 {
         eprintln!("fitbead: error: {}", clip_message(&e.to_string()));
         return 2;
     }
+    let files: Vec<(PathBuf, FileState)> = file_outputs(&cli.command)
+        .into_iter()
+        .filter(|p| !is_char_device(p))
+        .map(|p| {
+            let st = file_state(&p);
+            (p, st)
+        })
+        .collect();
     let r = match cli.command {
         Command::Forward(a) => forward::run(a),
         Command::K(a) => k::run(a),
@@ -281,7 +289,25 @@ pub(crate) fn run(cli: Cli) -> i32 {
     };
     match r {
         Ok(()) => 0,
-        Err(CliError::Io(e)) if e.kind() == std::io::ErrorKind::BrokenPipe => 0,
+        // A reader that stops early (`| head`) ends the run quietly, unless files it was to
+        // write are left unwritten: then it is an error that names them.
+        Err(CliError::Io(e)) if e.kind() == std::io::ErrorKind::BrokenPipe => {
+            let unwritten: Vec<String> = files
+                .iter()
+                .filter(|(p, before)| file_state(p) == *before)
+                .map(|(p, _)| p.display().to_string())
+                .collect();
+            if unwritten.is_empty() {
+                0
+            } else {
+                eprintln!(
+                    "fitbead: error: standard output was closed before the run ended (broken \
+                     pipe): {} not written",
+                    unwritten.join(", ")
+                );
+                2
+            }
+        }
         Err(e @ (CliError::Interrupted | CliError::InterruptedPartial | CliError::Stopped(_))) => {
             eprintln!("fitbead: {e}");
             130
@@ -366,14 +392,13 @@ fn check_stdout(c: &Command) -> Result<(), CliError> {
 /// Paths named by the flag that gives them (absent when the flag is not given).
 pub(crate) type NamedPaths<'a> = Vec<(&'static str, Option<&'a Path>)>;
 
-/// Refuses, before any work, an output that is also an input or another output of the same
-/// run (after following symbolic links), an output that is a directory, and two outputs to
-/// standard output (`-`, `/dev/stdout`; without `--output` the result takes it).
-fn check_paths(c: &Command) -> Result<(), CliError> {
+/// The inputs and outputs of a command, named by the flags that give them (absent ones
+/// `None`; the first output is the result's, `--output`, where the command has one).
+fn paths(c: &Command) -> (NamedPaths<'_>, NamedPaths<'_>) {
     fn opt(p: &Option<PathBuf>) -> Option<&Path> {
         p.as_deref()
     }
-    let (inputs, outputs): (NamedPaths<'_>, NamedPaths<'_>) = match c {
+    match c {
         Command::Forward(a) => (
             vec![("--input", opt(&a.input))],
             vec![("--output", opt(&a.out.output))],
@@ -411,7 +436,55 @@ fn check_paths(c: &Command) -> Result<(), CliError> {
                 ("--plot", opt(&a.plot.plot)),
             ],
         ),
-    };
+    }
+}
+
+/// What a file's metadata says of its content: none (no file), or its inode, size and
+/// modification time (a file replaced by a rename gets a new inode).
+type FileState = Option<(u64, u64, Option<std::time::SystemTime>)>;
+
+fn file_state(p: &Path) -> FileState {
+    #[cfg(unix)]
+    use std::os::unix::fs::MetadataExt;
+    let m = std::fs::metadata(p).ok()?;
+    #[cfg(unix)]
+    let ino = m.ino();
+    #[cfg(not(unix))]
+    let ino = 0;
+    Some((ino, m.len(), m.modified().ok()))
+}
+
+/// Whether `p` is a character device (`/dev/null`, a terminal): never "unwritten".
+fn is_char_device(p: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        std::fs::metadata(p).is_ok_and(|m| m.file_type().is_char_device())
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = p;
+        false
+    }
+}
+
+/// The output files of a command that are not standard output (`--out-dir` aside): what a
+/// broken standard output leaves unwritten.
+fn file_outputs(c: &Command) -> Vec<PathBuf> {
+    paths(c)
+        .1
+        .into_iter()
+        .filter_map(|(_, p)| p)
+        .filter(|p| crate::io::stream_of(p) != Some(1))
+        .map(Path::to_path_buf)
+        .collect()
+}
+
+/// Refuses, before any work, an output that is also an input or another output of the same
+/// run (after following symbolic links), an output that is a directory, and two outputs to
+/// standard output (`-`, `/dev/stdout`; without `--output` the result takes it).
+fn check_paths(c: &Command) -> Result<(), CliError> {
+    let (inputs, outputs) = paths(c);
     distinct_paths(&inputs, &outputs)?;
     // Without --output the result goes to standard output, which no other output may take.
     let result_on_stdout =

@@ -107,7 +107,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         Some(p) => Some((p, None)),
         None => None,
     };
-    let r = design(&s).map_err(design_error)?;
+    let r = design_until_stopped(&s)?.map_err(design_error)?;
     let bytes = csv_bytes(&r)?;
     let summary = summary(&s, &r);
     if let Some((p, file)) = plot {
@@ -129,6 +129,35 @@ pub fn run(a: Args) -> Result<(), CliError> {
         Ok(())
     } else {
         super::print_stdout(summary.as_bytes())
+    }
+}
+
+/// The design of `s`, computed on a thread of its own while this one watches the stop flag
+/// (SIGINT, SIGTERM, SIGHUP): a signal ends the run at once (exit 130), the figure's
+/// temporary file removed as the run unwinds, and the computation is dropped with the
+/// process.
+fn design_until_stopped(s: &DesignSettings) -> Result<Result<DesignResult, DesignError>, CliError> {
+    use std::sync::atomic::Ordering;
+    use std::sync::mpsc::RecvTimeoutError;
+    let stop = super::stop_flag();
+    let (tx, rx) = std::sync::mpsc::channel();
+    let owned = s.clone();
+    std::thread::spawn(move || {
+        let _ = tx.send(design(&owned));
+    });
+    loop {
+        match rx.recv_timeout(std::time::Duration::from_millis(50)) {
+            Ok(r) => return Ok(r),
+            Err(RecvTimeoutError::Timeout) if stop.load(Ordering::SeqCst) => {
+                return Err(CliError::Interrupted)
+            }
+            Err(RecvTimeoutError::Timeout) => {}
+            Err(RecvTimeoutError::Disconnected) => {
+                return Err(CliError::Other(
+                    "design: the computation ended without a result".into(),
+                ))
+            }
+        }
     }
 }
 

@@ -117,7 +117,7 @@ pub struct StreamOptions {
     pub chunk_rows: usize,
     /// Rows per parallel task (at least 1): the input is cut into ranges of about this many
     /// rows (from the mean bytes per line, between 4 KiB and 1 MiB), each parsed, checked,
-    /// computed and formatted by one task, which also looks at the stop flag this often.
+    /// computed and formatted by one task, which looks at the stop flag before each row.
     pub task_rows: usize,
     /// Raised by the caller (e.g. on Ctrl-C): the stream stops before its next task and
     /// returns [`StreamError::Stopped`].
@@ -598,8 +598,10 @@ impl<R: Read + Send, P: RowPlan> Pipe<'_, R, P> {
 
     fn compute(&self, d: &mut Done<P::Note>) {
         let mut scratch = P::Scratch::default();
-        for (i, rec) in d.recs.iter().enumerate() {
-            if i % self.task == 0 && stopped(self.opts) {
+        // The stop flag is looked at before every row (one relaxed load): a row of the
+        // contact or md model can take milliseconds, and a task's rows seconds.
+        for rec in d.recs.iter() {
+            if stopped(self.opts) {
                 d.error = Some(StreamError::Stopped);
                 return;
             }

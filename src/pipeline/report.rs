@@ -170,7 +170,11 @@ pub fn report(
     if s.stopped() {
         return Err(RunError::Interrupted);
     }
-    refuse_unsteady_under_all(&unsteady, t, ds)?;
+    // With --keep-going such points are left out of every contact model's fits, and listed
+    // below with each model's.
+    if !s.keep_going {
+        refuse_unsteady_under_all(&unsteady, t, ds)?;
+    }
     let implausible = crate::io::measurements::plausibility(t, rows);
     let mut input_warnings = Vec::new();
     for (u, name) in unsteady.iter().zip(CONTACT_NAMES) {
@@ -338,7 +342,8 @@ fn refuse_unsteady_under_all(
     if let Some((i, why)) = under_none.first() {
         return Err(RunError::Failed(format!(
             "{}: {why} (and {} more such point(s)); no K of the rolling or stick/slip model \
-             makes this point steady: leave it out of the data",
+             makes this point steady: leave it out of the data (--keep-going leaves it out of \
+             their fits)",
             locate_point(t, ds, *i),
             under_none.len() - 1
         )));

@@ -6,7 +6,7 @@
 
 use super::summary::{FitResult, ParamRow};
 use crate::inverse::SigmaKind;
-use crate::numfmt::fmt_sig;
+use crate::numfmt::{clip, fmt_sig};
 use std::fmt;
 
 /// Correlations at or below this magnitude are left out of the report.
@@ -60,11 +60,14 @@ fn method_name(r: &FitResult) -> &'static str {
     }
 }
 
+/// Longest series label the report shows, in characters (the tables keep it whole).
+const LABEL_CHARS: usize = 120;
+
 fn param_line(f: &mut fmt::Formatter<'_>, r: &FitResult, p: &ParamRow) -> fmt::Result {
     let name = if p.series == r.stats.series {
         p.parameter.clone()
     } else {
-        format!("{}[{}]", p.parameter, p.series)
+        format!("{}[{}]", p.parameter, clip(&p.series, LABEL_CHARS))
     };
     write!(f, "    {name:<12} = {:>12}", num(p.value))?;
     match p.stderr {
@@ -99,7 +102,7 @@ fn param_line(f: &mut fmt::Formatter<'_>, r: &FitResult, p: &ParamRow) -> fmt::R
 impl fmt::Display for FitResult {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let s = &self.stats;
-        writeln!(f, "[[Fit {} [{}]]]", s.fit, s.series)?;
+        writeln!(f, "[[Fit {} [{}]]]", s.fit, clip(&s.series, LABEL_CHARS))?;
         writeln!(f, "    method             = {}", method_name(self))?;
         writeln!(f, "    data points        = {}", s.n_points)?;
         writeln!(f, "    variables          = {}", s.n_params)?;

@@ -73,16 +73,20 @@ fn warnings_section(ctx: &ReportContext) -> String {
     m
 }
 
-/// `s` as a Markdown table cell: `|` escaped (`\|`), every line break a space. Series labels
-/// are data: one with `|` or a newline must not split or end a row.
+/// `s` as a Markdown table cell: `|` escaped (`\|`), every line break a space, cut to 120
+/// characters ([`crate::numfmt::clip`]). Series labels are data: one with `|` or a newline
+/// must not split or end a row, and a huge one must not flood the page (the CSV tables keep
+/// it whole).
 pub(crate) fn table_cell(s: &str) -> String {
-    one_line(s).replace('|', "\\|")
+    one_line(&crate::numfmt::clip(s, 120)).replace('|', "\\|")
 }
 
 /// `s` on one Markdown line (a list item, a paragraph): every line break (CR, LF or both) a
-/// space.
+/// space; cut to 4,000 characters ([`crate::numfmt::clip`]).
 pub fn one_line(s: &str) -> String {
-    s.replace("\r\n", " ").replace(['\r', '\n'], " ")
+    crate::numfmt::clip(s, 4000)
+        .replace("\r\n", " ")
+        .replace(['\r', '\n'], " ")
 }
 
 /// A parameter's name in the report's tables: qualified by series where a fit across series
@@ -91,7 +95,7 @@ fn param_name(r: &ParamRow, fit_series: &str) -> String {
     if r.series == fit_series {
         r.parameter.clone()
     } else {
-        format!("{}[{}]", r.parameter, r.series)
+        format!("{}[{}]", r.parameter, crate::numfmt::clip(&r.series, 120))
     }
 }
 
@@ -385,7 +389,7 @@ pub fn terminal_summary(an: &Analysis, dir: &str) -> String {
             s.push_str(&format!(
                 "{:<31} {:<5} {:<8} {:>18}  {}{}\n",
                 f.stats.fit,
-                f.stats.series,
+                crate::numfmt::clip(&f.stats.series, 120),
                 param_name(r, &f.stats.series),
                 value_pm(r),
                 interval_cell(r),
@@ -402,7 +406,7 @@ pub fn terminal_summary(an: &Analysis, dir: &str) -> String {
     for r in an.mu_rows() {
         s.push_str(&format!(
             "{:<8} {:>6} {:>22} {:<22} {:>22} {:>9}  {}\n",
-            r.series,
+            crate::numfmt::clip(&r.series, 120),
             fmt_f64(r.xi),
             format!(
                 "{} [{}, {}]",

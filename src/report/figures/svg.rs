@@ -43,6 +43,10 @@ fn num_formatted(x: f64) -> String {
     s.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
+/// Longest text a figure draws, in characters of its markup: a longer one (a legend or title
+/// holding a huge series label) keeps its first characters and ends in `…`.
+pub(crate) const MAX_TEXT_CHARS: usize = 120;
+
 /// Escapes text for an SVG text node or attribute.
 pub(crate) fn escape(s: &str) -> String {
     let mut o = String::with_capacity(s.len());
@@ -452,6 +456,19 @@ impl Svg {
         vertical: bool,
         colour: &str,
     ) {
+        // A series label can be megabytes long (it is data): a figure shows its start.
+        let clipped;
+        let markup = match markup.char_indices().nth(MAX_TEXT_CHARS) {
+            Some(_) => {
+                let end = markup
+                    .char_indices()
+                    .nth(MAX_TEXT_CHARS - 1)
+                    .map_or(markup.len(), |(i, _)| i);
+                clipped = format!("{}…", &markup[..end]);
+                clipped.as_str()
+            }
+            None => markup,
+        };
         let width = text_width(markup, size);
         let x0 = match anchor {
             Anchor::Start => x,

@@ -87,8 +87,8 @@ struct Keys {
     format: Option<String>,
     /// dimensionless or si.
     units: Option<String>,
-    /// single, double or a width in mm.
-    figure_width: Option<String>,
+    /// single, double or a width in mm (a string or a number).
+    figure_width: Option<Width>,
     /// ρ.
     rho: Option<f64>,
     /// f.
@@ -103,6 +103,16 @@ struct Keys {
     min_ess: Option<f64>,
     /// MCMC maximum steps.
     max_steps: Option<usize>,
+}
+
+/// A recipe's figure width: `"single"`, `"double"`, or millimetres as a number or a string.
+#[derive(Debug, Clone, serde::Deserialize, serde::Serialize)]
+#[serde(untagged)]
+enum Width {
+    /// A width in millimetres written as a number (`figure_width = 120`).
+    Mm(f64),
+    /// A name or a width written as a string.
+    Text(String),
 }
 
 /// The keys that apply to a posterior run only: ignored under least squares.
@@ -173,12 +183,21 @@ impl Recipe {
                 .and_then(|t| <FitMethod as clap::ValueEnum>::from_str(t.trim(), true).ok()),
         };
         let mcmc = method == Some(FitMethod::Mcmc);
+        // Unsigned counts are written as they are (a TOML value holds at most i64::MAX, and
+        // a seed may be any u64); the rest through TOML's own values.
+        let counts = [
+            ("seed", keys.seed.take().map(|n| n.to_string())),
+            ("max_steps", keys.max_steps.take().map(|n| n.to_string())),
+        ];
         let toml::Value::Table(map) =
             toml::Value::try_from(&keys).map_err(|e| CliError::Other(e.to_string()))?
         else {
             return Ok(Some(r));
         };
-        for (key, value) in map {
+        let counts = counts
+            .into_iter()
+            .filter_map(|(k, v)| v.map(|v| (k.to_string(), toml::Value::String(v))));
+        for (key, value) in map.into_iter().chain(counts) {
             let text = match value {
                 toml::Value::String(s) => s,
                 toml::Value::Float(x) => crate::numfmt::echo_f64(x),

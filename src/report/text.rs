@@ -73,12 +73,11 @@ fn warnings_section(ctx: &ReportContext) -> String {
     m
 }
 
-/// `s` as a Markdown table cell: `|` escaped (`\|`), every line break a space, cut to 120
-/// characters ([`crate::numfmt::clip`]). Series labels are data: one with `|` or a newline
-/// must not split or end a row, and a huge one must not flood the page (the CSV tables keep
-/// it whole).
+/// `s` as a Markdown table cell: `|` escaped (`\|`), every line break a space, cut as
+/// [`one_line`] cuts. Series labels are data: one with `|` or a newline must not split or end
+/// a row, and a huge one must not flood the page (the CSV tables keep it whole).
 pub(crate) fn table_cell(s: &str) -> String {
-    one_line(&crate::numfmt::clip(s, 120)).replace('|', "\\|")
+    one_line(s).replace('|', "\\|")
 }
 
 /// `s` on one Markdown line (a list item, a paragraph): every line break (CR, LF or both) a
@@ -205,15 +204,15 @@ fn bound_of(r: &ParamRow) -> f64 {
 
 /// The Jaeger section: the fitted a1–a3 per series against the paper's Fig. 9, the branch, the
 /// points in the bistable band (eq 90), and what a2 on its bound 0 means.
-fn jaeger_section(an: &Analysis) -> String {
+fn jaeger_section(an: &Analysis, ctx: &ReportContext) -> String {
     let mut m = String::new();
     m.push_str("## Jaeger's law (eqs 80–90)\n\n");
-    m.push_str(
+    m.push_str(&format!(
         "tan δ = a3 u² + a1/(1 + a2 u²) with Jaeger's velocity u (eq 81), fitted per series on \
          the branch of eq 84 named below; a1 is the friction at rest, a1/(1 + a2 u²) its decay \
-         with speed and a3 u² the collisional drag. Figure: [jaeger.svg](jaeger.svg) (Figs. \
-         9–10).\n\n",
-    );
+         with speed and a3 u² the collisional drag. Figure: {} (Figs. 9–10).\n\n",
+        figure_link(ctx, "jaeger.svg")
+    ));
     m.push_str(
         "| series | ξ | a1 | a2 | a3 | χ²/dof | branch | a1·a2 > a3 (eq 82) | points in the \
          bistable band (eq 90) | paper a1, a2, a3 (Fig. 9) |\n|---|---|---|---|---|---|---|---|---|---|\n",
@@ -471,8 +470,8 @@ pub fn markdown(an: &Analysis, ctx: &ReportContext, method: &str) -> String {
     m.push_str(&parameter_table(an));
     m.push_str(&bulk_friction_section(an));
     m.push_str(&energy_section(an));
-    m.push_str(&regimes_section(an));
-    m.push_str(&jaeger_section(an));
+    m.push_str(&regimes_section(an, ctx));
+    m.push_str(&jaeger_section(an, ctx));
     m.push_str(&model_choice_section(an));
     m.push_str(&figures_section(ctx));
     m.push_str(&fit_reports(an));
@@ -566,15 +565,16 @@ fn energy_section(an: &Analysis) -> String {
 }
 
 /// report.md's regimes: the regime map and the regime of every point per contact model.
-fn regimes_section(an: &Analysis) -> String {
+fn regimes_section(an: &Analysis, ctx: &ReportContext) -> String {
     let mut m = String::new();
     m.push_str("## Regimes\n\n");
-    m.push_str(
+    m.push_str(&format!(
         "δ_m (eq 32) and δ_d (eq 31) against α for the reference and fitted laws, with the \
          critical ξ below which no steady motion exists: [regime_map.csv](regime_map.csv); \
          the regime each contact model (at its law-c fit) assigns to every point: \
-         [points.csv](points.csv); figure [regime_map.svg](regime_map.svg).\n\n",
-    );
+         [points.csv](points.csv); figure {}.\n\n",
+        figure_link(ctx, "regime_map.svg")
+    ));
     let reg = an.point_regimes();
     for (c, r) in an.contact.iter().zip(&reg) {
         let count = |g: &str| r.iter().filter(|x| x.as_str() == g).count();

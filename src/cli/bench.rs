@@ -47,6 +47,16 @@ pub fn run(a: Args) -> Result<(), CliError> {
             .find(|b| b.0 == r.model)
             .map(|b| b.1)
             .unwrap_or(0.0);
+        if r.scenes == 0 {
+            eprintln!(
+                "reference {:<10} {:<42} scenes     0: no scenes: none of the {} drawn falls in \
+                 this check's domain (draw more with --scenes)",
+                r.model,
+                r.method,
+                scenes.len()
+            );
+            continue;
+        }
         eprintln!(
             "reference {:<10} {:<42} scenes {:>5}  max {:.2e}  median {:.2e}  bound {:.0e}: {}",
             r.model,

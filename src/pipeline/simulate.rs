@@ -538,6 +538,25 @@ fn read_design(path: &std::path::Path) -> Result<Vec<DesignLine>, RunError> {
         } else {
             cell(cs).to_string()
         };
+        // A series is one bead size: the fits refuse a series that mixes ξ values.
+        if let Some(first) = out
+            .iter()
+            .find(|d: &&DesignLine| d.series == series && d.xi != xi)
+        {
+            return Err(err(
+                Some(line),
+                Some("xi"),
+                Some(cell(cx)),
+                format!(
+                    "series '{}' mixes xi values: {} on line {}, {} here (a series is one bead \
+                     size)",
+                    crate::numfmt::clip(&series, crate::numfmt::ECHO_CHARS),
+                    fmt_f64(first.xi),
+                    first.line,
+                    fmt_f64(xi)
+                ),
+            ));
+        }
         out.push(DesignLine {
             line,
             series,

@@ -78,6 +78,26 @@ pub(crate) fn clip(s: &str, max: usize) -> std::borrow::Cow<'_, str> {
     }
 }
 
+/// `s` as a message echoes a user's value: cut by [`clip`], and every control character
+/// (a NUL byte, a tab, an escape) written as its escape (`\0`, `\t`, `\u{1b}`), so that it
+/// neither vanishes nor acts on the terminal.
+pub(crate) fn echo(s: &str, max: usize) -> std::borrow::Cow<'_, str> {
+    let c = clip(s, max);
+    if c.chars().any(char::is_control) {
+        let mut o = String::with_capacity(c.len() + 8);
+        for ch in c.chars() {
+            if ch.is_control() {
+                o.extend(ch.escape_debug());
+            } else {
+                o.push(ch);
+            }
+        }
+        std::borrow::Cow::Owned(o)
+    } else {
+        c
+    }
+}
+
 /// Decimal places that show `stderr` to two significant digits (`None` when it is not a
 /// positive finite number or would need more than 15 places).
 fn pm_places(stderr: f64) -> Option<usize> {

@@ -127,7 +127,11 @@ impl FromStr for CollisionLaw {
             "impact" => return Ok(CollisionLaw::Impact),
             _ => {}
         }
-        if let Some(rest) = t.strip_prefix("c=") {
+        let rest = t
+            .get(..2)
+            .filter(|p| p.eq_ignore_ascii_case("c="))
+            .map(|_| &t[2..]);
+        if let Some(rest) = rest {
             return match rest.trim().parse::<f64>() {
                 Ok(c) if c.is_finite() => Ok(CollisionLaw::C(c)),
                 _ => Err(ParameterError::UnknownLaw(t.to_string())),

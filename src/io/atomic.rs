@@ -16,7 +16,9 @@
 //!   that descriptor is;
 //! - a **directory** is an error before anything is written;
 //! - a **new file** gets mode 0666 less the process umask (0644 under umask 022), as a file
-//!   made by `>` in a shell would; an **existing file** keeps its mode.
+//!   made by `>` in a shell would; an **existing file** keeps its mode, and is replaced only
+//!   if this user may write it (a read-only file, or another user's, in a directory anyone
+//!   may write is refused).
 //!
 //! A group of files ([`write_atomic_all`]) is checked whole before the first rename (every
 //! target resolved, none a directory, no two the same file), then renamed one after the other;
@@ -187,9 +189,35 @@ fn dir_of(target: &Path) -> PathBuf {
     }
 }
 
+/// Refuses to replace an existing regular file `p` that this user could not write in place
+/// (opened for writing, nothing written): renaming a file over it needs only the directory's
+/// permission, and would let anyone who may write in a shared directory (`/tmp`) replace
+/// another user's read-only file.
+fn writable(p: &Path) -> std::io::Result<()> {
+    match OpenOptions::new().write(true).open(p) {
+        Ok(_) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::PermissionDenied => Err(std::io::Error::new(
+            e.kind(),
+            "the file exists and this user may not write it: fitbead does not replace a \
+                 file it could not write in place",
+        )),
+        Err(_) => Ok(()),
+    }
+}
+
 /// Refuses an output path (named by `flag`) whose directory does not exist or is not a
-/// directory: the run would fail only when it writes, after all its work.
+/// directory, or that is an existing file this user may not write ([`writable`]): the run
+/// would fail only when it writes, after all its work.
 fn ready_directory(flag: &str, p: &Path) -> Result<(), InputError> {
+    if let Ok(Target::Regular(target, _)) = resolve(p) {
+        if let Err(e) = writable(&target) {
+            return Err(setting_error(
+                flag.trim_start_matches("--"),
+                &p.display().to_string(),
+                e.to_string(),
+            ));
+        }
+    }
     let dir = dir_of(p);
     match std::fs::metadata(&dir) {
         Ok(m) if m.is_dir() => Ok(()),
@@ -396,10 +424,13 @@ impl AtomicFile {
                 tmp: temp_in(&p, None).map_err(|e| with_path(path, e))?,
                 target: p,
             },
-            Target::Regular(p, perm) => Sink::Temp {
-                tmp: temp_in(&p, Some(perm)).map_err(|e| with_path(path, e))?,
-                target: p,
-            },
+            Target::Regular(p, perm) => {
+                writable(&p).map_err(|e| with_path(path, e))?;
+                Sink::Temp {
+                    tmp: temp_in(&p, Some(perm)).map_err(|e| with_path(path, e))?,
+                    target: p,
+                }
+            }
         };
         Ok(AtomicFile {
             sink,

@@ -22,7 +22,7 @@ pub(crate) use atomic::{
     distinct_paths, remove_stale_temporaries, stream_of, write_atomic, write_atomic_all, AtomicFile,
 };
 
-pub(crate) use crate::numfmt::{clip, fmt_f64, fmt_sig, ECHO_CHARS};
+pub(crate) use crate::numfmt::{clip, echo, fmt_f64, fmt_sig, ECHO_CHARS};
 
 use std::fmt;
 
@@ -105,11 +105,11 @@ impl fmt::Display for InputError {
             && self.column.as_ref().is_some_and(|c| c.starts_with("--"));
         if let Some(c) = &self.column {
             let what = if setting { "flag" } else { "column" };
-            write!(f, ", {what} '{}'", clip(c, ECHO_CHARS))?;
+            write!(f, ", {what} '{}'", echo(c, ECHO_CHARS))?;
         }
         match &self.value {
             Some(v) if setting && v.is_empty() => {}
-            Some(v) => write!(f, ", value '{}'", clip(v, ECHO_CHARS))?,
+            Some(v) => write!(f, ", value '{}'", echo(v, ECHO_CHARS))?,
             None => {}
         }
         write!(f, ": {}", clip(&self.message, MESSAGE_CHARS))

@@ -5,7 +5,8 @@
 use crate::common::{bin, records, s, stderr, tmpdir, write};
 use std::collections::HashMap;
 use std::path::Path;
-use std::process::Output;
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
 
 /// Runs fitbead with `args` in `dir`.
 fn fb(dir: &Path, args: &[&str]) -> Output {
@@ -423,4 +424,740 @@ fn simulated_velocities_are_positive_at_high_noise() {
         fitted += usize::from(out.status.success());
     }
     assert!(fitted >= 25, "{fitted} of 26 fitted");
+}
+
+/// A posterior run cut off at `--max-steps` says so on every parameter row, as an interrupted
+/// run does; its sd and interval come from chains that have not mixed.
+#[test]
+fn a_run_stopped_at_the_step_cap_flags_every_row() {
+    let d = tmpdir();
+    let data = crate::common::root().join("data/default.csv");
+    let out = fb(
+        d.path(),
+        &[
+            "klaw",
+            "--model",
+            "stick",
+            "--law",
+            "free-per-series",
+            s(&data),
+            "--method",
+            "mcmc",
+            "--max-steps",
+            "1",
+            "--output",
+            "-",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    let (_, rows) = records(&String::from_utf8(out.stdout.clone()).unwrap());
+    let posterior: Vec<_> = rows
+        .iter()
+        .filter(|r| r["ci_method"] == "posterior")
+        .collect();
+    assert_eq!(posterior.len(), 4);
+    for r in posterior {
+        assert!(
+            r["note"].starts_with("stopped at the step cap, not converged"),
+            "{}",
+            r["note"]
+        );
+    }
+    // The non-convergence message names a parameter as the draws file does (K[0.8]).
+    let e = stderr(&out);
+    assert!(!e.contains("of this fit"), "{e}");
+    assert!(
+        e.contains("parameter 'K[") || e.contains("too few draws"),
+        "{e}"
+    );
+}
+
+/// The last row of `forward`'s CSV output, keyed by column.
+fn forward_row(dir: &Path, args: &[&str]) -> HashMap<String, String> {
+    let mut a = vec!["forward"];
+    a.extend_from_slice(args);
+    let (_, rows) = records(&fb_ok(dir, &a));
+    rows.into_iter().last().unwrap()
+}
+
+/// Floating-point edges: f² overflowing, ξ at the ends of the doubles. A steady result with
+/// no finite positive velocity is `invalid`, never `ok`.
+#[test]
+fn floating_point_edges_of_the_forward_models() {
+    let d = tmpdir();
+    let p = d.path();
+    let base = ["--model", "stickslip", "--xi", "0.8", "--delta-deg", "12"];
+    let at = |f: &str| {
+        let mut a = base.to_vec();
+        a.extend_from_slice(&["--f", f]);
+        forward_row(p, &a)
+    };
+    let reference = at("1e150");
+    assert_eq!(reference["status"], "ok");
+    for f in ["1e154", "1e200", "1.7e308"] {
+        let r = at(f);
+        assert_eq!(r["status"], "ok", "f {f}: {r:?}");
+        assert_eq!(r["v"], reference["v"], "f {f}: rolling, as at 1e150");
+    }
+    for (model, xi, extra) in [
+        ("slip", "1e300", vec!["--K", "0.5"]),
+        ("slip", "1e20", vec!["--K", "0.5"]),
+        (
+            "jaeger",
+            "5e-324",
+            vec!["--K", "0.5", "--a1", "0.1", "--a2", "1", "--a3", "1"],
+        ),
+    ] {
+        let mut a = vec!["--model", model, "--xi", xi, "--delta-deg", "12"];
+        a.extend(extra);
+        let r = forward_row(p, &a);
+        assert_eq!(r["status"], "invalid", "{model} at xi {xi}: {r:?}");
+        assert!(r["v"].is_empty());
+    }
+}
+
+/// A design for an absolute σ does not depend on σ: the same slopes at 1e-160, 0.01 and 1e160,
+/// the same efficiency, and standard errors in proportion to σ.
+#[test]
+fn an_absolute_noise_design_does_not_depend_on_sigma() {
+    let d = tmpdir();
+    let run = |noise: &str| {
+        let out = fb(
+            d.path(),
+            &[
+                "design",
+                "--fit",
+                "klaw",
+                "--model",
+                "stickslip",
+                "--noise",
+                noise,
+                "--output",
+                "-",
+            ],
+        );
+        assert!(out.status.success(), "{noise}: {}", stderr(&out));
+        (String::from_utf8(out.stdout.clone()).unwrap(), stderr(&out))
+    };
+    let (mid, mid_summary) = run("abs=0.01");
+    for noise in ["abs=1e-160", "abs=1e160"] {
+        let (rows, summary) = run(noise);
+        assert_eq!(rows, mid, "{noise}: the design moved");
+        let eff = |s: &str| {
+            s.lines()
+                .find(|l| l.contains("efficiency"))
+                .unwrap_or_else(|| panic!("{s}"))
+                .to_string()
+        };
+        assert_eq!(eff(&summary), eff(&mid_summary), "{noise}");
+        assert!(!summary.contains("NaN"), "{summary}");
+    }
+    let se = |s: &str| -> f64 {
+        let l = s.lines().find(|l| l.contains("c = 0.5:")).unwrap();
+        l.split(':')
+            .nth(1)
+            .unwrap()
+            .split('/')
+            .next()
+            .unwrap()
+            .trim()
+            .parse()
+            .unwrap()
+    };
+    let (_, small) = run("abs=1e-160");
+    let ratio = se(&small) / se(&mid_summary);
+    assert!((ratio / 1e-158 - 1.0).abs() < 1e-2, "{ratio:e}");
+}
+
+/// σ finer than the rounding of the velocity is refused, naming the cell (so is a velocity of
+/// 1e200 beside σ = 0.006, which once fitted to χ² = ∞ with no word); a velocity of 1e10 is
+/// named an implausible misfit.
+#[test]
+fn sigma_below_rounding_is_refused_and_an_absurd_velocity_warned() {
+    let d = tmpdir();
+    let text = std::fs::read_to_string(crate::common::root().join("data/default.csv")).unwrap();
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let mut cells: Vec<String> = lines[2].split(',').map(String::from).collect();
+    cells[4] = "1e-300".into();
+    lines[2] = cells.join(",");
+    let p = write(d.path(), "tiny.csv", &(lines.join("\n") + "\n"));
+    let out = fb(d.path(), &["klaw", "--model", "stickslip", s(&p)]);
+    crate::common::expect(
+        &out,
+        2,
+        &["line 3", "column 'sigma_v'", "value '1e-300'"],
+        "tiny sigma",
+    );
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let mut cells: Vec<String> = lines[2].split(',').map(String::from).collect();
+    cells[3] = "1e200".into();
+    lines[2] = cells.join(",");
+    let p = write(d.path(), "huge.csv", &(lines.join("\n") + "\n"));
+    let out = fb(
+        d.path(),
+        &[
+            "klaw",
+            "--model",
+            "stickslip",
+            s(&p),
+            "--output",
+            "/dev/null",
+        ],
+    );
+    crate::common::expect(
+        &out,
+        2,
+        &["line 3", "column 'sigma_v'", "(1e200)"],
+        "v 1e200",
+    );
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let mut cells: Vec<String> = lines[2].split(',').map(String::from).collect();
+    cells[3] = "1e10".into();
+    lines[2] = cells.join(",");
+    let p = write(d.path(), "big.csv", &(lines.join("\n") + "\n"));
+    let out = fb(
+        d.path(),
+        &[
+            "klaw",
+            "--model",
+            "stickslip",
+            s(&p),
+            "--output",
+            "/dev/null",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("warning: klaw-c [all]: reduced chi2 ="),
+        "{}",
+        stderr(&out)
+    );
+}
+
+/// Runs `args` in `dir` for at most `limit`; the output and how long it took.
+fn within(dir: &Path, args: &[&str], limit: Duration) -> (Output, Duration) {
+    let t0 = Instant::now();
+    let mut child = bin()
+        .args(args)
+        .current_dir(dir)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    while child.try_wait().unwrap().is_none() && t0.elapsed() < limit {
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let _ = child.kill();
+    (child.wait_with_output().unwrap(), t0.elapsed())
+}
+
+/// md settings that would carry the bead past a row bead per step, or sink it into the row,
+/// are refused at once (they once ran for ever, deaf to signals), blaming the setting given.
+#[test]
+fn md_extreme_settings_are_refused_at_once() {
+    let d = tmpdir();
+    let p = d.path();
+    let lv = write(p, "lv.csv", "xi,delta_deg,launch_velocity\n1,12,1e12\n");
+    let md = ["forward", "--model", "md", "--xi", "1", "--delta-deg", "12"];
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["--md-g", "1e20"], "flag '--md-g'"),
+        (
+            vec!["--launch-velocity", "1e12"],
+            "flag '--launch-velocity'",
+        ),
+        (vec!["--young-pa", "1e-300"], "flag '--young-pa'"),
+        (vec!["--row-radius-m", "1e300"], "flag '--row-radius-m'"),
+    ];
+    for (extra, blamed) in cases {
+        let mut a = md.to_vec();
+        a.extend(extra.iter().copied());
+        let (out, took) = within(p, &a, Duration::from_secs(10));
+        assert!(took < Duration::from_secs(2), "{extra:?} took {took:?}");
+        crate::common::expect(&out, 2, &[blamed], &format!("{extra:?}"));
+    }
+    let (out, took) = within(
+        p,
+        &["forward", "--model", "md", "--input", s(&lv)],
+        Duration::from_secs(10),
+    );
+    assert!(took < Duration::from_secs(2), "column: {took:?}");
+    crate::common::expect(&out, 2, &["column 'launch_velocity'"], "column");
+    let (out, took) = within(
+        p,
+        &["simulate", "--model", "md", "--launch-velocity", "1e13"],
+        Duration::from_secs(10),
+    );
+    assert!(took < Duration::from_secs(2), "simulate: {took:?}");
+    crate::common::expect(&out, 2, &["launch_velocity"], "simulate");
+}
+
+/// `--input -` with standard input redirected from the output file is refused, the file kept.
+#[test]
+fn standard_input_from_the_output_file_is_refused() {
+    let d = tmpdir();
+    let text = std::fs::read(crate::common::root().join("data/default.csv")).unwrap();
+    let p = d.path().join("d.csv");
+    std::fs::write(&p, &text).unwrap();
+    for cmd in [
+        vec![
+            "k",
+            "--model",
+            "stickslip",
+            "--input",
+            "-",
+            "--output",
+            "d.csv",
+        ],
+        vec![
+            "klaw",
+            "--model",
+            "stickslip",
+            "--input",
+            "-",
+            "--output",
+            "d.csv",
+        ],
+    ] {
+        let out = bin()
+            .args(&cmd)
+            .current_dir(d.path())
+            .stdin(std::fs::File::open(&p).unwrap())
+            .output()
+            .unwrap();
+        crate::common::expect(
+            &out,
+            2,
+            &["is the same file as --input"],
+            &format!("{cmd:?}"),
+        );
+        assert_eq!(
+            std::fs::read(&p).unwrap(),
+            text,
+            "{cmd:?} replaced the input"
+        );
+    }
+}
+
+/// A measurements file of `n` plain rows (one series at ξ = 1).
+fn many_rows(n: usize) -> String {
+    let mut t = String::from("series,xi,delta_deg,v,sigma_v\n");
+    for i in 0..n {
+        let d = 10.0 + (i % 1000) as f64 * 1e-3;
+        let v = 0.4 + (i % 997) as f64 * 1e-5;
+        t.push_str(&format!("1,1,{d},{v},0.01\n"));
+    }
+    t
+}
+
+/// A broken standard output (`| head -1`) with a figure still to write: an error naming the
+/// figure, not a quiet exit 0 without it.
+#[test]
+fn a_broken_stdout_names_the_files_left_unwritten() {
+    let d = tmpdir();
+    let p = write(d.path(), "big.csv", &many_rows(300_000));
+    let mut child = bin()
+        .args([
+            "k",
+            "--model",
+            "stickslip",
+            "--input",
+            s(&p),
+            "--output",
+            "-",
+            "--plot",
+            "k.svg",
+        ])
+        .current_dir(d.path())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    {
+        use std::io::Read;
+        let mut first = [0u8; 64];
+        child.stdout.take().unwrap().read_exact(&mut first).unwrap();
+        // The pipe's reader is gone here.
+    }
+    let out = child.wait_with_output().unwrap();
+    crate::common::expect(&out, 2, &["broken pipe", "k.svg not written"], "k | head");
+    assert!(!d.path().join("k.svg").exists());
+    assert!(crate::common::leftovers(d.path()).is_empty());
+}
+
+/// `design` on SIGTERM exits 130 at once and leaves no temporary file of its figure.
+#[test]
+fn design_stops_on_sigterm_without_leftovers() {
+    let d = tmpdir();
+    let mut child = bin()
+        .args([
+            "design",
+            "--fit",
+            "klaw",
+            "--model",
+            "stickslip",
+            "--prior",
+            "c=normal(0.5,0.1)",
+            "--draws",
+            "10000",
+            "--plot",
+            "p.svg",
+            "--output",
+            "o.csv",
+        ])
+        .current_dir(d.path())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(400));
+    assert!(
+        child.try_wait().unwrap().is_none(),
+        "design ended before the signal"
+    );
+    crate::common::signal(&child, "-TERM");
+    let t0 = Instant::now();
+    let status = child.wait().unwrap();
+    assert!(t0.elapsed() < Duration::from_secs(1), "{:?}", t0.elapsed());
+    assert_eq!(status.code(), Some(130));
+    assert!(crate::common::leftovers(d.path()).is_empty());
+    assert!(!d.path().join("p.svg").exists() && !d.path().join("o.csv").exists());
+}
+
+/// `k --model contact` stops within a second of SIGINT (the flag was once looked at only
+/// between tasks of 512 rows, seconds apart under the contact model).
+#[test]
+fn contact_k_stops_within_a_second_of_sigint() {
+    let d = tmpdir();
+    let p = write(d.path(), "kc.csv", &many_rows(100_000));
+    let mut child = bin()
+        .args([
+            "k",
+            "--model",
+            "contact",
+            "--input",
+            s(&p),
+            "--output",
+            "out.csv",
+        ])
+        .current_dir(d.path())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(1500));
+    assert!(
+        child.try_wait().unwrap().is_none(),
+        "k ended before the signal"
+    );
+    crate::common::signal(&child, "-INT");
+    let t0 = Instant::now();
+    let status = child.wait().unwrap();
+    let took = t0.elapsed();
+    assert!(
+        took < Duration::from_secs(1),
+        "stopped {took:?} after SIGINT"
+    );
+    assert_eq!(status.code(), Some(130));
+    assert!(!d.path().join("out.csv").exists());
+}
+
+/// Outputs that cannot be written are refused before any work, not after it.
+#[test]
+fn unwritable_output_places_are_refused_before_the_work() {
+    let d = tmpdir();
+    let p = d.path();
+    write(p, "afile", "mine\n");
+    let data = crate::common::root().join("data/default.csv");
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec!["report", "--method", "mcmc", "--out-dir", "afile"],
+            "is not a directory",
+        ),
+        (
+            vec!["report", "--out-dir", "afile/sub"],
+            "cannot be created",
+        ),
+        (
+            vec![
+                "klaw",
+                "--model",
+                "stickslip",
+                s(&data),
+                "--output",
+                "nodir/x.csv",
+            ],
+            "cannot be created in nodir",
+        ),
+        (
+            vec!["bench", "--output", "nodir/x.csv"],
+            "cannot be created in nodir",
+        ),
+    ];
+    for (args, msg) in cases {
+        let (out, took) = within(p, &args, Duration::from_secs(30));
+        assert!(took < Duration::from_secs(1), "{args:?} took {took:?}");
+        crate::common::expect(&out, 2, &[msg], &format!("{args:?}"));
+    }
+    assert_eq!(std::fs::read_to_string(p.join("afile")).unwrap(), "mine\n");
+    // A new directory, and its missing parents, are still made.
+    let out = fb(p, &["report", "--out-dir", "new/sub"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(p.join("new/sub/report.md").exists());
+}
+
+/// A huge series label is cut in the figures and in report.md (the CSV tables keep it).
+#[test]
+fn a_huge_label_does_not_flood_the_figures() {
+    let d = tmpdir();
+    let label = "L".repeat(200_000);
+    let text = std::fs::read_to_string(crate::common::root().join("data/default.csv")).unwrap();
+    let mut out = String::new();
+    for (i, l) in text.lines().enumerate() {
+        if i > 0 && l.starts_with("0.8,") {
+            out.push_str(&format!("{label}{}\n", &l[3..]));
+        } else {
+            out.push_str(l);
+            out.push('\n');
+        }
+    }
+    let p = write(d.path(), "big.csv", &out);
+    let r = fb(d.path(), &["report", "--input", s(&p), "--out-dir", "r"]);
+    assert!(r.status.success(), "{}", stderr(&r));
+    assert!(r.stdout.len() < 100_000, "stdout {} bytes", r.stdout.len());
+    for e in std::fs::read_dir(d.path().join("r")).unwrap() {
+        let e = e.unwrap();
+        let name = e.file_name().to_string_lossy().into_owned();
+        let len = e.metadata().unwrap().len();
+        if name.ends_with(".svg") || name == "report.md" {
+            assert!(len < 400_000, "{name}: {len} bytes");
+        }
+    }
+    // The data keep the label whole.
+    let pts = std::fs::read_to_string(d.path().join("r/points.csv")).unwrap();
+    assert!(pts.contains(&label));
+}
+
+/// `report --keep-going` with a point no contact model can make steady writes the report
+/// without it, as GUIDE says, instead of exiting 2.
+#[test]
+fn keep_going_leaves_out_a_point_no_model_makes_steady() {
+    let d = tmpdir();
+    let mut text = std::fs::read_to_string(crate::common::root().join("data/default.csv")).unwrap();
+    text.push_str("0.8,0.8,60,0.3,0.01,0.3\n");
+    let p = write(d.path(), "kg.csv", &text);
+    let out = fb(d.path(), &["report", "--input", s(&p), "--out-dir", "r"]);
+    crate::common::expect(
+        &out,
+        2,
+        &["line 38", "--keep-going"],
+        "without --keep-going",
+    );
+    let out = fb(
+        d.path(),
+        &["report", "--input", s(&p), "--keep-going", "--out-dir", "r"],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let md = std::fs::read_to_string(d.path().join("r/report.md")).unwrap();
+    assert!(
+        md.contains("line 38 (series '0.8', xi 0.8, delta_deg 60)"),
+        "{md}"
+    );
+}
+
+/// Every flag GUIDE's table for `simulate` documents is one the parser accepts.
+#[test]
+fn guide_documents_only_flags_simulate_takes() {
+    let guide = std::fs::read_to_string(crate::common::root().join("docs/GUIDE.md")).unwrap();
+    let section = guide.split("\n## simulate\n").nth(1).unwrap();
+    let section = section.split("\n## ").next().unwrap();
+    let help =
+        String::from_utf8(bin().args(["simulate", "--help"]).output().unwrap().stdout).unwrap();
+    let mut seen = 0;
+    for line in section.lines().filter(|l| l.starts_with("| `--")) {
+        for flag in line.split('`').filter(|t| t.starts_with("--")) {
+            let name = flag.split([' ', '=']).next().unwrap();
+            assert!(
+                help.contains(&format!("{name} ")),
+                "GUIDE documents {name}: not a flag"
+            );
+            seen += 1;
+        }
+    }
+    assert!(seen > 10, "{seen} flags read from GUIDE");
+}
+
+/// Flags documented to take negative numbers reach their own checks with the project's
+/// message (clap once took `-5` for an unknown flag).
+#[test]
+fn negative_list_values_reach_their_checks() {
+    let d = tmpdir();
+    for args in [
+        vec!["simulate", "--delta-range", "-5,10"],
+        vec!["simulate", "--series", "-1,2"],
+        vec!["simulate", "--model", "jan", "--jan", "-1,4.96,0.0025,7.46"],
+    ] {
+        let out = fb(d.path(), &args);
+        let e = stderr(&out);
+        assert!(!e.contains("unexpected argument"), "{args:?}: {e}");
+        match out.status.code() {
+            // Taken: the range is cut to the steady one.
+            Some(0) => {}
+            Some(2) => assert!(
+                e.starts_with("fitbead: error: <command line>, flag '"),
+                "{args:?}: {e}"
+            ),
+            c => panic!("{args:?}: exit {c:?}: {e}"),
+        }
+    }
+    // A value that is a number list starting with a negative one is accepted where valid.
+    let out = fb(
+        d.path(),
+        &[
+            "simulate",
+            "--model",
+            "jan",
+            "--jan",
+            "0.063,-4.96,0.0025,7.46",
+            "--output",
+            "/dev/null",
+        ],
+    );
+    assert!(
+        !stderr(&out).contains("unexpected argument"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+/// Recipes take a seed up to u64::MAX (as the flag does) and a figure width as a number.
+#[test]
+fn recipes_take_large_seeds_and_numeric_widths() {
+    let d = tmpdir();
+    let data = crate::common::root().join("data/default.csv");
+    let recipe = format!(
+        "input = \"{}\"\nmethod = \"lsq\"\nseed = 18446744073709551615\nfigure_width = 120\n",
+        s(&data)
+    );
+    let r = write(d.path(), "r.toml", &recipe);
+    let out = fb(d.path(), &["report", "--recipe", s(&r), "--out-dir", "out"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let svg = std::fs::read_to_string(d.path().join("out/velocity.svg")).unwrap();
+    assert!(
+        svg.contains("width=\"120mm\""),
+        "{}",
+        &svg[..300.min(svg.len())]
+    );
+    let r = write(d.path(), "bad.toml", "figure_width = 1000\n");
+    let out = fb(
+        d.path(),
+        &["report", "--recipe", s(&r), "--out-dir", "out2"],
+    );
+    crate::common::expect(&out, 2, &["bad.toml, line 1", "figure_width"], "width 1000");
+}
+
+/// A PNG-only report links PNG figures only.
+#[test]
+fn a_png_report_links_no_svg() {
+    let d = tmpdir();
+    let out = fb(d.path(), &["report", "--format", "png", "--out-dir", "r"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let md = std::fs::read_to_string(d.path().join("r/report.md")).unwrap();
+    assert!(!md.contains(".svg"), "report.md links an SVG");
+    for f in ["regime_map.png", "jaeger.png"] {
+        assert!(md.contains(&format!("]({f})")), "{f}");
+        assert!(d.path().join("r").join(f).exists());
+    }
+}
+
+/// `bench --scenes 1` says which checks drew no scene instead of failing them.
+#[test]
+fn bench_with_too_few_scenes_says_so() {
+    let d = tmpdir();
+    let out = fb(
+        d.path(),
+        &["bench", "--scenes", "1", "--output", "/dev/null"],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let e = stderr(&out);
+    assert!(!e.contains("FAILED"), "{e}");
+    assert!(!e.contains("NaN"), "{e}");
+    assert!(e.contains("no scenes: none of the 1 drawn"), "{e}");
+}
+
+/// A design file whose series mixes ξ values is refused by `simulate --design`.
+#[test]
+fn a_design_mixing_xi_in_a_series_is_refused() {
+    let d = tmpdir();
+    let p = write(
+        d.path(),
+        "des.csv",
+        "series,xi,delta_deg,replicates\n1,1,10,2\n1,1.5,12,2\n",
+    );
+    let out = fb(
+        d.path(),
+        &["simulate", "--design", s(&p), "--output", "o.csv"],
+    );
+    crate::common::expect(
+        &out,
+        2,
+        &["line 3", "column 'xi'", "mixes xi values"],
+        "design",
+    );
+    assert!(!d.path().join("o.csv").exists());
+}
+
+/// Small messages: a NUL byte shown as `\0`, law `C=0.5` in any case.
+#[test]
+fn values_echoed_visibly_and_laws_in_any_case() {
+    let d = tmpdir();
+    let p = write(
+        d.path(),
+        "nul.csv",
+        "series,xi,delta_deg,v,sigma_v\n1,1,10,0.38\0x,0.01\n",
+    );
+    let out = fb(d.path(), &["klaw", "--model", "stick", s(&p)]);
+    crate::common::expect(&out, 2, &["value '0.38\\0x'"], "nul");
+    assert!(!stderr(&out).contains('\0'));
+    let a = fb_ok(d.path(), &["simulate", "--law", "C=0.5", "--output", "-"]);
+    let b = fb_ok(d.path(), &["simulate", "--law", "c=0.5", "--output", "-"]);
+    assert_eq!(a, b);
+}
+
+/// An existing file the user may not write is not replaced, even in a directory anyone may
+/// write. As root the command runs as `nobody` (root may write any file).
+#[test]
+fn a_file_the_user_may_not_write_is_not_replaced() {
+    let d = tmpdir();
+    let p = d.path();
+    let data = crate::common::root().join("data/default.csv");
+    std::fs::copy(&data, p.join("in.csv")).unwrap();
+    std::fs::write(p.join("ro.csv"), "precious\n").unwrap();
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::set_permissions(p.join("ro.csv"), std::fs::Permissions::from_mode(0o444)).unwrap();
+    std::fs::set_permissions(p, std::fs::Permissions::from_mode(0o1777)).unwrap();
+    std::fs::set_permissions(p.join("in.csv"), std::fs::Permissions::from_mode(0o644)).unwrap();
+    let root = Command::new("id").arg("-u").output().unwrap().stdout == b"0\n";
+    let args = [
+        "klaw",
+        "--model",
+        "stickslip",
+        "in.csv",
+        "--output",
+        "ro.csv",
+    ];
+    let out = if root {
+        let mut c = Command::new("setpriv");
+        c.args(["--reuid=nobody", "--regid=nogroup", "--clear-groups"])
+            .arg(env!("CARGO_BIN_EXE_fitbead"));
+        c.args(args).current_dir(p).output().unwrap()
+    } else {
+        fb(p, &args)
+    };
+    crate::common::expect(&out, 2, &["may not write it"], "read-only target");
+    assert_eq!(
+        std::fs::read_to_string(p.join("ro.csv")).unwrap(),
+        "precious\n"
+    );
+    assert!(crate::common::leftovers(p).is_empty());
 }

@@ -1,16 +1,17 @@
 //! What every bead fit reports: one row per parameter (value, standard error, confidence
 //! interval and how it was obtained) and one row of fit statistics, and their CSV forms.
 //!
-//! The interval in `ci_low`/`ci_high` is the profile-likelihood one when both of its ends were
-//! determined (`ci_method = profile`): an end is where Δχ² reaches its threshold (`found`), the
-//! bound of the parameter's box (`bound`: no value beyond is admissible), or the edge of the
-//! region where the constrained fits converge (`edge`: their optimum lies against the edge of
-//! the model's feasible region, or the warm start left it), where Δχ² is still below its
-//! threshold, so that the interval reaches at least that far; the note says so. An end the
-//! profile search could not close (`not_found`) leaves the covariance (Wald) interval in the
-//! cells (`ci_method = covariance`), widened to hold the other end where the profile found it,
-//! with the profile's state in the extra columns and the note; with neither, the cells are
-//! empty and `ci_method = none`.
+//! The interval in `ci_low`/`ci_high` is the profile-likelihood one where the profile closed
+//! both of its ends (`ci_method = profile`): an end is where Δχ² reaches its threshold
+//! (`found`) or the bound of the parameter's box (`bound`: no value beyond is admissible). An
+//! end marked `edge` is where the constrained fits stop converging inside the feasible region
+//! (their optimum lies against the region's edge, or the warm start left it) with Δχ² still
+//! below its threshold: the interval reaches at least that far, and the reported end is the
+//! farther of the edge and the covariance (Wald) interval's end on that side. An end the
+//! search could not close (`not_found`) is the covariance interval's. Wherever an end is the
+//! covariance interval's, `ci_method = covariance`; an end the profile found is kept either
+//! way, so the interval holds every profile end found. The profile's state is in the extra
+//! columns and the note; with neither interval the cells are empty and `ci_method = none`.
 
 use crate::inverse::mcmc::ParameterDiagnostics;
 pub use crate::inverse::posterior::Draws;
@@ -87,29 +88,41 @@ impl PowerScaling {
 }
 
 impl ParamRow {
-    /// The reported interval and its method: profile when both ends were determined (found,
-    /// bound or edge), else covariance widened to hold the profile end that was determined,
-    /// else none (module docs).
+    /// The reported interval and its method (module docs): per end, the profile's (found, or
+    /// the box's bound); at an `edge`, the farther of the edge and the covariance end; where
+    /// the profile could not close the end, the covariance end. `profile` when neither end is
+    /// the covariance interval's, else `covariance`; `none` without either.
     pub fn interval(&self) -> (Option<(f64, f64)>, &'static str) {
         if let Some(d) = &self.posterior {
             return (Some(d.interval), "posterior");
         }
-        let profile = self
-            .profile
-            .map(|(lo, hi)| (closed_end(lo), closed_end(hi)));
-        if let Some((Some(a), Some(b))) = profile {
-            return (Some((a, b)), "profile");
-        }
-        let Some((a, b)) = self.cov else {
-            return (None, "none");
+        let cov = self
+            .cov
+            .map(|(a, b)| (a.max(self.bounds.0), b.min(self.bounds.1)));
+        let Some((lo, hi)) = self.profile else {
+            return match cov {
+                Some(c) => (Some(c), "covariance"),
+                None => (None, "none"),
+            };
         };
-        let (mut a, mut b) = (a.max(self.bounds.0), b.min(self.bounds.1));
-        // An end the profile did determine stays inside the reported interval.
-        if let Some((lo, hi)) = profile {
-            a = lo.map_or(a, |x| a.min(x));
-            b = hi.map_or(b, |x| b.max(x));
+        // One end: its value, and whether it is the profile's.
+        let end = |e: ProfileEnd, c: Option<f64>, lower: bool| -> (Option<f64>, bool) {
+            match (e, c) {
+                (ProfileEnd::Found(v) | ProfileEnd::Bound(v), _) => (Some(v), true),
+                (ProfileEnd::Edge(v), Some(c)) if (lower && c < v) || (!lower && c > v) => {
+                    (Some(c), false)
+                }
+                (ProfileEnd::Edge(v), _) => (Some(v), true),
+                (ProfileEnd::NotFound, c) => (c, false),
+            }
+        };
+        let (a, pa) = end(lo, cov.map(|c| c.0), true);
+        let (b, pb) = end(hi, cov.map(|c| c.1), false);
+        match (a, b) {
+            (Some(a), Some(b)) if pa && pb => (Some((a, b)), "profile"),
+            (Some(a), Some(b)) => (Some((a, b)), "covariance"),
+            _ => (None, "none"),
         }
-        (Some((a, b)), "covariance")
     }
 }
 
@@ -860,12 +873,10 @@ pub(crate) fn information_criteria(r: &[f64], sigma: SigmaKind) -> (f64, f64) {
     }
 }
 
-/// An end that closes the profile interval: Δχ² reached its threshold, the box ends there,
-/// or the constrained fits stop there with Δχ² still below it (the interval reaches at least
-/// that far).
+/// An end that closes the profile interval: Δχ² reached its threshold, or the box ends there.
 fn closed_end(e: ProfileEnd) -> Option<f64> {
     match e {
-        ProfileEnd::Found(v) | ProfileEnd::Bound(v) | ProfileEnd::Edge(v) => Some(v),
-        ProfileEnd::NotFound => None,
+        ProfileEnd::Found(v) | ProfileEnd::Bound(v) => Some(v),
+        _ => None,
     }
 }

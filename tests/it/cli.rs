@@ -235,15 +235,15 @@ fn forward_file_and_stdout_agree_on_many_chunks() {
     );
 }
 
-/// An output that cannot be created (missing directory) is exit 2 "cannot write", reported
-/// only when the input is good: a bad input is reported first.
+/// An output that cannot be created (missing directory) is exit 2, refused before any work:
+/// before the input is read, good or bad.
 #[test]
-fn unwritable_output_is_reported_after_the_input() {
+fn unwritable_output_is_refused_before_the_input_is_read() {
     let d = tmpdir();
     let good = write(&d, "good.csv", "xi,delta_deg\n1,12\n");
     let bad = write(&d, "bad.csv", "xi,delta_deg\n1,12\n1,abc\n");
     let outp = d.path().join("missing").join("o.csv");
-    for (inp, want) in [(&good, "cannot write"), (&bad, "'abc'")] {
+    for (inp, want) in [(&good, "cannot be created"), (&bad, "cannot be created")] {
         let o = bin()
             .args(["forward", "--model", "stick", "--input"])
             .arg(inp)

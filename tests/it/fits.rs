@@ -349,16 +349,11 @@ fn jaeger_coverage_over_200_replicates() {
             }
         }
     }
-    // Known shortfall, measured: at ξ = 2 (a1 = 0.042 far below the slopes sampled) a1's
-    // interval covers the truth in 85.5 % of the replicates, 15 of them without any interval
-    // (rank-deficient Jacobian and a profile end that the constrained fits cannot reach).
-    // Every other parameter must be in the band; if a1 at ξ = 2 enters it, this list shrinks.
-    for (xi, k, rate) in &outside {
-        assert!(
-            *xi == 2.0 && *k == 1,
-            "jaeger ξ = {xi} a{k}: coverage {rate} outside {COVERAGE_BAND:?}"
-        );
-        // The known shortfall must not grow: 85.5 % measured, floor 80 %.
-        assert!(*rate >= 0.80, "jaeger ξ = 2 a1: coverage {rate} below 0.80");
-    }
+    // Every parameter in the band: at ξ = 2 a1 (0.042, far below the slopes sampled) once
+    // covered 85.5 %, when an edge end on one side of its profile dropped the other end too;
+    // with each end decided on its own it covers 92.5 % (docs/ACCURACY.md).
+    assert!(
+        outside.is_empty(),
+        "coverage outside {COVERAGE_BAND:?}: {outside:?}"
+    );
 }

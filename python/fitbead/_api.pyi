@@ -20,6 +20,10 @@ class UnitWarning(FitbeadWarning):
     """The data look like a unit mistake: slopes in radians, velocities in m/s, mm/s or cm/s
     in the dimensionless column, radii in millimetres, or a reduced χ² far above 1 with σ
     given."""
+class MisfitWarning(FitbeadWarning):
+    """A fit with σ given does not describe the data within their σ: the χ² tail probability
+    P(χ²_dof ≥ χ²) is below 0.001, so its intervals, which assume the model holds, are too
+    narrow."""
 class ConvergenceWarning(FitbeadWarning):
     """A fit stopped without converging (least squares: its termination; MCMC: R̂ or ESS
     short of the target, or the run cut short)."""

@@ -1088,7 +1088,7 @@ impl PyFitResult {
     /// Fit statistics, keyed by the columns of the statistics report (stats.csv): the same
     /// record the command line writes; an empty cell is None.
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        record_dict(py, &StatsRecord::from(&self.inner.stats))
+        record_dict(py, &StatsRecord::from(&self.inner.stats.with_misfit_note()))
     }
 
     /// One dict per fitted point, keyed by the columns of residuals.csv (the command line's

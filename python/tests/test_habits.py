@@ -4,6 +4,7 @@ the command line's warnings as Python warnings, covariance, residuals, evaluatio
 fitted model and its band, fit sets to pandas, and the pointwise log likelihood."""
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -268,3 +269,19 @@ def test_prior_sensitivity_reaches_the_parameters(data):
     assert a2.prior_sensitivity >= 0.05 and a2.prior_diagnosis in ("prior-driven", "prior-data conflict")
     p = set_.to_pandas()
     assert p["prior_sensitivity"].dtype == np.float64 and (p["prior_sensitivity"] >= 0).all()
+
+
+def test_a_misfit_is_a_misfit_warning():
+    """The shipped data (stick/slip) under the rolling model: χ² 129.4 on 35 degrees of freedom,
+    tail probability about 1e-12 < 0.001, so the fit warns as the command line does, naming
+    the probability; the stick/slip fit of the same data (p about 0.45) does not."""
+    d = fitbead.Dataset.default()
+    with pytest.warns(fitbead.MisfitWarning, match="chi2 tail probability") as rec:
+        fit = fitbead.fit_klaw(d, model="stick", law="c")
+    assert not any(issubclass(w.category, fitbead.UnitWarning) for w in rec)
+    assert issubclass(fitbead.MisfitWarning, fitbead.FitbeadWarning)
+    assert fit._core.chi2_p_value() < 1e-3
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", fitbead.MisfitWarning)
+        ok = fitbead.fit_klaw(d, model="stickslip", law="c")
+    assert ok._core.chi2_p_value() > 1e-3

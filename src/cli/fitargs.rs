@@ -429,16 +429,10 @@ pub fn flag_absurd(stats: &[StatsRow]) -> Vec<StatsRow> {
     stats
         .iter()
         .map(|s| {
-            let mut s = s.clone();
             if let Some(w) = s.misfit_warning() {
                 eprintln!("fitbead: warning: {} [{}]: {w}", s.fit, s.series);
-                s.note = if s.note.is_empty() {
-                    w
-                } else {
-                    format!("{}; {w}", s.note)
-                };
             }
-            s
+            s.with_misfit_note()
         })
         .collect()
 }

@@ -194,7 +194,7 @@ impl StatsRow {
 
     /// Why this fit's misfit should make the user doubt its intervals, if it should: the
     /// implausible misfit of [`StatsRow::absurd_misfit`] (a unit mistake), else a χ² tail
-    /// probability below [`MISFIT_P_VALUE`] with σ given (the model does not describe the data
+    /// probability below 0.001 with σ given (the model does not describe the data
     /// within their σ, and every interval assumes it does). A law whose χ² is infinite
     /// because some points have no steady state under it (termination `infeasible`) is not
     /// flagged again: its note says so.
@@ -223,6 +223,20 @@ impl StatsRow {
                 fmt_f64(MISFIT_P_VALUE)
             )
         })
+    }
+
+    /// This row with [`StatsRow::misfit_warning`] appended to its note, as every report of
+    /// it (the command line's stats.csv, the report, Python) shows it.
+    pub fn with_misfit_note(&self) -> StatsRow {
+        let mut s = self.clone();
+        if let Some(w) = s.misfit_warning() {
+            s.note = if s.note.is_empty() {
+                w
+            } else {
+                format!("{}; {w}", s.note)
+            };
+        }
+        s
     }
 
     /// Why this fit's misfit is implausible for the σ given, if it is: reduced χ² above

@@ -1489,6 +1489,26 @@ impl Bookkeeping {
     }
 }
 
+/// Brings the centre's x back into its row bead's cell [0, `s`) after a step, moving `cell`
+/// along. A step that carried the bead past more than a row bead (or out of the numbers) is
+/// beyond the integration: `false`, and the run ends there instead of walking the cells one
+/// by one.
+#[inline]
+fn advance_cell(pos: &mut Vector2<f64>, cell: &mut i64, s: f64) -> bool {
+    if !(pos.x.abs() < 2.0 * s && pos.y.is_finite()) {
+        return false;
+    }
+    while pos.x >= s {
+        pos.x -= s;
+        *cell += 1;
+    }
+    while pos.x < 0.0 {
+        pos.x += s;
+        *cell -= 1;
+    }
+    true
+}
+
 /// Integrates an md run by velocity Verlet from the launch until the bead has crossed the
 /// last row bead of the window, is trapped (regime A, recorded in `res`), runs past the
 /// time limit or sees the stop flag (recorded in `res.failure`).
@@ -1545,19 +1565,9 @@ fn integrate(
         let h = v + e.a * (0.5 * dt);
         let hw = w + 0.5 * dt * e.aw;
         pos += h * dt;
-        // A step that carries the bead past more than a row bead (or out of the numbers) is
-        // beyond the integration: the run ends there instead of walking the cells one by one.
-        if !(pos.x.abs() < 2.0 * s && pos.y.is_finite()) {
+        if !advance_cell(&mut pos, &mut cell, s) {
             res.failure = Some(MdFailure::StepTooLong);
             break;
-        }
-        while pos.x >= s {
-            pos.x -= s;
-            cell += 1;
-        }
-        while pos.x < 0.0 {
-            pos.x += s;
-            cell -= 1;
         }
         let pv = h + e.a * (0.5 * dt);
         let pw = hw + 0.5 * dt * e.aw;

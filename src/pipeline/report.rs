@@ -160,34 +160,8 @@ pub fn report(
     }
     let never = Arc::new(AtomicBool::new(false));
     let stop = s.stop.clone().unwrap_or(never);
-    // A point that no contact model of the report can make steady is an error, as in klaw.
-    // Per contact model, the points it cannot make steady at any K (`klaw`'s input check);
-    // a point in every model's list is steady under none of them.
-    let unsteady: Vec<Vec<(usize, String)>> = CONTACT_MODELS
-        .iter()
-        .map(|m| unsteady_points(std::slice::from_ref(m), ds, Some(&stop)))
-        .collect();
-    if s.stopped() {
-        return Err(RunError::Interrupted);
-    }
-    // With --keep-going such points are left out of every contact model's fits, and listed
-    // below with each model's.
-    if !s.keep_going {
-        refuse_unsteady_under_all(&unsteady, t, ds)?;
-    }
+    let mut input_warnings = unsteady_checks(s, t, ds, &stop)?;
     let implausible = crate::io::measurements::plausibility(t, rows);
-    let mut input_warnings = Vec::new();
-    for (u, name) in unsteady.iter().zip(CONTACT_NAMES) {
-        if let Some((i, why)) = u.first() {
-            input_warnings.push(format!(
-                "{}: {why} (and {} more such point(s)); no K of the {name} model makes this \
-                 point steady (the {name} fits leave such points out)",
-                locate_point(t, ds, *i),
-                u.len() - 1
-            ));
-        }
-    }
-    refuse_unless_keep_going(s.keep_going, &input_warnings)?;
     let mut an = analyse(ds, s.level, &s.method);
     an.print_width_mm = figure_width.map(FigureWidth::mm);
     let law_failures = law_failures(&an, t, ds);
@@ -328,6 +302,41 @@ fn figure_settings(s: &ReportSettings) -> Result<(FigureFormat, Option<FigureWid
     Ok((format, figure_width))
 }
 
+/// The input checks of the fit commands, per contact model: the points it cannot make steady
+/// at any K (`klaw`'s input check), as warnings; a point steady under no contact model is an
+/// error, as in klaw, and so is any warning, unless `--keep-going` (the fits then leave such
+/// points out).
+fn unsteady_checks(
+    s: &ReportSettings,
+    t: &Table,
+    ds: &Dataset,
+    stop: &Arc<AtomicBool>,
+) -> Result<Vec<String>, RunError> {
+    let unsteady: Vec<Vec<(usize, String)>> = CONTACT_MODELS
+        .iter()
+        .map(|m| unsteady_points(std::slice::from_ref(m), ds, Some(stop)))
+        .collect();
+    if s.stopped() {
+        return Err(RunError::Interrupted);
+    }
+    if !s.keep_going {
+        refuse_unsteady_under_all(&unsteady, t, ds)?;
+    }
+    let mut input_warnings = Vec::new();
+    for (u, name) in unsteady.iter().zip(CONTACT_NAMES) {
+        if let Some((i, why)) = u.first() {
+            input_warnings.push(format!(
+                "{}: {why} (and {} more such point(s)); no K of the {name} model makes this \
+                 point steady (the {name} fits leave such points out)",
+                locate_point(t, ds, *i),
+                u.len() - 1
+            ));
+        }
+    }
+    refuse_unless_keep_going(s.keep_going, &input_warnings)?;
+    Ok(input_warnings)
+}
+
 /// An error naming the first point steady under none of the contact models (`unsteady`:
 /// per model, the points it cannot make steady, with why).
 fn refuse_unsteady_under_all(
@@ -393,16 +402,11 @@ fn analysis_tables(an: &Analysis) -> Result<Vec<(String, Vec<u8>)>, RunError> {
 fn flag_absurd_misfits(stats: Vec<StatsRow>, warnings: &mut Vec<String>) -> Vec<StatsRow> {
     stats
         .into_iter()
-        .map(|mut s| {
+        .map(|s| {
             if let Some(w) = s.misfit_warning() {
                 warnings.push(format!("{} [{}]: {w}", s.fit, s.series));
-                s.note = if s.note.is_empty() {
-                    w
-                } else {
-                    format!("{}; {w}", s.note)
-                };
             }
-            s
+            s.with_misfit_note()
         })
         .collect()
 }

@@ -44,7 +44,7 @@ pub struct SimulateSettings {
     /// Points per series (`--points`).
     pub points: usize,
     /// Relative noise (`--noise`): v = v_true (1 + noise · z), σ = noise · v_true, with z
-    /// standard normal truncated to v > 0 ([`noisy`]).
+    /// standard normal truncated to v > 0 (drawn again until the velocity is positive).
     pub noise: f64,
     /// Seed of the random stream (`--seed`).
     pub seed: u64,

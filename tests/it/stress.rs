@@ -1156,7 +1156,10 @@ fn a_file_the_user_may_not_write_is_not_replaced() {
     let out = if root {
         let mut c = Command::new("setpriv");
         c.args(["--reuid=nobody", "--regid=nogroup", "--clear-groups"])
-            .arg(env!("CARGO_BIN_EXE_fitbead"));
+            .arg(
+                std::env::var_os("FITBEAD_BIN")
+                    .unwrap_or_else(|| env!("CARGO_BIN_EXE_fitbead").into()),
+            );
         c.args(args).current_dir(p).output().unwrap()
     } else {
         fb(p, &args)

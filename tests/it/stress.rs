@@ -576,63 +576,51 @@ fn an_absolute_noise_design_does_not_depend_on_sigma() {
     assert!((ratio / 1e-158 - 1.0).abs() < 1e-2, "{ratio:e}");
 }
 
+/// The shipped data with the cell of `column` (0-based) on file line 3 set to `value`,
+/// written to `name` in `dir`.
+fn default_with(dir: &Path, name: &str, column: usize, value: &str) -> std::path::PathBuf {
+    let text = std::fs::read_to_string(crate::common::root().join("data/default.csv")).unwrap();
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let mut cells: Vec<String> = lines[2].split(',').map(String::from).collect();
+    cells[column] = value.into();
+    lines[2] = cells.join(",");
+    write(dir, name, &(lines.join("\n") + "\n"))
+}
+
 /// σ finer than the rounding of the velocity is refused, naming the cell (so is a velocity of
 /// 1e200 beside σ = 0.006, which once fitted to χ² = ∞ with no word); a velocity of 1e10 is
 /// named an implausible misfit.
 #[test]
 fn sigma_below_rounding_is_refused_and_an_absurd_velocity_warned() {
     let d = tmpdir();
-    let text = std::fs::read_to_string(crate::common::root().join("data/default.csv")).unwrap();
-    let mut lines: Vec<String> = text.lines().map(String::from).collect();
-    let mut cells: Vec<String> = lines[2].split(',').map(String::from).collect();
-    cells[4] = "1e-300".into();
-    lines[2] = cells.join(",");
-    let p = write(d.path(), "tiny.csv", &(lines.join("\n") + "\n"));
-    let out = fb(d.path(), &["klaw", "--model", "stickslip", s(&p)]);
+    let klaw = |p: &Path| {
+        fb(
+            d.path(),
+            &[
+                "klaw",
+                "--model",
+                "stickslip",
+                s(p),
+                "--output",
+                "/dev/null",
+            ],
+        )
+    };
+    let out = klaw(&default_with(d.path(), "tiny.csv", 4, "1e-300"));
     crate::common::expect(
         &out,
         2,
         &["line 3", "column 'sigma_v'", "value '1e-300'"],
         "tiny sigma",
     );
-    let mut lines: Vec<String> = text.lines().map(String::from).collect();
-    let mut cells: Vec<String> = lines[2].split(',').map(String::from).collect();
-    cells[3] = "1e200".into();
-    lines[2] = cells.join(",");
-    let p = write(d.path(), "huge.csv", &(lines.join("\n") + "\n"));
-    let out = fb(
-        d.path(),
-        &[
-            "klaw",
-            "--model",
-            "stickslip",
-            s(&p),
-            "--output",
-            "/dev/null",
-        ],
-    );
+    let out = klaw(&default_with(d.path(), "huge.csv", 3, "1e200"));
     crate::common::expect(
         &out,
         2,
         &["line 3", "column 'sigma_v'", "(1e200)"],
         "v 1e200",
     );
-    let mut lines: Vec<String> = text.lines().map(String::from).collect();
-    let mut cells: Vec<String> = lines[2].split(',').map(String::from).collect();
-    cells[3] = "1e10".into();
-    lines[2] = cells.join(",");
-    let p = write(d.path(), "big.csv", &(lines.join("\n") + "\n"));
-    let out = fb(
-        d.path(),
-        &[
-            "klaw",
-            "--model",
-            "stickslip",
-            s(&p),
-            "--output",
-            "/dev/null",
-        ],
-    );
+    let out = klaw(&default_with(d.path(), "big.csv", 3, "1e10"));
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(
         stderr(&out).contains("warning: klaw-c [all]: reduced chi2 ="),

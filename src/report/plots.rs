@@ -66,12 +66,16 @@ impl Analysis {
         f.to_svg()
     }
 
-    /// "ξ = 0.8" for a series whose label is its ξ, else "series L (ξ = …)".
+    /// "ξ = 0.8" for a series whose label is its ξ, else "series L (ξ = …)", a label over 24
+    /// characters cut to its first 23 and `…` so that the title fits its panel.
     fn series_title(&self, s: usize) -> String {
         let label = &self.data.labels[s];
         let xi = self.data.series(s).next().map_or(f64::NAN, |p| p.scene.xi);
         if label.parse::<f64>().ok() == Some(xi) {
             format!("ξ = {label}")
+        } else if label.chars().count() > 24 {
+            let short: String = label.chars().take(23).collect();
+            format!("series {short}… (ξ = {})", g4(xi))
         } else {
             format!("series {label} (ξ = {})", g4(xi))
         }

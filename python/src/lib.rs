@@ -1726,15 +1726,7 @@ fn report(
                 .map(|w| format!("{} [{}]: {w}", s.fit, s.series))
         })
         .collect();
-    let misfits: Vec<String> = out
-        .stats
-        .iter()
-        .filter(|s| s.absurd_misfit().is_none())
-        .filter_map(|s| {
-            s.misfit_warning()
-                .map(|w| format!("{} [{}]: {w}", s.fit, s.series))
-        })
-        .collect();
+    let misfits = out.misfits;
     let unconverged: Vec<String> = out
         .warnings
         .iter()

@@ -90,9 +90,12 @@ pub struct ReportOutput {
     pub summary: String,
     /// Every fit's statistics (the rows of stats.csv).
     pub stats: Vec<StatsRow>,
-    /// The warnings of the run: fits whose misfit is implausible for the σ given, posterior
-    /// runs that did not converge.
+    /// The warnings of the run: fits whose misfit is implausible or improbable for the σ
+    /// given, posterior runs that did not converge.
     pub warnings: Vec<String>,
+    /// Of those, the fits whose χ² tail probability is below 0.001 and whose misfit is not
+    /// implausible ([`StatsRow::misfit_warning`]), as `FIT [SERIES]: message`.
+    pub misfits: Vec<String>,
     /// Whether a posterior run was cut short by the stop flag (its files are marked so).
     pub interrupted: bool,
 }
@@ -256,7 +259,7 @@ pub fn report(
             .map(|w| w.to_string())
             .chain(absurd)
             .collect(),
-        misfits,
+        misfits: misfits.clone(),
     };
     let md = report_markdown(&an, &context, s, &not_converged);
     warnings.extend(not_converged);
@@ -275,6 +278,7 @@ pub fn report(
         summary: terminal_summary(&an, &shown_dir),
         stats,
         warnings,
+        misfits,
         interrupted,
     })
 }

@@ -353,8 +353,9 @@ fn misfits_warn_by_their_chi2_tail_probability() {
         assert!(run.rows.iter().all(|r| r.4), "{label} does not warn");
     }
     println!(
-        "{flagged} misfits flagged over {} mismatched pairs",
-        mismatched.len()
+        "{flagged} fit rows flagged over {} mismatched pairs; {} matched pairs, none flagged",
+        mismatched.len(),
+        matched.len()
     );
 }
 

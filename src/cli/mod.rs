@@ -264,7 +264,8 @@ pub(crate) fn run(cli: Cli) -> i32 {
     }
     let files: Vec<(PathBuf, FileState)> = file_outputs(&cli.command)
         .into_iter()
-        .filter(|p| !is_char_device(p))
+        // A character device (/dev/null, a terminal) is never "unwritten".
+        .filter(|p| !crate::io::is_char_device(p))
         .map(|p| {
             let st = file_state(&p);
             (p, st)
@@ -452,20 +453,6 @@ fn file_state(p: &Path) -> FileState {
     #[cfg(not(unix))]
     let ino = 0;
     Some((ino, m.len(), m.modified().ok()))
-}
-
-/// Whether `p` is a character device (`/dev/null`, a terminal): never "unwritten".
-fn is_char_device(p: &Path) -> bool {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        std::fs::metadata(p).is_ok_and(|m| m.file_type().is_char_device())
-    }
-    #[cfg(not(unix))]
-    {
-        let _ = p;
-        false
-    }
 }
 
 /// The output files of a command that are not standard output (`--out-dir` aside): what a

@@ -804,7 +804,7 @@ pub(crate) fn write_atomic_all_then(
 }
 
 /// Whether `p` is a character device (`/dev/null`, a terminal), after following links.
-fn is_char_device(p: &Path) -> bool {
+pub(crate) fn is_char_device(p: &Path) -> bool {
     #[cfg(unix)]
     {
         use std::os::unix::fs::FileTypeExt;

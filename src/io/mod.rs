@@ -19,7 +19,8 @@ pub(crate) mod scenes;
 pub(crate) mod stream;
 
 pub(crate) use atomic::{
-    distinct_paths, remove_stale_temporaries, stream_of, write_atomic, write_atomic_all, AtomicFile,
+    distinct_paths, is_char_device, remove_stale_temporaries, stream_of, write_atomic,
+    write_atomic_all, AtomicFile,
 };
 
 pub(crate) use crate::numfmt::{clip, echo, fmt_f64, fmt_sig, ECHO_CHARS};

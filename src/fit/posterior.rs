@@ -34,8 +34,8 @@
 
 use super::data::Dataset;
 use super::summary::{
-    chi2_vanishes, summarise, FitResult, McmcFailure, McmcStats, ParamRow, ParamSpec, PowerScaling,
-    Solved,
+    chi2_vanishes, join, summarise, FitResult, McmcFailure, McmcStats, ParamRow, ParamSpec,
+    PowerScaling, Solved,
 };
 use crate::inverse::mcmc::sensitivity::sensitivity;
 use crate::inverse::mcmc::{EnsembleSampler, McmcError, McmcOptions, McmcResult, StopReason};
@@ -750,12 +750,4 @@ fn draws_correlation(chains: &[Vec<Vec<f64>>]) -> Option<Vec<Vec<f64>>> {
             })
             .collect(),
     )
-}
-
-fn join(a: &str, b: &str) -> String {
-    match (a.is_empty(), b.is_empty()) {
-        (true, _) => b.to_string(),
-        (_, true) => a.to_string(),
-        _ => format!("{a}; {b}"),
-    }
 }

@@ -230,11 +230,7 @@ impl StatsRow {
     pub fn with_misfit_note(&self) -> StatsRow {
         let mut s = self.clone();
         if let Some(w) = s.misfit_warning() {
-            s.note = if s.note.is_empty() {
-                w
-            } else {
-                format!("{}; {w}", s.note)
-            };
+            s.note = join(&s.note, &w);
         }
         s
     }
@@ -892,5 +888,14 @@ fn closed_end(e: ProfileEnd) -> Option<f64> {
     match e {
         ProfileEnd::Found(v) | ProfileEnd::Bound(v) => Some(v),
         _ => None,
+    }
+}
+
+/// Two notes as one, `a; b` (either alone where the other is empty).
+pub(crate) fn join(a: &str, b: &str) -> String {
+    match (a.is_empty(), b.is_empty()) {
+        (true, _) => b.to_string(),
+        (_, true) => a.to_string(),
+        _ => format!("{a}; {b}"),
     }
 }

@@ -208,7 +208,7 @@ fn writable(p: &Path) -> std::io::Result<()> {
 /// Refuses an output path (named by `flag`) whose directory does not exist or is not a
 /// directory, or that is an existing file this user may not write ([`writable`]): the run
 /// would fail only when it writes, after all its work.
-fn ready_directory(flag: &str, p: &Path) -> Result<(), InputError> {
+fn ready_output(flag: &str, p: &Path) -> Result<(), InputError> {
     if let Ok(Target::Regular(target, _)) = resolve(p) {
         if let Err(e) = writable(&target) {
             return Err(setting_error(
@@ -841,7 +841,7 @@ pub fn distinct_paths(
             ));
         }
         if stream.is_none() {
-            ready_directory(flag, p)?;
+            ready_output(flag, p)?;
         }
         for (iflag, q) in inputs.iter().filter_map(|(n, q)| q.map(|q| (*n, q))) {
             // `-` is standard input: the same file as the output when it is redirected from it.

@@ -1083,41 +1083,30 @@ impl Md {
     /// The setting that, put back to its value in [`Md::default`], lowers
     /// [`Md::step_bound`] most, with its value here.
     fn costliest_setting(&self, scene: &Scene) -> (MdSetting, f64) {
-        let (d, p, c) = (Md::default(), &self.params, &self.config);
         let candidates = [
-            (MdSetting::Young, p.young),
-            (MdSetting::Density, p.density),
-            (MdSetting::RowRadius, p.row_radius),
-            (MdSetting::Gravity, p.g),
-            (MdSetting::Poisson, p.poisson),
-            (MdSetting::Beta, p.beta),
-            (MdSetting::StepFraction, c.step_fraction),
-            (MdSetting::Beads, c.beads as f64),
+            MdSetting::Young,
+            MdSetting::Density,
+            MdSetting::RowRadius,
+            MdSetting::Gravity,
+            MdSetting::Poisson,
+            MdSetting::Beta,
+            MdSetting::StepFraction,
+            MdSetting::Beads,
         ];
         let bound_without = |s: MdSetting| {
-            let mut m = *self;
-            match s {
-                MdSetting::Young => m.params.young = d.params.young,
-                MdSetting::Density => m.params.density = d.params.density,
-                MdSetting::RowRadius => m.params.row_radius = d.params.row_radius,
-                MdSetting::Gravity => m.params.g = d.params.g,
-                MdSetting::Poisson => m.params.poisson = d.params.poisson,
-                MdSetting::Beta => m.params.beta = d.params.beta,
-                MdSetting::StepFraction => m.config.step_fraction = d.config.step_fraction,
-                _ => m.config.beads = d.config.beads,
-            }
-            let b = m.step_bound(scene);
+            let b = self.with_default(s).step_bound(scene);
             if b.is_nan() {
                 f64::INFINITY
             } else {
                 b
             }
         };
-        candidates
+        let s = candidates
             .into_iter()
-            .map(|(s, x)| (bound_without(s), s, x))
+            .map(|s| (bound_without(s), s))
             .min_by(|a, b| a.0.total_cmp(&b.0))
-            .map_or((MdSetting::Young, p.young), |(_, s, x)| (s, x))
+            .map_or(MdSetting::Young, |(_, s)| s);
+        (s, self.value_of(s))
     }
 
     /// Simulates one scene (ξ, δ, ρ; K and f of the scene are not used). `dt_scale`

@@ -111,3 +111,40 @@ pub fn signal(child: &Child, sig: &str) {
         .unwrap();
     assert!(ok.success());
 }
+
+/// Starts `args` in `dir`, sends `sig` after `after`, and returns the exit status and how
+/// long the command took to stop after the signal (panics if it has not ended 30 s after).
+pub fn interrupt(
+    dir: &Path,
+    args: &[&str],
+    sig: &str,
+    after: std::time::Duration,
+) -> (std::process::ExitStatus, std::time::Duration) {
+    use std::process::Stdio;
+    use std::time::{Duration, Instant};
+    let mut child = bin()
+        .args(args)
+        .current_dir(dir)
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(after);
+    assert!(
+        child.try_wait().unwrap().is_none(),
+        "{args:?} ended before the signal"
+    );
+    signal(&child, sig);
+    let t0 = Instant::now();
+    loop {
+        if let Some(st) = child.try_wait().unwrap() {
+            return (st, t0.elapsed());
+        }
+        if t0.elapsed() > Duration::from_secs(30) {
+            let _ = child.kill();
+            panic!("{args:?} still running 30 s after {sig}");
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}

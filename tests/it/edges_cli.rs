@@ -2,9 +2,9 @@
 //! ever, values echoed as the user wrote them, outputs that may coincide, and files as people
 //! write them (misspelt, differently cased or differently separated columns).
 
-use crate::common::{bin, expect, s, signal, stderr, tmpdir, write};
+use crate::common::{bin, expect, interrupt, s, stderr, tmpdir, write};
 use std::path::Path;
-use std::process::{ExitStatus, Output, Stdio};
+use std::process::{Output, Stdio};
 use std::time::{Duration, Instant};
 
 /// Runs fitbead with `args`, killed after `limit`; the output and whether it ended in time.
@@ -38,36 +38,6 @@ fn fb(args: &[&str]) -> Output {
         "{args:?} did not end in 60 s"
     );
     out
-}
-
-/// Starts `args` in `dir`, sends `sig` after `after`, and returns the exit status and how
-/// long the command took to stop after the signal.
-fn interrupt(dir: &Path, args: &[&str], sig: &str, after: Duration) -> (ExitStatus, Duration) {
-    let mut child = bin()
-        .args(args)
-        .current_dir(dir)
-        .stdin(Stdio::null())
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    std::thread::sleep(after);
-    assert!(
-        child.try_wait().unwrap().is_none(),
-        "{args:?} ended before the signal"
-    );
-    signal(&child, sig);
-    let t0 = Instant::now();
-    loop {
-        if let Some(st) = child.try_wait().unwrap() {
-            return (st, t0.elapsed());
-        }
-        if t0.elapsed() > Duration::from_secs(60) {
-            let _ = child.kill();
-            panic!("{args:?} still running 60 s after {sig}");
-        }
-        std::thread::sleep(Duration::from_millis(10));
-    }
 }
 
 /// The default data set copied `copies` times, each copy's series renamed apart (4 series

@@ -3,9 +3,9 @@
 //! panic, a hang, a clobbered file or a silent wrong fit. The fuzz harness that looks for the
 //! next such fault is the ignored test [`fuzz_mutated_inputs`] (docs/GUIDE.md, "Exit codes").
 
-use crate::common::{bin, col, expect, leftovers, s, signal, stderr, table, tmpdir, write};
-use std::path::{Path, PathBuf};
-use std::process::{Command, ExitStatus, Output, Stdio};
+use crate::common::{bin, col, expect, interrupt, leftovers, s, stderr, table, tmpdir, write};
+use std::path::PathBuf;
+use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 /// Runs `cmd` to its end or until `limit`, then kills it; the output and whether it ended in
@@ -175,36 +175,6 @@ fn huge_counts_are_refused_before_any_work() {
 }
 
 // Signals.
-
-/// Starts `args` in `dir`, sends `sig` after `after`, and returns the exit status and how
-/// long the command took to stop after the signal.
-fn interrupt(dir: &Path, args: &[&str], sig: &str, after: Duration) -> (ExitStatus, Duration) {
-    let mut child = bin()
-        .args(args)
-        .current_dir(dir)
-        .stdin(Stdio::null())
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    std::thread::sleep(after);
-    assert!(
-        child.try_wait().unwrap().is_none(),
-        "{args:?} ended before the signal"
-    );
-    signal(&child, sig);
-    let t0 = Instant::now();
-    loop {
-        if let Some(st) = child.try_wait().unwrap() {
-            return (st, t0.elapsed());
-        }
-        if t0.elapsed() > Duration::from_secs(30) {
-            let _ = child.kill();
-            panic!("{args:?} still running 30 s after {sig}");
-        }
-        std::thread::sleep(Duration::from_millis(10));
-    }
-}
 
 /// Every long command stops soon after SIGINT or SIGTERM with exit 130, leaves an existing
 /// output untouched and no temporary file.

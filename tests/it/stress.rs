@@ -785,36 +785,24 @@ fn a_broken_stdout_names_the_files_left_unwritten() {
 #[test]
 fn design_stops_on_sigterm_without_leftovers() {
     let d = tmpdir();
-    let mut child = bin()
-        .args([
-            "design",
-            "--fit",
-            "klaw",
-            "--model",
-            "stickslip",
-            "--prior",
-            "c=normal(0.5,0.1)",
-            "--draws",
-            "10000",
-            "--plot",
-            "p.svg",
-            "--output",
-            "o.csv",
-        ])
-        .current_dir(d.path())
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    std::thread::sleep(Duration::from_millis(400));
-    assert!(
-        child.try_wait().unwrap().is_none(),
-        "design ended before the signal"
-    );
-    crate::common::signal(&child, "-TERM");
-    let t0 = Instant::now();
-    let status = child.wait().unwrap();
-    assert!(t0.elapsed() < Duration::from_secs(1), "{:?}", t0.elapsed());
+    let args = [
+        "design",
+        "--fit",
+        "klaw",
+        "--model",
+        "stickslip",
+        "--prior",
+        "c=normal(0.5,0.1)",
+        "--draws",
+        "10000",
+        "--plot",
+        "p.svg",
+        "--output",
+        "o.csv",
+    ];
+    let (status, took) =
+        crate::common::interrupt(d.path(), &args, "-TERM", Duration::from_millis(400));
+    assert!(took < Duration::from_secs(1), "{took:?}");
     assert_eq!(status.code(), Some(130));
     assert!(crate::common::leftovers(d.path()).is_empty());
     assert!(!d.path().join("p.svg").exists() && !d.path().join("o.csv").exists());
@@ -826,30 +814,17 @@ fn design_stops_on_sigterm_without_leftovers() {
 fn contact_k_stops_within_a_second_of_sigint() {
     let d = tmpdir();
     let p = write(d.path(), "kc.csv", &many_rows(100_000));
-    let mut child = bin()
-        .args([
-            "k",
-            "--model",
-            "contact",
-            "--input",
-            s(&p),
-            "--output",
-            "out.csv",
-        ])
-        .current_dir(d.path())
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    std::thread::sleep(Duration::from_millis(1500));
-    assert!(
-        child.try_wait().unwrap().is_none(),
-        "k ended before the signal"
-    );
-    crate::common::signal(&child, "-INT");
-    let t0 = Instant::now();
-    let status = child.wait().unwrap();
-    let took = t0.elapsed();
+    let args = [
+        "k",
+        "--model",
+        "contact",
+        "--input",
+        s(&p),
+        "--output",
+        "out.csv",
+    ];
+    let (status, took) =
+        crate::common::interrupt(d.path(), &args, "-INT", Duration::from_millis(1500));
     assert!(
         took < Duration::from_secs(1),
         "stopped {took:?} after SIGINT"

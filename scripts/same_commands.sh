@@ -119,7 +119,7 @@ done
 # Its summary on stderr quotes timings, and the cheapest method they pick: the words
 # around them must agree.
 for b in old new; do
-  sed -E 's/[0-9]+ ns/N ns/g; s/reference): [^,]+,/reference): M,/' "$work/$b/bench/stderr" >"$work/$b/bench/stderr.cmp"
+  sed -E 's/[0-9]+ ns/N ns/g; s/reference[)]: [^,]+,/reference): M,/' "$work/$b/bench/stderr" >"$work/$b/bench/stderr.cmp"
 done
 for f in rc stdout stderr.cmp b.csv.cmp; do
   if ! cmp -s "$work/old/bench/$f" "$work/new/bench/$f"; then

@@ -8,17 +8,23 @@
 # Usage: scripts/same_commands.sh OLD_BINARY NEW_BINARY [WORKDIR]
 # Prints one line per differing case and a count; exits 1 when any case differs.
 set -u
-old=$(realpath "$1")
-new=$(realpath "$2")
 work=${3:-/tmp/same_commands}
 here=$(cd "$(dirname "$0")/.." && pwd)
 rm -rf "$work"
-mkdir -p "$work/in"
+mkdir -p "$work/in" "$work/bin/old" "$work/bin/new"
+# Both binaries under the same name, which their messages quote.
+cp "$1" "$work/bin/old/fitbead"
+cp "$2" "$work/bin/new/fitbead"
+old=$work/bin/old/fitbead
+new=$work/bin/new/fitbead
 in=$work/in
 cp "$here/data/default.csv" "$in/default.csv"
 "$old" simulate --model stickslip --series 0.8,1,1.6 --points 8 --seed 4 --noise 0.05 \
   >"$in/sim.csv" 2>/dev/null
 "$old" simulate --model stick --series 0.8,1 --points 6 --seed 5 >"$in/nosigma.csv" 2>/dev/null
+# Slip-model data with one point of sim.csv that the slip model cannot make steady.
+"$old" simulate --model slip --series 0.8,1 --points 6 --seed 6 >"$in/slip.csv" 2>/dev/null
+sed -n 18p "$in/sim.csv" >>"$in/slip.csv"
 python3 - "$in" <<'EOF'
 import sys, os
 d = sys.argv[1]
@@ -33,14 +39,17 @@ cases=$(cat <<EOF
 klaw_lsq	klaw --model stickslip $in/sim.csv --output p.csv --output-stats s.csv --plot f.svg
 klaw_lsq_report	klaw --model stick $in/default.csv
 klaw_lsq_png	klaw --model stick --law free-per-series $in/sim.csv --output p.csv --plot f.png
-klaw_impact	klaw --model slip --law impact $in/sim.csv
+klaw_impact	klaw --model stick --law impact $in/sim.csv
+klaw_auto_skip	klaw --model auto --skip-unsteady $in/slip.csv
 klaw_noprofile	klaw --model stick --no-profile --level 0.9 $in/sim.csv --output - --output-stats s.csv
 klaw_auto	klaw --model auto $in/sim.csv --output p.csv --output-stats s.csv
 klaw_auto_tol	klaw --model auto --tol 1e-6 $in/default.csv
 klaw_unsteady	klaw --model slip $in/default.csv
-klaw_skip	klaw --model slip --skip-unsteady $in/default.csv --output p.csv --output-stats s.csv
+klaw_skip	klaw --model slip --skip-unsteady $in/slip.csv --output p.csv --output-stats s.csv --plot f.svg
+klaw_skip_report	klaw --model slip --skip-unsteady --law free-per-series $in/slip.csv
+klaw_skip_empty_box	klaw --model slip --skip-unsteady $in/default.csv
 klaw_skip_free	klaw --model slip --law free-per-series --skip-unsteady $in/default.csv --output p.csv --plot f.svg
-klaw_skip_mcmc	klaw --model slip --skip-unsteady --method mcmc --min-ess 100 --max-steps 2000 $in/default.csv
+klaw_skip_mcmc	klaw --model slip --skip-unsteady --method mcmc --min-ess 100 --max-steps 2000 $in/slip.csv --output p.csv --output-stats s.csv
 klaw_mcmc	klaw --model stick --method mcmc --min-ess 150 --max-steps 3000 --seed 3 $in/sim.csv --output p.csv --output-stats s.csv --draws d.csv --plot c.svg
 klaw_mcmc_report	klaw --model stick --law free-per-series --method mcmc --min-ess 100 --max-steps 2000 --thin 2 --walkers 36 $in/sim.csv
 klaw_mcmc_prior	klaw --model stick --method mcmc --min-ess 100 --max-steps 2000 --prior 'c=normal(0.5,0.1)' --fit-scatter $in/sim.csv --output p.csv --draws -
@@ -61,10 +70,10 @@ jaeger_lower	jaeger --branch lower $in/sim.csv
 jaeger_mcmc	jaeger $in/default.csv --method mcmc --min-ess 100 --max-steps 2000 --output - --draws d.csv
 report_lsq	report $in/sim.csv --out-dir r
 report_default	report --out-dir r
-report_pdf	report $in/default.csv --out-dir r --figures pdf
+report_pdf	report $in/default.csv --out-dir r --format all --figure-width single
 report_mcmc	report $in/sim.csv --out-dir r --method mcmc --min-ess 100 --max-steps 2000
 design_d	design --model stick --law c=0.5 --series 0.8,1.6 --points 5 --output d.csv --plot d.svg
-design_t	design --model stick --vs slip --series 1 --points 4
+design_t	design --model stick --vs slip --criterion t --series 1 --points 4
 simulate	simulate --model contact --series 0.8,1.2 --points 5 --seed 2 --noise 0.03
 regimes	regimes --law c=0.4 --xi 0.5,1,2
 EOF
@@ -92,7 +101,7 @@ while IFS=$'\t' read -r name args; do
   find "$work/old/$name" "$work/new/$name" -name '*.pdf' | while read -r f; do
     LC_ALL=C sort "$f" -o "$f"
   done
-  if ! diff -r -q "$work/old/$name" "$work/new/$name" >/dev/null; then
+  if ! diff -r -q "$work/old/$name" "$work/new/$name" >/dev/null 2>&1; then
     differ=$((differ + 1))
     echo "differs: $name ($args)"
     diff -r -q "$work/old/$name" "$work/new/$name" | sed 's/^/  /'

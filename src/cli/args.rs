@@ -116,21 +116,11 @@ impl PlotArgs {
     /// The figure `svg` as the bytes of the `--plot` file: rendered to PNG or converted to PDF
     /// when the file's name ends .png or .pdf.
     pub fn bytes(&self, svg: String) -> Result<Vec<u8>, super::CliError> {
-        let ext = self
-            .plot
-            .as_deref()
-            .and_then(|p| p.extension())
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase);
-        let format = match ext.as_deref() {
-            Some("png") => crate::report::figures::FigureFormat::Png,
-            Some("pdf") => crate::report::figures::FigureFormat::Pdf,
-            _ => return Ok(svg.into_bytes()),
-        };
-        let out = format
-            .apply(vec![("plot.svg".to_string(), svg.into_bytes())])
-            .map_err(|e| super::CliError::Other(format!("--plot: {e}")))?;
-        Ok(out.into_iter().next().map(|f| f.1).unwrap_or_default())
+        match self.plot.as_deref() {
+            Some(p) => crate::pipeline::figure_bytes(p, svg)
+                .map_err(|e| super::CliError::Other(e.to_string())),
+            None => Ok(svg.into_bytes()),
+        }
     }
 }
 

@@ -3,18 +3,13 @@
 use super::args::{DataArgs, LevelArgs, PlotArgs};
 use super::values::{self, FitMethod, NamedPrior};
 use super::{emit, read_input, CliError};
-use crate::fit::data::Dataset;
 use crate::fit::posterior::{McmcSettings, Method, SCALE_NAME};
-use crate::fit::summary::{FitResult, McmcFailure, ParamRow, StatsRow};
+use crate::fit::summary::StatsRow;
 use crate::inverse::mcmc::McmcOptions;
-use crate::io::measurements::{dataset_of, read_measurements, Measurement};
-use crate::io::reports::{draws_csv, params_csv, stats_csv};
+use crate::io::measurements::{dataset_of, read_measurements, MeasurementFile};
 use crate::io::scenes::Table;
 use crate::io::{fmt_sig, write_atomic_all};
-use crate::report::bands::Curve;
-use crate::report::figures::{corner_svg, CornerBlock};
-use crate::report::file_stems;
-use crate::report::plots::lsq_fit_figure;
+use crate::pipeline::{FitCommand, FitRun, RunError};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
@@ -105,17 +100,6 @@ pub struct FitArgs {
     /// plot of every posterior (marginal histograms and pairwise scatter).
     #[command(flatten)]
     pub plot: PlotArgs,
-}
-
-/// What the least-squares figure of `--plot` draws: its title, the data fitted and the curve
-/// of each fit passed to [`FitArgs::write`] (in the same order).
-pub struct LsqPlot<'a> {
-    /// Title of the figure.
-    pub title: &'a str,
-    /// The data the fits were made on.
-    pub data: &'a crate::fit::data::Dataset,
-    /// One curve per fit.
-    pub curves: &'a [Curve],
 }
 
 /// The estimation method asked for on the command line (a posterior run carries the stop
@@ -218,7 +202,7 @@ impl FitArgs {
     }
 
     /// Reads the measurements.
-    pub fn read(&self) -> Result<(Table, Vec<Measurement>, Dataset), CliError> {
+    pub fn read(&self) -> Result<MeasurementFile, CliError> {
         let input = self.data.path();
         let (source, text) = read_input(input)?;
         let t = Table::parse(&source, &text)?;
@@ -227,74 +211,66 @@ impl FitArgs {
         let rows = read_measurements(&t, &defaults)?;
         let ds = dataset_of(&t, &rows)?;
         super::warn_implausible(&t, &rows);
-        Ok((t, rows, ds))
+        Ok(MeasurementFile {
+            table: t,
+            rows,
+            dataset: ds,
+        })
     }
 
-    /// Writes the reports: the files given are staged and renamed together (a failure leaves
-    /// all of them untouched); the report goes to stdout without `--output`, the statistics to
-    /// stderr as a table without `--output-stats`.
+    /// Runs the fit command `command` on the measurements of the flags with the method and
+    /// level of the flags, then writes what it made ([`FitArgs::write`]). Its notes go to
+    /// stderr as they come; a least-squares fit shows its model evaluations on a terminal once
+    /// it has run for a couple of seconds (a posterior run shows the sampler's steps instead).
+    pub fn fit(&self, command: FitCommand) -> Result<(), CliError> {
+        // The handler goes in before the data are read: a signal while a large file is read
+        // and checked raises the flag (polled from the first bracket on) instead of killing
+        // the process with no exit code.
+        super::stop_flag();
+        let file = self.read()?;
+        let choice = self.method(command.parameters())?;
+        let progress = super::delayed_progress_bar("model evaluations");
+        let name = command.name();
+        let run = command
+            .run(
+                &file,
+                choice.method,
+                self.level.level(),
+                progress,
+                &mut |n| eprintln!("fitbead {name}: {n}"),
+            )
+            .map_err(|e| match e {
+                RunError::Input(e) => CliError::Input(e),
+                RunError::Interrupted => CliError::Interrupted,
+                e => CliError::Other(e.to_string()),
+            })?;
+        self.write(&run)
+    }
+
+    /// Writes what a fit command made: the files given are staged and renamed together (a
+    /// failure leaves all of them untouched); the fit reports go to stdout without
+    /// `--output`, the statistics to stderr as a table without `--output-stats`.
     ///
-    /// `posteriors` are the fits sampled by MCMC: their draws go to `--draws` and their corner
-    /// plots to `--plot`, in the same atomic group. A run stopped by Ctrl-C writes everything
-    /// and then returns [`CliError::Interrupted`].
-    pub fn write(&self, fits: &[&FitResult], plot: &LsqPlot<'_>) -> Result<(), CliError> {
-        let posteriors: Vec<&FitResult> =
-            fits.iter().copied().filter(|f| f.draws.is_some()).collect();
-        let posteriors = posteriors.as_slice();
-        let params: Vec<ParamRow> = fits.iter().flat_map(|f| f.params.iter().cloned()).collect();
-        let stats: Vec<StatsRow> = fits.iter().map(|f| f.stats.clone()).collect();
-        let interrupted = posteriors
-            .iter()
-            .any(|p| p.draws.as_ref().is_some_and(|d| d.interrupted));
-        // Least squares stopped by a signal: nothing is written.
-        if super::stop_requested() && !interrupted {
-            return Err(CliError::Interrupted);
+    /// The draws of the posterior runs go to `--draws` and their corner plots to `--plot`,
+    /// in the same atomic group. A run stopped by Ctrl-C writes everything and then returns
+    /// [`CliError::InterruptedPartial`].
+    pub fn write(&self, run: &FitRun) -> Result<(), CliError> {
+        let interrupted = run.interrupted();
+        for w in run.misfits() {
+            eprintln!("fitbead: warning: {w}");
         }
-        posterior_faults(&stats)?;
-        let stats = &flag_absurd(&stats);
-        let p_csv = params_csv(&params).map_err(|e| CliError::Other(e.to_string()))?;
-        let s = stats_csv(stats).map_err(|e| CliError::Other(e.to_string()))?;
+        let stats = &run.stats();
+        let failed = |e: RunError| CliError::Other(e.to_string());
+        let p_csv = run.params_csv().map_err(failed)?;
+        let s = run.stats_csv().map_err(failed)?;
         let d_csv = match &self.draws {
-            Some(_) => draws_csv(posteriors).map_err(|e| CliError::Other(e.to_string()))?,
+            Some(_) => run.draws_csv().map_err(failed)?,
             None => Vec::new(),
         };
-        // The figure files: under least squares one figure; under MCMC one corner plot per
-        // fit and series, PATH's stem followed by _FIT_SERIES (all stacked in one document
-        // when the figure goes to stdout).
-        let mut figures: Vec<(PathBuf, Vec<u8>)> = Vec::new();
-        if let Some(path) = &self.plot.plot {
-            if posteriors.is_empty() {
-                let with: Vec<(&FitResult, Curve)> = fits
-                    .iter()
-                    .zip(plot.curves)
-                    .map(|(f, c)| (*f, *c))
-                    .collect();
-                let svg = lsq_fit_figure(plot.title, plot.data, &with)
-                    .map_err(|e| CliError::Other(format!("--plot: {e}")))?;
-                figures.push((path.clone(), self.plot.bytes(svg)?));
-            } else if path.as_os_str() == "-" {
-                let svg = corner_svg(&CornerBlock::from_posteriors(posteriors))
-                    .map_err(|e| CliError::Other(format!("corner plot: {e}")))?;
-                figures.push((path.clone(), svg.into_bytes()));
-            } else {
-                let labels: Vec<String> =
-                    posteriors.iter().map(|p| p.stats.series.clone()).collect();
-                let stems = file_stems(&labels);
-                let stem = path.file_stem().map_or_else(
-                    || "corner".to_string(),
-                    |s| s.to_string_lossy().into_owned(),
-                );
-                let ext = path
-                    .extension()
-                    .map_or_else(|| "svg".to_string(), |e| e.to_string_lossy().into_owned());
-                for (p, series) in posteriors.iter().zip(&stems) {
-                    let svg = corner_svg(&CornerBlock::from_posteriors(&[*p]))
-                        .map_err(|e| CliError::Other(format!("corner plot: {e}")))?;
-                    let name = format!("{stem}_{}_{series}.{ext}", p.stats.fit);
-                    figures.push((path.with_file_name(name), self.plot.bytes(svg)?));
-                }
-            }
-        }
+        let figures = match &self.plot.plot {
+            Some(path) => run.figures(path).map_err(failed)?,
+            None => Vec::new(),
+        };
         let files: Vec<(&std::path::Path, &[u8])> = self
             .out
             .output
@@ -336,7 +312,7 @@ impl FitArgs {
         if self.out.to_stdout() {
             emit(None, &p_csv)?;
         } else if self.out.output.is_none() {
-            emit(None, fit_reports(fits, stats).as_bytes())?;
+            emit(None, run.fit_reports().as_bytes())?;
         }
         if interrupted {
             // The posterior runs cut short go to stderr even when the statistics go to a file.
@@ -352,87 +328,11 @@ impl FitArgs {
     }
 }
 
-/// The fit report of every fit, one after another (`stats` are the fits' statistics as
-/// written, with any warning added to their notes).
-fn fit_reports(fits: &[&FitResult], stats: &[StatsRow]) -> String {
-    let mut out = String::new();
-    for (i, f) in fits.iter().enumerate() {
-        if i > 0 {
-            out.push('\n');
-        }
-        match stats.get(i) {
-            Some(s) if *s != f.stats => {
-                let mut g = FitResult {
-                    draws: None,
-                    ..(*f).clone()
-                };
-                g.stats = s.clone();
-                out.push_str(&g.to_string());
-            }
-            _ => out.push_str(&f.to_string()),
-        }
-    }
-    out
-}
-
-/// A prior that leaves nothing to sample (its support misses the parameter's feasible box) is
-/// a bad flag: exit 2 naming the prior, its support and the box, before anything is written.
-pub fn posterior_faults(stats: &[StatsRow]) -> Result<(), CliError> {
-    for s in stats {
-        if let Some(
-            f @ McmcFailure::PriorOutsideBox {
-                parameter, prior, ..
-            },
-        ) = s.mcmc.as_ref().and_then(|m| m.failure.as_ref())
-        {
-            return Err(super::flag_error(
-                "--prior",
-                &format!("{parameter}={prior}"),
-                format!("{} [{}]: {f}", s.fit, s.series),
-            ));
-        }
-    }
-    Ok(())
-}
-
-/// Exit 1 for fits that did not converge, once their outputs are written: a least-squares
-/// fit that stopped short of its tolerance, a posterior run that could not start (its rows
-/// hold the least-squares values, marked) or one that stopped at `--max-steps` before its
-/// R̂ and ESS targets. A law with no free parameter is scored, not fitted: a point it cannot
-/// make steady is said in its note, not in the exit code. The message names each fit, its
-/// series and why.
+/// Exit 1 for fits that did not converge, once their outputs are written, with the message
+/// that names each fit, its series and why ([`crate::pipeline::FitRun::not_converged`]).
 pub fn not_converged(stats: &[StatsRow]) -> Result<(), CliError> {
-    let failed: Vec<String> = stats
-        .iter()
-        .filter_map(|s| {
-            let why = match s.mcmc.as_ref().and_then(|m| m.failure.as_ref()) {
-                Some(f) => {
-                    format!("{f} (its rows hold the least-squares values, marked in their notes)")
-                }
-                // A law with nothing to fit (impact, cos 2α) is scored, not solved.
-                None if !s.converged && s.n_params > 0 => s.note.clone(),
-                None => return None,
-            };
-            Some(format!("{} [{}]: {why}", s.fit, s.series))
-        })
-        .collect();
-    if failed.is_empty() {
-        Ok(())
-    } else {
-        Err(CliError::NotConverged(failed.join("; ")))
+    match crate::pipeline::not_converged(stats) {
+        Some(m) => Err(CliError::NotConverged(m)),
+        None => Ok(()),
     }
-}
-
-/// `stats` with every fit whose misfit is absurd or improbable for the σ given flagged in its
-/// note and on stderr ([`StatsRow::misfit_warning`]).
-pub fn flag_absurd(stats: &[StatsRow]) -> Vec<StatsRow> {
-    stats
-        .iter()
-        .map(|s| {
-            if let Some(w) = s.misfit_warning() {
-                eprintln!("fitbead: warning: {} [{}]: {w}", s.fit, s.series);
-            }
-            s.with_misfit_note()
-        })
-        .collect()
 }

@@ -14,7 +14,6 @@ mod report;
 mod simulate;
 mod values;
 
-use crate::fit::posterior::Method;
 use crate::io::{clip, distinct_paths, write_atomic, InputError, ECHO_CHARS};
 use crate::progress::{Progress, ProgressEvent};
 use clap::{Parser, Subcommand};
@@ -697,37 +696,6 @@ fn progress_delay() -> std::time::Duration {
             std::time::Duration::from_secs(2),
             std::time::Duration::from_millis,
         )
-}
-
-/// A task on a progress sink, reported finished when dropped.
-pub(crate) struct Task(Option<Progress>);
-
-impl Drop for Task {
-    fn drop(&mut self) {
-        if let Some(p) = self.0.take() {
-            p.report(ProgressEvent::Finish);
-        }
-    }
-}
-
-/// The least-squares runs of a fit command counted on a terminal's delayed progress bar
-/// ([`delayed_progress_bar`], task `label`, in model evaluations: residual vectors and
-/// Jacobians over the data); a posterior run keeps its sampler's own bar. The bar goes when
-/// the returned [`Task`] is dropped.
-pub(crate) fn counted_fit(label: &str, method: Method) -> (Method, Task) {
-    let bar = match method {
-        Method::Lsq { .. } => delayed_progress_bar("model evaluations"),
-        Method::Mcmc(_) => None,
-    };
-    if let Some(p) = &bar {
-        p.report(ProgressEvent::Start {
-            label,
-            total: 0,
-            check_every: 0,
-        });
-    }
-    let tally = bar.clone().map(crate::progress::Tally::new);
-    (method.with_progress(tally), Task(bar))
 }
 
 /// An error about a command-line flag value.

@@ -326,13 +326,8 @@ fn run_with(a: Args, shown: Option<String>) -> Result<(), CliError> {
         ],
         &outputs,
     )?;
-    let (table, rows, dataset) = io.read()?;
+    let data = io.read()?;
     let choice = io.method(&[])?;
-    let data = crate::io::measurements::MeasurementFile {
-        table,
-        rows,
-        dataset,
-    };
     let settings = ReportSettings {
         level: io.level.level(),
         method: choice.method,

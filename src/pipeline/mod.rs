@@ -1,5 +1,6 @@
 //! Whole runs of the command line as library calls: synthetic measurements ([`simulate`]),
-//! the report of every model fitted to one data set ([`report`]), the work-precision table
+//! the fit commands `klaw`, `jan` and `jaeger` ([`FitCommand::run`]), the report of every
+//! model fitted to one data set ([`report`]), the work-precision table
 //! of the forward models ([`work_precision`]) and the molecular-dynamics runs of a scene table
 //! ([`forward_md`]). The command line parses its
 //! flags into these settings, calls these functions and prints or writes what they return;
@@ -10,10 +11,16 @@
 //! alike.
 
 mod bench;
+mod fit_run;
+mod jaeger;
+mod jan;
+mod klaw;
 mod report;
 mod simulate;
 
 pub use bench::{forward_md, work_precision};
+pub(crate) use fit_run::{figure_bytes, not_converged};
+pub use fit_run::{FitCommand, FitRun};
 pub(crate) use report::law_error;
 pub use report::{report, ReportOutput, ReportSettings};
 pub(crate) use simulate::MAX_POINTS;

@@ -83,7 +83,7 @@ pub(crate) fn cells<R: Serialize>(record: &R) -> Vec<(&'static str, Cell<'static
 }
 
 /// The columns of record type `R`, generated from its fields (their serde names, in order).
-pub fn columns<R: Serialize + Default>() -> Vec<&'static str> {
+pub(crate) fn columns<R: Serialize + Default>() -> Vec<&'static str> {
     let mut out = Vec::new();
     each_cell(&R::default(), |k, _| out.push(k));
     out

@@ -1126,6 +1126,60 @@ def _fitted(core: Any, context: Dict[str, Any]) -> FitResult:
     return fr
 
 
+def _fit_data(data: Any, rho: Optional[float], f: Optional[float], g: Optional[float]) -> Dataset:
+    """The data of a fit, read again with the defaults given for the columns rows leave out."""
+    d = _dataset(data)
+    if rho is None and f is None and g is None:
+        return d
+    return Dataset(d._core.with_defaults(rho=rho, f=f, g=g))
+
+
+def _priors(priors: Any) -> List[Tuple[str, str]]:
+    """Priors as (name, distribution) pairs, from a mapping or from ``NAME=DIST`` strings."""
+    if priors is None:
+        return []
+    if isinstance(priors, Mapping):
+        return [(str(k), str(v)) for k, v in priors.items()]
+    if isinstance(priors, str):
+        priors = [priors]
+    out = []
+    for p in priors:
+        name, sep, dist = str(p).partition("=")
+        if not sep:
+            raise FitbeadError(f"prior = '{p}': expected NAME=DIST, e.g. 'c=normal(0.5,0.1)'")
+        out.append((name.strip(), dist.strip()))
+    return out
+
+
+def _draws_wanted(path: Any, method: str) -> bool:
+    """Whether the draws CSV is asked for; an error before the fit when the method has none."""
+    if path is None:
+        return False
+    if str(method).lower() != "mcmc":
+        raise FitbeadError("draws: applies to method = 'mcmc' only")
+    return True
+
+
+def _write_draws(path: Any, text: Optional[bytes]) -> None:
+    """Writes the draws CSV to `path` atomically (a temporary file renamed over it)."""
+    if path is None or text is None:
+        return
+    import os
+    import tempfile
+
+    target = os.fspath(path)
+    folder = os.path.dirname(os.path.abspath(target))
+    fd, tmp = tempfile.mkstemp(dir=folder, prefix=".fitbead-draws-")
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(bytes(text))
+        os.replace(tmp, target)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
 def fit_klaw(
     data: Any = None,
     *,
@@ -1138,6 +1192,15 @@ def fit_klaw(
     walkers: Optional[int] = None,
     max_steps: Optional[int] = None,
     min_ess: Optional[float] = None,
+    tol: float = 1e-10,
+    skip_unsteady: bool = False,
+    thin: Optional[int] = None,
+    priors: Any = None,
+    fit_scatter: bool = False,
+    draws: Any = None,
+    rho: Optional[float] = None,
+    f: Optional[float] = None,
+    g: Optional[float] = None,
 ) -> FitResult:
     """A law K(α) fitted to every series at once (``fitbead klaw``).
 
@@ -1147,7 +1210,8 @@ def fit_klaw(
         The measurements (default: the shipped data).
     model : str, default "stickslip"
         The contact model: ``stick``, ``stick-approx``, ``slip``, ``slip-approx``,
-        ``stickslip`` or ``contact``.
+        ``stickslip``, ``contact``, or ``auto`` (the most general model any point needs at
+        its stick K, for all points; said in a :class:`FitbeadWarning`).
     law : str, default "c"
         ``c`` (K = cos 2α + c sin²α sin 2α), ``free-per-series`` (one K per series) or
         ``impact`` (nothing fitted: scored).
@@ -1166,6 +1230,25 @@ def fit_klaw(
     min_ess : float, optional
         MCMC: the bulk and tail ESS every parameter must reach (with rank-normalised split-R̂
         ≤ 1.01) before the run stops (default 1000).
+    tol : float, default 1e-10
+        With ``model="auto"``: the target relative tolerance on v.
+    skip_unsteady : bool, default False
+        Leave out the points no K makes steady under the model (each named in a
+        :class:`FitbeadWarning`) instead of raising.
+    thin : int, optional
+        MCMC: keep one step in ``thin`` (default 1).
+    priors : mapping or sequence, optional
+        MCMC: priors by parameter, as ``{"c": "normal(0.5,0.1)"}`` or ``["c=normal(0.5,0.1)"]``;
+        a distribution is ``flat``, ``jeffreys``, ``uniform(a,b)``, ``normal(mean,sd)``,
+        ``lognormal(mu,sigma)`` or ``halfnormal(scale)`` (the command line's ``--prior``).
+    fit_scatter : bool, default False
+        MCMC: also sample an error scale ``sigma_scale`` multiplying every sigma_v.
+    draws : str or path, optional
+        MCMC: write the kept draws to this CSV (the command line's ``--draws`` file),
+        atomically.
+    rho, f, g : float, optional
+        ρ, f and g (m/s²) of the rows whose columns leave them out (defaults 0.4, 0.1, 9.81):
+        the data are read again with them.
 
     Returns
     -------
@@ -1183,12 +1266,14 @@ def fit_klaw(
     UnitWarning, ConvergenceWarning, BoundWarning
         The command line's warnings on the data and the fit.
     """
-    d = _dataset(data)
-    core = _core.fit_klaw(
+    d = _fit_data(data, rho, f, g)
+    fits, notes, text = _core.fit_klaw(
         d._core, model=_model_name(model), law=law, method=method, level=level, profile=profile, seed=seed, walkers=walkers,
-        max_steps=max_steps, min_ess=min_ess,
+        max_steps=max_steps, min_ess=min_ess, tol=tol, thin=thin, priors=_priors(priors), fit_scatter=fit_scatter,
+        skip_unsteady=skip_unsteady, draws=_draws_wanted(draws, method),
     )
-    return _fitted(core, {"model": _model_name(model)})
+    _write_draws(draws, text)
+    return _fitted(fits[0], {"model": _model_name(model)})
 
 
 def fit_jan(
@@ -1201,6 +1286,13 @@ def fit_jan(
     walkers: Optional[int] = None,
     max_steps: Optional[int] = None,
     min_ess: Optional[float] = None,
+    thin: Optional[int] = None,
+    priors: Any = None,
+    fit_scatter: bool = False,
+    draws: Any = None,
+    rho: Optional[float] = None,
+    f: Optional[float] = None,
+    g: Optional[float] = None,
 ) -> FitSet:
     """Jan's energy balance (eq 74): λ and μ per series (at least 3 points), then the global
     laws of eqs 75–76 (``fitbead jan``).
@@ -1216,8 +1308,10 @@ def fit_jan(
         Confidence level of the intervals, in (0, 1).
     profile : bool, default True
         Least squares: profile-likelihood intervals (else the covariance's).
-    seed, walkers, max_steps, min_ess
+    seed, walkers, max_steps, min_ess, thin, priors, fit_scatter, draws
         MCMC settings, as in :func:`fit_klaw`.
+    rho, f, g : float, optional
+        As in :func:`fit_klaw`.
 
     Returns
     -------
@@ -1230,8 +1324,12 @@ def fit_jan(
     UnitWarning, ConvergenceWarning, BoundWarning
         The command line's warnings on the data and the fits.
     """
-    d = _dataset(data)
-    fits, notes = _core.fit_jan(d._core, method=method, level=level, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps, min_ess=min_ess)
+    d = _fit_data(data, rho, f, g)
+    fits, notes, text = _core.fit_jan(
+        d._core, method=method, level=level, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps,
+        min_ess=min_ess, thin=thin, priors=_priors(priors), fit_scatter=fit_scatter, draws=_draws_wanted(draws, method),
+    )
+    _write_draws(draws, text)
     return FitSet([_fitted(x, {}) for x in fits], notes)
 
 
@@ -1246,6 +1344,13 @@ def fit_jaeger(
     walkers: Optional[int] = None,
     max_steps: Optional[int] = None,
     min_ess: Optional[float] = None,
+    thin: Optional[int] = None,
+    priors: Any = None,
+    fit_scatter: bool = False,
+    draws: Any = None,
+    rho: Optional[float] = None,
+    f: Optional[float] = None,
+    g: Optional[float] = None,
 ) -> FitSet:
     """Jaeger's heuristic law (eqs 80–84): a1, a2, a3 per series with at least 4 points
     (``fitbead jaeger``).
@@ -1263,8 +1368,10 @@ def fit_jaeger(
         Confidence level of the intervals, in (0, 1).
     profile : bool, default True
         Least squares: profile-likelihood intervals (else the covariance's).
-    seed, walkers, max_steps, min_ess
+    seed, walkers, max_steps, min_ess, thin, priors, fit_scatter, draws
         MCMC settings, as in :func:`fit_klaw`.
+    rho, f, g : float, optional
+        As in :func:`fit_klaw`.
 
     Returns
     -------
@@ -1276,11 +1383,12 @@ def fit_jaeger(
     UnitWarning, ConvergenceWarning, BoundWarning
         The command line's warnings on the data and the fits.
     """
-    d = _dataset(data)
-    fits, notes = _core.fit_jaeger(
+    d = _fit_data(data, rho, f, g)
+    fits, notes, text = _core.fit_jaeger(
         d._core, branch=branch, method=method, level=level, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps,
-        min_ess=min_ess,
+        min_ess=min_ess, thin=thin, priors=_priors(priors), fit_scatter=fit_scatter, draws=_draws_wanted(draws, method),
     )
+    _write_draws(draws, text)
     return FitSet([_fitted(x, {"branch": branch}) for x in fits], notes)
 
 

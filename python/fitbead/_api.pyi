@@ -390,7 +390,7 @@ class FitSet(list):
         ``residuals`` or ``correlations``, with the command line's columns (its CSV of the
         whole run), numeric dtypes and NaN for empty cells."""
 
-def fit_klaw(data: Any = None, *, model: str = 'stickslip', law: str = 'c', method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None) -> FitResult:
+def fit_klaw(data: Any = None, *, model: str = 'stickslip', law: str = 'c', method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None, tol: float = 1e-10, skip_unsteady: bool = False, thin: int | None = None, priors: Any = None, fit_scatter: bool = False, draws: Any = None, rho: float | None = None, f: float | None = None, g: float | None = None) -> FitResult:
     '''A law K(α) fitted to every series at once (``fitbead klaw``).
 
     Parameters
@@ -435,7 +435,7 @@ def fit_klaw(data: Any = None, *, model: str = 'stickslip', law: str = 'c', meth
     UnitWarning, ConvergenceWarning, BoundWarning
         The command line\'s warnings on the data and the fit.
     '''
-def fit_jan(data: Any = None, *, method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None) -> FitSet:
+def fit_jan(data: Any = None, *, method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None, thin: int | None = None, priors: Any = None, fit_scatter: bool = False, draws: Any = None, rho: float | None = None, f: float | None = None, g: float | None = None) -> FitSet:
     '''Jan\'s energy balance (eq 74): λ and μ per series (at least 3 points), then the global
     laws of eqs 75–76 (``fitbead jan``).
 
@@ -464,7 +464,7 @@ def fit_jan(data: Any = None, *, method: str = 'lsq', level: float = 0.95, profi
     UnitWarning, ConvergenceWarning, BoundWarning
         The command line\'s warnings on the data and the fits.
     '''
-def fit_jaeger(data: Any = None, *, branch: str = 'upper', method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None) -> FitSet:
+def fit_jaeger(data: Any = None, *, branch: str = 'upper', method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None, thin: int | None = None, priors: Any = None, fit_scatter: bool = False, draws: Any = None, rho: float | None = None, f: float | None = None, g: float | None = None) -> FitSet:
     '''Jaeger\'s heuristic law (eqs 80–84): a1, a2, a3 per series with at least 4 points
     (``fitbead jaeger``).
 

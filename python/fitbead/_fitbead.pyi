@@ -50,6 +50,9 @@ class _Dataset:
         series: List[str], xi: F64, delta_deg: F64, v: F64, sigma_v: F64, rho: F64, f: F64
     ) -> "_Dataset": ...
     def invert_k(self, model: str, tol: float = 1e-10) -> Dict[str, Any]: ...
+    def with_defaults(
+        self, rho: Optional[float] = None, f: Optional[float] = None, g: Optional[float] = None
+    ) -> "_Dataset": ...
     def __len__(self) -> int: ...
     @property
     def labels(self) -> List[str]: ...
@@ -87,7 +90,12 @@ def fit_klaw(
     max_steps: Optional[int] = None,
     min_ess: Optional[float] = None,
     tol: float = 1e-10,
-) -> _FitResult: ...
+    thin: Optional[int] = None,
+    priors: List[Tuple[str, str]] = ...,
+    fit_scatter: bool = False,
+    skip_unsteady: bool = False,
+    draws: bool = False,
+) -> Tuple[List[_FitResult], List[str], Optional[bytes]]: ...
 def fit_jan(
     data: _Dataset,
     method: str = "lsq",
@@ -97,7 +105,11 @@ def fit_jan(
     walkers: Optional[int] = None,
     max_steps: Optional[int] = None,
     min_ess: Optional[float] = None,
-) -> Tuple[List[_FitResult], List[str]]: ...
+    thin: Optional[int] = None,
+    priors: List[Tuple[str, str]] = ...,
+    fit_scatter: bool = False,
+    draws: bool = False,
+) -> Tuple[List[_FitResult], List[str], Optional[bytes]]: ...
 def fit_jaeger(
     data: _Dataset,
     branch: str = "upper",
@@ -108,7 +120,11 @@ def fit_jaeger(
     walkers: Optional[int] = None,
     max_steps: Optional[int] = None,
     min_ess: Optional[float] = None,
-) -> Tuple[List[_FitResult], List[str]]: ...
+    thin: Optional[int] = None,
+    priors: List[Tuple[str, str]] = ...,
+    fit_scatter: bool = False,
+    draws: bool = False,
+) -> Tuple[List[_FitResult], List[str], Optional[bytes]]: ...
 def simulate(model: str = "stickslip", **settings: Any) -> str: ...
 def report(
     data: _Dataset, out_dir: Optional[str] = None, method: str = "lsq", **settings: Any

@@ -7,15 +7,13 @@
 //! of categories (`(codes, names)`), which the Python layer turns into string arrays. Every
 //! number is computed by the Rust library exactly as the command line computes it.
 
-use fitbead::fit::builder::{JaegerFitter, JanFitter, KLawFitter};
 use fitbead::fit::data::Dataset as RsDataset;
 use fitbead::fit::klaw::KLaw;
-use fitbead::fit::report::FitSet;
 use fitbead::fit::summary::FitResult as RsFitResult;
-use fitbead::inverse::posterior::McmcSettings;
+use fitbead::inverse::posterior::{McmcSettings, Method};
 use fitbead::io::measurements::{MeasurementDefaults, MeasurementFile};
 use fitbead::io::records::{
-    columns, each_cell, AutoRecord, Cell, ContactRecord, CorrelationRecord, ForwardRecord, KRecord,
+    each_cell, AutoRecord, Cell, ContactRecord, CorrelationRecord, ForwardRecord, KRecord,
     ParamRecord, RegimeRecord, ResidualRecord, StatsRecord,
 };
 use fitbead::models::auto::Auto;
@@ -24,6 +22,7 @@ use fitbead::models::jaeger::Jaeger;
 use fitbead::models::jan::Jan;
 use fitbead::models::regimes::{alpha_of_xi, critical_xi};
 use fitbead::models::{JaegerBranch, Model, ModelKind};
+use fitbead::pipeline::FitCommand;
 use fitbead::scene::{CollisionLaw, Scene};
 use numpy::{PyArray1, PyArray3, PyReadonlyArray1};
 use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
@@ -875,6 +874,25 @@ impl PyDataset {
         Ok(PyDataset::of_file(m))
     }
 
+    /// The same measurements read again with these defaults for the columns their rows leave
+    /// out (`None` keeps the reader's default: ρ 0.4, f 0.1, g 9.81 m/s²).
+    #[pyo3(signature = (rho=None, f=None, g=None))]
+    fn with_defaults(&self, rho: Option<f64>, f: Option<f64>, g: Option<f64>) -> PyResult<Self> {
+        let base = MeasurementDefaults::default();
+        let d = MeasurementDefaults {
+            rho: rho.unwrap_or(base.rho),
+            f: f.unwrap_or(base.f),
+            g: g.unwrap_or(base.g),
+        }
+        .checked()
+        .map_err(|e| value_error(e.to_string()))?;
+        let m = self
+            .file
+            .with_defaults(&d)
+            .map_err(|e| value_error(e.to_string()))?;
+        Ok(PyDataset::of_file(m))
+    }
+
     /// The shipped synthetic data set (data/default.csv).
     #[staticmethod]
     fn default_data() -> PyResult<Self> {
@@ -1185,25 +1203,21 @@ impl PyFitResult {
     }
 }
 
-/// A list of fits with the notes of the run (Jan's and Jaeger's per-series fits).
-fn fit_set(set: FitSet) -> (Vec<PyFitResult>, Vec<String>) {
-    (
-        set.fits
-            .into_iter()
-            .map(|inner| PyFitResult { inner })
-            .collect(),
-        set.notes,
-    )
-}
-
-/// Method settings shared by the fit functions.
+/// The estimation settings shared by the fit functions, as their keywords give them.
 struct MethodArgs {
-    mcmc: Option<McmcSettings>,
-    profile: bool,
+    method: Method,
     level: f64,
     stop: Arc<AtomicBool>,
 }
 
+/// The keywords of the posterior runs that are not the sampler's options.
+struct Sampling {
+    thin: Option<usize>,
+    priors: Vec<(String, String)>,
+    fit_scatter: bool,
+}
+
+#[allow(clippy::too_many_arguments)]
 fn method_args(
     method: &str,
     level: f64,
@@ -1212,10 +1226,27 @@ fn method_args(
     walkers: Option<usize>,
     max_steps: Option<usize>,
     min_ess: Option<f64>,
+    sampling: Sampling,
 ) -> PyResult<MethodArgs> {
     let stop = Arc::new(AtomicBool::new(false));
-    let mcmc = match method.to_ascii_lowercase().as_str() {
-        "lsq" => None,
+    let method = match method.to_ascii_lowercase().as_str() {
+        "lsq" => {
+            let sampler_only = [
+                ("thin", sampling.thin.is_some()),
+                ("priors", !sampling.priors.is_empty()),
+                ("fit_scatter", sampling.fit_scatter),
+            ];
+            if let Some((name, _)) = sampler_only.iter().find(|k| k.1) {
+                return Err(value_error(format!(
+                    "{name}: applies to method = 'mcmc' only"
+                )));
+            }
+            Method::Lsq {
+                profile,
+                stop: Some(stop.clone()),
+                progress: None,
+            }
+        }
         "mcmc" => {
             let mut s = McmcSettings::seeded(seed);
             if let Some(w) = walkers {
@@ -1227,9 +1258,19 @@ fn method_args(
             if let Some(e) = min_ess {
                 s.options.min_ess = e;
             }
+            if let Some(t) = sampling.thin {
+                s.options.thin = t;
+            }
             s.options.check().map_err(|e| value_error(e.to_string()))?;
             s.options.stop = Some(stop.clone());
-            Some(s)
+            for (name, dist) in sampling.priors {
+                let prior = dist
+                    .parse::<fitbead::prelude::Prior>()
+                    .map_err(|e| value_error(format!("prior = '{name}={dist}': {e}")))?;
+                s.priors.push((name, prior));
+            }
+            s.fit_scatter = sampling.fit_scatter;
+            Method::Mcmc(Box::new(s))
         }
         _ => {
             return Err(value_error(format!(
@@ -1238,8 +1279,7 @@ fn method_args(
         }
     };
     Ok(MethodArgs {
-        mcmc,
-        profile,
+        method,
         level,
         stop,
     })
@@ -1293,27 +1333,56 @@ fn interruptible<T: Send>(
     })
 }
 
-/// Sets the level and the method of the [`MethodArgs`] `a` on one of the library's fit
-/// builders (they share these setters) and fits `data` without the GIL, interruptibly.
-macro_rules! run_fit {
-    ($py:expr, $data:expr, $a:expr, $builder:expr) => {{
-        let fitter = $builder.level($a.level);
-        let fitter = match $a.mcmc {
-            Some(s) => fitter.mcmc(s),
-            None => fitter.least_squares($a.profile),
-        };
-        let ds = &$data.inner;
-        interruptible($py, &$a.stop, || fitter.fit(ds))?
-    }};
+/// Runs the fit command `command` of the library on `data` without the GIL, interruptibly:
+/// the fits, their draws as the command line's `--draws` CSV when `draws`, and the run's
+/// notes. With `warn`, each note is also a `FitbeadWarning` (`fitbead COMMAND: note`, as the
+/// command line prints it), raised as it would be printed: before an error as well.
+fn run_fit(
+    py: Python<'_>,
+    data: &PyDataset,
+    command: FitCommand,
+    a: MethodArgs,
+    draws: bool,
+    warn: bool,
+) -> PyResult<(Vec<PyFitResult>, Vec<String>, Option<Vec<u8>>)> {
+    let file = &data.file;
+    let MethodArgs {
+        method,
+        level,
+        stop,
+    } = a;
+    let (r, notes) = interruptible(py, &stop, || {
+        let mut notes = Vec::new();
+        let r = command
+            .run(file, method, level, None, &mut |n| {
+                notes.push(n.to_string())
+            })
+            .and_then(|run| {
+                let d = if draws { Some(run.draws_csv()?) } else { None };
+                Ok((run.fits, d))
+            });
+        (r, notes)
+    })?;
+    if warn && !notes.is_empty() {
+        let category = py.import("fitbead._api")?.getattr("FitbeadWarning")?;
+        for n in &notes {
+            let text = std::ffi::CString::new(format!("fitbead {}: {n}", command.name()))
+                .map_err(|e| value_error(e.to_string()))?;
+            PyErr::warn(py, &category, &text, 2)?;
+        }
+    }
+    let (fits, d) = r.map_err(pipeline_error)?;
+    let fits = fits
+        .into_iter()
+        .map(|inner| PyFitResult { inner })
+        .collect();
+    Ok((fits, notes, d))
 }
 
-fn fit_error(e: fitbead::fit::error::FitError) -> PyErr {
-    value_error(e.to_string())
-}
-
-/// A K(α) law fitted across series (see the Python `fitbead.fit_klaw`).
+/// A K(α) law fitted across series (see the Python `fitbead.fit_klaw`): the law's fit and the
+/// impact law's (unless the law is impact), the notes, and the draws CSV when `draws`.
 #[pyfunction]
-#[pyo3(signature = (data, model="stickslip", law="c", method="lsq", level=0.95, profile=true, seed=1, walkers=None, max_steps=None, min_ess=None, tol=1e-10))]
+#[pyo3(signature = (data, model="stickslip", law="c", method="lsq", level=0.95, profile=true, seed=1, walkers=None, max_steps=None, min_ess=None, tol=1e-10, thin=None, priors=vec![], fit_scatter=false, skip_unsteady=false, draws=false))]
 #[allow(clippy::too_many_arguments)]
 fn fit_klaw(
     py: Python<'_>,
@@ -1328,24 +1397,43 @@ fn fit_klaw(
     max_steps: Option<usize>,
     min_ess: Option<f64>,
     tol: f64,
-) -> PyResult<PyFitResult> {
-    let (m, auto) = k_model(model, tol)?;
-    if auto.is_some() {
-        return Err(value_error(
-            "model = 'auto' is not available for the law fits here; choose a contact model",
-        ));
-    }
+    thin: Option<usize>,
+    priors: Vec<(String, String)>,
+    fit_scatter: bool,
+    skip_unsteady: bool,
+    draws: bool,
+) -> PyResult<(Vec<PyFitResult>, Vec<String>, Option<Vec<u8>>)> {
+    let (_, auto) = k_model(model, tol)?;
+    let kind = if auto.is_some() {
+        ModelKind::Auto
+    } else {
+        model
+            .parse::<ModelKind>()
+            .map_err(|e| value_error(format!("model = '{model}': {e}")))?
+    };
     let l: KLaw = law
         .parse()
         .map_err(|e: String| value_error(format!("law = '{law}': {e}")))?;
-    let a = method_args(method, level, profile, seed, walkers, max_steps, min_ess)?;
-    let r = run_fit!(py, data, a, KLawFitter::new(m, l));
-    r.map(|inner| PyFitResult { inner }).map_err(fit_error)
+    let command = FitCommand::Klaw {
+        model: kind,
+        law: l,
+        tol,
+        skip_unsteady,
+    };
+    let sampling = Sampling {
+        thin,
+        priors,
+        fit_scatter,
+    };
+    let a = method_args(
+        method, level, profile, seed, walkers, max_steps, min_ess, sampling,
+    )?;
+    run_fit(py, data, command, a, draws, true)
 }
 
 /// Jan's λ and μ per series and the global laws (see the Python `fitbead.fit_jan`).
 #[pyfunction]
-#[pyo3(signature = (data, method="lsq", level=0.95, profile=true, seed=1, walkers=None, max_steps=None, min_ess=None))]
+#[pyo3(signature = (data, method="lsq", level=0.95, profile=true, seed=1, walkers=None, max_steps=None, min_ess=None, thin=None, priors=vec![], fit_scatter=false, draws=false))]
 #[allow(clippy::too_many_arguments)]
 fn fit_jan(
     py: Python<'_>,
@@ -1357,15 +1445,26 @@ fn fit_jan(
     walkers: Option<usize>,
     max_steps: Option<usize>,
     min_ess: Option<f64>,
-) -> PyResult<(Vec<PyFitResult>, Vec<String>)> {
-    let a = method_args(method, level, profile, seed, walkers, max_steps, min_ess)?;
-    let r = run_fit!(py, data, a, JanFitter::new());
-    r.map(fit_set).map_err(fit_error)
+    thin: Option<usize>,
+    priors: Vec<(String, String)>,
+    fit_scatter: bool,
+    draws: bool,
+) -> PyResult<(Vec<PyFitResult>, Vec<String>, Option<Vec<u8>>)> {
+    let command = FitCommand::Jan;
+    let sampling = Sampling {
+        thin,
+        priors,
+        fit_scatter,
+    };
+    let a = method_args(
+        method, level, profile, seed, walkers, max_steps, min_ess, sampling,
+    )?;
+    run_fit(py, data, command, a, draws, false)
 }
 
 /// Jaeger's a1–a3 per series (see the Python `fitbead.fit_jaeger`).
 #[pyfunction]
-#[pyo3(signature = (data, branch="upper", method="lsq", level=0.95, profile=true, seed=1, walkers=None, max_steps=None, min_ess=None))]
+#[pyo3(signature = (data, branch="upper", method="lsq", level=0.95, profile=true, seed=1, walkers=None, max_steps=None, min_ess=None, thin=None, priors=vec![], fit_scatter=false, draws=false))]
 #[allow(clippy::too_many_arguments)]
 fn fit_jaeger(
     py: Python<'_>,
@@ -1378,16 +1477,33 @@ fn fit_jaeger(
     walkers: Option<usize>,
     max_steps: Option<usize>,
     min_ess: Option<f64>,
-) -> PyResult<(Vec<PyFitResult>, Vec<String>)> {
+    thin: Option<usize>,
+    priors: Vec<(String, String)>,
+    fit_scatter: bool,
+    draws: bool,
+) -> PyResult<(Vec<PyFitResult>, Vec<String>, Option<Vec<u8>>)> {
     let b: JaegerBranch = branch
         .parse()
         .map_err(|e: String| value_error(format!("branch = '{branch}': {e}")))?;
-    let a = method_args(method, level, profile, seed, walkers, max_steps, min_ess)?;
-    let r = run_fit!(py, data, a, JaegerFitter::new().branch(b));
-    r.map(fit_set).map_err(fit_error)
+    let command = FitCommand::Jaeger { branch: b };
+    let sampling = Sampling {
+        thin,
+        priors,
+        fit_scatter,
+    };
+    let a = method_args(
+        method, level, profile, seed, walkers, max_steps, min_ess, sampling,
+    )?;
+    run_fit(py, data, command, a, draws, false)
 }
 
-/// The version of the Rust library.
+/// The columns of records `R`: the keys [`each_cell`] visits, in order.
+fn columns<R: serde::Serialize + Default>() -> Vec<&'static str> {
+    let mut v = Vec::new();
+    each_cell(&R::default(), |k, _| v.push(k));
+    v
+}
+
 /// The column names of the command line's CSV report `kind`: `params`, `stats`,
 /// `residuals` or `correlations` (the records both write).
 #[pyfunction]
@@ -1413,14 +1529,10 @@ fn output_columns(command: &str, model: &str) -> PyResult<Vec<String>> {
     let kind = model
         .parse::<ModelKind>()
         .map_err(|e| value_error(e.to_string()))?;
-    let names = match command {
-        "forward" => fitbead::io::forward::output_columns(kind),
-        "k" => fitbead::io::kstream::output_columns(kind == ModelKind::Auto),
-        _ => {
-            return Err(value_error(format!(
-                "command = {command:?}: expected forward or k"
-            )))
-        }
+    let Some(names) = fitbead::io::output_columns(command, kind) else {
+        return Err(value_error(format!(
+            "command = {command:?}: expected forward or k"
+        )));
     };
     Ok(names.into_iter().map(String::from).collect())
 }

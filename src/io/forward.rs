@@ -52,7 +52,7 @@ pub(crate) fn scene_columns() -> Vec<&'static str> {
 /// The columns `forward` adds after the input's own under a model of `kind`, in order,
 /// generated from the records: [`ForwardRecord`]'s (every model), then [`ContactRecord`]'s
 /// (the contact model) or [`AutoRecord`]'s (auto).
-pub fn output_columns(kind: ModelKind) -> Vec<&'static str> {
+pub(crate) fn output_columns(kind: ModelKind) -> Vec<&'static str> {
     let mut outputs = columns::<ForwardRecord>();
     if kind == ModelKind::Contact {
         outputs.extend(columns::<ContactRecord>());

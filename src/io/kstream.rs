@@ -41,7 +41,7 @@ struct KInput<'a> {
 /// The columns of a K row in order, generated from the records: the measurement's own
 /// (`KInput`), [`KRecord`]'s, and [`AutoRecord`]'s when `auto`; the input's other columns
 /// follow them.
-pub fn output_columns(auto: bool) -> Vec<&'static str> {
+pub(crate) fn output_columns(auto: bool) -> Vec<&'static str> {
     let mut v = columns::<KInput>();
     v.extend(columns::<KRecord>());
     if auto {

@@ -529,6 +529,18 @@ impl MeasurementFile {
         })
     }
 
+    /// The same file read again with `defaults` for the columns its rows leave out (ρ, f,
+    /// g).
+    pub fn with_defaults(&self, defaults: &MeasurementDefaults) -> Result<Self, InputError> {
+        let rows = read_measurements(&self.table, defaults)?;
+        let dataset = dataset_of(&self.table, &rows)?;
+        Ok(MeasurementFile {
+            table: self.table.clone(),
+            rows,
+            dataset,
+        })
+    }
+
     /// Reads the file at `path`.
     pub fn read(path: &Path, defaults: &MeasurementDefaults) -> Result<Self, InputError> {
         let name = path.display().to_string();

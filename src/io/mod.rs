@@ -25,6 +25,22 @@ pub(crate) use atomic::{
 
 pub(crate) use crate::numfmt::{clip, echo, fmt_f64, fmt_sig, ECHO_CHARS};
 
+/// The columns the streaming command `command` writes under a model of `kind`, in order,
+/// generated from the records; `None` for a command other than `forward` and `k`.
+///
+/// `forward`: the columns it adds after the input's own (every model's, then the contact
+/// model's or auto's). `k`: the input's columns that have an output of their own, then K's
+/// (then auto's two under auto); the input's other columns follow them.
+pub fn output_columns(command: &str, kind: crate::models::ModelKind) -> Option<Vec<&'static str>> {
+    match command {
+        "forward" => Some(forward::output_columns(kind)),
+        "k" => Some(kstream::output_columns(
+            kind == crate::models::ModelKind::Auto,
+        )),
+        _ => None,
+    }
+}
+
 use std::fmt;
 
 /// Where the settings come from, as messages name it.

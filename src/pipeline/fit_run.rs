@@ -6,7 +6,8 @@ use super::{jaeger, jan, klaw, setting_error, RunError};
 use crate::fit::data::Dataset;
 use crate::fit::klaw::KLaw;
 use crate::fit::summary::{FitResult, McmcFailure, ParamRow, StatsRow};
-use crate::inverse::posterior::Method;
+use crate::inverse::posterior::{Method, SCALE_NAME};
+use crate::io::fmt_f64;
 use crate::io::measurements::MeasurementFile;
 use crate::io::reports::{draws_csv, params_csv, stats_csv};
 use crate::models::{JaegerBranch, ModelKind};
@@ -88,6 +89,7 @@ impl FitCommand {
         progress: Option<Progress>,
         note: &mut dyn FnMut(&str),
     ) -> Result<FitRun, RunError> {
+        self.check(&method, level)?;
         let progress = progress.filter(|_| matches!(method, Method::Lsq { .. }));
         let run = match *self {
             FitCommand::Klaw {
@@ -119,6 +121,36 @@ impl FitCommand {
         }
         prior_faults(&run.fits)?;
         Ok(run)
+    }
+}
+
+impl FitCommand {
+    /// Refuses a level outside (0, 1) and a prior on a parameter the fit does not have.
+    fn check(&self, method: &Method, level: f64) -> Result<(), RunError> {
+        if !(level > 0.0 && level < 1.0) {
+            return Err(setting_error(
+                "--level",
+                &fmt_f64(level),
+                format!("confidence level {} is not in (0, 1)", fmt_f64(level)),
+            ));
+        }
+        let Method::Mcmc(m) = method else {
+            return Ok(());
+        };
+        let params = self.parameters();
+        for (name, prior) in &m.priors {
+            if name != SCALE_NAME && !params.contains(&name.as_str()) {
+                return Err(setting_error(
+                    "--prior",
+                    &format!("{name}={prior}"),
+                    format!(
+                        "no parameter '{name}' in this fit; expected one of {}, {SCALE_NAME}",
+                        params.join(", ")
+                    ),
+                ));
+            }
+        }
+        Ok(())
     }
 }
 

@@ -1333,6 +1333,10 @@ fn interruptible<T: Send>(
     })
 }
 
+/// What a fit function returns to the Python layer: the fits, the run's notes, and the draws
+/// CSV when it was asked for.
+type Fitted = (Vec<PyFitResult>, Vec<String>, Option<Vec<u8>>);
+
 /// Runs the fit command `command` of the library on `data` without the GIL, interruptibly:
 /// the fits, their draws as the command line's `--draws` CSV when `draws`, and the run's
 /// notes. With `warn`, each note is also a `FitbeadWarning` (`fitbead COMMAND: note`, as the
@@ -1344,7 +1348,7 @@ fn run_fit(
     a: MethodArgs,
     draws: bool,
     warn: bool,
-) -> PyResult<(Vec<PyFitResult>, Vec<String>, Option<Vec<u8>>)> {
+) -> PyResult<Fitted> {
     let file = &data.file;
     let MethodArgs {
         method,
@@ -1402,7 +1406,7 @@ fn fit_klaw(
     fit_scatter: bool,
     skip_unsteady: bool,
     draws: bool,
-) -> PyResult<(Vec<PyFitResult>, Vec<String>, Option<Vec<u8>>)> {
+) -> PyResult<Fitted> {
     let (_, auto) = k_model(model, tol)?;
     let kind = if auto.is_some() {
         ModelKind::Auto
@@ -1449,7 +1453,7 @@ fn fit_jan(
     priors: Vec<(String, String)>,
     fit_scatter: bool,
     draws: bool,
-) -> PyResult<(Vec<PyFitResult>, Vec<String>, Option<Vec<u8>>)> {
+) -> PyResult<Fitted> {
     let command = FitCommand::Jan;
     let sampling = Sampling {
         thin,
@@ -1481,7 +1485,7 @@ fn fit_jaeger(
     priors: Vec<(String, String)>,
     fit_scatter: bool,
     draws: bool,
-) -> PyResult<(Vec<PyFitResult>, Vec<String>, Option<Vec<u8>>)> {
+) -> PyResult<Fitted> {
     let b: JaegerBranch = branch
         .parse()
         .map_err(|e: String| value_error(format!("branch = '{branch}': {e}")))?;

@@ -7,7 +7,7 @@
 //! `lambda`, `mu` (Jan), `a1`, `a2`, `a3` (Jaeger) and `spin` (contact); an empty cell or an
 //! absent column takes the setting. Every input cell passes through (trimmed), an input column
 //! whose name is also an output column renamed `in_NAME` (see `pass_through_names`); then the
-//! records' columns ([`output_columns`]).
+//! records' columns ([`super::output_columns`]).
 //!
 //! Settings are named in messages as the command line's flags (`--rho` of
 //! `SETTINGS_ORIGIN`), since that is where they come from.

@@ -18,8 +18,8 @@
 //! ## Layers
 //!
 //! ```text
-//!   pipeline ───── whole runs as library calls: synthetic data (simulate), the report
-//!                  directory (report)
+//!   pipeline ───── whole runs as library calls: synthetic data (simulate), the fit
+//!                  commands (FitCommand: klaw, jan, jaeger), the report directory (report)
 //!   io ─────────── CSV schemas, measurements with units (Dataset::from_csv), atomic files;
 //!                  one typed record per output row (io::records: ForwardRecord, KRecord, …)
 //!   report ─────── the paper's comparisons, figures, the work-precision engine

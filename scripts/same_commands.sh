@@ -73,7 +73,10 @@ report_default	report --out-dir r
 report_pdf	report $in/default.csv --out-dir r --format all --figure-width single
 report_mcmc	report $in/sim.csv --out-dir r --method mcmc --min-ess 100 --max-steps 2000
 design_d	design --model stick --law c=0.5 --series 0.8,1.6 --points 5 --output d.csv --plot d.svg
-design_t	design --model stick --vs slip --criterion t --series 1 --points 4
+design_t	design --model stick --vs slip --criterion t --series 1 --points 4 --plot t.svg
+design_c	design --model stickslip --criterion c --target c --series 1,2 --total 9 --output d.csv
+design_bayes	design --model stick --prior 'c=normal(0.5,0.05)' --draws 8 --series 1 --points 4 --output d.csv --plot -
+design_jaeger	design --fit jaeger --series 1 --points 6 --noise abs=0.01
 simulate	simulate --model contact --series 0.8,1.2 --points 5 --seed 2 --noise 0.03
 regimes	regimes --law c=0.4 --xi 0.5,1,2
 EOF

@@ -4,7 +4,8 @@
 use super::args::{OutputArgs, PlotArgs};
 use super::{emit, CliError};
 use crate::io::write_atomic_all;
-use crate::report::workprecision::{draw_scenes, plot, render, run_bench_until, XCHECK_BOUNDS};
+use crate::pipeline::RunError;
+use crate::report::workprecision::render;
 
 /// Arguments of `fitbead bench`.
 #[derive(Debug, clap::Args)]
@@ -27,76 +28,17 @@ pub struct Args {
 
 /// Runs `fitbead bench`.
 pub fn run(a: Args) -> Result<(), CliError> {
-    let scenes = draw_scenes(a.scenes, a.seed);
-    if scenes.len() < a.scenes {
-        return Err(CliError::Other(format!(
-            "could draw only {} of {} scenes",
-            scenes.len(),
-            a.scenes
-        )));
-    }
     let stop = super::stop_flag();
-    let res = run_bench_until(&scenes, &stop).map_err(|_| CliError::Interrupted)?;
-    for r in res
-        .rows
-        .iter()
-        .filter(|r| r.method.starts_with("crosscheck"))
-    {
-        let bound = XCHECK_BOUNDS
-            .iter()
-            .find(|b| b.0 == r.model)
-            .map(|b| b.1)
-            .unwrap_or(0.0);
-        if r.scenes == 0 {
-            eprintln!(
-                "reference {:<10} {:<42} scenes     0: no scenes: none of the {} drawn falls in \
-                 this check's domain (draw more with --scenes)",
-                r.model,
-                r.method,
-                scenes.len()
-            );
-            continue;
-        }
-        eprintln!(
-            "reference {:<10} {:<42} scenes {:>5}  max {:.2e}  median {:.2e}  bound {:.0e}: {}",
-            r.model,
-            r.method,
-            r.scenes,
-            r.err_max,
-            r.err_median,
-            bound,
-            if r.err_max <= bound { "ok" } else { "FAILED" }
-        );
-    }
-    for (t, best) in &res.cheapest {
-        let auto = res
-            .rows
-            .iter()
-            .find(|r| r.model == "auto" && r.tol == Some(*t))
-            .and_then(|r| r.ns_median)
-            .unwrap_or(f64::NAN);
-        match best {
-            Some((name, ns)) => eprintln!(
-                "auto at T = {t:e}: median {auto:.0} ns; cheapest single method meeting T on all scenes (vs physics reference): {name}, {ns:.0} ns"
-            ),
-            None => eprintln!(
-                "auto at T = {t:e}: median {auto:.0} ns; no single method meets T on all scenes"
-            ),
-        }
-    }
-    eprintln!(
-        "auto at T = 1e-10 used stick on {}, stickslip on {}, contact on {} scenes",
-        res.auto_mix.0, res.auto_mix.1, res.auto_mix.2
-    );
-    let bytes = render(&res.rows).map_err(|e| CliError::Other(e.to_string()))?;
+    let b = crate::pipeline::bench(a.scenes, a.seed, Some(&stop)).map_err(|e| match e {
+        RunError::Interrupted => CliError::Interrupted,
+        e => CliError::Other(e.to_string()),
+    })?;
+    eprint!("{}", b.summary());
+    let bytes = render(&b.result.rows).map_err(|e| CliError::Other(e.to_string()))?;
     let svg = match &a.plot.plot {
-        Some(_) => a.plot.bytes(
-            plot(
-                &res.rows,
-                &format!("Work-precision, {} scenes (seed {})", scenes.len(), a.seed),
-            )
-            .map_err(CliError::Other)?,
-        )?,
+        Some(_) => a
+            .plot
+            .bytes(b.figure().map_err(|e| CliError::Other(e.to_string()))?)?,
         None => Vec::new(),
     };
     // The plot and the CSV file are written as one group: both or neither.

@@ -49,6 +49,7 @@
 
 mod optimal;
 mod problem;
+mod text;
 
 use crate::inverse::posterior::Prior;
 use crate::models::{JaegerBranch, ModelKind};

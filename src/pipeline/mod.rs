@@ -11,6 +11,7 @@
 //! alike.
 
 mod bench;
+mod fit_command;
 mod fit_run;
 mod jaeger;
 mod jan;
@@ -18,9 +19,11 @@ mod klaw;
 mod report;
 mod simulate;
 
+pub(crate) use bench::bench;
 pub use bench::{forward_md, work_precision};
+pub use fit_command::FitCommand;
+pub use fit_run::FitRun;
 pub(crate) use fit_run::{figure_bytes, not_converged};
-pub use fit_run::{FitCommand, FitRun};
 pub(crate) use report::law_error;
 pub use report::{report, ReportOutput, ReportSettings};
 pub(crate) use simulate::MAX_POINTS;

@@ -11,6 +11,7 @@ use super::figures::{
     coincide, scatter_panel, series_style, Anchor, Axis, Figure, Item, LegendEntry, Mark, Panel,
     PointSeries, Scatter, Stroke, DASHES, PALETTE,
 };
+use crate::design::{DesignResult, DesignSettings};
 use crate::fit::data::Dataset;
 use crate::fit::jaeger::{paper_values, JaegerModel};
 use crate::fit::jan::velocity as jan_velocity;
@@ -21,7 +22,7 @@ use crate::models::regimes::{
     alpha_of_xi, critical_xi, delta_d_law, delta_m_law, regime_b_interval,
 };
 use crate::models::{ForwardModel, JaegerBranch, Model};
-use crate::numfmt::fmt_sig;
+use crate::numfmt::{fmt_f64, fmt_sig};
 use crate::scene::CollisionLaw;
 use rayon::prelude::*;
 
@@ -1406,4 +1407,94 @@ mod tests {
             }
         }
     }
+}
+
+/// The figure: per series, the sensitivity of every candidate slope with the chosen ones
+/// marked (marker height: the sensitivity there; the label the replicates).
+pub(crate) fn design_figure(s: &DesignSettings, r: &DesignResult) -> Figure {
+    let mut panels = Vec::new();
+    for (k, xi) in s.series.iter().enumerate() {
+        let colour = PALETTE[k % PALETTE.len()];
+        let mut p = Panel::new(
+            &format!("ξ = {}", fmt_f64(*xi)),
+            Axis::new("slope δ (deg)"),
+            Axis::new(&r.sensitivity_label),
+        );
+        let curve = &r.sensitivity[k];
+        p.curve(curve.clone(), Stroke::solid(colour, 2.0));
+        let chosen: Vec<(f64, f64, f64, f64)> = r
+            .rows
+            .iter()
+            .filter(|row| row.xi == *xi)
+            .map(|row| {
+                let y = curve
+                    .iter()
+                    .min_by(|a, b| {
+                        (a.0 - row.delta_deg)
+                            .abs()
+                            .total_cmp(&(b.0 - row.delta_deg).abs())
+                    })
+                    .map_or(f64::NAN, |c| c.1);
+                (row.delta_deg, y, y, y)
+            })
+            .collect();
+        for row in r.rows.iter().filter(|row| row.xi == *xi) {
+            p.items.push(Item::VLine {
+                x: row.delta_deg,
+                stroke: Stroke::solid("#808080", 1.0).dashed("4 3"),
+            });
+        }
+        p.items.push(Item::HLine {
+            y: 1.0,
+            stroke: Stroke::solid("#404040", 1.0).dashed("2 3"),
+        });
+        p.points(chosen, colour, Mark::Circle);
+        let even: Vec<(f64, f64, f64, f64)> = r
+            .even
+            .iter()
+            .filter(|row| row.xi == *xi)
+            .map(|row| {
+                let y = curve
+                    .iter()
+                    .min_by(|a, b| {
+                        (a.0 - row.delta_deg)
+                            .abs()
+                            .total_cmp(&(b.0 - row.delta_deg).abs())
+                    })
+                    .map_or(f64::NAN, |c| c.1);
+                (row.delta_deg, y, y, y)
+            })
+            .collect();
+        p.points(even, "#808080", Mark::Cross);
+        panels.push(p);
+    }
+    let cols = if panels.len() > 2 { 2 } else { panels.len() };
+    let mut f = Figure::new(
+        "Where to measure: sensitivity per slope",
+        cols,
+        (380.0, 240.0),
+        panels,
+    );
+    f.legend = vec![
+        LegendEntry::mark("design slopes", Mark::Circle, "#404040"),
+        LegendEntry::mark("evenly spaced slopes", Mark::Cross, "#808080"),
+    ];
+    f.legend.push(LegendEntry::line(
+        "equivalence bound (1 on the design)",
+        &Stroke::solid("#404040", 1.0).dashed("2 3"),
+    ));
+    f.notes = s
+        .series
+        .iter()
+        .map(|xi| {
+            let at: Vec<String> = r
+                .rows
+                .iter()
+                .filter(|row| row.xi == *xi)
+                .map(|row| format!("{}° ×{}", fmt_f64(row.delta_deg), row.replicates))
+                .collect();
+            format!("design at ξ = {}: {}", fmt_f64(*xi), at.join(", "))
+        })
+        .collect();
+    f
 }

@@ -424,6 +424,74 @@ pub(crate) struct BenchResult {
     pub auto_mix: (usize, usize, usize),
 }
 
+impl BenchResult {
+    /// The summary `fitbead bench` prints on stderr, one line each: every cross-check of the
+    /// references against its bound (or that none of the `drawn` scenes falls in its domain),
+    /// auto's median time beside the cheapest single method meeting each tolerance, and the
+    /// models auto used.
+    pub(crate) fn summary(&self, drawn: usize) -> String {
+        use std::fmt::Write as _;
+        let mut o = String::new();
+        for r in self
+            .rows
+            .iter()
+            .filter(|r| r.method.starts_with("crosscheck"))
+        {
+            let bound = XCHECK_BOUNDS
+                .iter()
+                .find(|b| b.0 == r.model)
+                .map(|b| b.1)
+                .unwrap_or(0.0);
+            if r.scenes == 0 {
+                let _ = writeln!(
+                    o,
+                    "reference {:<10} {:<42} scenes     0: no scenes: none of the {drawn} drawn \
+                     falls in this check's domain (draw more with --scenes)",
+                    r.model, r.method,
+                );
+                continue;
+            }
+            let _ = writeln!(
+                o,
+                "reference {:<10} {:<42} scenes {:>5}  max {:.2e}  median {:.2e}  bound {:.0e}: {}",
+                r.model,
+                r.method,
+                r.scenes,
+                r.err_max,
+                r.err_median,
+                bound,
+                if r.err_max <= bound { "ok" } else { "FAILED" }
+            );
+        }
+        for (t, best) in &self.cheapest {
+            let auto = self
+                .rows
+                .iter()
+                .find(|r| r.model == "auto" && r.tol == Some(*t))
+                .and_then(|r| r.ns_median)
+                .unwrap_or(f64::NAN);
+            let _ = match best {
+                Some((name, ns)) => writeln!(
+                    o,
+                    "auto at T = {t:e}: median {auto:.0} ns; cheapest single method meeting T on \
+                     all scenes (vs physics reference): {name}, {ns:.0} ns"
+                ),
+                None => writeln!(
+                    o,
+                    "auto at T = {t:e}: median {auto:.0} ns; no single method meets T on all \
+                     scenes"
+                ),
+            };
+        }
+        let _ = writeln!(
+            o,
+            "auto at T = 1e-10 used stick on {}, stickslip on {}, contact on {} scenes",
+            self.auto_mix.0, self.auto_mix.1, self.auto_mix.2
+        );
+        o
+    }
+}
+
 /// Runs the whole bench on `scenes` (single thread), stopping with [`Interrupted`] once `stop` is raised (polled before every
 /// scene of every variant: a few milliseconds apart at most).
 pub(crate) fn run_bench_until(

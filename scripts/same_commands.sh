@@ -19,6 +19,8 @@ old=$work/bin/old/fitbead
 new=$work/bin/new/fitbead
 in=$work/in
 cp "$here/data/default.csv" "$in/default.csv"
+cp "$here/data/virtual/md_ristow.csv" "$in/md_ristow.csv"
+head -5 "$here/data/virtual/md_ristow.csv" >"$in/md5.csv"
 "$old" simulate --model stickslip --series 0.8,1,1.6 --points 8 --seed 4 --noise 0.05 \
   >"$in/sim.csv" 2>/dev/null
 "$old" simulate --model stick --series 0.8,1 --points 6 --seed 5 >"$in/nosigma.csv" 2>/dev/null
@@ -78,6 +80,10 @@ design_c	design --model stickslip --criterion c --target c --series 1,2 --total 
 design_bayes	design --model stick --prior 'c=normal(0.5,0.05)' --draws 8 --series 1 --points 4 --output d.csv --plot -
 design_jaeger	design --fit jaeger --series 1 --points 6 --noise abs=0.01
 simulate	simulate --model contact --series 0.8,1.2 --points 5 --seed 2 --noise 0.03
+simulate_md	simulate --model md --series 0.8 --points 3 --seed 2
+forward_md	forward --model md --input $in/md_ristow.csv --output o.csv
+forward_md_check	forward --model md --check-step --md-preset steel --input $in/md5.csv
+forward_md_bad	forward --model md --input $in/default.csv --beads 0
 regimes	regimes --law c=0.4 --xi 0.5,1,2
 EOF
 )

@@ -6,15 +6,17 @@ use super::args::{ContactArgs, OutputArgs};
 use super::values::{self, MdPreset};
 use super::{emit, read_input, CliError};
 use crate::io::forward::{scene_columns, ForwardPlan, ForwardSettings, ForwardText};
-use crate::io::md::{md_csv, md_jobs, MdTable};
+use crate::io::md::MdTable;
 use crate::io::scenes::{check_columns, Header, Table, TableReader};
 use crate::io::stream::{stream, RowPlan, StreamError, StreamOptions, Streamed};
 use crate::io::{fmt_f64, AtomicFile, InputError};
-use crate::models::md::{Md, MdParams, MdResult, MdRunConfig, MdSetting, MdSettings, ReducedMass};
+use crate::models::md::{Md, MdParams, MdRunConfig, MdSetting, MdSettings, ReducedMass};
 use crate::models::{JaegerBranch, ModelKind};
-use rayon::prelude::*;
+use crate::pipeline::RunError;
+use crate::progress::{Progress, ProgressEvent};
 use std::io::{Cursor, Read, Write};
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 /// Arguments of `fitbead forward`.
 #[derive(Debug, clap::Args)]
@@ -422,6 +424,34 @@ pub fn md_progress_bar(total: u64, what: &str) -> Option<indicatif::ProgressBar>
     Some(b)
 }
 
+/// The md runs' progress on a terminal's stderr (nothing elsewhere), drawn for tasks of at
+/// least `min_total` units.
+pub fn md_progress(min_total: u64) -> Progress {
+    let bar: Mutex<Option<indicatif::ProgressBar>> = Mutex::new(None);
+    Progress::new(move |e| {
+        let Ok(mut slot) = bar.lock() else { return };
+        match e {
+            ProgressEvent::Start { label, total, .. } => {
+                *slot = if total >= min_total {
+                    md_progress_bar(total, label)
+                } else {
+                    None
+                };
+            }
+            ProgressEvent::Position(p) => {
+                if let Some(b) = slot.as_ref() {
+                    b.set_position(p);
+                }
+            }
+            ProgressEvent::Finish => {
+                if let Some(b) = slot.take() {
+                    b.finish_and_clear();
+                }
+            }
+        }
+    })
+}
+
 fn run_md(a: &Args, t: &Table) -> Result<(), CliError> {
     let base = MdTable {
         md: build_md(
@@ -433,42 +463,12 @@ fn run_md(a: &Args, t: &Table) -> Result<(), CliError> {
         rho: a.contact.rho(),
         f: a.contact.f(),
     };
-    let jobs = md_jobs(t, &base)?;
     let stop = super::stop_flag();
-    let reps: u64 = if a.md.check_step { 3 } else { 1 };
-    let total: u64 = jobs.iter().map(|(_, m)| m.config.beads as u64 * reps).sum();
-    let bar = if total >= 2000 {
-        md_progress_bar(total, "md")
-    } else {
-        None
-    };
-    let tick = |n: u64| {
-        if let Some(b) = &bar {
-            b.inc(n);
-        }
-    };
-    let results: Vec<(MdResult, Option<f64>)> = jobs
-        .par_iter()
-        .map(|(scene, md)| {
-            let r = md.simulate_until(scene, 1.0, Some(&tick), Some(&stop));
-            let rel = if a.md.check_step {
-                let h = md.simulate_until(scene, 0.5, Some(&tick), Some(&stop));
-                match (r.mean_velocity, h.mean_velocity) {
-                    (Some(x), Some(y)) => Some(((y - x) / x).abs()),
-                    _ => None,
-                }
-            } else {
-                None
-            };
-            (r, rel)
-        })
-        .collect();
-    if let Some(b) = bar {
-        b.finish_and_clear();
-    }
-    if stop.load(std::sync::atomic::Ordering::SeqCst) {
-        return Err(CliError::Interrupted);
-    }
-    let bytes = md_csv(t, &jobs, &results).map_err(|e| CliError::Other(e.to_string()))?;
+    let bytes = crate::pipeline::md_runs(t, &base, a.md.check_step, Some(md_progress(2000)), &stop)
+        .map_err(|e| match e {
+            RunError::Input(e) => CliError::Input(e),
+            RunError::Interrupted => CliError::Interrupted,
+            e => CliError::Other(e.to_string()),
+        })?;
     emit(a.out.output.as_deref(), &bytes)
 }

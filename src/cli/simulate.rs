@@ -7,9 +7,8 @@ use super::{emit, CliError};
 use crate::models::contact::SpinRule;
 use crate::models::{JaegerBranch, ModelKind};
 use crate::pipeline::{simulate, RunError, SimulateSettings};
-use crate::progress::{Progress, ProgressEvent};
 use crate::scene::CollisionLaw;
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 /// Arguments of `fitbead simulate`.
 #[derive(Debug, clap::Args)]
@@ -78,29 +77,6 @@ pub struct Args {
     pub md: super::forward::MdArgs,
 }
 
-/// The md runs' progress on a terminal's stderr (nothing elsewhere).
-fn md_progress() -> Progress {
-    let bar: Mutex<Option<indicatif::ProgressBar>> = Mutex::new(None);
-    Progress::new(move |e| {
-        let Ok(mut slot) = bar.lock() else { return };
-        match e {
-            ProgressEvent::Start { label, total, .. } => {
-                *slot = super::forward::md_progress_bar(total, label);
-            }
-            ProgressEvent::Position(p) => {
-                if let Some(b) = slot.as_ref() {
-                    b.set_position(p);
-                }
-            }
-            ProgressEvent::Finish => {
-                if let Some(b) = slot.take() {
-                    b.finish_and_clear();
-                }
-            }
-        }
-    })
-}
-
 /// Runs `fitbead simulate`.
 pub fn run(a: Args) -> Result<(), CliError> {
     let kind = a.model;
@@ -139,7 +115,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         spin: a.spin,
         md,
         stop: Some(super::stop_flag()),
-        progress: Some(md_progress()),
+        progress: Some(super::forward::md_progress(0)),
         notes: Some(Arc::new(|n: &str| eprintln!("fitbead: note: {n}"))),
     };
     let bytes = simulate(&settings).map_err(|e| match e {

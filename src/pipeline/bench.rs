@@ -1,5 +1,4 @@
-//! The work-precision table of `fitbead bench` and the molecular-dynamics runs of `fitbead
-//! forward --model md`.
+//! `fitbead bench`: the work-precision table and the summary of its checks.
 
 use super::{setting_error, RunError};
 use crate::report::workprecision::{draw_scenes, plot, run_bench_until, BenchResult, WpRow};
@@ -74,39 +73,4 @@ pub fn work_precision(
     stop: Option<&AtomicBool>,
 ) -> Result<Vec<WpRow>, RunError> {
     bench(scenes, seed, stop).map(|b| b.result.rows)
-}
-
-/// `fitbead forward --model md` on a scene table (CSV `xi,delta_deg[,rho][,f]` and per-row md
-/// settings, as the command line reads it; `source` names it in errors): one md run of every
-/// row under `md`, as the CSV the command line writes (the input's columns, then the md
-/// columns). `rho` and `f` are those of rows without the columns. A raised `stop` ends the
-/// run with [`RunError::Interrupted`].
-pub fn forward_md(
-    table: &[u8],
-    source: &str,
-    md: crate::models::md::Md,
-    rho: f64,
-    f: f64,
-    stop: Option<&AtomicBool>,
-) -> Result<Vec<u8>, RunError> {
-    use crate::io::md::{md_csv, md_jobs, MdTable};
-    use rayon::prelude::*;
-    let t = crate::io::scenes::Table::parse(source, table)?;
-    let base = MdTable {
-        md,
-        flags: crate::models::md::MdSettings::default(),
-        rho,
-        f,
-    };
-    let jobs = md_jobs(&t, &base)?;
-    let never = AtomicBool::new(false);
-    let stop = stop.unwrap_or(&never);
-    let results: Vec<(crate::models::md::MdResult, Option<f64>)> = jobs
-        .par_iter()
-        .map(|(scene, md)| (md.simulate_until(scene, 1.0, None, Some(stop)), None))
-        .collect();
-    if stop.load(std::sync::atomic::Ordering::SeqCst) {
-        return Err(RunError::Interrupted);
-    }
-    md_csv(&t, &jobs, &results).map_err(|e| RunError::Failed(e.to_string()))
 }

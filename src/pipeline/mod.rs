@@ -13,6 +13,7 @@
 mod bench;
 mod fit_command;
 mod fit_run;
+mod forward;
 mod jaeger;
 mod jan;
 mod klaw;
@@ -20,10 +21,12 @@ mod report;
 mod simulate;
 
 pub(crate) use bench::bench;
-pub use bench::{forward_md, work_precision};
+pub use bench::work_precision;
 pub use fit_command::FitCommand;
 pub use fit_run::FitRun;
 pub(crate) use fit_run::{figure_bytes, not_converged};
+pub use forward::forward_md;
+pub(crate) use forward::md_runs;
 pub(crate) use report::law_error;
 pub use report::{report, ReportOutput, ReportSettings};
 pub(crate) use simulate::MAX_POINTS;

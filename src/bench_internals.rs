@@ -32,8 +32,9 @@ pub fn push_number_cells(out: &mut Vec<u8>, xs: &[f64]) {
 
 /// A work-precision table written by `fitbead bench --output`, re-plotted as the bench
 /// command's SVG figure under `title`.
-pub fn replot(csv_bytes: &[u8], title: &str) -> Result<String, String> {
-    crate::report::workprecision::plot(&crate::report::workprecision::read_rows(csv_bytes)?, title)
+pub fn replot(csv_bytes: &[u8], title: &str) -> Result<String, Box<dyn std::error::Error>> {
+    let rows = crate::report::workprecision::read_rows(csv_bytes)?;
+    Ok(crate::report::workprecision::plot(&rows, title)?)
 }
 
 /// `n` random scenes as python/bench/bench_forward.py draws them (ξ in [0.8, 3], the adjusted

@@ -6,7 +6,7 @@
 //! `Arc`) to the long computations (least-squares iterations and profiles through
 //! `LsqOptions::stop`, the sampler through `McmcOptions::stop`, the work-precision bench, md
 //! runs), which poll it and end early; a computation with nothing useful to return then says
-//! [`Interrupted`]. The library never installs a signal handler: the command line raises the
+//! so in its error (`RunError::Interrupted`, `Termination::Interrupted`, …). The library never installs a signal handler: the command line raises the
 //! flag on SIGINT, SIGTERM and SIGHUP.
 
 use std::fmt;
@@ -86,7 +86,7 @@ impl Tally {
 
 /// A computation stopped early because its caller raised the stop flag.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Interrupted;
+pub(crate) struct Interrupted;
 
 impl fmt::Display for Interrupted {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {

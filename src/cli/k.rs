@@ -100,7 +100,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
                 |e: std::io::Error| CliError::Other(format!("{}: cannot write: {e}", p.display()));
             let svg = ledger
                 .plot_svg(&prose_model_name(a.model))
-                .map_err(CliError::Other)?;
+                .map_err(|e| CliError::Other(e.to_string()))?;
             let bytes = a.plot.bytes(svg)?;
             let mut f = file.map_err(cannot)?;
             f.write_all(&bytes).map_err(cannot)?;

@@ -311,8 +311,9 @@ fn run_with(a: Args, shown: Option<String>) -> Result<(), CliError> {
         })
         .map(|f| out_dir.join(f))
         .collect();
-    crate::io::outdir::check_dir(&out_dir)
-        .map_err(|e| super::flag_error("--out-dir", &out_dir.display().to_string(), e))?;
+    crate::io::outdir::check_dir(&out_dir).map_err(|e| {
+        super::flag_error("--out-dir", &out_dir.display().to_string(), e.to_string())
+    })?;
     // A directory still to be made holds no input.
     let outputs: Vec<(&str, Option<&Path>)> = targets
         .iter()

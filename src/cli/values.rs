@@ -293,7 +293,10 @@ impl ValueEnum for FigureFormat {
 
 impl Choice for FigureFormat {
     fn unknown(name: &str) -> String {
-        name.parse::<FigureFormat>().err().unwrap_or_default()
+        name.parse::<FigureFormat>()
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default()
     }
 }
 
@@ -608,7 +611,7 @@ pub(crate) fn spin_text(s: &str) -> Result<String, Refusal> {
 pub(crate) fn figure_width(s: &str) -> Result<String, Refusal> {
     s.parse::<FigureWidth>()
         .map(|_| s.to_string())
-        .map_err(Refusal::new)
+        .map_err(|e| Refusal::new(e.to_string()))
 }
 
 /// A prior of a parameter named on the command line, with the flag's text.

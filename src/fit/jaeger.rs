@@ -190,7 +190,7 @@ pub(crate) fn fit_jaeger_with(
     for r in fits {
         match r {
             Ok(f) => series.push(Some(f)),
-            Err(note) => {
+            Err(Unfitted(note)) => {
                 notes.push(note);
                 series.push(None);
             }
@@ -198,6 +198,9 @@ pub(crate) fn fit_jaeger_with(
     }
     JaegerFits { series, notes }
 }
+
+/// Why a series was not fitted, as its note (`series 'LABEL': …`).
+struct Unfitted(String);
 
 /// Jaeger's law fitted to series `s` (labelled `label`) of `data` on `model`'s branch, or the
 /// note saying why not.
@@ -208,14 +211,14 @@ fn fit_jaeger_series(
     model: JaegerModel,
     level: f64,
     method: &Method,
-) -> Result<JaegerFit, String> {
+) -> Result<JaegerFit, Unfitted> {
     let branch = model.0;
     let pts: Vec<_> = data.series(s).collect();
     if pts.len() < 4 {
-        return Err(format!(
+        return Err(Unfitted(format!(
             "series '{label}': {} points, need at least 4 for a1, a2, a3",
             pts.len()
-        ));
+        )));
     }
     let x: Vec<JaegerX> = pts
         .iter()
@@ -228,15 +231,15 @@ fn fit_jaeger_series(
     let sg: Vec<f64> = pts.iter().map(|p| p.sigma).collect();
     let norm = observed_norm(y.iter().zip(&sg));
     let Some(p0) = start(&model, &x, &y, &sg) else {
-        return Err(format!(
+        return Err(Unfitted(format!(
             "series '{label}': no start with every point on the {} branch",
             branch_name(branch)
-        ));
+        )));
     };
     let problem = match WeightedData::new(model, x.clone(), y, Some(sg)) {
         Ok(p) => p,
         Err(e) => {
-            return Err(format!("series '{label}': {e}"));
+            return Err(Unfitted(format!("series '{label}': {e}")));
         }
     };
     let opts = LsqOptions {
@@ -249,7 +252,7 @@ fn fit_jaeger_series(
     let f = match fit(&problem, &p0, &opts) {
         Ok(f) => f,
         Err(e) => {
-            return Err(format!("series '{label}': {e}"));
+            return Err(Unfitted(format!("series '{label}': {e}")));
         }
     };
     let paper = paper_values(pts[0].scene.xi);

@@ -166,7 +166,10 @@ impl KLedger {
 
     /// K against the steady final velocity, one colour per series (series label, or ξ where
     /// there is none), with each series' K = cos 2α line (the paper's Fig. 5), as SVG.
-    pub fn plot_svg(&self, model_name: &str) -> Result<String, String> {
+    pub fn plot_svg(
+        &self,
+        model_name: &str,
+    ) -> Result<String, crate::report::figures::FigureError> {
         scatter_svg(&Scatter {
             title: format!("K per measurement (eq 69), {model_name} model"),
             x_label: "steady final velocity v_{f} / √(g(R + r))".into(),

@@ -25,7 +25,7 @@ use std::path::Path;
 /// Whether `dir` can take the output files before any work is done: an existing directory,
 /// or a path whose nearest existing ancestor is a directory (the missing ones are made when
 /// the files are written). The error says what stands in the way (without naming `dir`).
-pub(crate) fn check_dir(dir: &Path) -> Result<(), String> {
+pub(crate) fn check_dir(dir: &Path) -> std::io::Result<()> {
     let mut p = Some(dir);
     while let Some(d) = p {
         let d = if d.as_os_str().is_empty() {
@@ -35,15 +35,20 @@ pub(crate) fn check_dir(dir: &Path) -> Result<(), String> {
         };
         match std::fs::metadata(d) {
             Ok(m) if m.is_dir() => return Ok(()),
-            Ok(_) if d == dir => return Err("is not a directory".into()),
+            Ok(_) if d == dir => return Err(std::io::Error::other("is not a directory")),
             Ok(_) => {
-                return Err(format!(
+                return Err(std::io::Error::other(format!(
                     "cannot be created: {} is not a directory",
                     d.display()
-                ))
+                )))
             }
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => p = d.parent(),
-            Err(e) => return Err(format!("cannot be created: {}: {e}", d.display())),
+            Err(e) => {
+                return Err(std::io::Error::other(format!(
+                    "cannot be created: {}: {e}",
+                    d.display()
+                )))
+            }
         }
     }
     Ok(())

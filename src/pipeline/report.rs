@@ -15,7 +15,7 @@ use crate::io::scenes::Table;
 use crate::numfmt::fmt_f64;
 use crate::report::analysis::{analyse, Analysis};
 use crate::report::bands::PosteriorBands;
-use crate::report::figures::{FigureFormat, FigureWidth};
+use crate::report::figures::{FigureError, FigureFormat, FigureWidth};
 use crate::report::text::{markdown, one_line, terminal_summary, ReportContext};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -264,7 +264,9 @@ pub fn report(
     let md = report_markdown(&an, &context, s, &not_converged);
     warnings.extend(not_converged);
     files.push(("report.md".into(), md.into_bytes()));
-    let files = format.apply(files).map_err(RunError::Failed)?;
+    let files = format
+        .apply(files)
+        .map_err(|e| RunError::Failed(e.to_string()))?;
     // A stop that came while the tables and figures were drawn: nothing is written.
     if s.stopped() && !interrupted {
         return Err(RunError::Interrupted);
@@ -295,11 +297,11 @@ fn figure_settings(s: &ReportSettings) -> Result<(FigureFormat, Option<FigureWid
     let format: FigureFormat = s
         .format
         .parse()
-        .map_err(|e: String| flag_error("--format", &s.format, e))?;
+        .map_err(|e: FigureError| flag_error("--format", &s.format, e.to_string()))?;
     let figure_width: Option<FigureWidth> = match &s.figure_width {
         Some(w) => Some(
             w.parse()
-                .map_err(|e: String| flag_error("--figure-width", w, e))?,
+                .map_err(|e: FigureError| flag_error("--figure-width", w, e.to_string()))?,
         ),
         None => None,
     };
@@ -462,7 +464,7 @@ impl Figures<'_> {
     /// Draws the figures and the corner plots onto `files`; the corner plots' names.
     fn draw(&self, files: &mut Vec<(String, Vec<u8>)>) -> Result<Vec<String>, RunError> {
         let (an, bands, units_m_s) = (self.an, self.bands, self.units_m_s);
-        let fig = |name: &str, r: Result<String, String>| {
+        let fig = |name: &str, r: Result<String, FigureError>| {
             r.map(|s| (name.to_string(), s.into_bytes()))
                 .map_err(|e| RunError::Failed(format!("figure {name}: {e}")))
         };

@@ -6,11 +6,11 @@
 use super::analysis::{k_of_c, lsq, Analysis};
 use super::bands::{lsq_band, Curve, PosteriorBands};
 use super::figures::corner::{corner_figure, CornerBlock};
-use super::figures::ErrPoint;
 use super::figures::{
     coincide, scatter_panel, series_style, Anchor, Axis, Figure, Item, LegendEntry, Mark, Panel,
     PointSeries, Scatter, Stroke, DASHES, PALETTE,
 };
+use super::figures::{ErrPoint, FigureError};
 use crate::design::{DesignResult, DesignSettings};
 use crate::fit::data::Dataset;
 use crate::fit::jaeger::{paper_values, JaegerModel};
@@ -185,7 +185,7 @@ impl Analysis {
         &self,
         bands: Option<&PosteriorBands>,
         units_m_s: Option<&[f64]>,
-    ) -> Result<String, String> {
+    ) -> Result<String, FigureError> {
         let unit = |s: usize| units_m_s.and_then(|u| u.get(s).copied()).unwrap_or(1.0);
         let v_label = if units_m_s.is_some() {
             "mean velocity v\u{304} (m/s)"
@@ -404,7 +404,7 @@ impl Analysis {
     /// Figure: v̄²/cos δ against tan δ with Jan's straight lines (the paper's Fig. 8), each
     /// series' points and line in one colour; with `units_m_s` (per series, as for
     /// [`Analysis::velocity_figure_with`]) v̄² in m²/s².
-    pub fn jan_figure(&self, units_m_s: Option<&[f64]>) -> Result<String, String> {
+    pub fn jan_figure(&self, units_m_s: Option<&[f64]>) -> Result<String, FigureError> {
         let unit = |s: usize| units_m_s.and_then(|u| u.get(s).copied()).unwrap_or(1.0);
         let y_label = if units_m_s.is_some() {
             "v\u{304}^{2} / cos δ  (m^{2}/s^{2})"
@@ -475,7 +475,7 @@ impl Analysis {
     /// Figure: K per point (eq 69, stick/slip) against the steady final velocity (the
     /// paper's Figs. 5–6), with each series' K = cos 2α; with `units_m_s` (per series, as
     /// for [`Analysis::velocity_figure_with`]) the velocity in m/s.
-    pub fn k_figure(&self, units_m_s: Option<&[f64]>) -> Result<String, String> {
+    pub fn k_figure(&self, units_m_s: Option<&[f64]>) -> Result<String, FigureError> {
         let unit = |s: usize| units_m_s.and_then(|u| u.get(s).copied()).unwrap_or(1.0);
         let ks = self.k_points(Model::StickSlip);
         let series = ks
@@ -511,7 +511,7 @@ impl Analysis {
 
     /// Figure: K per point (eq 69) against α under each contact model, with its fitted law c,
     /// its per-series K and K = cos 2α.
-    pub fn k_alpha_figure(&self) -> Result<String, String> {
+    pub fn k_alpha_figure(&self) -> Result<String, FigureError> {
         let alphas: Vec<f64> = self.data.points.iter().map(|p| p.scene.alpha).collect();
         let a0 = alphas.iter().copied().fold(f64::INFINITY, f64::min);
         let a1 = alphas.iter().copied().fold(f64::NEG_INFINITY, f64::max);
@@ -585,7 +585,7 @@ impl Analysis {
     /// shaded between the model's own limits — δ_m (eq 32) and δ_d (eq 31) for rolling, the
     /// ends of the steady interval found by scanning the model for stick/slip — the critical
     /// ξ marked, and the points by the regime the model assigns them.
-    pub fn regime_figure(&self) -> Result<String, String> {
+    pub fn regime_figure(&self) -> Result<String, FigureError> {
         let rho = self.rho();
         let f = self.data.points.first().map_or(0.1, |p| p.scene.f);
         let n = 48;
@@ -699,7 +699,7 @@ impl Analysis {
     /// Figure: Jaeger's plane (the paper's Figs. 9–10): Jaeger's velocity u against tan δ per
     /// series, with the fitted law (eq 83) on both branches of eq 84 and its bistable band
     /// (eq 90), and the paper's Fig. 9 law where ξ is one of its series.
-    pub fn jaeger_figure(&self) -> Result<String, String> {
+    pub fn jaeger_figure(&self) -> Result<String, FigureError> {
         let fit_stroke = Stroke::solid(PALETTE[3], 2.2);
         let lower_stroke = Stroke::solid(PALETTE[3], 2.2).dashed(DASHES[0]);
         let paper_stroke = Stroke::solid(REFERENCE, 1.6).dashed(DASHES[1]);
@@ -779,7 +779,7 @@ impl Analysis {
     /// Figure: the energy partition of every point under each contact model at its law-c
     /// fit: collision loss in translation and in spin and friction work, as fractions of the
     /// potential drop 2 sin α sin δ (the data of `energy.csv`), stacked per point.
-    pub fn energy_figure(&self) -> Result<String, String> {
+    pub fn energy_figure(&self) -> Result<String, FigureError> {
         let parts = [
             ("collision, translation", PALETTE[0]),
             ("collision, spin", PALETTE[4]),
@@ -899,7 +899,7 @@ impl Analysis {
     /// coloured by series, with the ±2 lines, of `fits` as [`Analysis::fit_results`] or
     /// [`Analysis::fit_results_at`] give them (under a posterior run, residuals at the
     /// posterior medians); fits of one name make one panel.
-    pub fn residuals_figure_with(&self, fits: &[FitResult]) -> Result<String, String> {
+    pub fn residuals_figure_with(&self, fits: &[FitResult]) -> Result<String, FigureError> {
         let mut groups: Vec<(String, Vec<&FitResult>)> = Vec::new();
         for f in fits {
             match groups.iter_mut().find(|g| g.0 == f.stats.fit) {
@@ -1264,7 +1264,7 @@ pub fn lsq_fit_figure(
     title: &str,
     data: &Dataset,
     fits: &[(&FitResult, Curve)],
-) -> Result<String, String> {
+) -> Result<String, FigureError> {
     let mut names: Vec<&str> = Vec::new();
     for (f, _) in fits {
         if !names.contains(&f.stats.fit.as_str()) {
@@ -1330,7 +1330,7 @@ pub fn lsq_fit_figure(
         panels.push(p);
     }
     if panels.is_empty() {
-        return Err("no series to draw".to_string());
+        return Err(FigureError::Empty("no series to draw".to_string()));
     }
     let cols = panels.len().min(2);
     let mut f = Figure::new(title, cols, GRID_PLOT, panels);
@@ -1351,62 +1351,6 @@ pub fn lsq_fit_figure(
         0.3,
     ));
     Ok(f.to_svg())
-}
-
-#[cfg(test)]
-mod tests {
-    use crate::fit::data::Dataset;
-    use crate::inverse::posterior::Method;
-    use crate::report::analysis::analyse;
-    use crate::report::bands::{Band, PosteriorBands};
-
-    /// A posterior band under a model's curve in the velocity figure is drawn in that model's
-    /// colour (Jaeger's, #CC79A7, at the band's opacity 0.18 over white), under the data,
-    /// with its legend entry.
-    #[test]
-    fn velocity_band_renders_under_the_curve() {
-        let ds = Dataset::default_data();
-        let an = analyse(&ds, 0.95, &Method::lsq(false));
-        let delta_deg: Vec<f64> = (0..=20).map(|i| 11.0 + 2.5 * i as f64 / 20.0).collect();
-        let line =
-            |a: f64| -> Vec<f64> { delta_deg.iter().map(|d| a + 0.03 * (d - 11.0)).collect() };
-        let bands = PosteriorBands {
-            bands: vec![Band {
-                fit: "jaeger".into(),
-                series: ds.labels[0].clone(),
-                xi: 0.8,
-                q05: line(0.30),
-                q50: line(0.32),
-                q95: line(0.34),
-                delta_deg: delta_deg.clone(),
-                draws: 1000,
-            }],
-            points: Vec::new(),
-        };
-        let svg = an.velocity_figure_with(Some(&bands), None).unwrap();
-        assert!(svg.contains("posterior band"));
-        let band = svg.find("fill-opacity=\"0.25\"").expect("a band");
-        let first_marker = svg.find("<circle").expect("markers");
-        assert!(band < first_marker, "the band is drawn under the data");
-        #[cfg(feature = "png")]
-        {
-            // #CC79A7 = (204, 121, 167) at opacity 0.18 over white, and at full opacity.
-            let pixmap = crate::report::figures::png::render_pixmap(&svg, 1.0).unwrap();
-            let mix = |c: f64| (0.18 * c + 0.82 * 255.0_f64).round() as i32;
-            for want in [[mix(204.0), mix(121.0), mix(167.0)], [204, 121, 167]] {
-                let n = pixmap
-                    .pixels()
-                    .iter()
-                    .filter(|p| {
-                        (p.red() as i32 - want[0]).abs() <= 6
-                            && (p.green() as i32 - want[1]).abs() <= 6
-                            && (p.blue() as i32 - want[2]).abs() <= 6
-                    })
-                    .count();
-                assert!(n >= 20, "colour {want:?} on {n} pixels");
-            }
-        }
-    }
 }
 
 /// The figure: per series, the sensitivity of every candidate slope with the chosen ones
@@ -1497,4 +1441,60 @@ pub(crate) fn design_figure(s: &DesignSettings, r: &DesignResult) -> Figure {
         })
         .collect();
     f
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::fit::data::Dataset;
+    use crate::inverse::posterior::Method;
+    use crate::report::analysis::analyse;
+    use crate::report::bands::{Band, PosteriorBands};
+
+    /// A posterior band under a model's curve in the velocity figure is drawn in that model's
+    /// colour (Jaeger's, #CC79A7, at the band's opacity 0.18 over white), under the data,
+    /// with its legend entry.
+    #[test]
+    fn velocity_band_renders_under_the_curve() {
+        let ds = Dataset::default_data();
+        let an = analyse(&ds, 0.95, &Method::lsq(false));
+        let delta_deg: Vec<f64> = (0..=20).map(|i| 11.0 + 2.5 * i as f64 / 20.0).collect();
+        let line =
+            |a: f64| -> Vec<f64> { delta_deg.iter().map(|d| a + 0.03 * (d - 11.0)).collect() };
+        let bands = PosteriorBands {
+            bands: vec![Band {
+                fit: "jaeger".into(),
+                series: ds.labels[0].clone(),
+                xi: 0.8,
+                q05: line(0.30),
+                q50: line(0.32),
+                q95: line(0.34),
+                delta_deg: delta_deg.clone(),
+                draws: 1000,
+            }],
+            points: Vec::new(),
+        };
+        let svg = an.velocity_figure_with(Some(&bands), None).unwrap();
+        assert!(svg.contains("posterior band"));
+        let band = svg.find("fill-opacity=\"0.25\"").expect("a band");
+        let first_marker = svg.find("<circle").expect("markers");
+        assert!(band < first_marker, "the band is drawn under the data");
+        #[cfg(feature = "png")]
+        {
+            // #CC79A7 = (204, 121, 167) at opacity 0.18 over white, and at full opacity.
+            let pixmap = crate::report::figures::png::render_pixmap(&svg, 1.0).unwrap();
+            let mix = |c: f64| (0.18 * c + 0.82 * 255.0_f64).round() as i32;
+            for want in [[mix(204.0), mix(121.0), mix(167.0)], [204, 121, 167]] {
+                let n = pixmap
+                    .pixels()
+                    .iter()
+                    .filter(|p| {
+                        (p.red() as i32 - want[0]).abs() <= 6
+                            && (p.green() as i32 - want[1]).abs() <= 6
+                            && (p.blue() as i32 - want[2]).abs() <= 6
+                    })
+                    .count();
+                assert!(n >= 20, "colour {want:?} on {n} pixels");
+            }
+        }
+    }
 }

@@ -12,6 +12,7 @@ use crate::models::slip::SlipPhase;
 use crate::models::{slip, stick, stickquad, stickslip, Model, Outcome, Phases};
 use crate::progress::Interrupted;
 use crate::record::to_csv;
+use crate::report::figures::FigureError;
 use crate::scene::Scene;
 use crate::special::quad::{integrate, QuadOptions};
 use serde::Serialize;
@@ -739,21 +740,27 @@ pub fn render(rows: &[WpRow]) -> csv::Result<Vec<u8>> {
 /// Reads back the rows [`render`] wrote (a `bench --output` file), to re-plot measured rows
 /// without measuring again. An empty error cell reads as NaN, `inf` as infinity.
 #[cfg(any(test, feature = "bench-internals"))]
-pub(crate) fn read_rows(csv_bytes: &[u8]) -> Result<Vec<WpRow>, String> {
+pub(crate) fn read_rows(csv_bytes: &[u8]) -> std::io::Result<Vec<WpRow>> {
+    use std::io::Error;
     let mut r = csv::Reader::from_reader(csv_bytes);
-    let h = r.headers().map_err(|e| e.to_string())?.clone();
+    let h = r.headers().map_err(Error::other)?.clone();
     let columns = crate::record::columns::<WpRow>();
     if h.iter().collect::<Vec<_>>() != columns {
-        return Err(format!("expected the columns {}", columns.join(",")));
+        return Err(Error::other(format!(
+            "expected the columns {}",
+            columns.join(",")
+        )));
     }
-    let num = |s: &str| -> Result<f64, String> {
+    let num = |s: &str| -> std::io::Result<f64> {
         match s {
             "" => Ok(f64::NAN),
             "inf" => Ok(f64::INFINITY),
-            _ => s.parse().map_err(|_| format!("not a number: {s:?}")),
+            _ => s
+                .parse()
+                .map_err(|_| Error::other(format!("not a number: {s:?}"))),
         }
     };
-    let opt = |s: &str| -> Result<Option<f64>, String> {
+    let opt = |s: &str| -> std::io::Result<Option<f64>> {
         if s.is_empty() {
             Ok(None)
         } else {
@@ -762,14 +769,14 @@ pub(crate) fn read_rows(csv_bytes: &[u8]) -> Result<Vec<WpRow>, String> {
     };
     let mut rows = Vec::new();
     for rec in r.records() {
-        let rec = rec.map_err(|e| e.to_string())?;
+        let rec = rec.map_err(Error::other)?;
         rows.push(WpRow {
             model: rec[0].to_string(),
             method: rec[1].to_string(),
             tol: opt(&rec[2])?,
             scenes: rec[3]
                 .parse()
-                .map_err(|_| format!("not a count: {:?}", &rec[3]))?,
+                .map_err(|_| Error::other(format!("not a count: {:?}", &rec[3])))?,
             err_median: num(&rec[4])?,
             err_p99: num(&rec[5])?,
             err_max: num(&rec[6])?,
@@ -785,7 +792,7 @@ pub(crate) fn read_rows(csv_bytes: &[u8]) -> Result<Vec<WpRow>, String> {
 /// points, the legend outside the plot. A method that is invalid on some scenes (infinite
 /// maximum error) is drawn at its median error and says so in its label; errors below 1e-17
 /// are drawn at 1e-17.
-pub(crate) fn plot(rows: &[WpRow], title: &str) -> Result<String, String> {
+pub(crate) fn plot(rows: &[WpRow], title: &str) -> Result<String, FigureError> {
     use super::figures::{series_style, Axis, Figure, LegendEntry, Panel, Stroke};
     let floor = 1e-17f64;
     // (row, error, time, drawn at the median error)

@@ -8,6 +8,7 @@
 
 use super::plot::{Axis, Figure, Item, LegendEntry, Panel, PALETTE};
 use super::svg::{Mark, Stroke};
+use super::FigureError;
 use crate::fit::posterior::draws_column;
 use crate::fit::summary::FitResult;
 
@@ -431,7 +432,7 @@ fn pair(x: &[f64], y: &[f64], xr: (f64, f64), yr: (f64, f64), xa: Axis, ya: Axis
 }
 
 /// Corner plots of `blocks`, one under the other in one SVG document.
-pub fn corner_svg(blocks: &[CornerBlock]) -> Result<String, String> {
+pub fn corner_svg(blocks: &[CornerBlock]) -> Result<String, FigureError> {
     let figs: Vec<Figure> = blocks.iter().map(corner_figure).collect();
     Ok(super::plot::stack_svg(&figs))
 }

@@ -21,6 +21,23 @@ pub(crate) mod png;
 pub(crate) mod svg;
 
 pub use corner::{corner_svg, CornerBlock};
+
+/// Why a figure could not be drawn, rendered to PNG or converted to PDF. The message names the
+/// figure where there are several.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum FigureError {
+    /// There is nothing to draw (the message says what is missing).
+    #[error("{0}")]
+    Empty(String),
+    /// The SVG document could not be rendered or converted, or the format needs a crate
+    /// feature (`png`, `pdf`) this build lacks.
+    #[error("{0}")]
+    Render(String),
+    /// A figure setting (format, print width) that cannot be used.
+    #[error("{0}")]
+    Setting(String),
+}
 pub(crate) use plot::{
     coincide, Axis, ErrPoint, Figure, Item, LegendEntry, Panel, DASHES, PALETTE,
 };
@@ -77,7 +94,7 @@ pub(crate) fn scatter_panel(fig: &Scatter) -> Panel {
 }
 
 /// Renders a scatter figure to an SVG document.
-pub(crate) fn scatter_svg(fig: &Scatter) -> Result<String, String> {
+pub(crate) fn scatter_svg(fig: &Scatter) -> Result<String, FigureError> {
     Ok(Figure::new(&fig.title, 1, (720.0, 460.0), vec![scatter_panel(fig)]).to_svg())
 }
 
@@ -106,21 +123,24 @@ impl FigureWidth {
 }
 
 impl std::str::FromStr for FigureWidth {
-    type Err = String;
+    type Err = FigureError;
     /// `single`, `double`, or a width in mm (`120`, or `120mm`).
-    fn from_str(s: &str) -> Result<Self, String> {
+    fn from_str(s: &str) -> Result<Self, FigureError> {
         let t = s.trim().to_ascii_lowercase();
         match t.as_str() {
             "single" => return Ok(FigureWidth::Single),
             "double" => return Ok(FigureWidth::Double),
             _ => {}
         }
-        let mm: f64 =
-            t.trim_end_matches("mm").trim().parse().map_err(|_| {
-                "must be single (86 mm), double (178 mm) or a width in mm".to_string()
-            })?;
+        let mm: f64 = t.trim_end_matches("mm").trim().parse().map_err(|_| {
+            FigureError::Setting(
+                "must be single (86 mm), double (178 mm) or a width in mm".to_string(),
+            )
+        })?;
         if !(40.0..=500.0).contains(&mm) {
-            return Err("a width in mm must be between 40 and 500".into());
+            return Err(FigureError::Setting(
+                "a width in mm must be between 40 and 500".into(),
+            ));
         }
         Ok(FigureWidth::Mm(mm))
     }
@@ -143,15 +163,17 @@ pub(crate) enum FigureFormat {
 }
 
 impl std::str::FromStr for FigureFormat {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = FigureError;
+    fn from_str(s: &str) -> Result<Self, FigureError> {
         match s.trim().to_ascii_lowercase().as_str() {
             "svg" => Ok(FigureFormat::Svg),
             "png" => Ok(FigureFormat::Png),
             "pdf" => Ok(FigureFormat::Pdf),
             "both" => Ok(FigureFormat::Both),
             "all" => Ok(FigureFormat::All),
-            _ => Err("must be svg, png, pdf, both (svg and png) or all".into()),
+            _ => Err(FigureError::Setting(
+                "must be svg, png, pdf, both (svg and png) or all".into(),
+            )),
         }
     }
 }
@@ -180,7 +202,10 @@ impl FigureFormat {
     /// `files` (name, bytes) with every `*.svg` written in this format: kept, rendered to PNG
     /// (`png::svg_to_png` at `png::REPORT_SCALE`), converted to PDF, or several of these.
     /// Without the `png` or `pdf` feature such a format is an error.
-    pub fn apply(self, files: Vec<(String, Vec<u8>)>) -> Result<Vec<(String, Vec<u8>)>, String> {
+    pub fn apply(
+        self,
+        files: Vec<(String, Vec<u8>)>,
+    ) -> Result<Vec<(String, Vec<u8>)>, FigureError> {
         if self == FigureFormat::Svg {
             return Ok(files);
         }
@@ -205,33 +230,35 @@ impl FigureFormat {
 }
 
 #[cfg(feature = "png")]
-fn render_png(name: &str, svg: &[u8]) -> Result<Vec<u8>, String> {
-    let text = std::str::from_utf8(svg).map_err(|e| format!("{name}: {e}"))?;
+fn render_png(name: &str, svg: &[u8]) -> Result<Vec<u8>, FigureError> {
+    let render = |e: &dyn std::fmt::Display| FigureError::Render(format!("{name}: {e}"));
+    let text = std::str::from_utf8(svg).map_err(|e| render(&e))?;
     // A figure sized for print (width in mm) is rendered at 300 dots per inch.
     let scale = if svg::print_sized(text) {
         png::PRINT_SCALE
     } else {
         png::REPORT_SCALE
     };
-    png::svg_to_png(text, scale).map_err(|e| format!("{name}: {e}"))
+    png::svg_to_png(text, scale).map_err(|e| render(&e))
 }
 
 #[cfg(not(feature = "png"))]
-fn render_png(name: &str, _svg: &[u8]) -> Result<Vec<u8>, String> {
-    Err(format!(
+fn render_png(name: &str, _svg: &[u8]) -> Result<Vec<u8>, FigureError> {
+    Err(FigureError::Render(format!(
         "{name}: PNG figures need the crate feature `png` (built without it)"
-    ))
+    )))
 }
 
 #[cfg(feature = "pdf")]
-fn render_pdf(name: &str, svg: &[u8]) -> Result<Vec<u8>, String> {
-    let text = std::str::from_utf8(svg).map_err(|e| format!("{name}: {e}"))?;
-    pdf::svg_to_pdf(text).map_err(|e| format!("{name}: {e}"))
+fn render_pdf(name: &str, svg: &[u8]) -> Result<Vec<u8>, FigureError> {
+    let render = |e: &dyn std::fmt::Display| FigureError::Render(format!("{name}: {e}"));
+    let text = std::str::from_utf8(svg).map_err(|e| render(&e))?;
+    pdf::svg_to_pdf(text).map_err(|e| render(&e))
 }
 
 #[cfg(not(feature = "pdf"))]
-fn render_pdf(name: &str, _svg: &[u8]) -> Result<Vec<u8>, String> {
-    Err(format!(
+fn render_pdf(name: &str, _svg: &[u8]) -> Result<Vec<u8>, FigureError> {
+    Err(FigureError::Render(format!(
         "{name}: PDF figures need the crate feature `pdf` (built without it)"
-    ))
+    )))
 }

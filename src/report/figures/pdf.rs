@@ -3,20 +3,21 @@
 //! text selectable, and it looks like the PNG.
 
 use super::png::parse;
+use super::FigureError;
 
 /// The resolution at which SVG px become PDF points: 96 px to the inch, the CSS pixel, so that
 /// a document sized in mm prints at that size.
 const PX_PER_INCH: f32 = 96.0;
 
 /// Converts an SVG document to PDF bytes: one page the size of the document.
-pub(crate) fn svg_to_pdf(svg: &str) -> Result<Vec<u8>, String> {
+pub(crate) fn svg_to_pdf(svg: &str) -> Result<Vec<u8>, FigureError> {
     let tree = parse(svg)?;
     svg2pdf::to_pdf(
         &tree,
         svg2pdf::ConversionOptions::default(),
         svg2pdf::PageOptions { dpi: PX_PER_INCH },
     )
-    .map_err(|e| format!("cannot convert to PDF: {e}"))
+    .map_err(|e| FigureError::Render(format!("cannot convert to PDF: {e}")))
 }
 
 #[cfg(test)]

@@ -2,6 +2,7 @@
 //! renders the same on a machine with no system fonts, and nothing outside the crate decides
 //! how a figure looks.
 
+use super::FigureError;
 use resvg::{tiny_skia, usvg};
 
 /// The embedded font: a subset of DejaVu Sans 2.37 (Latin, Greek, combining marks, punctuation,
@@ -25,21 +26,27 @@ pub fn options() -> usvg::Options<'static> {
 }
 
 /// Parses an SVG document with [`options`].
-pub fn parse(svg: &str) -> Result<usvg::Tree, String> {
-    usvg::Tree::from_str(svg, &options()).map_err(|e| format!("not a valid SVG document: {e}"))
+pub fn parse(svg: &str) -> Result<usvg::Tree, FigureError> {
+    usvg::Tree::from_str(svg, &options())
+        .map_err(|e| FigureError::Render(format!("not a valid SVG document: {e}")))
 }
 
 /// Renders an SVG document at `scale` (1: one pixel per SVG unit) on a white background to a
 /// pixmap.
-pub fn render_pixmap(svg: &str, scale: f32) -> Result<tiny_skia::Pixmap, String> {
+pub fn render_pixmap(svg: &str, scale: f32) -> Result<tiny_skia::Pixmap, FigureError> {
     let tree = parse(svg)?;
     let size = tree
         .size()
         .to_int_size()
         .scale_by(scale)
-        .ok_or("empty figure")?;
-    let mut pixmap = tiny_skia::Pixmap::new(size.width(), size.height())
-        .ok_or_else(|| format!("cannot allocate {}×{} px", size.width(), size.height()))?;
+        .ok_or_else(|| FigureError::Empty("empty figure".into()))?;
+    let mut pixmap = tiny_skia::Pixmap::new(size.width(), size.height()).ok_or_else(|| {
+        FigureError::Render(format!(
+            "cannot allocate {}×{} px",
+            size.width(),
+            size.height()
+        ))
+    })?;
     pixmap.fill(tiny_skia::Color::WHITE);
     resvg::render(
         &tree,
@@ -50,10 +57,10 @@ pub fn render_pixmap(svg: &str, scale: f32) -> Result<tiny_skia::Pixmap, String>
 }
 
 /// Renders an SVG document to PNG bytes at `scale`.
-pub(crate) fn svg_to_png(svg: &str, scale: f32) -> Result<Vec<u8>, String> {
+pub(crate) fn svg_to_png(svg: &str, scale: f32) -> Result<Vec<u8>, FigureError> {
     render_pixmap(svg, scale)?
         .encode_png()
-        .map_err(|e| format!("cannot encode PNG: {e}"))
+        .map_err(|e| FigureError::Render(format!("cannot encode PNG: {e}")))
 }
 
 /// The pixel scale of the PNG files `fitbead report --format png` writes (2: sharp on a

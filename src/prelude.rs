@@ -7,7 +7,7 @@ pub use crate::fit::data::Dataset;
 pub use crate::fit::error::FitError;
 pub use crate::fit::k::{estimate as estimate_k, KEstimate, KFailure};
 pub use crate::fit::klaw::KLaw;
-pub use crate::fit::report::FitSet;
+pub use crate::fit::summary::FitSet;
 pub use crate::fit::summary::{FitResult, ParamRow, PointFit};
 pub use crate::inverse::posterior::{McmcSettings, Prior};
 pub use crate::io::measurements::MeasurementDefaults;

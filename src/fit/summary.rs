@@ -326,7 +326,8 @@ impl std::fmt::Display for McmcFailure {
 
 /// One fit: its parameters with their uncertainties, its statistics, the correlations, every
 /// point against the fitted curve and, for a posterior run, the draws. `Display` prints a
-/// one-screen fit report (see [`super::report`]).
+/// one-screen fit report, in the spirit of lmfit's `fit_report`: the statistics, each
+/// parameter ± standard error with its interval, the correlations above 0.1 and warnings.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FitResult {
     /// One row per parameter.
@@ -897,5 +898,30 @@ pub(crate) fn join(a: &str, b: &str) -> String {
         (true, _) => b.to_string(),
         (_, true) => a.to_string(),
         _ => format!("{a}; {b}"),
+    }
+}
+
+/// Several fits made together (Jan's per-series and global laws, Jaeger's per-series fits), with
+/// the reasons any fit was not made.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FitSet {
+    /// The fits, in the order they were made.
+    pub fits: Vec<FitResult>,
+    /// Why a fit was not made (too few points in a series, no start, …).
+    pub notes: Vec<String>,
+}
+
+impl FitSet {
+    /// The fit named `name` (e.g. `jan-series`) of series `series` (`all` for a fit across
+    /// series).
+    pub fn get(&self, name: &str, series: &str) -> Option<&FitResult> {
+        self.fits
+            .iter()
+            .find(|f| f.stats.fit == name && f.stats.series == series)
+    }
+
+    /// Whether every fit converged.
+    pub fn converged(&self) -> bool {
+        self.fits.iter().all(|f| f.converged())
     }
 }

@@ -7,6 +7,7 @@
 mod atomic;
 pub(crate) mod cells;
 mod csvsyntax;
+pub(crate) mod fit_tables;
 pub mod forward;
 pub mod kstream;
 pub(crate) mod md;
@@ -14,7 +15,6 @@ pub mod measurements;
 pub(crate) mod outdir;
 mod ranges;
 pub mod records;
-pub(crate) mod reports;
 pub(crate) mod scenes;
 pub(crate) mod stream;
 

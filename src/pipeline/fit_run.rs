@@ -5,7 +5,7 @@
 use super::RunError;
 use crate::fit::data::Dataset;
 use crate::fit::summary::{FitResult, ParamRow, StatsRow};
-use crate::io::reports::{draws_csv, params_csv, stats_csv};
+use crate::io::fit_tables::{draws_csv, params_csv, stats_csv};
 use crate::report::bands::Curve;
 use crate::report::figures::{corner_svg, CornerBlock, FigureFormat};
 use crate::report::file_stems;

@@ -198,11 +198,11 @@ pub fn report(
     let stats = flag_absurd_misfits(stats, &mut warnings);
     files.push((
         "params.csv".into(),
-        crate::io::reports::params_csv(&params).map_err(csv_error)?,
+        crate::io::fit_tables::params_csv(&params).map_err(csv_error)?,
     ));
     files.push((
         "stats.csv".into(),
-        crate::io::reports::stats_csv(&stats).map_err(csv_error)?,
+        crate::io::fit_tables::stats_csv(&stats).map_err(csv_error)?,
     ));
     // Velocities in m/s on the figures: each series' unit sqrt(g R (1 + ξ)).
     let si = si_conversion(t, &s.defaults);
@@ -214,11 +214,11 @@ pub fn report(
     let fit_refs: Vec<&crate::fit::summary::FitResult> = fits.iter().collect();
     files.push((
         "residuals.csv".into(),
-        crate::io::reports::residuals_csv(&fit_refs).map_err(csv_error)?,
+        crate::io::fit_tables::residuals_csv(&fit_refs).map_err(csv_error)?,
     ));
     files.push((
         "correlations.csv".into(),
-        crate::io::reports::correlations_csv(&fit_refs).map_err(csv_error)?,
+        crate::io::fit_tables::correlations_csv(&fit_refs).map_err(csv_error)?,
     ));
     let figures = Figures {
         an: &an,

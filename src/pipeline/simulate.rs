@@ -403,7 +403,7 @@ fn trace(
     v0: f64,
     model: Contact,
 ) -> Result<Vec<u8>, RunError> {
-    use crate::io::reports::transient_csv;
+    use crate::io::fit_tables::transient_csv;
     if !(v0.is_finite() && v0 >= 0.0) {
         return Err(flag_error(
             "--v0",

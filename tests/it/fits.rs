@@ -11,7 +11,7 @@
 use fitbead::fit::builder::{JaegerFitter, JanFitter, KLawFitter};
 use fitbead::fit::data::Dataset;
 use fitbead::fit::klaw::KLaw;
-use fitbead::fit::report::FitSet;
+use fitbead::fit::summary::FitSet;
 use fitbead::fit::summary::{FitResult, ParamRow};
 use fitbead::models::jaeger::Jaeger;
 use fitbead::models::jan::Jan;

@@ -1,4 +1,4 @@
-//! The CSV schemas of the fit reports: one row per parameter (`--output`, params.csv), one row
+//! The CSV tables of the fits: one row per parameter (`--output`, params.csv), one row
 //! of statistics per fit (`--output-stats`, stats.csv), the posterior draws (`--draws`), and the
 //! contact model's bead-by-bead transient (`simulate --v0`), and every point against its fit
 //! (residuals.csv) and every pair of parameters with its correlation (correlations.csv).

@@ -4,38 +4,13 @@
 //! above 0.1 in magnitude, and warnings (a parameter on a bound of its box, a posterior run
 //! that did not converge).
 
-use super::summary::{FitResult, ParamRow};
+use super::summary::{FitResult, FitSet, ParamRow};
 use crate::inverse::SigmaKind;
 use crate::numfmt::{clip, fmt_sig};
 use std::fmt;
 
 /// Correlations at or below this magnitude are left out of the report.
-pub(crate) const CORRELATION_SHOWN: f64 = 0.1;
-
-/// Several fits made together (Jan's per-series and global laws, Jaeger's per-series fits), with
-/// the reasons any fit was not made.
-#[derive(Debug, Clone, PartialEq)]
-pub struct FitSet {
-    /// The fits, in the order they were made.
-    pub fits: Vec<FitResult>,
-    /// Why a fit was not made (too few points in a series, no start, …).
-    pub notes: Vec<String>,
-}
-
-impl FitSet {
-    /// The fit named `name` (e.g. `jan-series`) of series `series` (`all` for a fit across
-    /// series).
-    pub fn get(&self, name: &str, series: &str) -> Option<&FitResult> {
-        self.fits
-            .iter()
-            .find(|f| f.stats.fit == name && f.stats.series == series)
-    }
-
-    /// Whether every fit converged.
-    pub fn converged(&self) -> bool {
-        self.fits.iter().all(|f| f.converged())
-    }
-}
+const CORRELATION_SHOWN: f64 = 0.1;
 
 fn num(x: f64) -> String {
     fmt_sig(x, 6)

@@ -134,11 +134,16 @@ impl Analysis {
             let k = k_of_c(s0.alpha, lsq(r));
             grid.par_iter()
                 .map(|&d| {
-                    let v =
-                        crate::Scene::from_radians(s0.xi, d, s0.rho, s0.f, CollisionLaw::Value(k))
-                            .ok()
-                            .and_then(|sc| c.model.evaluate(&sc).ok())
-                            .map_or(f64::NAN, |st| st.mean_velocity);
+                    let v = crate::scene::Scene::from_radians(
+                        s0.xi,
+                        d,
+                        s0.rho,
+                        s0.f,
+                        CollisionLaw::Value(k),
+                    )
+                    .ok()
+                    .and_then(|sc| c.model.evaluate(&sc).ok())
+                    .map_or(f64::NAN, |st| st.mean_velocity);
                     (d.to_degrees(), v)
                 })
                 .collect()

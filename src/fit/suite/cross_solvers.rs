@@ -20,7 +20,8 @@ use crate::inverse::{fit, Fit, LeastSquares, LsqOptions, Residuals, WeightedData
 use crate::models::jaeger::Jaeger;
 use crate::models::regimes::regime_b_interval;
 use crate::models::JaegerBranch;
-use crate::{CollisionLaw, ForwardModel, Model, Scene};
+use crate::models::{ForwardModel, Model};
+use crate::scene::{CollisionLaw, Scene};
 
 /// Log relative error, capped at 11; 0 for anything non-finite.
 fn lre(est: f64, reference: f64) -> f64 {
@@ -255,7 +256,7 @@ impl CostFunction for JaegerLogA2<'_> {
 fn jaeger_start_grid_against_particle_swarm() {
     use crate::fit::jaeger::start;
     use crate::models::JaegerBranch;
-    use crate::CollisionLaw;
+    use crate::scene::CollisionLaw;
     use argmin::solver::particleswarm::ParticleSwarm;
     use rand::SeedableRng;
 

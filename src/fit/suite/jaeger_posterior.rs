@@ -3,6 +3,7 @@
 //! against finite differences, and the posterior it gives against the one sampled in
 //! (ln a1, ln a2, ln a3) on the series where that sampler converges.
 
+use crate::fit::data::Dataset;
 use crate::fit::jaeger::{fit_jaeger_with, JaegerModel, JaegerX};
 use crate::fit::jaeger_coordinates::JaegerCoordinates;
 use crate::fit::posterior::{McmcSettings, Method, Prior};
@@ -11,7 +12,6 @@ use crate::inverse::mcmc::{EnsembleSampler, McmcOptions};
 use crate::inverse::posterior::Posterior;
 use crate::inverse::WeightedData;
 use crate::models::JaegerBranch;
-use crate::Dataset;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

@@ -10,7 +10,8 @@
 
 use crate::fit::k::search::estimate_in_k;
 use crate::fit::k::{bracket, estimate, KFailure};
-use crate::{CollisionLaw, ForwardModel, Model, Scene};
+use crate::models::{ForwardModel, Model};
+use crate::scene::{CollisionLaw, Scene};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;

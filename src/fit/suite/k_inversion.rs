@@ -6,7 +6,8 @@
 
 use crate::fit::k::search::estimate_in_k;
 use crate::fit::k::{bracket, estimate, solve, KFailure, LowerLimit, UpperLimit};
-use crate::{CollisionLaw, ForwardModel, Model, Scene};
+use crate::models::{ForwardModel, Model};
+use crate::scene::{CollisionLaw, Scene};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

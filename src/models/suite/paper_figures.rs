@@ -6,7 +6,7 @@
 
 use crate::models::regimes::{bulk_friction, critical_xi, delta_d, delta_m, theta_g};
 use crate::models::{stick, stickslip};
-use crate::{CollisionLaw, Scene};
+use crate::scene::{CollisionLaw, Scene};
 
 #[test]
 fn critical_xi_of_the_fitted_law_is_0_6215() {

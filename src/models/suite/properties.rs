@@ -2,7 +2,8 @@
 //! energy balance closes (eqs 70–72).
 
 use crate::models::{energy, regimes, stick, stickslip};
-use crate::{CollisionLaw, ForwardModel, Model, Scene};
+use crate::models::{ForwardModel, Model};
+use crate::scene::{CollisionLaw, Scene};
 use proptest::prelude::*;
 
 fn models() -> [Model; 5] {

@@ -5,7 +5,8 @@
 //! `python3 tests/reference/make_refs.py`.
 
 use crate::models::{stick, NotSteady, Regime};
-use crate::{CollisionLaw, ForwardModel, Model, Scene};
+use crate::models::{ForwardModel, Model};
+use crate::scene::{CollisionLaw, Scene};
 
 use super::{col, reference_table};
 

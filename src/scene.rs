@@ -419,45 +419,7 @@ impl Scene {
             None => OfXi::new(xi),
         };
         let alpha = of_xi.alpha;
-        let k = law.k(alpha, rho);
-        if !law.is_value() && !(k > 0.0) {
-            // The law, not a number the user gave, is at fault: its K vanishes at this ξ.
-            return Err(ParameterError::InvalidParameter {
-                field: "xi",
-                value: crate::numfmt::echo_f64(xi),
-                reason: "the collision law gives no K > 0 at this xi (its contact angle alpha \
-                         is too close to 90 degrees): use a larger xi, or give K as a number",
-            });
-        }
-        check("K", k, k > 0.0, "collisional parameter must be > 0")?;
-        if !law.is_value() && !(k < 1.0) {
-            // A law such as c = 10 can exceed 1 at small ξ (eq 1 bounds K by 1).
-            return Err(ParameterError::InvalidParameter {
-                field: "K",
-                value: format!(
-                    "{} (law {} at xi = {})",
-                    crate::numfmt::echo_f64(k),
-                    match law {
-                        CollisionLaw::C(c) => format!("c={}", crate::numfmt::echo_f64(c)),
-                        _ => law.to_string(),
-                    },
-                    crate::numfmt::echo_f64(xi)
-                ),
-                reason: "the collision law gives K >= 1 here (a collision cannot return more \
-                         velocity than it receives): choose a law or coefficient with K < 1 \
-                         at this xi",
-            });
-        }
-        if law.is_value() {
-            // A collision returns at most the tangential velocity it receives (eq 1).
-            check(
-                "K",
-                k,
-                k < 1.0,
-                "collisional parameter must be < 1 (a collision cannot return more velocity \
-                 than it receives)",
-            )?;
-        }
+        let k = law_k(law, alpha, rho, xi)?;
         let theta_0 = delta - alpha;
         let theta_f = delta + alpha;
         let sc_half_delta = SinCos::of(0.5 * delta);
@@ -645,4 +607,49 @@ impl Scene {
     pub fn sin_delta_sin_alpha(&self) -> f64 {
         self.sc_delta.s * self.sin_alpha
     }
+}
+/// K of `law` at contact angle `alpha` (and ρ), checked: a law's K must lie in (0, 1) at
+/// this ξ, a value given as a number too (eq 1 bounds K by 1).
+#[inline]
+fn law_k(law: CollisionLaw, alpha: f64, rho: f64, xi: f64) -> Result<f64> {
+    let k = law.k(alpha, rho);
+    if !law.is_value() && !(k > 0.0) {
+        // The law, not a number the user gave, is at fault: its K vanishes at this ξ.
+        return Err(ParameterError::InvalidParameter {
+            field: "xi",
+            value: crate::numfmt::echo_f64(xi),
+            reason: "the collision law gives no K > 0 at this xi (its contact angle alpha \
+                     is too close to 90 degrees): use a larger xi, or give K as a number",
+        });
+    }
+    check("K", k, k > 0.0, "collisional parameter must be > 0")?;
+    if !law.is_value() && !(k < 1.0) {
+        // A law such as c = 10 can exceed 1 at small ξ (eq 1 bounds K by 1).
+        return Err(ParameterError::InvalidParameter {
+            field: "K",
+            value: format!(
+                "{} (law {} at xi = {})",
+                crate::numfmt::echo_f64(k),
+                match law {
+                    CollisionLaw::C(c) => format!("c={}", crate::numfmt::echo_f64(c)),
+                    _ => law.to_string(),
+                },
+                crate::numfmt::echo_f64(xi)
+            ),
+            reason: "the collision law gives K >= 1 here (a collision cannot return more \
+                     velocity than it receives): choose a law or coefficient with K < 1 \
+                     at this xi",
+        });
+    }
+    if law.is_value() {
+        // A collision returns at most the tangential velocity it receives (eq 1).
+        check(
+            "K",
+            k,
+            k < 1.0,
+            "collisional parameter must be < 1 (a collision cannot return more velocity \
+             than it receives)",
+        )?;
+    }
+    Ok(k)
 }

@@ -342,24 +342,8 @@ pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
         }
     };
     let (draws, even_draws, bayes) = if priors.is_empty() {
-        let c = target_c(&prob.guess).ok_or_else(|| {
-            DesignError::new(
-                "law",
-                &s.law.to_string(),
-                "K at the guess is outside (0, 1): eq 79 has no μ there",
-            )
-        })?;
-        (
-            vec![Draw {
-                cands: cands.clone(),
-                c: c.clone(),
-            }],
-            vec![Draw {
-                cands: even_cands.clone(),
-                c,
-            }],
-            None,
-        )
+        let (d, e) = guess_draws(s, target_c(&prob.guess), &cands, &even_cands)?;
+        (d, e, None)
     } else {
         let (d, e, redrawn) =
             prior_draws(s, &prob, &priors, &cands, &strata, &even_cands, &target_c)?;
@@ -393,27 +377,17 @@ pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
     let efficiency = match s.criterion {
         Criterion::T => {
             let rival = rival.expect("t has a rival");
-            let pts: Vec<Cand> = exact
-                .iter()
-                .flatten()
-                .map(|&(j, _)| cands[j].clone())
-                .collect();
-            let wts: Vec<f64> = exact.iter().flatten().map(|&(_, n)| n as f64).collect();
-            let t_design = t_value(s, &prob, &rival, &pts, &wts).unwrap_or(f64::NAN);
-            let t_even = t_value(s, &prob, &rival, &even_cands, &ones).unwrap_or(f64::NAN);
-            discrimination = Some((t_design, t_even));
-            let total = total_points as f64;
-            // t is in units of the noise ([`sigma`]): the points needed scale as its square.
-            let need = |t: f64| {
-                let per_point = t / total;
-                if per_point > 0.0 {
-                    (noncentrality(0.05, 0.8) / per_point * s.noise * s.noise).ceil()
-                } else {
-                    f64::INFINITY
-                }
-            };
-            points_needed = Some((need(t_design), need(t_even)));
-            t_even / t_design
+            let (t, needed) = discriminate(
+                s,
+                &prob,
+                &rival,
+                (&cands, &exact),
+                &even_cands,
+                total_points,
+            );
+            discrimination = Some(t);
+            points_needed = Some(needed);
+            t.1 / t.0
         }
         Criterion::D => cmp.d_efficiency(bayes.is_some(), p),
         Criterion::C => cmp.c_efficiency(target.expect("c has a target")),
@@ -1227,6 +1201,67 @@ fn fit_rival(
     };
     let f = fit(&data, start, &opts).ok()?;
     f.chi2.is_finite().then_some((f.params, f.chi2))
+}
+
+/// The one "draw" of a locally optimal design, at the guess: the candidates and the evenly
+/// spaced slopes with the target's gradient `c` there (`None`: K at the guess has no μ).
+fn guess_draws(
+    s: &DesignSettings,
+    c: Option<Vec<f64>>,
+    cands: &[Cand],
+    even: &[Cand],
+) -> Result<(Vec<Draw>, Vec<Draw>), DesignError> {
+    let c = c.ok_or_else(|| {
+        DesignError::new(
+            "law",
+            &s.law.to_string(),
+            "K at the guess is outside (0, 1): eq 79 has no μ there",
+        )
+    })?;
+    Ok((
+        vec![Draw {
+            cands: cands.to_vec(),
+            c: c.clone(),
+        }],
+        vec![Draw {
+            cands: even.to_vec(),
+            c,
+        }],
+    ))
+}
+
+/// How well the exact design (`exact`, replicates of candidates `cands`) and the evenly
+/// spaced one (`even`, one point each) tell the model of `truth` from `rival`: T of each
+/// (the rival's least χ², in units of the noise), and the points in all each needs for power
+/// 0.8 at significance 0.05.
+fn discriminate(
+    s: &DesignSettings,
+    truth: &Problem,
+    rival: &Problem,
+    (cands, exact): (&[Cand], &[Vec<(usize, usize)>]),
+    even: &[Cand],
+    total_points: usize,
+) -> ((f64, f64), (f64, f64)) {
+    let pts: Vec<Cand> = exact
+        .iter()
+        .flatten()
+        .map(|&(j, _)| cands[j].clone())
+        .collect();
+    let wts: Vec<f64> = exact.iter().flatten().map(|&(_, n)| n as f64).collect();
+    let ones = vec![1.0; even.len()];
+    let t_design = t_value(s, truth, rival, &pts, &wts).unwrap_or(f64::NAN);
+    let t_even = t_value(s, truth, rival, even, &ones).unwrap_or(f64::NAN);
+    let total = total_points as f64;
+    // t is in units of the noise ([`sigma`]): the points needed scale as its square.
+    let need = |t: f64| {
+        let per_point = t / total;
+        if per_point > 0.0 {
+            (noncentrality(0.05, 0.8) / per_point * s.noise * s.noise).ceil()
+        } else {
+            f64::INFINITY
+        }
+    };
+    ((t_design, t_even), (need(t_design), need(t_even)))
 }
 
 /// T at an exact design: the rival's least χ² against the true curve.

@@ -107,6 +107,26 @@ pub(crate) fn summarise_reparameterised<R: Residuals + Sync + ?Sized>(
 /// (logarithms, dimensionless shapes), and the ensemble widens from a small ball by itself.
 const REPARAMETERISED_BALL: f64 = 1e-3;
 
+/// The error scale the least-squares optimum implies, sqrt(χ²/dof) (1 where that is not a
+/// positive number).
+fn scatter_scale(chi2: f64, dof: usize) -> f64 {
+    let s = (chi2 / dof.max(1) as f64).sqrt();
+    if s > 0.0 && s.is_finite() {
+        s
+    } else {
+        1.0
+    }
+}
+
+/// The unit of the error scale `sigma_scale`: of v itself without σ, else a factor on σ_v.
+fn scale_unit(sigma: SigmaKind) -> &'static str {
+    if sigma == SigmaKind::Relative {
+        "v (scatter of v; no sigma given)"
+    } else {
+        "1 (multiplies sigma_v)"
+    }
+}
+
 /// A posterior run started from the least-squares optimum of `solved` (module docs), in
 /// stages: the priors and their checks, the starting ball, the sampler's run, then the rows
 /// and the fit's statistics from the draws.
@@ -158,15 +178,8 @@ fn sample<R: Residuals + Sync + ?Sized>(
     if let Some(t) = transform {
         target = target.with_reparameterisation(t);
     }
-    // Start: the optimum; the scale at the scatter it implies, sqrt(χ²/dof).
-    let s0 = {
-        let s = (f.chi2 / f.dof.max(1) as f64).sqrt();
-        if s > 0.0 && s.is_finite() {
-            s
-        } else {
-            1.0
-        }
-    };
+    // Start: the optimum; the scale at the scatter it implies.
+    let s0 = scatter_scale(f.chi2, f.dof);
     if let Err(failure) = check_prior_supports(specs, &priors, scale_prior.as_ref(), &lower, &upper)
     {
         return failed(out, failure);
@@ -192,11 +205,6 @@ fn sample<R: Residuals + Sync + ?Sized>(
     options.level = level;
     options.init_scale = Some(ball);
     let thin = options.thin.max(1);
-    let scale_unit = if f.sigma == SigmaKind::Relative {
-        "v (scatter of v; no sigma given)"
-    } else {
-        "1 (multiplies sigma_v)"
-    };
     let run = run_sampler(&target, options, settings, fit_name, series, &start);
     let (res, walkers) = match run {
         Ok(r) => r,
@@ -207,7 +215,7 @@ fn sample<R: Residuals + Sync + ?Sized>(
     // Rows: the parameters, then the scale.
     if with_scale {
         out.params
-            .push(scale_row(fit_name, series, s0, level, scale_unit));
+            .push(scale_row(fit_name, series, s0, level, scale_unit(f.sigma)));
     }
     let all_priors: Vec<&Prior> = priors.iter().chain(scale_prior.iter()).collect();
     // What the least-squares run noted is about the optimum the chains start from.

@@ -196,14 +196,7 @@ pub fn report(
     let stats: Vec<StatsRow> = fits.iter().map(|f| f.stats.clone()).collect();
     let mut warnings = Vec::new();
     let stats = flag_absurd_misfits(stats, &mut warnings);
-    files.push((
-        "params.csv".into(),
-        crate::io::fit_tables::params_csv(&params).map_err(csv_error)?,
-    ));
-    files.push((
-        "stats.csv".into(),
-        crate::io::fit_tables::stats_csv(&stats).map_err(csv_error)?,
-    ));
+    files.extend(fit_tables(&params, &stats, &fits)?);
     // Velocities in m/s on the figures: each series' unit sqrt(g R (1 + ξ)).
     let si = si_conversion(t, &s.defaults);
     let units_m_s = if s.si_units {
@@ -211,15 +204,6 @@ pub fn report(
     } else {
         None
     };
-    let fit_refs: Vec<&crate::fit::summary::FitResult> = fits.iter().collect();
-    files.push((
-        "residuals.csv".into(),
-        crate::io::fit_tables::residuals_csv(&fit_refs).map_err(csv_error)?,
-    ));
-    files.push((
-        "correlations.csv".into(),
-        crate::io::fit_tables::correlations_csv(&fit_refs).map_err(csv_error)?,
-    ));
     let figures = Figures {
         an: &an,
         bands: bands.as_ref(),
@@ -227,26 +211,11 @@ pub fn report(
         fits: &fits,
     };
     let corner_files = figures.draw(&mut files)?;
-    let not_converged: Vec<String> = stats
-        .iter()
-        .filter(|s| s.mcmc.is_some() && !s.converged)
-        .map(|s| format!("{} [{}]: {}", s.fit, s.series, s.note))
-        .collect();
-    let absurd: Vec<String> = stats
-        .iter()
-        .filter_map(|s| {
-            s.absurd_misfit()
-                .map(|w| format!("{} [{}]: {w}", s.fit, s.series))
-        })
-        .collect();
-    let misfits: Vec<String> = stats
-        .iter()
-        .filter(|s| s.absurd_misfit().is_none())
-        .filter_map(|s| {
-            s.misfit_warning()
-                .map(|w| format!("{} [{}]: {w}", s.fit, s.series))
-        })
-        .collect();
+    let StatsWarnings {
+        not_converged,
+        absurd,
+        misfits,
+    } = stats_warnings(&stats);
     let context = ReportContext {
         source: s.source.clone().unwrap_or_else(|| t.source.clone()),
         shipped_synthetic: is_shipped_data(ds),
@@ -283,6 +252,59 @@ pub fn report(
         misfits,
         interrupted,
     })
+}
+
+/// The fits' tables of the report: params.csv, stats.csv (`stats` as written, with their
+/// misfit notes), residuals.csv and correlations.csv.
+fn fit_tables(
+    params: &[crate::fit::summary::ParamRow],
+    stats: &[StatsRow],
+    fits: &[crate::fit::summary::FitResult],
+) -> Result<Vec<(String, Vec<u8>)>, RunError> {
+    use crate::io::fit_tables::{correlations_csv, params_csv, residuals_csv, stats_csv};
+    let fit_refs: Vec<&crate::fit::summary::FitResult> = fits.iter().collect();
+    Ok(vec![
+        ("params.csv".into(), params_csv(params).map_err(csv_error)?),
+        ("stats.csv".into(), stats_csv(stats).map_err(csv_error)?),
+        (
+            "residuals.csv".into(),
+            residuals_csv(&fit_refs).map_err(csv_error)?,
+        ),
+        (
+            "correlations.csv".into(),
+            correlations_csv(&fit_refs).map_err(csv_error)?,
+        ),
+    ])
+}
+
+/// What the statistics of the report's fits warn of, each as `FIT [SERIES]: message`.
+struct StatsWarnings {
+    /// Posterior runs that did not converge (their notes).
+    not_converged: Vec<String>,
+    /// Misfits so large that the units are in doubt.
+    absurd: Vec<String>,
+    /// Misfits improbable for the σ given (the others).
+    misfits: Vec<String>,
+}
+
+fn stats_warnings(stats: &[StatsRow]) -> StatsWarnings {
+    let named = |s: &StatsRow, w: String| format!("{} [{}]: {w}", s.fit, s.series);
+    StatsWarnings {
+        not_converged: stats
+            .iter()
+            .filter(|s| s.mcmc.is_some() && !s.converged)
+            .map(|s| named(s, s.note.clone()))
+            .collect(),
+        absurd: stats
+            .iter()
+            .filter_map(|s| s.absurd_misfit().map(|w| named(s, w.to_string())))
+            .collect(),
+        misfits: stats
+            .iter()
+            .filter(|s| s.absurd_misfit().is_none())
+            .filter_map(|s| s.misfit_warning().map(|w| named(s, w.to_string())))
+            .collect(),
+    }
 }
 
 /// The figure settings of `s`, checked with its level: the format and the print width.

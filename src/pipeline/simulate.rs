@@ -446,6 +446,19 @@ struct DesignLine {
     replicates: usize,
 }
 
+/// A series is one bead size (the fits refuse a series that mixes ξ values): the message when
+/// `series` already has lines of `out` at another ξ than `xi`.
+fn mixed_series(out: &[DesignLine], series: &str, xi: f64) -> Option<String> {
+    let first = out.iter().find(|d| d.series == series && d.xi != xi)?;
+    Some(format!(
+        "series '{}' mixes xi values: {} on line {}, {} here (a series is one bead size)",
+        crate::numfmt::clip(series, crate::numfmt::ECHO_CHARS),
+        fmt_f64(first.xi),
+        first.line,
+        fmt_f64(xi)
+    ))
+}
+
 /// Reads a design file (series,xi,delta_deg,replicates; other columns ignored), every cell
 /// checked: a bad one is an error naming file, line, column and value.
 fn read_design(path: &std::path::Path) -> Result<Vec<DesignLine>, RunError> {
@@ -538,24 +551,8 @@ fn read_design(path: &std::path::Path) -> Result<Vec<DesignLine>, RunError> {
         } else {
             cell(cs).to_string()
         };
-        // A series is one bead size: the fits refuse a series that mixes ξ values.
-        if let Some(first) = out
-            .iter()
-            .find(|d: &&DesignLine| d.series == series && d.xi != xi)
-        {
-            return Err(err(
-                Some(line),
-                Some("xi"),
-                Some(cell(cx)),
-                format!(
-                    "series '{}' mixes xi values: {} on line {}, {} here (a series is one bead \
-                     size)",
-                    crate::numfmt::clip(&series, crate::numfmt::ECHO_CHARS),
-                    fmt_f64(first.xi),
-                    first.line,
-                    fmt_f64(xi)
-                ),
-            ));
+        if let Some(message) = mixed_series(&out, &series, xi) {
+            return Err(err(Some(line), Some("xi"), Some(cell(cx)), message));
         }
         out.push(DesignLine {
             line,

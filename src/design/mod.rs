@@ -377,14 +377,8 @@ pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
     let efficiency = match s.criterion {
         Criterion::T => {
             let rival = rival.expect("t has a rival");
-            let (t, needed) = discriminate(
-                s,
-                &prob,
-                &rival,
-                (&cands, &exact),
-                &even_cands,
-                total_points,
-            );
+            let (t, needed) =
+                discriminate(s, &prob, &rival, &cands, &exact, &even_cands, total_points);
             discrimination = Some(t);
             points_needed = Some(needed);
             t.1 / t.0
@@ -1238,7 +1232,8 @@ fn discriminate(
     s: &DesignSettings,
     truth: &Problem,
     rival: &Problem,
-    (cands, exact): (&[Cand], &[Vec<(usize, usize)>]),
+    cands: &[Cand],
+    exact: &[Vec<(usize, usize)>],
     even: &[Cand],
     total_points: usize,
 ) -> ((f64, f64), (f64, f64)) {

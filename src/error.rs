@@ -11,6 +11,7 @@ use crate::fit::klaw::KLawError;
 use crate::inverse::{LsqError, McmcError};
 use crate::io::InputError;
 use crate::models::NotSteady;
+use crate::report::figures::FigureError;
 use crate::scene::ParameterError;
 use thiserror::Error;
 
@@ -48,6 +49,9 @@ pub enum Error {
     /// Design settings that cannot make a design.
     #[error(transparent)]
     Design(#[from] DesignError),
+    /// A figure that cannot be drawn, rendered or converted.
+    #[error(transparent)]
+    Figure(#[from] FigureError),
     /// Reading or writing a file failed.
     #[error(transparent)]
     Io(#[from] std::io::Error),

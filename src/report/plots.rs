@@ -208,14 +208,8 @@ impl Analysis {
         let mut curves_by_panel = Vec::new();
         for s in 0..self.data.labels.len() {
             let ds: Vec<f64> = self.data.series(s).map(|p| p.scene.delta).collect();
-            let d0 = ds.iter().copied().fold(f64::INFINITY, f64::min);
-            let d1 = ds.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            let pad = 0.1 * (d1 - d0).max(1f64.to_radians());
-            let grid: Vec<f64> = (0..=160)
-                .map(|i| (d0 - pad).max(1e-4) + (d1 - d0 + 2.0 * pad) * i as f64 / 160.0)
-                .collect();
             let u = unit(s);
-            let curves = self.model_curves(s, &grid);
+            let curves = self.model_curves(s, &delta_grid(&ds));
             curves_by_panel.push(curves.map(|c| {
                 c.into_iter()
                     .map(|(d, v)| (d, v * u))
@@ -233,20 +227,7 @@ impl Analysis {
             );
             panels.push(p);
         }
-        // Which model lies on which earlier one, and in which series.
-        let mut on: Vec<Vec<(usize, usize)>> = vec![Vec::new(); 4];
-        for (s, cs) in curves_by_panel.iter().enumerate() {
-            let ys = cs.iter().flatten().map(|p| p.1).filter(|v| v.is_finite());
-            let (lo, hi) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-                (a.min(v), b.max(v))
-            });
-            let tol = 0.006 * (hi - lo).max(1e-12);
-            for b in 1..4 {
-                if let Some(a) = (0..b).find(|&a| coincide(&cs[a], &cs[b], tol)) {
-                    on[b].push((a, s));
-                }
-            }
-        }
+        let on = coinciding(&curves_by_panel);
         let mut legend = vec![LegendEntry::mark(
             if self.data.sigma == SigmaKind::Absolute {
                 "data (bars: ±σ)"
@@ -1356,6 +1337,36 @@ pub fn lsq_fit_figure(
         0.3,
     ));
     Ok(f.to_svg())
+}
+
+/// 161 slopes (radians) across the measured slopes `ds` of a series, a tenth of their range
+/// (at least 1°) beyond either end, none below 1e-4.
+fn delta_grid(ds: &[f64]) -> Vec<f64> {
+    let d0 = ds.iter().copied().fold(f64::INFINITY, f64::min);
+    let d1 = ds.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let pad = 0.1 * (d1 - d0).max(1f64.to_radians());
+    (0..=160)
+        .map(|i| (d0 - pad).max(1e-4) + (d1 - d0 + 2.0 * pad) * i as f64 / 160.0)
+        .collect()
+}
+
+/// Which of the four velocity models' curves lies on an earlier one, and in which series:
+/// per model, (the earlier model, the series), the curves of every series given by panel.
+fn coinciding(curves_by_panel: &[[Vec<(f64, f64)>; 4]]) -> Vec<Vec<(usize, usize)>> {
+    let mut on: Vec<Vec<(usize, usize)>> = vec![Vec::new(); 4];
+    for (s, cs) in curves_by_panel.iter().enumerate() {
+        let ys = cs.iter().flatten().map(|p| p.1).filter(|v| v.is_finite());
+        let (lo, hi) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+        let tol = 0.006 * (hi - lo).max(1e-12);
+        for b in 1..4 {
+            if let Some(a) = (0..b).find(|&a| coincide(&cs[a], &cs[b], tol)) {
+                on[b].push((a, s));
+            }
+        }
+    }
+    on
 }
 
 /// The figure: per series, the sensitivity of every candidate slope with the chosen ones

@@ -726,24 +726,8 @@ pub(crate) fn summarise_with_profiles<R: Residuals + ?Sized>(
                 opts.lower.as_ref().map_or(f64::NEG_INFINITY, |l| l[j]),
                 opts.upper.as_ref().map_or(f64::INFINITY, |u| u[j]),
             );
-            let mut pnote = String::new();
-            let profile_closed = ci.as_ref().is_some_and(|c| {
-                closed_end(c[j].lower).is_some() && closed_end(c[j].upper).is_some()
-            });
-            if let Some((a, b)) = wald.as_ref().map(|w| (w[j].lower, w[j].upper)) {
-                if !profile_closed && (a < bounds.0 || b > bounds.1) {
-                    pnote.push_str("covariance interval cut to the parameter's box. ");
-                }
-            }
-            if f.at_bound.get(j).copied().unwrap_or(false) {
-                pnote.push_str("on a bound of its box; the covariance ignores the bound. ");
-            }
-            if unknown.is_some() {
-                pnote.push_str("not determined by the data: no standard error or interval. ");
-            }
-            if let Some(ends) = prof {
-                push_profile_notes(&mut pnote, ends, level, s.name);
-            }
+            let cov = wald.as_ref().map(|w| (w[j].lower, w[j].upper));
+            let pnote = param_note(f, j, bounds, cov, prof, unknown.is_some(), (level, s.name));
             ParamRow {
                 fit: fit_name.to_string(),
                 series: series.to_string(),
@@ -755,13 +739,13 @@ pub(crate) fn summarise_with_profiles<R: Residuals + ?Sized>(
                     None
                 },
                 level,
-                cov: wald.as_ref().map(|w| (w[j].lower, w[j].upper)),
+                cov,
                 profile: prof,
                 unit: s.unit,
                 at_bound: f.at_bound.get(j).copied().unwrap_or(false),
                 paper_value: s.paper_value,
                 paper_source: s.paper_source,
-                note: pnote.trim_end().to_string(),
+                note: pnote,
                 bounds,
                 lsq_value: Some(f.params[j]),
                 posterior: None,
@@ -799,6 +783,38 @@ pub(crate) fn summarise_with_profiles<R: Residuals + ?Sized>(
         residuals: f.residuals.clone(),
         points: Vec::new(),
     }
+}
+
+/// The note of parameter `j` of the fit `f` (box `bounds`, covariance interval `cov`,
+/// profile ends `prof`; `undetermined` when the data do not determine it): an interval cut to
+/// the box, a parameter on a bound, no standard error, and what the profile's ends say.
+fn param_note(
+    f: &Fit,
+    j: usize,
+    bounds: (f64, f64),
+    cov: Option<(f64, f64)>,
+    prof: Option<(ProfileEnd, ProfileEnd)>,
+    undetermined: bool,
+    (level, name): (f64, &str),
+) -> String {
+    let mut pnote = String::new();
+    let profile_closed =
+        prof.is_some_and(|(lo, hi)| closed_end(lo).is_some() && closed_end(hi).is_some());
+    if let Some((a, b)) = cov {
+        if !profile_closed && (a < bounds.0 || b > bounds.1) {
+            pnote.push_str("covariance interval cut to the parameter's box. ");
+        }
+    }
+    if f.at_bound.get(j).copied().unwrap_or(false) {
+        pnote.push_str("on a bound of its box; the covariance ignores the bound. ");
+    }
+    if undetermined {
+        pnote.push_str("not determined by the data: no standard error or interval. ");
+    }
+    if let Some(ends) = prof {
+        push_profile_notes(&mut pnote, ends, level, name);
+    }
+    pnote.trim_end().to_string()
 }
 
 /// AIC and BIC of the fit `f`, undefined (NaN, with why appended to `note`) where the

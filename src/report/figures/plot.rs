@@ -1141,29 +1141,19 @@ impl Figure {
         f.plot = (w, (h0 * w / w0).max(y_label.min(h0)));
     }
 
-    fn grid(&self) -> Grid {
+    /// Panels whose legend cannot sit inside widen their column on the right (or, with the
+    /// legends below, deepen their row): `right` and `bottom` grow, per column and row, given
+    /// the panels' layouts `lays` and the columns' `left` margins.
+    fn make_room_for_legends(
+        &self,
+        lays: &[Option<Layout>],
+        left: &[f64],
+        right: &mut [f64],
+        bottom: &mut [f64],
+    ) {
         let (w, h) = self.plot;
         let cols = self.cols;
-        let rows = self.panels.len().div_ceil(cols).max(1);
-        let lays: Vec<Option<Layout>> = self
-            .panels
-            .iter()
-            .map(|p| p.as_ref().map(|p| Layout::new(p, w, h)))
-            .collect();
-        let mut left = vec![0.0f64; cols];
-        let mut right = vec![GAP * 2.0; cols];
-        let mut top = vec![0.0f64; rows];
-        let mut bottom = vec![0.0f64; rows];
-        for (i, l) in lays.iter().enumerate() {
-            let (r, c) = (i / cols, i % cols);
-            if let Some(l) = l {
-                left[c] = left[c].max(l.left);
-                top[r] = top[r].max(l.top);
-                bottom[r] = bottom[r].max(l.bottom);
-            }
-        }
-        // Panels whose legend cannot sit inside widen their column on the right.
-        for (i, (p, l)) in self.panels.iter().zip(&lays).enumerate() {
+        for (i, (p, l)) in self.panels.iter().zip(lays).enumerate() {
             let (Some(p), Some(l)) = (p, l) else { continue };
             if p.legend.is_empty() {
                 continue;
@@ -1189,6 +1179,30 @@ impl Figure {
                 }
             }
         }
+    }
+
+    fn grid(&self) -> Grid {
+        let (w, h) = self.plot;
+        let cols = self.cols;
+        let rows = self.panels.len().div_ceil(cols).max(1);
+        let lays: Vec<Option<Layout>> = self
+            .panels
+            .iter()
+            .map(|p| p.as_ref().map(|p| Layout::new(p, w, h)))
+            .collect();
+        let mut left = vec![0.0f64; cols];
+        let mut right = vec![GAP * 2.0; cols];
+        let mut top = vec![0.0f64; rows];
+        let mut bottom = vec![0.0f64; rows];
+        for (i, l) in lays.iter().enumerate() {
+            let (r, c) = (i / cols, i % cols);
+            if let Some(l) = l {
+                left[c] = left[c].max(l.left);
+                top[r] = top[r].max(l.top);
+                bottom[r] = bottom[r].max(l.bottom);
+            }
+        }
+        self.make_room_for_legends(&lays, &left, &mut right, &mut bottom);
         let title_h = if self.title.is_empty() {
             GAP
         } else {

@@ -267,6 +267,23 @@ fn stickslip_within_1e_9_of_the_saddle_node() {
     assert!(r.is_ok(), "K = {k}: {r:?}");
 }
 
+/// dv̄/dK of `m` at `k` by Richardson-extrapolated differences of the forward model, K's
+/// bracket being `(lo, hi)`: central, with steps 1e-2 and 5e-3 of the distance to K_min or
+/// 1e-4 of the bracket or of 1 − K; backward within 2e-4 of the bracket's top.
+fn dv_dk_by_differences(m: &Model, s: &Scene, k: f64, (lo, hi): (f64, f64)) -> f64 {
+    let v_at = |kk: f64| m.evaluate(&with_k(s, kk)).unwrap().mean_velocity;
+    let w = hi - lo;
+    let w1 = w.min(1.0 - k);
+    if hi - k < 2e-4 * w {
+        let bd = |h: f64| (3.0 * v_at(k) - 4.0 * v_at(k - h) + v_at(k - 2.0 * h)) / (2.0 * h);
+        (4.0 * bd(5e-5 * w1) - bd(1e-4 * w1)) / 3.0
+    } else {
+        let h = (1e-2 * (k - lo)).min(1e-4 * w1);
+        let cd = |h: f64| (v_at(k + h) - v_at(k - h)) / (2.0 * h);
+        (4.0 * cd(0.5 * h) - cd(h)) / 3.0
+    }
+}
+
 /// The launch-speed paths of `estimate` (src/fit/k/launch.rs: from the crawl, and from rest past
 /// the top for stick) against the general search in K
 /// (`estimate_in_k`, the path of every test above) and against the forward models: K, K_lo,
@@ -340,18 +357,7 @@ fn launch_speed_path_agrees_with_the_search_in_k() {
                 // K = 1); backward within 2e-4 of the bracket's top (lift-off: no steady
                 // state above).
                 let a = fast.dv_dk.unwrap();
-                let v_at = |kk: f64| m.evaluate(&with_k(&s, kk)).unwrap().mean_velocity;
-                let w1 = w.min(1.0 - rf.k);
-                let reference = if br.hi - rf.k < 2e-4 * w {
-                    let bd = |h: f64| {
-                        (3.0 * v_at(rf.k) - 4.0 * v_at(rf.k - h) + v_at(rf.k - 2.0 * h)) / (2.0 * h)
-                    };
-                    (4.0 * bd(5e-5 * w1) - bd(1e-4 * w1)) / 3.0
-                } else {
-                    let h = (1e-2 * (rf.k - br.lo)).min(1e-4 * w1);
-                    let cd = |h: f64| (v_at(rf.k + h) - v_at(rf.k - h)) / (2.0 * h);
-                    (4.0 * cd(0.5 * h) - cd(h)) / 3.0
-                };
+                let reference = dv_dk_by_differences(&m, &s, rf.k, (br.lo, br.hi));
                 // The difference itself is good to ~1e-7 only: within 1e-6 of K_min one ulp
                 // of K is 1e-10 of K − K_min (the launch path is held to 3e-10 against mpmath
                 // at such points in `dv_dk_matches_mpmath_at_hard_points`). Stick/slip near

@@ -495,11 +495,7 @@ impl<'a, D: LogDensity + ?Sized> EnsembleSampler<'a, D> {
             let step = steps as u128;
             let accepted_before = accepted.clone();
             for h in 0..2 {
-                let (moving, other) = if h == 0 {
-                    (0..half, half..nw)
-                } else {
-                    (half..nw, 0..half)
-                };
+                let (moving, other) = halves(h, half, nw);
                 let complement = &pos[other.clone()];
                 let updates: Vec<Option<(Vec<f64>, f64)>> = moving
                     .clone()
@@ -560,29 +556,14 @@ impl<'a, D: LogDensity + ?Sized> EnsembleSampler<'a, D> {
             _ => self.assess(&chains, true),
         };
         let burn = assessment.burn;
-        let kept_chains: Vec<Vec<Vec<f64>>> = chains
-            .into_iter()
-            .map(|mut c| c.split_off(burn.min(c.len())))
-            .collect();
-        let kept_lps: Vec<Vec<f64>> = lps
-            .into_iter()
-            .map(|mut c| c.split_off(burn.min(c.len())))
-            .collect();
+        let kept_chains = after_burn_in(chains, burn);
+        let kept_lps = after_burn_in(lps, burn);
         let diagnostics = if stored > burn {
             summarise(&kept_chains, o.level)
         } else {
             Vec::new()
         };
-        let acceptance: Vec<f64> = accepted
-            .iter()
-            .map(|&n| {
-                if steps > 0 {
-                    n as f64 / steps as f64
-                } else {
-                    0.0
-                }
-            })
-            .collect();
+        let acceptance = acceptance_rates(&accepted, steps);
         let acceptance_overall = acceptance.iter().sum::<f64>() / nw as f64;
         Ok(McmcResult {
             chains: kept_chains,
@@ -770,4 +751,35 @@ struct Assessment {
     failing: Option<usize>,
     /// Whether `failing` is final (false for a check that stopped at an unreliable τ).
     complete: bool,
+}
+/// The walkers that move in half-step `h` (0: the first half, 1: the second) and those they
+/// move against, of `nw` walkers split at `half`.
+fn halves(h: usize, half: usize, nw: usize) -> (std::ops::Range<usize>, std::ops::Range<usize>) {
+    if h == 0 {
+        (0..half, half..nw)
+    } else {
+        (half..nw, 0..half)
+    }
+}
+
+/// Each walker's stored draws after the first `burn`.
+fn after_burn_in<T>(chains: Vec<Vec<T>>, burn: usize) -> Vec<Vec<T>> {
+    chains
+        .into_iter()
+        .map(|mut c| c.split_off(burn.min(c.len())))
+        .collect()
+}
+
+/// Each walker's acceptance rate over `steps` steps (0 before any step).
+fn acceptance_rates(accepted: &[usize], steps: usize) -> Vec<f64> {
+    accepted
+        .iter()
+        .map(|&n| {
+            if steps > 0 {
+                n as f64 / steps as f64
+            } else {
+                0.0
+            }
+        })
+        .collect()
 }

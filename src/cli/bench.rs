@@ -4,7 +4,6 @@
 use super::args::{OutputArgs, PlotArgs};
 use super::{emit, CliError};
 use crate::io::write_atomic_all;
-use crate::pipeline::RunError;
 use crate::report::workprecision::render;
 
 /// Arguments of `fitbead bench`.
@@ -29,10 +28,7 @@ pub struct Args {
 /// Runs `fitbead bench`.
 pub fn run(a: Args) -> Result<(), CliError> {
     let stop = super::stop_flag();
-    let b = crate::pipeline::bench(a.scenes, a.seed, Some(&stop)).map_err(|e| match e {
-        RunError::Interrupted => CliError::Interrupted,
-        e => CliError::Other(e.to_string()),
-    })?;
+    let b = crate::pipeline::bench(a.scenes, a.seed, Some(&stop))?;
     eprint!("{}", b.summary());
     let bytes = render(&b.result.rows).map_err(|e| CliError::Other(e.to_string()))?;
     let svg = match &a.plot.plot {

@@ -239,11 +239,7 @@ impl FitArgs {
                 progress,
                 &mut |n| eprintln!("fitbead {name}: {n}"),
             )
-            .map_err(|e| match e {
-                RunError::Input(e) => CliError::Input(e),
-                RunError::Interrupted => CliError::Interrupted,
-                e => CliError::Other(e.to_string()),
-            })?;
+            .map_err(CliError::from)?;
         self.write(&run)
     }
 

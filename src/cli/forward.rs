@@ -12,7 +12,6 @@ use crate::io::stream::{stream, RowPlan, StreamError, StreamOptions, Streamed};
 use crate::io::{fmt_f64, AtomicFile, InputError};
 use crate::models::md::{Md, MdParams, MdRunConfig, MdSetting, MdSettings, ReducedMass};
 use crate::models::{JaegerBranch, ModelKind};
-use crate::pipeline::RunError;
 use crate::progress::{Progress, ProgressEvent};
 use std::io::{Cursor, Read, Write};
 use std::path::{Path, PathBuf};
@@ -465,10 +464,6 @@ fn run_md(a: &Args, t: &Table) -> Result<(), CliError> {
     };
     let stop = super::stop_flag();
     let bytes = crate::pipeline::md_runs(t, &base, a.md.check_step, Some(md_progress(2000)), &stop)
-        .map_err(|e| match e {
-            RunError::Input(e) => CliError::Input(e),
-            RunError::Interrupted => CliError::Interrupted,
-            e => CliError::Other(e.to_string()),
-        })?;
+        .map_err(CliError::from)?;
     emit(a.out.output.as_deref(), &bytes)
 }

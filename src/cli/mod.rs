@@ -118,6 +118,18 @@ impl From<crate::Error> for CliError {
 
 impl std::error::Error for CliError {}
 
+impl From<crate::pipeline::RunError> for CliError {
+    fn from(e: crate::pipeline::RunError) -> Self {
+        use crate::pipeline::RunError;
+        match e {
+            RunError::Input(i) => CliError::Input(i),
+            RunError::Failed(s) => CliError::Other(s),
+            RunError::Interrupted => CliError::Interrupted,
+            RunError::Library(e) => CliError::from(e),
+        }
+    }
+}
+
 impl From<InputError> for CliError {
     fn from(e: InputError) -> Self {
         CliError::Input(e)

@@ -128,13 +128,3 @@ pub fn run(a: Args) -> Result<(), CliError> {
     })?;
     emit(a.out.output.as_deref(), &bytes)
 }
-
-impl From<RunError> for CliError {
-    fn from(e: RunError) -> Self {
-        match e {
-            RunError::Input(i) => CliError::Input(i),
-            RunError::Failed(s) => CliError::Other(s),
-            RunError::Interrupted => CliError::Interrupted,
-        }
-    }
-}

@@ -26,7 +26,7 @@ impl Bench {
             &self.result.rows,
             &format!("Work-precision, {} scenes (seed {})", self.drawn, self.seed),
         )
-        .map_err(|e| RunError::Failed(e.to_string()))
+        .map_err(RunError::from)
     }
 }
 

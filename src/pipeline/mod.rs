@@ -46,6 +46,9 @@ pub enum RunError {
     Failed(String),
     /// Stopped by the settings' stop flag before anything was written.
     Interrupted,
+    /// A library call that failed (a figure that could not be drawn or rendered, …), with the
+    /// library's own error.
+    Library(crate::Error),
 }
 
 impl fmt::Display for RunError {
@@ -54,6 +57,7 @@ impl fmt::Display for RunError {
             RunError::Input(e) => write!(f, "{e}"),
             RunError::Failed(s) => f.write_str(s),
             RunError::Interrupted => f.write_str("interrupted: nothing written"),
+            RunError::Library(e) => write!(f, "{e}"),
         }
     }
 }
@@ -63,6 +67,18 @@ impl std::error::Error for RunError {}
 impl From<InputError> for RunError {
     fn from(e: InputError) -> Self {
         RunError::Input(e)
+    }
+}
+
+impl From<crate::Error> for RunError {
+    fn from(e: crate::Error) -> Self {
+        RunError::Library(e)
+    }
+}
+
+impl From<crate::report::figures::FigureError> for RunError {
+    fn from(e: crate::report::figures::FigureError) -> Self {
+        RunError::Library(e.into())
     }
 }
 

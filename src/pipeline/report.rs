@@ -233,9 +233,7 @@ pub fn report(
     let md = report_markdown(&an, &context, s, &not_converged);
     warnings.extend(not_converged);
     files.push(("report.md".into(), md.into_bytes()));
-    let files = format
-        .apply(files)
-        .map_err(|e| RunError::Failed(e.to_string()))?;
+    let files = format.apply(files)?;
     // A stop that came while the tables and figures were drawn: nothing is written.
     if s.stopped() && !interrupted {
         return Err(RunError::Interrupted);

@@ -20,6 +20,7 @@
 //! ```text
 //!   pipeline ───── whole runs as library calls: synthetic data (simulate), the fit
 //!                  commands (FitCommand: klaw, jan, jaeger), the report directory (report)
+//!   error ──────── the one error type (Error) wrapping every layer's below
 //!   io ─────────── CSV schemas, measurements with units (Dataset::from_csv), atomic files;
 //!                  one typed record per output row (io::records: ForwardRecord, KRecord, …)
 //!   report ─────── the paper's comparisons, figures, the work-precision engine
@@ -35,8 +36,8 @@
 //!   special ────── math with no beads in it: elliptic integrals, quadrature, roots, dd
 //! ```
 //!
-//! Each layer uses only the layers below it (`numfmt`, `progress`, `record` and `error` are
-//! leaves or the crate's top). The command line is the module `cli` (`src/cli/`, one module per
+//! Each layer uses only the layers below it (`numfmt`, `progress` and `record` are leaves;
+//! `prelude` and the crate root's re-exports are the crate's top). The command line is the module `cli` (`src/cli/`, one module per
 //! subcommand), compiled with the default feature `cli` and above every layer; its one public
 //! function, `cli::main`, is the whole of the binary `src/main.rs`. Without the feature
 //! (`default-features = false`) the library has no command-line module and no command-line

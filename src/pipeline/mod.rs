@@ -48,7 +48,7 @@ pub enum RunError {
     Interrupted,
     /// A library call that failed (a figure that could not be drawn or rendered, …), with the
     /// library's own error.
-    Library(crate::Error),
+    Library(crate::error::Error),
 }
 
 impl fmt::Display for RunError {
@@ -70,8 +70,8 @@ impl From<InputError> for RunError {
     }
 }
 
-impl From<crate::Error> for RunError {
-    fn from(e: crate::Error) -> Self {
+impl From<crate::error::Error> for RunError {
+    fn from(e: crate::error::Error) -> Self {
         RunError::Library(e)
     }
 }

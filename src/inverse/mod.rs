@@ -40,8 +40,6 @@ mod qr;
 pub mod state;
 #[cfg(test)]
 mod suite;
-#[cfg(test)]
-mod tests;
 
 pub use estimate::{fit, fit_result, Covariance, Fit};
 pub use lm::LevenbergMarquardt;

@@ -17,6 +17,8 @@ mod ranges;
 pub mod records;
 pub(crate) mod scenes;
 pub(crate) mod stream;
+#[cfg(test)]
+mod suite;
 
 pub(crate) use atomic::{
     distinct_paths, is_char_device, remove_stale_temporaries, stream_of, write_atomic,

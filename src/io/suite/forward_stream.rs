@@ -166,10 +166,17 @@ const GENERATED_ROWS: usize = 44;
 #[test]
 fn same_bytes_as_the_golden_outputs_on_the_shipped_data() {
     for m in &MODELS {
-        same(m.flags, include_bytes!("../../data/default.csv"), m.default);
         same(
             m.flags,
-            include_bytes!("../../data/virtual/md_ristow.csv"),
+            include_bytes!(concat!(env!("CARGO_MANIFEST_DIR"), "/data/default.csv")),
+            m.default,
+        );
+        same(
+            m.flags,
+            include_bytes!(concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/data/virtual/md_ristow.csv"
+            )),
             m.md_ristow,
         );
     }

@@ -1,13 +1,13 @@
 //! Tests of the least-squares estimate together with its profile intervals: the fit of
-//! [`super::estimate`] and the intervals of [`super::profile`] on problems with known answers.
+//! [`crate::inverse::estimate`] and the intervals of [`crate::inverse::profile`] on problems with known answers.
 
-use super::estimate::*;
-use super::lm::LevenbergMarquardt;
-use super::lsq::{LsqError, LsqOptions, Residuals, SigmaKind, Termination};
-use super::problem::LeastSquares;
-use super::state::LmState;
+use crate::inverse::estimate::*;
+use crate::inverse::lm::LevenbergMarquardt;
 use crate::inverse::lsq::{CurveModel, Infeasible, WeightedData};
+use crate::inverse::lsq::{LsqError, LsqOptions, Residuals, SigmaKind, Termination};
+use crate::inverse::problem::LeastSquares;
 use crate::inverse::profile::{confidence_intervals, ProfileEnd};
+use crate::inverse::state::LmState;
 use std::cell::Cell;
 
 /// y = a + b·x.

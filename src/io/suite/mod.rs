@@ -1,5 +1,5 @@
 //! Tests of the streaming engine ([`super::stream`]) with the row plans of `forward` and `k`,
-//! against the golden outputs of `tests/golden/`: `cargo test --release --lib io::tests`.
+//! against the golden outputs of `tests/golden/`: `cargo test --release --lib io::suite`.
 
 mod csv_ranges;
 mod forward_stream;

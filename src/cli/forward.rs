@@ -12,10 +12,9 @@ use crate::io::stream::{stream, RowPlan, StreamError, StreamOptions, Streamed};
 use crate::io::{fmt_f64, AtomicFile, InputError};
 use crate::models::md::{Md, MdParams, MdRunConfig, MdSetting, MdSettings, ReducedMass};
 use crate::models::{JaegerBranch, ModelKind};
-use crate::progress::{Progress, ProgressEvent};
+use crate::progress::Progress;
 use std::io::{Cursor, Read, Write};
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
 
 /// Arguments of `fitbead forward`.
 #[derive(Debug, clap::Args)]
@@ -426,27 +425,11 @@ pub fn md_progress_bar(total: u64, what: &str) -> Option<indicatif::ProgressBar>
 /// The md runs' progress on a terminal's stderr (nothing elsewhere), drawn for tasks of at
 /// least `min_total` units.
 pub fn md_progress(min_total: u64) -> Progress {
-    let bar: Mutex<Option<indicatif::ProgressBar>> = Mutex::new(None);
-    Progress::new(move |e| {
-        let Ok(mut slot) = bar.lock() else { return };
-        match e {
-            ProgressEvent::Start { label, total, .. } => {
-                *slot = if total >= min_total {
-                    md_progress_bar(total, label)
-                } else {
-                    None
-                };
-            }
-            ProgressEvent::Position(p) => {
-                if let Some(b) = slot.as_ref() {
-                    b.set_position(p);
-                }
-            }
-            ProgressEvent::Finish => {
-                if let Some(b) = slot.take() {
-                    b.finish_and_clear();
-                }
-            }
+    super::bar_sink(move |label, total, _| {
+        if total >= min_total {
+            md_progress_bar(total, label)
+        } else {
+            None
         }
     })
 }

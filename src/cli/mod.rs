@@ -597,6 +597,25 @@ pub(crate) fn warn_implausible(
 /// A progress bar on stderr for posterior runs: one bar per run, drawn from the library's
 /// progress events.
 pub(crate) fn sampler_progress_bar() -> Progress {
+    bar_sink(|label, total, check_every| {
+        let b = indicatif::ProgressBar::new(total);
+        b.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{msg} {bar:30} {pos}/{len} steps ({elapsed}, checks every {prefix})",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        b.set_prefix(check_every.to_string());
+        b.set_message(label.to_string());
+        Some(b)
+    })
+}
+
+/// A progress sink that draws one bar per task: `start(label, total, check_every)` makes the
+/// task's bar (or none), which follows the task's positions and is cleared when it finishes.
+pub(crate) fn bar_sink(
+    start: impl Fn(&str, u64, u64) -> Option<indicatif::ProgressBar> + Send + Sync + 'static,
+) -> Progress {
     let bar: Mutex<Option<indicatif::ProgressBar>> = Mutex::new(None);
     Progress::new(move |e| {
         let Ok(mut slot) = bar.lock() else { return };
@@ -605,18 +624,7 @@ pub(crate) fn sampler_progress_bar() -> Progress {
                 label,
                 total,
                 check_every,
-            } => {
-                let b = indicatif::ProgressBar::new(total);
-                b.set_style(
-                    indicatif::ProgressStyle::with_template(
-                        "{msg} {bar:30} {pos}/{len} steps ({elapsed}, checks every {prefix})",
-                    )
-                    .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-                );
-                b.set_prefix(check_every.to_string());
-                b.set_message(label.to_string());
-                *slot = Some(b);
-            }
+            } => *slot = start(label, total, check_every),
             ProgressEvent::Position(p) => {
                 if let Some(b) = slot.as_ref() {
                     b.set_position(p);

@@ -1382,22 +1382,24 @@ pub(crate) fn design_figure(s: &DesignSettings, r: &DesignResult) -> Figure {
         );
         let curve = &r.sensitivity[k];
         p.curve(curve.clone(), Stroke::solid(colour, 2.0));
-        let chosen: Vec<(f64, f64, f64, f64)> = r
-            .rows
-            .iter()
-            .filter(|row| row.xi == *xi)
-            .map(|row| {
-                let y = curve
-                    .iter()
-                    .min_by(|a, b| {
-                        (a.0 - row.delta_deg)
-                            .abs()
-                            .total_cmp(&(b.0 - row.delta_deg).abs())
-                    })
-                    .map_or(f64::NAN, |c| c.1);
-                (row.delta_deg, y, y, y)
-            })
-            .collect();
+        // Each slope of a design marked at the sensitivity of the nearest candidate.
+        let on_curve = |rows: &[crate::design::DesignRow]| -> Vec<(f64, f64, f64, f64)> {
+            rows.iter()
+                .filter(|row| row.xi == *xi)
+                .map(|row| {
+                    let y = curve
+                        .iter()
+                        .min_by(|a, b| {
+                            (a.0 - row.delta_deg)
+                                .abs()
+                                .total_cmp(&(b.0 - row.delta_deg).abs())
+                        })
+                        .map_or(f64::NAN, |c| c.1);
+                    (row.delta_deg, y, y, y)
+                })
+                .collect()
+        };
+        let chosen = on_curve(&r.rows);
         for row in r.rows.iter().filter(|row| row.xi == *xi) {
             p.items.push(Item::VLine {
                 x: row.delta_deg,
@@ -1409,23 +1411,7 @@ pub(crate) fn design_figure(s: &DesignSettings, r: &DesignResult) -> Figure {
             stroke: Stroke::solid("#404040", 1.0).dashed("2 3"),
         });
         p.points(chosen, colour, Mark::Circle);
-        let even: Vec<(f64, f64, f64, f64)> = r
-            .even
-            .iter()
-            .filter(|row| row.xi == *xi)
-            .map(|row| {
-                let y = curve
-                    .iter()
-                    .min_by(|a, b| {
-                        (a.0 - row.delta_deg)
-                            .abs()
-                            .total_cmp(&(b.0 - row.delta_deg).abs())
-                    })
-                    .map_or(f64::NAN, |c| c.1);
-                (row.delta_deg, y, y, y)
-            })
-            .collect();
-        p.points(even, "#808080", Mark::Cross);
+        p.points(on_curve(&r.even), "#808080", Mark::Cross);
         panels.push(p);
     }
     let cols = if panels.len() > 2 { 2 } else { panels.len() };

@@ -180,6 +180,31 @@ pub(crate) fn not_converged(stats: &[StatsRow]) -> Option<String> {
     (!failed.is_empty()).then(|| failed.join("; "))
 }
 
+/// A command of fits per series (`jan`, `jaeger`) that made none fails, naming why each was
+/// not made (or [`RunError::Interrupted`] when the stop flag cut them short); otherwise each
+/// note of a fit not made goes to `note`.
+pub(crate) fn some_fit_made(
+    command: &str,
+    fits: &[FitResult],
+    notes: &[String],
+    method: &crate::inverse::posterior::Method,
+    note: &mut dyn FnMut(&str),
+) -> Result<(), RunError> {
+    if fits.iter().all(|f| f.params.is_empty()) {
+        if method.stopped() {
+            return Err(RunError::Interrupted);
+        }
+        return Err(RunError::Failed(format!(
+            "{command}: no fit could be made: {}",
+            notes.join("; ")
+        )));
+    }
+    for n in notes {
+        note(n);
+    }
+    Ok(())
+}
+
 /// The figure `svg` as the bytes of the file `path`: rendered to PNG or converted to PDF when
 /// its name ends `.png` or `.pdf`.
 pub(crate) fn figure_bytes(path: &Path, svg: String) -> Result<Vec<u8>, RunError> {

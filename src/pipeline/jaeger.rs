@@ -1,6 +1,6 @@
 //! `fitbead jaeger`: Jaeger's a1, a2, a3 per series (eqs 80–84), with the branch of eq 84.
 
-use super::fit_run::FitRun;
+use super::fit_run::{some_fit_made, FitRun};
 use super::RunError;
 use crate::fit::jaeger::{fit_jaeger_with, JaegerModel};
 use crate::inverse::posterior::Method;
@@ -32,18 +32,7 @@ pub(crate) fn run(
         .flatten()
         .map(|f| f.summary)
         .collect();
-    if fits.iter().all(|f| f.params.is_empty()) {
-        if method.stopped() {
-            return Err(RunError::Interrupted);
-        }
-        return Err(RunError::Failed(format!(
-            "jaeger: no fit could be made: {}",
-            notes.join("; ")
-        )));
-    }
-    for n in &notes {
-        note(n);
-    }
+    some_fit_made("jaeger", &fits, &notes, method, note)?;
     Ok(FitRun {
         fits,
         title: "Jaeger's law (eqs 80–84) fitted on v\u{304}".to_string(),

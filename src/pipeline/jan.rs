@@ -1,7 +1,7 @@
 //! `fitbead jan`: Jan's λ and μ per series (eq 74, fitted on v̄) and the global laws
 //! λ = λ0 e^{λ1 sin α}, μ = μ0 e^{μ1 sin α} (form of eqs 75–76).
 
-use super::fit_run::FitRun;
+use super::fit_run::{some_fit_made, FitRun};
 use super::RunError;
 use crate::fit::jan::fit_jan_with;
 use crate::inverse::posterior::Method;
@@ -31,18 +31,7 @@ pub(crate) fn run(
         .flatten()
         .chain(fits.global)
         .collect();
-    if fits.iter().all(|f| f.params.is_empty()) {
-        if method.stopped() {
-            return Err(RunError::Interrupted);
-        }
-        return Err(RunError::Failed(format!(
-            "jan: no fit could be made: {}",
-            notes.join("; ")
-        )));
-    }
-    for n in &notes {
-        note(n);
-    }
+    some_fit_made("jan", &fits, &notes, method, note)?;
     Ok(FitRun {
         fits,
         title: "Jan's law (eq 74) fitted on v\u{304}".to_string(),

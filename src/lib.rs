@@ -37,11 +37,11 @@
 //! ```
 //!
 //! Each layer uses only the layers below it (`numfmt`, `progress` and `record` are leaves;
-//! `prelude` and the crate root's re-exports are the crate's top). The command line is the module `cli` (`src/cli/`, one module per
-//! subcommand), compiled with the default feature `cli` and above every layer; its one public
-//! function, `cli::main`, is the whole of the binary `src/main.rs`. Without the feature
-//! (`default-features = false`) the library has no command-line module and no command-line
-//! dependencies.
+//! `prelude` and the crate root's re-exports are the crate's top). Every command of the
+//! command line is a call of [`pipeline`] (or of [`design`] for `design`). The command line
+//! itself is the workspace package `fitbead-cli` (`crates/fitbead-cli`, binary `fitbead`),
+//! which parses flags, calls those doors and writes what they return; the library depends on
+//! none of its crates (argument parsing, progress bars, signals, recipes, its allocator).
 //!
 //! ## Which crate does what
 //!
@@ -54,7 +54,7 @@
 //! | rand, rand_chacha, rand_distr | random streams reproducible from a seed whatever the thread count: the MCMC sampler, simulated data |
 //! | rayon | parallel per-row and per-point work (`forward`, `k`, the K-law fits) |
 //! | csv, serde, ryu | the CSV formats; shortest round-trip printing of floats |
-//! | resvg (feature `png`, in `cli`) | PNG rendering of the figures, with the embedded font |
+//! | resvg (feature `png`, default), svg2pdf (feature `pdf`, default) | PNG rendering of the figures, with the embedded font |
 //! | thiserror, tempfile | error types; atomic output files |
 //!
 //! What is hand-written instead, and the measurement that keeps it so, is said where it lives:
@@ -74,10 +74,6 @@
 #![doc = "```"]
 // `!(x > 0.0)` is deliberate throughout: a NaN must land in the failure branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
-// Without the feature `cli`, the crate-private helpers only the command line calls (its file
-// formats, streaming plans and figure writers) are unused; the default build, where the lints
-// are errors, still reports dead code.
-#![cfg_attr(not(feature = "cli"), allow(dead_code, unused_imports))]
 
 pub mod design;
 pub mod error;
@@ -94,9 +90,6 @@ pub(crate) mod special;
 
 pub mod io;
 pub mod prelude;
-
-#[cfg(feature = "cli")]
-pub mod cli;
 
 #[cfg(feature = "bench-internals")]
 pub mod bench_internals;

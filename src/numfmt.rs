@@ -24,7 +24,7 @@ pub fn fmt_f64(x: f64) -> String {
 
 /// `x` as a message echoes it: the shortest decimal that reads back as the same double
 /// (`1e300`, never its 301 digits), `NaN`, `inf` or `-inf`.
-pub(crate) fn echo_f64(x: f64) -> String {
+pub fn echo_f64(x: f64) -> String {
     if x.is_finite() {
         fmt_f64(x)
     } else {

@@ -5,7 +5,7 @@ use crate::numfmt::{fmt_f64, fmt_sig};
 
 impl DesignResult {
     /// The design as `fitbead design` writes it: CSV `series,xi,delta_deg,replicates`.
-    pub(crate) fn csv(&self) -> csv::Result<Vec<u8>> {
+    pub fn csv(&self) -> csv::Result<Vec<u8>> {
         let mut w = csv::Writer::from_writer(Vec::new());
         w.write_record(["series", "xi", "delta_deg", "replicates"])?;
         for row in &self.rows {
@@ -21,7 +21,7 @@ impl DesignResult {
 
     /// The summary `fitbead design` prints: the design of `s`, the predicted standard errors
     /// and the efficiency of evenly spaced slopes.
-    pub(crate) fn summary(&self, s: &DesignSettings) -> String {
+    pub fn summary(&self, s: &DesignSettings) -> String {
         summary(s, self)
     }
 }

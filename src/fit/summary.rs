@@ -176,6 +176,28 @@ pub(crate) const ABSURD_REDUCED_CHI2: f64 = 1000.0;
 pub(crate) const MISFIT_P_VALUE: f64 = 1e-3;
 
 impl StatsRow {
+    /// The row as one line, as the command line prints it on stderr when the statistics go
+    /// nowhere else: `FIT [SERIES]: chi2 … dof … reduced … AIC … BIC … (termination)`, the
+    /// numbers to 7 significant digits, and ` — note` when there is a note.
+    pub fn summary_line(&self) -> String {
+        format!(
+            "{} [{}]: chi2 {} dof {} reduced {} AIC {} BIC {} ({}){}",
+            self.fit,
+            self.series,
+            fmt_sig(self.chi2, 7),
+            self.dof,
+            fmt_sig(self.reduced_chi2, 7),
+            fmt_sig(self.aic, 7),
+            fmt_sig(self.bic, 7),
+            self.termination,
+            if self.note.is_empty() {
+                String::new()
+            } else {
+                format!(" — {}", self.note)
+            }
+        )
+    }
+
     /// The χ² tail probability P(χ²_dof ≥ χ²): the chance of a misfit at least this large if
     /// the model holds and σ is right. `None` without σ given (unit weights), with no degree of
     /// freedom, or where χ² is not a number; 0 where χ² is infinite.

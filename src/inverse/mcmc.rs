@@ -145,6 +145,9 @@ pub struct OptionError {
 }
 
 impl McmcOptions {
+    /// Most walkers a run may have: each step keeps one draw per walker in memory.
+    pub const MAX_WALKERS: usize = MAX_WALKERS;
+
     /// Checks the settings a user chooses (walkers, min_ess, max_steps, thin) against their
     /// ranges: walkers even, at least 4 and at most `MAX_WALKERS`; min_ess finite and ≥ 0;
     /// max_steps and thin ≥ 1. The command line and the Python binding refuse the same values.

@@ -289,6 +289,10 @@ pub struct McmcSettings {
 }
 
 impl McmcSettings {
+    /// The name of the error-scale parameter (sampled when σ is not given or
+    /// [`McmcSettings::fit_scatter`] asks for it); a prior may be given to it by this name.
+    pub const SCALE_NAME: &'static str = SCALE_NAME;
+
     /// The default settings (flat priors on the parameter boxes, R̂ ≤ 1.01 and ESS ≥ 1000 or
     /// 100 000 steps) with the sampler seeded by `seed`: the same seed gives the same draws
     /// whatever the number of threads.

@@ -20,7 +20,7 @@
 //!   if this user may write it (a read-only file, or another user's, in a directory anyone
 //!   may write is refused).
 //!
-//! A group of files ([`write_atomic_all`]) is checked whole before the first rename (every
+//! A group of files ([`AtomicFile::write_files`]) is checked whole before the first rename (every
 //! target resolved, none a directory, no two the same file), then renamed one after the other;
 //! if a rename fails, the files already renamed are put back as they were (the previous
 //! contents of a replaced file are kept under a hard link until the group succeeds).
@@ -275,14 +275,6 @@ pub fn same_file(a: &Path, b: &Path) -> bool {
     }
 }
 
-/// Whether `path` resolves to an open descriptor of this process (`-` is standard output):
-/// descriptor N, or `None` for a path.
-pub fn stream_of(path: &Path) -> Option<i32> {
-    match resolve(path) {
-        Ok(Target::Descriptor(fd)) => Some(fd),
-        _ => None,
-    }
-}
 
 /// What a path names, directories included.
 enum Resolved {
@@ -456,7 +448,7 @@ impl AtomicFile {
 
     /// Whether the bytes go straight to the target (a device or FIFO), seen as they are
     /// written, rather than to a temporary file that replaces the target on commit.
-    pub(crate) fn is_direct(&self) -> bool {
+    pub fn is_direct(&self) -> bool {
         matches!(self.sink, Sink::Direct(_))
     }
 
@@ -716,23 +708,9 @@ impl Write for AtomicFile {
     }
 }
 
-/// Writes `bytes` to `path` atomically: a temporary file in the same directory, flushed and
-/// synced, then renamed over the target. On any error the target is untouched. Symbolic
-/// links, devices and FIFOs: module docs.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    write_atomic_all(&[(path, bytes)])
-}
 
-/// Writes several files atomically as a group. Every target is resolved and checked first
-/// (none a directory, no two the same file), every temporary file is written and synced, and
-/// only then are they renamed into place; a rename that fails puts back the files already
-/// renamed. Devices and FIFOs among the targets are written last, once every rename
-/// succeeded. On any error no regular target has changed.
-pub fn write_atomic_all(files: &[(&Path, &[u8])]) -> std::io::Result<()> {
-    write_atomic_all_then(files, || {})
-}
 
-/// [`write_atomic_all`] with `before_rename` called once every temporary file is written,
+/// [`AtomicFile::write_files`] with `before_rename` called once every temporary file is written,
 /// just before the first rename: a hook for tests of the roll-back (a target can be made to
 /// fail there).
 pub(crate) fn write_atomic_all_then(
@@ -803,88 +781,119 @@ pub(crate) fn write_atomic_all_then(
     Ok(())
 }
 
-/// Whether `p` is a character device (`/dev/null`, a terminal), after following links.
-pub(crate) fn is_char_device(p: &Path) -> bool {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        std::fs::metadata(p).is_ok_and(|m| m.file_type().is_char_device())
-    }
-    #[cfg(not(unix))]
-    {
-        p == Path::new("NUL")
-    }
-}
 
-/// Refuses, before any work, an output that is a directory, whose directory does not exist,
-/// that is one of the `inputs` (after following symbolic links; `-`, standard input, when it
-/// is redirected from that file) or that is another of the `outputs` (a character device such
-/// as `/dev/null` excepted). An output `-` is standard
-/// output; two outputs to the same standard stream or descriptor (`-` and `/dev/stdout`, say)
-/// are refused as well: their bytes would be mixed. Paths are named by the flag that gives
-/// them (absent ones skipped); the error names the flag.
-pub fn distinct_paths(
-    inputs: &[(&str, Option<&Path>)],
-    outputs: &[(&str, Option<&Path>)],
-) -> Result<(), InputError> {
-    let outs: Vec<(&str, &Path)> = outputs
-        .iter()
-        .filter_map(|(n, p)| p.map(|p| (*n, p)))
-        .collect();
-    for (i, (flag, p)) in outs.iter().enumerate() {
-        let stream = stream_of(p);
-        if stream.is_none() && p.is_dir() {
-            return Err(setting_error(
-                flag.trim_start_matches("--"),
-                &p.display().to_string(),
-                "is a directory",
-            ));
-        }
-        if stream.is_none() {
-            ready_output(flag, p)?;
-        }
-        for (iflag, q) in inputs.iter().filter_map(|(n, q)| q.map(|q| (*n, q))) {
-            // `-` is standard input: the same file as the output when it is redirected from it.
-            let q = if q == Path::new("-") {
-                Path::new("/dev/stdin")
-            } else {
-                q
-            };
-            if same_file(p, q) {
+
+/// Whole files and sets of files written atomically, and the checks of output paths that
+/// come before any work.
+impl AtomicFile {
+    /// Writes `bytes` to `path` atomically: a temporary file in the same directory, flushed and
+    /// synced, then renamed over the target. On any error the target is untouched. Symbolic
+    /// links, devices and FIFOs: module docs.
+    pub fn write_file(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+        Self::write_files(&[(path, bytes)])
+    }
+
+    /// Writes several files atomically as a group. Every target is resolved and checked first
+    /// (none a directory, no two the same file), every temporary file is written and synced, and
+    /// only then are they renamed into place; a rename that fails puts back the files already
+    /// renamed. Devices and FIFOs among the targets are written last, once every rename
+    /// succeeded. On any error no regular target has changed.
+    pub fn write_files(files: &[(&Path, &[u8])]) -> std::io::Result<()> {
+        write_atomic_all_then(files, || {})
+    }
+
+    /// Refuses, before any work, an output that is a directory, whose directory does not exist,
+    /// that is one of the `inputs` (after following symbolic links; `-`, standard input, when it
+    /// is redirected from that file) or that is another of the `outputs` (a character device such
+    /// as `/dev/null` excepted). An output `-` is standard
+    /// output; two outputs to the same standard stream or descriptor (`-` and `/dev/stdout`, say)
+    /// are refused as well: their bytes would be mixed. Paths are named by the flag that gives
+    /// them (absent ones skipped); the error names the flag.
+    pub fn distinct_paths(
+        inputs: &[(&str, Option<&Path>)],
+        outputs: &[(&str, Option<&Path>)],
+    ) -> Result<(), InputError> {
+        let outs: Vec<(&str, &Path)> = outputs
+            .iter()
+            .filter_map(|(n, p)| p.map(|p| (*n, p)))
+            .collect();
+        for (i, (flag, p)) in outs.iter().enumerate() {
+            let stream = Self::stream_of(p);
+            if stream.is_none() && p.is_dir() {
                 return Err(setting_error(
                     flag.trim_start_matches("--"),
                     &p.display().to_string(),
-                    format!("is the same file as {iflag}: the input would be overwritten"),
+                    "is a directory",
                 ));
             }
-        }
-        for (oflag, q) in &outs[..i] {
-            if let Some(fd) = stream.filter(|fd| stream_of(q) == Some(*fd)) {
-                let name = match fd {
-                    1 => "standard output".to_string(),
-                    2 => "standard error".to_string(),
-                    n => format!("descriptor {n}"),
+            if stream.is_none() {
+                ready_output(flag, p)?;
+            }
+            for (iflag, q) in inputs.iter().filter_map(|(n, q)| q.map(|q| (*n, q))) {
+                // `-` is standard input: the same file as the output when it is redirected from it.
+                let q = if q == Path::new("-") {
+                    Path::new("/dev/stdin")
+                } else {
+                    q
                 };
-                return Err(setting_error(
-                    flag.trim_start_matches("--"),
-                    &p.display().to_string(),
-                    format!(
-                        "goes to {name}, as {oflag} does: only one output may go to a stream \
-                         (give one of them a file)"
-                    ),
-                ));
+                if same_file(p, q) {
+                    return Err(setting_error(
+                        flag.trim_start_matches("--"),
+                        &p.display().to_string(),
+                        format!("is the same file as {iflag}: the input would be overwritten"),
+                    ));
+                }
             }
-            // A character device (/dev/null, a terminal) takes any number of writers.
-            if same_file(p, q) && !is_char_device(p) {
-                return Err(setting_error(
-                    flag.trim_start_matches("--"),
-                    &p.display().to_string(),
-                    format!("is the same file as {oflag}: one output would overwrite the other"),
-                ));
+            for (oflag, q) in &outs[..i] {
+                if let Some(fd) = stream.filter(|fd| Self::stream_of(q) == Some(*fd)) {
+                    let name = match fd {
+                        1 => "standard output".to_string(),
+                        2 => "standard error".to_string(),
+                        n => format!("descriptor {n}"),
+                    };
+                    return Err(setting_error(
+                        flag.trim_start_matches("--"),
+                        &p.display().to_string(),
+                        format!(
+                            "goes to {name}, as {oflag} does: only one output may go to a stream \
+                             (give one of them a file)"
+                        ),
+                    ));
+                }
+                // A character device (/dev/null, a terminal) takes any number of writers.
+                if same_file(p, q) && !Self::is_char_device(p) {
+                    return Err(setting_error(
+                        flag.trim_start_matches("--"),
+                        &p.display().to_string(),
+                        format!("is the same file as {oflag}: one output would overwrite the other"),
+                    ));
+                }
             }
+        }
+        Ok(())
+    }
+
+    /// Whether `path` resolves to an open descriptor of this process (`-` is standard output):
+    /// descriptor N, or `None` for a path.
+    pub fn stream_of(path: &Path) -> Option<i32> {
+        match resolve(path) {
+            Ok(Target::Descriptor(fd)) => Some(fd),
+            _ => None,
         }
     }
-    Ok(())
+
+    /// Whether `p` is a character device (`/dev/null`, a terminal), after following links.
+    pub fn is_char_device(p: &Path) -> bool {
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::FileTypeExt;
+            std::fs::metadata(p).is_ok_and(|m| m.file_type().is_char_device())
+        }
+        #[cfg(not(unix))]
+        {
+            p == Path::new("NUL")
+        }
+    }
 }
 
 #[cfg(test)]

@@ -68,7 +68,7 @@ pub(crate) use super::{setting_error, SETTINGS_ORIGIN};
 /// The values rows fall back on where their column is absent or their cell empty, and the
 /// model to evaluate.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct ForwardSettings {
+pub struct ForwardSettings {
     /// The model (every kind but md, which does not stream).
     pub kind: ModelKind,
     /// Collision law of rows without a `K` cell.
@@ -383,6 +383,7 @@ pub(crate) struct ForwardPlan {
 /// rule as text (parsed by [`ForwardPlan::from_text`], errors naming `--K` and `--spin`), the
 /// rest in `base` (whose `law` and `spin` are replaced).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg(test)]
 pub(crate) struct ForwardText<'a> {
     /// The collision law: a number, `cos2a`, `adjusted`, `impact` or `c=VALUE`.
     pub k: &'a str,
@@ -393,6 +394,7 @@ pub(crate) struct ForwardText<'a> {
 }
 
 impl ForwardPlan {
+    #[cfg(test)]
     /// The plan for a table with `reader`'s header and the settings `text`: the columns are
     /// checked first, then `--spin`, `--tol` (in (0, 1)) and `--K`, so that their errors come
     /// in that order.
@@ -405,14 +407,7 @@ impl ForwardPlan {
             .spin
             .parse()
             .map_err(|e: ParameterError| setting_error("spin", text.spin, e.to_string()))?;
-        let tol = text.base.tol;
-        if !(tol > 0.0 && tol < 1.0) {
-            return Err(setting_error(
-                "tol",
-                &tol.to_string(),
-                "expected a relative tolerance in (0, 1)",
-            ));
-        }
+        check_tol(text.base.tol)?;
         let law = text
             .k
             .parse()
@@ -422,6 +417,17 @@ impl ForwardPlan {
             spin,
             ..text.base
         };
+        Ok(ForwardPlan::new(reader, cols, settings))
+    }
+
+    /// The plan for a table with `reader`'s header and the settings `settings`: the columns
+    /// are checked first, then the tolerance (in (0, 1)).
+    pub fn checked<R: Read>(
+        reader: &TableReader<R>,
+        settings: ForwardSettings,
+    ) -> Result<Self, InputError> {
+        let cols = SceneColumns::new(reader)?;
+        check_tol(settings.tol)?;
         Ok(ForwardPlan::new(reader, cols, settings))
     }
 
@@ -437,6 +443,19 @@ impl ForwardPlan {
             cols,
             headers: reader.headers().to_vec(),
         }
+    }
+}
+
+/// Refuses a tolerance outside (0, 1), as the setting `--tol`.
+fn check_tol(tol: f64) -> Result<(), InputError> {
+    if tol > 0.0 && tol < 1.0 {
+        Ok(())
+    } else {
+        Err(setting_error(
+            "tol",
+            &tol.to_string(),
+            "expected a relative tolerance in (0, 1)",
+        ))
     }
 }
 

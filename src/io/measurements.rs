@@ -513,6 +513,45 @@ pub struct MeasurementFile {
 }
 
 impl MeasurementFile {
+    /// The shipped default data set, as CSV (synthetic, 36 points in 4 series).
+    pub const DEFAULT_DATA: &'static str = DEFAULT_DATA;
+
+    /// The name of [`MeasurementFile::DEFAULT_DATA`] in messages.
+    pub const DEFAULT_DATA_NAME: &'static str = DEFAULT_DATA_NAME;
+
+    /// Reads `bytes`, named `source` in errors, as the command line reads a measurements file
+    /// given to it: with `check_columns`, a column fitbead does not read is an error when
+    /// `strict`, else a column close to a known name is a warning; the defaults are checked
+    /// (ρ ≥ 0, f ≥ 0, g > 0) once the table proved well formed; the data's plausibility
+    /// warnings (unit mistakes, [`MeasurementFile::plausibility`]) follow, each preceded by
+    /// `source` and `: `. Every warning goes to `warn` as it is found.
+    pub fn read_checked(
+        source: &str,
+        bytes: &[u8],
+        defaults: &MeasurementDefaults,
+        check_columns: bool,
+        strict: bool,
+        warn: &mut dyn FnMut(&str),
+    ) -> Result<Self, InputError> {
+        let table = Table::parse(source, bytes)?;
+        if check_columns {
+            for w in crate::io::scenes::check_columns(&table, &MEASUREMENT_COLUMNS, strict)? {
+                warn(&w.to_string());
+            }
+        }
+        let defaults = defaults.checked()?;
+        let rows = read_measurements(&table, &defaults)?;
+        let dataset = dataset_of(&table, &rows)?;
+        for x in plausibility(&table, &rows) {
+            warn(&format!("{source}: {x}"));
+        }
+        Ok(MeasurementFile {
+            table,
+            rows,
+            dataset,
+        })
+    }
+
     /// Parses and validates `bytes`, named `source` in errors.
     pub fn parse(
         source: &str,

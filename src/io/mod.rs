@@ -1,5 +1,5 @@
 //! Files: CSV reading with errors that name file, line, column and value; atomic writing
-//! (`AtomicFile`, `write_atomic_all`: whole files or none, modes kept, links followed;
+//! (`AtomicFile`, `AtomicFile::write_files`: whole files or none, modes kept, links followed;
 //! directories of outputs written as one unit: `outdir`);
 //! tables streamed through a per-row computation in bounded memory (`stream`), with the
 //! row plans of `fitbead forward` ([`forward`]) and `fitbead k` ([`kstream`]).
@@ -8,8 +8,8 @@ mod atomic;
 pub(crate) mod cells;
 mod csvsyntax;
 pub(crate) mod fit_tables;
-pub mod forward;
-pub mod kstream;
+pub(crate) mod forward;
+pub(crate) mod kstream;
 pub(crate) mod md;
 pub mod measurements;
 pub(crate) mod outdir;
@@ -20,28 +20,10 @@ pub(crate) mod stream;
 #[cfg(test)]
 mod suite;
 
-pub(crate) use atomic::{
-    distinct_paths, is_char_device, remove_stale_temporaries, stream_of, write_atomic,
-    write_atomic_all, AtomicFile,
-};
+pub use atomic::AtomicFile;
+pub(crate) use atomic::remove_stale_temporaries;
 
-pub(crate) use crate::numfmt::{clip, echo, fmt_f64, fmt_sig, ECHO_CHARS};
-
-/// The columns the streaming command `command` writes under a model of `kind`, in order,
-/// generated from the records; `None` for a command other than `forward` and `k`.
-///
-/// `forward`: the columns it adds after the input's own (every model's, then the contact
-/// model's or auto's). `k`: the input's columns that have an output of their own, then K's
-/// (then auto's two under auto); the input's other columns follow them.
-pub fn output_columns(command: &str, kind: crate::models::ModelKind) -> Option<Vec<&'static str>> {
-    match command {
-        "forward" => Some(forward::output_columns(kind)),
-        "k" => Some(kstream::output_columns(
-            kind == crate::models::ModelKind::Auto,
-        )),
-        _ => None,
-    }
-}
+pub(crate) use crate::numfmt::{clip, echo, fmt_f64, ECHO_CHARS};
 
 use std::fmt;
 
@@ -75,6 +57,20 @@ pub struct InputError {
 }
 
 impl InputError {
+    /// The name settings go under as the file of an error: the command line's flags, or the
+    /// keywords of a call.
+    pub const SETTINGS: &'static str = SETTINGS_ORIGIN;
+
+    /// Longest echo of a user's value in a message, in characters ([`InputError::clip`]).
+    pub const ECHO_CHARS: usize = ECHO_CHARS;
+
+    /// `s` cut to at most `max` characters for a message: a longer text keeps its first
+    /// `max` − 1 characters followed by `…` and its full length in bytes, so that a huge cell
+    /// or argument is never echoed whole.
+    pub fn clip(s: &str, max: usize) -> std::borrow::Cow<'_, str> {
+        clip(s, max)
+    }
+
     /// An error about a whole file.
     pub fn file(file: &str, message: impl Into<String>) -> Self {
         InputError {

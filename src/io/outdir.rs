@@ -10,7 +10,7 @@
 //!    ([`super::remove_stale_temporaries`]: those of runs that are gone, never a live run's);
 //! 3. records in the manifest `MANIFEST` that this run is writing (naming the run, and
 //!    every file of the previous run and of this one);
-//! 4. writes every file as one group ([`super::write_atomic_all`]: all of them or, on an
+//! 4. writes every file as one group ([`super::AtomicFile::write_files`]: all of them or, on an
 //!    error, none changed);
 //! 5. removes the files the previous run listed in the manifest that this run did not write
 //!    (a corner plot of a series no longer in the data, say) — and no other file;
@@ -19,7 +19,7 @@
 //! A run killed during step 4 can leave a mix of old and new files: the manifest then says
 //! `state writing` and names the run, and the next run replaces and removes them all.
 
-use super::{remove_stale_temporaries, write_atomic, write_atomic_all};
+use super::{remove_stale_temporaries, AtomicFile};
 use std::path::Path;
 
 /// Whether `dir` can take the output files before any work is done: an existing directory,
@@ -148,17 +148,17 @@ pub fn write_dir(dir: &Path, files: &[(String, Vec<u8>)]) -> std::io::Result<()>
         run: run.clone(),
         files: all,
     };
-    write_atomic(&manifest, writing.text().as_bytes())?;
+    AtomicFile::write_file(&manifest, writing.text().as_bytes())?;
     let paths: Vec<std::path::PathBuf> = files.iter().map(|(n, _)| dir.join(n)).collect();
     let group: Vec<(&Path, &[u8])> = paths
         .iter()
         .zip(files)
         .map(|(p, (_, b))| (p.as_path(), b.as_slice()))
         .collect();
-    if let Err(e) = write_atomic_all(&group) {
+    if let Err(e) = AtomicFile::write_files(&group) {
         // Nothing was written: the manifest goes back to what it was.
         let _ = match &previous {
-            Some(m) => write_atomic(&manifest, m.text().as_bytes()),
+            Some(m) => AtomicFile::write_file(&manifest, m.text().as_bytes()),
             None => std::fs::remove_file(&manifest),
         };
         return Err(e);
@@ -178,7 +178,7 @@ pub fn write_dir(dir: &Path, files: &[(String, Vec<u8>)]) -> std::io::Result<()>
         run,
         files: files.iter().map(|(n, _)| n.clone()).collect(),
     };
-    write_atomic(&manifest, complete.text().as_bytes())
+    AtomicFile::write_file(&manifest, complete.text().as_bytes())
 }
 
 /// An exclusive lock on the directory itself, held until the returned handle is dropped

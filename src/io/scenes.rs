@@ -488,7 +488,7 @@ impl std::fmt::Display for UnknownColumn {
 /// otherwise those close to a known name are returned, for the caller to warn about (other
 /// columns pass through on purpose, e.g. an `id`).
 pub fn check_columns(
-    t: &impl Header,
+    t: &(impl Header + ?Sized),
     known: &[&str],
     strict: bool,
 ) -> Result<Vec<UnknownColumn>, InputError> {

@@ -444,7 +444,7 @@ impl MdSetting {
 /// left `None` keeps the preset's value. Counts are held as numbers so that a value such as
 /// 2.5 can be refused with the setting named.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub(crate) struct MdSettings {
+pub struct MdSettings {
     /// Radius R of the row beads, m.
     pub row_radius_m: Option<f64>,
     /// Young's modulus E, Pa.
@@ -477,12 +477,12 @@ pub(crate) struct MdSettings {
 
 impl MdSettings {
     /// The value given for `s`.
-    pub fn get(&self, s: MdSetting) -> Option<f64> {
+    pub(crate) fn get(&self, s: MdSetting) -> Option<f64> {
         *self.slot(s)
     }
 
     /// Gives `s` the value `x`.
-    pub fn set(&mut self, s: MdSetting, x: f64) {
+    pub(crate) fn set(&mut self, s: MdSetting, x: f64) {
         *self.slot_mut(s) = Some(x);
     }
 
@@ -526,7 +526,7 @@ impl MdSettings {
 
     /// `base` with the values given here, validated ([`Md::validate`]); a refusal names the
     /// setting at fault when it is one of these (a count must be a whole number ≤ 1e9).
-    pub fn apply(&self, base: Md) -> std::result::Result<Md, (Option<MdSetting>, Error)> {
+    pub(crate) fn apply(&self, base: Md) -> std::result::Result<Md, (Option<MdSetting>, Error)> {
         let Md {
             mut params,
             mut config,

@@ -415,6 +415,17 @@ impl ModelKind {
         })
     }
 
+    /// The model's name on the command line, one of [`Model::NAMES`] (`stickslip`,
+    /// `stick-approx`).
+    pub fn name(self) -> &'static str {
+        match self {
+            ModelKind::StickSlip => "stickslip",
+            ModelKind::Jan => "jan",
+            ModelKind::Jaeger => "jaeger",
+            k => k.prose_name(),
+        }
+    }
+
     /// The model's name in prose (titles and sentences): "stick/slip" for `stickslip`, the
     /// command-line name otherwise.
     pub fn prose_name(self) -> &'static str {

@@ -3,7 +3,7 @@
 use super::RunError;
 use crate::io::md::{md_csv, md_jobs, MdTable};
 use crate::io::scenes::Table;
-use crate::models::md::{Md, MdResult, MdSettings};
+use crate::models::md::MdResult;
 use crate::progress::{Progress, ProgressEvent, Tally};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -60,28 +60,4 @@ pub(crate) fn md_runs(
         return Err(RunError::Interrupted);
     }
     md_csv(t, &jobs, &results).map_err(|e| RunError::Failed(e.to_string()))
-}
-
-/// `fitbead forward --model md` on a scene table (CSV `xi,delta_deg[,rho][,f]` and per-row md
-/// settings, as the command line reads it; `source` names it in errors): one md run of every
-/// row under `md`, as the CSV the command line writes (the input's columns, then the md
-/// columns). `rho` and `f` are those of rows without the columns. A raised `stop` ends the
-/// run with [`RunError::Interrupted`].
-pub fn forward_md(
-    table: &[u8],
-    source: &str,
-    md: Md,
-    rho: f64,
-    f: f64,
-    stop: Option<&AtomicBool>,
-) -> Result<Vec<u8>, RunError> {
-    let t = Table::parse(source, table)?;
-    let base = MdTable {
-        md,
-        flags: MdSettings::default(),
-        rho,
-        f,
-    };
-    let never = AtomicBool::new(false);
-    md_runs(&t, &base, false, None, stop.unwrap_or(&never))
 }

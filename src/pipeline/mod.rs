@@ -1,10 +1,10 @@
-//! Whole runs of the command line as library calls: synthetic measurements ([`simulate`]),
-//! the fit commands `klaw`, `jan` and `jaeger` ([`FitCommand::run`]), the report of every
-//! model fitted to one data set ([`report`]), the work-precision table
-//! of the forward models ([`work_precision`]) and the molecular-dynamics runs of a scene table
-//! ([`forward_md`]). The command line parses its
-//! flags into these settings, calls these functions and prints or writes what they return;
-//! the Python package calls the same functions.
+//! Whole runs of the command line as library calls, one door per command: `forward` and `k`
+//! ([`TableCommand::run`]), the fit commands `klaw`, `jan` and `jaeger`
+//! ([`FitCommand::run`]), `regimes` ([`RegimeRecord::csv`](crate::io::records::RegimeRecord::csv)),
+//! `report` ([`ReportSettings::run`]), `simulate` ([`SimulateSettings::run`]) and `bench`
+//! ([`Bench::run`]); `design` is [`crate::design::design`]. The command line parses its flags
+//! into these settings, calls these doors and prints or writes what they return; the Python
+//! package calls the same doors.
 //!
 //! A setting that cannot be used is an [`InputError`] named as the command line's flag
 //! (`--points`, `--series`, …) in the column of the error, so that both front ends report it
@@ -17,20 +17,21 @@ mod forward;
 mod jaeger;
 mod jan;
 mod klaw;
+mod regimes;
 mod report;
 mod simulate;
+mod table;
 
-pub(crate) use bench::bench;
-pub use bench::work_precision;
+pub use bench::Bench;
 pub use fit_command::FitCommand;
 pub use fit_run::FitRun;
 pub(crate) use fit_run::{figure_bytes, not_converged};
-pub use forward::forward_md;
-pub(crate) use forward::md_runs;
 pub(crate) use report::law_error;
-pub use report::{report, ReportOutput, ReportSettings};
-pub(crate) use simulate::MAX_POINTS;
-pub use simulate::{simulate, SimulateSettings};
+pub use report::{ReportOutput, ReportSettings};
+pub use crate::io::forward::ForwardSettings;
+pub use crate::io::stream::StreamOptions;
+pub use simulate::SimulateSettings;
+pub use table::{TableCommand, TableRun};
 
 use crate::io::InputError;
 use std::fmt;

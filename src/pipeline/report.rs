@@ -28,7 +28,7 @@ const CONTACT_MODELS: [crate::models::Model; 2] =
 /// [`CONTACT_MODELS`] in prose.
 const CONTACT_NAMES: [&str; 2] = ["rolling", "stick/slip"];
 
-/// How [`report`] fits and draws: the settings of `fitbead report` (the defaults are its
+/// How [`ReportSettings::run`] fits and draws: the settings of `fitbead report` (the defaults are its
 /// flags' defaults).
 #[derive(Debug, Clone)]
 pub struct ReportSettings {
@@ -80,7 +80,7 @@ impl Default for ReportSettings {
     }
 }
 
-/// What [`report`] made.
+/// What [`ReportSettings::run`] made.
 #[derive(Debug, Clone)]
 pub struct ReportOutput {
     /// Every file of the directory, by name, in the order written: the CSV tables, the
@@ -101,8 +101,75 @@ pub struct ReportOutput {
 }
 
 impl ReportSettings {
+    /// The names `format` takes: the file formats of the figures.
+    pub const FORMATS: [&'static str; 5] = ["svg", "png", "pdf", "both", "all"];
+
+    /// Runs `fitbead report` on `data`: every model fitted, the comparisons drawn, and, when
+    /// `out_dir` is given, the directory written as one unit (locked while written, every file or
+    /// none, the run recorded in `.fitbead.manifest`; missing parents created and removed again
+    /// on failure). The files are returned either way.
+    ///
+    /// In stages: the flags checked, the input checked (points no contact model makes steady),
+    /// the models fitted and their laws checked, then the tables, the figures and report.md
+    /// drawn, and the directory written.
+    pub fn run(
+        &self,
+        data: &MeasurementFile,
+        out_dir: Option<&Path>,
+    ) -> Result<ReportOutput, RunError> {
+        report(data, self, out_dir)
+    }
+
+    /// Checks a figure format's name (one of [`ReportSettings::FORMATS`], any case, spaces
+    /// around it ignored); the error says which names there are.
+    pub fn check_format(name: &str) -> Result<(), FigureError> {
+        name.parse::<FigureFormat>().map(|_| ())
+    }
+
+    /// Checks a figure width: `single` (86 mm), `double` (178 mm) or a width in mm from 40
+    /// to 500 (`120` or `120mm`).
+    pub fn check_figure_width(width: &str) -> Result<(), FigureError> {
+        width.parse::<FigureWidth>().map(|_| ())
+    }
+
+    /// Whether `dir` can take a report's files before any work is done: an existing
+    /// directory, or a path whose nearest existing ancestor is a directory (the missing ones
+    /// are made when the files are written). The error says what stands in the way (without
+    /// naming `dir`).
+    pub fn check_out_dir(dir: &Path) -> std::io::Result<()> {
+        crate::io::outdir::check_dir(dir)
+    }
+
     fn stopped(&self) -> bool {
         self.stop.as_ref().is_some_and(|s| s.load(Ordering::SeqCst))
+    }
+}
+
+impl ReportOutput {
+    /// The files of a report directory, in the order they are written (the figures as SVG;
+    /// the format of the settings gives each figure's other files).
+    pub const FILES: [&'static str; 19] = crate::report::REPORT_FILES;
+
+    /// [`ReportOutput::FILES`] with each figure's names in the figure format `format` (one
+    /// of [`ReportSettings::FORMATS`]): `NAME.svg`, `NAME.png` or both, and so on.
+    pub fn file_names(format: &str) -> Result<Vec<String>, FigureError> {
+        let format: FigureFormat = format.parse()?;
+        Ok(Self::FILES
+            .iter()
+            .flat_map(|f| {
+                if f.ends_with(".svg") {
+                    format.names(f)
+                } else {
+                    vec![f.to_string()]
+                }
+            })
+            .collect())
+    }
+
+    /// `FIT [SERIES]: why` for each fit that did not converge, joined by `; `; `None` when
+    /// every fit converged (as [`FitRun::not_converged`](super::FitRun::not_converged)).
+    pub fn not_converged(&self) -> Option<String> {
+        super::not_converged(&self.stats)
     }
 }
 
@@ -141,15 +208,8 @@ pub(crate) fn law_error(e: &KLawError, locate: &dyn Fn(usize) -> String) -> Stri
     }
 }
 
-/// Runs `fitbead report` on `data`: every model fitted, the comparisons drawn, and, when
-/// `out_dir` is given, the directory written as one unit (locked while written, every file or
-/// none, the run recorded in `.fitbead.manifest`; missing parents created and removed again
-/// on failure). The files are returned either way.
-///
-/// In stages: the flags checked, the input checked (points no contact model makes steady),
-/// the models fitted and their laws checked, then the tables, the figures and report.md
-/// drawn, and the directory written.
-pub fn report(
+/// [`ReportSettings::run`].
+fn report(
     data: &MeasurementFile,
     s: &ReportSettings,
     out_dir: Option<&Path>,

@@ -143,6 +143,15 @@ impl Default for SimulateSettings {
 }
 
 impl SimulateSettings {
+    /// The most points per series a steady-state run draws.
+    pub const MAX_POINTS: usize = MAX_POINTS;
+
+    /// Runs `fitbead simulate`: the CSV it writes (`series,xi,delta_deg,v,sigma_v,v_true`, md
+    /// adding `v_md_stderr,v_m_s`; with `v0` the transient's columns).
+    pub fn run(&self) -> Result<Vec<u8>, RunError> {
+        simulate(self)
+    }
+
     fn stopped(&self) -> bool {
         self.stop
             .as_ref()
@@ -150,9 +159,8 @@ impl SimulateSettings {
     }
 }
 
-/// Runs `fitbead simulate`: the CSV it writes (`series,xi,delta_deg,v,sigma_v,v_true`, md
-/// adding `v_md_stderr,v_m_s`; with `v0` the transient's columns).
-pub fn simulate(a: &SimulateSettings) -> Result<Vec<u8>, RunError> {
+/// [`SimulateSettings::run`].
+fn simulate(a: &SimulateSettings) -> Result<Vec<u8>, RunError> {
     check_series(a)?;
     // The contact model under the spin rule (other models have none).
     let contact = Contact {

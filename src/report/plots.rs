@@ -1369,6 +1369,14 @@ fn coinciding(curves_by_panel: &[[Vec<(f64, f64)>; 4]]) -> Vec<Vec<(usize, usize
     on
 }
 
+impl DesignResult {
+    /// The figure of `fitbead design --plot` (SVG): per series, the sensitivity of every
+    /// candidate slope, the chosen slopes marked ([`design_figure`]).
+    pub fn figure_svg(&self, settings: &DesignSettings) -> String {
+        design_figure(settings, self).to_svg()
+    }
+}
+
 /// The figure: per series, the sensitivity of every candidate slope with the chosen ones
 /// marked (marker height: the sensitivity there; the label the replicates).
 pub(crate) fn design_figure(s: &DesignSettings, r: &DesignResult) -> Figure {

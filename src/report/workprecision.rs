@@ -733,7 +733,7 @@ fn k_rows(
 }
 
 /// The CSV of the rows (one [`WpRow`] record each).
-pub fn render(rows: &[WpRow]) -> csv::Result<Vec<u8>> {
+pub(crate) fn render(rows: &[WpRow]) -> csv::Result<Vec<u8>> {
     to_csv(rows.iter().cloned())
 }
 

@@ -3,13 +3,11 @@
 use super::args::{DataArgs, LevelArgs, PlotArgs};
 use super::values::{self, FitMethod, NamedPrior};
 use super::{emit, read_input, CliError};
-use crate::fit::posterior::{McmcSettings, Method, SCALE_NAME};
-use crate::fit::summary::StatsRow;
-use crate::inverse::mcmc::McmcOptions;
-use crate::io::measurements::{dataset_of, read_measurements, MeasurementFile};
-use crate::io::scenes::Table;
-use crate::io::{fmt_sig, write_atomic_all};
-use crate::pipeline::{FitCommand, FitRun, RunError};
+use fitbead::fit::posterior::{McmcSettings, Method};
+use fitbead::inverse::mcmc::McmcOptions;
+use fitbead::io::measurements::MeasurementFile;
+use fitbead::io::AtomicFile;
+use fitbead::pipeline::{FitCommand, FitRun, RunError};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
@@ -162,13 +160,14 @@ impl FitArgs {
         })?;
         let mut priors = Vec::new();
         for NamedPrior { name, prior, text } in &self.priors {
-            if name != SCALE_NAME && !params.contains(&name.as_str()) {
+            if name != McmcSettings::SCALE_NAME && !params.contains(&name.as_str()) {
                 return Err(super::flag_error(
                     "--prior",
                     text,
                     format!(
-                        "no parameter '{name}' in this fit; expected one of {}, {SCALE_NAME}",
-                        params.join(", ")
+                        "no parameter '{name}' in this fit; expected one of {}, {}",
+                        params.join(", "),
+                        McmcSettings::SCALE_NAME
                     ),
                 ));
             }
@@ -205,17 +204,14 @@ impl FitArgs {
     pub fn read(&self) -> Result<MeasurementFile, CliError> {
         let input = self.data.path();
         let (source, text) = read_input(input)?;
-        let t = Table::parse(&source, &text)?;
-        self.data.check_columns(&t)?;
-        let defaults = self.data.defaults()?;
-        let rows = read_measurements(&t, &defaults)?;
-        let ds = dataset_of(&t, &rows)?;
-        super::warn_implausible(&t, &rows);
-        Ok(MeasurementFile {
-            table: t,
-            rows,
-            dataset: ds,
-        })
+        Ok(MeasurementFile::read_checked(
+            &source,
+            &text,
+            &self.data.defaults(),
+            input.is_some(),
+            self.data.strict_columns,
+            &mut |w| eprintln!("fitbead: warning: {w}"),
+        )?)
     }
 
     /// Runs the fit command `command` on the measurements of the flags with the method and
@@ -282,27 +278,12 @@ impl FitArgs {
             .chain(figures.iter().map(|(q, b)| (q.as_path(), b.as_slice())))
             .collect();
         if !files.is_empty() {
-            write_atomic_all(&files).map_err(|e| CliError::Other(format!("cannot write: {e}")))?;
+            AtomicFile::write_files(&files).map_err(|e| CliError::Other(format!("cannot write: {e}")))?;
         }
         // Without --output the fit reports on stdout carry the statistics.
         if self.output_stats.is_none() && self.out.output.is_some() {
             for r in stats {
-                eprintln!(
-                    "{} [{}]: chi2 {} dof {} reduced {} AIC {} BIC {} ({}){}",
-                    r.fit,
-                    r.series,
-                    fmt_sig(r.chi2, 7),
-                    r.dof,
-                    fmt_sig(r.reduced_chi2, 7),
-                    fmt_sig(r.aic, 7),
-                    fmt_sig(r.bic, 7),
-                    r.termination,
-                    if r.note.is_empty() {
-                        String::new()
-                    } else {
-                        format!(" — {}", r.note)
-                    }
-                );
+                eprintln!("{}", r.summary_line());
             }
         }
         if self.out.to_stdout() {
@@ -320,14 +301,14 @@ impl FitArgs {
             return Err(CliError::InterruptedPartial);
         }
         // Every fit that did not converge is named once, with why, by the exit-1 message.
-        not_converged(stats)
+        not_converged(run.not_converged())
     }
 }
 
 /// Exit 1 for fits that did not converge, once their outputs are written, with the message
-/// that names each fit, its series and why ([`crate::pipeline::FitRun::not_converged`]).
-pub fn not_converged(stats: &[StatsRow]) -> Result<(), CliError> {
-    match crate::pipeline::not_converged(stats) {
+/// that names each fit, its series and why ([`fitbead::pipeline::FitRun::not_converged`]).
+pub fn not_converged(message: Option<String>) -> Result<(), CliError> {
+    match message {
         Some(m) => Err(CliError::NotConverged(m)),
         None => Ok(()),
     }

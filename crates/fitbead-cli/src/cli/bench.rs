@@ -1,10 +1,10 @@
-//! `fitbead bench`: the work-precision report of `crate::report::workprecision`, as CSV and
-//! SVG.
+//! `fitbead bench`: the work-precision report of the library's door [`Bench::run`], as CSV
+//! and SVG.
 
 use super::args::{OutputArgs, PlotArgs};
 use super::{emit, CliError};
-use crate::io::write_atomic_all;
-use crate::report::workprecision::render;
+use fitbead::io::AtomicFile;
+use fitbead::pipeline::Bench;
 
 /// Arguments of `fitbead bench`.
 #[derive(Debug, clap::Args)]
@@ -28,13 +28,11 @@ pub struct Args {
 /// Runs `fitbead bench`.
 pub fn run(a: Args) -> Result<(), CliError> {
     let stop = super::stop_flag();
-    let b = crate::pipeline::bench(a.scenes, a.seed, Some(&stop))?;
+    let b = Bench::run(a.scenes, a.seed, Some(&stop))?;
     eprint!("{}", b.summary());
-    let bytes = render(&b.result.rows).map_err(|e| CliError::Other(e.to_string()))?;
+    let bytes = b.csv()?;
     let svg = match &a.plot.plot {
-        Some(_) => a
-            .plot
-            .bytes(b.figure().map_err(|e| CliError::Other(e.to_string()))?)?,
+        Some(p) => b.figure(p).map_err(|e| CliError::Other(e.to_string()))?,
         None => Vec::new(),
     };
     // The plot and the CSV file are written as one group: both or neither.
@@ -46,7 +44,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         .chain(a.out.output.iter().map(|p| (p.as_path(), bytes.as_slice())))
         .collect();
     if !files.is_empty() {
-        write_atomic_all(&files).map_err(|e| CliError::Other(format!("cannot write: {e}")))?;
+        AtomicFile::write_files(&files).map_err(|e| CliError::Other(format!("cannot write: {e}")))?;
     }
     if a.out.output.is_none() {
         emit(None, &bytes)?;

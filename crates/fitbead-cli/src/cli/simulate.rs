@@ -4,10 +4,10 @@
 use super::args::{ContactArgs, OutputArgs};
 use super::values::{self, Numbers, SlopeRange};
 use super::{emit, CliError};
-use crate::models::contact::SpinRule;
-use crate::models::{JaegerBranch, ModelKind};
-use crate::pipeline::{simulate, RunError, SimulateSettings};
-use crate::scene::CollisionLaw;
+use fitbead::models::contact::SpinRule;
+use fitbead::models::{JaegerBranch, ModelKind};
+use fitbead::pipeline::{RunError, SimulateSettings};
+use fitbead::scene::CollisionLaw;
 use std::sync::Arc;
 
 /// Arguments of `fitbead simulate`.
@@ -118,7 +118,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         progress: Some(super::forward::md_progress(0)),
         notes: Some(Arc::new(|n: &str| eprintln!("fitbead: note: {n}"))),
     };
-    let bytes = simulate(&settings).map_err(|e| match e {
+    let bytes = settings.run().map_err(|e| match e {
         // The range as given on the command line.
         RunError::Input(mut ie) if ie.column.as_deref() == Some("--delta-range") => {
             ie.value = range.map(|r| r.text.clone());

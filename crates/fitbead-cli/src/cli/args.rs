@@ -2,10 +2,8 @@
 //! arguments: the measurements file with the defaults of the columns it may leave out, ρ and
 //! f, the output file, the figure and the interval level.
 
-use super::{values, CliError};
-use crate::io::measurements::{MeasurementDefaults, MEASUREMENT_COLUMNS};
-use crate::io::scenes::{check_columns, Header};
-use crate::io::InputError;
+use super::values;
+use fitbead::io::measurements::MeasurementDefaults;
 use std::path::{Path, PathBuf};
 
 /// `--rho` and `--f`: the defaults of rows without a `rho` or `f` column.
@@ -67,27 +65,13 @@ impl DataArgs {
         self.g.unwrap_or(MeasurementDefaults::default().g)
     }
 
-    /// Checks the columns of a measurements file given: an error for an unknown one with
-    /// `--strict-columns`, else a warning on stderr for each close to a known name (the
-    /// embedded data set is not checked).
-    pub fn check_columns(&self, t: &impl Header) -> Result<(), InputError> {
-        if self.path().is_none() {
-            return Ok(());
-        }
-        for w in check_columns(t, &MEASUREMENT_COLUMNS, self.strict_columns)? {
-            eprintln!("fitbead: warning: {w}");
-        }
-        Ok(())
-    }
-
-    /// The defaults, checked (ρ ≥ 0, f ≥ 0, g > 0).
-    pub fn defaults(&self) -> Result<MeasurementDefaults, CliError> {
-        let d = MeasurementDefaults {
+    /// The defaults given (unchecked: [`MeasurementDefaults::checked`]).
+    pub fn defaults(&self) -> MeasurementDefaults {
+        MeasurementDefaults {
             rho: self.contact.rho(),
             f: self.contact.f(),
             g: self.g(),
-        };
-        Ok(d.checked()?)
+        }
     }
 }
 
@@ -110,18 +94,6 @@ pub struct PlotArgs {
     /// to stdout (only one output may go there: without --output the result takes it).
     #[arg(long)]
     pub plot: Option<PathBuf>,
-}
-
-impl PlotArgs {
-    /// The figure `svg` as the bytes of the `--plot` file: rendered to PNG or converted to PDF
-    /// when the file's name ends .png or .pdf.
-    pub fn bytes(&self, svg: String) -> Result<Vec<u8>, super::CliError> {
-        match self.plot.as_deref() {
-            Some(p) => crate::pipeline::figure_bytes(p, svg)
-                .map_err(|e| super::CliError::Other(e.to_string())),
-            None => Ok(svg.into_bytes()),
-        }
-    }
 }
 
 /// `--level`: the level of every interval.

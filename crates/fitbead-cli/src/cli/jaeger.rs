@@ -3,8 +3,8 @@
 
 use super::fitargs::FitArgs;
 use super::CliError;
-use crate::models::JaegerBranch;
-use crate::pipeline::FitCommand;
+use fitbead::models::JaegerBranch;
+use fitbead::pipeline::FitCommand;
 
 /// Arguments of `fitbead jaeger`.
 #[derive(Debug, clap::Args)]

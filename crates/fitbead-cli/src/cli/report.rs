@@ -4,11 +4,10 @@
 
 use super::args::{DataArgs, LevelArgs, PlotArgs};
 use super::fitargs::{not_converged, FitArgs, FitOutputArgs};
-use super::values::{self, FitMethod, Units};
+use super::values::{self, FigureFormat, FitMethod, Units};
 use super::CliError;
-use crate::io::InputError;
-use crate::pipeline::{report, ReportSettings};
-use crate::report::figures::FigureFormat;
+use fitbead::io::InputError;
+use fitbead::pipeline::{ReportOutput, ReportSettings};
 use std::path::{Path, PathBuf};
 
 /// Arguments of `fitbead report`.
@@ -200,7 +199,7 @@ impl Recipe {
         for (key, value) in map.into_iter().chain(counts) {
             let text = match value {
                 toml::Value::String(s) => s,
-                toml::Value::Float(x) => crate::numfmt::echo_f64(x),
+                toml::Value::Float(x) => fitbead::numfmt::echo_f64(x),
                 toml::Value::Integer(n) => n.to_string(),
                 _ => continue,
             };
@@ -251,7 +250,7 @@ impl Recipe {
         let key = ie
             .column
             .as_deref()
-            .filter(|_| ie.file == crate::io::SETTINGS_ORIGIN)
+            .filter(|_| ie.file == InputError::SETTINGS)
             .and_then(|c| c.strip_prefix("--"))
             .map(|f| f.replace('-', "_"))
             .filter(|k| self.keys.iter().any(|(key, _)| key == k));
@@ -300,18 +299,12 @@ fn run_with(a: Args, shown: Option<String>) -> Result<(), CliError> {
         plot: PlotArgs::default(),
     };
     // No file of the report may be the input (or the recipe).
-    let targets: Vec<PathBuf> = crate::report::REPORT_FILES
+    let targets: Vec<PathBuf> = ReportOutput::file_names(format.0)
+        .map_err(|e| CliError::Other(e.to_string()))?
         .iter()
-        .flat_map(|f| {
-            if f.ends_with(".svg") {
-                format.names(f)
-            } else {
-                vec![f.to_string()]
-            }
-        })
         .map(|f| out_dir.join(f))
         .collect();
-    crate::io::outdir::check_dir(&out_dir).map_err(|e| {
+    ReportSettings::check_out_dir(&out_dir).map_err(|e| {
         super::flag_error("--out-dir", &out_dir.display().to_string(), e.to_string())
     })?;
     // A directory still to be made holds no input.
@@ -320,7 +313,7 @@ fn run_with(a: Args, shown: Option<String>) -> Result<(), CliError> {
         .filter(|_| out_dir.is_dir())
         .map(|p| ("--out-dir", Some(p.as_path())))
         .collect();
-    crate::io::distinct_paths(
+    fitbead::io::AtomicFile::distinct_paths(
         &[
             ("--input", input.as_deref()),
             ("--recipe", a.recipe.as_deref()),
@@ -332,16 +325,16 @@ fn run_with(a: Args, shown: Option<String>) -> Result<(), CliError> {
     let settings = ReportSettings {
         level: io.level.level(),
         method: choice.method,
-        format: values::name_of(&format),
+        format: format.0.to_string(),
         si_units: a.units == Some(Units::Si),
         figure_width: a.figure_width.clone(),
         keep_going: a.keep_going,
-        defaults: io.data.defaults()?,
+        defaults: io.data.defaults().checked()?,
         source: shown,
         stop: Some(super::stop_flag()),
         method_name: Some(values::name_of(&io.method)),
     };
-    let out = report(&data, &settings, Some(&out_dir))?;
+    let out = settings.run(&data, Some(&out_dir))?;
     for s in &out.stats {
         if let Some(w) = s.misfit_warning() {
             eprintln!("fitbead: warning: {} [{}]: {w}", s.fit, s.series);
@@ -366,5 +359,5 @@ fn run_with(a: Args, shown: Option<String>) -> Result<(), CliError> {
     if out.interrupted {
         return Err(CliError::InterruptedPartial);
     }
-    not_converged(&out.stats)
+    not_converged(out.not_converged())
 }

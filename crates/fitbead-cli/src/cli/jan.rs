@@ -3,7 +3,7 @@
 
 use super::fitargs::FitArgs;
 use super::CliError;
-use crate::pipeline::FitCommand;
+use fitbead::pipeline::FitCommand;
 
 /// Arguments of `fitbead jan`.
 #[derive(Debug, clap::Args)]

@@ -4,8 +4,7 @@
 use super::args::OutputArgs;
 use super::values::LawText;
 use super::{emit, values, CliError};
-use crate::io::records::{to_csv, RegimeRecord};
-use crate::models::regimes::alpha_of_xi;
+use fitbead::io::records::RegimeRecord;
 
 /// Arguments of `fitbead regimes`.
 #[derive(Debug, clap::Args)]
@@ -27,23 +26,6 @@ pub struct Args {
 
 /// Runs `fitbead regimes`.
 pub fn run(a: Args) -> Result<(), CliError> {
-    let law = a.law.law;
-    for &xi in &a.xi {
-        let k = law.k(alpha_of_xi(xi), a.rho);
-        if !(k.is_finite() && k > 0.0 && k < 1.0) {
-            return Err(super::flag_error(
-                "--law",
-                &a.law.text,
-                format!(
-                    "K = {} at xi = {}: a law's K must be in (0, 1) (a collision cannot return \
-                     more velocity than it receives)",
-                    crate::numfmt::echo_f64(k),
-                    crate::numfmt::echo_f64(xi)
-                ),
-            ));
-        }
-    }
-    let bytes = to_csv(RegimeRecord::table(&a.xi, law, a.rho))
-        .map_err(|e| CliError::Other(e.to_string()))?;
+    let bytes = RegimeRecord::csv(&a.xi, a.law.law, &a.law.text, a.rho)?;
     emit(a.out.output.as_deref(), &bytes)
 }

@@ -1,17 +1,17 @@
 //! The values of the flags, parsed by clap: every flag whose value is one of fixed names is a
-//! [`clap::ValueEnum`] read by [`choice`] (whole names, any case, surrounding spaces ignored),
+//! [`Choice`] read by [`choice`] (whole names, any case, surrounding spaces ignored),
 //! and every number with a range of its own, list or text with a grammar has a value parser
 //! here that refuses a bad value before any work. A refusal is a [`Refusal`]; `super::parse`
 //! renders it in the project's form (`<command line>, flag '--NAME', value 'V': message`).
 
-use crate::design::{Criterion, DesignFit};
-use crate::fit::klaw::KLaw;
-use crate::inverse::posterior::Prior;
-use crate::models::contact::SpinRule;
-use crate::models::md::ReducedMass;
-use crate::models::{JaegerBranch, Model, ModelKind};
-use crate::report::figures::{FigureFormat, FigureWidth};
-use crate::scene::CollisionLaw;
+use fitbead::design::{Criterion, DesignFit};
+use fitbead::fit::klaw::KLaw;
+use fitbead::inverse::posterior::Prior;
+use fitbead::models::contact::SpinRule;
+use fitbead::models::md::ReducedMass;
+use fitbead::models::{JaegerBranch, Model, ModelKind};
+use fitbead::pipeline::ReportSettings;
+use fitbead::scene::CollisionLaw;
 use clap::builder::{PossibleValue, TypedValueParser};
 use clap::ValueEnum;
 use std::marker::PhantomData;
@@ -52,10 +52,31 @@ impl std::fmt::Display for Refusal {
 
 impl std::error::Error for Refusal {}
 
-/// A flag's fixed names: a [`ValueEnum`] with the message for a name that is none of them.
-pub(crate) trait Choice: ValueEnum + Clone + Send + Sync + 'static {
+/// A flag's fixed names, in the order of the help, with the message for a name that is none of
+/// them. The command line's own enums derive [`ValueEnum`] and take their names from it
+/// ([`choice_of_value_enum`]); the library's enums are named here.
+pub(crate) trait Choice: Clone + Send + Sync + 'static {
+    /// Every value, in the order the help lists them.
+    fn variants() -> &'static [Self];
+
+    /// The value's name on the command line.
+    fn possible(&self) -> PossibleValue;
+
     /// The message for `name`, which is none of the names.
     fn unknown(name: &str) -> String;
+}
+
+/// [`Choice::variants`] and [`Choice::possible`] of an enum that derives [`ValueEnum`].
+macro_rules! choice_of_value_enum {
+    () => {
+        fn variants() -> &'static [Self] {
+            <Self as clap::ValueEnum>::value_variants()
+        }
+
+        fn possible(&self) -> clap::builder::PossibleValue {
+            clap::ValueEnum::to_possible_value(self).expect("every value is named")
+        }
+    };
 }
 
 /// The value parser of a [`Choice`]: a whole name in any case, spaces around it ignored; the
@@ -82,39 +103,39 @@ impl<E: Choice> TypedValueParser for ChoiceParser<E> {
         arg: Option<&clap::Arg>,
         value: &std::ffi::OsStr,
     ) -> Result<E, clap::Error> {
-        let named = |s: &str| E::from_str(s.trim(), true).map_err(|_| Refusal::new(E::unknown(s)));
+        let named = |s: &str| {
+            E::variants()
+                .iter()
+                .find(|v| v.possible().matches(s.trim(), true))
+                .cloned()
+                .ok_or_else(|| Refusal::new(E::unknown(s)))
+        };
         named.parse_ref(cmd, arg, value)
     }
 
     fn possible_values(&self) -> Option<Box<dyn Iterator<Item = PossibleValue> + '_>> {
         Some(Box::new(
-            E::value_variants()
-                .iter()
-                .filter_map(ValueEnum::to_possible_value),
+            E::variants().iter().map(Choice::possible),
         ))
     }
 }
 
 /// The names of `E`, joined by `, `.
-fn names<E: ValueEnum>() -> String {
-    E::value_variants()
+fn names<E: Choice>() -> String {
+    E::variants()
         .iter()
-        .filter_map(|v| v.to_possible_value())
-        .map(|p| p.get_name().to_string())
+        .map(|p| p.possible().get_name().to_string())
         .collect::<Vec<_>>()
         .join(", ")
 }
 
 /// The command-line name of `value`.
-pub(crate) fn name_of<E: ValueEnum>(value: &E) -> String {
-    value
-        .to_possible_value()
-        .map(|p| p.get_name().to_string())
-        .unwrap_or_default()
+pub(crate) fn name_of<E: Choice>(value: &E) -> String {
+    value.possible().get_name().to_string()
 }
 
-impl ValueEnum for ModelKind {
-    fn value_variants<'a>() -> &'a [Self] {
+impl Choice for ModelKind {
+    fn variants() -> &'static [Self] {
         // The order of `Model::NAMES`.
         &[
             ModelKind::Stick,
@@ -130,13 +151,11 @@ impl ValueEnum for ModelKind {
         ]
     }
 
-    fn to_possible_value(&self) -> Option<PossibleValue> {
-        let i = Self::value_variants().iter().position(|k| k == self)?;
-        Some(PossibleValue::new(Model::NAMES[i]))
+    fn possible(&self) -> PossibleValue {
+        let i = Self::variants().iter().position(|k| k == self);
+        PossibleValue::new(Model::NAMES[i.expect("every model is listed")])
     }
-}
 
-impl Choice for ModelKind {
     fn unknown(_: &str) -> String {
         format!("unknown model; expected one of {}", Model::NAMES.join(", "))
     }
@@ -177,13 +196,11 @@ impl KModel {
         }
     }
 
-    /// The command-line name.
-    pub fn name(self) -> String {
-        name_of(&self)
-    }
 }
 
 impl Choice for KModel {
+    choice_of_value_enum!();
+
     fn unknown(name: &str) -> String {
         match name.parse::<ModelKind>() {
             Ok(ModelKind::Md) => {
@@ -194,126 +211,114 @@ impl Choice for KModel {
     }
 }
 
-impl ValueEnum for JaegerBranch {
-    fn value_variants<'a>() -> &'a [Self] {
+impl Choice for JaegerBranch {
+    fn variants() -> &'static [Self] {
         &[JaegerBranch::Upper, JaegerBranch::Lower]
     }
 
-    fn to_possible_value(&self) -> Option<PossibleValue> {
-        Some(PossibleValue::new(match self {
+    fn possible(&self) -> PossibleValue {
+        PossibleValue::new(match self {
             JaegerBranch::Upper => "upper",
             JaegerBranch::Lower => "lower",
-        }))
+        })
     }
-}
 
-impl Choice for JaegerBranch {
     fn unknown(_: &str) -> String {
         "expected upper or lower".into()
     }
 }
 
-impl ValueEnum for KLaw {
-    fn value_variants<'a>() -> &'a [Self] {
+impl Choice for KLaw {
+    fn variants() -> &'static [Self] {
         &[KLaw::C, KLaw::Impact, KLaw::FreePerSeries]
     }
 
-    fn to_possible_value(&self) -> Option<PossibleValue> {
-        Some(PossibleValue::new(self.name()))
+    fn possible(&self) -> PossibleValue {
+        PossibleValue::new(self.name())
     }
-}
 
-impl Choice for KLaw {
     fn unknown(name: &str) -> String {
         name.parse::<KLaw>().err().unwrap_or_default()
     }
 }
 
-impl ValueEnum for DesignFit {
-    fn value_variants<'a>() -> &'a [Self] {
+impl Choice for DesignFit {
+    fn variants() -> &'static [Self] {
         &[DesignFit::KLaw, DesignFit::Jan, DesignFit::Jaeger]
     }
 
-    fn to_possible_value(&self) -> Option<PossibleValue> {
-        Some(PossibleValue::new(match self {
+    fn possible(&self) -> PossibleValue {
+        PossibleValue::new(match self {
             DesignFit::KLaw => "klaw",
             DesignFit::Jan => "jan",
             DesignFit::Jaeger => "jaeger",
-        }))
+        })
     }
-}
 
-impl Choice for DesignFit {
     fn unknown(name: &str) -> String {
         name.parse::<DesignFit>().err().unwrap_or_default()
     }
 }
 
-impl ValueEnum for Criterion {
-    fn value_variants<'a>() -> &'a [Self] {
+impl Choice for Criterion {
+    fn variants() -> &'static [Self] {
         &[Criterion::D, Criterion::C, Criterion::T]
     }
 
-    fn to_possible_value(&self) -> Option<PossibleValue> {
-        Some(PossibleValue::new(match self {
+    fn possible(&self) -> PossibleValue {
+        PossibleValue::new(match self {
             Criterion::D => "d",
             Criterion::C => "c",
             Criterion::T => "t",
-        }))
+        })
     }
-}
 
-impl Choice for Criterion {
     fn unknown(name: &str) -> String {
         name.parse::<Criterion>().err().unwrap_or_default()
     }
 }
 
-impl ValueEnum for FigureFormat {
-    fn value_variants<'a>() -> &'a [Self] {
-        &[
-            FigureFormat::Svg,
-            FigureFormat::Png,
-            FigureFormat::Pdf,
-            FigureFormat::Both,
-            FigureFormat::All,
-        ]
-    }
+/// A figure format of `report --format`, one of [`ReportSettings::FORMATS`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct FigureFormat(pub &'static str);
 
-    fn to_possible_value(&self) -> Option<PossibleValue> {
-        Some(PossibleValue::new(match self {
-            FigureFormat::Svg => "svg",
-            FigureFormat::Png => "png",
-            FigureFormat::Pdf => "pdf",
-            FigureFormat::Both => "both",
-            FigureFormat::All => "all",
-        }))
+impl Default for FigureFormat {
+    /// SVG.
+    fn default() -> Self {
+        FigureFormat(ReportSettings::FORMATS[0])
     }
 }
 
 impl Choice for FigureFormat {
+    fn variants() -> &'static [Self] {
+        static ALL: std::sync::OnceLock<Vec<FigureFormat>> = std::sync::OnceLock::new();
+        ALL.get_or_init(|| ReportSettings::FORMATS.iter().map(|f| FigureFormat(f)).collect())
+    }
+
+    fn possible(&self) -> PossibleValue {
+        PossibleValue::new(self.0)
+    }
+
     fn unknown(name: &str) -> String {
-        name.parse::<FigureFormat>()
+        ReportSettings::check_format(name)
             .err()
             .map(|e| e.to_string())
             .unwrap_or_default()
     }
 }
 
-impl ValueEnum for ReducedMass {
-    fn value_variants<'a>() -> &'a [Self] {
+impl Choice for ReducedMass {
+    fn variants() -> &'static [Self] {
         &[ReducedMass::Pair, ReducedMass::Mobile]
     }
 
-    fn to_possible_value(&self) -> Option<PossibleValue> {
-        Some(PossibleValue::new(match self {
+    fn possible(&self) -> PossibleValue {
+        PossibleValue::new(match self {
             ReducedMass::Pair => "pair",
             ReducedMass::Mobile => "mobile",
-        }))
+        })
     }
-}
 
-impl Choice for ReducedMass {
     fn unknown(_: &str) -> String {
         "expected pair or mobile".into()
     }
@@ -330,6 +335,8 @@ pub(crate) enum FitMethod {
 }
 
 impl Choice for FitMethod {
+    choice_of_value_enum!();
+
     fn unknown(_: &str) -> String {
         "expected lsq or mcmc".into()
     }
@@ -346,6 +353,8 @@ pub(crate) enum Units {
 }
 
 impl Choice for Units {
+    choice_of_value_enum!();
+
     fn unknown(_: &str) -> String {
         "expected dimensionless or si".into()
     }
@@ -362,6 +371,8 @@ pub(crate) enum MdPreset {
 }
 
 impl Choice for MdPreset {
+    choice_of_value_enum!();
+
     fn unknown(_: &str) -> String {
         "expected ristow or steel".into()
     }
@@ -449,7 +460,7 @@ pub(crate) fn at_least_one(s: &str) -> Result<usize, Refusal> {
 /// The MCMC walkers: even, at least 4 and at most the sampler's limit (that there are more
 /// walkers than parameters is checked with the fit).
 pub(crate) fn walkers(s: &str) -> Result<usize, Refusal> {
-    use crate::inverse::mcmc::MAX_WALKERS;
+    const MAX_WALKERS: usize = fitbead::inverse::mcmc::McmcOptions::MAX_WALKERS;
     count(
         s,
         |w| w >= 4 && w % 2 == 0 && w <= MAX_WALKERS,
@@ -461,7 +472,7 @@ pub(crate) fn walkers(s: &str) -> Result<usize, Refusal> {
 
 /// The points per series of a simulation.
 pub(crate) fn points(s: &str) -> Result<usize, Refusal> {
-    use crate::pipeline::MAX_POINTS;
+    const MAX_POINTS: usize = fitbead::pipeline::SimulateSettings::MAX_POINTS;
     count(
         s,
         |n| (1..=MAX_POINTS).contains(&n),
@@ -511,7 +522,7 @@ pub(crate) fn series(s: &str) -> Result<Numbers, Refusal> {
                 text,
                 format!(
                     "xi {} is given twice (values {} and {}): each series needs its own xi",
-                    crate::io::fmt_f64(*x),
+                    fitbead::numfmt::fmt_f64(*x),
                     i + 1,
                     j + 1
                 ),
@@ -571,7 +582,7 @@ pub(crate) fn design_noise(s: &str) -> Result<(f64, bool), Refusal> {
 /// A collision law: a number, cos2a, adjusted, impact or c=VALUE.
 pub(crate) fn law(s: &str) -> Result<CollisionLaw, Refusal> {
     s.parse()
-        .map_err(|e: crate::scene::ParameterError| Refusal::new(e.to_string()))
+        .map_err(|e: fitbead::scene::ParameterError| Refusal::new(e.to_string()))
 }
 
 /// A collision law with its text as given.
@@ -599,7 +610,7 @@ pub(crate) fn law_text(s: &str) -> Result<String, Refusal> {
 /// A spin rule: roll, keep, factor=L or impact.
 pub(crate) fn spin(s: &str) -> Result<SpinRule, Refusal> {
     s.parse()
-        .map_err(|e: crate::scene::ParameterError| Refusal::new(e.to_string()))
+        .map_err(|e: fitbead::scene::ParameterError| Refusal::new(e.to_string()))
 }
 
 /// A spin rule, kept as its text (checked as [`spin`]).
@@ -609,8 +620,8 @@ pub(crate) fn spin_text(s: &str) -> Result<String, Refusal> {
 
 /// A figure width (single, double or a width in mm), kept as its text.
 pub(crate) fn figure_width(s: &str) -> Result<String, Refusal> {
-    s.parse::<FigureWidth>()
-        .map(|_| s.to_string())
+    ReportSettings::check_figure_width(s)
+        .map(|()| s.to_string())
         .map_err(|e| Refusal::new(e.to_string()))
 }
 
@@ -667,28 +678,28 @@ mod tests {
         }
         assert!(ModelKind::from_str("stic", true).is_err());
         // Every name of the library's list is a possible value, in its order.
-        let names: Vec<String> = ModelKind::value_variants().iter().map(name_of).collect();
+        let names: Vec<String> = ModelKind::variants().iter().map(name_of).collect();
         assert_eq!(names, Model::NAMES);
     }
 
     #[test]
     fn every_choice_reads_back_the_library_names() {
-        for k in KLaw::value_variants() {
+        for k in KLaw::variants() {
             assert_eq!(name_of(k).parse::<KLaw>().unwrap(), *k);
         }
-        for k in DesignFit::value_variants() {
+        for k in DesignFit::variants() {
             assert_eq!(name_of(k).parse::<DesignFit>().unwrap(), *k);
         }
-        for k in Criterion::value_variants() {
+        for k in Criterion::variants() {
             assert_eq!(name_of(k).parse::<Criterion>().unwrap(), *k);
         }
-        for k in FigureFormat::value_variants() {
-            assert_eq!(name_of(k).parse::<FigureFormat>().unwrap(), *k);
+        for k in FigureFormat::variants() {
+            assert!(ReportSettings::check_format(&name_of(k)).is_ok());
         }
-        for k in JaegerBranch::value_variants() {
+        for k in JaegerBranch::variants() {
             assert_eq!(name_of(k).parse::<JaegerBranch>().unwrap(), *k);
         }
-        for k in KModel::value_variants() {
+        for k in KModel::variants() {
             assert_eq!(name_of(k).parse::<ModelKind>().unwrap(), k.kind());
         }
     }

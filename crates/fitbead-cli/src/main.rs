@@ -1,6 +1,8 @@
-//! The `fitbead` binary: the command line of the library (`fitbead::cli`, built with the
-//! default feature `cli`), which parses the arguments, calls the library and renders its
-//! results and errors.
+//! The `fitbead` binary: the command line of the library. It parses the arguments, calls the
+//! library's commands and writes their results and errors (module `cli`, one module per
+//! subcommand).
+
+mod cli;
 
 /// mimalloc in place of the system allocator: the streaming commands hand buffers between
 /// threads, which glibc's malloc serialises on many cores (docs/PERFORMANCE.md, "The
@@ -10,5 +12,5 @@
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 fn main() {
-    std::process::exit(fitbead::cli::main());
+    std::process::exit(cli::main());
 }

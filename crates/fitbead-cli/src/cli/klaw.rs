@@ -4,8 +4,8 @@
 use super::fitargs::FitArgs;
 use super::values::{self, KModel};
 use super::CliError;
-use crate::fit::klaw::KLaw;
-use crate::pipeline::FitCommand;
+use fitbead::fit::klaw::KLaw;
+use fitbead::pipeline::FitCommand;
 
 /// Arguments of `fitbead klaw`.
 #[derive(Debug, clap::Args)]

@@ -1,18 +1,17 @@
-//! `fitbead forward`: mean velocity, regime and diagnostics of each scene under one model.
-//! The rows stream through the library's engine (`crate::io::stream`) with the scene plan
-//! of `crate::io::forward`; md, whose runs are long and few, reads the whole table.
+//! `fitbead forward`: mean velocity, regime and diagnostics of each scene under one model,
+//! by the library's door [`TableCommand::run`] (the rows stream in bounded memory; md, whose
+//! runs are long and few, reads the whole table).
 
 use super::args::{ContactArgs, OutputArgs};
 use super::values::{self, MdPreset};
-use super::{emit, read_input, CliError};
-use crate::io::forward::{scene_columns, ForwardPlan, ForwardSettings, ForwardText};
-use crate::io::md::MdTable;
-use crate::io::scenes::{check_columns, Header, Table, TableReader};
-use crate::io::stream::{stream, RowPlan, StreamError, StreamOptions, Streamed};
-use crate::io::{fmt_f64, AtomicFile, InputError};
-use crate::models::md::{Md, MdParams, MdRunConfig, MdSetting, MdSettings, ReducedMass};
-use crate::models::{JaegerBranch, ModelKind};
-use crate::progress::Progress;
+use super::{emit, CliError};
+use fitbead::io::measurements::MeasurementFile;
+use fitbead::io::{AtomicFile, InputError};
+use fitbead::models::md::{Md, MdParams, MdRunConfig, MdSettings, ReducedMass};
+use fitbead::models::{JaegerBranch, ModelKind};
+use fitbead::numfmt::fmt_f64;
+use fitbead::pipeline::{ForwardSettings, RunError, StreamOptions, TableCommand, TableRun};
+use fitbead::progress::Progress;
 use std::io::{Cursor, Read, Write};
 use std::path::{Path, PathBuf};
 
@@ -80,18 +79,8 @@ pub struct Args {
     pub strict_columns: bool,
 }
 
-/// Checks the columns of a scenes table: an error for an unknown one with `--strict-columns`,
-/// else a warning on stderr for each close to a known name.
-fn check_scene_columns(a: &Args, t: &impl Header) -> Result<(), CliError> {
-    for w in check_columns(t, &scene_columns(), a.strict_columns)? {
-        eprintln!("fitbead: warning: {w}");
-    }
-    Ok(())
-}
-
 /// Runs `fitbead forward`.
 pub fn run(a: Args) -> Result<(), CliError> {
-    let (kind, branch) = (a.model, a.branch);
     let single = if let (Some(xi), Some(d)) = (a.xi, a.delta_deg) {
         Some(format!("xi,delta_deg\n{},{}\n", fmt_f64(xi), fmt_f64(d)).into_bytes())
     } else if a.xi.is_some() || a.delta_deg.is_some() {
@@ -103,56 +92,73 @@ pub fn run(a: Args) -> Result<(), CliError> {
     } else {
         None
     };
-    if kind == ModelKind::Md {
-        let (source, text) = match single {
-            Some(text) => (crate::io::SETTINGS_ORIGIN.to_string(), text),
-            None => read_input(a.input.as_deref())?,
-        };
-        let t = Table::parse(&source, &text)?;
-        check_scene_columns(&a, &t)?;
-        return run_md(&a, &t);
-    }
+    let md = a.model == ModelKind::Md;
+    let command = if md {
+        TableCommand::ForwardMd {
+            md: a.md.preset()?,
+            flags: a.md.settings(),
+            rho: a.contact.rho(),
+            f: a.contact.f(),
+            check_step: a.md.check_step,
+            strict_columns: a.strict_columns,
+        }
+    } else {
+        TableCommand::Forward {
+            settings: settings(&a)?,
+            strict_columns: a.strict_columns,
+        }
+    };
     let (source, input, size) = match single {
         Some(text) => {
             let n = text.len() as u64;
             (
-                crate::io::SETTINGS_ORIGIN.to_string(),
+                InputError::SETTINGS.to_string(),
                 Input::Text(Cursor::new(text)),
                 n,
             )
         }
         None => open_input(a.input.as_deref())?,
     };
-    let reader = TableReader::new(&source, input)?;
-    check_scene_columns(&a, &reader)?;
-    let opts = stream_options("forward", size);
-    let make = |r: &TableReader<Input>| plan(&a, kind, branch, r);
-    stream_to(reader, make, (), a.out.output.as_deref(), &opts, |_| Ok(())).map(|_| ())
+    if md {
+        let opts = StreamOptions {
+            stop: Some(super::stop_flag()),
+            progress: Some(md_progress(2000)),
+            ..command.options()
+        };
+        let mut bytes = Vec::new();
+        command.run(&source, input, &mut bytes, &opts, &mut warn)?;
+        return emit(a.out.output.as_deref(), &bytes);
+    }
+    let opts = stream_options(&command, size);
+    stream_to(&command, &source, input, a.out.output.as_deref(), &opts, |_| Ok(())).map(|_| ())
 }
 
-/// The scene plan of `a` for a table with `r`'s header ([`ForwardPlan::from_text`]).
-fn plan<R: Read>(
-    a: &Args,
-    kind: ModelKind,
-    branch: JaegerBranch,
-    r: &TableReader<R>,
-) -> Result<ForwardPlan, InputError> {
-    let text = ForwardText {
-        k: &a.k,
-        spin: &a.spin,
-        base: ForwardSettings {
-            kind,
-            rho: a.contact.rho(),
-            f: a.contact.f(),
-            lambda: a.lambda,
-            mu: a.mu,
-            a: [a.a1, a.a2, a.a3],
-            branch,
-            tol: a.tol,
-            ..ForwardSettings::default()
-        },
-    };
-    ForwardPlan::from_text(r, &text)
+/// Prints a warning of a command on stderr.
+pub(super) fn warn(w: &str) {
+    eprintln!("fitbead: warning: {w}");
+}
+
+/// The forward settings of the flags (every model but md).
+fn settings(a: &Args) -> Result<ForwardSettings, CliError> {
+    let law = a
+        .k
+        .parse()
+        .map_err(|e: fitbead::scene::ParameterError| super::flag_error("--K", &a.k, e.to_string()))?;
+    let spin = a.spin.parse().map_err(|e: fitbead::scene::ParameterError| {
+        super::flag_error("--spin", &a.spin, e.to_string())
+    })?;
+    Ok(ForwardSettings {
+        kind: a.model,
+        law,
+        rho: a.contact.rho(),
+        f: a.contact.f(),
+        lambda: a.lambda,
+        mu: a.mu,
+        a: [a.a1, a.a2, a.a3],
+        branch: a.branch,
+        spin,
+        tol: a.tol,
+    })
 }
 
 /// A streamed input: a file, the embedded default data, or text from the command line.
@@ -186,9 +192,9 @@ pub(super) fn open_input(path: Option<&Path>) -> Result<(String, Input, u64), Cl
             Ok(("<stdin>".to_string(), Input::Stdin(std::io::stdin()), 0))
         }
         None => Ok((
-            super::DEFAULT_DATA_NAME.to_string(),
-            Input::Static(super::DEFAULT_DATA.as_bytes()),
-            super::DEFAULT_DATA.len() as u64,
+            MeasurementFile::DEFAULT_DATA_NAME.to_string(),
+            Input::Static(MeasurementFile::DEFAULT_DATA.as_bytes()),
+            MeasurementFile::DEFAULT_DATA.len() as u64,
         )),
         Some(p) => {
             let name = p.display().to_string();
@@ -200,36 +206,30 @@ pub(super) fn open_input(path: Option<&Path>) -> Result<(String, Input, u64), Cl
     }
 }
 
-/// Stream options with a stop flag raised by Ctrl-C or SIGTERM (the stream then ends between
-/// tasks, `--output` untouched, exit 130) and a progress bar on a terminal's stderr for runs
-/// longer than a couple of seconds.
-pub(super) fn stream_options(label: &str, input_bytes: u64) -> StreamOptions {
+/// The options of `command` with a stop flag raised by Ctrl-C or SIGTERM (the stream then
+/// ends between tasks, `--output` untouched, exit 130) and a progress bar on a terminal's
+/// stderr for runs longer than a couple of seconds.
+pub(super) fn stream_options(command: &TableCommand, input_bytes: u64) -> StreamOptions {
     StreamOptions {
         stop: Some(super::stop_flag()),
         progress: super::delayed_progress_bar("bytes"),
-        label: label.to_string(),
         input_bytes: Some(input_bytes),
-        ..StreamOptions::default()
+        ..command.options()
     }
 }
 
-/// Streams `reader` through the plan `make` builds into `output` (written atomically: a
-/// temporary file renamed over the target only when the whole input proved good and `finish`
-/// succeeded; a target that cannot be created is reported only after the input proved good)
-/// or stdout. `finish` runs on the plan's ledger before the output is committed.
-pub(super) fn stream_to<R, P, F>(
-    reader: TableReader<R>,
-    make: F,
-    ledger: P::Ledger,
+/// Streams `input` through `command` into `output` (written atomically: a temporary file
+/// renamed over the target only when the whole input proved good and `finish` succeeded; a
+/// target that cannot be created is reported only after the input proved good) or stdout.
+/// `finish` runs on what the run kept before the output is committed.
+pub(super) fn stream_to(
+    command: &TableCommand,
+    source: &str,
+    input: Input,
     output: Option<&Path>,
     opts: &StreamOptions,
-    finish: impl FnOnce(&P::Ledger) -> Result<(), CliError>,
-) -> Result<Streamed<P::Ledger>, CliError>
-where
-    R: Read + Send,
-    P: RowPlan,
-    F: FnOnce(&TableReader<R>) -> Result<P, InputError>,
-{
+    finish: impl FnOnce(&TableRun) -> Result<(), CliError>,
+) -> Result<TableRun, CliError> {
     // `--output -` is standard output, as for the fit commands.
     match output.filter(|p| *p != Path::new("-")) {
         Some(p) => {
@@ -243,12 +243,12 @@ where
                 ..opts.clone()
             };
             let r = match &mut file {
-                Ok(f) => stream(reader, make, ledger, f, &opts),
-                Err(_) => stream(reader, make, ledger, &mut std::io::sink(), &opts),
+                Ok(f) => command.run(source, input, f, &opts, &mut warn),
+                Err(_) => command.run(source, input, &mut std::io::sink(), &opts, &mut warn),
             };
             match r {
                 Ok(done) => {
-                    finish(&done.ledger)?;
+                    finish(&done)?;
                     file.and_then(AtomicFile::commit).map_err(cannot)?;
                     Ok(done)
                 }
@@ -257,11 +257,12 @@ where
         }
         None => {
             let mut out = std::io::stdout();
-            let r = stream(reader, make, ledger, &mut out, opts)
-                .and_then(|d| out.flush().map(|()| d).map_err(StreamError::Write));
+            let r = command
+                .run(source, input, &mut out, opts, &mut warn)
+                .and_then(|d| out.flush().map(|()| d).map_err(|e| RunError::Library(e.into())));
             match r {
                 Ok(done) => {
-                    finish(&done.ledger)?;
+                    finish(&done)?;
                     Ok(done)
                 }
                 Err(e) => Err(stream_error(e, "<stdout>", false)),
@@ -270,17 +271,22 @@ where
     }
 }
 
-fn stream_error(e: StreamError, target: &str, file: bool) -> CliError {
+/// The error of a streamed run whose output is `target` (a file when `file`).
+fn stream_error(e: RunError, target: &str, file: bool) -> CliError {
     match e {
-        StreamError::Input(e) => CliError::Input(e),
-        StreamError::Write(e) if file => CliError::Other(format!("{target}: cannot write: {e}")),
-        StreamError::Write(e) if e.kind() == std::io::ErrorKind::BrokenPipe => CliError::Io(e),
-        StreamError::Write(e) => CliError::Other(format!("{target}: {e}")),
-        StreamError::Stopped => CliError::Stopped(if file {
+        RunError::Library(fitbead::Error::Io(e)) if file => {
+            CliError::Other(format!("{target}: cannot write: {e}"))
+        }
+        RunError::Library(fitbead::Error::Io(e)) if e.kind() == std::io::ErrorKind::BrokenPipe => {
+            CliError::Io(e)
+        }
+        RunError::Library(fitbead::Error::Io(e)) => CliError::Other(format!("{target}: {e}")),
+        RunError::Interrupted => CliError::Stopped(if file {
             format!("interrupted: {target} was not written")
         } else {
             "interrupted: the output on stdout is incomplete".into()
         }),
+        e => CliError::from(e),
     }
 }
 
@@ -347,16 +353,25 @@ pub struct MdArgs {
 }
 
 impl MdArgs {
-    /// The model from the preset and the flags (no table).
+    /// The model from the preset, `--reduced-mass` and the flags (no table).
     pub fn model(&self) -> Result<Md, CliError> {
-        let given = self.settings();
-        build_md(self, &given, &|s: MdSetting, msg: String| {
-            super::flag_error(
-                &format!("--{}", s.flag()),
-                &given.get(s).map(fmt_f64).unwrap_or_default(),
-                msg,
-            )
-        })
+        Ok(self.settings().apply_flags(self.preset()?)?)
+    }
+
+    /// The model of the preset and `--reduced-mass`, before the other flags.
+    fn preset(&self) -> Result<Md, CliError> {
+        let mut params = match self.md_preset {
+            MdPreset::Ristow => MdParams::ristow(),
+            MdPreset::Steel => MdParams::steel(),
+        };
+        if let Some(m) = self.reduced_mass {
+            params.reduced_mass = m;
+        }
+        let base = Md {
+            params,
+            config: MdRunConfig::default(),
+        };
+        Ok(MdSettings::default().apply_flags(base)?)
     }
 
     /// The md settings the flags give.
@@ -379,30 +394,6 @@ impl MdArgs {
             step_fraction: self.step_fraction,
         }
     }
-}
-
-/// Builds the md model from the preset, `--reduced-mass` and the settings given (flags or
-/// cells); `err(setting, message)` locates a bad value.
-fn build_md(
-    a: &MdArgs,
-    given: &MdSettings,
-    err: &dyn Fn(MdSetting, String) -> CliError,
-) -> Result<Md, CliError> {
-    let mut params = match a.md_preset {
-        MdPreset::Ristow => MdParams::ristow(),
-        MdPreset::Steel => MdParams::steel(),
-    };
-    if let Some(m) = a.reduced_mass {
-        params.reduced_mass = m;
-    }
-    let base = Md {
-        params,
-        config: MdRunConfig::default(),
-    };
-    given.apply(base).map_err(|(s, e)| match s {
-        Some(s) => err(s, e.to_string()),
-        None => CliError::Other(e.to_string()),
-    })
 }
 
 /// A progress bar over `total` units on a terminal's stderr only.
@@ -432,21 +423,4 @@ pub fn md_progress(min_total: u64) -> Progress {
             None
         }
     })
-}
-
-fn run_md(a: &Args, t: &Table) -> Result<(), CliError> {
-    let base = MdTable {
-        md: build_md(
-            &a.md,
-            &MdSettings::default(),
-            &|s: MdSetting, msg: String| super::flag_error(&format!("--{}", s.flag()), "", msg),
-        )?,
-        flags: a.md.settings(),
-        rho: a.contact.rho(),
-        f: a.contact.f(),
-    };
-    let stop = super::stop_flag();
-    let bytes = crate::pipeline::md_runs(t, &base, a.md.check_step, Some(md_progress(2000)), &stop)
-        .map_err(CliError::from)?;
-    emit(a.out.output.as_deref(), &bytes)
 }

@@ -14,14 +14,14 @@ mod report;
 mod simulate;
 mod values;
 
-use crate::io::{clip, distinct_paths, write_atomic, InputError, ECHO_CHARS};
-use crate::progress::{Progress, ProgressEvent};
+use fitbead::io::{AtomicFile, InputError};
+use fitbead::progress::{Progress, ProgressEvent};
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 
-use crate::io::measurements::{plausibility, DEFAULT_DATA, DEFAULT_DATA_NAME};
+use fitbead::io::measurements::MeasurementFile;
 
 /// fitbead: a bead rolling down a row of beads (Ancey, Evesque & Coussot 1996) — forward
 /// models, regime limits and synthetic data. Velocities are dimensionless (units
@@ -106,11 +106,11 @@ impl From<csv::Error> for CliError {
     }
 }
 
-impl From<crate::Error> for CliError {
-    fn from(e: crate::Error) -> Self {
+impl From<fitbead::Error> for CliError {
+    fn from(e: fitbead::Error) -> Self {
         match e {
-            crate::Error::Input(i) => CliError::Input(i),
-            crate::Error::Io(io) => CliError::Io(io),
+            fitbead::Error::Input(i) => CliError::Input(i),
+            fitbead::Error::Io(io) => CliError::Io(io),
             e => CliError::Other(e.to_string()),
         }
     }
@@ -118,14 +118,15 @@ impl From<crate::Error> for CliError {
 
 impl std::error::Error for CliError {}
 
-impl From<crate::pipeline::RunError> for CliError {
-    fn from(e: crate::pipeline::RunError) -> Self {
-        use crate::pipeline::RunError;
+impl From<fitbead::pipeline::RunError> for CliError {
+    fn from(e: fitbead::pipeline::RunError) -> Self {
+        use fitbead::pipeline::RunError;
         match e {
             RunError::Input(i) => CliError::Input(i),
             RunError::Failed(s) => CliError::Other(s),
             RunError::Interrupted => CliError::Interrupted,
             RunError::Library(e) => CliError::from(e),
+            e => CliError::Other(e.to_string()),
         }
     }
 }
@@ -154,18 +155,18 @@ impl std::fmt::Display for CliError {
     }
 }
 
-/// Longest error message printed, in characters; a run of more than [`ECHO_CHARS`]
+/// Longest error message printed, in characters; a run of more than [`InputError::ECHO_CHARS`]
 /// characters without a space (a value quoted whole) is cut as well.
 const MESSAGE_CHARS: usize = 2000;
 
-/// `message` with every word longer than [`ECHO_CHARS`] characters cut ([`clip`]) and the
+/// `message` with every word longer than [`InputError::ECHO_CHARS`] characters cut ([`InputError::clip`]) and the
 /// whole cut at [`MESSAGE_CHARS`].
 fn clip_message(message: &str) -> String {
     let words: Vec<std::borrow::Cow<'_, str>> = message
         .split(' ')
-        .map(|w| clip(w, 2 * ECHO_CHARS))
+        .map(|w| InputError::clip(w, 2 * InputError::ECHO_CHARS))
         .collect();
-    clip(&words.join(" "), MESSAGE_CHARS).into_owned()
+    InputError::clip(&words.join(" "), MESSAGE_CHARS).into_owned()
 }
 
 /// The command line's parser: [`Cli`]'s, with negative numbers allowed as the values of every
@@ -276,7 +277,7 @@ pub(crate) fn run(cli: Cli) -> i32 {
     let files: Vec<(PathBuf, FileState)> = file_outputs(&cli.command)
         .into_iter()
         // A character device (/dev/null, a terminal) is never "unwritten".
-        .filter(|p| !crate::io::is_char_device(p))
+        .filter(|p| !fitbead::io::AtomicFile::is_char_device(p))
         .map(|p| {
             let st = file_state(&p);
             (p, st)
@@ -473,7 +474,7 @@ fn file_outputs(c: &Command) -> Vec<PathBuf> {
         .1
         .into_iter()
         .filter_map(|(_, p)| p)
-        .filter(|p| crate::io::stream_of(p) != Some(1))
+        .filter(|p| fitbead::io::AtomicFile::stream_of(p) != Some(1))
         .map(Path::to_path_buf)
         .collect()
 }
@@ -483,13 +484,13 @@ fn file_outputs(c: &Command) -> Vec<PathBuf> {
 /// standard output (`-`, `/dev/stdout`; without `--output` the result takes it).
 fn check_paths(c: &Command) -> Result<(), CliError> {
     let (inputs, outputs) = paths(c);
-    distinct_paths(&inputs, &outputs)?;
+    AtomicFile::distinct_paths(&inputs, &outputs)?;
     // Without --output the result goes to standard output, which no other output may take.
     let result_on_stdout =
         matches!(outputs.first(), Some(("--output", None))) && !matches!(c, Command::Report(_));
     if result_on_stdout {
         for (flag, p) in outputs.iter().skip(1) {
-            if let Some(p) = p.filter(|p| crate::io::stream_of(p) == Some(1)) {
+            if let Some(p) = p.filter(|p| fitbead::io::AtomicFile::stream_of(p) == Some(1)) {
                 return Err(flag_error(
                     flag,
                     &p.display().to_string(),
@@ -531,8 +532,8 @@ static STOP: OnceLock<Arc<AtomicBool>> = OnceLock::new();
 pub(crate) fn read_input(path: Option<&Path>) -> Result<(String, Vec<u8>), CliError> {
     match path {
         None => Ok((
-            DEFAULT_DATA_NAME.to_string(),
-            DEFAULT_DATA.as_bytes().to_vec(),
+            MeasurementFile::DEFAULT_DATA_NAME.to_string(),
+            MeasurementFile::DEFAULT_DATA.as_bytes().to_vec(),
         )),
         Some(p) if p == Path::new("-") => {
             use std::io::Read;
@@ -558,7 +559,7 @@ pub(crate) fn read_input(path: Option<&Path>) -> Result<(String, Vec<u8>), CliEr
 pub(crate) fn emit(output: Option<&Path>, bytes: &[u8]) -> Result<(), CliError> {
     // `--output -` is standard output, as for the fit commands.
     match output.filter(|p| *p != Path::new("-")) {
-        Some(p) => write_atomic(p, bytes)
+        Some(p) => AtomicFile::write_file(p, bytes)
             .map_err(|e| CliError::Other(format!("{}: cannot write: {e}", p.display()))),
         None => print_stdout(bytes),
     }
@@ -579,19 +580,6 @@ pub(crate) fn print_stdout(bytes: &[u8]) -> Result<(), CliError> {
         Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Err(CliError::Io(e)),
         Err(e) => Err(CliError::Other(format!("<stdout>: {e}"))),
     }
-}
-
-/// Prints the plausibility warnings of measurements read from `t` (unit mistakes:
-/// [`plausibility`]) on stderr, and returns them.
-pub(crate) fn warn_implausible(
-    t: &crate::io::scenes::Table,
-    rows: &[crate::io::measurements::Measurement],
-) -> Vec<crate::io::measurements::Implausible> {
-    let w = plausibility(t, rows);
-    for x in &w {
-        eprintln!("fitbead: warning: {}: {x}", t.source);
-    }
-    w
 }
 
 /// A progress bar on stderr for posterior runs: one bar per run, drawn from the library's
@@ -721,7 +709,7 @@ fn progress_delay() -> std::time::Duration {
 /// An error about a command-line flag value.
 pub(crate) fn flag_error(flag: &str, value: &str, message: impl Into<String>) -> CliError {
     CliError::Input(InputError {
-        file: crate::io::SETTINGS_ORIGIN.into(),
+        file: InputError::SETTINGS.into(),
         line: None,
         column: Some(flag.to_string()),
         value: Some(value.to_string()),

@@ -5,10 +5,10 @@
 use super::args::{ContactArgs, OutputArgs, PlotArgs};
 use super::values::{self, NamedPrior, Numbers, SlopeRange};
 use super::{emit, CliError};
-use crate::design::{design, Criterion, DesignError, DesignFit, DesignResult, DesignSettings};
-use crate::io::AtomicFile;
-use crate::models::{JaegerBranch, ModelKind};
-use crate::scene::CollisionLaw;
+use fitbead::design::{design, Criterion, DesignError, DesignFit, DesignResult, DesignSettings};
+use fitbead::io::AtomicFile;
+use fitbead::models::{JaegerBranch, ModelKind};
+use fitbead::scene::CollisionLaw;
 use std::io::Write;
 use std::path::Path;
 
@@ -109,7 +109,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
     let bytes = r.csv().map_err(|e| CliError::Other(e.to_string()))?;
     let summary = r.summary(&s);
     if let Some((p, file)) = plot {
-        let svg = crate::report::plots::design_figure(&s, &r).to_svg();
+        let svg = r.figure_svg(&s);
         match file {
             Some(mut f) => {
                 f.write_all(svg.as_bytes())

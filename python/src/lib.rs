@@ -826,9 +826,6 @@ struct PyDataset {
     file: MeasurementFile,
 }
 
-/// The name the shipped data set goes by in messages and reports (the command line's).
-const DEFAULT_DATA_NAME: &str = "<embedded default data: data/default.csv>";
-
 /// The name data given as arrays go by in warnings and reports (a line N is element N - 2).
 const ARRAYS_NAME: &str = "<arrays>";
 
@@ -897,8 +894,8 @@ impl PyDataset {
     #[staticmethod]
     fn default_data() -> PyResult<Self> {
         let m = MeasurementFile::parse(
-            DEFAULT_DATA_NAME,
-            include_bytes!("../../data/default.csv"),
+            MeasurementFile::DEFAULT_DATA_NAME,
+            MeasurementFile::DEFAULT_DATA.as_bytes(),
             &MeasurementDefaults::default(),
         )
         .map_err(|e| value_error(e.to_string()))?;
@@ -1533,9 +1530,32 @@ fn output_columns(command: &str, model: &str) -> PyResult<Vec<String>> {
     let kind = model
         .parse::<ModelKind>()
         .map_err(|e| value_error(e.to_string()))?;
-    let Some(names) = fitbead::io::output_columns(command, kind) else {
+    use fitbead::pipeline::{ForwardSettings, TableCommand};
+    let table = match command {
+        "forward" => TableCommand::Forward {
+            settings: ForwardSettings {
+                kind,
+                ..ForwardSettings::default()
+            },
+            strict_columns: false,
+        },
+        "k" => TableCommand::K {
+            model: kind,
+            tol: 1e-10,
+            defaults: Default::default(),
+            check_columns: false,
+            strict_columns: false,
+            plot: false,
+        },
+        _ => {
+            return Err(value_error(format!(
+                "command = {command:?}: expected forward or k"
+            )))
+        }
+    };
+    let Some(names) = table.columns() else {
         return Err(value_error(format!(
-            "command = {command:?}: expected forward or k"
+            "model = {model:?}: the columns of md follow its settings"
         )));
     };
     Ok(names.into_iter().map(String::from).collect())
@@ -1732,7 +1752,7 @@ fn simulate(
         stop: Some(stop.clone()),
         ..SimulateSettings::default()
     };
-    let r = interruptible(py, &stop, || fitbead::pipeline::simulate(&settings))?;
+    let r = interruptible(py, &stop, || settings.run())?;
     let bytes = r.map_err(pipeline_error)?;
     String::from_utf8(bytes).map_err(|e| value_error(e.to_string()))
 }
@@ -1828,9 +1848,7 @@ fn report(
     };
     let file = &data.file;
     let dir = out_dir.as_deref();
-    let r = interruptible(py, &stop, || {
-        fitbead::pipeline::report(file, &settings, dir)
-    })?;
+    let r = interruptible(py, &stop, || settings.run(file, dir))?;
     let out = r.map_err(pipeline_error)?;
     // The warnings by kind: implausible misfits (unit mistakes), posterior runs that did not
     // converge.
@@ -1879,8 +1897,23 @@ fn forward_md(py: Python<'_>, table: &str, rho: f64, f: f64, md_preset: &str) ->
         config: MdRunConfig::default(),
     };
     let stop = Arc::new(AtomicBool::new(false));
+    let command = fitbead::pipeline::TableCommand::ForwardMd {
+        md,
+        flags: Default::default(),
+        rho,
+        f,
+        check_step: false,
+        strict_columns: false,
+    };
+    let options = fitbead::pipeline::StreamOptions {
+        stop: Some(stop.clone()),
+        ..command.options()
+    };
     let r = interruptible(py, &stop, || {
-        fitbead::pipeline::forward_md(table.as_bytes(), "<arrays>", md, rho, f, Some(&stop))
+        let mut out = Vec::new();
+        command
+            .run("<arrays>", table.as_bytes(), &mut out, &options, &mut |_| {})
+            .map(|_| out)
     })?;
     let bytes = r.map_err(pipeline_error)?;
     String::from_utf8(bytes).map_err(|e| value_error(e.to_string()))
@@ -1892,11 +1925,9 @@ fn forward_md(py: Python<'_>, table: &str, rho: f64, f: f64, md_preset: &str) ->
 fn work_precision(py: Python<'_>, scenes: usize, seed: u64) -> PyResult<String> {
     let stop = Arc::new(AtomicBool::new(false));
     let r = interruptible(py, &stop, || {
-        fitbead::pipeline::work_precision(scenes, seed, Some(&stop))
+        fitbead::pipeline::Bench::run(scenes, seed, Some(&stop))
     })?;
-    let rows = r.map_err(pipeline_error)?;
-    let bytes =
-        fitbead::report::workprecision::render(&rows).map_err(|e| value_error(e.to_string()))?;
+    let bytes = r.and_then(|b| b.csv()).map_err(pipeline_error)?;
     String::from_utf8(bytes).map_err(|e| value_error(e.to_string()))
 }
 

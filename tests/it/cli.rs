@@ -746,7 +746,7 @@ fn jan_and_jaeger_draw_their_progress_bar_on_a_terminal_only() {
             !err.contains("model evaluations") && !err.contains('\r'),
             "{cmd}: a bar on a piped stderr: {err:?}"
         );
-        let exe = std::env::var("FITBEAD_BIN").unwrap_or(env!("CARGO_BIN_EXE_fitbead").into());
+        let exe = crate::common::bin_path().display().to_string();
         let shell = format!(
             "'{exe}' {cmd} --output '{}' --output-stats '{}'",
             o.display(),
@@ -789,7 +789,7 @@ fn klaw_draws_its_progress_bar_on_a_terminal_only() {
         !err.contains("model evaluations") && !err.contains('\r'),
         "a bar on a piped stderr: {err:?}"
     );
-    let exe = std::env::var("FITBEAD_BIN").unwrap_or(env!("CARGO_BIN_EXE_fitbead").into());
+    let exe = crate::common::bin_path().display().to_string();
     let shell = format!(
         "'{exe}' klaw --model stick --no-profile --output '{}'",
         o.display()

@@ -5,14 +5,33 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output};
 
-/// A command that runs the fitbead binary cargo built for these tests, or the one named by
-/// the environment variable `FITBEAD_BIN` (to run the tests against another build, e.g. to
-/// check that a regression test fails on the code before its fix).
-pub fn bin() -> Command {
-    match std::env::var_os("FITBEAD_BIN") {
-        Some(p) => Command::new(p),
-        None => Command::new(env!("CARGO_BIN_EXE_fitbead")),
+/// The fitbead binary these tests run: the one named by the environment variable
+/// `FITBEAD_BIN` (to run the tests against another build, e.g. to check that a regression
+/// test fails on the code before its fix), else the one cargo built beside these tests (the
+/// package `fitbead-cli`, built by `cargo test` at the root: its own tests need it).
+pub fn bin_path() -> PathBuf {
+    if let Some(p) = std::env::var_os("FITBEAD_BIN") {
+        return PathBuf::from(p);
     }
+    // The tests run from target/PROFILE/deps/; the binary is target/PROFILE/fitbead.
+    let exe = std::env::current_exe().expect("the test executable's path");
+    let built = exe
+        .parent()
+        .and_then(Path::parent)
+        .map(|d| d.join(format!("fitbead{}", std::env::consts::EXE_SUFFIX)))
+        .expect("the test executable is in target/PROFILE/deps");
+    assert!(
+        built.exists(),
+        "{} is missing: build it with `cargo build -p fitbead-cli` (same profile), run the \
+         tests with `cargo test` at the root (which builds it), or name a binary in FITBEAD_BIN",
+        built.display()
+    );
+    built
+}
+
+/// A command that runs the fitbead binary of [`bin_path`].
+pub fn bin() -> Command {
+    Command::new(bin_path())
 }
 
 /// The stdout of a run that must have succeeded; panics with its stderr otherwise.

@@ -3,6 +3,7 @@
 //! previous run's files and stale temporaries removed, foreign files kept), series labels that
 //! are data and not paths or markup, and recipes whose values are blamed on the recipe.
 
+use crate::common::bin_path;
 use crate::common::{bin, expect, leftovers, s, stderr, tmpdir, write};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
@@ -16,13 +17,6 @@ fn fb_in(dir: &Path, args: &[&str]) -> Output {
         .stdin(Stdio::null())
         .output()
         .unwrap()
-}
-
-fn bin_path() -> PathBuf {
-    match std::env::var_os("FITBEAD_BIN") {
-        Some(p) => PathBuf::from(p),
-        None => PathBuf::from(env!("CARGO_BIN_EXE_fitbead")),
-    }
 }
 
 /// Runs `fitbead ARGS... >> file` through sh (stdout opened in append mode).

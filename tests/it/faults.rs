@@ -398,10 +398,7 @@ fn new_outputs_honour_the_umask_and_replaced_ones_keep_their_mode() {
     let new = dir.path().join("new.csv");
     let kept = write(&dir, "kept.csv", "old\n");
     std::fs::set_permissions(&kept, std::fs::Permissions::from_mode(0o640)).unwrap();
-    let bin_path = match std::env::var_os("FITBEAD_BIN") {
-        Some(p) => PathBuf::from(p),
-        None => PathBuf::from(env!("CARGO_BIN_EXE_fitbead")),
-    };
+    let bin_path = crate::common::bin_path();
     for (umask, out, want) in [("022", &new, 0o644), ("077", &kept, 0o640)] {
         let st = Command::new("sh")
             .arg("-c")
@@ -489,10 +486,7 @@ fn an_output_that_is_an_input_or_another_output_is_refused() {
 #[cfg(unix)]
 #[test]
 fn a_closed_stdout_is_an_error() {
-    let bin_path = match std::env::var_os("FITBEAD_BIN") {
-        Some(p) => PathBuf::from(p),
-        None => PathBuf::from(env!("CARGO_BIN_EXE_fitbead")),
-    };
+    let bin_path = crate::common::bin_path();
     for cmd in [
         "forward --model stick",
         "regimes",

@@ -1120,8 +1120,7 @@ fn a_file_the_user_may_not_write_is_not_replaced() {
     let out = if root {
         // A copy of the binary in the shared directory: the checkout's own may sit under a
         // directory that `nobody` cannot enter.
-        let exe =
-            std::env::var_os("FITBEAD_BIN").unwrap_or_else(|| env!("CARGO_BIN_EXE_fitbead").into());
+        let exe = crate::common::bin_path();
         let copy = p.join("fitbead-copy");
         std::fs::copy(&exe, &copy).unwrap();
         std::fs::set_permissions(&copy, std::fs::Permissions::from_mode(0o755)).unwrap();

@@ -149,6 +149,7 @@ pub(crate) fn text_width(markup: &str, size: f64) -> f64 {
 }
 
 /// Whether `svg`, a document of [`Svg::finish`], is sized for print (its width in mm).
+#[cfg(any(test, feature = "png"))]
 pub(crate) fn print_sized(svg: &str) -> bool {
     svg.split_once('>')
         .is_some_and(|(root, _)| root.starts_with("<svg") && root.contains("mm\" height="))

@@ -1912,7 +1912,13 @@ fn forward_md(py: Python<'_>, table: &str, rho: f64, f: f64, md_preset: &str) ->
     let r = interruptible(py, &stop, || {
         let mut out = Vec::new();
         command
-            .run("<arrays>", table.as_bytes(), &mut out, &options, &mut |_| {})
+            .run(
+                "<arrays>",
+                table.as_bytes(),
+                &mut out,
+                &options,
+                &mut |_| {},
+            )
             .map(|_| out)
     })?;
     let bytes = r.map_err(pipeline_error)?;

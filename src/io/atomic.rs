@@ -275,7 +275,6 @@ pub fn same_file(a: &Path, b: &Path) -> bool {
     }
 }
 
-
 /// What a path names, directories included.
 enum Resolved {
     Path(PathBuf),
@@ -708,8 +707,6 @@ impl Write for AtomicFile {
     }
 }
 
-
-
 /// [`AtomicFile::write_files`] with `before_rename` called once every temporary file is written,
 /// just before the first rename: a hook for tests of the roll-back (a target can be made to
 /// fail there).
@@ -780,8 +777,6 @@ pub(crate) fn write_atomic_all_then(
     }
     Ok(())
 }
-
-
 
 /// Whole files and sets of files written atomically, and the checks of output paths that
 /// come before any work.
@@ -865,7 +860,9 @@ impl AtomicFile {
                     return Err(setting_error(
                         flag.trim_start_matches("--"),
                         &p.display().to_string(),
-                        format!("is the same file as {oflag}: one output would overwrite the other"),
+                        format!(
+                            "is the same file as {oflag}: one output would overwrite the other"
+                        ),
                     ));
                 }
             }

@@ -2,7 +2,8 @@
 //! (`AtomicFile`, `AtomicFile::write_files`: whole files or none, modes kept, links followed;
 //! directories of outputs written as one unit: `outdir`);
 //! tables streamed through a per-row computation in bounded memory (`stream`), with the
-//! row plans of `fitbead forward` ([`forward`]) and `fitbead k` ([`kstream`]).
+//! row plans of `fitbead forward` (`forward`) and `fitbead k` (`kstream`), which the door
+//! [`crate::pipeline::TableCommand`] runs.
 
 mod atomic;
 pub(crate) mod cells;
@@ -20,8 +21,8 @@ pub(crate) mod stream;
 #[cfg(test)]
 mod suite;
 
-pub use atomic::AtomicFile;
 pub(crate) use atomic::remove_stale_temporaries;
+pub use atomic::AtomicFile;
 
 pub(crate) use crate::numfmt::{clip, echo, fmt_f64, ECHO_CHARS};
 

@@ -120,7 +120,8 @@ pub struct StreamOptions {
     /// computed and formatted by one task, which looks at the stop flag before each row.
     pub task_rows: usize,
     /// Raised by the caller (e.g. on Ctrl-C): the stream stops before its next task and
-    /// returns [`StreamError::Stopped`].
+    /// returns `StreamError::Stopped` (the door [`TableCommand::run`](crate::pipeline::TableCommand::run):
+    /// [`RunError::Interrupted`](crate::pipeline::RunError::Interrupted)).
     pub stop: Option<Arc<AtomicBool>>,
     /// Where progress goes: a `Start` whose total is `input_bytes` (0 when unknown), the
     /// input bytes whose rows have been taken in order (about every MiB), and `Finish`.
@@ -137,7 +138,7 @@ pub struct StreamOptions {
 }
 
 impl Default for StreamOptions {
-    /// [`CHUNK_ROWS`], [`TASK_ROWS`], no stop flag, no progress, an output seen as written.
+    /// 32,768 rows per chunk, 512 rows per task, no stop flag, no progress, an output seen as written.
     fn default() -> Self {
         StreamOptions {
             chunk_rows: CHUNK_ROWS,

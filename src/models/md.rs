@@ -440,7 +440,7 @@ impl MdSetting {
     }
 }
 
-/// Values given for some md settings, laid over a preset by [`MdSettings::apply`]; a setting
+/// Values given for some md settings, laid over a preset by [`MdSettings::apply_flags`]; a setting
 /// left `None` keeps the preset's value. Counts are held as numbers so that a value such as
 /// 2.5 can be refused with the setting named.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

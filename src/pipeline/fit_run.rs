@@ -7,7 +7,7 @@ use crate::fit::data::Dataset;
 use crate::fit::summary::{FitResult, ParamRow, StatsRow};
 use crate::io::fit_tables::{draws_csv, params_csv, stats_csv};
 use crate::report::bands::Curve;
-use crate::report::figures::{corner_svg, CornerBlock, FigureFormat};
+use crate::report::figures::{CornerBlock, FigureFormat};
 use crate::report::file_stems;
 use crate::report::plots::lsq_fit_figure;
 use std::path::{Path, PathBuf};
@@ -127,7 +127,7 @@ impl FitRun {
                 .map_err(|e| RunError::Failed(format!("--plot: {e}")))?;
             figures.push((path.to_path_buf(), figure_bytes(path, svg)?));
         } else if path.as_os_str() == "-" {
-            let svg = corner_svg(&CornerBlock::from_posteriors(&posteriors))
+            let svg = CornerBlock::svg(&CornerBlock::from_posteriors(&posteriors))
                 .map_err(|e| RunError::Failed(format!("corner plot: {e}")))?;
             figures.push((path.to_path_buf(), svg.into_bytes()));
         } else {
@@ -141,7 +141,7 @@ impl FitRun {
                 .extension()
                 .map_or_else(|| "svg".to_string(), |e| e.to_string_lossy().into_owned());
             for (p, series) in posteriors.iter().zip(&stems) {
-                let svg = corner_svg(&CornerBlock::from_posteriors(&[*p]))
+                let svg = CornerBlock::svg(&CornerBlock::from_posteriors(&[*p]))
                     .map_err(|e| RunError::Failed(format!("corner plot: {e}")))?;
                 let name = path.with_file_name(format!("{stem}_{}_{series}.{ext}", p.stats.fit));
                 let bytes = figure_bytes(&name, svg)?;

@@ -22,14 +22,14 @@ mod report;
 mod simulate;
 mod table;
 
+pub use crate::io::forward::ForwardSettings;
+pub use crate::io::stream::StreamOptions;
 pub use bench::Bench;
 pub use fit_command::FitCommand;
 pub use fit_run::FitRun;
 pub(crate) use fit_run::{figure_bytes, not_converged};
 pub(crate) use report::law_error;
 pub use report::{ReportOutput, ReportSettings};
-pub use crate::io::forward::ForwardSettings;
-pub use crate::io::stream::StreamOptions;
 pub use simulate::SimulateSettings;
 pub use table::{TableCommand, TableRun};
 

@@ -1,8 +1,8 @@
 //! `fitbead regimes`: δ_m (eq 32) and δ_d (eq 31) per ξ, the bulk friction μ (eq 79) and the
 //! critical ξ of a collision law, as CSV.
 
-use crate::io::records::{to_csv, RegimeRecord};
 use super::{setting_error, RunError};
+use crate::io::records::{to_csv, RegimeRecord};
 use crate::models::regimes::alpha_of_xi;
 use crate::numfmt::echo_f64;
 use crate::scene::CollisionLaw;

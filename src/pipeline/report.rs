@@ -53,7 +53,7 @@ pub struct ReportSettings {
     pub defaults: MeasurementDefaults,
     /// How report.md names the data; `None`: the name the data were read under.
     pub source: Option<String>,
-    /// Raised to stop the run: [`report`] then returns [`RunError::Interrupted`] (or, once a
+    /// Raised to stop the run: [`ReportSettings::run`] then returns [`RunError::Interrupted`] (or, once a
     /// posterior run has been cut short, writes what it has, marked interrupted).
     pub stop: Option<Arc<AtomicBool>>,
     /// The method as report.md names it (the command line gives its flag's text); `None`:

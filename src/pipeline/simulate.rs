@@ -30,7 +30,7 @@ pub(crate) const MAX_ROWS: usize = 10_000_000;
 /// Most series (`series`).
 pub(crate) const MAX_SERIES: usize = 10_000;
 
-/// What [`simulate`] makes: the settings of `fitbead simulate`, one field per flag (the
+/// What [`SimulateSettings::run`] makes: the settings of `fitbead simulate`, one field per flag (the
 /// defaults are the flags' defaults).
 #[derive(Clone)]
 pub struct SimulateSettings {
@@ -75,7 +75,7 @@ pub struct SimulateSettings {
     pub spin: SpinRule,
     /// The molecular-dynamics model of `model` md (the md flags).
     pub md: Md,
-    /// Raised to stop the run: [`simulate`] then returns [`RunError::Interrupted`].
+    /// Raised to stop the run: [`SimulateSettings::run`] then returns [`RunError::Interrupted`].
     pub stop: Option<Arc<AtomicBool>>,
     /// Progress of the md runs (label `md simulate`).
     pub progress: Option<Progress>,

@@ -22,6 +22,8 @@ use std::sync::atomic::AtomicBool;
 /// A command that reads a table and writes one output row per input row, with its settings.
 #[derive(Debug, Clone)]
 #[non_exhaustive]
+// One command is built per run: the md variant's size costs nothing.
+#[allow(clippy::large_enum_variant)]
 pub enum TableCommand {
     /// `fitbead forward` under every model but md: per scene (`xi`, `delta_deg` and the
     /// optional columns of the settings), v̄ and its diagnostics.
@@ -81,7 +83,10 @@ pub struct TableRun {
 impl TableRun {
     /// The warnings about data that read fine but look like a unit mistake (`k` only).
     pub fn warnings(&self) -> Vec<Implausible> {
-        self.ledger.as_ref().map(KLedger::warnings).unwrap_or_default()
+        self.ledger
+            .as_ref()
+            .map(KLedger::warnings)
+            .unwrap_or_default()
     }
 
     /// `k`'s figure, K against the steady final velocity, one colour per series, with the

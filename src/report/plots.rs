@@ -1371,7 +1371,7 @@ fn coinciding(curves_by_panel: &[[Vec<(f64, f64)>; 4]]) -> Vec<Vec<(usize, usize
 
 impl DesignResult {
     /// The figure of `fitbead design --plot` (SVG): per series, the sensitivity of every
-    /// candidate slope, the chosen slopes marked ([`design_figure`]).
+    /// candidate slope, the chosen slopes marked.
     pub fn figure_svg(&self, settings: &DesignSettings) -> String {
         design_figure(settings, self).to_svg()
     }

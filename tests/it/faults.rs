@@ -4,7 +4,6 @@
 //! next such fault is the ignored test [`fuzz_mutated_inputs`] (docs/GUIDE.md, "Exit codes").
 
 use crate::common::{bin, col, expect, interrupt, leftovers, s, stderr, table, tmpdir, write};
-use std::path::PathBuf;
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 

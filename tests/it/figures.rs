@@ -6,7 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
-use fitbead::report::figures::{corner_svg, CornerBlock};
+use fitbead::report::figures::CornerBlock;
 use resvg::{tiny_skia, usvg};
 
 /// The figures' series colours, in order (Okabe–Ito, then black and brown), as
@@ -29,7 +29,7 @@ fn report_files() -> &'static [String] {
         )
         .unwrap();
         let settings = fitbead::pipeline::ReportSettings::default();
-        let out = fitbead::pipeline::report(&data, &settings, None).unwrap();
+        let out = settings.run(&data, None).unwrap();
         out.files.into_iter().map(|(name, _)| name).collect()
     })
 }
@@ -266,7 +266,7 @@ fn corner_plot_of_many_draws_stays_small() {
         draws: (0..3).map(|k| z.iter().map(|d| d[k]).collect()).collect(),
         optimum: vec![0.19, 18.0, 1.3],
     };
-    let svg = corner_svg(&[block]).unwrap();
+    let svg = CornerBlock::svg(&[block]).unwrap();
     assert!(svg.len() < 400_000, "{} bytes", svg.len());
     // The axis label a₁: a subscript 1 set smaller (0.72 of 16 px), at its own position.
     assert!(svg.contains(">a</tspan><tspan x=\""));
@@ -293,7 +293,7 @@ fn corner_plot_of_many_draws_stays_small() {
                 .collect(),
             optimum: (0..n).map(|k| 0.5 + 0.1 * k as f64).collect(),
         };
-        let svg = corner_svg(&[block]).unwrap();
+        let svg = CornerBlock::svg(&[block]).unwrap();
         look(
             &format!("corner_synthetic_{n}"),
             &svg,

@@ -4,7 +4,7 @@
 use crate::common::{bin, root, stdout_ok, tmpdir, write};
 use fitbead::io::measurements::{MeasurementDefaults, MeasurementFile};
 use fitbead::models::{JaegerBranch, ModelKind};
-use fitbead::pipeline::{report, simulate, ReportSettings, RunError, SimulateSettings};
+use fitbead::pipeline::{ReportSettings, RunError, SimulateSettings};
 
 #[test]
 fn simulate_from_the_library_is_the_commands_output() {
@@ -16,7 +16,7 @@ fn simulate_from_the_library_is_the_commands_output() {
         .output()
         .unwrap();
     let cli = stdout_ok(&out);
-    let lib = simulate(&SimulateSettings {
+    let lib = (SimulateSettings {
         model: ModelKind::Jaeger,
         series: vec![1.0, 2.0],
         points: 4,
@@ -25,6 +25,7 @@ fn simulate_from_the_library_is_the_commands_output() {
         branch: JaegerBranch::Lower,
         ..SimulateSettings::default()
     })
+    .run()
     .unwrap();
     assert_eq!(String::from_utf8(lib).unwrap(), cli);
 }
@@ -42,32 +43,35 @@ fn simulate_from_a_design_in_the_library_is_the_commands_output() {
         .arg(&design)
         .output()
         .unwrap();
-    let lib = simulate(&SimulateSettings {
+    let lib = (SimulateSettings {
         model: ModelKind::Stick,
         seed: 3,
         design: Some(design),
         ..SimulateSettings::default()
     })
+    .run()
     .unwrap();
     assert_eq!(String::from_utf8(lib).unwrap(), stdout_ok(&out));
 }
 
 #[test]
 fn a_bad_simulate_setting_is_named_by_its_flag() {
-    let e = simulate(&SimulateSettings {
+    let e = (SimulateSettings {
         points: 0,
         ..SimulateSettings::default()
     })
+    .run()
     .unwrap_err();
     let RunError::Input(ie) = &e else {
         panic!("expected an input error, got {e}")
     };
     assert_eq!(ie.column.as_deref(), Some("--points"));
     assert_eq!(ie.value.as_deref(), Some("0"));
-    let e = simulate(&SimulateSettings {
+    let e = (SimulateSettings {
         series: vec![1.0, 2.0, 1.0],
         ..SimulateSettings::default()
     })
+    .run()
     .unwrap_err();
     assert!(e.to_string().contains("xi 1 is given twice"), "{e}");
 }
@@ -86,7 +90,9 @@ fn report_from_the_library_writes_the_commands_directory() {
         .unwrap();
     let summary = stdout_ok(&out);
     let file = MeasurementFile::read(&data, &MeasurementDefaults::default()).unwrap();
-    let rep = report(&file, &ReportSettings::default(), Some(lib_dir.as_path())).unwrap();
+    let rep = ReportSettings::default()
+        .run(&file, Some(lib_dir.as_path()))
+        .unwrap();
     assert_eq!(
         rep.summary.replace(&lib_dir.display().to_string(), "DIR"),
         summary.replace(&cli_dir.display().to_string(), "DIR")
@@ -116,14 +122,11 @@ fn a_bad_report_setting_is_named_by_its_flag_and_writes_nothing() {
     let dir = tmpdir();
     let data = root().join("data").join("default.csv");
     let file = MeasurementFile::read(&data, &MeasurementDefaults::default()).unwrap();
-    let e = report(
-        &file,
-        &ReportSettings {
-            format: "gif".into(),
-            ..ReportSettings::default()
-        },
-        Some(dir.path().join("never").as_path()),
-    )
+    let e = (ReportSettings {
+        format: "gif".into(),
+        ..ReportSettings::default()
+    })
+    .run(&file, Some(dir.path().join("never").as_path()))
     .unwrap_err();
     let RunError::Input(ie) = &e else {
         panic!("expected an input error, got {e}")

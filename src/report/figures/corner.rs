@@ -431,10 +431,12 @@ fn pair(x: &[f64], y: &[f64], xr: (f64, f64), yr: (f64, f64), xa: Axis, ya: Axis
     p
 }
 
-/// Corner plots of `blocks`, one under the other in one SVG document.
-pub fn corner_svg(blocks: &[CornerBlock]) -> Result<String, FigureError> {
-    let figs: Vec<Figure> = blocks.iter().map(corner_figure).collect();
-    Ok(super::plot::stack_svg(&figs))
+impl CornerBlock {
+    /// Corner plots of `blocks`, one under the other in one SVG document.
+    pub fn svg(blocks: &[CornerBlock]) -> Result<String, FigureError> {
+        let figs: Vec<Figure> = blocks.iter().map(corner_figure).collect();
+        Ok(super::plot::stack_svg(&figs))
+    }
 }
 
 #[cfg(test)]

@@ -20,7 +20,7 @@ pub(crate) mod plot;
 pub(crate) mod png;
 pub(crate) mod svg;
 
-pub use corner::{corner_svg, CornerBlock};
+pub use corner::CornerBlock;
 
 /// Why a figure could not be drawn, rendered to PNG or converted to PDF. The message names the
 /// figure where there are several.

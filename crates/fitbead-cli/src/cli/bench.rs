@@ -44,7 +44,8 @@ pub fn run(a: Args) -> Result<(), CliError> {
         .chain(a.out.output.iter().map(|p| (p.as_path(), bytes.as_slice())))
         .collect();
     if !files.is_empty() {
-        AtomicFile::write_files(&files).map_err(|e| CliError::Other(format!("cannot write: {e}")))?;
+        AtomicFile::write_files(&files)
+            .map_err(|e| CliError::Other(format!("cannot write: {e}")))?;
     }
     if a.out.output.is_none() {
         emit(None, &bytes)?;

@@ -278,7 +278,8 @@ impl FitArgs {
             .chain(figures.iter().map(|(q, b)| (q.as_path(), b.as_slice())))
             .collect();
         if !files.is_empty() {
-            AtomicFile::write_files(&files).map_err(|e| CliError::Other(format!("cannot write: {e}")))?;
+            AtomicFile::write_files(&files)
+                .map_err(|e| CliError::Other(format!("cannot write: {e}")))?;
         }
         // Without --output the fit reports on stdout carry the statistics.
         if self.output_stats.is_none() && self.out.output.is_some() {

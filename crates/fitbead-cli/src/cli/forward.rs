@@ -130,7 +130,15 @@ pub fn run(a: Args) -> Result<(), CliError> {
         return emit(a.out.output.as_deref(), &bytes);
     }
     let opts = stream_options(&command, size);
-    stream_to(&command, &source, input, a.out.output.as_deref(), &opts, |_| Ok(())).map(|_| ())
+    stream_to(
+        &command,
+        &source,
+        input,
+        a.out.output.as_deref(),
+        &opts,
+        |_| Ok(()),
+    )
+    .map(|_| ())
 }
 
 /// Prints a warning of a command on stderr.
@@ -140,13 +148,15 @@ pub(super) fn warn(w: &str) {
 
 /// The forward settings of the flags (every model but md).
 fn settings(a: &Args) -> Result<ForwardSettings, CliError> {
-    let law = a
-        .k
-        .parse()
-        .map_err(|e: fitbead::scene::ParameterError| super::flag_error("--K", &a.k, e.to_string()))?;
-    let spin = a.spin.parse().map_err(|e: fitbead::scene::ParameterError| {
-        super::flag_error("--spin", &a.spin, e.to_string())
+    let law = a.k.parse().map_err(|e: fitbead::scene::ParameterError| {
+        super::flag_error("--K", &a.k, e.to_string())
     })?;
+    let spin = a
+        .spin
+        .parse()
+        .map_err(|e: fitbead::scene::ParameterError| {
+            super::flag_error("--spin", &a.spin, e.to_string())
+        })?;
     Ok(ForwardSettings {
         kind: a.model,
         law,
@@ -259,7 +269,11 @@ pub(super) fn stream_to(
             let mut out = std::io::stdout();
             let r = command
                 .run(source, input, &mut out, opts, &mut warn)
-                .and_then(|d| out.flush().map(|()| d).map_err(|e| RunError::Library(e.into())));
+                .and_then(|d| {
+                    out.flush()
+                        .map(|()| d)
+                        .map_err(|e| RunError::Library(e.into()))
+                });
             match r {
                 Ok(done) => {
                     finish(&done)?;

@@ -14,9 +14,9 @@ mod report;
 mod simulate;
 mod values;
 
+use clap::{Parser, Subcommand};
 use fitbead::io::{AtomicFile, InputError};
 use fitbead::progress::{Progress, ProgressEvent};
-use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};

@@ -4,6 +4,8 @@
 //! here that refuses a bad value before any work. A refusal is a [`Refusal`]; `super::parse`
 //! renders it in the project's form (`<command line>, flag '--NAME', value 'V': message`).
 
+use clap::builder::{PossibleValue, TypedValueParser};
+use clap::ValueEnum;
 use fitbead::design::{Criterion, DesignFit};
 use fitbead::fit::klaw::KLaw;
 use fitbead::inverse::posterior::Prior;
@@ -12,8 +14,6 @@ use fitbead::models::md::ReducedMass;
 use fitbead::models::{JaegerBranch, Model, ModelKind};
 use fitbead::pipeline::ReportSettings;
 use fitbead::scene::CollisionLaw;
-use clap::builder::{PossibleValue, TypedValueParser};
-use clap::ValueEnum;
 use std::marker::PhantomData;
 
 /// Why a flag's value is refused: the message, and the part of the value it is about when
@@ -89,6 +89,14 @@ impl<E> Clone for ChoiceParser<E> {
     }
 }
 
+/// The value of `E` named `s`: a whole name in any case, spaces around it ignored.
+pub(crate) fn named<E: Choice>(s: &str) -> Option<E> {
+    E::variants()
+        .iter()
+        .find(|v| v.possible().matches(s.trim(), true))
+        .cloned()
+}
+
 /// The value parser of the choice `E`.
 pub(crate) fn choice<E: Choice>() -> ChoiceParser<E> {
     ChoiceParser(PhantomData)
@@ -103,20 +111,12 @@ impl<E: Choice> TypedValueParser for ChoiceParser<E> {
         arg: Option<&clap::Arg>,
         value: &std::ffi::OsStr,
     ) -> Result<E, clap::Error> {
-        let named = |s: &str| {
-            E::variants()
-                .iter()
-                .find(|v| v.possible().matches(s.trim(), true))
-                .cloned()
-                .ok_or_else(|| Refusal::new(E::unknown(s)))
-        };
-        named.parse_ref(cmd, arg, value)
+        let parse = |s: &str| named::<E>(s).ok_or_else(|| Refusal::new(E::unknown(s)));
+        parse.parse_ref(cmd, arg, value)
     }
 
     fn possible_values(&self) -> Option<Box<dyn Iterator<Item = PossibleValue> + '_>> {
-        Some(Box::new(
-            E::variants().iter().map(Choice::possible),
-        ))
+        Some(Box::new(E::variants().iter().map(Choice::possible)))
     }
 }
 
@@ -195,7 +195,6 @@ impl KModel {
             KModel::Auto => ModelKind::Auto,
         }
     }
-
 }
 
 impl Choice for KModel {
@@ -292,7 +291,12 @@ impl Default for FigureFormat {
 impl Choice for FigureFormat {
     fn variants() -> &'static [Self] {
         static ALL: std::sync::OnceLock<Vec<FigureFormat>> = std::sync::OnceLock::new();
-        ALL.get_or_init(|| ReportSettings::FORMATS.iter().map(|f| FigureFormat(f)).collect())
+        ALL.get_or_init(|| {
+            ReportSettings::FORMATS
+                .iter()
+                .map(|f| FigureFormat(f))
+                .collect()
+        })
     }
 
     fn possible(&self) -> PossibleValue {
@@ -671,12 +675,12 @@ mod tests {
             ("STICKSLIP", ModelKind::StickSlip),
             ("md", ModelKind::Md),
         ] {
-            let got = ModelKind::from_str(text.trim(), true).unwrap();
+            let got = named::<ModelKind>(text).unwrap();
             assert_eq!(got, want, "{text}");
             // The library reads the same names.
             assert_eq!(text.parse::<ModelKind>().unwrap(), want, "{text}");
         }
-        assert!(ModelKind::from_str("stic", true).is_err());
+        assert!(named::<ModelKind>("stic").is_none());
         // Every name of the library's list is a possible value, in its order.
         let names: Vec<String> = ModelKind::variants().iter().map(name_of).collect();
         assert_eq!(names, Model::NAMES);

@@ -6,6 +6,7 @@ modules included; declarations without a body are not counted) and lists those l
 threshold, longest first, as `lines file start-line name`.
 
     scripts/long_functions.py                  # list the functions over 150 lines under src/
+                                               # and crates/ (the command line)
     scripts/long_functions.py --max 150        # ... and exit 1 if one is not exempt
     scripts/long_functions.py --min 100 src/fit
 
@@ -58,7 +59,12 @@ def functions(path):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("dirs", nargs="*", default=["src"], help="directories to scan (default src)")
+    ap.add_argument(
+        "dirs",
+        nargs="*",
+        default=["src", "crates"],
+        help="directories to scan (default: the library's src and the crates of crates/)",
+    )
     ap.add_argument("--min", type=int, default=150, help="list functions longer than this")
     ap.add_argument(
         "--max", type=int, help="exit 1 if a function not exempt is longer than this many lines"

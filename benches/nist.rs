@@ -9,6 +9,12 @@ use fitbead::inverse::fit;
 #[path = "../tests/it/nist.rs"]
 mod nist;
 
+/// The log relative error the NIST module reports (shared with the tests).
+#[allow(dead_code)]
+#[path = "../tests/shared/cross_check.rs"]
+mod cross_check;
+use fitbead::inverse::{LeastSquares, LsqOptions, Residuals};
+
 fn bench(c: &mut Criterion) {
     let probs = nist::problems();
     let data: Vec<_> = probs.iter().map(nist::data).collect();

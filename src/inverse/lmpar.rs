@@ -162,27 +162,7 @@ impl Subproblem {
         let dwarf = f64::MIN_POSITIVE;
         let mut par = par;
 
-        // Gauss–Newton direction (least-squares solution if R is rank deficient).
-        let mut nsing = n;
-        for j in 0..n {
-            self.wa1[j] = qtb[j];
-            if self.at(j, j) == 0.0 && nsing == n {
-                nsing = j;
-            }
-            if nsing < n {
-                self.wa1[j] = 0.0;
-            }
-        }
-        for j in (0..nsing).rev() {
-            self.wa1[j] /= self.at(j, j);
-            let temp = self.wa1[j];
-            for i in 0..j {
-                self.wa1[i] -= self.at(i, j) * temp;
-            }
-        }
-        for j in 0..n {
-            self.x[ipvt[j]] = self.wa1[j];
-        }
+        let nsing = self.gauss_newton_direction(ipvt, qtb);
 
         // Accept the Gauss–Newton step if it is inside (or close to) the trust region.
         for j in 0..n {
@@ -196,36 +176,14 @@ impl Subproblem {
         }
 
         // Lower bound parl on λ (zero if R is singular).
-        let mut parl = 0.0;
-        if nsing >= n {
-            for j in 0..n {
-                let l = ipvt[j];
-                self.wa1[j] = diag[l] * (self.wa2[l] / dxnorm);
-            }
-            for j in 0..n {
-                let mut sum = 0.0;
-                for i in 0..j {
-                    sum += self.at(i, j) * self.wa1[i];
-                }
-                self.wa1[j] = (self.wa1[j] - sum) / self.at(j, j);
-            }
-            let temp = enorm(&self.wa1);
-            parl = ((fp / delta) / temp) / temp;
-            if !parl.is_finite() {
-                parl = 0.0;
-            }
-        }
+        let mut parl = if nsing >= n {
+            self.lower_bound(ipvt, diag, dxnorm, fp, delta)
+        } else {
+            0.0
+        };
 
         // Upper bound paru.
-        for j in 0..n {
-            let mut sum = 0.0;
-            for i in 0..=j {
-                sum += self.at(i, j) * qtb[i];
-            }
-            let l = ipvt[j];
-            self.wa1[j] = sum / diag[l];
-        }
-        let gnorm = enorm(&self.wa1);
+        let gnorm = self.scaled_gradient_norm(ipvt, diag, qtb);
         let mut paru = gnorm / delta;
         if paru == 0.0 {
             paru = dwarf / delta.min(0.1);
@@ -286,6 +244,80 @@ impl Subproblem {
             }
         }
         par
+    }
+
+    /// The Gauss–Newton direction into `x` (the least-squares solution when R is rank
+    /// deficient: the components from the first zero on R's diagonal on are zero); the rank
+    /// found, `nsing`.
+    fn gauss_newton_direction(&mut self, ipvt: &[usize], qtb: &[f64]) -> usize {
+        let n = self.n;
+        let mut nsing = n;
+        for j in 0..n {
+            self.wa1[j] = qtb[j];
+            if self.at(j, j) == 0.0 && nsing == n {
+                nsing = j;
+            }
+            if nsing < n {
+                self.wa1[j] = 0.0;
+            }
+        }
+        for j in (0..nsing).rev() {
+            self.wa1[j] /= self.at(j, j);
+            let temp = self.wa1[j];
+            for i in 0..j {
+                self.wa1[i] -= self.at(i, j) * temp;
+            }
+        }
+        for j in 0..n {
+            self.x[ipvt[j]] = self.wa1[j];
+        }
+        nsing
+    }
+
+    /// MINPACK's lower bound parl on λ for a full-rank R, from the Gauss–Newton step's scaled
+    /// norm `dxnorm` (its scaled components in `wa2`) and φ = `fp` at λ = 0; 0 where it is
+    /// not finite.
+    fn lower_bound(
+        &mut self,
+        ipvt: &[usize],
+        diag: &[f64],
+        dxnorm: f64,
+        fp: f64,
+        delta: f64,
+    ) -> f64 {
+        let n = self.n;
+        for j in 0..n {
+            let l = ipvt[j];
+            self.wa1[j] = diag[l] * (self.wa2[l] / dxnorm);
+        }
+        for j in 0..n {
+            let mut sum = 0.0;
+            for i in 0..j {
+                sum += self.at(i, j) * self.wa1[i];
+            }
+            self.wa1[j] = (self.wa1[j] - sum) / self.at(j, j);
+        }
+        let temp = enorm(&self.wa1);
+        let parl = ((fp / delta) / temp) / temp;
+        if parl.is_finite() {
+            parl
+        } else {
+            0.0
+        }
+    }
+
+    /// ‖D⁻¹ (QR)ᵀ Qᵀb‖, the norm of the scaled gradient, whose ratio to Δ is MINPACK's upper
+    /// bound paru on λ.
+    fn scaled_gradient_norm(&mut self, ipvt: &[usize], diag: &[f64], qtb: &[f64]) -> f64 {
+        for j in 0..self.n {
+            let mut sum = 0.0;
+            for i in 0..=j {
+                sum += self.at(i, j) * qtb[i];
+            }
+            let l = ipvt[j];
+            self.wa1[j] = sum / diag[l];
+        }
+        enorm(&self.wa1)
     }
 }
 

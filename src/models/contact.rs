@@ -429,48 +429,7 @@ impl Contact {
         let tf = scene.theta_f;
         let ph = SlipPhase::new(ta, ua, sigma * f);
         let u = |t: f64| ph.speed_sq(t);
-        let nrm = |t: f64| t.cos() - ph.speed_sq(t);
-        // 1. Stop: Θ̇² has at most one interior minimum on the bead (at a critical point
-        // d²Θ̇²/dθ² = 2 (cos θ + σ f sin θ) > 0), where its slope changes sign.
-        let mut end = tf;
-        let mut fail: Option<NotSteady> = None;
-        let ga = ph.speed_sq_slope(ta);
-        let gb = ph.speed_sq_slope(tf);
-        let tm = if ga >= 0.0 {
-            ta
-        } else if gb <= 0.0 {
-            tf
-        } else {
-            brent(|t| ph.speed_sq_slope(t), ta, tf, ga, gb, 1e-15, 200)
-                .map(|r| r.x)
-                .unwrap_or(tf)
-        };
-        let um = u(tm);
-        if !(um > 0.0) {
-            let angle = if ua <= 0.0 {
-                ta
-            } else {
-                brent(u, ta, tm, ua, um, 1e-15, 200)
-                    .map(|r| r.x)
-                    .unwrap_or(ta)
-            };
-            end = angle;
-            fail = Some(NotSteady::Stops { angle });
-        }
-        // 2. Lift-off: N' = −3 sin θ + 2σf N, so at a critical point N'' = −3 cos θ < 0: N has
-        // no interior minimum and is negative somewhere iff it is at an end.
-        let na = nrm(ta);
-        if na < 0.0 {
-            return Err(NotSteady::LiftOff { angle: ta });
-        }
-        let ne = nrm(end);
-        if ne < 0.0 {
-            let angle = brent(nrm, ta, end, na, ne, 1e-15, 200)
-                .map(|r| r.x)
-                .unwrap_or(end);
-            end = angle;
-            fail = Some(NotSteady::LiftOff { angle });
-        }
+        let (end, fail, tm, um) = slip_limits(&ph, ta, ua, tf)?;
         // 3. Slip → stick (s = 0). ds/dθ has the sign of q(θ) = ρ sin θ/(1+ρ) − σ f N: s moves
         // towards 0 only where σ q < 0.
         let eps_f = sigma * f / rho;
@@ -950,6 +909,62 @@ impl Contact {
             collision_spin: spin_loss,
         })
     }
+}
+
+/// Where a slip phase from `ta` (Θ̇² = `ua` there) ends at the latest, before any stick:
+/// the end of the bead `tf`, or the angle where the bead stops (Θ̇² = 0) or lifts off (N = 0),
+/// with that failure; a lift-off at `ta` itself is the error. Also the angle `tm` of Θ̇²'s
+/// lowest point between `ta` and `tf` and Θ̇² there, `um`.
+fn slip_limits(
+    ph: &SlipPhase,
+    ta: f64,
+    ua: f64,
+    tf: f64,
+) -> std::result::Result<(f64, Option<NotSteady>, f64, f64), NotSteady> {
+    let u = |t: f64| ph.speed_sq(t);
+    let nrm = |t: f64| t.cos() - ph.speed_sq(t);
+    // 1. Stop: Θ̇² has at most one interior minimum on the bead (at a critical point
+    // d²Θ̇²/dθ² = 2 (cos θ + σ f sin θ) > 0), where its slope changes sign.
+    let mut end = tf;
+    let mut fail: Option<NotSteady> = None;
+    let ga = ph.speed_sq_slope(ta);
+    let gb = ph.speed_sq_slope(tf);
+    let tm = if ga >= 0.0 {
+        ta
+    } else if gb <= 0.0 {
+        tf
+    } else {
+        brent(|t| ph.speed_sq_slope(t), ta, tf, ga, gb, 1e-15, 200)
+            .map(|r| r.x)
+            .unwrap_or(tf)
+    };
+    let um = u(tm);
+    if !(um > 0.0) {
+        let angle = if ua <= 0.0 {
+            ta
+        } else {
+            brent(u, ta, tm, ua, um, 1e-15, 200)
+                .map(|r| r.x)
+                .unwrap_or(ta)
+        };
+        end = angle;
+        fail = Some(NotSteady::Stops { angle });
+    }
+    // 2. Lift-off: N' = −3 sin θ + 2σf N, so at a critical point N'' = −3 cos θ < 0: N has
+    // no interior minimum and is negative somewhere iff it is at an end.
+    let na = nrm(ta);
+    if na < 0.0 {
+        return Err(NotSteady::LiftOff { angle: ta });
+    }
+    let ne = nrm(end);
+    if ne < 0.0 {
+        let angle = brent(nrm, ta, end, na, ne, 1e-15, 200)
+            .map(|r| r.x)
+            .unwrap_or(end);
+        end = angle;
+        fail = Some(NotSteady::LiftOff { angle });
+    }
+    Ok((end, fail, tm, um))
 }
 
 /// The slip → stick search of one slip phase with sgn(s) = σ from (Θa, Θ̇a², ωa/ε): the

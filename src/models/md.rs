@@ -1498,6 +1498,73 @@ fn advance_cell(pos: &mut Vector2<f64>, cell: &mut i64, s: f64) -> bool {
     true
 }
 
+/// The launch of an md run: on the top of row bead 0 (φ = −δ from the row's normal, Θ = 0),
+/// sunk by the static overlap, rolling downslope at the speed `v0`. The centre's abscissa,
+/// its row bead, its position relative to that bead (x in [0, s)), its velocity and its spin.
+fn launch(nd: &Nd, v0: f64, delta: f64) -> (f64, i64, Vector2<f64>, Vector2<f64>, f64) {
+    let s = nd.s;
+    let phi = -delta;
+    let rad = 1.0 - nd.static_overlap;
+    let xabs = rad * phi.sin();
+    let cell = (xabs / s).floor() as i64;
+    let pos = Vector2::new(xabs - cell as f64 * s, rad * phi.cos());
+    let v = Vector2::new(v0 * phi.cos(), -v0 * phi.sin());
+    (xabs, cell, pos, v, -v0 / nd.rhat)
+}
+
+/// The trap test of an md run (regime A): only below δ = α is there a top to stop at.
+struct Trap {
+    /// Whether the slope has tops the bead can stop below (δ < α, and the margin smaller
+    /// than their depth).
+    possible: bool,
+    /// The energy margin below a top that counts as trapped.
+    margin: f64,
+    /// δ, rad.
+    delta: f64,
+    /// Row-bead spacing.
+    s: f64,
+    /// The highest position upslope of the next top since the last crossing (x; −∞ after a
+    /// crossing), and its height.
+    climb_x: f64,
+    climb_y: f64,
+}
+
+impl Trap {
+    fn new(nd: &Nd, delta: f64, alpha: f64) -> Self {
+        let depth = 1.0 - (delta - alpha).cos();
+        let margin = 0.05 * depth + 2.0 * nd.static_overlap;
+        Trap {
+            possible: delta < alpha && margin < depth,
+            margin,
+            delta,
+            s: nd.s,
+            climb_x: f64::NEG_INFINITY,
+            climb_y: 1.0,
+        }
+    }
+
+    /// The stop angle when the energy `etot` is below the top of row bead `cell` + 1 while
+    /// the bead (at `xabs`, height `y`) is still upslope of that top.
+    fn trapped(&mut self, nd: &Nd, cell: i64, xabs: f64, y: f64, etot: f64) -> Option<f64> {
+        if !self.possible {
+            return None;
+        }
+        let s = self.s;
+        let k1 = (cell + 1) as f64;
+        let x_top = k1 * s - nd.sin_d;
+        if xabs >= x_top {
+            return None;
+        }
+        if xabs > self.climb_x {
+            self.climb_x = xabs;
+            self.climb_y = y;
+        }
+        let v_top = 1.0 - nd.sin_d * s * k1;
+        (etot < v_top - self.margin)
+            .then(|| (self.climb_x - k1 * s).atan2(self.climb_y) + self.delta)
+    }
+}
+
 /// Integrates an md run by velocity Verlet from the launch until the bead has crossed the
 /// last row bead of the window, is trapped (regime A, recorded in `res`), runs past the
 /// time limit or sees the stop flag (recorded in `res.failure`).
@@ -1513,17 +1580,8 @@ fn integrate(
     let dt = nd.dt;
     let alpha = scene.alpha;
     let delta = scene.delta;
-    // Launch: on the top of row bead 0 (φ = −δ from the row's normal, Θ = 0), sunk by the
-    // static overlap, rolling downslope at the launch speed.
-    let phi = -delta;
-    let rad = 1.0 - nd.static_overlap;
     // The centre relative to row bead `cell` (x in [0, s)), its velocity and its spin.
-    let mut xabs = rad * phi.sin();
-    let mut cell = (xabs / s).floor() as i64;
-    let mut pos = Vector2::new(xabs - cell as f64 * s, rad * phi.cos());
-    let v0 = c.launch_velocity;
-    let mut v = Vector2::new(v0 * phi.cos(), -v0 * phi.sin());
-    let mut w = -v0 / nd.rhat;
+    let (mut xabs, mut cell, mut pos, mut v, mut w) = launch(nd, c.launch_velocity, delta);
     let mut t = 0.0;
     let mut e = nd.eval(cell, pos, v, w);
     let e0 = energy(nd, xabs, pos.y, v, w, e.u_el);
@@ -1539,12 +1597,7 @@ fn integrate(
     // Contact bookkeeping.
     let mut book = Bookkeeping::new(nd, delta, &e, xabs);
 
-    // Trap test: only below δ = α is there a top to stop at.
-    let depth = 1.0 - (delta - alpha).cos();
-    let margin = 0.05 * depth + 2.0 * nd.static_overlap;
-    let trap_possible = delta < alpha && margin < depth;
-    let mut climb_x = f64::NEG_INFINITY;
-    let mut climb_y = 1.0;
+    let mut trap = Trap::new(nd, delta, alpha);
     let mut last_progress_t = 0.0;
     let t_max = c.max_time_per_bead * (nb as f64 + 1.0);
 
@@ -1594,7 +1647,7 @@ fn integrate(
                 }
             }
             last_progress_t = t;
-            climb_x = f64::NEG_INFINITY;
+            trap.climb_x = f64::NEG_INFINITY;
             res.beads_passed = crossings.len().saturating_sub(1) as u64;
             if crossings.len() > nb {
                 break;
@@ -1602,28 +1655,14 @@ fn integrate(
         }
         e = en;
 
-        // Trap (regime A): the energy is below the top of row bead cell + 1 while the bead
-        // is still upslope of that top.
-        if trap_possible {
-            let k1 = (cell + 1) as f64;
-            let x_top = k1 * s - nd.sin_d;
-            if xabs < x_top {
-                if xabs > climb_x {
-                    climb_x = xabs;
-                    climb_y = pos.y;
-                }
-                let v_top = 1.0 - nd.sin_d * s * k1;
-                if etot < v_top - margin {
-                    let angle = (climb_x - k1 * s).atan2(climb_y) + delta;
-                    res.stop = Some(MdStop {
-                        bead: crossings.len().saturating_sub(1) as u64,
-                        angle,
-                        time: t,
-                    });
-                    res.regime = Some(Regime::A);
-                    break;
-                }
-            }
+        if let Some(angle) = trap.trapped(nd, cell, xabs, pos.y, etot) {
+            res.stop = Some(MdStop {
+                bead: crossings.len().saturating_sub(1) as u64,
+                angle,
+                time: t,
+            });
+            res.regime = Some(Regime::A);
+            break;
         }
         if t > t_max || t - last_progress_t > c.max_time_per_bead {
             res.failure = Some(MdFailure::TimeLimit);

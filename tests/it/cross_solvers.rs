@@ -14,91 +14,14 @@
 //! print with `cargo test --release --test it cross_solvers:: -- --nocapture`; the counts of
 //! cases each method solves are the measured ones, kept as floors.
 
-use argmin::core::{CostFunction, Executor, State};
-use argmin::solver::gaussnewton::GaussNewtonLS;
-use argmin::solver::linesearch::MoreThuenteLineSearch;
-use argmin::solver::neldermead::NelderMead;
+use argmin::core::{Executor, State};
 use faer::Mat;
-use fitbead::inverse::{fit, LeastSquares, LevenbergMarquardt, LsqOptions, Residuals};
+use fitbead::inverse::{fit, LeastSquares, LevenbergMarquardt, Residuals};
 use levenberg_marquardt::LeastSquaresProblem;
 use nalgebra::{DMatrix, DVector, Dyn, Owned};
 
-use crate::nist::{data, lre, min_lres, options, problems, Data, Problem};
-
-/// Smallest LRE of `est` against `reference`.
-fn min_lre(est: &[f64], reference: &[f64]) -> f64 {
-    est.iter()
-        .zip(reference)
-        .map(|(e, c)| lre(*e, *c))
-        .fold(11.0, f64::min)
-}
-
-/// argmin's Gauss–Newton with a Moré–Thuente line search from `start`: the estimate, or why
-/// it failed.
-fn gauss_newton<R: Residuals>(problem: R, start: &[f64]) -> Result<Vec<f64>, String> {
-    let ls =
-        LeastSquares::new(problem, start, &LsqOptions::default()).map_err(|e| e.to_string())?;
-    let solver = GaussNewtonLS::new(MoreThuenteLineSearch::new())
-        .with_tolerance(1e-12)
-        .map_err(|e| e.to_string())?;
-    let res = Executor::new(ls, solver)
-        .configure(|s| s.param(DVector::from_column_slice(start)).max_iters(1000))
-        .ctrlc(false)
-        .run()
-        .map_err(|e| first_line(&e.to_string()))?;
-    let p = res.state().get_best_param().ok_or("no estimate")?;
-    if p.iter().all(|v| v.is_finite()) {
-        Ok(p.as_slice().to_vec())
-    } else {
-        Err("non-finite estimate".into())
-    }
-}
-
-/// argmin's Nelder–Mead from `start` (initial simplex: each coordinate moved by 5 %, or by
-/// 0.00025 where it is 0, as scipy does), restarted from its best vertex until a restart no
-/// longer lowers χ² by 1e-15 relative (at most 10 runs of 10,000 iterations, each ended when the
-/// standard deviation of χ² over the simplex is below 1e-15 of χ²).
-fn nelder_mead<R: Residuals>(problem: R, start: &[f64]) -> Result<Vec<f64>, String> {
-    let mut ls =
-        LeastSquares::new(problem, start, &LsqOptions::default()).map_err(|e| e.to_string())?;
-    let mut x = DVector::from_column_slice(start);
-    let mut best = ls.cost(&x).map_err(|e| e.to_string())?;
-    if !best.is_finite() {
-        return Err("infeasible start".into());
-    }
-    for _ in 0..10 {
-        let mut simplex = vec![x.clone()];
-        for j in 0..x.len() {
-            let mut v = x.clone();
-            v[j] = if v[j] != 0.0 { 1.05 * v[j] } else { 0.00025 };
-            simplex.push(v);
-        }
-        let solver = NelderMead::new(simplex)
-            .with_sd_tolerance(1e-15 * best)
-            .map_err(|e| e.to_string())?;
-        let res = Executor::new(ls, solver)
-            .configure(|s| s.max_iters(10_000))
-            .ctrlc(false)
-            .run()
-            .map_err(|e| first_line(&e.to_string()))?;
-        let cost = res.state().get_best_cost();
-        let p = res.state().get_best_param().ok_or("no estimate")?.clone();
-        ls = res.problem.problem.ok_or("problem lost")?;
-        let improved = cost < best * (1.0 - 1e-15);
-        if cost <= best {
-            best = cost;
-            x = p;
-        }
-        if !improved {
-            break;
-        }
-    }
-    Ok(x.as_slice().to_vec())
-}
-
-fn first_line(s: &str) -> String {
-    s.lines().next().unwrap_or("").chars().take(60).collect()
-}
+use crate::cross_check::{first_line, gauss_newton, min_lre, nelder_mead};
+use crate::nist::{data, min_lres, options, problems, Data, Problem};
 
 /// A NIST case for the `levenberg-marquardt` crate.
 struct Minpack {

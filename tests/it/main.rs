@@ -3,6 +3,10 @@
 //! the tests print (measured errors, coverage tables).
 
 mod common;
+/// The LRE and argmin's solvers, shared with the library's in-crate cross-checks.
+#[path = "../shared/cross_check.rs"]
+mod cross_check;
+use fitbead::inverse::{LeastSquares, LsqOptions, Residuals};
 
 mod bench_cli;
 mod cli;

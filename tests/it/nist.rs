@@ -12,6 +12,7 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::cross_check::lre;
 use dd::Dd;
 use faer::MatMut;
 use fitbead::inverse::{
@@ -723,22 +724,6 @@ pub fn data(p: &Problem) -> Data {
 pub fn run(p: &Problem, start: usize, opts: &LsqOptions) -> Fit {
     let d = data(p);
     fit(&d, &p.starts[start], opts).unwrap_or_else(|e| panic!("{}: {e}", p.name))
-}
-
-/// Log relative error, capped at 11 (the certified digits); 0 for anything non-finite.
-pub fn lre(est: f64, cert: f64) -> f64 {
-    let r = if cert != 0.0 {
-        (est - cert).abs() / cert.abs()
-    } else {
-        est.abs()
-    };
-    if r == 0.0 {
-        11.0
-    } else if r.is_finite() {
-        (-r.log10()).clamp(0.0, 11.0)
-    } else {
-        0.0
-    }
 }
 
 /// Minimum LREs of the parameters and of the standard errors (0 without a covariance).

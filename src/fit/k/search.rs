@@ -122,35 +122,23 @@ fn solve_with(
         })
     });
     // Lower end of the s-bracket: step down until the time exceeds τ*.
-    let (mut s_lo, mut g_lo, mut s_up, mut g_up) = match near {
+    let start = match near {
         Some(b) => b,
         None => (s_hi - 2.0, g(s_hi - 2.0, &mut evals, &mut last), s_hi, g_hi),
     };
-    let mut step = 4.0;
-    while g_lo > 0.0 {
-        s_up = s_lo;
-        g_up = g_lo;
-        s_lo -= step;
-        step *= 2.0;
-        if s_lo.exp() < ulp_floor {
-            // The lowest K above K_min that double precision resolves (K_min + K_min ε is at
-            // least one ulp above it).
-            s_lo = ulp_floor.ln();
-            g_lo = g(s_lo, &mut evals, &mut last);
-            if g_lo > 0.0 {
-                // v is slower than the motion at every K that double precision distinguishes
-                // from K_min.
-                return match last {
-                    Some((s, st)) if s == s_lo => {
-                        below_resolution(model, scene, br, tau_star, k_of(s), st, evals)
-                    }
-                    _ => Err(KFailure::BelowRange),
-                };
+    let Some((s_lo, g_lo, mut s_up, mut g_up)) =
+        step_down(start, ulp_floor, |s| g(s, &mut evals, &mut last))
+    else {
+        // v is slower than the motion at every K that double precision distinguishes from
+        // K_min.
+        let s_floor = ulp_floor.ln();
+        return match last {
+            Some((s, st)) if s == s_floor => {
+                below_resolution(model, scene, br, tau_star, k_of(s), st, evals)
             }
-            break;
-        }
-        g_lo = g(s_lo, &mut evals, &mut last);
-    }
+            _ => Err(KFailure::BelowRange),
+        };
+    };
     if g_lo == 0.0 {
         s_up = s_lo;
         g_up = 0.0;
@@ -185,6 +173,35 @@ fn solve_with(
         resolved(model, scene, br, tau_star, k, &steady, &mut evals)?;
     }
     Ok(KRoot { k, steady, evals })
+}
+
+/// The bracket `(s_lo, g_lo, s_up, g_up)` of `start` with its lower end stepped down in s (by
+/// 4, 8, 16, …) until `g` there is no longer positive, the upper end following; the lowest
+/// step is ln `ulp_floor` (the lowest K above K_min that double precision resolves: K_min +
+/// K_min ε is at least one ulp above it). `None` when `g` is still positive there.
+fn step_down(
+    start: (f64, f64, f64, f64),
+    ulp_floor: f64,
+    mut g: impl FnMut(f64) -> f64,
+) -> Option<(f64, f64, f64, f64)> {
+    let (mut s_lo, mut g_lo, mut s_up, mut g_up) = start;
+    let mut step = 4.0;
+    while g_lo > 0.0 {
+        s_up = s_lo;
+        g_up = g_lo;
+        s_lo -= step;
+        step *= 2.0;
+        if s_lo.exp() < ulp_floor {
+            s_lo = ulp_floor.ln();
+            g_lo = g(s_lo);
+            if g_lo > 0.0 {
+                return None;
+            }
+            break;
+        }
+        g_lo = g(s_lo);
+    }
+    Some((s_lo, g_lo, s_up, g_up))
 }
 
 /// The sign change of `g` (increasing in s) near `seed`: g at the seed, then at steps of

@@ -1,25 +1,20 @@
 //! Files: CSV reading with errors that name file, line, column and value; atomic writing
 //! (`AtomicFile`, `AtomicFile::write_files`: whole files or none, modes kept, links followed;
 //! directories of outputs written as one unit: `outdir`);
-//! tables streamed through a per-row computation in bounded memory (`stream`), with the
-//! row plans of `fitbead forward` (`forward`) and `fitbead k` (`kstream`), which the door
-//! [`crate::pipeline::TableCommand`] runs.
+//! tables streamed through a per-row computation in bounded memory (`stream`), which the
+//! door of `fitbead forward` and `fitbead k` ([`crate::pipeline::TableCommand`]) runs with
+//! their row plans.
 
 mod atomic;
 pub(crate) mod cells;
 mod csvsyntax;
 pub(crate) mod fit_tables;
-pub(crate) mod forward;
-pub(crate) mod kstream;
-pub(crate) mod md;
 pub mod measurements;
 pub(crate) mod outdir;
 mod ranges;
 pub mod records;
 pub(crate) mod scenes;
 pub(crate) mod stream;
-#[cfg(test)]
-mod suite;
 
 pub(crate) use atomic::remove_stale_temporaries;
 pub use atomic::AtomicFile;

@@ -19,8 +19,8 @@
 //! the output is in input order, byte for byte the same at any number of threads.
 //!
 //! What a row means is a [`RowPlan`]'s business: `fitbead forward`'s scenes
-//! ([`super::forward::ForwardPlan`]) and `fitbead k`'s measurements
-//! ([`super::kstream::KPlan`]) are two. The engine gives every plan the same error rules as
+//! (`pipeline::forward::plan::ForwardPlan`) and `fitbead k`'s measurements
+//! (`pipeline::k::KPlan`) are two. The engine gives every plan the same error rules as
 //! reading the whole table first: a malformed row anywhere in the input (or an input with no
 //! rows) is reported before any bad value, then the first bad row in input order; a failed
 //! write is reported only once the whole input proved good, writing stopping at the failure.

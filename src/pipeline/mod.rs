@@ -16,18 +16,21 @@ mod fit_run;
 mod forward;
 mod jaeger;
 mod jan;
+mod k;
 mod klaw;
 mod regimes;
 mod report;
 mod simulate;
+#[cfg(test)]
+mod suite;
 mod table;
 
-pub use crate::io::forward::ForwardSettings;
 pub use crate::io::stream::StreamOptions;
 pub use bench::Bench;
 pub use fit_command::FitCommand;
 pub use fit_run::FitRun;
 pub(crate) use fit_run::{figure_bytes, not_converged};
+pub use forward::plan::ForwardSettings;
 pub(crate) use report::law_error;
 pub use report::{ReportOutput, ReportSettings};
 pub use simulate::SimulateSettings;

@@ -1,13 +1,13 @@
-//! `fitbead forward` and `fitbead k`: a table in, one output row per input row out. Every
-//! model but md streams the rows through the engine of `io::stream` in bounded memory (the
-//! row plans `io::forward::ForwardPlan` and `io::kstream::KPlan`); md, whose runs are long
-//! and few, reads the whole table.
+//! The door of `fitbead forward` and `fitbead k`: a table in, one output row per input row
+//! out. Every model but md streams the rows through the engine of `io::stream` in bounded
+//! memory, with the row plans of `forward` (`forward/plan.rs`) and `k` (`k.rs`); md, whose
+//! runs are long and few, reads the whole table (`forward/md.rs`).
 
+use super::forward::md::MdTable;
 use super::forward::md_runs;
+use super::forward::plan::{scene_columns, ForwardPlan, ForwardSettings};
+use super::k::{self as kstream, KLedger, KPlan, KSettings};
 use super::{figure_bytes, RunError};
-use crate::io::forward::{scene_columns, ForwardPlan, ForwardSettings};
-use crate::io::kstream::{self, KLedger, KPlan, KSettings};
-use crate::io::md::MdTable;
 use crate::io::measurements::{Implausible, MeasurementDefaults, MEASUREMENT_COLUMNS};
 use crate::io::scenes::{check_columns, Header, Table, TableReader};
 use crate::io::stream::{stream, StreamError, StreamOptions};
@@ -111,7 +111,7 @@ impl TableCommand {
     pub fn columns(&self) -> Option<Vec<&'static str>> {
         match self {
             TableCommand::Forward { settings, .. } => {
-                Some(crate::io::forward::output_columns(settings.kind))
+                Some(super::forward::plan::output_columns(settings.kind))
             }
             TableCommand::ForwardMd { .. } => None,
             TableCommand::K { model, .. } => {

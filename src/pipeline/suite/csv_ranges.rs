@@ -5,10 +5,10 @@
 //! lone CR line ends, blank lines, byte order marks inside rows, invalid UTF-8, ragged rows,
 //! an unterminated quote — and the same bytes at 1 thread as at several.
 
-use crate::io::forward::{ForwardPlan, ForwardSettings, ForwardText};
 use crate::io::scenes::{Row, Table, TableReader};
 use crate::io::stream::{stream, RowPlan, StreamError, StreamOptions};
 use crate::io::InputError;
+use crate::pipeline::forward::plan::{ForwardPlan, ForwardSettings, ForwardText};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

@@ -12,11 +12,11 @@
 //! Settings are named in messages as the command line's flags (`--rho` of
 //! `SETTINGS_ORIGIN`), since that is where they come from.
 
-use super::cells::Cells;
-use super::records::{columns, AutoRecord, ContactRecord, ForwardRecord};
-use super::scenes::{Row, TableReader};
-use super::stream::RowPlan;
-use super::InputError;
+use crate::io::cells::Cells;
+use crate::io::records::{columns, AutoRecord, ContactRecord, ForwardRecord};
+use crate::io::scenes::{Row, TableReader};
+use crate::io::stream::RowPlan;
+use crate::io::InputError;
 use crate::models::auto::Auto;
 use crate::models::contact::{Contact, SpinRule};
 use crate::models::jaeger::Jaeger;
@@ -63,7 +63,7 @@ pub(crate) fn output_columns(kind: ModelKind) -> Vec<&'static str> {
     outputs
 }
 
-pub(crate) use super::{setting_error, SETTINGS_ORIGIN};
+pub(crate) use crate::io::{setting_error, SETTINGS_ORIGIN};
 
 /// The values rows fall back on where their column is absent or their cell empty, and the
 /// model to evaluate.
@@ -477,7 +477,7 @@ impl RowPlan for ForwardPlan {
         let mut w = Cells::new(out);
         let outputs = output_columns(self.settings.kind);
         let inputs = self.headers.iter().map(String::as_str);
-        for name in super::pass_through_names(inputs, &outputs) {
+        for name in crate::io::pass_through_names(inputs, &outputs) {
             w.text(&name);
         }
         for c in outputs {

@@ -3,11 +3,11 @@
 //! bad cell or a series that changes ξ after the first chunks, the same message naming the
 //! same line (the first ξ of the series kept across chunks).
 
-use crate::io::kstream::{KLedger, KPlan, KSettings};
 use crate::io::measurements::MeasurementDefaults;
 use crate::io::scenes::TableReader;
 use crate::io::stream::{stream, StreamError, StreamOptions, CHUNK_ROWS, TASK_ROWS};
 use crate::models::Model;
+use crate::pipeline::k::{KLedger, KPlan, KSettings};
 
 const SIZES: [(usize, usize); 4] = [(1, 1), (7, 3), (64, 5), (CHUNK_ROWS, TASK_ROWS)];
 

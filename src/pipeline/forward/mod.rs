@@ -1,10 +1,13 @@
 //! `fitbead forward --model md`: one molecular-dynamics run per row of a scene table.
 
+pub(crate) mod md;
+pub(crate) mod plan;
+
 use super::RunError;
-use crate::io::md::{md_csv, md_jobs, MdTable};
 use crate::io::scenes::Table;
 use crate::models::md::MdResult;
 use crate::progress::{Progress, ProgressEvent, Tally};
+use md::{md_csv, md_jobs, MdTable};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 

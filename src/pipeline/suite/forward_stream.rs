@@ -4,10 +4,10 @@
 //! but md, at chunk sizes from 1 row to [`CHUNK_ROWS`]; the same message for every kind of
 //! bad input.
 
-use crate::io::forward::{ForwardPlan, ForwardSettings, ForwardText};
 use crate::io::scenes::TableReader;
 use crate::io::stream::{stream, StreamError, StreamOptions, CHUNK_ROWS, TASK_ROWS};
 use crate::models::JaegerBranch;
+use crate::pipeline::forward::plan::{ForwardPlan, ForwardSettings, ForwardText};
 
 /// The command line's flags as the library's settings: `--model`, `--K`, `--rho`, `--f`,
 /// `--spin`, `--tol`, `--lambda`, `--mu`, `--a1`..`--a3`, `--branch` (`--NAME VALUE` or

@@ -5,17 +5,17 @@
 //! record of `COLUMNS`, `EXTRA_COLUMNS`, `AUTO_COLUMNS` (auto only), then the input's
 //! other columns (trimmed; a name clashing with an output column renamed `in_NAME`).
 
-use super::cells::{Cells, Repeat};
-use super::measurements::{
+use crate::fit::k::auto::{self as kauto, KChoice};
+use crate::fit::k::KEstimate;
+use crate::io::cells::{Cells, Repeat};
+use crate::io::measurements::{
     Implausible, Measured, MeasurementColumns, MeasurementDefaults, Plausibility, PlausiblePoint,
     SeriesLedger, StopSlopes,
 };
-use super::records::{columns, AutoRecord, KRecord};
-use super::scenes::{Header, Row};
-use super::stream::RowPlan;
-use super::InputError;
-use crate::fit::k::auto::{self as kauto, KChoice};
-use crate::fit::k::KEstimate;
+use crate::io::records::{columns, AutoRecord, KRecord};
+use crate::io::scenes::{Header, Row};
+use crate::io::stream::RowPlan;
+use crate::io::InputError;
 use crate::models::auto::Auto;
 use crate::models::Model;
 use crate::numfmt::fmt_f64;
@@ -244,7 +244,7 @@ impl RowPlan for KPlan {
         }
         let own: Vec<&str> = self.own_columns().collect();
         let pass = self.pass.iter().map(|&i| self.headers[i].as_str());
-        for name in super::pass_through_names(pass, &own) {
+        for name in crate::io::pass_through_names(pass, &own) {
             w.text(&name);
         }
         w.end();

@@ -4,9 +4,9 @@
 //! Unlike the closed-form models, md runs take seconds each, so the table is read whole and
 //! the runs are the caller's to schedule.
 
-use super::forward::{check_scene_cells, scene_error, setting_error};
-use super::scenes::Table;
-use super::InputError;
+use super::plan::{check_scene_cells, scene_error, setting_error};
+use crate::io::scenes::Table;
+use crate::io::InputError;
 use crate::models::md::{Md, MdResult, MdSetting, MdSettings};
 use crate::models::Regime;
 use crate::numfmt::fmt_f64;
@@ -109,7 +109,7 @@ pub fn md_jobs(t: &Table, base: &MdTable) -> Result<Vec<(Scene, Md)>, InputError
                 ),
             }
         };
-        let other = |e: &Error| InputError::file(super::forward::SETTINGS_ORIGIN, e.to_string());
+        let other = |e: &Error| InputError::file(super::plan::SETTINGS_ORIGIN, e.to_string());
         let md = given.apply(base.md).map_err(|(s, e)| match s {
             Some(s) => err(s, e.to_string()),
             None => other(&e),
@@ -138,7 +138,7 @@ pub fn md_csv(
 ) -> csv::Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::with_capacity(t.rows.len() * 400));
     let mut header =
-        super::pass_through_names(t.headers.iter().map(String::as_str), &MD_OUTPUT_COLUMNS);
+        crate::io::pass_through_names(t.headers.iter().map(String::as_str), &MD_OUTPUT_COLUMNS);
     header.extend(MD_OUTPUT_COLUMNS.iter().map(|s| s.to_string()));
     w.write_record(&header)?;
     let opt = |x: Option<f64>| x.map(fmt_f64).unwrap_or_default();

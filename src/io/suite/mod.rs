@@ -1,6 +1,0 @@
-//! Tests of the streaming engine ([`super::stream`]) with the row plans of `forward` and `k`,
-//! against the golden outputs of `tests/golden/`: `cargo test --release --lib io::suite`.
-
-mod csv_ranges;
-mod forward_stream;
-mod k_stream;

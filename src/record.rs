@@ -60,9 +60,60 @@ impl Cell<'_> {
 /// # Panics
 /// If `R` is not such a struct, which the records of this crate all are.
 #[inline]
-pub fn each_cell<R: Serialize + ?Sized>(record: &R, mut visit: impl FnMut(&'static str, Cell<'_>)) {
-    if let Err(e) = record.serialize(RecordSerializer { visit: &mut visit }) {
+pub fn each_cell<R: Serialize + ?Sized>(record: &R, visit: impl FnMut(&'static str, Cell<'_>)) {
+    walk(record, &mut ByCell(visit));
+}
+
+/// What a walk of a record ([`walk`]) hands over, field by field, in column order: one call
+/// per field, by the kind of its value. [`each_cell`] makes each a [`Cell`]; the streaming
+/// writer (`io::cells`) writes each straight into its buffer.
+pub(crate) trait Visit {
+    /// A number (non-finite as it is).
+    fn number(&mut self, key: &'static str, x: f64);
+    /// A count.
+    fn count(&mut self, key: &'static str, n: u64);
+    /// Text.
+    fn text(&mut self, key: &'static str, s: &str);
+    /// A flag.
+    fn flag(&mut self, key: &'static str, b: bool);
+    /// No value.
+    fn empty(&mut self, key: &'static str);
+}
+
+/// Walks `record`'s fields with serde, handing each to `visit` (the walker of [`each_cell`]).
+///
+/// # Panics
+/// As [`each_cell`].
+#[inline]
+pub(crate) fn walk<R: Serialize + ?Sized, V: Visit>(record: &R, visit: &mut V) {
+    if let Err(e) = record.serialize(RecordSerializer { visit }) {
         panic!("not a record of flat fields: {e}");
+    }
+}
+
+/// A [`Visit`] that hands every field to a closure as a [`Cell`].
+struct ByCell<F>(F);
+
+impl<F: FnMut(&'static str, Cell<'_>)> Visit for ByCell<F> {
+    #[inline]
+    fn number(&mut self, key: &'static str, x: f64) {
+        (self.0)(key, Cell::Number(x))
+    }
+    #[inline]
+    fn count(&mut self, key: &'static str, n: u64) {
+        (self.0)(key, Cell::Count(n))
+    }
+    #[inline]
+    fn text(&mut self, key: &'static str, s: &str) {
+        (self.0)(key, Cell::Text(Cow::Borrowed(s)))
+    }
+    #[inline]
+    fn flag(&mut self, key: &'static str, b: bool) {
+        (self.0)(key, Cell::Flag(b))
+    }
+    #[inline]
+    fn empty(&mut self, key: &'static str) {
+        (self.0)(key, Cell::Empty)
     }
 }
 
@@ -103,7 +154,7 @@ pub(crate) fn to_csv<R: Serialize + Default>(
 
 /// Why a value is not a record of flat fields.
 #[derive(Debug)]
-pub(crate) struct NotFlat(String);
+struct NotFlat(String);
 
 impl fmt::Display for NotFlat {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -119,29 +170,21 @@ impl ser::Error for NotFlat {
     }
 }
 
-pub(crate) fn not_flat<T>(what: &str) -> Result<T, NotFlat> {
+fn not_flat<T>(what: &str) -> Result<T, NotFlat> {
     Err(NotFlat(format!(
         "{what} where a record or a flat field was expected"
     )))
 }
 
 /// Serialises a record (a struct) by visiting its fields.
-struct RecordSerializer<'v, F> {
-    visit: &'v mut F,
+struct RecordSerializer<'v, V> {
+    visit: &'v mut V,
 }
 
-/// Serialises one field's value as a [`Cell`] handed to the visitor.
-struct FieldSerializer<'v, F> {
+/// Serialises one field's value by handing it to the visitor.
+struct FieldSerializer<'v, V> {
     key: &'static str,
-    visit: &'v mut F,
-}
-
-impl<F: FnMut(&'static str, Cell<'_>)> FieldSerializer<'_, F> {
-    #[inline]
-    fn cell(self, c: Cell<'_>) -> Result<(), NotFlat> {
-        (self.visit)(self.key, c);
-        Ok(())
-    }
+    visit: &'v mut V,
 }
 
 /// The serializer methods of a kind of value a record does not hold: each an error.
@@ -152,9 +195,8 @@ macro_rules! refuse {
         })*
     };
 }
-pub(crate) use refuse;
 
-impl<'v, F: FnMut(&'static str, Cell<'_>)> Serializer for RecordSerializer<'v, F> {
+impl<'v, V: Visit> Serializer for RecordSerializer<'v, V> {
     type Ok = ();
     type Error = NotFlat;
     type SerializeSeq = Impossible<(), NotFlat>;
@@ -165,6 +207,7 @@ impl<'v, F: FnMut(&'static str, Cell<'_>)> Serializer for RecordSerializer<'v, F
     type SerializeStruct = Self;
     type SerializeStructVariant = Impossible<(), NotFlat>;
 
+    #[inline]
     fn serialize_struct(self, _: &'static str, _: usize) -> Result<Self, NotFlat> {
         Ok(self)
     }
@@ -219,10 +262,11 @@ impl<'v, F: FnMut(&'static str, Cell<'_>)> Serializer for RecordSerializer<'v, F
     }
 }
 
-impl<F: FnMut(&'static str, Cell<'_>)> SerializeStruct for RecordSerializer<'_, F> {
+impl<V: Visit> SerializeStruct for RecordSerializer<'_, V> {
     type Ok = ();
     type Error = NotFlat;
 
+    #[inline(always)]
     fn serialize_field<T: Serialize + ?Sized>(
         &mut self,
         key: &'static str,
@@ -239,7 +283,7 @@ impl<F: FnMut(&'static str, Cell<'_>)> SerializeStruct for RecordSerializer<'_, 
     }
 }
 
-impl<'v, F: FnMut(&'static str, Cell<'_>)> Serializer for FieldSerializer<'v, F> {
+impl<'v, V: Visit> Serializer for FieldSerializer<'v, V> {
     type Ok = ();
     type Error = NotFlat;
     type SerializeSeq = Impossible<(), NotFlat>;
@@ -250,8 +294,10 @@ impl<'v, F: FnMut(&'static str, Cell<'_>)> Serializer for FieldSerializer<'v, F>
     type SerializeStruct = Impossible<(), NotFlat>;
     type SerializeStructVariant = Impossible<(), NotFlat>;
 
+    #[inline]
     fn serialize_bool(self, v: bool) -> Result<(), NotFlat> {
-        self.cell(Cell::Flag(v))
+        self.visit.flag(self.key, v);
+        Ok(())
     }
     fn serialize_i8(self, v: i8) -> Result<(), NotFlat> {
         self.serialize_i64(v.into())
@@ -262,10 +308,11 @@ impl<'v, F: FnMut(&'static str, Cell<'_>)> Serializer for FieldSerializer<'v, F>
     fn serialize_i32(self, v: i32) -> Result<(), NotFlat> {
         self.serialize_i64(v.into())
     }
+    #[inline]
     fn serialize_i64(self, v: i64) -> Result<(), NotFlat> {
         match u64::try_from(v) {
-            Ok(n) => self.cell(Cell::Count(n)),
-            Err(_) => self.cell(Cell::Number(v as f64)),
+            Ok(n) => self.serialize_u64(n),
+            Err(_) => self.serialize_f64(v as f64),
         }
     }
     fn serialize_u8(self, v: u8) -> Result<(), NotFlat> {
@@ -277,30 +324,42 @@ impl<'v, F: FnMut(&'static str, Cell<'_>)> Serializer for FieldSerializer<'v, F>
     fn serialize_u32(self, v: u32) -> Result<(), NotFlat> {
         self.serialize_u64(v.into())
     }
+    #[inline(always)]
     fn serialize_u64(self, v: u64) -> Result<(), NotFlat> {
-        self.cell(Cell::Count(v))
+        self.visit.count(self.key, v);
+        Ok(())
     }
     fn serialize_f32(self, v: f32) -> Result<(), NotFlat> {
         self.serialize_f64(v.into())
     }
+    #[inline(always)]
     fn serialize_f64(self, v: f64) -> Result<(), NotFlat> {
-        self.cell(Cell::Number(v))
+        self.visit.number(self.key, v);
+        Ok(())
     }
     fn serialize_char(self, v: char) -> Result<(), NotFlat> {
         self.serialize_str(v.encode_utf8(&mut [0; 4]))
     }
+    #[inline(always)]
     fn serialize_str(self, v: &str) -> Result<(), NotFlat> {
-        self.cell(Cell::Text(Cow::Borrowed(v)))
+        self.visit.text(self.key, v);
+        Ok(())
     }
+    #[inline(always)]
     fn serialize_none(self) -> Result<(), NotFlat> {
-        self.cell(Cell::Empty)
+        self.visit.empty(self.key);
+        Ok(())
     }
+    #[inline(always)]
     fn serialize_some<T: Serialize + ?Sized>(self, value: &T) -> Result<(), NotFlat> {
         value.serialize(self)
     }
+    #[inline]
     fn serialize_unit(self) -> Result<(), NotFlat> {
-        self.cell(Cell::Empty)
+        self.visit.empty(self.key);
+        Ok(())
     }
+    #[inline]
     fn serialize_unit_variant(
         self,
         _: &'static str,

@@ -1,13 +1,11 @@
 //! Writing CSV records straight into a byte buffer, cell by cell or a whole record (a struct
-//! of [`crate::record`]) at once, with the bytes of the `csv` crate's default writer (comma
-//! separators, quotes only where needed, `\n` after a record) and without allocating: numbers
-//! by [`push_f64`], text quoted by `push_csv_field`.
+//! of [`crate::record`], walked by [`crate::record::walk`], the walker of `each_cell`) at once, with the bytes of
+//! the `csv` crate's default writer (comma separators, quotes only where needed, `\n` after a
+//! record) and without allocating: numbers by [`push_f64`], text quoted by `push_csv_field`.
 
 use super::push_csv_field;
 use crate::numfmt::push_f64;
-use crate::record::columns;
-use crate::record::{not_flat, refuse, NotFlat};
-use serde::ser::{Impossible, SerializeStruct, Serializer};
+use crate::record::{columns, walk, Visit};
 use serde::Serialize;
 
 /// The cells of one CSV record, appended to a byte buffer (the test below shows the calls).
@@ -87,15 +85,16 @@ impl<'b> Cells<'b> {
         self.write_record(record, Some(repeat));
     }
 
+    #[inline]
     fn write_record<R: Serialize>(&mut self, record: &R, repeat: Option<&mut Repeat>) {
-        let mut w = RecordWriter {
-            cells: self,
-            repeat,
-            field: 0,
-        };
-        if let Err(e) = record.serialize(&mut w) {
-            panic!("not a record of flat fields: {e}");
-        }
+        walk(
+            record,
+            &mut CellWriter {
+                cells: self,
+                repeat,
+                field: 0,
+            },
+        );
     }
 
     /// Ends the record.
@@ -104,224 +103,52 @@ impl<'b> Cells<'b> {
     }
 }
 
-/// Writes a record's fields straight into [`Cells`]: serde's walk of the record, one cell per
-/// field, with no intermediate value (the streaming commands' writer; the tests check it
-/// against [`crate::record::each_cell`] and the `csv` crate).
-struct RecordWriter<'w, 'b> {
+/// Writes each field of a record walked by [`crate::record::walk`] straight into [`Cells`],
+/// one cell per field, with no intermediate value.
+struct CellWriter<'w, 'b> {
     cells: &'w mut Cells<'b>,
     repeat: Option<&'w mut Repeat>,
     /// The index of the field being written.
     field: usize,
 }
 
-/// One field of a record being written by a [`RecordWriter`].
-struct FieldWriter<'f, 'w, 'b>(&'f mut RecordWriter<'w, 'b>);
-
-impl<'f, 'w, 'b> Serializer for &'f mut RecordWriter<'w, 'b> {
-    type Ok = ();
-    type Error = NotFlat;
-    type SerializeSeq = Impossible<(), NotFlat>;
-    type SerializeTuple = Impossible<(), NotFlat>;
-    type SerializeTupleStruct = Impossible<(), NotFlat>;
-    type SerializeTupleVariant = Impossible<(), NotFlat>;
-    type SerializeMap = Impossible<(), NotFlat>;
-    type SerializeStruct = Self;
-    type SerializeStructVariant = Impossible<(), NotFlat>;
-
-    fn serialize_struct(self, _: &'static str, _: usize) -> Result<Self, NotFlat> {
-        Ok(self)
-    }
-
-    fn serialize_newtype_struct<T: Serialize + ?Sized>(
-        self,
-        _: &'static str,
-        value: &T,
-    ) -> Result<(), NotFlat> {
-        value.serialize(self)
-    }
-
-    fn serialize_some<T: Serialize + ?Sized>(self, _: &T) -> Result<(), NotFlat> {
-        not_flat("an option")
-    }
-
-    fn serialize_newtype_variant<T: Serialize + ?Sized>(
-        self,
-        _: &'static str,
-        _: u32,
-        _: &'static str,
-        _: &T,
-    ) -> Result<(), NotFlat> {
-        not_flat("an enum")
-    }
-
-    refuse! {
-        serialize_bool(bool) -> ();
-        serialize_i8(i8) -> ();
-        serialize_i16(i16) -> ();
-        serialize_i32(i32) -> ();
-        serialize_i64(i64) -> ();
-        serialize_u8(u8) -> ();
-        serialize_u16(u16) -> ();
-        serialize_u32(u32) -> ();
-        serialize_u64(u64) -> ();
-        serialize_f32(f32) -> ();
-        serialize_f64(f64) -> ();
-        serialize_char(char) -> ();
-        serialize_str(&str) -> ();
-        serialize_bytes(&[u8]) -> ();
-        serialize_none() -> ();
-        serialize_unit() -> ();
-        serialize_unit_struct(&'static str) -> ();
-        serialize_unit_variant(&'static str, u32, &'static str) -> ();
-        serialize_seq(Option<usize>) -> Self::SerializeSeq;
-        serialize_tuple(usize) -> Self::SerializeTuple;
-        serialize_tuple_struct(&'static str, usize) -> Self::SerializeTupleStruct;
-        serialize_tuple_variant(&'static str, u32, &'static str, usize) -> Self::SerializeTupleVariant;
-        serialize_map(Option<usize>) -> Self::SerializeMap;
-        serialize_struct_variant(&'static str, u32, &'static str, usize) -> Self::SerializeStructVariant;
-    }
-}
-
-impl SerializeStruct for &mut RecordWriter<'_, '_> {
-    type Ok = ();
-    type Error = NotFlat;
-
+impl Visit for CellWriter<'_, '_> {
     #[inline]
-    fn serialize_field<T: Serialize + ?Sized>(
-        &mut self,
-        _: &'static str,
-        value: &T,
-    ) -> Result<(), NotFlat> {
-        value.serialize(FieldWriter(self))?;
-        self.field += 1;
-        Ok(())
-    }
-
-    fn end(self) -> Result<(), NotFlat> {
-        Ok(())
-    }
-}
-
-impl Serializer for FieldWriter<'_, '_, '_> {
-    type Ok = ();
-    type Error = NotFlat;
-    type SerializeSeq = Impossible<(), NotFlat>;
-    type SerializeTuple = Impossible<(), NotFlat>;
-    type SerializeTupleStruct = Impossible<(), NotFlat>;
-    type SerializeTupleVariant = Impossible<(), NotFlat>;
-    type SerializeMap = Impossible<(), NotFlat>;
-    type SerializeStruct = Impossible<(), NotFlat>;
-    type SerializeStructVariant = Impossible<(), NotFlat>;
-
-    fn serialize_bool(self, v: bool) -> Result<(), NotFlat> {
-        self.serialize_str(if v { "true" } else { "false" })
-    }
-    fn serialize_i8(self, v: i8) -> Result<(), NotFlat> {
-        self.serialize_i64(v.into())
-    }
-    fn serialize_i16(self, v: i16) -> Result<(), NotFlat> {
-        self.serialize_i64(v.into())
-    }
-    fn serialize_i32(self, v: i32) -> Result<(), NotFlat> {
-        self.serialize_i64(v.into())
-    }
-    fn serialize_i64(self, v: i64) -> Result<(), NotFlat> {
-        match u64::try_from(v) {
-            Ok(n) => self.serialize_u64(n),
-            Err(_) => self.serialize_f64(v as f64),
-        }
-    }
-    fn serialize_u8(self, v: u8) -> Result<(), NotFlat> {
-        self.serialize_u64(v.into())
-    }
-    fn serialize_u16(self, v: u16) -> Result<(), NotFlat> {
-        self.serialize_u64(v.into())
-    }
-    fn serialize_u32(self, v: u32) -> Result<(), NotFlat> {
-        self.serialize_u64(v.into())
-    }
-    #[inline]
-    fn serialize_u64(self, v: u64) -> Result<(), NotFlat> {
-        self.0.cells.count(v);
-        Ok(())
-    }
-    fn serialize_f32(self, v: f32) -> Result<(), NotFlat> {
-        self.serialize_f64(v.into())
-    }
-    #[inline]
-    fn serialize_f64(self, x: f64) -> Result<(), NotFlat> {
-        let w = self.0;
-        if let Some(r) = &mut w.repeat {
-            if r.mask >> w.field & 1 == 1 {
-                w.cells.sep();
-                let (bits, text) = &mut r.last[w.field];
+    fn number(&mut self, _: &'static str, x: f64) {
+        match self.repeat.as_deref_mut() {
+            Some(r) if r.mask >> self.field & 1 == 1 => {
+                self.cells.sep();
+                let (bits, text) = &mut r.last[self.field];
                 if *bits != Some(x.to_bits()) {
                     *bits = Some(x.to_bits());
                     text.clear();
                     push_f64(text, x);
                 }
-                w.cells.out.extend_from_slice(text);
-                return Ok(());
+                self.cells.out.extend_from_slice(text);
             }
+            _ => self.cells.num(x),
         }
-        w.cells.num(x);
-        Ok(())
-    }
-    fn serialize_char(self, v: char) -> Result<(), NotFlat> {
-        self.serialize_str(v.encode_utf8(&mut [0; 4]))
+        self.field += 1;
     }
     #[inline]
-    fn serialize_str(self, v: &str) -> Result<(), NotFlat> {
-        self.0.cells.text(v);
-        Ok(())
+    fn count(&mut self, _: &'static str, n: u64) {
+        self.cells.count(n);
+        self.field += 1;
     }
     #[inline]
-    fn serialize_none(self) -> Result<(), NotFlat> {
-        self.0.cells.empty();
-        Ok(())
+    fn text(&mut self, _: &'static str, s: &str) {
+        self.cells.text(s);
+        self.field += 1;
     }
     #[inline]
-    fn serialize_some<T: Serialize + ?Sized>(self, value: &T) -> Result<(), NotFlat> {
-        value.serialize(self)
+    fn flag(&mut self, _: &'static str, b: bool) {
+        self.cells.text(if b { "true" } else { "false" });
+        self.field += 1;
     }
-    fn serialize_unit(self) -> Result<(), NotFlat> {
-        self.serialize_none()
-    }
-    fn serialize_unit_variant(
-        self,
-        _: &'static str,
-        _: u32,
-        variant: &'static str,
-    ) -> Result<(), NotFlat> {
-        self.serialize_str(variant)
-    }
-    fn serialize_newtype_struct<T: Serialize + ?Sized>(
-        self,
-        _: &'static str,
-        value: &T,
-    ) -> Result<(), NotFlat> {
-        value.serialize(self)
-    }
-    fn serialize_newtype_variant<T: Serialize + ?Sized>(
-        self,
-        _: &'static str,
-        _: u32,
-        _: &'static str,
-        _: &T,
-    ) -> Result<(), NotFlat> {
-        not_flat("an enum with data")
-    }
-
-    refuse! {
-        serialize_bytes(&[u8]) -> ();
-        serialize_unit_struct(&'static str) -> ();
-        serialize_seq(Option<usize>) -> Self::SerializeSeq;
-        serialize_tuple(usize) -> Self::SerializeTuple;
-        serialize_tuple_struct(&'static str, usize) -> Self::SerializeTupleStruct;
-        serialize_tuple_variant(&'static str, u32, &'static str, usize) -> Self::SerializeTupleVariant;
-        serialize_map(Option<usize>) -> Self::SerializeMap;
-        serialize_struct(&'static str, usize) -> Self::SerializeStruct;
-        serialize_struct_variant(&'static str, u32, &'static str, usize) -> Self::SerializeStructVariant;
+    #[inline]
+    fn empty(&mut self, _: &'static str) {
+        self.cells.empty();
+        self.field += 1;
     }
 }
 

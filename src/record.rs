@@ -65,19 +65,22 @@ pub fn each_cell<R: Serialize + ?Sized>(record: &R, visit: impl FnMut(&'static s
 }
 
 /// What a walk of a record ([`walk`]) hands over, field by field, in column order: one call
-/// per field, by the kind of its value. [`each_cell`] makes each a [`Cell`]; the streaming
+/// per field, by the kind of its value, with the field's name and index. [`each_cell`] makes each a [`Cell`]; the streaming
 /// writer (`io::cells`) writes each straight into its buffer.
 pub(crate) trait Visit {
+    /// Whether the visitor reads the fields' names (when not, the walk does not keep them:
+    /// one store less per field on the streaming path).
+    const KEYS: bool = true;
     /// A number (non-finite as it is).
-    fn number(&mut self, key: &'static str, x: f64);
+    fn number(&mut self, key: &'static str, field: usize, x: f64);
     /// A count.
-    fn count(&mut self, key: &'static str, n: u64);
+    fn count(&mut self, key: &'static str, field: usize, n: u64);
     /// Text.
-    fn text(&mut self, key: &'static str, s: &str);
+    fn text(&mut self, key: &'static str, field: usize, s: &str);
     /// A flag.
-    fn flag(&mut self, key: &'static str, b: bool);
+    fn flag(&mut self, key: &'static str, field: usize, b: bool);
     /// No value.
-    fn empty(&mut self, key: &'static str);
+    fn empty(&mut self, key: &'static str, field: usize);
 }
 
 /// Walks `record`'s fields with serde, handing each to `visit` (the walker of [`each_cell`]).
@@ -86,7 +89,11 @@ pub(crate) trait Visit {
 /// As [`each_cell`].
 #[inline]
 pub(crate) fn walk<R: Serialize + ?Sized, V: Visit>(record: &R, visit: &mut V) {
-    if let Err(e) = record.serialize(RecordSerializer { visit }) {
+    if let Err(e) = record.serialize(RecordSerializer {
+        visit,
+        key: "",
+        field: 0,
+    }) {
         panic!("not a record of flat fields: {e}");
     }
 }
@@ -96,23 +103,23 @@ struct ByCell<F>(F);
 
 impl<F: FnMut(&'static str, Cell<'_>)> Visit for ByCell<F> {
     #[inline]
-    fn number(&mut self, key: &'static str, x: f64) {
+    fn number(&mut self, key: &'static str, _: usize, x: f64) {
         (self.0)(key, Cell::Number(x))
     }
     #[inline]
-    fn count(&mut self, key: &'static str, n: u64) {
+    fn count(&mut self, key: &'static str, _: usize, n: u64) {
         (self.0)(key, Cell::Count(n))
     }
     #[inline]
-    fn text(&mut self, key: &'static str, s: &str) {
+    fn text(&mut self, key: &'static str, _: usize, s: &str) {
         (self.0)(key, Cell::Text(Cow::Borrowed(s)))
     }
     #[inline]
-    fn flag(&mut self, key: &'static str, b: bool) {
+    fn flag(&mut self, key: &'static str, _: usize, b: bool) {
         (self.0)(key, Cell::Flag(b))
     }
     #[inline]
-    fn empty(&mut self, key: &'static str) {
+    fn empty(&mut self, key: &'static str, _: usize) {
         (self.0)(key, Cell::Empty)
     }
 }
@@ -179,13 +186,14 @@ fn not_flat<T>(what: &str) -> Result<T, NotFlat> {
 /// Serialises a record (a struct) by visiting its fields.
 struct RecordSerializer<'v, V> {
     visit: &'v mut V,
+    /// The name of the field being serialised.
+    key: &'static str,
+    /// Its index.
+    field: usize,
 }
 
 /// Serialises one field's value by handing it to the visitor.
-struct FieldSerializer<'v, V> {
-    key: &'static str,
-    visit: &'v mut V,
-}
+struct FieldSerializer<'f, 'v, V>(&'f mut RecordSerializer<'v, V>);
 
 /// The serializer methods of a kind of value a record does not hold: each an error.
 macro_rules! refuse {
@@ -272,10 +280,12 @@ impl<V: Visit> SerializeStruct for RecordSerializer<'_, V> {
         key: &'static str,
         value: &T,
     ) -> Result<(), NotFlat> {
-        value.serialize(FieldSerializer {
-            key,
-            visit: &mut *self.visit,
-        })
+        if V::KEYS {
+            self.key = key;
+        }
+        value.serialize(FieldSerializer(self))?;
+        self.field += 1;
+        Ok(())
     }
 
     fn end(self) -> Result<(), NotFlat> {
@@ -283,7 +293,7 @@ impl<V: Visit> SerializeStruct for RecordSerializer<'_, V> {
     }
 }
 
-impl<'v, V: Visit> Serializer for FieldSerializer<'v, V> {
+impl<V: Visit> Serializer for FieldSerializer<'_, '_, V> {
     type Ok = ();
     type Error = NotFlat;
     type SerializeSeq = Impossible<(), NotFlat>;
@@ -296,7 +306,7 @@ impl<'v, V: Visit> Serializer for FieldSerializer<'v, V> {
 
     #[inline]
     fn serialize_bool(self, v: bool) -> Result<(), NotFlat> {
-        self.visit.flag(self.key, v);
+        self.0.visit.flag(self.0.key, self.0.field, v);
         Ok(())
     }
     fn serialize_i8(self, v: i8) -> Result<(), NotFlat> {
@@ -326,7 +336,7 @@ impl<'v, V: Visit> Serializer for FieldSerializer<'v, V> {
     }
     #[inline(always)]
     fn serialize_u64(self, v: u64) -> Result<(), NotFlat> {
-        self.visit.count(self.key, v);
+        self.0.visit.count(self.0.key, self.0.field, v);
         Ok(())
     }
     fn serialize_f32(self, v: f32) -> Result<(), NotFlat> {
@@ -334,7 +344,7 @@ impl<'v, V: Visit> Serializer for FieldSerializer<'v, V> {
     }
     #[inline(always)]
     fn serialize_f64(self, v: f64) -> Result<(), NotFlat> {
-        self.visit.number(self.key, v);
+        self.0.visit.number(self.0.key, self.0.field, v);
         Ok(())
     }
     fn serialize_char(self, v: char) -> Result<(), NotFlat> {
@@ -342,12 +352,12 @@ impl<'v, V: Visit> Serializer for FieldSerializer<'v, V> {
     }
     #[inline(always)]
     fn serialize_str(self, v: &str) -> Result<(), NotFlat> {
-        self.visit.text(self.key, v);
+        self.0.visit.text(self.0.key, self.0.field, v);
         Ok(())
     }
     #[inline(always)]
     fn serialize_none(self) -> Result<(), NotFlat> {
-        self.visit.empty(self.key);
+        self.0.visit.empty(self.0.key, self.0.field);
         Ok(())
     }
     #[inline(always)]
@@ -356,7 +366,7 @@ impl<'v, V: Visit> Serializer for FieldSerializer<'v, V> {
     }
     #[inline]
     fn serialize_unit(self) -> Result<(), NotFlat> {
-        self.visit.empty(self.key);
+        self.0.visit.empty(self.0.key, self.0.field);
         Ok(())
     }
     #[inline]

@@ -92,7 +92,6 @@ impl<'b> Cells<'b> {
             &mut CellWriter {
                 cells: self,
                 repeat,
-                field: 0,
             },
         );
     }
@@ -108,47 +107,43 @@ impl<'b> Cells<'b> {
 struct CellWriter<'w, 'b> {
     cells: &'w mut Cells<'b>,
     repeat: Option<&'w mut Repeat>,
-    /// The index of the field being written.
-    field: usize,
 }
 
 impl Visit for CellWriter<'_, '_> {
+    const KEYS: bool = false;
+
     #[inline]
-    fn number(&mut self, _: &'static str, x: f64) {
-        match self.repeat.as_deref_mut() {
-            Some(r) if r.mask >> self.field & 1 == 1 => {
+    fn number(&mut self, _: &'static str, field: usize, x: f64) {
+        if let Some(r) = &mut self.repeat {
+            if r.mask >> field & 1 == 1 {
                 self.cells.sep();
-                let (bits, text) = &mut r.last[self.field];
+                let (bits, text) = &mut r.last[field];
                 if *bits != Some(x.to_bits()) {
                     *bits = Some(x.to_bits());
                     text.clear();
                     push_f64(text, x);
                 }
                 self.cells.out.extend_from_slice(text);
+                return;
             }
-            _ => self.cells.num(x),
         }
-        self.field += 1;
+        self.cells.num(x);
     }
     #[inline]
-    fn count(&mut self, _: &'static str, n: u64) {
+    fn count(&mut self, _: &'static str, _: usize, n: u64) {
         self.cells.count(n);
-        self.field += 1;
     }
     #[inline]
-    fn text(&mut self, _: &'static str, s: &str) {
+    fn text(&mut self, _: &'static str, _: usize, s: &str) {
         self.cells.text(s);
-        self.field += 1;
     }
     #[inline]
-    fn flag(&mut self, _: &'static str, b: bool) {
+    fn flag(&mut self, _: &'static str, _: usize, b: bool) {
         self.cells.text(if b { "true" } else { "false" });
-        self.field += 1;
     }
     #[inline]
-    fn empty(&mut self, _: &'static str) {
+    fn empty(&mut self, _: &'static str, _: usize) {
         self.cells.empty();
-        self.field += 1;
     }
 }
 

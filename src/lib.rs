@@ -36,7 +36,7 @@
 //!   special ────── math with no beads in it: elliptic integrals, quadrature, roots, dd
 //! ```
 //!
-//! Each layer uses only the layers below it (`numfmt`, `progress` and `record` are leaves;
+//! Each layer uses only the layers below it (`numfmt`, `progress`, `record` and `last` are leaves;
 //! `prelude` and the crate root's re-exports are the crate's top). Every command of the
 //! command line is a call of [`pipeline`] (or of [`design`] for `design`). The command line
 //! itself is the workspace package `fitbead-cli` (`crates/fitbead-cli`, binary `fitbead`),
@@ -79,6 +79,7 @@ pub mod design;
 pub mod error;
 pub mod fit;
 pub mod inverse;
+pub(crate) mod last;
 pub mod models;
 pub mod numfmt;
 pub mod pipeline;

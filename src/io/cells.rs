@@ -4,6 +4,7 @@
 //! record) and without allocating: numbers by [`push_f64`], text quoted by `push_csv_field`.
 
 use super::push_csv_field;
+use crate::last::Last;
 use crate::numfmt::push_f64;
 use crate::record::{columns, walk, Visit};
 use serde::Serialize;
@@ -117,12 +118,10 @@ impl Visit for CellWriter<'_, '_> {
         if let Some(r) = &mut self.repeat {
             if r.mask >> field & 1 == 1 {
                 self.cells.sep();
-                let (bits, text) = &mut r.last[field];
-                if *bits != Some(x.to_bits()) {
-                    *bits = Some(x.to_bits());
+                let text = r.last[field].get(x.to_bits(), |text| {
                     text.clear();
                     push_f64(text, x);
-                }
+                });
                 self.cells.out.extend_from_slice(text);
                 return;
             }
@@ -154,8 +153,8 @@ impl Visit for CellWriter<'_, '_> {
 pub(crate) struct Repeat {
     /// Bit i set: field i's text is kept (a record has at most 64 fields).
     mask: u64,
-    /// Per field: the bits of its last value and that value's text.
-    last: Vec<(Option<u64>, Vec<u8>)>,
+    /// Per field: the text of its last value, keyed by the value's bits.
+    last: Vec<Last<u64, Vec<u8>>>,
 }
 
 impl Repeat {
@@ -175,7 +174,7 @@ impl Repeat {
         }
         Repeat {
             mask,
-            last: vec![(None, Vec::new()); columns.len()],
+            last: vec![Last::default(); columns.len()],
         }
     }
 }

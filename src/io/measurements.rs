@@ -16,6 +16,7 @@ use super::scenes::{Header, Row, Table};
 use super::InputError;
 pub(crate) use crate::fit::data::SiSeries;
 use crate::fit::data::{DataError, Dataset};
+use crate::last::Last;
 use crate::numfmt::fmt_f64;
 use crate::scene::{CollisionLaw, Scene};
 use std::path::Path;
@@ -764,23 +765,19 @@ pub(crate) struct PlausiblePoint {
 
 /// δ_m and δ_d (degrees) at the paper's law for the last (ξ, ρ) seen, which the next row of
 /// the same pair reuses (rows of a series usually follow each other).
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub(crate) struct StopSlopes(Option<((u64, u64), f64, f64)>);
+#[derive(Debug, Clone, Default, PartialEq)]
+pub(crate) struct StopSlopes(Last<(u64, u64), (f64, f64)>);
 
 impl StopSlopes {
     fn of(&mut self, xi: f64, alpha: f64, rho: f64) -> (f64, f64) {
         use crate::models::regimes::{delta_d_law, delta_m_law};
-        let key = (xi.to_bits(), rho.to_bits());
-        match self.0 {
-            Some((k, dm, dd)) if k == key => (dm, dd),
-            _ => {
-                let law = CollisionLaw::Adjusted;
-                let dm = delta_m_law(alpha, law, rho).to_degrees();
-                let dd = delta_d_law(alpha, law, rho).to_degrees();
-                self.0 = Some((key, dm, dd));
-                (dm, dd)
-            }
-        }
+        *self.0.get((xi.to_bits(), rho.to_bits()), |v| {
+            let law = CollisionLaw::Adjusted;
+            *v = (
+                delta_m_law(alpha, law, rho).to_degrees(),
+                delta_d_law(alpha, law, rho).to_degrees(),
+            );
+        })
     }
 }
 

@@ -16,6 +16,7 @@ use crate::io::records::{columns, AutoRecord, KRecord};
 use crate::io::scenes::{Header, Row};
 use crate::io::stream::RowPlan;
 use crate::io::InputError;
+use crate::last::Last;
 use crate::models::auto::Auto;
 use crate::models::Model;
 use crate::numfmt::fmt_f64;
@@ -89,9 +90,8 @@ pub(crate) struct KLedger {
 #[derive(Debug, Clone)]
 pub(crate) struct KScratch {
     scene: Option<Scene>,
-    key: Option<(u64, u64)>,
-    /// K of cos 2α, the adjusted law and the impact law.
-    laws: [f64; 3],
+    /// K of cos 2α, the adjusted law and the impact law, for the last (ξ, ρ).
+    laws: Last<(u64, u64), [f64; 3]>,
     /// The text of ξ.
     input: Repeat,
     /// The text of the three laws' K.
@@ -104,8 +104,7 @@ impl Default for KScratch {
     fn default() -> Self {
         KScratch {
             scene: None,
-            key: None,
-            laws: [f64::NAN; 3],
+            laws: Last::default(),
             input: Repeat::new::<KInput>(&["xi"]),
             record: Repeat::new::<KRecord>(&["K_cos2a", "K_adjusted", "K_impact"]),
             slopes: StopSlopes::default(),
@@ -114,19 +113,19 @@ impl Default for KScratch {
 }
 
 impl KScratch {
-    fn update(&mut self, s: &Scene) {
-        let key = (s.xi().to_bits(), s.rho().to_bits());
-        if self.key == Some(key) {
-            return;
-        }
-        self.key = Some(key);
+    /// K of cos 2α, the adjusted law and the impact law at `s`'s ξ and ρ.
+    fn laws(&mut self, s: &Scene) -> [f64; 3] {
         let (alpha, rho) = (s.alpha_rad(), s.rho());
-        self.laws = [
-            CollisionLaw::Cos2a,
-            CollisionLaw::Adjusted,
-            CollisionLaw::Impact,
-        ]
-        .map(|l| l.k(alpha, rho));
+        *self
+            .laws
+            .get((s.xi().to_bits(), s.rho().to_bits()), |laws| {
+                *laws = [
+                    CollisionLaw::Cos2a,
+                    CollisionLaw::Adjusted,
+                    CollisionLaw::Impact,
+                ]
+                .map(|l| l.k(alpha, rho));
+            })
     }
 }
 
@@ -259,7 +258,7 @@ impl RowPlan for KPlan {
     fn write(&self, row: &Row<'_>, m: Measured, cache: &mut KScratch, out: &mut Vec<u8>) -> KNote {
         let (e, choice) = self.invert(&m);
         let s = &m.scene;
-        cache.update(s);
+        let laws = cache.laws(s);
         let mut w = Cells::new(out);
         w.record_repeating(
             &KInput {
@@ -272,7 +271,7 @@ impl RowPlan for KPlan {
             },
             &mut cache.input,
         );
-        w.record_repeating(&KRecord::new(&e, cache.laws), &mut cache.record);
+        w.record_repeating(&KRecord::new(&e, laws), &mut cache.record);
         if self.settings.auto.is_some() {
             w.record(&choice.map(AutoRecord::of_choice).unwrap_or_default());
         }
@@ -289,7 +288,7 @@ impl RowPlan for KPlan {
                     e.k_lo.unwrap_or(r.k),
                     e.k_hi.unwrap_or(r.k),
                 ),
-                cos2a: cache.laws[0],
+                cos2a: laws[0],
             }),
             _ => None,
         };

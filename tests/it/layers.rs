@@ -17,7 +17,7 @@ const LAYERS: [&str; 10] = [
     "special", "scene", "models", "inverse", "fit", "design", "report", "io", "error", "pipeline",
 ];
 /// Modules every layer may use; each uses only the leaves listed before it.
-const LEAVES: [&str; 3] = ["numfmt", "progress", "record"];
+const LEAVES: [&str; 4] = ["numfmt", "progress", "record", "last"];
 /// The crate's top: may use every layer, and no layer may use it.
 const TOP: [&str; 2] = ["prelude", ""];
 

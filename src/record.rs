@@ -61,7 +61,7 @@ impl Cell<'_> {
 /// If `R` is not such a struct, which the records of this crate all are.
 #[inline]
 pub fn each_cell<R: Serialize + ?Sized>(record: &R, visit: impl FnMut(&'static str, Cell<'_>)) {
-    walk(record, &mut ByCell(visit));
+    walk(record, ByCell(visit));
 }
 
 /// What a walk of a record ([`walk`]) hands over, field by field, in column order: one call
@@ -88,7 +88,7 @@ pub(crate) trait Visit {
 /// # Panics
 /// As [`each_cell`].
 #[inline]
-pub(crate) fn walk<R: Serialize + ?Sized, V: Visit>(record: &R, visit: &mut V) {
+pub(crate) fn walk<R: Serialize + ?Sized, V: Visit>(record: &R, visit: V) {
     if let Err(e) = record.serialize(RecordSerializer {
         visit,
         key: "",
@@ -184,8 +184,9 @@ fn not_flat<T>(what: &str) -> Result<T, NotFlat> {
 }
 
 /// Serialises a record (a struct) by visiting its fields.
-struct RecordSerializer<'v, V> {
-    visit: &'v mut V,
+struct RecordSerializer<V> {
+    /// The visitor, held in place: a field reaches it with no pointer between.
+    visit: V,
     /// The name of the field being serialised.
     key: &'static str,
     /// Its index.
@@ -193,7 +194,7 @@ struct RecordSerializer<'v, V> {
 }
 
 /// Serialises one field's value by handing it to the visitor.
-struct FieldSerializer<'f, 'v, V>(&'f mut RecordSerializer<'v, V>);
+struct FieldSerializer<'f, V>(&'f mut RecordSerializer<V>);
 
 /// The serializer methods of a kind of value a record does not hold: each an error.
 macro_rules! refuse {
@@ -204,7 +205,7 @@ macro_rules! refuse {
     };
 }
 
-impl<'v, V: Visit> Serializer for RecordSerializer<'v, V> {
+impl<V: Visit> Serializer for RecordSerializer<V> {
     type Ok = ();
     type Error = NotFlat;
     type SerializeSeq = Impossible<(), NotFlat>;
@@ -270,7 +271,7 @@ impl<'v, V: Visit> Serializer for RecordSerializer<'v, V> {
     }
 }
 
-impl<V: Visit> SerializeStruct for RecordSerializer<'_, V> {
+impl<V: Visit> SerializeStruct for RecordSerializer<V> {
     type Ok = ();
     type Error = NotFlat;
 
@@ -293,7 +294,7 @@ impl<V: Visit> SerializeStruct for RecordSerializer<'_, V> {
     }
 }
 
-impl<V: Visit> Serializer for FieldSerializer<'_, '_, V> {
+impl<V: Visit> Serializer for FieldSerializer<'_, V> {
     type Ok = ();
     type Error = NotFlat;
     type SerializeSeq = Impossible<(), NotFlat>;

@@ -90,7 +90,7 @@ impl<'b> Cells<'b> {
     fn write_record<R: Serialize>(&mut self, record: &R, repeat: Option<&mut Repeat>) {
         walk(
             record,
-            &mut CellWriter {
+            CellWriter {
                 cells: self,
                 repeat,
             },

@@ -9,20 +9,25 @@ What it computes, and from what:
   reversed, a Lorentz peak, and the smaller checks of that file: ticket 1253, work_ind and the
   built-in linear, exponential, polynomial, univariate-linear and quadratic models). Data,
   models, Jacobians, starting values, weights and job settings are copied from that file;
-  each problem is fitted with ``scipy.odr`` (ODRPACK, Boggs, Byrd & Schnabel 1987), and the
-  result is checked against the values the SciPy test asserts, to that test's own tolerance.
+  each problem is fitted with ``scipy.odr`` (ODRPACK, Boggs, Byrd & Schnabel 1987) as the test
+  fits it, and the result is checked against the values the SciPy test asserts, to that test's
+  own tolerance. Each problem is also fitted with tighter stopping tolerances, and its optimum
+  is found independently (Levenberg-Marquardt and Gauss-Newton on the stacked ODR residuals,
+  complex-step Jacobians; York's iteration for the straight lines).
 * Part 2, ``tests/reference/odr/bead_stick.csv`` and ``bead_stick.json``: a simulated data
   set of the pure-rolling model (``fitbead.forward("stick", ...)``, collision law
-  K = cos 2α + c sin²α sin 2α with c = 0.5, ρ = 0.4, f = 0.1) with errors in both the slope δ
-  and the mean velocity v̄, fitted for c by ODR (errors in δ and v̄) and by weighted least
-  squares that ignores the slope errors, both with ``scipy.odr``; plus independent checks of
-  both optima (a nested profile minimisation) and of their covariances (the linearised
-  effective-variance formula).
+  K = cos 2α + c sin²α sin 2α with c = 0.5, ρ = 0.4, f = 0.1, ξ = 0.8, 1, 1.6) with errors in
+  both the slope δ (0.1°) and the mean velocity v̄ (1 %), seed 58, fitted for c with
+  ``scipy.odr`` by ODR (errors in δ and v̄) and by weighted least squares that ignores the
+  slope errors; plus independent checks of both optima (the roots of their stationarity
+  conditions) and of their covariances (the linearised effective-variance formula).
 * Part 2, ``tests/reference/odr/bead_stick_coverage.json``: the same simulation repeated with
-  seeds 1000, 1001, ...: how often each method's 95 % interval (1.96 sqrt(cov_beta), cov_beta
-  unscaled) covers the true c, and its mean width.
+  seeds 1000 … 1399: how often each method's 95 % interval (1.96 sqrt(cov_beta), cov_beta
+  unscaled) covers the true c, and its mean width (fewer replicates only if the first 10 show
+  that 400 would take more than 8 minutes).
 
-Rerun from the repository root (every output is overwritten; the run is deterministic):
+Rerun from the repository root (every output is overwritten; the run is deterministic apart
+from the recorded timings; about 3 s):
 
     target/python-venv/bin/python scripts/odr_reference.py
 
@@ -39,15 +44,14 @@ from pathlib import Path
 import numpy as np
 import scipy
 from numpy.testing import assert_array_almost_equal, assert_equal
-from scipy.optimize import minimize_scalar
+from scipy.optimize import brentq, least_squares
 
 # scipy.odr is deprecated as of SciPy 1.17 (to be removed in 1.19) in favour of the separate
 # `odrpack` package. It is still ODRPACK, which is what these references need, so the
 # DeprecationWarning it raises on import is silenced here (and only for scipy.odr).
 with warnings.catch_warnings():
     warnings.filterwarnings("ignore", category=DeprecationWarning)
-    from scipy import odr
-    from scipy.odr import Data, Model, ODR, RealData
+    from scipy.odr import Data, Model, ODR, OdrStop, RealData
     from scipy.odr import exponential, multilinear, polynomial, quadratic, unilinear
 
 import fitbead
@@ -144,6 +148,7 @@ def check_almost_equal(quantity, actual, expected, source):
 # Part 1: ODRPACK's explicit-model examples, as scipy/odr/tests/test_odr.py sets them up
 
 TEST_FILE = "scipy/odr/tests/test_odr.py"
+TIGHT = {"sstol": 1e-30, "partol": 1e-15, "maxit": 1000}
 
 
 def explicit_fcn(B, x):
@@ -215,7 +220,7 @@ def part1_problems():
     p_sx = np.array([0.03, 0.03, 0.04, 0.035, 0.07, 0.11, 0.13, 0.22, 0.74, 1.0])
     p_sy = np.array([1.0, 0.74, 0.5, 0.35, 0.22, 0.22, 0.12, 0.12, 0.1, 0.04])
     probs.append(dict(
-        name="pearson",
+        name="pearson", york=True,
         test="TestODR.test_pearson",
         description="Pearson's data (Phil. Mag. 2, 559, 1901) with York's weights",
         formula="y = b0 + b1 * x",
@@ -233,7 +238,7 @@ def part1_problems():
         },
     ))
     probs.append(dict(
-        name="pearson_reversed",
+        name="pearson_reversed", york=True,
         test="TestODR.test_pearson",
         description="Pearson's data with x and y (and sx and sy) exchanged",
         formula="y = b0 + b1 * x (x: Pearson's y, y: Pearson's x)",
@@ -305,7 +310,7 @@ def part1_problems():
     w_y = np.where(w_x % 2, w_x + 0.1, w_x - 0.1)
     w_s = np.full(4, 0.1)
     probs.append(dict(
-        name="work_ind",
+        name="work_ind", york=True,
         test="TestODR.test_work_ind",
         description="four points alternating 0.1 below and above y = x",
         formula="y = b0 + b1 * x",
@@ -354,6 +359,109 @@ def _set_job(o, **kw):
     return o
 
 
+def augmented_check(fit, out, ifixx):
+    """Independent optimum of the same weighted ODR problem, by general least squares on the
+    stacked residuals r = [sqrt(we) (y - f(beta, x + delta)), sqrt(wd) delta] over (beta, delta),
+    delta held at zero where ifixx is 0: MINPACK's Levenberg-Marquardt
+    (scipy.optimize.least_squares, method 'lm') from ODRPACK's (beta, delta), then Gauss-Newton
+    steps with complex-step Jacobians while they shrink. Its
+    covariance is the beta block of (J^T J)^-1, J the Jacobian of r at the optimum."""
+    x = np.asarray(fit.data.x, float)
+    y = np.asarray(fit.data.y, float)
+    n = x.size
+    we = np.broadcast_to(np.asarray(1.0 if fit.data.we is None else fit.data.we, float), (n,))
+    wd = np.broadcast_to(np.asarray(1.0 if fit.data.wd is None else fit.data.wd, float), (n,))
+    free = np.ones(n, bool) if ifixx is None else np.asarray(ifixx) != 0
+    extra = fit.model.extra_args or ()
+    p = len(out.beta)
+
+    def resid(q):
+        beta, d = q[:p], np.zeros(n, dtype=q.dtype)
+        d[free] = q[p:]
+        return np.concatenate([np.sqrt(we) * (y - fit.model.fcn(beta, x + d, *extra)),
+                               np.sqrt(wd[free]) * q[p:]])
+
+    def jac(q):
+        J = np.empty((n + int(free.sum()), q.size))
+        for k in range(q.size):
+            qc = q.astype(complex)
+            qc[k] += 1e-30j
+            J[:, k] = resid(qc).imag / 1e-30
+        return J
+
+    q0 = np.concatenate([out.beta, np.asarray(out.delta, float)[free]])
+    r = least_squares(resid, q0, jac="cs", method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15,
+                      max_nfev=100000)
+    q = r.x
+    f = resid(q)
+    ss = float(f @ f)
+    # Near the optimum the sum of squares is flat to rounding before beta is: the Gauss-Newton
+    # steps are accepted while they shrink (and the sum of squares does not grow beyond rounding).
+    gn_steps = 0
+    last = math.inf
+    for _ in range(30):
+        step = np.linalg.lstsq(jac(q), -f, rcond=None)[0]
+        size = float(np.max(np.abs(step) / np.maximum(np.abs(q), 1e-300)))
+        f_new = resid(q + step)
+        ss_new = float(f_new @ f_new)
+        if not (size < last and ss_new <= ss * (1 + 1e-12) + 1e-300):
+            break
+        q, f, ss, last = q + step, f_new, ss_new, size
+        gn_steps += 1
+        if size == 0.0:
+            break
+    J = jac(q)
+    cov = np.linalg.inv(J.T @ J)[:p, :p]
+    beta = q[:p]
+    g = J.T @ f
+    cosine = np.abs(g) / np.maximum(np.linalg.norm(J, axis=0) * np.linalg.norm(f), 1e-300)
+    dof = n - p
+    scale = np.maximum(np.abs(beta), 1e-300)
+    return {
+        "method": ("scipy.optimize.least_squares(method='lm', jac='cs', xtol=ftol=gtol=1e-15) on "
+                   "[sqrt(we)(y - f(beta, x + delta)), sqrt(wd) delta] from ODRPACK's solution, then "
+                   "Gauss-Newton steps (complex-step Jacobian) while they shrink"),
+        "lm_status": int(r.status),
+        "gauss_newton_steps": gn_steps,
+        "beta": beta,
+        "delta": _scatter(q[p:], free),
+        "cov_beta": cov,
+        "sd_beta": np.sqrt(np.diag(cov) * ss / dof) if dof > 0 else None,
+        "sum_square": ss,
+        "res_var": ss / dof if dof > 0 else None,
+        "gradient_cosine_max": float(cosine.max()) if ss > 1e-20 else None,
+        "gradient_cosine_note": ("max over unknowns of |J_k . r| / (|J_k| |r|): 0 at a stationary "
+                                 "point (null for exact data, where r is rounding noise)"),
+        "beta_max_rel_diff_odrpack": float(np.max(np.abs(out.beta - beta) / scale)),
+        "cov_beta_max_diff_odrpack_rel_to_max": float(np.max(np.abs(out.cov_beta - cov))
+                                                      / np.max(np.abs(cov))),
+        "sum_square_odrpack_minus_check": float(out.sum_square - ss),
+    }
+
+
+def york_line(x, y, sx, sy):
+    """Straight line y = a + b x with independent errors sx, sy: York's iteration (York et al.,
+    Am. J. Phys. 72, 367, 2004), which solves the weighted ODR problem's normal equations."""
+    wx, wy = 1.0 / sx ** 2, 1.0 / sy ** 2
+    b = np.polyfit(x, y, 1)[0]
+    for _ in range(10000):
+        w = wx * wy / (wx + b * b * wy)
+        xb, yb = np.sum(w * x) / w.sum(), np.sum(w * y) / w.sum()
+        u, v = x - xb, y - yb
+        beta = w * (u / wy + b * v / wx)
+        b_new = np.sum(w * beta * v) / np.sum(w * beta * u)
+        if b_new == b:
+            break
+        b = b_new
+    return yb - b * xb, b
+
+
+def _scatter(values, free):
+    d = np.zeros(free.size)
+    d[free] = values
+    return d
+
+
 def run_part1():
     entries = []
     for p in part1_problems():
@@ -400,6 +508,39 @@ def run_part1():
         e["job_note"] = ("set_job as the test calls it; other settings (maxit, sstol, partol, "
                          "taufac, ndigit, scaling, step sizes) are ODRPACK's defaults")
         e["result"] = output_dict(out)
+
+        # The same problem converged further: sstol off, partol 1e-15, and central instead of
+        # forward differences where the test lets ODRPACK difference (its default stopping
+        # rule, sstol = sqrt(eps) on the relative fall of the sum of squares, stops ~1e-6 short
+        # in beta on these problems).
+        tight = p["make"]()
+        tight.set_iprint(init=0, iter=0, final=0)
+        for k, v in TIGHT.items():
+            setattr(tight, k, v)
+        if decode_job(tight.job)["deriv"] == 0:
+            tight.set_job(deriv=1)
+        out_t = tight.run()
+        e["result_tight"] = output_dict(out_t)
+        e["result_tight"]["job"] = decode_job(tight.job)
+        e["result_tight"]["settings"] = dict(TIGHT)
+
+        ic = augmented_check(fit, out, p.get("ifixx"))
+        scale = np.maximum(np.abs(ic["beta"]), 1e-300)
+        ic["beta_max_rel_diff_tight"] = float(np.max(np.abs(out_t.beta - ic["beta"]) / scale))
+        ic["cov_beta_max_diff_tight_rel_to_max"] = float(
+            np.max(np.abs(out_t.cov_beta - ic["cov_beta"])) / np.max(np.abs(ic["cov_beta"])))
+        beta_asserted = p["asserted"].get("beta")
+        if beta_asserted is not None:
+            ic["beta_max_rel_diff_asserted"] = float(
+                np.max(np.abs(np.asarray(beta_asserted) - ic["beta"]) / scale))
+        if p.get("york"):
+            a, b = york_line(np.asarray(p["x"], float), np.asarray(p["y"], float),
+                             np.asarray(p["weights"]["sx"], float), np.asarray(p["weights"]["sy"], float))
+            ic["york_line"] = {"note": "York et al. (2004) iteration for a straight line, b0 = a, b1 = b",
+                               "beta": [a, b],
+                               "max_rel_diff": float(max(abs(a - ic["beta"][0]) / abs(ic["beta"][0]),
+                                                         abs(b - ic["beta"][1]) / abs(ic["beta"][1])))}
+        e["independent_check"] = ic
         e["asserted"] = checks
         e["all_asserted_pass"] = all(c["passed"] for c in checks)
         entries.append(e)
@@ -411,6 +552,16 @@ def run_part1():
 
 C_TRUE = 0.5
 C_START = 0.45
+C_FALLBACK = 0.5  # the second start, where C_START has no steady state at an observed slope
+# Tighter than ODRPACK's defaults (sstol = eps^(1/2) would stop once the sum of squares changes
+# by less than 1.5e-8 of itself, leaving c off by up to ~1e-4 of its standard error): the fits
+# stop on the relative change in c instead.
+ODR_TOLERANCES = {"sstol": 1e-30, "partol": 1e-14, "maxit": 200}
+# v̄ is smooth to a few 1e-16 relative; ndigit=15 tells ODRPACK so, and its central-difference
+# steps become ~1e-5 relative instead of the ~2e-4 its own noise estimate leads to.
+ODR_NDIGIT = 15
+START_MARGIN_DEG = 0.01
+C_CROSS_CHECK = 0.55  # a start above the optimum, to show fallback fits do not depend on their start
 XIS = (0.8, 1.0, 1.6)
 RHO = 0.4
 FRICTION = 0.1
@@ -472,7 +623,15 @@ def steady_range(xi, c):
 
 
 class BeadModel:
-    """v = v̄(δ; c) per point, ξ fixed per point; NaN where (δ, c) has no steady state."""
+    """v = v̄(δ; c) per point, ξ fixed per point.
+
+    Where (δ, c) has no steady state v̄ is NaN; the call counts that and raises OdrStop instead
+    of handing NaN to ODRPACK. OdrStop sets ODRPACK's ISTOP > 0, its signal that the trial point
+    is unacceptable, on which it tries a shorter step. NaN handed back instead made the run fail
+    ("could not generate output"), and so did OdrStop inside a finite-difference Jacobian; after
+    either the interpreter crashed later in the run (segmentation fault), hence fit_bead's check
+    of the start.
+    """
 
     def __init__(self, xi):
         self.xi = np.asarray(xi, float)
@@ -490,6 +649,7 @@ class BeadModel:
             if len(self.nan_examples) < 5:
                 i = np.nonzero(~ok)[0]
                 self.nan_examples.append({"c": float(beta[0]), "points": i, "delta_deg": x[i]})
+            raise OdrStop
         return v
 
     def report(self):
@@ -525,70 +685,176 @@ def simulate(seed, d_true, v_true):
     return d_obs, v_obs
 
 
-def fit_bead(xi, d_obs, v_obs, sigma_v, fit_type):
-    """One scipy.odr fit of c: fit_type 0 ODR (sx = σ_δ, sy = σ_v), 2 weighted LS (sy = σ_v)."""
-    model = BeadModel(xi)
-    if fit_type == 0:
-        data = RealData(d_obs, v_obs, sx=np.full(d_obs.size, SIGMA_DELTA_DEG), sy=sigma_v)
-    else:
-        data = RealData(d_obs, v_obs, sy=sigma_v)
-    fit = ODR(data, Model(model), beta0=[C_START])
-    fit.set_job(fit_type=fit_type, deriv=1)
-    fit.set_iprint(init=0, iter=0, final=0)
-    out = fit.run()
-    return fit, out, model
+def fit_bead(xi, d_obs, v_obs, sigma_v, fit_type, starts=None):
+    """One scipy.odr fit of c: fit_type 0 ODR (sx = σ_δ, sy = σ_v), 2 weighted LS (sy = σ_v).
+
+    Starts from C_START. Where some observed slope within START_MARGIN_DEG has no steady state
+    at that start (ODRPACK's first Jacobian would step in delta across the range's edge), or the
+    fit fails, it starts again from C_FALLBACK; ``starts`` replaces that pair. Returns the ODR
+    object, its Output, the model (with its NaN counts), the start used and the attempts that
+    failed (all None but the last where every start fails).
+    """
+    failed = []
+    for c0 in starts or (C_START, C_FALLBACK):
+        model = BeadModel(xi)
+        # A start whose slopes lie within START_MARGIN_DEG of the steady range's edge would have
+        # ODRPACK's finite-difference steps in delta cross the edge at its first Jacobian.
+        near = np.concatenate([d_obs - START_MARGIN_DEG, d_obs + START_MARGIN_DEG])
+        if not vbar(np.tile(xi, 2), near, c0)[1].all():
+            failed.append({"beta0": c0, "error": "no steady state within "
+                           f"{START_MARGIN_DEG} deg of an observed slope at the start"})
+            continue
+        if fit_type == 0:
+            data = RealData(d_obs, v_obs, sx=np.full(d_obs.size, SIGMA_DELTA_DEG), sy=sigma_v)
+        else:
+            data = RealData(d_obs, v_obs, sy=sigma_v)
+        try:
+            # ODR() evaluates the model once at beta0: OdrStop here means an infeasible start.
+            fit = ODR(data, Model(model), beta0=[c0], ndigit=ODR_NDIGIT, **ODR_TOLERANCES)
+            fit.set_job(fit_type=fit_type, deriv=1)
+            fit.set_iprint(init=0, iter=0, final=0)
+            out = fit.run()
+        except (OdrStop, RuntimeError) as e:
+            failed.append({"beta0": c0, "error": type(e).__name__ + (f": {e}" if str(e) else ""),
+                           "nan_evaluations": model.report()})
+            continue
+        if out.info >= 10000 or out.info % 10 >= 4:
+            failed.append({"beta0": c0, "error": f"info {out.info}: {out.stopreason}",
+                           "nan_evaluations": model.report()})
+            continue
+        return fit, out, model, c0, failed
+    return None, None, None, None, failed
 
 
-def profile_optimum(xi, d_obs, v_obs, sigma_v, odr_mode, c_bracket):
-    """Independent optimum: min over c of Σ min over δ_i of the weighted squares (ODR), or of Σ
-    ((v_i - v̄(δ_obs,i; c)) / σ_v,i)² (WLS). Brent's method, both levels."""
+def vbar_and_derivatives(xi, d, c, hd=1e-5, hc=1e-6):
+    """v̄, ∂v̄/∂δ (per degree) and ∂v̄/∂c by central differences, in one vectorised call."""
+    n = d.size
+    t = fitbead.forward("stick", xi=np.tile(xi, 3), delta_deg=np.concatenate([d, d + hd, d - hd]),
+                        c=float(c), rho=RHO, f=FRICTION)
+    v = np.asarray(t["v"], float)
+    ok = (np.asarray(t["status"]) == "ok") & np.isfinite(v)
+    v = np.where(ok, v, np.nan)
+    f0, fp, fm = v[:n], v[n:2 * n], v[2 * n:]
+    vc_p, _ = vbar(xi, d, c + hc)
+    vc_m, _ = vbar(xi, d, c - hc)
+    return f0, (fp - fm) / (2 * hd), (vc_p - vc_m) / (2 * hc)
 
-    def point_ss(i, c):
-        def g(d):
-            v, ok = vbar(np.array([xi[i]]), np.array([d]), c)
-            if not ok[0]:
-                return 1e30
-            return ((v_obs[i] - v[0]) / sigma_v[i]) ** 2 + ((d_obs[i] - d) / SIGMA_DELTA_DEG) ** 2
-        r = minimize_scalar(g, bracket=(d_obs[i] - 0.05, d_obs[i] + 0.05),
-                            options={"xtol": 1e-13, "maxiter": 500})
-        return r.fun, r.x
 
-    def total(c):
-        if odr_mode:
-            return sum(point_ss(i, c)[0] for i in range(len(xi)))
-        v, ok = vbar(xi, d_obs, c)
-        if not ok.all():
-            return 1e30
-        return float(np.sum(((v_obs - v) / sigma_v) ** 2))
+def adjusted_slopes(xi, d_obs, v_obs, sigma_v, c, half_width=0.5):
+    """Each point's δ* minimising ((v - v̄(δ; c)) / σ_v)² + ((δ_obs - δ) / σ_δ)²: the root of
+    (v - v̄) v̄_δ / σ_v² + (δ_obs - δ) / σ_δ² = 0, by bisection (vectorised over the points) from
+    [δ_obs - 0.5°, δ_obs + 0.5°], each end pulled towards δ_obs until it has a steady state."""
+    wv = 1.0 / sigma_v ** 2
+    wd = 1.0 / SIGMA_DELTA_DEG ** 2
 
-    r = minimize_scalar(total, bracket=c_bracket, options={"xtol": 1e-13, "maxiter": 500})
-    d_adj = np.array([point_ss(i, r.x)[1] for i in range(len(xi))]) if odr_mode else d_obs
-    return r.x, r.fun, d_adj
+    def h(d):
+        f0, fd, _ = vbar_and_derivatives(xi, d, c)
+        return wv * (v_obs - f0) * fd + wd * (d_obs - d)
+
+    lo = d_obs - half_width
+    hi = d_obs + half_width
+    for _ in range(60):
+        bad_lo = ~vbar(xi, lo, c)[1]
+        bad_hi = ~vbar(xi, hi, c)[1]
+        if not (bad_lo.any() or bad_hi.any()):
+            break
+        lo = np.where(bad_lo, 0.5 * (lo + d_obs), lo)
+        hi = np.where(bad_hi, 0.5 * (hi + d_obs), hi)
+    h_lo, h_hi = h(lo), h(hi)
+    if not (np.all(h_lo > 0) and np.all(h_hi < 0)):
+        raise RuntimeError("adjusted slope not bracketed")
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if np.all((mid == lo) | (mid == hi)):
+            break
+        pos = h(mid) > 0
+        lo = np.where(pos, mid, lo)
+        hi = np.where(pos, hi, mid)
+    return 0.5 * (lo + hi)
+
+
+def stationary_optimum(xi, d_obs, v_obs, sigma_v, odr_mode, c_guess, c_halfwidth):
+    """Independent optimum from the stationarity conditions, not from a minimiser's stopping rule:
+    the root in c of Σ (v_i - v̄(δ_i; c)) ∂v̄/∂c / σ_v,i² with δ_i the adjusted slopes (ODR) or the
+    observed ones (WLS); Brent's root finder, derivatives by central differences."""
+
+    def slopes(c):
+        return adjusted_slopes(xi, d_obs, v_obs, sigma_v, c) if odr_mode else d_obs
+
+    def g(c):
+        d = slopes(c)
+        f0, _, fc = vbar_and_derivatives(xi, d, c)
+        return float(np.sum((v_obs - f0) * fc / sigma_v ** 2))
+
+    a, b = c_guess - c_halfwidth, c_guess + c_halfwidth
+    c = brentq(g, a, b, xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=200)
+    d = slopes(c)
+    f0, _, _ = vbar_and_derivatives(xi, d, c)
+    ss = float(np.sum(((v_obs - f0) / sigma_v) ** 2 + (((d_obs - d) / SIGMA_DELTA_DEG) ** 2 if odr_mode else 0.0)))
+    return c, ss, d
 
 
 def linearised_cov(xi, c, d_at, sigma_v, odr_mode):
-    """Unscaled var(c) = 1 / Σ (∂v̄/∂c)² / (σ_v² + [ODR] (∂v̄/∂δ)² σ_δ²), central differences."""
-    hc = 1e-5
-    hd = 1e-5
-    dc = (vbar(xi, d_at, c + hc)[0] - vbar(xi, d_at, c - hc)[0]) / (2 * hc)
-    dd = (vbar(xi, d_at + hd, c)[0] - vbar(xi, d_at - hd, c)[0]) / (2 * hd)
+    """Unscaled var(c) = 1 / Σ (∂v̄/∂c)² / (σ_v² + [ODR] (∂v̄/∂δ)² σ_δ²) at (c, δ), central
+    differences: the parameter block of the inverse of the linearised normal matrix once the
+    slope adjustments are eliminated."""
+    _, dd, dc = vbar_and_derivatives(xi, d_at, c)
     var_eff = sigma_v ** 2 + (dd ** 2 * SIGMA_DELTA_DEG ** 2 if odr_mode else 0.0)
     return 1.0 / float(np.sum(dc ** 2 / var_eff)), dc, dd
 
 
-def fit_record(fit, out, model, xi, d_obs, sigma_v):
+def edge_distances(xi, d, c):
+    """Per point, the distance (degrees) of δ from the nearer end of its series' steady range at c."""
+    out = np.empty(d.size)
+    ranges = {}
+    for x in np.unique(xi):
+        r = steady_range(float(x), float(c))
+        ranges[f"xi={x:g}"] = [r["delta_lo_deg"], r["delta_hi_deg"]]
+        m = xi == x
+        out[m] = np.minimum(d[m] - r["delta_lo_deg"], r["delta_hi_deg"] - d[m])
+    return out, ranges
+
+
+def fit_record(fit, out, model, c0, failed, xi, d_obs, v_obs, sigma_v):
+    odr_mode = decode_job(fit.job)["fit_type"] == 0
     r = output_dict(out)
+    r["beta0_used"] = c0
+    r["failed_attempts"] = failed
     r["job"] = decode_job(fit.job)
     r["sqrt_cov_beta"] = np.sqrt(np.diag(out.cov_beta))
     r["reduced_chi2"] = out.res_var
     r["dof"] = d_obs.size - 1
     r["adjusted_delta_deg"] = out.xplus
-    c_hat = out.beta[0]
-    _, ok_adj = vbar(xi, out.xplus, c_hat)
-    _, ok_obs = vbar(xi, d_obs, c_hat)
-    r["adjusted_slopes_steady_at_fitted_c"] = bool(ok_adj.all())
-    r["observed_slopes_steady_at_fitted_c"] = bool(ok_obs.all())
+    c_hat = float(out.beta[0])
+    dist_adj, ranges = edge_distances(xi, out.xplus, c_hat)
+    dist_obs, _ = edge_distances(xi, d_obs, c_hat)
+    r["steady_ranges_at_fitted_c"] = ranges
+    r["adjusted_slopes_inside_steady_range_at_fitted_c"] = bool(np.all(dist_adj > 0))
+    r["observed_slopes_inside_steady_range_at_fitted_c"] = bool(np.all(dist_obs > 0))
+    r["min_edge_distance_deg"] = {"adjusted": float(dist_adj.min()), "observed": float(dist_obs.min())}
     r["nan_evaluations"] = model.report()
+
+    c_s, ss_s, d_s = stationary_optimum(xi, d_obs, v_obs, sigma_v, odr_mode, c_hat,
+                                        8 * math.sqrt(out.cov_beta[0, 0]))
+    var_lin, dc, dd = linearised_cov(xi, c_hat, out.xplus, sigma_v, odr_mode)
+    r["independent_check"] = {
+        "method": ("root in c of sum (v - vbar) dvbar/dc / sigma_v^2 with each point's adjusted slope "
+                   "the root of (v - vbar) dvbar/ddelta / sigma_v^2 + (delta_obs - delta) / sigma_delta^2"
+                   if odr_mode else
+                   "root in c of sum (v - vbar(delta_obs)) dvbar/dc / sigma_v^2")
+                  + "; Brent / bisection, central differences (h_delta = 1e-5 deg, h_c = 1e-6)",
+        "c": c_s, "sum_square": ss_s,
+        "c_odrpack_minus_check": c_hat - c_s,
+        "c_diff_in_sqrt_cov": (c_hat - c_s) / math.sqrt(out.cov_beta[0, 0]),
+        "sum_square_rel_diff": (out.sum_square - ss_s) / ss_s,
+        "adjusted_delta": d_s,
+        "adjusted_delta_max_abs_diff_deg": float(np.max(np.abs(d_s - out.xplus))),
+        "cov_linearised": var_lin,
+        "cov_linearised_note": ("1 / sum (dv/dc)^2 / (sigma_v^2 + (dv/ddelta)^2 sigma_delta^2) at "
+                                "(c_hat, xplus), central differences; WLS drops the delta term"),
+        "cov_rel_diff": (var_lin - out.cov_beta[0, 0]) / out.cov_beta[0, 0],
+        "dv_dc": dc, "dv_ddelta_per_deg": dd,
+    }
     return r
 
 
@@ -604,53 +870,52 @@ def run_part2():
         for row in zip(label, xi, d_obs, v_obs, sigma_v, sigma_d, d_true, v_true):
             fh.write(",".join([row[0]] + [repr(float(a)) for a in row[1:]]) + "\n")
 
-    _, obs_ok = vbar(xi, d_obs, C_TRUE)
+    dist_true, _ = edge_distances(xi, d_obs, C_TRUE)
+    dist_start, ranges_start = edge_distances(xi, d_obs, C_START)
     fits = {}
     for key, ft in (("odr", 0), ("wls", 2)):
-        fit, out, model = fit_bead(xi, d_obs, v_obs, sigma_v, ft)
-        rec = fit_record(fit, out, model, xi, d_obs, sigma_v)
-        c_hat = float(out.beta[0])
-        c_p, ss_p, d_p = profile_optimum(xi, d_obs, v_obs, sigma_v, ft == 0,
-                                         (c_hat - 0.01, c_hat + 0.01))
-        var_lin, dc, dd = linearised_cov(xi, c_hat, out.xplus, sigma_v, ft == 0)
-        rec["independent_check"] = {
-            "method": ("nested Brent minimisation: outer over c, inner over each point's delta"
-                       if ft == 0 else "Brent minimisation over c of the weighted squares at delta_obs"),
-            "c": c_p, "sum_square": ss_p,
-            "c_minus_odrpack": c_p - c_hat,
-            "c_diff_in_sqrt_cov": (c_p - c_hat) / math.sqrt(out.cov_beta[0, 0]),
-            "sum_square_rel_diff": (ss_p - out.sum_square) / out.sum_square,
-            "adjusted_delta_max_abs_diff_deg": float(np.max(np.abs(d_p - out.xplus))),
-            "cov_linearised": var_lin,
-            "cov_linearised_note": ("1 / sum (dv/dc)^2 / (sigma_v^2 + (dv/ddelta)^2 sigma_delta^2) at "
-                                    "(c_hat, xplus), central differences; WLS drops the delta term"),
-            "cov_rel_diff": (var_lin - out.cov_beta[0, 0]) / out.cov_beta[0, 0],
-            "dv_dc": dc, "dv_ddelta_per_deg": dd,
-        }
-        fits[key] = rec
+        fit, out, model, c0, failed = fit_bead(xi, d_obs, v_obs, sigma_v, ft)
+        if out is None:
+            raise RuntimeError(f"{key} fit failed: {failed}")
+        fits[key] = fit_record(fit, out, model, c0, failed, xi, d_obs, v_obs, sigma_v)
 
     odr_r, wls_r = fits["odr"], fits["wls"]
     result = {
         "description": ("pure-rolling model (fitbead.forward model 'stick'), v = vbar(delta; c) with "
-                        "K = cos 2a + c sin^2 a sin 2a, fitted for c by ODR (errors in delta and v) "
-                        "and by weighted least squares that ignores the slope errors"),
+                        "K = cos 2 alpha + c sin^2 alpha sin 2 alpha, fitted for c by ODR (errors in "
+                        "delta and v) and by weighted least squares that ignores the slope errors"),
         "data_file": "bead_stick.csv",
+        "versions": versions(),
         "settings": {
-            "model": "stick", "law": "c=VALUE (K = cos 2 alpha + c sin^2 alpha sin 2 alpha)",
-            "c_true": C_TRUE, "c_start": C_START, "rho": RHO, "f": FRICTION, "xi": list(XIS),
+            "model": "stick", "law": "K='c=VALUE' (K = cos 2 alpha + c sin^2 alpha sin 2 alpha)",
+            "c_true": C_TRUE, "rho": RHO, "f": FRICTION, "xi": list(XIS),
             "slopes_per_series": N_SLOPES,
-            "slope_design": "linspace over [lo + 0.1 w, lo + 0.9 w], [lo, lo + w] the steady range at c_true",
+            "slope_design": ("numpy.linspace(lo + 0.1 w, lo + 0.9 w, 8), [lo, lo + w] the steady "
+                             "range at c_true (status ok, regime B)"),
             "seed": SEED,
-            "rng": "numpy.random.default_rng(seed): standard_normal(24) for the slopes, then standard_normal(24) for v, rows in file order",
+            "rng": ("numpy.random.default_rng(seed): standard_normal(24) for the slopes (z_delta), then "
+                    "standard_normal(24) for v (z_v), rows in file order"),
             "sigma_delta_deg": SIGMA_DELTA_DEG,
             "delta_obs": "delta_true + sigma_delta * z_delta",
             "sigma_v": "0.01 * v_true",
             "v_obs": "v_true * (1 + 0.01 * z_v)",
-            "fit_settings": ("scipy.odr, RealData (sx/sy), Model without Jacobians, job deriv=1 "
-                             "(central finite differences); ODRPACK defaults otherwise"),
+            "odr": "fit_type 0: RealData(delta_obs, v_obs, sx=sigma_delta, sy=sigma_v)",
+            "wls": "fit_type 2: RealData(delta_obs, v_obs, sy=sigma_v)",
+            "c_start": C_START,
+            "c_fallback_start": C_FALLBACK,
+            "start_rule": (f"beta0 = {C_START}; where some observed slope +- {START_MARGIN_DEG} deg has no "
+                           f"steady state at beta0, or ODRPACK stops on an unacceptable point, beta0 = "
+                           f"{C_FALLBACK}"),
+            "odrpack_settings": {"deriv": 1, "deriv_note": "central finite differences (no Jacobians)",
+                                 "ndigit": ODR_NDIGIT, **ODR_TOLERANCES,
+                                 "other": "ODRPACK defaults (taufac, scaling, step sizes, var_calc 0)"},
+            "outside_steady_range": ("the model computes NaN there, counts it and raises OdrStop "
+                                     "(ODRPACK's ISTOP > 0: unacceptable point)"),
         },
         "steady_ranges_at_c_true": ranges,
-        "observed_slopes_steady_at_c_true": bool(obs_ok.all()),
+        "steady_ranges_at_c_start": ranges_start,
+        "observed_slopes_min_edge_distance_deg": {"at_c_true": float(dist_true.min()),
+                                                  "at_c_start": float(dist_start.min())},
         "fits": fits,
         "ratios": {
             "sd_beta_odr_over_wls": odr_r["sd_beta"][0] / wls_r["sd_beta"][0],
@@ -669,10 +934,19 @@ def one_replicate(seed, xi, d_true, v_true, sigma_v):
     d_obs, v_obs = simulate(seed, d_true, v_true)
     row = {"seed": seed}
     for key, ft in (("odr", 0), ("wls", 2)):
-        _, out, model = fit_bead(xi, d_obs, v_obs, sigma_v, ft)
+        _, out, model, c0, failed = fit_bead(xi, d_obs, v_obs, sigma_v, ft)
+        if out is None:
+            row[key] = {"c": math.nan, "sqrt_cov": math.nan, "sd_beta": math.nan, "res_var": math.nan,
+                        "info": -1, "nan_calls": 0, "beta0": math.nan, "failed": failed}
+            continue
         row[key] = {"c": float(out.beta[0]), "sqrt_cov": float(math.sqrt(out.cov_beta[0, 0])),
                     "sd_beta": float(out.sd_beta[0]), "res_var": float(out.res_var),
-                    "info": int(out.info), "nan_calls": model.nan_calls}
+                    "info": int(out.info), "nan_calls": model.nan_calls, "beta0": c0,
+                    "failed": failed}
+        if c0 != C_START:
+            # The same fit from the other side of the optimum, where that start is usable.
+            _, out2, _, c2, _ = fit_bead(xi, d_obs, v_obs, sigma_v, ft, starts=(C_CROSS_CHECK,))
+            row[key]["cross_check_c"] = math.nan if out2 is None else float(out2.beta[0])
     return row
 
 
@@ -683,25 +957,36 @@ def summarise(rows, key):
     rv = np.array([r[key]["res_var"] for r in rows])
     info = np.array([r[key]["info"] for r in rows])
     nan = np.array([r[key]["nan_calls"] for r in rows])
-    good = np.isfinite(c) & np.isfinite(s) & (info % 10 < 4)
-    cover = np.abs(c - C_TRUE) <= 1.96 * s
-    cover_scaled = np.abs(c - C_TRUE) <= 1.96 * sd
-    n = len(rows)
+    fallback = np.array([r[key]["beta0"] == C_FALLBACK for r in rows])
+    cross = np.array([abs(r[key]["c"] - r[key]["cross_check_c"]) / r[key]["sqrt_cov"]
+                      for r in rows if "cross_check_c" in r[key]])
+    good = np.isfinite(c) & np.isfinite(s)
+    cg, sg, sdg = c[good], s[good], sd[good]
+    cover = np.abs(cg - C_TRUE) <= 1.96 * sg
+    cover_scaled = np.abs(cg - C_TRUE) <= 1.96 * sdg
+    n = int(good.sum())
     p = float(cover.mean())
     return {
-        "replicates": n,
+        "replicates_fitted": n,
         "fits_failed": int((~good).sum()),
         "replicates_with_nan_evaluations": int((nan > 0).sum()),
+        "replicates_started_from_fallback": int(fallback.sum()),
+        "fallback_cross_check": {
+            "note": (f"fallback replicates refitted from beta0 = {C_CROSS_CHECK}: max |c - c_cross| / "
+                     "sqrt(cov_beta); NaN where that start is unusable too"),
+            "count": int(cross.size), "usable": int(np.isfinite(cross).sum()),
+            "max_diff_in_sqrt_cov": float(np.nanmax(cross)) if np.isfinite(cross).any() else None,
+        },
         "info_counts": {str(k): int(v) for k, v in zip(*np.unique(info, return_counts=True))},
         "coverage_95_unscaled": p,
         "coverage_95_unscaled_binomial_se": math.sqrt(p * (1 - p) / n),
-        "mean_width_95_unscaled": float(np.mean(2 * 1.96 * s)),
+        "mean_width_95_unscaled": float(np.mean(2 * 1.96 * sg)),
         "coverage_95_scaled_sd_beta": float(cover_scaled.mean()),
-        "mean_width_95_scaled_sd_beta": float(np.mean(2 * 1.96 * sd)),
-        "mean_c": float(c.mean()), "bias": float(c.mean() - C_TRUE),
-        "empirical_sd_c": float(c.std(ddof=1)),
-        "rms_sqrt_cov": float(math.sqrt(np.mean(s ** 2))),
-        "mean_reduced_chi2": float(rv.mean()),
+        "mean_width_95_scaled_sd_beta": float(np.mean(2 * 1.96 * sdg)),
+        "mean_c": float(cg.mean()), "bias": float(cg.mean() - C_TRUE),
+        "empirical_sd_c": float(cg.std(ddof=1)),
+        "rms_sqrt_cov": float(math.sqrt(np.mean(sg ** 2))),
+        "mean_reduced_chi2": float(rv[good].mean()),
     }
 
 
@@ -720,9 +1005,12 @@ def run_coverage(design_arrays):
     result = {
         "description": ("bead_stick.json's simulation repeated with seeds "
                         f"{REPLICATE_SEED0}..{REPLICATE_SEED0 + n_run - 1} (same design, same noise "
-                        "model); 95 % interval c_hat +- 1.96 sqrt(cov_beta), cov_beta unscaled"),
+                        "model, same fit settings and start rule); 95 % interval "
+                        "c_hat +- 1.96 sqrt(cov_beta), cov_beta unscaled"),
+        "versions": versions(),
         "replicates_requested": REPLICATES,
         "replicates_run": n_run,
+        "time_budget_s": TIME_BUDGET_S,
         "seeds": [REPLICATE_SEED0, REPLICATE_SEED0 + n_run - 1],
         "seconds_first_10": t10,
         "seconds_total": total,
@@ -732,7 +1020,7 @@ def run_coverage(design_arrays):
         "per_replicate": {
             "seed": [r["seed"] for r in rows],
             **{f"{key}_{q}": [r[key][q] for r in rows]
-               for key in ("odr", "wls") for q in ("c", "sqrt_cov", "res_var", "info")},
+               for key in ("odr", "wls") for q in ("c", "sqrt_cov", "res_var", "info", "beta0")},
         },
     }
     write_json(OUT / "bead_stick_coverage.json", result)
@@ -765,9 +1053,9 @@ def main():
     for e in part1:
         r = e["result"]
         print(f"  {e['name']:<17} beta={np.array2string(np.asarray(r['beta']), precision=10)} "
-              f"res_var={r['res_var']:.6g} info={r['info']} asserted: "
-              + ("pass" if e["all_asserted_pass"] else "FAIL ") +
-              " ".join(f"{c['quantity']}" + (f" ({c['max_abs_diff']:.1e})" if "max_abs_diff" in c else "")
+              f"res_var={r['res_var']:.6g} info={r['info']} asserted "
+              + ("pass: " if e["all_asserted_pass"] else "FAIL: ") +
+              ", ".join(f"{c['quantity']}" + (f" max diff {c['max_abs_diff']:.1e}" if "max_abs_diff" in c else "")
                        for c in e["asserted"]))
 
     p2, arrays = run_part2()
@@ -779,8 +1067,11 @@ def main():
         ic = f["independent_check"]
         print(f"  {key.upper()}: c = {f['beta'][0]:.10f} +- {f['sqrt_cov_beta'][0]:.6f} (sqrt cov), "
               f"sd_beta {f['sd_beta'][0]:.6f}, reduced chi2 {f['res_var']:.4f}, info {f['info']}, "
-              f"NaN calls {f['nan_evaluations']['calls_with_nan']}; check: dc {ic['c_minus_odrpack']:.2e}, "
-              f"cov rel {ic['cov_rel_diff']:.2e}")
+              f"start {f['beta0_used']}, NaN calls {f['nan_evaluations']['calls_with_nan']}")
+        print(f"       stationarity check: c {ic['c']:.12f} (ODRPACK - check {ic['c_odrpack_minus_check']:.1e}), "
+              f"cov rel diff {ic['cov_rel_diff']:.1e}; min edge distance "
+              f"{f['min_edge_distance_deg']['adjusted']:.3f} deg (adjusted), "
+              f"{f['min_edge_distance_deg']['observed']:.3f} deg (observed)")
     print(f"  sqrt(cov) ODR/WLS = {p2['ratios']['sqrt_cov_beta_odr_over_wls']:.6f}, "
           f"sd_beta ODR/WLS = {p2['ratios']['sd_beta_odr_over_wls']:.6f}")
 
@@ -792,7 +1083,8 @@ def main():
         print(f"  {key.upper()}: coverage {s['coverage_95_unscaled']:.4f} (se {s['coverage_95_unscaled_binomial_se']:.4f}), "
               f"mean width {s['mean_width_95_unscaled']:.6f}, mean c {s['mean_c']:.6f}, "
               f"sd(c) {s['empirical_sd_c']:.6f}, failed {s['fits_failed']}, "
-              f"with NaN {s['replicates_with_nan_evaluations']}")
+              f"with NaN {s['replicates_with_nan_evaluations']}, from fallback start "
+              f"{s['replicates_started_from_fallback']}")
     print(f"versions: {vers}; total {time.perf_counter() - t0:.1f} s; outputs in {OUT.relative_to(ROOT)}")
 
 

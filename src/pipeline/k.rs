@@ -1,6 +1,6 @@
 //! Measurements in, K out: `fitbead k`'s rows as a `KPlan` that
-//! `super::stream::stream` runs over a table of any size. Each row is read and checked as
-//! [`super::measurements`] reads a whole file (the series check in input order, keeping one
+//! `crate::io::stream::stream` runs over a table of any size. Each row is read and checked as
+//! [`crate::io::measurements`] reads a whole file (the series check in input order, keeping one
 //! entry per series), inverted (eq 69: [`crate::fit::k::estimate()`]) and written as one
 //! record of `COLUMNS`, `EXTRA_COLUMNS`, `AUTO_COLUMNS` (auto only), then the input's
 //! other columns (trimmed; a name clashing with an output column renamed `in_NAME`).
@@ -51,8 +51,8 @@ pub(crate) fn output_columns(auto: bool) -> Vec<&'static str> {
     v
 }
 
-/// Rows per chunk of a K stream ([`super::stream::StreamOptions::chunk_rows`]), a quarter of
-/// the engine's [`super::stream::CHUNK_ROWS`]: what `fitbead k` writes to a stream before a
+/// Rows per chunk of a K stream ([`crate::io::stream::StreamOptions::chunk_rows`]), a quarter of
+/// the engine's [`crate::io::stream::CHUNK_ROWS`]: what `fitbead k` writes to a stream before a
 /// bad row is whole chunks of this many rows (the memory the stream uses does not depend on
 /// it).
 pub(crate) const CHUNK_ROWS: usize = 8 * 1024;

@@ -1,13 +1,13 @@
 //! Scenes in, mean velocities out: the rows of a scenes table as typed scenes and models (a
 //! column map, `SceneColumns`, and the settings rows fall back on, `ForwardSettings`),
 //! evaluated and formatted as `fitbead forward`'s output records by a `ForwardPlan` that
-//! `super::stream::stream` runs over a table of any size.
+//! `crate::io::stream::stream` runs over a table of any size.
 //!
 //! Input columns `xi`, `delta_deg` (required), `K` (a number or a law name), `rho`, `f`,
 //! `lambda`, `mu` (Jan), `a1`, `a2`, `a3` (Jaeger) and `spin` (contact); an empty cell or an
 //! absent column takes the setting. Every input cell passes through (trimmed), an input column
 //! whose name is also an output column renamed `in_NAME` (see `pass_through_names`); then the
-//! records' columns ([`super::output_columns`]).
+//! records' columns ([`output_columns`]).
 //!
 //! Settings are named in messages as the command line's flags (`--rho` of
 //! `SETTINGS_ORIGIN`), since that is where they come from.
@@ -27,21 +27,9 @@ use crate::scene::{CollisionLaw, Scene};
 use std::io::Read;
 
 /// Every column a scenes table may have: the scene's, `SCENE_CELL_COLUMNS` and md's
-/// settings; any other passes through ([`super::scenes::check_columns`]).
+/// settings; any other passes through ([`crate::io::scenes::check_columns`]).
 pub(crate) fn scene_columns() -> Vec<&'static str> {
-    let mut v = vec![
-        "xi",
-        "delta_deg",
-        "K",
-        "rho",
-        "f",
-        "lambda",
-        "mu",
-        "a1",
-        "a2",
-        "a3",
-        "spin",
-    ];
+    let mut v = vec!["xi", "delta_deg"];
     v.extend(SCENE_CELL_COLUMNS);
     v.extend(crate::models::md::MdSetting::ALL.map(|s| s.column()));
     v.sort_unstable();

@@ -14,6 +14,9 @@ pub struct Point {
     pub v: f64,
     /// Its standard deviation (1 when the data carry none: see [`Dataset::sigma`]).
     pub sigma: f64,
+    /// Standard uncertainty of the slope δ, radians (column `sigma_delta_deg`, in degrees, or
+    /// the default of `--sigma-delta`); 0 when the slope is taken as exact.
+    pub sigma_delta: f64,
 }
 
 /// Points grouped in series (in order of first appearance).
@@ -92,6 +95,7 @@ impl Dataset {
                 scene,
                 v,
                 sigma: s.unwrap_or(1.0),
+                sigma_delta: 0.0,
             });
         }
         Ok(Dataset {
@@ -99,6 +103,12 @@ impl Dataset {
             points,
             sigma,
         })
+    }
+
+    /// True when some point's slope carries an uncertainty (σ_δ > 0): the fits then treat
+    /// the slopes as measured with error (orthogonal distance regression).
+    pub fn has_slope_errors(&self) -> bool {
+        self.points.iter().any(|p| p.sigma_delta > 0.0)
     }
 
     /// The points of series `s`.

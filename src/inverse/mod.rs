@@ -33,6 +33,7 @@ mod lmpar;
 pub mod lsq;
 pub mod mcmc;
 pub(crate) mod observer;
+pub mod odr;
 pub mod posterior;
 pub mod problem;
 pub mod profile;
@@ -50,6 +51,7 @@ pub use mcmc::{
     EnsembleSampler, LogDensity, McmcError, McmcOptions, McmcResult, ParameterDiagnostics,
     StopReason,
 };
+pub use odr::{Odr, OdrFit, OdrModel, OdrProblem};
 pub use problem::{ArgminResiduals, LeastSquares};
 pub use profile::{
     confidence_intervals, ConfidenceIntervals, Interval, ProfileEnd, ProfileInterval,

@@ -4,3 +4,4 @@
 
 mod estimate;
 mod mcmc;
+mod odr;

@@ -30,6 +30,8 @@ fn method_name(r: &FitResult) -> &'static str {
         "posterior sampling (affine-invariant ensemble)"
     } else if r.stats.n_params == 0 {
         "scored (nothing to fit)"
+    } else if r.stats.slope_errors {
+        "orthogonal distance regression (slope errors)"
     } else {
         "least squares (Levenberg-Marquardt)"
     }

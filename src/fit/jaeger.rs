@@ -25,6 +25,7 @@ use super::data::Dataset;
 use super::jaeger_coordinates::JaegerCoordinates;
 pub(crate) use super::jaeger_coordinates::JaegerX;
 use super::posterior::{per_series, summarise_reparameterised, summarise_with, Method, Prior};
+use super::slopes::{self, SlopeCurve};
 use super::summary::{distinct_points, observed_norm, FitResult, ParamSpec, Solved};
 use crate::inverse::{fit, CurveModel, Infeasible, LsqOptions, WeightedData};
 use crate::models::jaeger::Jaeger;
@@ -281,11 +282,22 @@ fn fit_jaeger_series(
         distinct: Some(distinct_points(x.iter().map(|q| [q.0, q.1, q.2]))),
         observed_norm: Some(norm),
     };
-    let mut summary = match JaegerCoordinates::for_series(&x, branch) {
-        Some(c) => summarise_reparameterised(method, solved, &c),
-        None => summarise_with(method, solved),
+    let index = data.series_index(s);
+    let jm = JaegerModel(branch);
+    let curve = SlopeCurve {
+        model: &jm,
+        base: &x,
+        at: at_slope,
     };
-    summary.attach_points(data, &data.series_index(s));
+    let odr = slopes::summarise(method, &solved, curve, data, &index, true);
+    let mut summary = odr.unwrap_or_else(|| {
+        let mut summary = match JaegerCoordinates::for_series(&x, branch) {
+            Some(c) => summarise_reparameterised(method, solved, &c),
+            None => summarise_with(method, solved),
+        };
+        summary.attach_points(data, &index);
+        summary
+    });
     // The notes describe the values reported: the optimum, or the posterior medians.
     let value = |k: usize| summary.params.get(k).map_or(f.params[k], |r| r.value);
     let m = Jaeger {
@@ -323,6 +335,12 @@ fn fit_jaeger_series(
         bistable_points,
         has_minimum,
     })
+}
+
+/// Jaeger's abscissa (tan δ, cos δ, ε) of a point at slope δ (radians).
+fn at_slope(x: &JaegerX, delta: f64) -> JaegerX {
+    let (sd, cd) = delta.sin_cos();
+    (sd / cd, cd, x.2)
 }
 
 /// `upper` or `lower`.

@@ -13,6 +13,7 @@
 
 use super::data::Dataset;
 use super::posterior::{per_series, summarise_with, Method};
+use super::slopes::{self, SlopeCurve};
 use super::summary::{distinct_points, observed_norm, FitResult, ParamSpec, Solved};
 use crate::inverse::{fit, CurveModel, Infeasible, LsqOptions, WeightedData};
 
@@ -31,6 +32,12 @@ pub(crate) fn velocity(x: &JanX, lambda: f64, mu: f64) -> Result<(f64, f64, f64)
     }
     let v = (2.0 * sa / lambda * drive).sqrt();
     Ok((v, -v / (2.0 * lambda), -sa * cd / (lambda * v)))
+}
+
+/// Jan's abscissa of a point at slope δ (radians).
+fn at_slope(x: &JanX, delta: f64) -> JanX {
+    let (sd, cd) = delta.sin_cos();
+    (x.0, sd, cd)
 }
 
 /// Per-series model: p = (λ, μ).
@@ -202,6 +209,7 @@ fn fit_jan_series(
     };
     let distinct = distinct_points(x.iter().map(|p| [p.1, p.2]));
     let norm = observed_norm(y.iter().zip(&sg));
+    let base = x.clone();
     let problem = match WeightedData::new(JanSeries, x, y, Some(sg)) {
         Ok(p) => p,
         Err(e) => {
@@ -241,21 +249,28 @@ fn fit_jan_series(
             default_prior: None,
         },
     ];
-    let mut sum = summarise_with(
-        method,
-        Solved {
-            name: "jan-series",
-            series: label,
-            specs: &specs,
-            problem: &problem,
-            fit: &f,
-            level,
-            options: &opts,
-            distinct: Some(distinct),
-            observed_norm: Some(norm),
-        },
-    );
-    sum.attach_points(data, &data.series_index(s));
+    let solved = Solved {
+        name: "jan-series",
+        series: label,
+        specs: &specs,
+        problem: &problem,
+        fit: &f,
+        level,
+        options: &opts,
+        distinct: Some(distinct),
+        observed_norm: Some(norm),
+    };
+    let index = data.series_index(s);
+    let curve = SlopeCurve {
+        model: &JanSeries,
+        base: &base,
+        at: at_slope,
+    };
+    let sum = slopes::summarise(method, &solved, curve, data, &index, true).unwrap_or_else(|| {
+        let mut sum = summarise_with(method, solved);
+        sum.attach_points(data, &index);
+        sum
+    });
     if f.converged() {
         let se = f.std_errors().map(|s| s.to_vec()).unwrap_or(vec![1.0; 2]);
         if f.params[0] > 0.0 {
@@ -361,21 +376,29 @@ fn fit_jan_global(
                 default_prior: None,
             },
         ];
-        let mut sum = summarise_with(
-            method,
-            Solved {
-                name: "jan-global",
-                series: "all",
-                specs: &specs,
-                problem: &problem,
-                fit: &f,
-                level,
-                options: &opts,
-                distinct: Some(distinct_points(x.iter().map(|p| [p.0, p.1, p.2]))),
-                observed_norm: Some(norm),
-            },
-        );
-        sum.attach_points(data, &(0..data.points.len()).collect::<Vec<_>>());
-        Some(sum)
+        let solved = Solved {
+            name: "jan-global",
+            series: "all",
+            specs: &specs,
+            problem: &problem,
+            fit: &f,
+            level,
+            options: &opts,
+            distinct: Some(distinct_points(x.iter().map(|p| [p.0, p.1, p.2]))),
+            observed_norm: Some(norm),
+        };
+        let index: Vec<usize> = (0..data.points.len()).collect();
+        let curve = SlopeCurve {
+            model: &JanGlobal,
+            base: &x,
+            at: at_slope,
+        };
+        Some(
+            slopes::summarise(method, &solved, curve, data, &index, true).unwrap_or_else(|| {
+                let mut sum = summarise_with(method, solved);
+                sum.attach_points(data, &index);
+                sum
+            }),
+        )
     })
 }

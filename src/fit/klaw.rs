@@ -33,14 +33,15 @@ use super::data::Dataset;
 use super::k::bracket::eval;
 use super::k::{bracket, dv_dk, estimate, KBracket};
 use super::posterior::{summarise_with, Method};
+use super::slopes;
 use super::summary::{
     information_criteria, observed_norm, summarise_with_profiles, FitResult, ParamSpec, Solved,
     StatsRow,
 };
 use crate::inverse::estimate::information_criteria as fit_criteria;
 use crate::inverse::{
-    fit, profile_interval, Covariance, Fit, Infeasible, LsqOptions, ProfileInterval, Residuals,
-    SigmaKind, Termination,
+    fit, profile_interval, Covariance, Fit, Infeasible, LsqOptions, OdrModel, ProfileInterval,
+    Residuals, SigmaKind, Termination,
 };
 use crate::models::Model;
 use crate::progress::{Progress, ProgressEvent, Tally};
@@ -184,6 +185,32 @@ pub(crate) struct KLawProblem<'a> {
     /// Forward evaluations so far, and where they are reported.
     evals: AtomicU64,
     progress: Option<Progress>,
+}
+
+/// A law's points with their slopes as ODR inputs ([`super::slopes`]): v̄ of point i at slope δ
+/// and the K of the law there (K depends on ξ alone, not on δ).
+struct Slopes<'p, 'a>(&'p KLawProblem<'a>);
+
+impl OdrModel for Slopes<'_, '_> {
+    fn n_params(&self) -> usize {
+        self.0.n
+    }
+    fn n_points(&self) -> usize {
+        self.0.data.points.len()
+    }
+    fn value(&self, i: usize, delta: f64, p: &[f64]) -> Result<f64, Infeasible> {
+        let pr = self.0;
+        let scene = pr.data.points[i]
+            .scene
+            .with_delta(delta)
+            .map_err(|_| Infeasible)?;
+        let mut n = 0;
+        pr.tick(1);
+        match eval(&pr.model, &scene, pr.k_of(i, p), &mut n) {
+            Ok(s) if s.mean_velocity.is_finite() => Ok(s.mean_velocity),
+            _ => Err(Infeasible),
+        }
+    }
 }
 
 /// Points per rayon task: a stick/slip evaluation costs a few µs, so small batches already pay.
@@ -907,14 +934,20 @@ pub(crate) fn fit_law_in(
         distinct: None,
         observed_norm: Some(observed_norm(data.points.iter().map(|p| (&p.v, &p.sigma)))),
     };
-    let mut summary = match method {
+    let index: Vec<usize> = (0..m).collect();
+    let odr = slopes::summarise(method, &solved, Slopes(&problem), data, &index, false);
+    let slope_errors = odr.is_some();
+    let mut summary = match (odr, method) {
+        (Some(s), _) => s,
         // Independent parameters: each profiled on its own series.
-        Method::Lsq { profile: true, .. } if law == KLaw::FreePerSeries && problem.n > 1 => {
+        (None, Method::Lsq { profile: true, .. })
+            if law == KLaw::FreePerSeries && problem.n > 1 =>
+        {
             summarise_with_profiles(solved, |s| {
                 separable_profiles(&problem, s.fit, s.level, s.options)
             })
         }
-        _ => summarise_with(method, solved),
+        (None, _) => summarise_with(method, solved),
     };
     if law == KLaw::FreePerSeries {
         for (j, row) in summary.params.iter_mut().take(problem.n).enumerate() {
@@ -929,8 +962,20 @@ pub(crate) fn fit_law_in(
             );
         }
     }
-    let k = (0..m).map(|i| problem.k_of(i, &f.params)).collect();
-    summary.attach_points(data, &(0..m).collect::<Vec<_>>());
+    let params: Vec<f64> = if slope_errors {
+        summary
+            .params
+            .iter()
+            .take(problem.n)
+            .map(|r| r.value)
+            .collect()
+    } else {
+        f.params.clone()
+    };
+    let k = (0..m).map(|i| problem.k_of(i, &params)).collect();
+    if !slope_errors {
+        summary.attach_points(data, &index);
+    }
     Ok(KLawFit { law, summary, k })
 }
 
@@ -1001,6 +1046,7 @@ fn score_impact(model: Model, data: &Dataset, fit_name: String) -> KLawFit {
             condition: None,
             note,
             mcmc: None,
+            slope_errors: false,
         },
         draws: None,
         correlation: None,

@@ -13,6 +13,7 @@ pub mod jan;
 pub mod k;
 pub mod klaw;
 pub mod posterior;
+pub(crate) mod slopes;
 #[cfg(test)]
 mod suite;
 pub mod summary;

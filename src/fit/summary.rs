@@ -163,6 +163,9 @@ pub struct StatsRow {
     pub note: String,
     /// The sampler's account, for a posterior run.
     pub mcmc: Option<McmcStats>,
+    /// True when the slopes were taken as measured with error: a least-squares fit is then
+    /// an orthogonal distance regression (`method` = `odr`), and χ² its objective.
+    pub slope_errors: bool,
 }
 
 /// A fit with σ given whose reduced χ² exceeds this is flagged ([`StatsRow::absurd_misfit`]):
@@ -389,6 +392,11 @@ pub struct PointFit {
     /// (v − v_fit)/σ; without σ, divided by the scatter estimated from the fit,
     /// sqrt(χ²/dof).
     pub normalised_residual: f64,
+    /// The adjusted slope, degrees, when the fit treated the slopes as measured with error
+    /// (orthogonal distance regression); `None` otherwise.
+    pub delta_fit_deg: Option<f64>,
+    /// (δ_fit − δ)/σ_δ, when the slope carries an uncertainty σ_δ > 0 in such a fit.
+    pub delta_residual: Option<f64>,
 }
 
 /// A parameter name that a fit does not have.
@@ -503,6 +511,8 @@ impl FitResult {
                     v_fit: p.v - residual,
                     residual,
                     normalised_residual: r / scatter,
+                    delta_fit_deg: None,
+                    delta_residual: None,
                 }
             })
             .collect();
@@ -795,6 +805,7 @@ pub(crate) fn summarise_with_profiles<R: Residuals + ?Sized>(
             condition: f.covariance.as_ref().map(|c| c.condition),
             note,
             mcmc: None,
+            slope_errors: false,
         },
         draws: None,
         correlation: f

@@ -199,6 +199,104 @@ impl<M: OdrModel> OdrProblem<M> {
     fn free(&self, i: usize) -> bool {
         self.inv_sx[i] > 0.0
     }
+
+    /// The best correction of input i at parameters β, from `at` = (r_i, ρ_i, δ_i), a feasible
+    /// point: Gauss–Newton steps on r_i(δ)² + ρ_i(δ)², each halved until it lowers the sum
+    /// (at most `SETTLE` steps, stopping once a step gains less than 1e-15 of it); returns the
+    /// point reached, counting model evaluations into `evals`.
+    fn correct(
+        &self,
+        i: usize,
+        beta: &[f64],
+        at: (f64, f64, f64),
+        evals: &mut usize,
+    ) -> (f64, f64, f64) {
+        let (mut r, mut rho, mut delta) = at;
+        if !self.free(i) {
+            return at;
+        }
+        let (isy, isx) = (self.inv_sy[i], self.inv_sx[i]);
+        let mut g = vec![0.0; beta.len()];
+        for _ in 0..SETTLE {
+            let xi = self.x[i] + delta;
+            let f0 = self.y[i] - r / isy;
+            *evals += 1;
+            let fx = match self.model.derivatives(i, xi, beta, &mut g) {
+                Some(Ok(fx)) => Some(fx),
+                Some(Err(_)) => None,
+                None => {
+                    let h = STEP * xi.abs().max(self.sx[i]);
+                    let inf = f64::INFINITY;
+                    difference(f0, h, -inf, inf, |t| self.model.value(i, xi + t, beta).ok())
+                }
+            };
+            let Some(fx) = fx.filter(|v| v.is_finite()) else {
+                break;
+            };
+            let d = -fx * isy;
+            let mut t = -(d * r + isx * rho) / (d * d + isx * isx);
+            let before = r * r + rho * rho;
+            let mut gain = 0.0;
+            for _ in 0..30 {
+                let trial = delta + t;
+                if let Ok(f) = self.model.value(i, self.x[i] + trial, beta) {
+                    let (r1, rho1) = ((self.y[i] - f) * isy, trial * isx);
+                    let after = r1 * r1 + rho1 * rho1;
+                    if after < before {
+                        (r, rho, delta, gain) = (r1, rho1, trial, before - after);
+                        break;
+                    }
+                }
+                t *= 0.5;
+            }
+            if !(gain > 1e-15 * before) {
+                break;
+            }
+        }
+        (r, rho, delta)
+    }
+
+    /// The objective minimised over the corrections at each β, as least-squares residuals
+    /// (r_i, then ρ_i, at each input's best correction, searched from `delta`): what the
+    /// profile intervals of an ODR fit profile.
+    pub(crate) fn reduced(&self, delta: Vec<f64>) -> Reduced<'_, M> {
+        Reduced {
+            problem: self,
+            delta,
+        }
+    }
+}
+
+/// [`OdrProblem::reduced`]: S(β, δ*(β)) as 2n residuals of β alone.
+pub(crate) struct Reduced<'a, M> {
+    problem: &'a OdrProblem<M>,
+    /// The corrections each evaluation starts its search from (the fit's).
+    delta: Vec<f64>,
+}
+
+impl<M: OdrModel> Residuals for Reduced<'_, M> {
+    fn n_params(&self) -> usize {
+        self.problem.p()
+    }
+    fn n_residuals(&self) -> usize {
+        2 * self.problem.n()
+    }
+    fn residuals(&self, p: &[f64], out: &mut [f64]) -> Result<(), Infeasible> {
+        let pr = self.problem;
+        let n = pr.n();
+        let mut evals = 0;
+        for i in 0..n {
+            // From the fit's correction, else from the measured input.
+            let start = [self.delta[i], 0.0].into_iter().find_map(|d| {
+                let f = pr.model.value(i, pr.x[i] + d, p).ok()?;
+                Some(((pr.y[i] - f) * pr.inv_sy[i], d * pr.inv_sx[i], d))
+            });
+            let (r, rho, _) = pr.correct(i, p, start.ok_or(Infeasible)?, &mut evals);
+            out[i] = r;
+            out[n + i] = rho;
+        }
+        Ok(())
+    }
 }
 
 /// The dimensions alone, for the checks of the start, box and typical magnitudes shared with
@@ -326,6 +424,14 @@ impl Odr {
     /// evaluations counted into `opts.progress`), then the covariance at the estimate.
     /// Numerical failure is reported in the fit's `termination`.
     pub fn fit<M: OdrModel>(problem: OdrProblem<M>, opts: &LsqOptions) -> Result<OdrFit, LsqError> {
+        Self::fit_keep(problem, opts).map(|(f, _)| f)
+    }
+
+    /// As [`Odr::fit`], handing the problem back.
+    pub(crate) fn fit_keep<M: OdrModel>(
+        problem: OdrProblem<M>,
+        opts: &LsqOptions,
+    ) -> Result<(OdrFit, OdrProblem<M>), LsqError> {
         let solver = Odr::new(opts);
         let mut exec = Executor::new(problem, solver)
             .configure(|s| s.max_iters(opts.max_iterations as u64))
@@ -345,7 +451,7 @@ impl Odr {
             Some(TerminationReason::MaxItersReached) => Termination::MaxIterations,
             _ => Termination::Interrupted,
         });
-        Ok(solver.finish(&problem, termination, opts.sigma))
+        Ok((solver.finish(&problem, termination, opts.sigma), problem))
     }
 
     /// Why the solver stopped, once it has.
@@ -589,63 +695,19 @@ impl Odr {
         }
     }
 
-    /// Moves every correction to its best value at the start's parameters: for each point,
-    /// Gauss–Newton steps on (r_i(δ_i)² + ρ_i(δ_i)²), halved until they lower it, at most
-    /// `SETTLE` of them. The iteration then starts from the parameters' best corrections, not
-    /// from δ = 0, whose objective may be dominated by inputs far from the curve (the first
-    /// steps then see every input pulled and can walk into a local minimum: SciPy's Pearson
-    /// data with x and y exchanged).
+    /// Moves every correction to its best value at the start's parameters
+    /// ([`OdrProblem::correct`]). The iteration then starts from the parameters' best
+    /// corrections, not from δ = 0, whose objective may be dominated by inputs far from the
+    /// curve (the first steps then see every input pulled and can walk into a local minimum:
+    /// SciPy's Pearson data with x and y exchanged).
     fn settle<M: OdrModel>(&mut self, pr: &OdrProblem<M>) {
-        let beta = self.cur.beta.clone();
-        let mut g = vec![0.0; pr.p()];
         for i in 0..pr.n() {
-            if !pr.free(i) {
-                continue;
-            }
-            let (isy, isx) = (pr.inv_sy[i], pr.inv_sx[i]);
-            let phi = |r: f64, rho: f64| r * r + rho * rho;
-            for _ in 0..SETTLE {
-                let (r, rho, delta) = (self.cur.r[i], self.cur.rho[i], self.cur.delta[i]);
-                let xi = pr.x[i] + delta;
-                let f0 = pr.y[i] - r / isy;
-                self.nfev += 1;
-                let fx = match pr.model.derivatives(i, xi, &beta, &mut g) {
-                    Some(Ok(fx)) => Some(fx),
-                    Some(Err(_)) => None,
-                    None => {
-                        let h = STEP * xi.abs().max(pr.sx[i]);
-                        let inf = f64::INFINITY;
-                        difference(f0, h, -inf, inf, |t| pr.model.value(i, xi + t, &beta).ok())
-                    }
-                };
-                let Some(fx) = fx.filter(|v| v.is_finite()) else {
-                    break;
-                };
-                let d = -fx * isy;
-                let mut t = -(d * r + isx * rho) / (d * d + isx * isx);
-                let before = phi(r, rho);
-                let mut moved = false;
-                for _ in 0..30 {
-                    let trial = delta + t;
-                    if let Ok(f) = pr.model.value(i, pr.x[i] + trial, &beta) {
-                        let (r1, rho1) = ((pr.y[i] - f) * isy, trial * isx);
-                        if r1.is_finite() && phi(r1, rho1) < before {
-                            self.cur.s += phi(r1, rho1) - before;
-                            self.cur.r[i] = r1;
-                            self.cur.rho[i] = rho1;
-                            self.cur.delta[i] = trial;
-                            moved = true;
-                            break;
-                        }
-                    }
-                    t *= 0.5;
-                }
-                if !moved || before - phi(self.cur.r[i], self.cur.rho[i]) <= 1e-12 * before {
-                    break;
-                }
-            }
+            let (r, rho, delta) = (self.cur.r[i], self.cur.rho[i], self.cur.delta[i]);
+            let (r, rho, delta) = pr.correct(i, &self.cur.beta, (r, rho, delta), &mut self.nfev);
+            self.cur.r[i] = r;
+            self.cur.rho[i] = rho;
+            self.cur.delta[i] = delta;
         }
-        // The running sum drifts by rounding: the objective afresh.
         self.cur.s = self.cur.r.iter().chain(&self.cur.rho).map(|v| v * v).sum();
     }
 

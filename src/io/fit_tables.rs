@@ -3,7 +3,9 @@
 //! contact model's bead-by-bead transient (`simulate --v0`), and every point against its fit
 //! (residuals.csv) and every pair of parameters with its correlation (correlations.csv).
 
-use super::records::{to_csv, CorrelationRecord, ParamRecord, ResidualRecord, StatsRecord};
+use super::records::{
+    to_csv, CorrelationRecord, ParamRecord, ResidualRecord, SlopeResidualRecord, StatsRecord,
+};
 use crate::fit::posterior::draws_column;
 use crate::fit::summary::{FitResult, ParamRow, StatsRow};
 use crate::models::contact::{Contact, ContactEnd, Launch};
@@ -91,8 +93,18 @@ pub fn draws_csv(posteriors: &[&FitResult]) -> csv::Result<Vec<u8>> {
 /// the measured v̄ and σ, the fitted v̄ at the reported estimate, the residual v − v̄_fit and
 /// the normalised residual (v − v̄_fit)/σ (without σ, divided by the scatter estimated from the
 /// fit). Cells are empty where there is no σ or no steady state.
+///
+/// When some fit took the slopes as measured with error, two more columns follow:
+/// `delta_fit_deg`, the adjusted slope, and `delta_residual`, (δ_fit − δ)/σ_δ.
 pub fn residuals_csv(fits: &[&FitResult]) -> csv::Result<Vec<u8>> {
-    to_csv(ResidualRecord::of(fits))
+    let slopes = fits
+        .iter()
+        .any(|f| f.points.iter().any(|p| p.delta_fit_deg.is_some()));
+    if slopes {
+        to_csv(SlopeResidualRecord::of(fits))
+    } else {
+        to_csv(ResidualRecord::of(fits))
+    }
 }
 
 /// Every pair of parameters of every fit with its correlation, one [`CorrelationRecord`] per

@@ -247,7 +247,14 @@ impl From<&StatsRow> for StatsRecord {
             .into(),
             condition: r.condition,
             note: r.note.clone(),
-            method: if m.is_some() { "mcmc" } else { "lsq" }.into(),
+            method: if m.is_some() {
+                "mcmc"
+            } else if r.slope_errors {
+                "odr"
+            } else {
+                "lsq"
+            }
+            .into(),
             mcmc_status: m.map(|m| m.status.clone()),
             walkers: m.map(|m| m.walkers as u64),
             steps: m.map(|m| m.steps as u64),
@@ -285,6 +292,50 @@ pub struct ResidualRecord {
     pub residual: f64,
     /// (v − v̄_fit)/σ (without σ, divided by the scatter estimated from the fit).
     pub normalised_residual: f64,
+}
+
+/// A [`ResidualRecord`] with the adjusted slope of a fit that took the slopes as measured
+/// with error: the columns `delta_fit_deg` (δ_fit, degrees) and `delta_residual`
+/// ((δ_fit − δ)/σ_δ, empty where the slope is exact) after the others.
+#[derive(Debug, Clone, Default, Serialize)]
+pub(crate) struct SlopeResidualRecord {
+    fit: String,
+    series: String,
+    xi: f64,
+    delta_deg: f64,
+    v: f64,
+    sigma_v: Option<f64>,
+    v_fit: f64,
+    residual: f64,
+    normalised_residual: f64,
+    delta_fit_deg: Option<f64>,
+    delta_residual: Option<f64>,
+}
+
+impl SlopeResidualRecord {
+    /// Every point of every fit, in order.
+    pub fn of(fits: &[&FitResult]) -> Vec<Self> {
+        fits.iter()
+            .flat_map(|f| {
+                f.points.iter().map(|p| {
+                    let b = ResidualRecord::new(&f.stats.fit, p);
+                    SlopeResidualRecord {
+                        fit: b.fit,
+                        series: b.series,
+                        xi: b.xi,
+                        delta_deg: b.delta_deg,
+                        v: b.v,
+                        sigma_v: b.sigma_v,
+                        v_fit: b.v_fit,
+                        residual: b.residual,
+                        normalised_residual: b.normalised_residual,
+                        delta_fit_deg: p.delta_fit_deg,
+                        delta_residual: p.delta_residual,
+                    }
+                })
+            })
+            .collect()
+    }
 }
 
 impl ResidualRecord {

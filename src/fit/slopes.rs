@@ -1,0 +1,174 @@
+//! Slopes measured with error: the fits' way to orthogonal distance regression
+//! ([`crate::inverse::odr`]). When some point carries σ_δ > 0 (column `sigma_delta_deg`, or
+//! `--sigma-delta`), a least-squares fit of `klaw`, `jan` or `jaeger` is refitted from its
+//! Levenberg–Marquardt optimum by ODR, with the slope δ as the input that carries error:
+//!
+//! S(β, δ̂) = Σ_i [ ((v_i − v̄_i(δ̂_i; β))/σ_v,i)² + ((δ̂_i − δ_i)/σ_δ,i)² ].
+//!
+//! χ² is S, the covariance ODRPACK's (the effective variance σ_v² + (∂v̄/∂δ)² σ_δ² at the
+//! adjusted slopes), and the profile intervals profile S minimised over the slopes at each
+//! parameter value. A point whose slope is exact (σ_δ = 0) keeps it. An adjusted slope never
+//! leaves the point's steady range: a trial step that would take one out is rejected.
+
+use super::data::Dataset;
+use super::summary::{self, FitResult, Solved};
+use crate::inverse::posterior::Method;
+use crate::inverse::{
+    CurveModel, Fit, Infeasible, LsqOptions, Odr, OdrFit, OdrModel, OdrProblem, Residuals,
+    SigmaKind,
+};
+
+/// A [`CurveModel`] fit whose abscissa of point i is built from the point's slope by `at`:
+/// the ODR model of `jan` and `jaeger`.
+pub(crate) struct SlopeCurve<'a, X, M> {
+    /// The least-squares model.
+    pub model: &'a M,
+    /// The abscissae at the measured slopes.
+    pub base: &'a [X],
+    /// The abscissa of a point (its measured one) at slope δ (radians).
+    pub at: fn(&X, f64) -> X,
+}
+
+impl<X, M: CurveModel<X>> OdrModel for SlopeCurve<'_, X, M> {
+    fn n_params(&self) -> usize {
+        self.model.n_params()
+    }
+    fn n_points(&self) -> usize {
+        self.base.len()
+    }
+    fn value(&self, i: usize, delta: f64, p: &[f64]) -> Result<f64, Infeasible> {
+        if !(delta > 0.0 && delta < std::f64::consts::FRAC_PI_2) {
+            return Err(Infeasible);
+        }
+        self.model.value(&(self.at)(&self.base[i], delta), p)
+    }
+}
+
+/// The ODR refit of a least-squares fit: the problem (for the profiles) and the fit.
+pub(crate) struct SlopeFit<M> {
+    pub problem: OdrProblem<M>,
+    pub odr: OdrFit,
+}
+
+impl<M: OdrModel> SlopeFit<M> {
+    /// The ODR fit of `model` to the points `index` of `data` (in the model's order), started
+    /// from the least-squares optimum `lm`, with the options of that fit (`bounds` false drops
+    /// its box: the box of a law is where every point is steady at its measured slope, and the
+    /// adjusted slopes have their own). `None` when no point of `index` carries σ_δ.
+    pub fn new(
+        model: M,
+        data: &Dataset,
+        index: &[usize],
+        lm: &Fit,
+        opts: &LsqOptions,
+        bounds: bool,
+    ) -> Option<Result<Self, String>> {
+        if !index.iter().any(|&i| data.points[i].sigma_delta > 0.0) {
+            return None;
+        }
+        let pts = index.iter().map(|&i| &data.points[i]);
+        let x = pts.clone().map(|p| p.scene.delta).collect();
+        let y = pts.clone().map(|p| p.v).collect();
+        let sx = pts.clone().map(|p| p.sigma_delta).collect();
+        let sy = (data.sigma == SigmaKind::Absolute).then(|| pts.map(|p| p.sigma).collect());
+        let opts = if bounds {
+            opts.clone()
+        } else {
+            LsqOptions {
+                lower: None,
+                upper: None,
+                ..opts.clone()
+            }
+        };
+        Some(
+            OdrProblem::new(model, x, y, sx, sy, &lm.params, &opts)
+                .and_then(|problem| {
+                    let (odr, problem) = Odr::fit_keep(problem, &opts)?;
+                    Ok(SlopeFit { problem, odr })
+                })
+                .map_err(|e| e.to_string()),
+        )
+    }
+
+    /// The corrections δ̂ − δ of the fit.
+    pub fn corrections(&self, data: &Dataset, index: &[usize]) -> Vec<f64> {
+        index
+            .iter()
+            .zip(&self.odr.x_fit)
+            .map(|(&i, x)| x - data.points[i].scene.delta)
+            .collect()
+    }
+}
+
+/// Marks `summary` as an ODR fit and gives its points (`index` of `data`, in order) their
+/// adjusted slopes and slope residuals.
+pub(crate) fn attach(summary: &mut FitResult, odr: &OdrFit, data: &Dataset, index: &[usize]) {
+    summary.stats.slope_errors = true;
+    for ((pt, &i), (x, rx)) in summary
+        .points
+        .iter_mut()
+        .zip(index)
+        .zip(odr.x_fit.iter().zip(&odr.x_residuals))
+    {
+        pt.delta_fit_deg = Some(x.to_degrees());
+        pt.delta_residual = (data.points[i].sigma_delta > 0.0).then_some(*rx);
+    }
+}
+
+/// The summary of a least-squares fit (`solved`, of the points `index` of `data`) refitted by
+/// ODR on `model` when those points carry slope errors, with its points, their adjusted
+/// slopes, and profiles of the ODR objective when `method` asks for profiles; `None` when
+/// they carry none, or for a posterior run. `bounds`: keep the least-squares box (see
+/// [`SlopeFit::new`]). A refit the solver refuses keeps the least-squares estimate, with a
+/// note saying why.
+pub(crate) fn summarise<R: Residuals + ?Sized, M: OdrModel>(
+    method: &Method,
+    solved: &Solved<'_, R>,
+    model: M,
+    data: &Dataset,
+    index: &[usize],
+    bounds: bool,
+) -> Option<FitResult> {
+    let Method::Lsq { profile, .. } = method else {
+        return None;
+    };
+    let sf = match SlopeFit::new(model, data, index, solved.fit, solved.options, bounds)? {
+        Ok(sf) => sf,
+        Err(e) => {
+            let mut s = summary::summarise(*solved, *profile);
+            s.stats.note = summary::join(
+                &s.stats.note,
+                &format!("orthogonal distance regression refused ({e}): slopes taken as exact"),
+            );
+            s.attach_points(data, index);
+            return Some(s);
+        }
+    };
+    let reduced = sf.problem.reduced(sf.corrections(data, index));
+    let opts = if bounds {
+        solved.options.clone()
+    } else {
+        LsqOptions {
+            lower: None,
+            upper: None,
+            ..solved.options.clone()
+        }
+    };
+    let mut s = summary::summarise(
+        Solved {
+            name: solved.name,
+            series: solved.series,
+            specs: solved.specs,
+            problem: &reduced,
+            fit: &sf.odr.fit,
+            level: solved.level,
+            options: &opts,
+            distinct: solved.distinct,
+            observed_norm: solved.observed_norm,
+        },
+        *profile,
+    );
+    s.attach_points(data, index);
+    attach(&mut s, &sf.odr, data, index);
+    Some(s)
+}

@@ -38,11 +38,14 @@ impl Default for Common {
 }
 
 impl Common {
-    fn check(&self) -> Result<(), FitError> {
-        if self.level > 0.0 && self.level < 1.0 {
-            Ok(())
-        } else {
-            Err(FitError::Level(self.level))
+    /// Refuses a level outside (0, 1) and a method that cannot fit `data`.
+    fn check(&self, data: &Dataset) -> Result<(), FitError> {
+        if !(self.level > 0.0 && self.level < 1.0) {
+            return Err(FitError::Level(self.level));
+        }
+        match super::slopes::unsupported(&self.method, data) {
+            Some(why) => Err(FitError::Method(why)),
+            None => Ok(()),
         }
     }
 }
@@ -93,7 +96,7 @@ impl KLawFitter {
 
     /// Fits the law to `data` (the impact law, with nothing to fit, is scored).
     pub fn fit(&self, data: &Dataset) -> Result<FitResult, FitError> {
-        self.common.check()?;
+        self.common.check(data)?;
         let f = fit_law_with(
             self.model,
             data,
@@ -121,7 +124,7 @@ impl JanFitter {
 
     /// Fits every series with at least 3 points, then the global laws.
     pub fn fit(&self, data: &Dataset) -> Result<FitSet, FitError> {
-        self.common.check()?;
+        self.common.check(data)?;
         let j = fit_jan_with(data, self.common.level, &self.common.method);
         Ok(FitSet {
             fits: j.series.into_iter().flatten().chain(j.global).collect(),
@@ -156,7 +159,7 @@ impl JaegerFitter {
 
     /// Fits every series with at least 4 points.
     pub fn fit(&self, data: &Dataset) -> Result<FitSet, FitError> {
-        self.common.check()?;
+        self.common.check(data)?;
         let j = fit_jaeger_with(data, self.branch, self.common.level, &self.common.method);
         Ok(FitSet {
             fits: j.series.into_iter().flatten().map(|f| f.summary).collect(),

@@ -14,6 +14,9 @@ pub enum FitError {
     /// A confidence level outside (0, 1).
     #[error("confidence level {0} is not in (0, 1)")]
     Level(f64),
+    /// The method cannot fit these data (a posterior run on slopes that carry errors).
+    #[error("{0}")]
+    Method(String),
     /// A parameter name that the fit does not have.
     #[error(transparent)]
     NoSuchParameter(#[from] NoSuchParameter),

@@ -172,3 +172,16 @@ pub(crate) fn summarise<R: Residuals + ?Sized, M: OdrModel>(
     attach(&mut s, &sf.odr, data, index);
     Some(s)
 }
+
+/// Why `method` cannot fit `data`, if it cannot: a posterior run on slopes that carry errors
+/// (its likelihood would have to integrate over each point's true slope, which the sampler
+/// does not do; it would treat the slopes as exact and report intervals too narrow).
+pub(crate) fn unsupported(method: &Method, data: &Dataset) -> Option<String> {
+    (matches!(method, Method::Mcmc(_)) && data.has_slope_errors()).then(|| {
+        "posterior sampling does not take slope errors (sigma_delta_deg or --sigma-delta): \
+         it would treat the slopes as exact and its intervals would be too narrow; use \
+         --method lsq (orthogonal distance regression), or --sigma-delta 0 to take the \
+         slopes as exact knowingly"
+            .into()
+    })
+}

@@ -4,6 +4,7 @@
 use super::fit_run::FitRun;
 use super::{jaeger, jan, klaw, setting_error, RunError};
 use crate::fit::klaw::KLaw;
+use crate::fit::slopes;
 use crate::fit::summary::{FitResult, McmcFailure};
 use crate::inverse::posterior::{Method, SCALE_NAME};
 use crate::io::fmt_f64;
@@ -83,6 +84,9 @@ impl FitCommand {
         note: &mut dyn FnMut(&str),
     ) -> Result<FitRun, RunError> {
         self.check(&method, level)?;
+        if let Some(why) = slopes::unsupported(&method, file.dataset()) {
+            return Err(setting_error("--method", "mcmc", why));
+        }
         let progress = progress.filter(|_| matches!(method, Method::Lsq { .. }));
         let run = match *self {
             FitCommand::Klaw {

@@ -851,9 +851,14 @@ impl PyDataset {
     #[staticmethod]
     #[pyo3(signature = (path, rho=0.4, f=0.1, g=9.81))]
     fn from_csv(path: &str, rho: f64, f: f64, g: f64) -> PyResult<Self> {
-        let d = MeasurementDefaults { rho, f, g }
-            .checked()
-            .map_err(|e| value_error(e.to_string()))?;
+        let d = MeasurementDefaults {
+            rho,
+            f,
+            g,
+            ..MeasurementDefaults::default()
+        }
+        .checked()
+        .map_err(|e| value_error(e.to_string()))?;
         let m = MeasurementFile::read(std::path::Path::new(path), &d)
             .map_err(|e| value_error(e.to_string()))?;
         Ok(PyDataset::of_file(m))
@@ -863,9 +868,14 @@ impl PyDataset {
     #[staticmethod]
     #[pyo3(signature = (text, source, rho=0.4, f=0.1, g=9.81))]
     fn from_text(text: &str, source: &str, rho: f64, f: f64, g: f64) -> PyResult<Self> {
-        let d = MeasurementDefaults { rho, f, g }
-            .checked()
-            .map_err(|e| value_error(e.to_string()))?;
+        let d = MeasurementDefaults {
+            rho,
+            f,
+            g,
+            ..MeasurementDefaults::default()
+        }
+        .checked()
+        .map_err(|e| value_error(e.to_string()))?;
         let m = MeasurementFile::parse(source, text.as_bytes(), &d)
             .map_err(|e| value_error(e.to_string()))?;
         Ok(PyDataset::of_file(m))
@@ -880,6 +890,7 @@ impl PyDataset {
             rho: rho.unwrap_or(base.rho),
             f: f.unwrap_or(base.f),
             g: g.unwrap_or(base.g),
+            ..base
         }
         .checked()
         .map_err(|e| value_error(e.to_string()))?;

@@ -5,7 +5,9 @@
 //! with an optional `sigma_v`, or `v_m_s` with `R_m` (the row beads' radius, metres), an
 //! optional `g` (m/s²) and an optional `sigma_v_m_s`, converted with
 //! v = v_m_s / sqrt(g R (1 + ξ)). Optional `series` (rows without one are grouped by ξ),
-//! `rho` and `f` (per-row values of the defaults). A series may not mix ξ values.
+//! `rho` and `f` (per-row values of the defaults), `sigma_delta_deg` (the standard uncertainty
+//! of the slope in degrees, ≥ 0; a missing column or an empty cell takes the default, 0: the
+//! slope is exact). A series may not mix ξ values.
 //!
 //! Units are never guessed: `sigma_v_m_s` beside `v`, `sigma_v` beside `v_m_s`, and `v` beside
 //! `v_m_s` with `R_m` are errors. A file can still read fine in the wrong unit (slopes in
@@ -26,9 +28,10 @@ pub(crate) const DEFAULT_DATA: &str = include_str!("../../data/default.csv");
 /// The name the default data set goes by in messages.
 pub(crate) const DEFAULT_DATA_NAME: &str = "<embedded default data: data/default.csv>";
 
-/// Every column a measurement file may have (module docs); any other passes through `fitbead
-/// k` and is otherwise unused ([`super::scenes::check_columns`]).
-pub(crate) const MEASUREMENT_COLUMNS: [&str; 11] = [
+/// Every column a measurement file may have (module docs), with `delta_true_deg` (the true
+/// slope `fitbead simulate` writes beside a noisy one, not read); any other passes through
+/// `fitbead k` and is otherwise unused ([`super::scenes::check_columns`]).
+pub(crate) const MEASUREMENT_COLUMNS: [&str; 13] = [
     "xi",
     "delta_deg",
     "series",
@@ -40,6 +43,8 @@ pub(crate) const MEASUREMENT_COLUMNS: [&str; 11] = [
     "g",
     "rho",
     "f",
+    "sigma_delta_deg",
+    "delta_true_deg",
 ];
 
 /// Values for the columns a measurement file may leave out.
@@ -51,25 +56,34 @@ pub struct MeasurementDefaults {
     pub f: f64,
     /// Gravity g (m/s²) of dimensional rows without a `g` column.
     pub g: f64,
+    /// Standard uncertainty of the slope, degrees, of rows without a `sigma_delta_deg` value
+    /// (0: the slopes are exact).
+    pub sigma_delta_deg: f64,
 }
 
 impl Default for MeasurementDefaults {
-    /// ρ = 0.4 (a sphere), f = 0.1, g = 9.81 m/s².
+    /// ρ = 0.4 (a sphere), f = 0.1, g = 9.81 m/s², exact slopes (σ_δ = 0).
     fn default() -> Self {
         MeasurementDefaults {
             rho: 0.4,
             f: 0.1,
             g: 9.81,
+            sigma_delta_deg: 0.0,
         }
     }
 }
 
 impl MeasurementDefaults {
-    /// These defaults as a command line's settings: ρ ≥ 0, f ≥ 0 and g > 0, all finite, or an
-    /// error naming `--rho`, `--f` or `--g` with its value.
+    /// These defaults as a command line's settings: ρ ≥ 0, f ≥ 0, σ_δ ≥ 0 and g > 0, all
+    /// finite, or an error naming `--rho`, `--f`, `--sigma-delta` or `--g` with its value.
     pub fn checked(self) -> Result<Self, InputError> {
         use super::setting_error;
-        for (name, x) in [("rho", self.rho), ("f", self.f)] {
+        let non_negative = [
+            ("rho", self.rho),
+            ("f", self.f),
+            ("sigma-delta", self.sigma_delta_deg),
+        ];
+        for (name, x) in non_negative {
             if !(x >= 0.0 && x.is_finite()) {
                 return Err(setting_error(
                     name,
@@ -84,7 +98,7 @@ impl MeasurementDefaults {
         Ok(self)
     }
 
-    /// Checks ρ ≥ 0, f ≥ 0 and g > 0, all finite.
+    /// Checks ρ ≥ 0, f ≥ 0, σ_δ ≥ 0 and g > 0, all finite.
     pub fn validate(&self, source: &str) -> Result<(), InputError> {
         let bad = |name: &str, x: f64, message: &str| InputError {
             file: source.to_string(),
@@ -93,7 +107,12 @@ impl MeasurementDefaults {
             value: Some(x.to_string()),
             message: format!("default {message}"),
         };
-        for (name, x) in [("rho", self.rho), ("f", self.f)] {
+        let non_negative = [
+            ("rho", self.rho),
+            ("f", self.f),
+            ("sigma_delta_deg", self.sigma_delta_deg),
+        ];
+        for (name, x) in non_negative {
             if !(x >= 0.0 && x.is_finite()) {
                 return Err(bad(name, x, "must be a finite number >= 0"));
             }
@@ -116,6 +135,8 @@ pub(crate) struct Measurement {
     pub v: f64,
     /// Its standard deviation, when given.
     pub sigma_v: Option<f64>,
+    /// Standard uncertainty of the slope, radians (0: exact).
+    pub sigma_delta: f64,
 }
 
 /// Where the measurement columns are in a table (module docs), with the defaults of the
@@ -134,6 +155,7 @@ pub(crate) struct MeasurementColumns {
     g: Option<usize>,
     rho: Option<usize>,
     f: Option<usize>,
+    sigma_delta_deg: Option<usize>,
     defaults: MeasurementDefaults,
 }
 
@@ -146,6 +168,8 @@ pub(crate) struct Measured {
     pub v: f64,
     /// Its standard deviation, when given.
     pub sigma_v: Option<f64>,
+    /// Standard uncertainty of the slope, radians (0: exact).
+    pub sigma_delta: f64,
 }
 
 /// What the checks across rows keep: per series, the first ξ and its line (a series may not
@@ -177,6 +201,7 @@ impl MeasurementColumns {
             g: t.col("g"),
             rho: t.col("rho"),
             f: t.col("f"),
+            sigma_delta_deg: t.col("sigma_delta_deg"),
             defaults: *defaults,
         };
         if c.v.is_none() && c.v_m_s.is_none() {
@@ -245,7 +270,12 @@ impl MeasurementColumns {
     /// [`MeasurementColumns::read`], its scene built by [`Scene::new_like`] from `like` (the
     /// scene of a row read before, usually the one before it).
     pub fn read_like(&self, r: &Row<'_>, like: Option<&Scene>) -> Result<Measured, InputError> {
-        let MeasurementDefaults { rho, f, g } = self.defaults;
+        let MeasurementDefaults {
+            rho,
+            f,
+            g,
+            sigma_delta_deg,
+        } = self.defaults;
         let xi = r.number(self.xi)?;
         let d = r.number(self.delta_deg)?;
         let rho = r.opt_number(self.rho)?.unwrap_or(rho);
@@ -308,7 +338,16 @@ impl MeasurementColumns {
                 (vms / scale, s)
             }
         };
-        Ok(Measured { scene, v, sigma_v })
+        let sigma_delta_deg = match given(self.sigma_delta_deg) {
+            Some(c) => non_negative(r, c, "sigma_delta_deg")?,
+            None => sigma_delta_deg,
+        };
+        Ok(Measured {
+            scene,
+            v,
+            sigma_v,
+            sigma_delta: sigma_delta_deg.to_radians(),
+        })
     }
 
     /// For a row of dimensional velocities (`v_m_s` with `R_m`, no `v`): the row beads' radius
@@ -404,6 +443,15 @@ fn positive(r: &Row<'_>, c: usize, what: &str) -> Result<f64, InputError> {
     }
 }
 
+fn non_negative(r: &Row<'_>, c: usize, what: &str) -> Result<f64, InputError> {
+    let x = r.number(c)?;
+    if x >= 0.0 {
+        Ok(x)
+    } else {
+        Err(r.err(c, format!("{what} must be >= 0")))
+    }
+}
+
 /// Reads and validates the measurements (dimensional input converted with
 /// v = v_m_s / sqrt(g R (1 + ξ))).
 pub(crate) fn read_measurements(
@@ -422,13 +470,14 @@ pub(crate) fn read_measurements(
             scene: m.scene,
             v: m.v,
             sigma_v: m.sigma_v,
+            sigma_delta: m.sigma_delta,
         });
     }
     Ok(rows)
 }
 
 /// Whether `ds` holds the measurements of the shipped synthetic data set ([`DEFAULT_DATA`]):
-/// the same series, ξ, δ, v and σ, whatever ρ and f it was read with.
+/// the same series, ξ, δ, v and σ, exact slopes, whatever ρ and f it was read with.
 pub(crate) fn is_shipped_data(ds: &Dataset) -> bool {
     let d = Dataset::default_data();
     ds.labels == d.labels
@@ -440,6 +489,7 @@ pub(crate) fn is_shipped_data(ds: &Dataset) -> bool {
                 && a.scene.delta_deg() == b.scene.delta_deg()
                 && a.v == b.v
                 && a.sigma == b.sigma
+                && a.sigma_delta == b.sigma_delta
         })
 }
 
@@ -481,7 +531,7 @@ pub(crate) fn si_conversion(t: &Table, defaults: &MeasurementDefaults) -> Option
 /// Groups validated measurements into a [`Dataset`]; `t` is the table they were read from
 /// (for the location of an error).
 pub(crate) fn dataset_of(t: &Table, rows: &[Measurement]) -> Result<Dataset, InputError> {
-    Dataset::new(
+    let mut ds = Dataset::new(
         rows.iter()
             .map(|r| (r.series.clone(), r.scene, r.v, r.sigma_v)),
     )
@@ -499,7 +549,12 @@ pub(crate) fn dataset_of(t: &Table, rows: &[Measurement]) -> Result<Dataset, Inp
                  or on none",
             )
         }
-    })
+    })?;
+    // One point per row, in the rows' order.
+    for (p, r) in ds.points.iter_mut().zip(rows) {
+        p.sigma_delta = r.sigma_delta;
+    }
+    Ok(ds)
 }
 
 /// A measurement file read whole: the table, its validated rows and their data set.
@@ -523,7 +578,7 @@ impl MeasurementFile {
     /// Reads `bytes`, named `source` in errors, as the command line reads a measurements file
     /// given to it: with `check_columns`, a column fitbead does not read is an error when
     /// `strict`, else a column close to a known name is a warning; the defaults are checked
-    /// (ρ ≥ 0, f ≥ 0, g > 0) once the table proved well formed; the data's plausibility
+    /// (ρ ≥ 0, f ≥ 0, σ_δ ≥ 0, g > 0) once the table proved well formed; the data's plausibility
     /// warnings (unit mistakes, [`MeasurementFile::plausibility`]) follow, each preceded by
     /// `source` and `: `. Every warning goes to `warn` as it is found.
     pub fn read_checked(
@@ -570,7 +625,7 @@ impl MeasurementFile {
     }
 
     /// The same file read again with `defaults` for the columns its rows leave out (ρ, f,
-    /// g).
+    /// g, σ_δ).
     pub fn with_defaults(&self, defaults: &MeasurementDefaults) -> Result<Self, InputError> {
         let rows = read_measurements(&self.table, defaults)?;
         let dataset = dataset_of(&self.table, &rows)?;
@@ -734,6 +789,7 @@ pub(crate) fn plausibility(t: &Table, rows: &[Measurement]) -> Vec<Implausible> 
             scene: m.scene,
             v: m.v,
             sigma_v: m.sigma_v,
+            sigma_delta: m.sigma_delta,
         };
         p.add(&t.row(i), &measured);
     }
@@ -976,5 +1032,103 @@ impl Plausibility {
             });
         }
         out
+    }
+}
+
+#[cfg(test)]
+mod slope_error_tests {
+    use super::*;
+
+    fn parse(text: &str, defaults: &MeasurementDefaults) -> Result<MeasurementFile, InputError> {
+        MeasurementFile::parse("m.csv", text.as_bytes(), defaults)
+    }
+
+    /// A bad `sigma_delta_deg` cell is refused with the file, line, column and value.
+    #[test]
+    fn bad_slope_uncertainties_are_located() {
+        for (cell, message) in [
+            ("-0.5", "sigma_delta_deg must be >= 0"),
+            ("NaN", "finite"),
+            ("inf", "finite"),
+            ("abc", "not a number"),
+        ] {
+            let text = format!(
+                "series,xi,delta_deg,v,sigma_delta_deg\na,1,12,0.3,0.1\na,1,14,0.4,{cell}\n"
+            );
+            let e = parse(&text, &MeasurementDefaults::default()).unwrap_err();
+            assert_eq!(e.file, "m.csv", "{cell}: {e}");
+            assert_eq!(e.line, Some(3), "{cell}: {e}");
+            assert_eq!(e.column.as_deref(), Some("sigma_delta_deg"), "{cell}: {e}");
+            assert_eq!(e.value.as_deref(), Some(cell), "{cell}: {e}");
+            assert!(e.message.contains(message), "{cell}: {e}");
+        }
+    }
+
+    /// The points carry σ_δ in radians; an empty cell or a missing column takes the default.
+    #[test]
+    fn slope_uncertainties_reach_the_points_in_radians() {
+        let text = "series,xi,delta_deg,v,sigma_delta_deg\na,1,12,0.3,0.5\na,1,14,0.4,\n\
+                    a,1,16,0.5,0\n";
+        let ds = parse(text, &MeasurementDefaults::default())
+            .unwrap()
+            .dataset;
+        let got: Vec<f64> = ds.points.iter().map(|p| p.sigma_delta).collect();
+        assert_eq!(got, [0.5f64.to_radians(), 0.0, 0.0]);
+        assert!(ds.has_slope_errors());
+        let d = MeasurementDefaults {
+            sigma_delta_deg: 0.25,
+            ..MeasurementDefaults::default()
+        };
+        let ds = parse(text, &d).unwrap().dataset;
+        let got: Vec<f64> = ds.points.iter().map(|p| p.sigma_delta).collect();
+        assert_eq!(got, [0.5f64.to_radians(), 0.25f64.to_radians(), 0.0]);
+        let plain = "series,xi,delta_deg,v\na,1,12,0.3\n";
+        let ds = parse(plain, &MeasurementDefaults::default())
+            .unwrap()
+            .dataset;
+        assert!(!ds.has_slope_errors());
+        let ds = parse(plain, &d).unwrap().dataset;
+        assert_eq!(ds.points[0].sigma_delta, 0.25f64.to_radians());
+        // Subsets keep each point's σ_δ.
+        assert_eq!(ds.only(0).points[0].sigma_delta, 0.25f64.to_radians());
+    }
+
+    /// A default σ_δ must be finite and ≥ 0, named as its flag on the command line.
+    #[test]
+    fn bad_default_slope_uncertainties_are_refused() {
+        for x in [-1.0, f64::NAN, f64::INFINITY] {
+            let d = MeasurementDefaults {
+                sigma_delta_deg: x,
+                ..MeasurementDefaults::default()
+            };
+            let e = d.checked().unwrap_err();
+            assert_eq!(e.column.as_deref(), Some("--sigma-delta"), "{x}: {e}");
+            let e = parse("xi,delta_deg,v\n1,12,0.3\n", &d).unwrap_err();
+            assert_eq!(e.column.as_deref(), Some("sigma_delta_deg"), "{x}: {e}");
+        }
+    }
+
+    /// `sigma_delta_deg` and `delta_true_deg` are columns fitbead knows: no near-miss warning,
+    /// no refusal under strict columns.
+    #[test]
+    fn slope_columns_are_known() {
+        let text = "series,xi,delta_deg,v,sigma_delta_deg,delta_true_deg\na,1,12,0.3,0.1,12.05\n";
+        let mut warnings = Vec::new();
+        let m = MeasurementFile::read_checked(
+            "m.csv",
+            text.as_bytes(),
+            &MeasurementDefaults::default(),
+            true,
+            true,
+            &mut |w| warnings.push(w.to_string()),
+        )
+        .unwrap();
+        assert!(
+            warnings
+                .iter()
+                .all(|w| !w.contains("not one fitbead reads")),
+            "{warnings:?}"
+        );
+        assert_eq!(m.dataset.points[0].sigma_delta, 0.1f64.to_radians());
     }
 }

@@ -46,6 +46,12 @@ pub struct SimulateSettings {
     /// Relative noise (`--noise`): v = v_true (1 + noise · z), σ = noise · v_true, with z
     /// standard normal truncated to v > 0 (drawn again until the velocity is positive).
     pub noise: f64,
+    /// Standard uncertainty of the recorded slope, degrees (`--sigma-delta`): each point's
+    /// `delta_deg` is δ_true + σ_δ · z (z standard normal from the seed's stream, drawn after
+    /// the velocity's, truncated to a slope in (0, 90) degrees), its velocity made at
+    /// δ_true; the columns `sigma_delta_deg` and `delta_true_deg` follow the others. 0: the
+    /// slopes are exact and no draw is made.
+    pub sigma_delta: f64,
     /// Seed of the random stream (`--seed`).
     pub seed: u64,
     /// Gyration parameter ρ (`--rho`).
@@ -92,6 +98,7 @@ impl std::fmt::Debug for SimulateSettings {
             .field("series", &self.series)
             .field("points", &self.points)
             .field("noise", &self.noise)
+            .field("sigma_delta", &self.sigma_delta)
             .field("seed", &self.seed)
             .field("rho", &self.rho)
             .field("f", &self.f)
@@ -119,6 +126,7 @@ impl Default for SimulateSettings {
             series: vec![0.8, 1.0, 1.6, 2.0],
             points: 9,
             noise: 0.02,
+            sigma_delta: 0.0,
             seed: 1,
             rho: 0.4,
             f: 0.1,
@@ -147,7 +155,8 @@ impl SimulateSettings {
     pub const MAX_POINTS: usize = MAX_POINTS;
 
     /// Runs `fitbead simulate`: the CSV it writes (`series,xi,delta_deg,v,sigma_v,v_true`, md
-    /// adding `v_md_stderr,v_m_s`; with `v0` the transient's columns).
+    /// adding `v_md_stderr,v_m_s`, σ_δ > 0 then `sigma_delta_deg,delta_true_deg`; with `v0`
+    /// the transient's columns).
     pub fn run(&self) -> Result<Vec<u8>, RunError> {
         simulate(self)
     }
@@ -162,6 +171,13 @@ impl SimulateSettings {
 /// [`SimulateSettings::run`].
 fn simulate(a: &SimulateSettings) -> Result<Vec<u8>, RunError> {
     check_series(a)?;
+    if !(a.sigma_delta.is_finite() && (0.0..90.0).contains(&a.sigma_delta)) {
+        return Err(flag_error(
+            "--sigma-delta",
+            &a.sigma_delta.to_string(),
+            "must be a finite number of degrees >= 0 and < 90",
+        ));
+    }
     // The contact model under the spin rule (other models have none).
     let contact = Contact {
         spin: a.spin,
@@ -173,6 +189,13 @@ fn simulate(a: &SimulateSettings) -> Result<Vec<u8>, RunError> {
                 "--v0",
                 &v0.to_string(),
                 "the bead-by-bead transient needs --model contact",
+            ));
+        }
+        if a.sigma_delta > 0.0 {
+            return Err(flag_error(
+                "--sigma-delta",
+                &fmt_f64(a.sigma_delta),
+                "the bead-by-bead transient (--v0) has no measured slopes",
             ));
         }
         return trace(a, a.law, &a.series, v0, contact);
@@ -358,8 +381,11 @@ fn steady_points(
 ) -> Result<Vec<u8>, RunError> {
     let mut w = csv::Writer::from_writer(Vec::new());
     let io = |e: csv::Error| RunError::Failed(e.to_string());
-    w.write_record(["series", "xi", "delta_deg", "v", "sigma_v", "v_true"])
-        .map_err(io)?;
+    w.write_record(slope_header(
+        a,
+        &["series", "xi", "delta_deg", "v", "sigma_v", "v_true"],
+    ))
+    .map_err(io)?;
     for &xi in &a.series {
         let model = model_for(xi)?;
         let (lo, hi, f0, f1) = slope_span(a, &model, xi)?;
@@ -382,15 +408,16 @@ fn steady_points(
                 Err(e) => return Err(RunError::Failed(format!("xi {xi}, delta {d_deg} deg: {e}"))),
             };
             let v = noisy(v_true, a.noise, rng);
-            w.write_record([
+            let slope = recorded_slope(a, d_deg, rng);
+            let cells = [
                 fmt_f64(xi),
                 fmt_f64(xi),
-                fmt_f64(d_deg),
+                slope.delta_cell(),
                 fmt_f64(v),
                 sigma_cell(a.noise * v_true),
                 fmt_f64(v_true),
-            ])
-            .map_err(io)?;
+            ];
+            w.write_record(slope.cells(cells)).map_err(io)?;
         }
     }
     w.into_inner().map_err(|e| RunError::Failed(e.to_string()))
@@ -588,8 +615,11 @@ fn simulate_design(
     let rows = read_design(path)?;
     let mut w = csv::Writer::from_writer(Vec::new());
     let io = |e: csv::Error| RunError::Failed(e.to_string());
-    w.write_record(["series", "xi", "delta_deg", "v", "sigma_v", "v_true"])
-        .map_err(io)?;
+    w.write_record(slope_header(
+        a,
+        &["series", "xi", "delta_deg", "v", "sigma_v", "v_true"],
+    ))
+    .map_err(io)?;
     for row in &rows {
         if a.stopped() {
             return Err(RunError::Interrupted);
@@ -612,15 +642,16 @@ fn simulate_design(
             .mean_velocity;
         for _ in 0..row.replicates {
             let v = noisy(v_true, a.noise, rng);
-            w.write_record([
+            let slope = recorded_slope(a, row.delta_deg, rng);
+            let cells = [
                 row.series.clone(),
                 fmt_f64(row.xi),
-                fmt_f64(row.delta_deg),
+                slope.delta_cell(),
                 fmt_f64(v),
                 sigma_cell(a.noise * v_true),
                 fmt_f64(v_true),
-            ])
-            .map_err(io)?;
+            ];
+            w.write_record(slope.cells(cells)).map_err(io)?;
         }
     }
     w.into_inner().map_err(|e| RunError::Failed(e.to_string()))
@@ -643,6 +674,59 @@ fn noisy(v_true: f64, noise: f64, rng: &mut ChaCha8Rng) -> f64 {
             return v;
         }
     }
+}
+
+/// The slope of a synthetic point as recorded: the true slope (degrees) and, with σ_δ > 0,
+/// the recorded one drawn around it ([`recorded_slope`]).
+struct RecordedSlope {
+    /// The slope the velocity was made at, degrees.
+    true_deg: f64,
+    /// The recorded slope and σ_δ, degrees; `None` when the slopes are exact.
+    noisy: Option<(f64, f64)>,
+}
+
+impl RecordedSlope {
+    /// The `delta_deg` cell: the recorded slope.
+    fn delta_cell(&self) -> String {
+        fmt_f64(self.noisy.map_or(self.true_deg, |(d, _)| d))
+    }
+
+    /// A row's `cells` with `sigma_delta_deg` and `delta_true_deg` after them when the slope
+    /// is noisy.
+    fn cells<const N: usize>(&self, cells: [String; N]) -> Vec<String> {
+        let mut out = cells.to_vec();
+        if let Some((_, sigma)) = self.noisy {
+            out.push(fmt_f64(sigma));
+            out.push(fmt_f64(self.true_deg));
+        }
+        out
+    }
+}
+
+/// The header `columns`, with `sigma_delta_deg` and `delta_true_deg` after them when the
+/// settings draw noisy slopes (σ_δ > 0).
+fn slope_header(a: &SimulateSettings, columns: &[&'static str]) -> Vec<&'static str> {
+    let mut out = columns.to_vec();
+    if a.sigma_delta > 0.0 {
+        out.extend(["sigma_delta_deg", "delta_true_deg"]);
+    }
+    out
+}
+
+/// The recorded slope of a point made at `true_deg` degrees: with σ_δ > 0, δ_true + σ_δ · z,
+/// z a standard normal draw from `rng` truncated to a slope in (0, 90) degrees (drawn again
+/// until it is, as [`noisy`] truncates a velocity); with σ_δ = 0 the true slope, no draw
+/// made (the stream, and so the output, is that of exact slopes).
+fn recorded_slope(a: &SimulateSettings, true_deg: f64, rng: &mut ChaCha8Rng) -> RecordedSlope {
+    let sigma = a.sigma_delta;
+    let noisy = (sigma > 0.0).then(|| loop {
+        let z: f64 = StandardNormal.sample(rng);
+        let d = true_deg + sigma * z;
+        if d > 0.0 && d < 90.0 {
+            break (d, sigma);
+        }
+    });
+    RecordedSlope { true_deg, noisy }
 }
 
 /// The `sigma_v` cell of a synthetic point: empty when σ is 0 (noise 0), so that the file
@@ -685,16 +769,19 @@ fn run_md(a: &SimulateSettings, series: &[f64]) -> Result<Vec<u8>, RunError> {
     let mut rng = ChaCha8Rng::seed_from_u64(a.seed);
     let mut w = csv::Writer::from_writer(Vec::new());
     let io = |e: csv::Error| RunError::Failed(e.to_string());
-    w.write_record([
-        "series",
-        "xi",
-        "delta_deg",
-        "v",
-        "sigma_v",
-        "v_true",
-        "v_md_stderr",
-        "v_m_s",
-    ])
+    w.write_record(slope_header(
+        a,
+        &[
+            "series",
+            "xi",
+            "delta_deg",
+            "v",
+            "sigma_v",
+            "v_true",
+            "v_md_stderr",
+            "v_m_s",
+        ],
+    ))
     .map_err(io)?;
     for &xi in series {
         let (lo, hi) = md_steady_range(a, &md, xi, &tick, stop)?;
@@ -706,17 +793,18 @@ fn run_md(a: &SimulateSettings, series: &[f64]) -> Result<Vec<u8>, RunError> {
             };
             let v = noisy(v_true, a.noise, &mut rng);
             let sigma = (a.noise * v_true).hypot(se);
-            w.write_record([
+            let slope = recorded_slope(a, d, &mut rng);
+            let cells = [
                 fmt_f64(xi),
                 fmt_f64(xi),
-                fmt_f64(d),
+                slope.delta_cell(),
                 fmt_f64(v),
                 sigma_cell(sigma),
                 fmt_f64(v_true),
                 fmt_f64(se),
                 r.mean_velocity_si.map(fmt_f64).unwrap_or_default(),
-            ])
-            .map_err(io)?;
+            ];
+            w.write_record(slope.cells(cells)).map_err(io)?;
         }
     }
     if let Some(p) = &a.progress {
@@ -866,4 +954,97 @@ fn md_error(a: &SimulateSettings, xi: f64, e: crate::scene::ParameterError) -> R
         },
     };
     flag_error(&flag, &value, e.to_string())
+}
+
+#[cfg(test)]
+mod slope_noise_tests {
+    use super::*;
+
+    fn run(s: &SimulateSettings) -> String {
+        String::from_utf8(s.run().unwrap()).unwrap()
+    }
+
+    /// σ_δ = 0 writes what the settings without it write; σ_δ > 0 adds the two columns, the
+    /// true slopes those of the exact run, the recorded ones spread around them by σ_δ.
+    #[test]
+    fn noisy_slopes_spread_by_sigma_delta() {
+        let base = SimulateSettings {
+            model: ModelKind::Stick,
+            series: vec![1.0, 2.0],
+            points: 250,
+            ..SimulateSettings::default()
+        };
+        let exact = run(&base);
+        let zero = run(&SimulateSettings {
+            sigma_delta: 0.0,
+            ..base.clone()
+        });
+        assert_eq!(zero, exact);
+        let sigma = 0.3;
+        let noisy = run(&SimulateSettings {
+            sigma_delta: sigma,
+            ..base.clone()
+        });
+        let mut lines = noisy.lines();
+        assert_eq!(
+            lines.next(),
+            Some("series,xi,delta_deg,v,sigma_v,v_true,sigma_delta_deg,delta_true_deg")
+        );
+        let mut diffs = Vec::new();
+        for (row, plain) in lines.zip(exact.lines().skip(1)) {
+            let c: Vec<&str> = row.split(',').collect();
+            let p: Vec<&str> = plain.split(',').collect();
+            assert_eq!(c[6], "0.3", "{row}");
+            // The velocity is made at the true slope, the exact run's.
+            assert_eq!((c[0], c[1], c[5], c[7]), (p[0], p[1], p[5], p[2]), "{row}");
+            let d: f64 = c[2].parse().unwrap();
+            let t: f64 = c[7].parse().unwrap();
+            diffs.push(t - d);
+        }
+        assert_eq!(diffs.len(), 500);
+        let n = diffs.len() as f64;
+        let mean = diffs.iter().sum::<f64>() / n;
+        let sd = (diffs.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+        // The sample sd of 500 normal draws is within 15 % of σ far beyond 3 standard errors
+        // (its relative standard error is 1/sqrt(2 (n − 1)) ≈ 3.2 %); the mean within 4 of its.
+        assert!((sd / sigma - 1.0).abs() < 0.15, "sd {sd}");
+        assert!(mean.abs() < 4.0 * sigma / n.sqrt(), "mean {mean}");
+    }
+
+    /// A design's points get the same columns; a bad σ_δ is named by its flag.
+    #[test]
+    fn noisy_slopes_of_a_design_and_bad_values() {
+        let dir = std::env::temp_dir().join(format!("fitbead-sd-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let design = dir.join("design.csv");
+        std::fs::write(&design, "series,xi,delta_deg,replicates\nA,1,10,3\n").unwrap();
+        let s = SimulateSettings {
+            model: ModelKind::Stick,
+            design: Some(design),
+            sigma_delta: 0.2,
+            ..SimulateSettings::default()
+        };
+        let out = run(&s);
+        std::fs::remove_dir_all(&dir).unwrap();
+        let mut lines = out.lines();
+        assert!(lines
+            .next()
+            .unwrap()
+            .ends_with(",sigma_delta_deg,delta_true_deg"));
+        for row in lines {
+            assert!(row.ends_with(",0.2,10"), "{row}");
+        }
+        for x in [-0.1, f64::NAN, f64::INFINITY, 90.0] {
+            let e = SimulateSettings {
+                sigma_delta: x,
+                ..SimulateSettings::default()
+            }
+            .run()
+            .unwrap_err();
+            let RunError::Input(ie) = &e else {
+                panic!("{x}: {e}")
+            };
+            assert_eq!(ie.column.as_deref(), Some("--sigma-delta"), "{x}: {e}");
+        }
+    }
 }

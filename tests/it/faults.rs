@@ -1077,3 +1077,83 @@ fn join(rows: &[Vec<String>], crlf: bool) -> Vec<u8> {
         .collect::<String>()
         .into_bytes()
 }
+
+// Errors in the slope.
+
+/// A bad `sigma_delta_deg` cell exits 2 naming file, line, column and value; so does a bad
+/// `--sigma-delta` on every command that reads measurements, or a bad recipe key.
+#[test]
+fn bad_slope_uncertainties_exit_2() {
+    let dir = tmpdir();
+    for cell in ["-1", "NaN", "abc"] {
+        let p = write(
+            &dir,
+            "d.csv",
+            &format!("series,xi,delta_deg,v,sigma_delta_deg\na,1,12,0.3,{cell}\n"),
+        );
+        for cmd in [
+            &["klaw", "--model", "stick"][..],
+            &["k", "--model", "stick"],
+        ] {
+            let mut args = cmd.to_vec();
+            args.push(s(&p));
+            let out = fb(&args);
+            let want = format!("line 2, column 'sigma_delta_deg', value '{cell}'");
+            expect(&out, 2, &["d.csv", &want], cell);
+        }
+    }
+    let data = crate::common::root().join("data/default.csv");
+    for cmd in [
+        &["klaw", "--model", "stick"][..],
+        &["jan"],
+        &["jaeger"],
+        &["k", "--model", "stick"],
+        &["report"],
+    ] {
+        let mut args = cmd.to_vec();
+        args.extend([s(&data), "--sigma-delta=-1"]);
+        let out = fb(&args);
+        expect(&out, 2, &["flag '--sigma-delta', value '-1'"], cmd[0]);
+    }
+    let recipe = write(
+        &dir,
+        "r.toml",
+        &format!("input = \"{}\"\nsigma_delta = -2\n", s(&data)),
+    );
+    let out = fb(&["report", "--recipe", s(&recipe)]);
+    expect(&out, 2, &["r.toml, line 2, column 'sigma_delta'"], "recipe");
+}
+
+/// `--sigma-delta 0` changes nothing; `simulate --sigma-delta` adds its two columns, which
+/// the fits read without a word about unknown columns.
+#[test]
+fn slope_uncertainty_flags_round_trip() {
+    let dir = tmpdir();
+    let data = crate::common::root().join("data/default.csv");
+    let plain = fb(&["klaw", "--model", "stick", s(&data)]);
+    let zero = fb(&["klaw", "--model", "stick", s(&data), "--sigma-delta", "0"]);
+    assert_eq!((plain.stdout, plain.stderr), (zero.stdout, zero.stderr));
+    let sim = |extra: &[&str]| {
+        let mut args = vec!["simulate", "--model", "stick", "--seed", "7"];
+        args.extend(extra);
+        let out = fb(&args);
+        assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+        String::from_utf8(out.stdout).unwrap()
+    };
+    assert_eq!(sim(&["--sigma-delta", "0"]), sim(&[]));
+    let noisy = sim(&["--sigma-delta", "0.01"]);
+    assert!(
+        noisy.starts_with("series,xi,delta_deg,v,sigma_v,v_true,sigma_delta_deg,delta_true_deg\n")
+    );
+    let p = write(&dir, "noisy.csv", &noisy);
+    let out = fb(&["klaw", "--model", "stick", s(&p)]);
+    let e = stderr(&out);
+    assert_eq!(out.status.code(), Some(0), "{e}");
+    assert!(!e.contains("not one fitbead reads"), "{e}");
+    expect(
+        &fb(&["simulate", "--sigma-delta", "90"]),
+        2,
+        &["flag '--sigma-delta', value '90'"],
+        "simulate",
+    );
+}

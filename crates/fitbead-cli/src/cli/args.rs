@@ -1,6 +1,6 @@
 //! Flags shared by several commands, declared once here and flattened into each command's
-//! arguments: the measurements file with the defaults of the columns it may leave out, ρ and
-//! f, the output file, the figure and the interval level.
+//! arguments: the measurements file with the defaults of the columns it may leave out (ρ, f,
+//! g, σ_δ), the output file, the figure and the interval level.
 
 use super::values;
 use fitbead::io::measurements::MeasurementDefaults;
@@ -31,7 +31,7 @@ impl ContactArgs {
 }
 
 /// The measurements file (`--input` or a plain argument) and the defaults of the columns it
-/// may leave out (`--rho`, `--f`, `--g`).
+/// may leave out (`--rho`, `--f`, `--g`, `--sigma-delta`).
 #[derive(Debug, Clone, Default, clap::Args)]
 pub struct DataArgs {
     /// Measurements CSV: series,xi,delta_deg,v[,sigma_v] (v dimensionless, units
@@ -48,6 +48,10 @@ pub struct DataArgs {
     /// Gravity g in m/s² of dimensional rows without a g column [default: 9.81]
     #[arg(long, value_parser = values::gravity)]
     pub g: Option<f64>,
+    /// Standard uncertainty of the slope, degrees, for rows without a sigma_delta_deg value
+    /// (0: slopes exact)
+    #[arg(long, value_name = "DEG", value_parser = values::non_negative)]
+    pub sigma_delta: Option<f64>,
     /// Refuse a column the measurements file has and fitbead does not read (without it, a
     /// column close to a known name gets a warning, others pass through)
     #[arg(long = "strict-columns")]
@@ -71,6 +75,9 @@ impl DataArgs {
             rho: self.contact.rho(),
             f: self.contact.f(),
             g: self.g(),
+            sigma_delta_deg: self
+                .sigma_delta
+                .unwrap_or(MeasurementDefaults::default().sigma_delta_deg),
         }
     }
 }

@@ -54,7 +54,7 @@ pub struct Args {
     #[arg(long, value_parser = values::at_least_one)]
     pub max_steps: Option<usize>,
     /// A TOML recipe with any of the keys input, out_dir, method, format, units, figure_width,
-    /// rho, f, g,
+    /// rho, f, g, sigma_delta (degrees),
     /// level, seed, min_ess, max_steps (paths relative to the recipe's directory, never
     /// empty); flags given on the command line win. seed, min_ess and max_steps apply to mcmc
     /// and are ignored under lsq. A bad value is reported with the recipe file, line and key
@@ -94,6 +94,8 @@ struct Keys {
     f: Option<f64>,
     /// g.
     g: Option<f64>,
+    /// Standard uncertainty of the slope, degrees.
+    sigma_delta: Option<f64>,
     /// Interval level.
     level: Option<f64>,
     /// MCMC seed.

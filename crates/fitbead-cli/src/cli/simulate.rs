@@ -31,6 +31,11 @@ pub struct Args {
     /// truncated to v > 0 (drawn again until the velocity is positive).
     #[arg(long, default_value_t = 0.02, value_parser = values::noise)]
     pub noise: f64,
+    /// Standard uncertainty of the recorded slope, degrees: delta_deg = δ_true + σ_δ · z (z
+    /// standard normal, truncated to (0, 90) degrees), the velocity made at δ_true; adds the
+    /// columns sigma_delta_deg and delta_true_deg. 0: exact slopes, columns as without it.
+    #[arg(long, value_name = "DEG", default_value_t = 0.0, value_parser = values::slope_sigma)]
+    pub sigma_delta: f64,
     /// Seed of the random stream.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -101,6 +106,7 @@ pub fn run(a: Args) -> Result<(), CliError> {
         series: a.series.0.clone(),
         points: a.points,
         noise: a.noise,
+        sigma_delta: a.sigma_delta,
         seed: a.seed,
         rho: a.contact.rho(),
         f: a.contact.f(),

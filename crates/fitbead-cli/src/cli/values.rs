@@ -414,6 +414,15 @@ pub(crate) fn non_negative(s: &str) -> Result<f64, Refusal> {
     )
 }
 
+/// The standard uncertainty of a simulated slope, degrees: finite, ≥ 0 and < 90.
+pub(crate) fn slope_sigma(s: &str) -> Result<f64, Refusal> {
+    number(
+        s,
+        |x| x.is_finite() && (0.0..90.0).contains(&x),
+        "must be a finite number of degrees >= 0 and < 90",
+    )
+}
+
 /// Gravity g > 0, m/s².
 pub(crate) fn gravity(s: &str) -> Result<f64, Refusal> {
     number(s, |x| x.is_finite() && x > 0.0, "g must be > 0")

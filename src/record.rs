@@ -60,8 +60,25 @@ impl Cell<'_> {
 /// # Panics
 /// If `R` is not such a struct, which the records of this crate all are.
 #[inline]
-pub fn each_cell<R: Serialize + ?Sized>(record: &R, visit: impl FnMut(&'static str, Cell<'_>)) {
+pub(crate) fn each_cell<R: Serialize + ?Sized>(
+    record: &R,
+    visit: impl FnMut(&'static str, Cell<'_>),
+) {
     walk(record, ByCell(visit));
+}
+
+impl Cell<'_> {
+    /// Hands every field of `record` to `visit`, in order, with its serde name and its value
+    /// as a [`Cell`]. A record is a struct of flat fields: numbers (`f64`, integers, `Option`
+    /// of them), text (`&str`, `String`, `Cow<str>`, unit enum variants), `bool`, and `Option`
+    /// of any of these (`None` is an empty cell).
+    ///
+    /// # Panics
+    /// If `R` is not such a struct, which the records of this crate all are.
+    #[inline]
+    pub fn each<R: Serialize + ?Sized>(record: &R, visit: impl FnMut(&'static str, Cell<'_>)) {
+        each_cell(record, visit);
+    }
 }
 
 /// What a walk of a record ([`walk`]) hands over, field by field, in column order: one call

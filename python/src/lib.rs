@@ -13,8 +13,8 @@ use fitbead::fit::summary::FitResult as RsFitResult;
 use fitbead::inverse::posterior::{McmcSettings, Method};
 use fitbead::io::measurements::{MeasurementDefaults, MeasurementFile};
 use fitbead::io::records::{
-    each_cell, AutoRecord, Cell, ContactRecord, CorrelationRecord, ForwardRecord, KRecord,
-    ParamRecord, RegimeRecord, ResidualRecord, StatsRecord,
+    AutoRecord, Cell, ContactRecord, CorrelationRecord, ForwardRecord, KRecord, ParamRecord,
+    RegimeRecord, ResidualRecord, StatsRecord,
 };
 use fitbead::models::auto::Auto;
 use fitbead::models::contact::{Contact, SpinRule};
@@ -220,7 +220,7 @@ enum Slot {
 /// number, a count, or an empty `Option`) is a number.
 fn fields<R: serde::Serialize + Default>() -> Vec<(&'static str, bool)> {
     let mut out = Vec::new();
-    each_cell(&R::default(), |k, c| {
+    Cell::each(&R::default(), |k, c| {
         out.push((k, !matches!(c, Cell::Text(_))))
     });
     out
@@ -293,7 +293,7 @@ impl RowSink<'_, '_> {
     /// Writes `record`'s fields as the row's next cells: a number (a count as a float, an
     /// empty cell as NaN) or a text.
     fn record<R: serde::Serialize>(&mut self, record: &R) {
-        each_cell(record, |_, c| {
+        Cell::each(record, |_, c| {
             match self.slots[self.slot] {
                 Slot::Num(i) => {
                     self.nums[i][self.j] = match c {
@@ -468,7 +468,7 @@ fn opt(x: Option<f64>) -> f64 {
 fn record_dict<'py, R: serde::Serialize>(py: Python<'py>, r: &R) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     let mut result = Ok(());
-    each_cell(r, |k, c| {
+    Cell::each(r, |k, c| {
         if result.is_err() {
             return;
         }
@@ -1509,10 +1509,10 @@ fn fit_jaeger(
     run_fit(py, data, command, a, draws, false)
 }
 
-/// The columns of records `R`: the keys [`each_cell`] visits, in order.
+/// The columns of records `R`: the keys [`Cell::each`] visits, in order.
 fn columns<R: serde::Serialize + Default>() -> Vec<&'static str> {
     let mut v = Vec::new();
-    each_cell(&R::default(), |k, _| v.push(k));
+    Cell::each(&R::default(), |k, _| v.push(k));
     v
 }
 

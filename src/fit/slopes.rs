@@ -180,8 +180,8 @@ pub(crate) fn unsupported(method: &Method, data: &Dataset) -> Option<String> {
     (matches!(method, Method::Mcmc(_)) && data.has_slope_errors()).then(|| {
         "posterior sampling does not take slope errors (sigma_delta_deg or --sigma-delta): \
          it would treat the slopes as exact and its intervals would be too narrow; use \
-         --method lsq (orthogonal distance regression), or --sigma-delta 0 to take the \
-         slopes as exact knowingly"
+         --method lsq (orthogonal distance regression), or give the slopes no uncertainty \
+         (sigma_delta_deg 0, --sigma-delta 0) to take them as exact knowingly"
             .into()
     })
 }

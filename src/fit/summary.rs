@@ -16,7 +16,7 @@
 use crate::inverse::mcmc::ParameterDiagnostics;
 pub use crate::inverse::posterior::Draws;
 use crate::inverse::{
-    confidence_intervals, Covariance, Fit, LsqOptions, ProfileEnd, ProfileInterval, Residuals,
+    ConfidenceIntervals, Covariance, Fit, LsqOptions, ProfileEnd, ProfileInterval, Residuals,
     SigmaKind, Termination,
 };
 use crate::numfmt::{fmt_f64, fmt_sig};
@@ -687,7 +687,7 @@ impl<R: ?Sized> Copy for Solved<'_, R> {}
 pub(crate) fn summarise<R: Residuals + ?Sized>(s: Solved<'_, R>, profile: bool) -> FitResult {
     summarise_with_profiles(s, |s| {
         if profile {
-            confidence_intervals(s.problem, s.fit, s.level, s.options)
+            ConfidenceIntervals::compute(s.problem, s.fit, s.level, s.options)
                 .ok()
                 .map(|c| c.profile)
         } else {

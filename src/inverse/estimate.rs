@@ -85,6 +85,20 @@ impl Fit {
     pub fn std_errors(&self) -> Option<&[f64]> {
         self.covariance.as_ref().map(|c| c.std_errors.as_slice())
     }
+
+    /// The [`Fit`] (estimate, statistics and covariance) of a run of
+    /// [`super::LevenbergMarquardt`] under argmin's `Executor` built by hand, e.g. with observers or
+    /// a timeout. A run that argmin stopped (iteration limit, timeout, target cost, interrupt)
+    /// reports the point reached, with [`Termination::MaxIterations`] for the iteration limit,
+    /// [`Termination::RelativeReduction`] for a target cost and [`Termination::Interrupted`] for the
+    /// others.
+    pub fn from_run<R: Residuals>(
+        result: OptimizationResult<LeastSquares<R>, LevenbergMarquardt, LmState>,
+        sigma: SigmaKind,
+    ) -> Result<Fit, LsqError> {
+        let (sol, solver, ls) = into_parts(result).map_err(|e| LsqError::Solver(e.to_string()))?;
+        Ok(finish(&mut solver.into_evaluator(), ls.view(), sol, sigma))
+    }
 }
 
 /// Fits `problem` from `start`: bounded Levenberg–Marquardt with Moré scaling
@@ -116,20 +130,6 @@ pub fn fit<R: Residuals + ?Sized>(
     let (sol, mut ev, ls) =
         solve(ls, opts, &mut Spare::new()).map_err(|e| LsqError::Solver(e.to_string()))?;
     Ok(finish(&mut ev, ls.view(), sol, opts.sigma))
-}
-
-/// The [`Fit`] (estimate, statistics and covariance) of a run of
-/// [`super::LevenbergMarquardt`] under argmin's `Executor` built by hand, e.g. with observers or
-/// a timeout. A run that argmin stopped (iteration limit, timeout, target cost, interrupt)
-/// reports the point reached, with [`Termination::MaxIterations`] for the iteration limit,
-/// [`Termination::RelativeReduction`] for a target cost and [`Termination::Interrupted`] for the
-/// others.
-pub fn fit_result<R: Residuals>(
-    result: OptimizationResult<LeastSquares<R>, LevenbergMarquardt, LmState>,
-    sigma: SigmaKind,
-) -> Result<Fit, LsqError> {
-    let (sol, solver, ls) = into_parts(result).map_err(|e| LsqError::Solver(e.to_string()))?;
-    Ok(finish(&mut solver.into_evaluator(), ls.view(), sol, sigma))
 }
 
 /// The [`Fit`] of a solution: statistics, and the covariance from the Jacobian at the estimate.

@@ -609,7 +609,7 @@ enum Stage {
 /// χ²; a `param` set on the initial state (`Executor::configure`) replaces the problem's start
 /// (projected onto the box). The solver's own reason for stopping is
 /// [`LevenbergMarquardt::termination`]; argmin's own stops (`max_iters`, a timeout, a target
-/// cost) end the run where it is; [`super::estimate::fit_result`] turns the executor's result
+/// cost) end the run where it is; [`super::Fit::from_run`] turns the executor's result
 /// into a [`super::Fit`] (argmin's reasons mapped onto [`Termination`]).
 ///
 /// ```
@@ -633,7 +633,7 @@ enum Stage {
 /// assert!((p[0] - 3.0).abs() < 1e-12 && (p[1] - 0.5).abs() < 1e-12);
 /// assert!(result.solver().termination().unwrap().converged());
 /// // The estimate with its statistics and covariance, as `fit` gives it.
-/// let fit = fitbead::inverse::fit_result(result, opts.sigma).unwrap();
+/// let fit = fitbead::inverse::Fit::from_run(result, opts.sigma).unwrap();
 /// assert!(fit.converged() && fit.std_errors().is_some());
 /// ```
 #[derive(Debug, Clone)]

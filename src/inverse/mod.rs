@@ -14,7 +14,7 @@
 //!   counts a fit's model evaluations for a progress bar;
 //! * [`ArgminResiduals`] — any argmin problem with residuals and their Jacobian
 //!   (`Operator` + `Jacobian` on nalgebra vectors) fitted by fitbead's solver;
-//! * [`confidence_intervals`] — covariance (Student-t / normal) and profile-likelihood
+//! * [`ConfidenceIntervals::compute`] — covariance (Student-t / normal) and profile-likelihood
 //!   intervals;
 //! * [`WeightedData`] — a [`CurveModel`] y = f(x; p) with data (x, y, σ) seen as residuals;
 //! * [`EnsembleSampler`] — Bayesian sampling of any [`LogDensity`] with the affine-invariant
@@ -42,7 +42,7 @@ pub mod state;
 #[cfg(test)]
 mod suite;
 
-pub use estimate::{fit, fit_result, Covariance, Fit};
+pub use estimate::{fit, Covariance, Fit};
 pub use lm::LevenbergMarquardt;
 pub use lsq::{
     CurveModel, Infeasible, LsqError, LsqOptions, Residuals, SigmaKind, Termination, WeightedData,
@@ -51,10 +51,9 @@ pub use mcmc::{
     EnsembleSampler, LogDensity, McmcError, McmcOptions, McmcResult, ParameterDiagnostics,
     StopReason,
 };
-pub use odr::{Odr, OdrFit, OdrModel, OdrProblem};
+pub(crate) use odr::OdrFit;
+pub use odr::{Odr, OdrModel, OdrProblem};
 pub use problem::{ArgminResiduals, LeastSquares};
-pub use profile::{
-    confidence_intervals, ConfidenceIntervals, Interval, ProfileEnd, ProfileInterval,
-};
 pub(crate) use profile::{covariance_intervals, profile_interval, DEFAULT_LEVEL};
+pub use profile::{ConfidenceIntervals, Interval, ProfileEnd, ProfileInterval};
 pub use state::{LmStage, LmState};

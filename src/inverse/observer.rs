@@ -52,8 +52,8 @@ impl Observe<LmState> for ProgressObserver {
 mod tests {
     use super::*;
     use crate::inverse::{
-        fit, fit_result, CurveModel, Infeasible, LeastSquares, LevenbergMarquardt, LmStage,
-        LsqOptions, WeightedData,
+        fit, CurveModel, Fit, Infeasible, LeastSquares, LevenbergMarquardt, LmStage, LsqOptions,
+        WeightedData,
     };
     use crate::progress::{Progress, ProgressEvent};
     use argmin::core::observers::ObserverMode;
@@ -158,7 +158,7 @@ mod tests {
                 result.solver().residual_evals(),
                 result.solver().jacobian_evals(),
             );
-            let observed = fit_result(result, opts.sigma).unwrap();
+            let observed = Fit::from_run(result, opts.sigma).unwrap();
             assert_eq!(observed, direct);
 
             let seen = seen.0.lock().unwrap().clone();

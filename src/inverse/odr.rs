@@ -1,6 +1,6 @@
 //! Weighted orthogonal distance regression (ODR) of explicit models y = f(x; β) whose input x
 //! is measured with error as well as the response y: [`Odr`], an argmin `Solver` on an
-//! [`OdrProblem`], with the estimate, its covariance and the adjusted inputs in an [`OdrFit`].
+//! [`OdrProblem`], returning the estimate with its covariance and the adjusted inputs.
 //!
 //! With σ_y,i and σ_x,i the standard deviations of point i, ODR minimises over the parameters β
 //! and one correction δ_i of every input
@@ -355,10 +355,11 @@ struct Linear {
 /// let y = vec![-0.1, 1.1, 1.9, 3.1];
 /// let problem = OdrProblem::new(Line, x, y, vec![0.1; 4], Some(vec![0.1; 4]), &[0.4, 0.4], &opts)
 ///     .unwrap();
-/// let fit = Odr::fit(problem, &opts).unwrap();
-/// assert!(fit.fit.converged());
+/// let (fit, x_fit) = Odr::fit(problem, &opts).unwrap();
+/// assert!(fit.converged());
 /// // ODRPACK (scipy.odr, SciPy's test_work_ind): β = (−0.0648034, 1.0432023).
-/// assert!((fit.fit.params[1] - 1.0432023).abs() < 1e-6);
+/// assert!((fit.params[1] - 1.0432023).abs() < 1e-6);
+/// assert_eq!(x_fit.len(), 4);
 /// ```
 #[derive(Debug, Clone)]
 pub struct Odr {
@@ -383,9 +384,9 @@ pub struct Odr {
     termination: Option<Termination>,
 }
 
-/// The result of [`Odr::fit`].
+/// An ODR fit with its adjusted inputs and their weighted corrections.
 #[derive(Debug, Clone, PartialEq)]
-pub struct OdrFit {
+pub(crate) struct OdrFit {
     /// The estimate. `chi2` is the whole objective S (responses and inputs), `residuals` the
     /// weighted response residuals (y_i − f_i(x_i + δ_i; β))/σ_y,i, `dof` = n − p, and the
     /// covariance is ODRPACK's (module docs).
@@ -423,8 +424,15 @@ impl Odr {
     /// Fits `problem` under argmin's `Executor` (at most `opts.max_iterations` iterations,
     /// evaluations counted into `opts.progress`), then the covariance at the estimate.
     /// Numerical failure is reported in the fit's `termination`.
-    pub fn fit<M: OdrModel>(problem: OdrProblem<M>, opts: &LsqOptions) -> Result<OdrFit, LsqError> {
-        Self::fit_keep(problem, opts).map(|(f, _)| f)
+    ///
+    /// Returns the estimate ([`Fit`]: `chi2` is the whole objective S, `residuals` the weighted
+    /// response residuals (y_i − f_i(x_i + δ_i; β))/σ_y,i, `dof` = n − p, the covariance
+    /// ODRPACK's) and the adjusted inputs x_i + δ_i.
+    pub fn fit<M: OdrModel>(
+        problem: OdrProblem<M>,
+        opts: &LsqOptions,
+    ) -> Result<(Fit, Vec<f64>), LsqError> {
+        Self::fit_keep(problem, opts).map(|(f, _)| (f.fit, f.x_fit))
     }
 
     /// As [`Odr::fit`], handing the problem back.

@@ -312,46 +312,6 @@ pub(crate) fn profile_interval<R: Residuals + ?Sized>(
     })
 }
 
-/// Covariance and profile-likelihood intervals of every parameter at `level`
-/// (0.95 is the usual choice).
-///
-/// ```
-/// use fitbead::inverse::{confidence_intervals, fit, Infeasible, LsqOptions, CurveModel, WeightedData};
-/// struct Decay;
-/// impl CurveModel<f64> for Decay {
-///     fn n_params(&self) -> usize { 2 }
-///     fn value(&self, x: &f64, p: &[f64]) -> Result<f64, Infeasible> { Ok(p[0] * (-p[1] * x).exp()) }
-/// }
-/// let x: Vec<f64> = (0..8).map(f64::from).collect();
-/// let y = vec![10.2, 6.0, 3.8, 2.1, 1.4, 0.8, 0.5, 0.3];
-/// let data = WeightedData::new(Decay, x, y, Some(vec![0.2; 8])).unwrap();
-/// let opts = LsqOptions::default();
-/// let f = fit(&data, &[5.0, 0.1], &opts).unwrap();
-/// let ci = confidence_intervals(&data, &f, 0.95, &opts).unwrap();
-/// let wald = ci.covariance.unwrap();
-/// let prof = &ci.profile[1];
-/// assert!(prof.lower.value().unwrap() < f.params[1] && wald[1].lower < f.params[1]);
-/// ```
-pub fn confidence_intervals<R: Residuals + ?Sized>(
-    problem: &R,
-    fit: &Fit,
-    level: f64,
-    opts: &LsqOptions,
-) -> Result<ConfidenceIntervals, LsqError> {
-    let (quantile, threshold) = thresholds(fit, level)?;
-    let covariance = covariance_intervals(fit, level)?;
-    let profile = (0..problem.n_params())
-        .map(|k| profile_interval(problem, fit, k, level, opts))
-        .collect::<Result<Vec<_>, _>>()?;
-    Ok(ConfidenceIntervals {
-        level,
-        quantile,
-        threshold,
-        covariance,
-        profile,
-    })
-}
-
 struct Profiler<'a, R: ?Sized> {
     problem: &'a R,
     /// The problem with the profiled parameter held.
@@ -493,5 +453,47 @@ impl<R: Residuals + ?Sized> Profiler<'_, R> {
             Some(r) if !failed => ProfileEnd::Found(r.x),
             _ => ProfileEnd::NotFound,
         }
+    }
+}
+
+impl ConfidenceIntervals {
+    /// Covariance and profile-likelihood intervals of every parameter at `level`
+    /// (0.95 is the usual choice).
+    ///
+    /// ```
+    /// use fitbead::inverse::{fit, ConfidenceIntervals, Infeasible, LsqOptions, CurveModel, WeightedData};
+    /// struct Decay;
+    /// impl CurveModel<f64> for Decay {
+    ///     fn n_params(&self) -> usize { 2 }
+    ///     fn value(&self, x: &f64, p: &[f64]) -> Result<f64, Infeasible> { Ok(p[0] * (-p[1] * x).exp()) }
+    /// }
+    /// let x: Vec<f64> = (0..8).map(f64::from).collect();
+    /// let y = vec![10.2, 6.0, 3.8, 2.1, 1.4, 0.8, 0.5, 0.3];
+    /// let data = WeightedData::new(Decay, x, y, Some(vec![0.2; 8])).unwrap();
+    /// let opts = LsqOptions::default();
+    /// let f = fit(&data, &[5.0, 0.1], &opts).unwrap();
+    /// let ci = ConfidenceIntervals::compute(&data, &f, 0.95, &opts).unwrap();
+    /// let wald = ci.covariance.unwrap();
+    /// let prof = &ci.profile[1];
+    /// assert!(prof.lower.value().unwrap() < f.params[1] && wald[1].lower < f.params[1]);
+    /// ```
+    pub fn compute<R: Residuals + ?Sized>(
+        problem: &R,
+        fit: &Fit,
+        level: f64,
+        opts: &LsqOptions,
+    ) -> Result<ConfidenceIntervals, LsqError> {
+        let (quantile, threshold) = thresholds(fit, level)?;
+        let covariance = covariance_intervals(fit, level)?;
+        let profile = (0..problem.n_params())
+            .map(|k| profile_interval(problem, fit, k, level, opts))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(ConfidenceIntervals {
+            level,
+            quantile,
+            threshold,
+            covariance,
+            profile,
+        })
     }
 }

@@ -69,11 +69,11 @@ impl<'b> Cells<'b> {
     }
 
     /// The cells of `record`, one per field in column order (the fields
-    /// [`crate::record::each_cell`] visits): numbers as [`Cells::num`], counts as
+    /// [`crate::record::Cell::each`] visits): numbers as [`Cells::num`], counts as
     /// [`Cells::count`], text quoted where needed, `None` empty.
     ///
     /// # Panics
-    /// If `R` is not a record of flat fields (see [`crate::record::each_cell`]).
+    /// If `R` is not a record of flat fields (see [`crate::record::Cell::each`]).
     #[inline]
     pub fn record<R: Serialize>(&mut self, record: &R) {
         self.write_record(record, None);
@@ -287,7 +287,7 @@ mod tests {
     }
 
     /// The streaming writer ([`Cells::record`]) writes a record's cells as
-    /// [`each_cell`] sees them, with the bytes the `csv` crate writes for those cells: checked
+    /// [`Cell::each`](crate::record::Cell::each) sees them, with the bytes the `csv` crate writes for those cells: checked
     /// on the records of scenes across every model (steady, stopped, lifted off, bistable, the
     /// contact model's phases and auto's reasons) and of K estimates.
     #[test]

@@ -6,7 +6,7 @@
 //! law's regime limits ([`RegimeRecord`]: `fitbead regimes`).
 //!
 //! Each record derives `serde::Serialize`; its columns are its fields, in order, with their
-//! serde names (`columns`, or the keys [`each_cell`] visits). Every writer reads the record ([`each_cell`]): the CSV files,
+//! serde names (`columns`, or the keys [`Cell::each`] visits). Every writer reads the record ([`Cell::each`]): the CSV files,
 //! the streaming commands and the Python binding's columns and dicts. A number is written as
 //! the shortest decimal that reads back as the same double ([`crate::numfmt::fmt_f64`]), an
 //! absent or non-finite number as an empty cell.
@@ -18,8 +18,8 @@ use crate::inverse::{ProfileEnd, SigmaKind};
 use crate::models::auto::Auto;
 use crate::models::contact::{SpinRule, SteadyContact};
 use crate::models::{Model, Outcome, Phases, Regime};
+pub use crate::record::Cell;
 pub(crate) use crate::record::{columns, to_csv};
-pub use crate::record::{each_cell, Cell};
 use crate::scene::{CollisionLaw, Scene};
 use serde::Serialize;
 use std::borrow::Cow;

@@ -907,7 +907,7 @@ fn nist_profile_intervals() {
         let d = data(&p);
         let f = run(&p, 1, &opts);
         assert!(f.converged());
-        let ci = fitbead::inverse::confidence_intervals(&d, &f, 0.95, &opts).unwrap();
+        let ci = fitbead::inverse::ConfidenceIntervals::compute(&d, &f, 0.95, &opts).unwrap();
         let wald = ci.covariance.as_ref().unwrap();
         for (k, pi) in ci.profile.iter().enumerate() {
             total += 2;

@@ -6,7 +6,7 @@ use crate::inverse::lm::LevenbergMarquardt;
 use crate::inverse::lsq::{CurveModel, Infeasible, WeightedData};
 use crate::inverse::lsq::{LsqError, LsqOptions, Residuals, SigmaKind, Termination};
 use crate::inverse::problem::LeastSquares;
-use crate::inverse::profile::{confidence_intervals, ProfileEnd};
+use crate::inverse::profile::{ConfidenceIntervals, ProfileEnd};
 use crate::inverse::state::LmState;
 use std::cell::Cell;
 
@@ -136,7 +136,7 @@ fn linear_profile_equals_covariance_interval() {
         };
         let f = fit(&data, &[0.0, 0.0], &opts).unwrap();
         for level in [0.683, 0.95, 0.99] {
-            let ci = confidence_intervals(&data, &f, level, &opts).unwrap();
+            let ci = ConfidenceIntervals::compute(&data, &f, level, &opts).unwrap();
             let wald = ci.covariance.as_ref().unwrap();
             for (k, wk) in wald.iter().enumerate().take(2) {
                 let lo = ci.profile[k].lower.value().unwrap();
@@ -178,7 +178,7 @@ fn exponential_profile_is_asymmetric() {
     let opts = LsqOptions::default();
     let f = fit(&data, &[0.1], &opts).unwrap();
     assert!(f.converged());
-    let ci = confidence_intervals(&data, &f, 0.95, &opts).unwrap();
+    let ci = ConfidenceIntervals::compute(&data, &f, 0.95, &opts).unwrap();
     let b = f.params[0];
     let lo = ci.profile[0].lower.value().unwrap();
     let hi = ci.profile[0].upper.value().unwrap();
@@ -241,7 +241,7 @@ fn progress_counts_the_fit_and_its_profiles() {
         assert!(seen.windows(2).all(|w| w[0] < w[1]), "{seen:?}");
         assert_eq!(seen.last().copied(), Some(tally.done()));
     }
-    let ci = confidence_intervals(&data, &f, 0.95, &opts).unwrap();
+    let ci = ConfidenceIntervals::compute(&data, &f, 0.95, &opts).unwrap();
     let profiled: usize = ci.profile.iter().map(|p| p.residual_evals).sum();
     assert!(profiled > 0);
     assert_eq!(tally.done() as usize, iterated + profiled);
@@ -261,7 +261,7 @@ fn profile_with_reminimisation() {
     let opts = LsqOptions::default();
     let f = fit(&data, &[1.0, 0.1], &opts).unwrap();
     assert!(f.converged());
-    let ci = confidence_intervals(&data, &f, 0.95, &opts).unwrap();
+    let ci = ConfidenceIntervals::compute(&data, &f, 0.95, &opts).unwrap();
     for k in 0..2 {
         let p = ci.profile[k];
         let (lo, hi) = (p.lower.value().unwrap(), p.upper.value().unwrap());
@@ -527,7 +527,7 @@ fn executor_runs_agree_with_fit() {
     let run = Executor::new(ls, LevenbergMarquardt::new(&opts))
         .run()
         .unwrap();
-    assert_eq!(fit_result(run, opts.sigma).unwrap(), direct);
+    assert_eq!(Fit::from_run(run, opts.sigma).unwrap(), direct);
 
     #[derive(Clone)]
     struct Seen(Arc<Mutex<Vec<f64>>>);
@@ -546,7 +546,7 @@ fn executor_runs_agree_with_fit() {
         .configure(|s| s.max_iters(2))
         .run()
         .unwrap();
-    let cut = fit_result(run, opts.sigma).unwrap();
+    let cut = Fit::from_run(run, opts.sigma).unwrap();
     assert_eq!(cut.termination, Termination::MaxIterations);
     assert!(!cut.converged());
     assert!(cut.chi2 > direct.chi2);
@@ -602,7 +602,7 @@ fn one_sided_profile_end_at_a_bound() {
     };
     let f = fit(&data, &[0.1], &opts).unwrap();
     assert!(f.converged());
-    let ci = confidence_intervals(&data, &f, 0.95, &opts).unwrap();
+    let ci = ConfidenceIntervals::compute(&data, &f, 0.95, &opts).unwrap();
     assert_eq!(ci.profile[0].upper, ProfileEnd::Bound(0.8));
     assert!(ci.profile[0].lower.value().is_some());
 
@@ -623,13 +623,13 @@ fn one_sided_profile_end_at_a_bound() {
         }
     }
     let free = fit(&data, &[0.1], &LsqOptions::default()).unwrap();
-    let ci = confidence_intervals(&data, &free, 0.95, &LsqOptions::default()).unwrap();
+    let ci = ConfidenceIntervals::compute(&data, &free, 0.95, &LsqOptions::default()).unwrap();
     let hi = ci.profile[0].upper.value().unwrap();
     let cap = free.params[0] + 0.5 * (hi - free.params[0]);
     let capped = Capped(data, cap);
     let f = fit(&capped, &[0.1], &LsqOptions::default()).unwrap();
     assert!(f.converged());
-    let ci = confidence_intervals(&capped, &f, 0.95, &LsqOptions::default()).unwrap();
+    let ci = ConfidenceIntervals::compute(&capped, &f, 0.95, &LsqOptions::default()).unwrap();
     match ci.profile[0].upper {
         ProfileEnd::Edge(v) => assert!(v <= cap && v > cap - 0.01 * (hi - f.params[0])),
         other => panic!("{other:?}"),

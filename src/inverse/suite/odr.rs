@@ -160,12 +160,12 @@ fn odrpack_examples() {
                 continue;
             }
             let (pr, _) = problem(e, analytic);
-            let abs = Odr::fit(pr.clone(), &LsqOptions::default()).unwrap();
+            let abs = Odr::fit_keep(pr.clone(), &LsqOptions::default()).unwrap().0;
             let relative = LsqOptions {
                 sigma: SigmaKind::Relative,
                 ..Default::default()
             };
-            let scaled = Odr::fit(pr, &relative).unwrap();
+            let scaled = Odr::fit_keep(pr, &relative).unwrap().0;
             assert!(abs.fit.converged(), "{name}: {:?}", abs.fit.termination);
             let beta = &abs.fit.params;
             let bscale = beta.iter().fold(0.0f64, |m, v| m.max(v.abs())) * 1e-12;
@@ -307,7 +307,7 @@ fn exact_inputs_reproduce_least_squares() {
             &opts,
         )
         .unwrap();
-        let odr = Odr::fit(pr, &opts).unwrap();
+        let odr = Odr::fit_keep(pr, &opts).unwrap().0;
         assert!(odr.fit.converged(), "{:?}", odr.fit.termination);
         for j in 0..3 {
             let d = rel(odr.fit.params[j], lm.params[j], 0.0);
@@ -366,7 +366,7 @@ fn adjusted_inputs_stay_in_the_domain() {
         &opts,
     )
     .unwrap();
-    let odr = Odr::fit(pr, &opts).unwrap();
+    let odr = Odr::fit_keep(pr, &opts).unwrap().0;
     assert!(
         matches!(odr.fit.termination, t if t.converged() || t == Termination::Stalled),
         "{:?}",

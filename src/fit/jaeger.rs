@@ -298,8 +298,26 @@ fn fit_jaeger_series(
         summary.attach_points(data, &index);
         summary
     });
-    // The notes describe the values reported: the optimum, or the posterior medians.
-    let value = |k: usize| summary.params.get(k).map_or(f.params[k], |r| r.value);
+    let (bistable_points, has_minimum) = describe(&mut summary, &x, &f.params, branch);
+    Ok(JaegerFit {
+        summary,
+        branch,
+        bistable_points,
+        has_minimum,
+    })
+}
+
+/// Notes the branch, the points in the bistable band of eq 90 and a resistance without a
+/// minimum (eq 82) on every row of `summary` and on its statistics; returns the number of
+/// bistable points and whether the resistance has a minimum. The notes describe the values
+/// reported: the optimum `optimum`, or the posterior medians.
+fn describe(
+    summary: &mut FitResult,
+    x: &[JaegerX],
+    optimum: &[f64],
+    branch: JaegerBranch,
+) -> (usize, bool) {
+    let value = |k: usize| summary.params.get(k).map_or(optimum[k], |r| r.value);
     let m = Jaeger {
         a1: value(0),
         a2: value(1),
@@ -329,12 +347,7 @@ fn fit_jaeger_series(
     } else {
         format!("{}; {extra}", summary.stats.note)
     };
-    Ok(JaegerFit {
-        summary,
-        branch,
-        bistable_points,
-        has_minimum,
-    })
+    (bistable_points, has_minimum)
 }
 
 /// Jaeger's abscissa (tan δ, cos δ, ε) of a point at slope δ (radians).

@@ -8,7 +8,6 @@ mod jaeger_posterior;
 mod k_edges;
 mod k_inversion;
 mod sbc;
-mod slopes;
 
 /// A table of tests/reference/ (docs/ACCURACY.md#reference-tables says how each was made):
 /// its header and its rows of cells.

@@ -11,6 +11,7 @@
 //! leaves the point's steady range: a trial step that would take one out is rejected.
 
 use super::data::Dataset;
+use super::posterior;
 use super::summary::{self, FitResult, Solved};
 use crate::inverse::posterior::Method;
 use crate::inverse::{
@@ -121,7 +122,7 @@ pub(crate) fn attach(summary: &mut FitResult, odr: &OdrFit, data: &Dataset, inde
 /// they carry none, or for a posterior run. `bounds`: keep the least-squares box (see
 /// [`SlopeFit::new`]). A refit the solver refuses keeps the least-squares estimate, with a
 /// note saying why.
-pub(crate) fn summarise<R: Residuals + ?Sized, M: OdrModel>(
+pub(crate) fn summarise<R: Residuals + ?Sized, M: OdrModel + Sync>(
     method: &Method,
     solved: &Solved<'_, R>,
     model: M,
@@ -129,13 +130,14 @@ pub(crate) fn summarise<R: Residuals + ?Sized, M: OdrModel>(
     index: &[usize],
     bounds: bool,
 ) -> Option<FitResult> {
-    let Method::Lsq { profile, .. } = method else {
-        return None;
+    let profile = match method {
+        Method::Lsq { profile, .. } => *profile,
+        Method::Mcmc(_) => false,
     };
     let sf = match SlopeFit::new(model, data, index, solved.fit, solved.options, bounds)? {
         Ok(sf) => sf,
         Err(e) => {
-            let mut s = summary::summarise(*solved, *profile);
+            let mut s = summary::summarise(*solved, profile);
             s.stats.note = summary::join(
                 &s.stats.note,
                 &format!("orthogonal distance regression refused ({e}): slopes taken as exact"),
@@ -144,7 +146,6 @@ pub(crate) fn summarise<R: Residuals + ?Sized, M: OdrModel>(
             return Some(s);
         }
     };
-    let reduced = sf.problem.reduced(sf.corrections(data, index));
     let opts = if bounds {
         solved.options.clone()
     } else {
@@ -154,34 +155,147 @@ pub(crate) fn summarise<R: Residuals + ?Sized, M: OdrModel>(
             ..solved.options.clone()
         }
     };
-    let mut s = summary::summarise(
-        Solved {
-            name: solved.name,
-            series: solved.series,
-            specs: solved.specs,
-            problem: &reduced,
-            fit: &sf.odr.fit,
-            level: solved.level,
-            options: &opts,
-            distinct: solved.distinct,
-            observed_norm: solved.observed_norm,
-        },
-        *profile,
-    );
+    let mut s = if let Method::Mcmc(_) = method {
+        let integrated = Integrated::new(sf.problem.model(), data, index);
+        posterior::summarise_with(
+            method,
+            Solved {
+                name: solved.name,
+                series: solved.series,
+                specs: solved.specs,
+                problem: &integrated,
+                fit: &sf.odr.fit,
+                level: solved.level,
+                options: &opts,
+                distinct: solved.distinct,
+                observed_norm: solved.observed_norm,
+            },
+        )
+    } else {
+        let reduced = sf.problem.reduced(sf.corrections(data, index));
+        summary::summarise(
+            Solved {
+                name: solved.name,
+                series: solved.series,
+                specs: solved.specs,
+                problem: &reduced,
+                fit: &sf.odr.fit,
+                level: solved.level,
+                options: &opts,
+                distinct: solved.distinct,
+                observed_norm: solved.observed_norm,
+            },
+            profile,
+        )
+    };
     s.attach_points(data, index);
     attach(&mut s, &sf.odr, data, index);
     Some(s)
 }
 
 /// Why `method` cannot fit `data`, if it cannot: a posterior run on slopes that carry errors
-/// (its likelihood would have to integrate over each point's true slope, which the sampler
-/// does not do; it would treat the slopes as exact and report intervals too narrow).
+/// when the velocities carry no σ, or with the scatter's scale sampled (the likelihood
+/// integrated over the slopes has σ_v inside the integral, so a common scale of σ_v does not
+/// factor out of it as the sampler's scale assumes).
 pub(crate) fn unsupported(method: &Method, data: &Dataset) -> Option<String> {
-    (matches!(method, Method::Mcmc(_)) && data.has_slope_errors()).then(|| {
-        "posterior sampling does not take slope errors (sigma_delta_deg or --sigma-delta): \
-         it would treat the slopes as exact and its intervals would be too narrow; use \
-         --method lsq (orthogonal distance regression), or give the slopes no uncertainty \
-         (sigma_delta_deg 0, --sigma-delta 0) to take them as exact knowingly"
+    let Method::Mcmc(settings) = method else {
+        return None;
+    };
+    let scaled = data.sigma == SigmaKind::Relative || settings.fit_scatter;
+    (data.has_slope_errors() && scaled).then(|| {
+        "posterior sampling with slope errors (sigma_delta_deg or --sigma-delta) needs \
+         absolute velocity errors (sigma_v) and no fitted scatter (--fit-scatter): the \
+         likelihood integrated over each slope does not factor a common scale out; use \
+         --method lsq (orthogonal distance regression), or give sigma_v"
             .into()
     })
+}
+
+/// Nodes of the quadrature over each point's true slope in a posterior run.
+pub(crate) const SLOPE_NODES: usize = 12;
+
+/// Gauss–Hermite nodes t_k and weights w_k for E[g(Z)] ≈ Σ w_k g(t_k), Z standard normal
+/// (probabilists' Hermite polynomials), by Golub & Welsch (Math. Comp. 23, 1969): the nodes
+/// are the eigenvalues of the symmetric tridiagonal Jacobi matrix with off-diagonal √k, the
+/// weights the squared first components of its unit eigenvectors.
+pub(crate) fn hermite(n: usize) -> (Vec<f64>, Vec<f64>) {
+    let mut j = nalgebra::DMatrix::<f64>::zeros(n, n);
+    for k in 1..n {
+        let b = (k as f64).sqrt();
+        j[(k, k - 1)] = b;
+        j[(k - 1, k)] = b;
+    }
+    let e = j.symmetric_eigen();
+    let mut pairs: Vec<(f64, f64)> = (0..n)
+        .map(|k| (e.eigenvalues[k], e.eigenvectors[(0, k)].powi(2)))
+        .collect();
+    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    pairs.into_iter().unzip()
+}
+
+/// The likelihood of each point integrated over its true slope, as residuals of a posterior:
+/// p(v_i | β) = ∫ N(v_i; v̄_i(δ̂; β), σ_v,i) N(δ̂; δ_i, σ_δ,i) dδ̂, by Gauss–Hermite quadrature
+/// on [`SLOPE_NODES`] nodes, the integrand 0 where the point has no steady state. Residual i
+/// is r_i = √(−2 ln(σ_v,i √(2π) p(v_i | β))) ≥ 0, so that −½ Σ r_i² is the log-likelihood up
+/// to a constant, as the posterior reads its problem; with σ_δ,i = 0 it is the ordinary
+/// (v_i − v̄_i)/σ_v,i. Infeasible where some point has no steady state at any node.
+pub(crate) struct Integrated<M> {
+    model: M,
+    x: Vec<f64>,
+    y: Vec<f64>,
+    sy: Vec<f64>,
+    sx: Vec<f64>,
+    nodes: Vec<f64>,
+    ln_weights: Vec<f64>,
+}
+
+impl<M: OdrModel> Integrated<M> {
+    /// The integrated likelihood of `model` on the points `index` of `data` (σ_v absolute).
+    pub fn new(model: M, data: &Dataset, index: &[usize]) -> Self {
+        let pts = || index.iter().map(|&i| &data.points[i]);
+        let (nodes, weights) = hermite(SLOPE_NODES);
+        Integrated {
+            model,
+            x: pts().map(|p| p.scene.delta).collect(),
+            y: pts().map(|p| p.v).collect(),
+            sy: pts().map(|p| p.sigma).collect(),
+            sx: pts().map(|p| p.sigma_delta).collect(),
+            nodes,
+            ln_weights: weights.iter().map(|w| w.ln()).collect(),
+        }
+    }
+}
+
+impl<M: OdrModel> Residuals for Integrated<M> {
+    fn n_params(&self) -> usize {
+        self.model.n_params()
+    }
+    fn n_residuals(&self) -> usize {
+        self.y.len()
+    }
+    fn residuals(&self, p: &[f64], out: &mut [f64]) -> Result<(), Infeasible> {
+        let mut terms = vec![f64::NEG_INFINITY; self.nodes.len()];
+        for i in 0..self.y.len() {
+            if self.sx[i] == 0.0 {
+                out[i] = (self.y[i] - self.model.value(i, self.x[i], p)?) / self.sy[i];
+                continue;
+            }
+            for (k, t) in self.nodes.iter().enumerate() {
+                terms[k] = match self.model.value(i, self.x[i] + self.sx[i] * t, p) {
+                    Ok(f) if f.is_finite() => {
+                        let z = (self.y[i] - f) / self.sy[i];
+                        self.ln_weights[k] - 0.5 * z * z
+                    }
+                    _ => f64::NEG_INFINITY,
+                };
+            }
+            let top = terms.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            if top == f64::NEG_INFINITY {
+                return Err(Infeasible);
+            }
+            let ln_l = top + terms.iter().map(|t| (t - top).exp()).sum::<f64>().ln();
+            out[i] = (-2.0 * ln_l).max(0.0).sqrt();
+        }
+        Ok(())
+    }
 }

@@ -87,6 +87,27 @@ pub trait OdrModel {
     }
 }
 
+impl<M: OdrModel + ?Sized> OdrModel for &M {
+    fn n_params(&self) -> usize {
+        (**self).n_params()
+    }
+    fn n_points(&self) -> usize {
+        (**self).n_points()
+    }
+    fn value(&self, i: usize, x: f64, p: &[f64]) -> Result<f64, Infeasible> {
+        (**self).value(i, x, p)
+    }
+    fn derivatives(
+        &self,
+        i: usize,
+        x: f64,
+        p: &[f64],
+        grad: &mut [f64],
+    ) -> Option<Result<f64, Infeasible>> {
+        (**self).derivatives(i, x, p, grad)
+    }
+}
+
 /// Data (x_i, y_i, σ_x,i, σ_y,i) and an [`OdrModel`], with the parameters' box, typical
 /// magnitudes and start: the problem of [`Odr`].
 #[derive(Debug, Clone)]

@@ -89,3 +89,107 @@ fn exact_slopes_keep_least_squares() {
     let want = num(&wls["beta"][0]);
     assert!((s.params[0].value - want).abs() < 1e-6 * want);
 }
+
+/// Coverage by simulation: `simulate --model stick --law c=0.5 --noise 0.01 --sigma-delta 0.1
+/// --seed S --design D` for S = 1 … 400, with D the true slopes of
+/// `tests/reference/odr/bead_stick.csv` (ξ = 0.8, 1, 1.6; 8 slopes each across 10–90 % of the
+/// steady range), each set fitted for c with its slope errors (ODR) and with the slopes taken
+/// as exact (weighted least squares). The 95 % intervals of ODR cover the true c = 0.5 in at
+/// least 93 % of the sets, as often as ODRPACK's do on 400 sets of the same design
+/// (`tests/reference/odr/bead_stick_coverage.json`: 97.0 %; the estimator is conservative
+/// there, its √cov 6 % above the spread of ĉ); those of least squares, which ignore the
+/// slopes' errors, far less often (ODRPACK's file: 52.3 %). Measured here: 97.75 % (covariance
+/// and profile intervals alike) and 50.75 %.
+#[test]
+fn odr_intervals_cover_at_their_level() {
+    use crate::io::measurements::MeasurementFile;
+    use crate::models::ModelKind;
+    use crate::pipeline::SimulateSettings;
+    use crate::scene::CollisionLaw;
+    let dir = tempfile::tempdir().unwrap();
+    let design = dir.path().join("design.csv");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/reference/odr/bead_stick.csv"
+    );
+    let mut reader = csv::Reader::from_path(path).unwrap();
+    let h = reader.headers().unwrap().clone();
+    let col = |name: &str| h.iter().position(|c| c == name).unwrap();
+    let (cs, cx, cd) = (col("series"), col("xi"), col("delta_true_deg"));
+    let mut text = String::from("series,xi,delta_deg,replicates\n");
+    for r in reader.records() {
+        let r = r.unwrap();
+        text.push_str(&format!("{},{},{},1\n", &r[cs], &r[cx], &r[cd]));
+    }
+    std::fs::write(&design, text).unwrap();
+    let (mut hit, mut hit_profile, mut hit_wls, mut fitted) = (0, 0, 0, 0);
+    let mut fails = Vec::new();
+    for seed in 1..=400u64 {
+        let sim = SimulateSettings {
+            model: ModelKind::Stick,
+            law: CollisionLaw::C(0.5),
+            design: Some(design.clone()),
+            noise: 0.01,
+            sigma_delta: 0.1,
+            seed,
+            ..Default::default()
+        };
+        let bytes = sim.run().unwrap();
+        let file = MeasurementFile::parse("sim", &bytes, &MeasurementDefaults::default()).unwrap();
+        let mut d = file.into_dataset();
+        // (covariance interval covers, profile interval covers) of the law-c fit.
+        let covers = |d: &Dataset, profile: bool| -> Option<(bool, bool)> {
+            let f = fit_law(Model::Stick, d, KLaw::C, 0.95, profile).ok()?;
+            let row = &f.summary.params[0];
+            let se = row.stderr?;
+            let by_profile = matches!(row.profile,
+                Some((ProfileEnd::Found(lo), ProfileEnd::Found(hi))) if lo <= 0.5 && 0.5 <= hi);
+            Some(((row.value - 0.5).abs() <= 1.959964 * se, by_profile))
+        };
+        match covers(&d, true) {
+            Some((c, p)) => {
+                fitted += 1;
+                hit += usize::from(c);
+                hit_profile += usize::from(p);
+                for p in &mut d.points {
+                    p.sigma_delta = 0.0;
+                }
+                hit_wls += usize::from(covers(&d, false).is_some_and(|c| c.0));
+            }
+            None => fails.push(seed),
+        }
+    }
+    let rate = |k: usize| k as f64 / fitted as f64;
+    let (odr, profile, wls) = (rate(hit), rate(hit_profile), rate(hit_wls));
+    eprintln!(
+        "coverage over {fitted} sets: ODR {odr:.4} (profile {profile:.4}), slopes exact \
+         {wls:.4}; not fitted: {fails:?}"
+    );
+    assert!(
+        fails.len() <= 8,
+        "{} sets not fitted: {fails:?}",
+        fails.len()
+    );
+    // The intervals are not too narrow: the issue's lower end.
+    assert!(odr >= 0.93, "ODR coverage {odr}");
+    // The same as ODRPACK's on the same design and noise (other draws): within three standard
+    // errors of the difference of two binomial proportions over 400 sets each.
+    let c: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/tests/reference/odr/bead_stick_coverage.json"
+        ))
+        .unwrap(),
+    )
+    .unwrap();
+    for (ours, key) in [(odr, "odr"), (wls, "wls")] {
+        let theirs = c[key]["coverage_95_unscaled"].as_f64().unwrap();
+        let p = 0.5 * (ours + theirs);
+        let se = (2.0 * p * (1.0 - p) / 400.0).sqrt();
+        assert!(
+            (ours - theirs).abs() <= 3.0 * se,
+            "{key}: {ours} against ODRPACK's {theirs}"
+        );
+    }
+    assert!(wls < 0.85, "least squares with exact slopes covers {wls}");
+}

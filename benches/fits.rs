@@ -1,6 +1,8 @@
 //! Speed of the bead fits: `klaw` (stick/slip model, 40 points), `jan` and `jaeger` (four
 //! series), each with covariance and profile-likelihood intervals as the commands compute them.
 //! The data are made as in `tests/it/fits.rs` (whose simulation helpers this bench shares).
+//! `klaw` on the shipped data is timed as it is and with slope errors of 0.1° on every point
+//! (orthogonal distance regression from the least-squares optimum).
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use fitbead::fit::builder::{JaegerFitter, JanFitter, KLawFitter};
@@ -31,8 +33,31 @@ fn bench(c: &mut Criterion) {
         7,
     );
     let jaeger = fits::simulate(fits::jaeger_model, fits::open_range(law), law, 9, 0.02, 7);
+    // The shipped data as they are, and with every slope uncertain by 0.1° (orthogonal
+    // distance regression instead of least squares).
+    let shipped = fitbead::fit::data::Dataset::default_data();
+    let mut sloped = shipped.clone();
+    for p in &mut sloped.points {
+        p.sigma_delta = 0.1f64.to_radians();
+    }
     let mut g = c.benchmark_group("fits");
     g.sample_size(30);
+    for (name, data) in [
+        ("", &shipped),
+        (" with slope errors 0.1 deg (ODR)", &sloped),
+    ] {
+        for profile in [false, true] {
+            let what = if profile {
+                "profile"
+            } else {
+                "covariance only"
+            };
+            g.bench_function(format!("klaw stick c, shipped data{name}, {what}"), |b| {
+                let fitter = KLawFitter::new(Model::Stick, KLaw::C).least_squares(profile);
+                b.iter(|| fitter.fit(black_box(data)).map(|f| f.stats.chi2))
+            });
+        }
+    }
     g.bench_function("klaw stickslip c, 40 points, profile", |b| {
         let fitter = KLawFitter::new(Model::StickSlip, KLaw::C).least_squares(true);
         b.iter(|| fitter.fit(black_box(&stickslip)).map(|f| f.stats.chi2))

@@ -84,7 +84,7 @@ impl<M: OdrModel> SlopeFit<M> {
         Some(
             OdrProblem::new(model, x, y, sx, sy, &lm.params, &opts)
                 .and_then(|problem| {
-                    let (odr, problem) = Odr::fit_keep(problem, &opts)?;
+                    let (odr, problem) = Odr::fit_keep(problem.from_optimum(), &opts)?;
                     Ok(SlopeFit { problem, odr })
                 })
                 .map_err(|e| e.to_string()),

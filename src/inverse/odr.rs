@@ -120,6 +120,9 @@ pub struct OdrProblem<M> {
     inv_sx: Vec<f64>,
     sx: Vec<f64>,
     setup: Setup,
+    /// The start is the weighted least-squares optimum with the inputs held: the first stage
+    /// is skipped.
+    from_optimum: bool,
 }
 
 impl<M: OdrModel> OdrProblem<M> {
@@ -196,6 +199,7 @@ impl<M: OdrModel> OdrProblem<M> {
             inv_sx,
             sx: sigma_x,
             setup,
+            from_optimum: false,
         })
     }
 
@@ -207,6 +211,13 @@ impl<M: OdrModel> OdrProblem<M> {
     /// The starting point, projected onto the box.
     pub fn start(&self) -> &[f64] {
         &self.setup.start
+    }
+
+    /// Declares the start the weighted least-squares optimum with every input held: the
+    /// solver's first stage (module docs) is then skipped.
+    pub(crate) fn from_optimum(mut self) -> Self {
+        self.from_optimum = true;
+        self
     }
 
     fn n(&self) -> usize {
@@ -238,28 +249,39 @@ impl<M: OdrModel> OdrProblem<M> {
         }
         let (isy, isx) = (self.inv_sy[i], self.inv_sx[i]);
         let mut g = vec![0.0; beta.len()];
+        // ∂f/∂x from the first point, kept while the steps it gives lower the sum (a chord
+        // iteration: one model evaluation per step), evaluated again when one does not.
+        let mut slope: Option<f64> = None;
         for _ in 0..SETTLE {
             let xi = self.x[i] + delta;
-            let f0 = self.y[i] - r / isy;
-            *evals += 1;
-            let fx = match self.model.derivatives(i, xi, beta, &mut g) {
-                Some(Ok(fx)) => Some(fx),
-                Some(Err(_)) => None,
+            let fresh = slope.is_none();
+            let fx = match slope {
+                Some(fx) => Some(fx),
                 None => {
-                    let h = STEP * xi.abs().max(self.sx[i]);
-                    let inf = f64::INFINITY;
-                    difference(f0, h, -inf, inf, |t| self.model.value(i, xi + t, beta).ok())
+                    let f0 = self.y[i] - r / isy;
+                    *evals += 1;
+                    match self.model.derivatives(i, xi, beta, &mut g) {
+                        Some(Ok(fx)) => Some(fx),
+                        Some(Err(_)) => None,
+                        None => {
+                            let h = STEP * xi.abs().max(self.sx[i]);
+                            let inf = f64::INFINITY;
+                            difference(f0, h, -inf, inf, |t| self.model.value(i, xi + t, beta).ok())
+                        }
+                    }
                 }
             };
             let Some(fx) = fx.filter(|v| v.is_finite()) else {
                 break;
             };
+            slope = Some(fx);
             let d = -fx * isy;
             let mut t = -(d * r + isx * rho) / (d * d + isx * isx);
             let before = r * r + rho * rho;
             let mut gain = 0.0;
             for _ in 0..30 {
                 let trial = delta + t;
+                *evals += 1;
                 if let Ok(f) = self.model.value(i, self.x[i] + trial, beta) {
                     let (r1, rho1) = ((self.y[i] - f) * isy, trial * isx);
                     let after = r1 * r1 + rho1 * rho1;
@@ -271,7 +293,11 @@ impl<M: OdrModel> OdrProblem<M> {
                 t *= 0.5;
             }
             if !(gain > 1e-15 * before) {
-                break;
+                if fresh {
+                    break;
+                }
+                // The kept slope may be stale: once more with a fresh one.
+                slope = None;
             }
         }
         (r, rho, delta)
@@ -942,6 +968,10 @@ impl<M: OdrModel> Solver<OdrProblem<M>, LmState> for Odr {
             Some(pt) => {
                 self.cur = pt;
                 self.frozen = (0..n).any(|i| pr.free(i));
+                if self.frozen && pr.from_optimum {
+                    self.frozen = false;
+                    self.settle(pr);
+                }
             }
             None => self.termination = Some(Termination::InfeasibleStart),
         }

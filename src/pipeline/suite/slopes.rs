@@ -107,21 +107,7 @@ fn odr_intervals_cover_at_their_level() {
     use crate::pipeline::SimulateSettings;
     use crate::scene::CollisionLaw;
     let dir = tempfile::tempdir().unwrap();
-    let design = dir.path().join("design.csv");
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/tests/reference/odr/bead_stick.csv"
-    );
-    let mut reader = csv::Reader::from_path(path).unwrap();
-    let h = reader.headers().unwrap().clone();
-    let col = |name: &str| h.iter().position(|c| c == name).unwrap();
-    let (cs, cx, cd) = (col("series"), col("xi"), col("delta_true_deg"));
-    let mut text = String::from("series,xi,delta_deg,replicates\n");
-    for r in reader.records() {
-        let r = r.unwrap();
-        text.push_str(&format!("{},{},{},1\n", &r[cs], &r[cx], &r[cd]));
-    }
-    std::fs::write(&design, text).unwrap();
+    let design = design_file(dir.path());
     let (mut hit, mut hit_profile, mut hit_wls, mut fitted) = (0, 0, 0, 0);
     let mut fails = Vec::new();
     for seed in 1..=400u64 {
@@ -192,4 +178,109 @@ fn odr_intervals_cover_at_their_level() {
         );
     }
     assert!(wls < 0.85, "least squares with exact slopes covers {wls}");
+}
+
+/// The posterior of c on `bead_stick.csv` with its slope errors (the likelihood integrated
+/// over each true slope) against the ODR fit of the same data: the same centre and spread to
+/// within the sampler's error (posterior sd within 10 % of ODR's √cov, which is ODRPACK's to
+/// 1e-4), and about twice the spread of the posterior that takes the slopes as exact (the ODR
+/// and least-squares errors of this set differ ×1.95).
+#[test]
+fn posterior_with_slope_errors_spreads_as_odr() {
+    use crate::fit::klaw::fit_law_with;
+    use crate::inverse::posterior::{McmcSettings, Method};
+    let run = |d: &Dataset| {
+        let method = Method::Mcmc(Box::new(McmcSettings::seeded(5)));
+        let f = fit_law_with(Model::Stick, d, KLaw::C, 0.95, &method).unwrap();
+        let row = f.summary.params[0].clone();
+        let post = row.posterior.expect("posterior summary");
+        assert!(f.summary.stats.mcmc.is_some());
+        (post.mean, post.sd)
+    };
+    let odr = fit_law(Model::Stick, &data(0.1), KLaw::C, 0.95, false).unwrap();
+    let (c, se) = (
+        odr.summary.params[0].value,
+        odr.summary.params[0].stderr.unwrap(),
+    );
+    let (mean, sd) = run(&data(0.1));
+    assert!(
+        (sd / se - 1.0).abs() < 0.10,
+        "posterior sd {sd} against ODR's {se}"
+    );
+    assert!(
+        (mean - c).abs() < 0.3 * se,
+        "posterior mean {mean} against ODR's {c}"
+    );
+    let (_, sd_exact) = run(&data(0.0));
+    let ratio = sd / sd_exact;
+    assert!(
+        (1.6..2.4).contains(&ratio),
+        "sd with slope errors / without: {ratio}"
+    );
+}
+
+/// Coverage of the posterior's 95 % intervals with slope errors, on 100 of the simulated sets
+/// of [`odr_intervals_cover_at_their_level`] (seeds 1–100): 90–99 %. Ignored by default (a
+/// few minutes on two cores): `cargo test --release --lib pipeline::suite::slopes::posterior_
+/// -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn posterior_intervals_cover_at_their_level() {
+    use crate::fit::klaw::fit_law_with;
+    use crate::inverse::posterior::{McmcSettings, Method};
+    use crate::io::measurements::MeasurementFile;
+    use crate::models::ModelKind;
+    use crate::pipeline::SimulateSettings;
+    use crate::scene::CollisionLaw;
+    let dir = tempfile::tempdir().unwrap();
+    let design = design_file(dir.path());
+    let (mut hit, mut fitted) = (0, 0);
+    for seed in 1..=100u64 {
+        let sim = SimulateSettings {
+            model: ModelKind::Stick,
+            law: CollisionLaw::C(0.5),
+            design: Some(design.clone()),
+            noise: 0.01,
+            sigma_delta: 0.1,
+            seed,
+            ..Default::default()
+        };
+        let bytes = sim.run().unwrap();
+        let file = MeasurementFile::parse("sim", &bytes, &MeasurementDefaults::default()).unwrap();
+        let d = file.into_dataset();
+        let method = Method::Mcmc(Box::new(McmcSettings::seeded(seed)));
+        let Ok(f) = fit_law_with(Model::Stick, &d, KLaw::C, 0.95, &method) else {
+            continue;
+        };
+        let Some(post) = f.summary.params[0].posterior.clone() else {
+            continue;
+        };
+        fitted += 1;
+        hit += usize::from(post.q025 <= 0.5 && 0.5 <= post.q975);
+    }
+    let rate = hit as f64 / fitted as f64;
+    eprintln!("posterior coverage over {fitted} sets: {rate:.3}");
+    assert!(fitted >= 98, "{fitted} of 100 sets sampled");
+    assert!((0.90..=0.99).contains(&rate), "posterior coverage {rate}");
+}
+
+/// A `simulate --design` file in `dir` with the true slopes of `bead_stick.csv` (ξ = 0.8, 1,
+/// 1.6; 8 slopes each across 10–90 % of the steady range at c = 0.5), one replicate each.
+fn design_file(dir: &std::path::Path) -> std::path::PathBuf {
+    let design = dir.join("design.csv");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/reference/odr/bead_stick.csv"
+    );
+    let mut reader = csv::Reader::from_path(path).unwrap();
+    let h = reader.headers().unwrap().clone();
+    let col = |name: &str| h.iter().position(|c| c == name).unwrap();
+    let (cs, cx, cd) = (col("series"), col("xi"), col("delta_true_deg"));
+    let mut text = String::from("series,xi,delta_deg,replicates\n");
+    for r in reader.records() {
+        let r = r.unwrap();
+        text.push_str(&format!("{},{},{},1\n", &r[cs], &r[cx], &r[cd]));
+    }
+    std::fs::write(&design, text).unwrap();
+    design
 }

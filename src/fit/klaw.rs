@@ -213,6 +213,40 @@ impl OdrModel for Slopes<'_, '_> {
     }
 }
 
+/// The series whose largest σ_δ is wider than their steady range of slopes at the law's
+/// parameters `p` (regime B at their ξ, ρ, f and K), as a note ("" when none): there, one
+/// standard uncertainty spans every slope at which the bead rolls steadily.
+fn wide_slope_errors(problem: &KLawProblem<'_>, p: &[f64]) -> String {
+    let data = problem.data;
+    let mut out = Vec::new();
+    for (s, label) in data.labels.iter().enumerate() {
+        let pts = data.series_index(s);
+        let Some(&i) = pts.first() else { continue };
+        let sd = pts
+            .iter()
+            .map(|&j| data.points[j].sigma_delta)
+            .fold(0.0, f64::max);
+        if sd == 0.0 {
+            continue;
+        }
+        let sc = &data.points[i].scene;
+        let law = crate::scene::CollisionLaw::Value(problem.k_of(i, p));
+        let range =
+            crate::models::regimes::regime_b_interval(&problem.model, sc.xi, sc.rho, sc.f, law);
+        if let Some((lo, hi)) = range.filter(|(lo, hi)| sd > hi - lo) {
+            out.push(format!(
+                "series '{}': sigma_delta {} deg is wider than its steady range of slopes ({} \
+                 to {} deg)",
+                crate::numfmt::clip(label, crate::numfmt::ECHO_CHARS),
+                crate::numfmt::fmt_sig(sd.to_degrees(), 3),
+                crate::numfmt::fmt_sig(lo.to_degrees(), 5),
+                crate::numfmt::fmt_sig(hi.to_degrees(), 5)
+            ));
+        }
+    }
+    out.join("; ")
+}
+
 /// Points per rayon task: a stick/slip evaluation costs a few µs, so small batches already pay.
 const MIN_CHUNK: usize = 4;
 
@@ -973,7 +1007,10 @@ pub(crate) fn fit_law_in(
         f.params.clone()
     };
     let k = (0..m).map(|i| problem.k_of(i, &params)).collect();
-    if !slope_errors {
+    if slope_errors {
+        let note = wide_slope_errors(&problem, &params);
+        summary.stats.note = super::summary::join(&summary.stats.note, &note);
+    } else {
         summary.attach_points(data, &index);
     }
     Ok(KLawFit { law, summary, k })

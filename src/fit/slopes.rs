@@ -18,6 +18,7 @@ use crate::inverse::{
     CurveModel, Fit, Infeasible, LsqOptions, Odr, OdrFit, OdrModel, OdrProblem, Residuals,
     SigmaKind,
 };
+use crate::numfmt::fmt_sig;
 
 /// A [`CurveModel`] fit whose abscissa of point i is built from the point's slope by `at`:
 /// the ODR model of `jan` and `jaeger`.
@@ -102,9 +103,11 @@ impl<M: OdrModel> SlopeFit<M> {
 }
 
 /// Marks `summary` as an ODR fit and gives its points (`index` of `data`, in order) their
-/// adjusted slopes and slope residuals.
+/// adjusted slopes and slope residuals; the statistics' note names the points whose slope
+/// moved by more than 2σ_δ.
 pub(crate) fn attach(summary: &mut FitResult, odr: &OdrFit, data: &Dataset, index: &[usize]) {
     summary.stats.slope_errors = true;
+    let mut moved = Vec::new();
     for ((pt, &i), (x, rx)) in summary
         .points
         .iter_mut()
@@ -113,8 +116,28 @@ pub(crate) fn attach(summary: &mut FitResult, odr: &OdrFit, data: &Dataset, inde
     {
         pt.delta_fit_deg = Some(x.to_degrees());
         pt.delta_residual = (data.points[i].sigma_delta > 0.0).then_some(*rx);
+        if rx.abs() > MOVED {
+            moved.push(format!(
+                "'{}' {} deg -> {} deg ({} sigma_delta)",
+                crate::numfmt::clip(&pt.series, crate::numfmt::ECHO_CHARS),
+                fmt_sig(pt.delta_deg, 6),
+                fmt_sig(x.to_degrees(), 6),
+                fmt_sig(*rx, 3)
+            ));
+        }
+    }
+    if !moved.is_empty() {
+        let note = format!(
+            "{} point(s) whose adjusted slope moved by more than {MOVED} sigma_delta: {}",
+            moved.len(),
+            moved.join("; ")
+        );
+        summary.stats.note = summary::join(&summary.stats.note, &note);
     }
 }
+
+/// How far an adjusted slope may move, in σ_δ, before the fit's note names its point.
+const MOVED: f64 = 2.0;
 
 /// The summary of a least-squares fit (`solved`, of the points `index` of `data`) refitted by
 /// ODR on `model` when those points carry slope errors, with its points, their adjusted

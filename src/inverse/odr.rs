@@ -249,39 +249,28 @@ impl<M: OdrModel> OdrProblem<M> {
         }
         let (isy, isx) = (self.inv_sy[i], self.inv_sx[i]);
         let mut g = vec![0.0; beta.len()];
-        // ∂f/∂x from the first point, kept while the steps it gives lower the sum (a chord
-        // iteration: one model evaluation per step), evaluated again when one does not.
-        let mut slope: Option<f64> = None;
         for _ in 0..SETTLE {
             let xi = self.x[i] + delta;
-            let fresh = slope.is_none();
-            let fx = match slope {
-                Some(fx) => Some(fx),
+            let f0 = self.y[i] - r / isy;
+            *evals += 1;
+            let fx = match self.model.derivatives(i, xi, beta, &mut g) {
+                Some(Ok(fx)) => Some(fx),
+                Some(Err(_)) => None,
                 None => {
-                    let f0 = self.y[i] - r / isy;
-                    *evals += 1;
-                    match self.model.derivatives(i, xi, beta, &mut g) {
-                        Some(Ok(fx)) => Some(fx),
-                        Some(Err(_)) => None,
-                        None => {
-                            let h = STEP * xi.abs().max(self.sx[i]);
-                            let inf = f64::INFINITY;
-                            difference(f0, h, -inf, inf, |t| self.model.value(i, xi + t, beta).ok())
-                        }
-                    }
+                    let h = STEP * xi.abs().max(self.sx[i]);
+                    let inf = f64::INFINITY;
+                    difference(f0, h, -inf, inf, |t| self.model.value(i, xi + t, beta).ok())
                 }
             };
             let Some(fx) = fx.filter(|v| v.is_finite()) else {
                 break;
             };
-            slope = Some(fx);
             let d = -fx * isy;
             let mut t = -(d * r + isx * rho) / (d * d + isx * isx);
             let before = r * r + rho * rho;
             let mut gain = 0.0;
             for _ in 0..30 {
                 let trial = delta + t;
-                *evals += 1;
                 if let Ok(f) = self.model.value(i, self.x[i] + trial, beta) {
                     let (r1, rho1) = ((self.y[i] - f) * isy, trial * isx);
                     let after = r1 * r1 + rho1 * rho1;
@@ -293,11 +282,7 @@ impl<M: OdrModel> OdrProblem<M> {
                 t *= 0.5;
             }
             if !(gain > 1e-15 * before) {
-                if fresh {
-                    break;
-                }
-                // The kept slope may be stale: once more with a fresh one.
-                slope = None;
+                break;
             }
         }
         (r, rho, delta)

@@ -284,3 +284,35 @@ fn design_file(dir: &std::path::Path) -> std::path::PathBuf {
     std::fs::write(&design, text).unwrap();
     design
 }
+
+/// A slope recorded 0.6° off (6 σ_δ) is adjusted back and named in the fit's note; a σ_δ wider
+/// than a series' steady range of slopes is named too.
+#[test]
+fn moved_slopes_and_wide_errors_are_named() {
+    let mut d = data(0.1);
+    d.points[3].scene = d.points[3]
+        .scene
+        .with_delta_deg(d.points[3].scene.delta_deg() + 0.6)
+        .unwrap();
+    let fit = fit_law(Model::Stick, &d, KLaw::C, 0.95, false).unwrap();
+    let s = &fit.summary;
+    let r = s.points[3].delta_residual.unwrap();
+    assert!(r < -2.0, "the shifted slope's residual {r}");
+    assert!(
+        s.stats
+            .note
+            .contains("1 point(s) whose adjusted slope moved by more than 2 sigma_delta"),
+        "{}",
+        s.stats.note
+    );
+    let mut d = data(0.1);
+    for p in d.points.iter_mut().filter(|p| p.series == 0) {
+        p.sigma_delta = 7f64.to_radians();
+    }
+    let fit = fit_law(Model::Stick, &d, KLaw::C, 0.95, false).unwrap();
+    let note = &fit.summary.stats.note;
+    assert!(
+        note.contains("sigma_delta 7 deg is wider than its steady range"),
+        "{note}"
+    );
+}

@@ -458,9 +458,13 @@ class Dataset:
         series: Optional[Iterable[Any]] = None,
         rho: ArrayLike = 0.4,
         f: ArrayLike = 0.1,
+        sigma_delta_deg: ArrayLike = 0.0,
     ) -> "Dataset":
         """From arrays (broadcast together). ``series`` labels group the points (default:
-        grouped by ξ); without ``sigma_v`` the fits weight relatively.
+        grouped by ξ); without ``sigma_v`` the fits weight relatively. ``sigma_delta_deg`` is
+        the standard uncertainty of each slope in degrees (0: exact); where it is above 0 the
+        least-squares fits are orthogonal distance regressions, and their residual tables
+        gain ``delta_fit_deg`` and ``delta_residual``.
 
         Warns
         -----
@@ -470,11 +474,23 @@ class Dataset:
             at index ``i`` is "line" ``i + 2``, as if written to a CSV file.
         """
         shape, a = _broadcast(
-            {"xi": xi, "delta_deg": delta_deg, "v": v, "sigma_v": np.nan if sigma_v is None else sigma_v, "rho": rho, "f": f}
+            {
+                "xi": xi,
+                "delta_deg": delta_deg,
+                "v": v,
+                "sigma_v": np.nan if sigma_v is None else sigma_v,
+                "rho": rho,
+                "f": f,
+                "sigma_delta_deg": sigma_delta_deg,
+            }
         )
         n = a["xi"].size  # type: ignore[union-attr]
         labels = [""] * n if series is None else [str(s) for s in np.ravel(np.asarray(list(series), dtype=object))]
-        return cls(_core._Dataset.from_arrays(labels, a["xi"], a["delta_deg"], a["v"], a["sigma_v"], a["rho"], a["f"]))
+        return cls(
+            _core._Dataset.from_arrays(
+                labels, a["xi"], a["delta_deg"], a["v"], a["sigma_v"], a["rho"], a["f"], a["sigma_delta_deg"]
+            )
+        )
 
     @classmethod
     def from_pandas(cls, df: Any, *, rho: float = 0.4, f: float = 0.1, g: float = 9.81) -> "Dataset":
@@ -976,7 +992,11 @@ class FitResult:
         if what == "stats":
             return _frame([self._core.stats()], _core.record_columns("stats"))
         if what == "residuals":
-            return _frame(self._core.residual_records(), _core.record_columns("residuals"))
+            records = self._core.residual_records()
+            columns = list(_core.record_columns("residuals"))
+            if any("delta_fit_deg" in r for r in records):
+                columns += ["delta_fit_deg", "delta_residual"]
+            return _frame(records, columns)
         if what == "correlations":
             return _frame(self._core.correlation_records(), _core.record_columns("correlations"))
         if what == "draws":

@@ -928,17 +928,27 @@ impl PyDataset {
         sigma_v: PyReadonlyArray1<'_, f64>,
         rho: PyReadonlyArray1<'_, f64>,
         f: PyReadonlyArray1<'_, f64>,
+        sigma_delta_deg: PyReadonlyArray1<'_, f64>,
     ) -> PyResult<Self> {
         let n = slice(&xi, "xi")?.len();
         check_len("series", series.len(), n)?;
-        let [xs, d, vs, ss, rs, fs] = slices_of([
+        let [xs, d, vs, ss, rs, fs, sd] = slices_of([
             (&xi, "xi"),
             (&delta_deg, "delta_deg"),
             (&v, "v"),
             (&sigma_v, "sigma_v"),
             (&rho, "rho"),
             (&f, "f"),
+            (&sigma_delta_deg, "sigma_delta_deg"),
         ])?;
+        if let Some(i) = sd.iter().position(|x| !(x.is_finite() && *x >= 0.0)) {
+            return Err(value_error(format!(
+                "sigma_delta_deg[{i}] = {}: the slope's standard uncertainty must be finite and \
+                 >= 0 (degrees; 0: the slope is exact)",
+                sd[i]
+            )));
+        }
+        let slopes = sd.iter().any(|x| *x > 0.0);
         let mut rows = Vec::with_capacity(n);
         // The same points as a measurement file, for the command line's checks of the data
         // (plausibility) and for the report: every number written in its shortest round-trip
@@ -948,6 +958,9 @@ impl PyDataset {
         if sigma {
             text.push_str(",sigma_v");
         }
+        if slopes {
+            text.push_str(",sigma_delta_deg");
+        }
         text.push('\n');
         for (i, label) in series.iter().enumerate() {
             let scene =
@@ -955,7 +968,10 @@ impl PyDataset {
             let (v, s) = measured(i, vs, ss).map_err(value_error)?;
             rows.push((label.clone(), scene, v, s));
         }
-        let inner = RsDataset::new(rows).map_err(|e| value_error(e.to_string()))?;
+        let mut inner = RsDataset::new(rows).map_err(|e| value_error(e.to_string()))?;
+        for (p, s) in inner.points.iter_mut().zip(sd) {
+            p.sigma_delta = s.to_radians();
+        }
         for (i, label) in series.iter().enumerate() {
             let quoted = format!("\"{}\"", label.replace('"', "\"\""));
             text.push_str(&quoted);
@@ -968,6 +984,10 @@ impl PyDataset {
                 if !ss[i].is_nan() {
                     text.push_str(&fitbead::numfmt::fmt_f64(ss[i]));
                 }
+            }
+            if slopes {
+                text.push(',');
+                text.push_str(&fitbead::numfmt::fmt_f64(sd[i]));
             }
             text.push('\n');
         }
@@ -1121,8 +1141,17 @@ impl PyFitResult {
     /// record).
     fn residual_records<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
         let l = PyList::empty(py);
-        for r in ResidualRecord::of(&[&self.inner]) {
-            l.append(record_dict(py, &r)?)?;
+        for (r, p) in ResidualRecord::of(&[&self.inner])
+            .iter()
+            .zip(&self.inner.points)
+        {
+            let d = record_dict(py, r)?;
+            // A fit that took the slopes as measured with error: the adjusted slope too.
+            if p.delta_fit_deg.is_some() {
+                d.set_item("delta_fit_deg", p.delta_fit_deg)?;
+                d.set_item("delta_residual", p.delta_residual)?;
+            }
+            l.append(d)?;
         }
         Ok(l)
     }

@@ -187,3 +187,29 @@ def test_parameter_and_statistics_records_are_the_cli_columns_and_cells(cli, dat
                         assert float(cell) == v, (method, k, cell, v)
                     else:
                         assert cell == str(v), (method, k, cell, v)
+
+
+def test_slope_errors_fit_by_odr_as_the_command_line():
+    """A file with sigma_delta_deg, and the same points from arrays: orthogonal distance
+    regression, the adjusted slopes in the residual table, and the same c as ODRPACK's on
+    these data (tests/reference/odr/bead_stick.json, c = 0.5036345)."""
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[2] / "tests" / "reference" / "odr" / "bead_stick.csv"
+    fit = fitbead.fit_klaw(str(path), model="stick", law="c")
+    assert fit.stats["method"] == "odr"
+    assert fit["c"].value == pytest.approx(0.5036345041006788, rel=1e-6)
+    res = fit.to_pandas("residuals")
+    assert {"delta_fit_deg", "delta_residual"} <= set(res.columns)
+    assert res["delta_residual"].abs().max() < 4
+    cols = read_csv_text(path.read_text())
+    c = {k: np.array([float(x) for x in cols[k]]) for k in ("xi", "delta_deg", "v", "sigma_v", "sigma_delta_deg")}
+    arr = fitbead.Dataset.from_arrays(
+        c["xi"], c["delta_deg"], c["v"], c["sigma_v"], series=cols["series"], sigma_delta_deg=c["sigma_delta_deg"]
+    )
+    again = fitbead.fit_klaw(arr, model="stick", law="c")
+    assert again["c"].value == fit["c"].value
+    with pytest.raises(ValueError, match="sigma_delta_deg"):
+        fitbead.Dataset.from_arrays(c["xi"], c["delta_deg"], c["v"], c["sigma_v"], sigma_delta_deg=-0.1)
+    with pytest.raises(fitbead.FitbeadError, match="posterior sampling with slope errors|slope errors"):
+        fitbead.fit_klaw(str(path), model="stick", law="c", method="mcmc", fit_scatter=True)

@@ -213,6 +213,23 @@ impl OdrModel for Slopes<'_, '_> {
     }
 }
 
+/// The parameters of `law` as the reports name them, with the paper's value of c.
+fn law_specs(problem: &KLawProblem<'_>, law: KLaw) -> Vec<ParamSpec> {
+    (0..problem.n)
+        .map(|_| ParamSpec {
+            name: problem.param_name(),
+            unit: "1",
+            paper_value: (law == KLaw::C).then_some(0.5),
+            paper_source: if law == KLaw::C {
+                "paper §3.6.1, Figs. 3-4 (rolling model, rho = 1/2)"
+            } else {
+                ""
+            },
+            default_prior: None,
+        })
+        .collect()
+}
+
 /// The series whose largest σ_δ is wider than their steady range of slopes at the law's
 /// parameters `p` (regime B at their ξ, ρ, f and K), as a note ("" when none): there, one
 /// standard uncertainty spans every slope at which the bead rolls steadily.
@@ -944,19 +961,7 @@ pub(crate) fn fit_law_in(
         }
         _ => fit(&problem, &start, &opts).map_err(|e| KLawError::Solver(e.to_string()))?,
     };
-    let specs: Vec<ParamSpec> = (0..problem.n)
-        .map(|_| ParamSpec {
-            name: problem.param_name(),
-            unit: "1",
-            paper_value: (law == KLaw::C).then_some(0.5),
-            paper_source: if law == KLaw::C {
-                "paper §3.6.1, Figs. 3-4 (rolling model, rho = 1/2)"
-            } else {
-                ""
-            },
-            default_prior: None,
-        })
-        .collect();
+    let specs = law_specs(&problem, law);
     let solved = Solved {
         name: &fit_name,
         series: "all",

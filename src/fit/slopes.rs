@@ -85,7 +85,7 @@ impl<M: OdrModel> SlopeFit<M> {
         Some(
             OdrProblem::new(model, x, y, sx, sy, &lm.params, &opts)
                 .and_then(|problem| {
-                    let (odr, problem) = Odr::fit_keep(problem.from_optimum(), &opts)?;
+                    let (odr, problem) = Odr::fit_keep(problem.started_at_optimum(), &opts)?;
                     Ok(SlopeFit { problem, odr })
                 })
                 .map_err(|e| e.to_string()),
@@ -298,9 +298,9 @@ impl<M: OdrModel> Residuals for Integrated<M> {
     }
     fn residuals(&self, p: &[f64], out: &mut [f64]) -> Result<(), Infeasible> {
         let mut terms = vec![f64::NEG_INFINITY; self.nodes.len()];
-        for i in 0..self.y.len() {
+        for (i, out) in out.iter_mut().enumerate() {
             if self.sx[i] == 0.0 {
-                out[i] = (self.y[i] - self.model.value(i, self.x[i], p)?) / self.sy[i];
+                *out = (self.y[i] - self.model.value(i, self.x[i], p)?) / self.sy[i];
                 continue;
             }
             for (k, t) in self.nodes.iter().enumerate() {
@@ -317,7 +317,7 @@ impl<M: OdrModel> Residuals for Integrated<M> {
                 return Err(Infeasible);
             }
             let ln_l = top + terms.iter().map(|t| (t - top).exp()).sum::<f64>().ln();
-            out[i] = (-2.0 * ln_l).max(0.0).sqrt();
+            *out = (-2.0 * ln_l).max(0.0).sqrt();
         }
         Ok(())
     }

@@ -122,7 +122,7 @@ pub struct OdrProblem<M> {
     setup: Setup,
     /// The start is the weighted least-squares optimum with the inputs held: the first stage
     /// is skipped.
-    from_optimum: bool,
+    at_optimum: bool,
 }
 
 impl<M: OdrModel> OdrProblem<M> {
@@ -199,7 +199,7 @@ impl<M: OdrModel> OdrProblem<M> {
             inv_sx,
             sx: sigma_x,
             setup,
-            from_optimum: false,
+            at_optimum: false,
         })
     }
 
@@ -215,8 +215,8 @@ impl<M: OdrModel> OdrProblem<M> {
 
     /// Declares the start the weighted least-squares optimum with every input held: the
     /// solver's first stage (module docs) is then skipped.
-    pub(crate) fn from_optimum(mut self) -> Self {
-        self.from_optimum = true;
+    pub(crate) fn started_at_optimum(mut self) -> Self {
+        self.at_optimum = true;
         self
     }
 
@@ -953,7 +953,7 @@ impl<M: OdrModel> Solver<OdrProblem<M>, LmState> for Odr {
             Some(pt) => {
                 self.cur = pt;
                 self.frozen = (0..n).any(|i| pr.free(i));
-                if self.frozen && pr.from_optimum {
+                if self.frozen && pr.at_optimum {
                     self.frozen = false;
                     self.settle(pr);
                 }

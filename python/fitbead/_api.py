@@ -1146,12 +1146,14 @@ def _fitted(core: Any, context: Dict[str, Any]) -> FitResult:
     return fr
 
 
-def _fit_data(data: Any, rho: Optional[float], f: Optional[float], g: Optional[float]) -> Dataset:
+def _fit_data(
+    data: Any, rho: Optional[float], f: Optional[float], g: Optional[float], sigma_delta: Optional[float] = None
+) -> Dataset:
     """The data of a fit, read again with the defaults given for the columns rows leave out."""
     d = _dataset(data)
-    if rho is None and f is None and g is None:
+    if rho is None and f is None and g is None and sigma_delta is None:
         return d
-    return Dataset(d._core.with_defaults(rho=rho, f=f, g=g))
+    return Dataset(d._core.with_defaults(rho=rho, f=f, g=g, sigma_delta=sigma_delta))
 
 
 def _priors(priors: Any) -> List[Tuple[str, str]]:
@@ -1221,6 +1223,7 @@ def fit_klaw(
     rho: Optional[float] = None,
     f: Optional[float] = None,
     g: Optional[float] = None,
+    sigma_delta: Optional[float] = None,
 ) -> FitResult:
     """A law K(α) fitted to every series at once (``fitbead klaw``).
 
@@ -1269,6 +1272,10 @@ def fit_klaw(
     rho, f, g : float, optional
         ρ, f and g (m/s²) of the rows whose columns leave them out (defaults 0.4, 0.1, 9.81):
         the data are read again with them.
+    sigma_delta : float, optional
+        Standard uncertainty of the slope, degrees, for rows without a ``sigma_delta_deg``
+        value (the command line's ``--sigma-delta``; default 0: slopes exact). Above 0 a
+        least-squares fit is an orthogonal distance regression.
 
     Returns
     -------
@@ -1286,7 +1293,7 @@ def fit_klaw(
     UnitWarning, ConvergenceWarning, BoundWarning
         The command line's warnings on the data and the fit.
     """
-    d = _fit_data(data, rho, f, g)
+    d = _fit_data(data, rho, f, g, sigma_delta)
     fits, notes, text = _core.fit_klaw(
         d._core, model=_model_name(model), law=law, method=method, level=level, profile=profile, seed=seed, walkers=walkers,
         max_steps=max_steps, min_ess=min_ess, tol=tol, thin=thin, priors=_priors(priors), fit_scatter=fit_scatter,
@@ -1313,6 +1320,7 @@ def fit_jan(
     rho: Optional[float] = None,
     f: Optional[float] = None,
     g: Optional[float] = None,
+    sigma_delta: Optional[float] = None,
 ) -> FitSet:
     """Jan's energy balance (eq 74): λ and μ per series (at least 3 points), then the global
     laws of eqs 75–76 (``fitbead jan``).
@@ -1344,7 +1352,7 @@ def fit_jan(
     UnitWarning, ConvergenceWarning, BoundWarning
         The command line's warnings on the data and the fits.
     """
-    d = _fit_data(data, rho, f, g)
+    d = _fit_data(data, rho, f, g, sigma_delta)
     fits, notes, text = _core.fit_jan(
         d._core, method=method, level=level, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps,
         min_ess=min_ess, thin=thin, priors=_priors(priors), fit_scatter=fit_scatter, draws=_draws_wanted(draws, method),
@@ -1371,6 +1379,7 @@ def fit_jaeger(
     rho: Optional[float] = None,
     f: Optional[float] = None,
     g: Optional[float] = None,
+    sigma_delta: Optional[float] = None,
 ) -> FitSet:
     """Jaeger's heuristic law (eqs 80–84): a1, a2, a3 per series with at least 4 points
     (``fitbead jaeger``).
@@ -1403,7 +1412,7 @@ def fit_jaeger(
     UnitWarning, ConvergenceWarning, BoundWarning
         The command line's warnings on the data and the fits.
     """
-    d = _fit_data(data, rho, f, g)
+    d = _fit_data(data, rho, f, g, sigma_delta)
     fits, notes, text = _core.fit_jaeger(
         d._core, branch=branch, method=method, level=level, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps,
         min_ess=min_ess, thin=thin, priors=_priors(priors), fit_scatter=fit_scatter, draws=_draws_wanted(draws, method),

@@ -178,9 +178,12 @@ class Dataset:
     def default(cls) -> Dataset:
         """The shipped synthetic data set (36 points in 4 series; data/default.csv)."""
     @classmethod
-    def from_arrays(cls, xi: ArrayLike, delta_deg: ArrayLike, v: ArrayLike, sigma_v: ArrayLike | None = None, *, series: Iterable[Any] | None = None, rho: ArrayLike = 0.4, f: ArrayLike = 0.1) -> Dataset:
+    def from_arrays(cls, xi: ArrayLike, delta_deg: ArrayLike, v: ArrayLike, sigma_v: ArrayLike | None = None, *, series: Iterable[Any] | None = None, rho: ArrayLike = 0.4, f: ArrayLike = 0.1, sigma_delta_deg: ArrayLike = 0.0) -> Dataset:
         """From arrays (broadcast together). ``series`` labels group the points (default:
-        grouped by ξ); without ``sigma_v`` the fits weight relatively."""
+        grouped by ξ); without ``sigma_v`` the fits weight relatively. ``sigma_delta_deg`` is
+        the standard uncertainty of each slope in degrees (0: exact); where it is above 0 the
+        least-squares fits are orthogonal distance regressions, and their residual tables
+        gain ``delta_fit_deg`` and ``delta_residual``."""
     @classmethod
     def from_pandas(cls, df: Any, *, rho: float = 0.4, f: float = 0.1, g: float = 9.81) -> Dataset:
         """From a DataFrame with the CSV's columns, checked as the command line checks a file
@@ -390,7 +393,7 @@ class FitSet(list):
         ``residuals`` or ``correlations``, with the command line's columns (its CSV of the
         whole run), numeric dtypes and NaN for empty cells."""
 
-def fit_klaw(data: Any = None, *, model: str = 'stickslip', law: str = 'c', method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None, tol: float = 1e-10, skip_unsteady: bool = False, thin: int | None = None, priors: Any = None, fit_scatter: bool = False, draws: Any = None, rho: float | None = None, f: float | None = None, g: float | None = None) -> FitResult:
+def fit_klaw(data: Any = None, *, model: str = 'stickslip', law: str = 'c', method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None, tol: float = 1e-10, skip_unsteady: bool = False, thin: int | None = None, priors: Any = None, fit_scatter: bool = False, draws: Any = None, rho: float | None = None, f: float | None = None, g: float | None = None, sigma_delta: float | None = None) -> FitResult:
     '''A law K(α) fitted to every series at once (``fitbead klaw``).
 
     Parameters
@@ -435,7 +438,7 @@ def fit_klaw(data: Any = None, *, model: str = 'stickslip', law: str = 'c', meth
     UnitWarning, ConvergenceWarning, BoundWarning
         The command line\'s warnings on the data and the fit.
     '''
-def fit_jan(data: Any = None, *, method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None, thin: int | None = None, priors: Any = None, fit_scatter: bool = False, draws: Any = None, rho: float | None = None, f: float | None = None, g: float | None = None) -> FitSet:
+def fit_jan(data: Any = None, *, method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None, thin: int | None = None, priors: Any = None, fit_scatter: bool = False, draws: Any = None, rho: float | None = None, f: float | None = None, g: float | None = None, sigma_delta: float | None = None) -> FitSet:
     '''Jan\'s energy balance (eq 74): λ and μ per series (at least 3 points), then the global
     laws of eqs 75–76 (``fitbead jan``).
 
@@ -464,7 +467,7 @@ def fit_jan(data: Any = None, *, method: str = 'lsq', level: float = 0.95, profi
     UnitWarning, ConvergenceWarning, BoundWarning
         The command line\'s warnings on the data and the fits.
     '''
-def fit_jaeger(data: Any = None, *, branch: str = 'upper', method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None, thin: int | None = None, priors: Any = None, fit_scatter: bool = False, draws: Any = None, rho: float | None = None, f: float | None = None, g: float | None = None) -> FitSet:
+def fit_jaeger(data: Any = None, *, branch: str = 'upper', method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None, thin: int | None = None, priors: Any = None, fit_scatter: bool = False, draws: Any = None, rho: float | None = None, f: float | None = None, g: float | None = None, sigma_delta: float | None = None) -> FitSet:
     '''Jaeger\'s heuristic law (eqs 80–84): a1, a2, a3 per series with at least 4 points
     (``fitbead jaeger``).
 

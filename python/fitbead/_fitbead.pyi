@@ -47,11 +47,22 @@ class _Dataset:
     def default_data() -> "_Dataset": ...
     @staticmethod
     def from_arrays(
-        series: List[str], xi: F64, delta_deg: F64, v: F64, sigma_v: F64, rho: F64, f: F64
+        series: List[str],
+        xi: F64,
+        delta_deg: F64,
+        v: F64,
+        sigma_v: F64,
+        rho: F64,
+        f: F64,
+        sigma_delta_deg: F64,
     ) -> "_Dataset": ...
     def invert_k(self, model: str, tol: float = 1e-10) -> Dict[str, Any]: ...
     def with_defaults(
-        self, rho: Optional[float] = None, f: Optional[float] = None, g: Optional[float] = None
+        self,
+        rho: Optional[float] = None,
+        f: Optional[float] = None,
+        g: Optional[float] = None,
+        sigma_delta: Optional[float] = None,
     ) -> "_Dataset": ...
     def __len__(self) -> int: ...
     @property

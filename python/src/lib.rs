@@ -882,15 +882,21 @@ impl PyDataset {
     }
 
     /// The same measurements read again with these defaults for the columns their rows leave
-    /// out (`None` keeps the reader's default: ρ 0.4, f 0.1, g 9.81 m/s²).
-    #[pyo3(signature = (rho=None, f=None, g=None))]
-    fn with_defaults(&self, rho: Option<f64>, f: Option<f64>, g: Option<f64>) -> PyResult<Self> {
+    /// out (`None` keeps the reader's default: ρ 0.4, f 0.1, g 9.81 m/s², σ_δ 0 degrees).
+    #[pyo3(signature = (rho=None, f=None, g=None, sigma_delta=None))]
+    fn with_defaults(
+        &self,
+        rho: Option<f64>,
+        f: Option<f64>,
+        g: Option<f64>,
+        sigma_delta: Option<f64>,
+    ) -> PyResult<Self> {
         let base = MeasurementDefaults::default();
         let d = MeasurementDefaults {
             rho: rho.unwrap_or(base.rho),
             f: f.unwrap_or(base.f),
             g: g.unwrap_or(base.g),
-            ..base
+            sigma_delta_deg: sigma_delta.unwrap_or(base.sigma_delta_deg),
         }
         .checked()
         .map_err(|e| value_error(e.to_string()))?;

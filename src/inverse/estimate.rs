@@ -148,21 +148,9 @@ fn finish(ev: &mut Evaluator, ls: View<'_>, sol: Solution, sigma: SigmaKind) -> 
     };
     let covariance = if chi2.is_finite() {
         let mut jac = Mat::<f64>::zeros(m, n);
-        let scale = match sigma {
-            SigmaKind::Absolute => Some(1.0),
-            SigmaKind::Relative if dof > 0 => Some(reduced_chi2),
-            SigmaKind::Relative => None,
-        };
-        match scale {
+        match covariance_scale(sigma, dof, reduced_chi2) {
             Some(s) if ev.jacobian(ls, &sol.x, &sol.f, &mut jac) => {
-                // Rank is judged to the precision of the Jacobian: ε for an analytic one,
-                // ε^(2/3) (the central-difference error) for differences.
-                let rtol = if ev.differenced {
-                    10.0 * f64::EPSILON.powf(2.0 / 3.0)
-                } else {
-                    f64::EPSILON * m.max(n) as f64
-                };
-                covariance(&jac, s, rtol)
+                covariance(&jac, s, rank_tolerance(ev.differenced, m, n))
             }
             _ => None,
         }
@@ -188,6 +176,27 @@ fn finish(ev: &mut Evaluator, ls: View<'_>, sol: Solution, sigma: SigmaKind) -> 
         jacobian_evals: ev.njev,
         termination: sol.termination,
         at_bound,
+    }
+}
+
+/// The factor of (JᵀJ)⁻¹ in the covariance: 1 for absolute σ, the reduced χ² for relative σ
+/// (`None` there without a degree of freedom).
+pub(crate) fn covariance_scale(sigma: SigmaKind, dof: usize, reduced_chi2: f64) -> Option<f64> {
+    match sigma {
+        SigmaKind::Absolute => Some(1.0),
+        SigmaKind::Relative if dof > 0 => Some(reduced_chi2),
+        SigmaKind::Relative => None,
+    }
+}
+
+/// The relative singular-value threshold below which an m × n Jacobian counts as rank
+/// deficient, to its precision: ε·max(m, n) for an analytic one, 10 ε^(2/3) (the
+/// central-difference error) for differences.
+pub(crate) fn rank_tolerance(differenced: bool, m: usize, n: usize) -> f64 {
+    if differenced {
+        10.0 * f64::EPSILON.powf(2.0 / 3.0)
+    } else {
+        f64::EPSILON * m.max(n) as f64
     }
 }
 

@@ -57,7 +57,7 @@ use faer::Mat;
 use nalgebra::{DMatrix, DVector};
 use std::sync::atomic::Ordering;
 
-use super::estimate::{covariance, information_criteria, Fit};
+use super::estimate::{covariance, covariance_scale, information_criteria, rank_tolerance, Fit};
 use super::lsq::{
     validate, Infeasible, LsqError, LsqOptions, Residuals, Setup, SigmaKind, Termination,
 };
@@ -232,6 +232,14 @@ impl<M: OdrModel> OdrProblem<M> {
         self.inv_sx[i] > 0.0
     }
 
+    /// ∂f_i/∂x at input `xi` (where f_i = `f0`) and parameters β, by the differences of
+    /// [`difference`] with step ε^{1/3}·max(|x|, σ_x,i); `None` where both sides are infeasible.
+    fn x_slope(&self, i: usize, xi: f64, f0: f64, beta: &[f64]) -> Option<f64> {
+        let h = STEP * xi.abs().max(self.sx[i]);
+        let inf = f64::INFINITY;
+        difference(f0, h, -inf, inf, |t| self.model.value(i, xi + t, beta).ok())
+    }
+
     /// The best correction of input i at parameters β, from `at` = (r_i, ρ_i, δ_i), a feasible
     /// point: Gauss–Newton steps on r_i(δ)² + ρ_i(δ)², each halved until it lowers the sum
     /// (at most `SETTLE` steps, stopping once a step gains less than 1e-15 of it); returns the
@@ -256,11 +264,7 @@ impl<M: OdrModel> OdrProblem<M> {
             let fx = match self.model.derivatives(i, xi, beta, &mut g) {
                 Some(Ok(fx)) => Some(fx),
                 Some(Err(_)) => None,
-                None => {
-                    let h = STEP * xi.abs().max(self.sx[i]);
-                    let inf = f64::INFINITY;
-                    difference(f0, h, -inf, inf, |t| self.model.value(i, xi + t, beta).ok())
-                }
+                None => self.x_slope(i, xi, f0, beta),
             };
             let Some(fx) = fx.filter(|v| v.is_finite()) else {
                 break;
@@ -563,9 +567,7 @@ impl Odr {
                         })?;
                     }
                     if self.moves(pr, i) {
-                        let h = STEP * xi.abs().max(pr.sx[i]);
-                        let inf = f64::INFINITY;
-                        difference(f0, h, -inf, inf, |t| pr.model.value(i, xi + t, &beta).ok())?
+                        pr.x_slope(i, xi, f0, &beta)?
                     } else {
                         0.0
                     }
@@ -800,11 +802,7 @@ impl Odr {
         } else {
             f64::INFINITY
         };
-        let scale = match sigma {
-            SigmaKind::Absolute => Some(1.0),
-            SigmaKind::Relative if dof > 0 => Some(reduced_chi2),
-            SigmaKind::Relative => None,
-        };
+        let scale = covariance_scale(sigma, dof, reduced_chi2);
         let covariance = match (started && chi2.is_finite(), scale) {
             (true, Some(scale)) => self.linearise(pr).and_then(|lin| {
                 let mut jac = Mat::<f64>::zeros(n, p);
@@ -819,12 +817,7 @@ impl Odr {
                         jac[(i, j)] = w * lin.a[i * p + j];
                     }
                 }
-                let rtol = if self.differenced {
-                    10.0 * f64::EPSILON.powf(2.0 / 3.0)
-                } else {
-                    f64::EPSILON * n.max(p) as f64
-                };
-                covariance(&jac, scale, rtol)
+                covariance(&jac, scale, rank_tolerance(self.differenced, n, p))
             }),
             _ => None,
         };

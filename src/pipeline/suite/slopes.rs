@@ -102,27 +102,12 @@ fn exact_slopes_keep_least_squares() {
 /// and profile intervals alike) and 50.75 %.
 #[test]
 fn odr_intervals_cover_at_their_level() {
-    use crate::io::measurements::MeasurementFile;
-    use crate::models::ModelKind;
-    use crate::pipeline::SimulateSettings;
-    use crate::scene::CollisionLaw;
     let dir = tempfile::tempdir().unwrap();
     let design = design_file(dir.path());
     let (mut hit, mut hit_profile, mut hit_wls, mut fitted) = (0, 0, 0, 0);
     let mut fails = Vec::new();
     for seed in 1..=400u64 {
-        let sim = SimulateSettings {
-            model: ModelKind::Stick,
-            law: CollisionLaw::C(0.5),
-            design: Some(design.clone()),
-            noise: 0.01,
-            sigma_delta: 0.1,
-            seed,
-            ..Default::default()
-        };
-        let bytes = sim.run().unwrap();
-        let file = MeasurementFile::parse("sim", &bytes, &MeasurementDefaults::default()).unwrap();
-        let mut d = file.into_dataset();
+        let mut d = simulated(&design, seed);
         // (covariance interval covers, profile interval covers) of the law-c fit.
         let covers = |d: &Dataset, profile: bool| -> Option<(bool, bool)> {
             let f = fit_law(Model::Stick, d, KLaw::C, 0.95, profile).ok()?;
@@ -228,26 +213,11 @@ fn posterior_with_slope_errors_spreads_as_odr() {
 fn posterior_intervals_cover_at_their_level() {
     use crate::fit::klaw::fit_law_with;
     use crate::inverse::posterior::{McmcSettings, Method};
-    use crate::io::measurements::MeasurementFile;
-    use crate::models::ModelKind;
-    use crate::pipeline::SimulateSettings;
-    use crate::scene::CollisionLaw;
     let dir = tempfile::tempdir().unwrap();
     let design = design_file(dir.path());
     let (mut hit, mut fitted) = (0, 0);
     for seed in 1..=100u64 {
-        let sim = SimulateSettings {
-            model: ModelKind::Stick,
-            law: CollisionLaw::C(0.5),
-            design: Some(design.clone()),
-            noise: 0.01,
-            sigma_delta: 0.1,
-            seed,
-            ..Default::default()
-        };
-        let bytes = sim.run().unwrap();
-        let file = MeasurementFile::parse("sim", &bytes, &MeasurementDefaults::default()).unwrap();
-        let d = file.into_dataset();
+        let d = simulated(&design, seed);
         let method = Method::Mcmc(Box::new(McmcSettings::seeded(seed)));
         let Ok(f) = fit_law_with(Model::Stick, &d, KLaw::C, 0.95, &method) else {
             continue;
@@ -315,4 +285,25 @@ fn moved_slopes_and_wide_errors_are_named() {
         note.contains("sigma_delta 7 deg is wider than its steady range"),
         "{note}"
     );
+}
+
+/// `simulate --model stick --law c=0.5 --design DESIGN --noise 0.01 --sigma-delta 0.1 --seed
+/// SEED`, read back as the fits read a file.
+fn simulated(design: &std::path::Path, seed: u64) -> Dataset {
+    use crate::io::measurements::MeasurementFile;
+    use crate::models::ModelKind;
+    use crate::pipeline::SimulateSettings;
+    use crate::scene::CollisionLaw;
+    let sim = SimulateSettings {
+        model: ModelKind::Stick,
+        law: CollisionLaw::C(0.5),
+        design: Some(design.to_path_buf()),
+        noise: 0.01,
+        sigma_delta: 0.1,
+        seed,
+        ..Default::default()
+    };
+    let bytes = sim.run().unwrap();
+    let file = MeasurementFile::parse("sim", &bytes, &MeasurementDefaults::default()).unwrap();
+    file.into_dataset()
 }

@@ -777,6 +777,14 @@ class FitResult:
         return np.asarray(self.residuals["normalised_residual"], dtype=float)
 
     @property
+    def delta_fit(self) -> Optional[np.ndarray]:
+        """The adjusted slopes δ_fit in degrees, one per fitted point, when the fit took the
+        slopes as measured with error (``sigma_delta_deg``: orthogonal distance regression, or
+        a posterior integrated over the slopes); None when it took them as exact."""
+        d = self.residuals.get("delta_fit_deg")
+        return None if d is None else np.asarray(d, dtype=float)
+
+    @property
     def correlations(self) -> Dict[Tuple[str, str], float]:
         """Correlation of each pair of parameters ``{(a, b): r}`` with a before b."""
         if self.correlation is None:

@@ -293,6 +293,11 @@ class FitResult:
         """The normalised residuals (v − v̄_fit)/σ of the fitted points (lmfit's
         ``residual``; divided by the relative weight where no σ is given)."""
     @property
+    def delta_fit(self) -> np.ndarray | None:
+        """The adjusted slopes δ_fit in degrees, one per fitted point, when the fit took the
+        slopes as measured with error (``sigma_delta_deg``: orthogonal distance regression, or
+        a posterior integrated over the slopes); None when it took them as exact."""
+    @property
     def correlations(self) -> dict[tuple[str, str], float]:
         """Correlation of each pair of parameters ``{(a, b): r}`` with a before b."""
     @property

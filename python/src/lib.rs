@@ -1216,6 +1216,13 @@ impl PyFitResult {
             "normalised_residual",
             PyArray1::from_vec(py, col(&|q| q.normalised_residual)),
         )?;
+        // A fit that took the slopes as measured with error: the adjusted slopes too.
+        if p.iter().any(|q| q.delta_fit_deg.is_some()) {
+            let fitted = col(&|q| opt(q.delta_fit_deg));
+            d.set_item("delta_fit_deg", PyArray1::from_vec(py, fitted))?;
+            let moved = col(&|q| opt(q.delta_residual));
+            d.set_item("delta_residual", PyArray1::from_vec(py, moved))?;
+        }
         Ok(d)
     }
 

@@ -202,6 +202,10 @@ def test_slope_errors_fit_by_odr_as_the_command_line():
     res = fit.to_pandas("residuals")
     assert {"delta_fit_deg", "delta_residual"} <= set(res.columns)
     assert res["delta_residual"].abs().max() < 4
+    assert np.array_equal(fit.delta_fit, res["delta_fit_deg"].to_numpy())
+    # The column wins over the keyword (which covers rows without it); exact slopes: no δ_fit.
+    assert fitbead.fit_klaw(str(path), model="stick", law="c", sigma_delta=0.0).delta_fit is not None
+    assert fitbead.fit_klaw(None, model="stick", law="c").delta_fit is None
     cols = read_csv_text(path.read_text())
     c = {k: np.array([float(x) for x in cols[k]]) for k in ("xi", "delta_deg", "v", "sigma_v", "sigma_delta_deg")}
     arr = fitbead.Dataset.from_arrays(

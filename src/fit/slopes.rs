@@ -50,6 +50,8 @@ impl<X, M: CurveModel<X>> OdrModel for SlopeCurve<'_, X, M> {
 pub(crate) struct SlopeFit<M> {
     pub problem: OdrProblem<M>,
     pub odr: OdrFit,
+    /// The options of the fit (the least-squares fit's, its box dropped unless kept).
+    pub options: LsqOptions,
 }
 
 impl<M: OdrModel> SlopeFit<M> {
@@ -86,7 +88,11 @@ impl<M: OdrModel> SlopeFit<M> {
             OdrProblem::new(model, x, y, sx, sy, &lm.params, &opts)
                 .and_then(|problem| {
                     let (odr, problem) = Odr::fit_keep(problem.started_at_optimum(), &opts)?;
-                    Ok(SlopeFit { problem, odr })
+                    Ok(SlopeFit {
+                        problem,
+                        odr,
+                        options: opts.clone(),
+                    })
                 })
                 .map_err(|e| e.to_string()),
         )
@@ -169,15 +175,7 @@ pub(crate) fn summarise<R: Residuals + ?Sized, M: OdrModel + Sync>(
             return Some(s);
         }
     };
-    let opts = if bounds {
-        solved.options.clone()
-    } else {
-        LsqOptions {
-            lower: None,
-            upper: None,
-            ..solved.options.clone()
-        }
-    };
+    let opts = &sf.options;
     let mut s = if let Method::Mcmc(_) = method {
         let integrated = Integrated::new(sf.problem.model(), data, index);
         posterior::summarise_with(
@@ -189,7 +187,7 @@ pub(crate) fn summarise<R: Residuals + ?Sized, M: OdrModel + Sync>(
                 problem: &integrated,
                 fit: &sf.odr.fit,
                 level: solved.level,
-                options: &opts,
+                options: opts,
                 distinct: solved.distinct,
                 observed_norm: solved.observed_norm,
             },
@@ -204,7 +202,7 @@ pub(crate) fn summarise<R: Residuals + ?Sized, M: OdrModel + Sync>(
                 problem: &reduced,
                 fit: &sf.odr.fit,
                 level: solved.level,
-                options: &opts,
+                options: opts,
                 distinct: solved.distinct,
                 observed_norm: solved.observed_norm,
             },

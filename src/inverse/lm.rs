@@ -897,20 +897,7 @@ impl LevenbergMarquardt {
         state: LmState,
     ) -> Result<(LmState, Option<KV>), Error> {
         let (m, n) = (ls.problem.n_residuals(), ls.problem.n_params());
-        let (lo, hi) = (&ls.setup.lower, &ls.setup.upper);
-        let start = match state.get_param() {
-            None => ls.setup.start.clone(),
-            Some(p) if p.len() == n && p.iter().all(|v| v.is_finite()) => {
-                (0..n).map(|j| p[j].clamp(lo[j], hi[j])).collect()
-            }
-            Some(p) => {
-                return Err(Error::msg(format!(
-                    "the initial parameter vector has length {} (expected {n}) or a \
-                     non-finite entry",
-                    p.len()
-                )))
-            }
-        };
+        let start = ls.setup.start_from(state.get_param())?;
         self.ev = Evaluator::new(m, n);
         let mut spare = self.spare.take();
         self.stage = match LmRun::start(&mut self.ev, ls, start, &mut spare) {

@@ -334,6 +334,29 @@ pub(crate) struct Setup {
     pub start: Vec<f64>,
 }
 
+impl Setup {
+    /// The start a solver's `init` takes: `given` (the state's parameters, configured on
+    /// argmin's `Executor`) projected onto the box, else the problem's start; an error when
+    /// `given` has the wrong length or a non-finite entry.
+    pub fn start_from(
+        &self,
+        given: Option<&nalgebra::DVector<f64>>,
+    ) -> Result<Vec<f64>, argmin::core::Error> {
+        let n = self.start.len();
+        match given {
+            None => Ok(self.start.clone()),
+            Some(p) if p.len() == n && p.iter().all(|v| v.is_finite()) => Ok((0..n)
+                .map(|j| p[j].clamp(self.lower[j], self.upper[j]))
+                .collect()),
+            Some(p) => Err(argmin::core::Error::msg(format!(
+                "the initial parameter vector has length {} (expected {n}) or a \
+                 non-finite entry",
+                p.len()
+            ))),
+        }
+    }
+}
+
 pub(crate) fn validate<R: Residuals + ?Sized>(
     problem: &R,
     start: &[f64],

@@ -737,6 +737,16 @@ impl Odr {
         }
     }
 
+    /// Ends the first stage (module docs): the inputs move from now on, each correction
+    /// starts from its best value at the present parameters ([`Odr::settle`]), and the damping
+    /// starts afresh.
+    fn release<M: OdrModel>(&mut self, pr: &OdrProblem<M>) {
+        self.frozen = false;
+        self.settle(pr);
+        self.lambda = LAMBDA0;
+        self.nu = 2.0;
+    }
+
     /// Moves every correction to its best value at the start's parameters
     /// ([`OdrProblem::correct`]). The iteration then starts from the parameters' best
     /// corrections, not from δ = 0, whose objective may be dominated by inputs far from the
@@ -927,19 +937,7 @@ impl<M: OdrModel> Solver<OdrProblem<M>, LmState> for Odr {
             .as_ref()
             .ok_or_else(|| Error::msg("no ODR problem"))?;
         let (n, p) = (pr.n(), pr.p());
-        let start = match state.get_param() {
-            None => pr.setup.start.clone(),
-            Some(b) if b.len() == p && b.iter().all(|v| v.is_finite()) => (0..p)
-                .map(|j| b[j].clamp(pr.setup.lower[j], pr.setup.upper[j]))
-                .collect(),
-            Some(b) => {
-                return Err(Error::msg(format!(
-                    "the initial parameter vector has length {} (expected {p}) or a \
-                     non-finite entry",
-                    b.len()
-                )))
-            }
-        };
+        let start = pr.setup.start_from(state.get_param())?;
         self.d_beta = vec![0.0; p];
         self.d_delta = vec![0.0; n];
         match self.evaluate(pr, start, vec![0.0; n]) {
@@ -947,8 +945,7 @@ impl<M: OdrModel> Solver<OdrProblem<M>, LmState> for Odr {
                 self.cur = pt;
                 self.frozen = (0..n).any(|i| pr.free(i));
                 if self.frozen && pr.at_optimum {
-                    self.frozen = false;
-                    self.settle(pr);
+                    self.release(pr);
                 }
             }
             None => self.termination = Some(Termination::InfeasibleStart),
@@ -967,13 +964,8 @@ impl<M: OdrModel> Solver<OdrProblem<M>, LmState> for Odr {
             .ok_or_else(|| Error::msg("no ODR problem"))?;
         if self.termination.is_none() {
             match self.iterate(pr) {
-                Some(t) if self.frozen && !FINAL.contains(&t) => {
-                    // The parameters' first fit, inputs held, has ended: now the inputs move.
-                    self.frozen = false;
-                    self.settle(pr);
-                    self.lambda = LAMBDA0;
-                    self.nu = 2.0;
-                }
+                // The parameters' first fit, inputs held, has ended: now the inputs move.
+                Some(t) if self.frozen && !FINAL.contains(&t) => self.release(pr),
                 t => self.termination = t,
             }
         }

@@ -357,8 +357,11 @@ def invert_k(
         ``final_velocity``, ``theta_G_deg``, the named laws' ``K_cos2a``, ``K_adjusted``,
         ``K_impact``, ``iterations``, the bracket ``K_min``/``K_max`` and what sets its ends
         (``lower_limit``, ``upper_limit``), ``regime``, ``status`` (``ok``,
-        ``below-range``, ``above-range``, ``invalid``) and ``message``; ``auto`` adds
-        ``model_used`` and ``reason``.
+        ``below-range``, ``above-range``, ``invalid``) and ``message``; a Dataset whose points
+        carry slope errors (``sigma_delta_deg``) adds ``sigma_K``, the standard uncertainty
+        of K from the velocity's and the slope's, and its ``K_lo``/``K_hi`` are at
+        v ∓ σ_eff, σ_eff² = σ_v² + (∂v̄/∂δ σ_δ)²; ``auto`` adds ``model_used`` and
+        ``reason``.
     """
     model = _model_name(model)
     if model not in K_MODELS:
@@ -369,7 +372,7 @@ def invert_k(
         for k in ("series", "xi", "delta_deg", "v", "sigma_v"):
             t[k] = cols[k]
         t["model"] = np.full(len(xi), model, dtype=object)
-        return _ordered(t, _core.output_columns("k", model))
+        return _ordered(t, _core.output_columns("k", model, slopes="sigma_K" in t))
     if delta_deg is None or v is None:
         raise FitbeadError("invert_k needs xi, delta_deg and v (or a Dataset)")
     if sigma_v is None:

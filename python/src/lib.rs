@@ -712,12 +712,12 @@ fn invert_k<'py>(
         (&f, "f"),
     ])?;
     let n = xi_s.len();
-    let mut cols = k_columns(auto.is_some());
+    let mut cols = k_columns(auto.is_some(), false);
     let r = py.detach(|| {
         fill(n, &mut cols, |i, sink| {
             let scene = scene_of(i, xi_s, d_s, rho_s, f_s, CollisionLaw::Value(0.5))?;
-            let (vi, sigma) = measured(i, v_s, s_s)?;
-            k_record(sink, &model, auto.as_ref(), &scene, vi, sigma);
+            let measured = measured(i, v_s, s_s)?;
+            k_record(sink, &model, auto.as_ref(), &scene, measured, None);
             Ok(())
         })
     });
@@ -748,26 +748,51 @@ fn measured(i: usize, v: &[f64], sigma_v: &[f64]) -> Result<(f64, Option<f64>), 
     Ok((vi, sigma))
 }
 
-/// The columns of the K records, with auto's when `auto`.
-fn k_columns(auto: bool) -> Columns {
+/// The column of σ_K that the K records of points with slope errors add.
+#[derive(Default, serde::Serialize)]
+struct SigmaK {
+    #[serde(rename = "sigma_K")]
+    sigma_k: Option<f64>,
+}
+
+/// The columns of the K records, with σ_K's when `slopes` and auto's when `auto`.
+fn k_columns(auto: bool, slopes: bool) -> Columns {
     let mut f = fields::<KRecord>();
+    if slopes {
+        f.extend(fields::<SigmaK>());
+    }
     if auto {
         f.extend(fields::<AutoRecord>());
     }
     Columns::of(f)
 }
 
-/// One measurement's K records (eq 69) written into `sink`.
+/// One measurement's K records (eq 69) written into `sink`; with `slope` = Some(σ_δ, radians)
+/// also σ_K, the slope's uncertainty carried into K's (`KRecord::estimate_with_slope`).
 fn k_record(
     sink: &mut RowSink<'_, '_>,
     model: &Model,
     auto: Option<&Auto>,
     scene: &Scene,
-    v: f64,
-    sigma_v: Option<f64>,
+    (v, sigma_v): (f64, Option<f64>),
+    slope: Option<f64>,
 ) {
-    let (rec, choice) = KRecord::estimate(model, auto, scene, v, sigma_v);
-    sink.record(&rec);
+    let (rec, choice) = match slope {
+        Some(sd) => {
+            let (rec, choice, sigma_k) =
+                KRecord::estimate_with_slope(model, auto, scene, v, sigma_v, sd);
+            sink.record(&rec);
+            sink.record(&SigmaK { sigma_k });
+            (None, choice)
+        }
+        None => {
+            let (rec, choice) = KRecord::estimate(model, auto, scene, v, sigma_v);
+            (Some(rec), choice)
+        }
+    };
+    if let Some(rec) = rec {
+        sink.record(&rec);
+    }
     if auto.is_some() {
         sink.record(&choice.unwrap_or_default());
     }
@@ -1026,13 +1051,15 @@ impl PyDataset {
     ) -> PyResult<Bound<'py, PyDict>> {
         let (model, auto) = k_model(model, tol)?;
         let p = &self.inner.points;
-        let mut cols = k_columns(auto.is_some());
+        let slopes = p.iter().any(|q| q.sigma_delta > 0.0);
+        let mut cols = k_columns(auto.is_some(), slopes);
         let abs = self.has_sigma();
         let r: Result<(), String> = py.detach(|| {
             fill(p.len(), &mut cols, |i, sink| {
                 let q = &p[i];
                 let sigma = abs.then_some(q.sigma);
-                k_record(sink, &model, auto.as_ref(), &q.scene, q.v, sigma);
+                let slope = slopes.then_some(q.sigma_delta);
+                k_record(sink, &model, auto.as_ref(), &q.scene, (q.v, sigma), slope);
                 Ok(())
             })
         });
@@ -1577,9 +1604,11 @@ fn record_columns(kind: &str) -> PyResult<Vec<String>> {
 
 /// The column names of the command line's `forward` output under `model` (after the input's
 /// own columns), or of its `k` output (the input columns with an output of their own first;
-/// auto's two when `model` is auto): `command` is `forward` or `k`.
+/// auto's two when `model` is auto; `sigma_K` before them when `slopes`, as for rows with slope
+/// errors): `command` is `forward` or `k`.
 #[pyfunction]
-fn output_columns(command: &str, model: &str) -> PyResult<Vec<String>> {
+#[pyo3(signature = (command, model, slopes=false))]
+fn output_columns(command: &str, model: &str, slopes: bool) -> PyResult<Vec<String>> {
     let kind = model
         .parse::<ModelKind>()
         .map_err(|e| value_error(e.to_string()))?;
@@ -1595,7 +1624,11 @@ fn output_columns(command: &str, model: &str) -> PyResult<Vec<String>> {
         "k" => TableCommand::K {
             model: kind,
             tol: 1e-10,
-            defaults: Default::default(),
+            // Any σ_δ above 0 gives the rows the column σ_K.
+            defaults: MeasurementDefaults {
+                sigma_delta_deg: if slopes { 1.0 } else { 0.0 },
+                ..MeasurementDefaults::default()
+            },
             check_columns: false,
             strict_columns: false,
             plot: false,

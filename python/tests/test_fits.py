@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import fitbead
-from conftest import DEFAULT_DATA, assert_bits_equal, read_csv_text
+from conftest import DEFAULT_DATA, assert_bits_equal, numbers, read_csv_text
 
 
 @pytest.fixture(scope="module")
@@ -217,3 +217,21 @@ def test_slope_errors_fit_by_odr_as_the_command_line():
         fitbead.Dataset.from_arrays(c["xi"], c["delta_deg"], c["v"], c["sigma_v"], sigma_delta_deg=-0.1)
     with pytest.raises(fitbead.FitbeadError, match="posterior sampling with slope errors|slope errors"):
         fitbead.fit_klaw(str(path), model="stick", law="c", method="mcmc", fit_scatter=True)
+
+
+def test_k_with_slope_errors_as_the_command_line(cli):
+    """K per point of a Dataset with slope errors: the command line's columns, sigma_K
+    included, bit for bit; without slope errors there is no sigma_K."""
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[2] / "tests" / "reference" / "odr" / "bead_stick.csv"
+    _, text, _ = cli("k", "--model", "stick", str(path))
+    want = read_csv_text(text)
+    got = fitbead.invert_k("stick", fitbead.Dataset.read_csv(str(path)))
+    assert list(got)[: list(want).index("sigma_K") + 1] == list(want)[: list(want).index("sigma_K") + 1]
+    for k in ("K", "K_lo", "K_hi", "dv_dK", "sigma_K"):
+        assert_bits_equal(k, got[k], want[k])
+    # The slope's share widens σ_K beyond the velocity's alone, σ_v/|dv̄/dK|.
+    velocity_only = numbers(want["sigma_v"]) / np.abs(numbers(want["dv_dK"]))
+    assert (np.asarray(got["sigma_K"]) > velocity_only).all()
+    assert "sigma_K" not in fitbead.invert_k("stick", fitbead.Dataset.default())

@@ -143,7 +143,7 @@ pub(crate) fn attach(summary: &mut FitResult, odr: &OdrFit, data: &Dataset, inde
 }
 
 /// How far an adjusted slope may move, in σ_δ, before the fit's note names its point.
-const MOVED: f64 = 2.0;
+pub(crate) const MOVED: f64 = 2.0;
 
 /// The summary of a least-squares fit (`solved`, of the points `index` of `data`) refitted by
 /// ODR on `model` when those points carry slope errors, with its points, their adjusted

@@ -256,6 +256,12 @@ impl MeasurementColumns {
         self.delta_deg
     }
 
+    /// Whether rows may carry a slope uncertainty: the table has a `sigma_delta_deg` column,
+    /// or the defaults give rows without one a σ_δ > 0.
+    pub fn has_slope_errors(&self) -> bool {
+        self.sigma_delta_deg.is_some() || self.defaults.sigma_delta_deg > 0.0
+    }
+
     /// The series label of a row: its `series` cell, empty when the table has none.
     pub fn series<'a>(&self, r: &Row<'a>) -> &'a str {
         self.series.map_or("", |c| r.cell(c))

@@ -12,6 +12,7 @@
 //! absent or non-finite number as an empty cell.
 
 use crate::fit::k::auto::{estimate_with, KChoice};
+use crate::fit::k::slope::estimate_with_slope;
 use crate::fit::k::KEstimate;
 use crate::fit::summary::{FitResult, ParamRow, PointFit, StatsRow};
 use crate::inverse::{ProfileEnd, SigmaKind};
@@ -636,14 +637,31 @@ impl KRecord {
         sigma_v: Option<f64>,
     ) -> (KRecord, Option<AutoRecord>) {
         let (e, choice) = estimate_with(model, auto, scene, v, sigma_v);
-        let (alpha, rho) = (scene.alpha_rad(), scene.rho());
-        let laws = [
-            CollisionLaw::Cos2a,
-            CollisionLaw::Adjusted,
-            CollisionLaw::Impact,
-        ]
-        .map(|l| l.k(alpha, rho));
-        (KRecord::new(&e, laws), choice.map(AutoRecord::of_choice))
+        (
+            KRecord::new(&e, named_laws(scene)),
+            choice.map(AutoRecord::of_choice),
+        )
+    }
+
+    /// [`KRecord::estimate`] for a slope with standard uncertainty `sigma_delta` (radians, 0
+    /// for an exact slope), with σ_K: K_lo and K_hi are the inverses at v ∓ σ_eff, σ_eff² =
+    /// σ_v² + (∂v̄/∂δ · σ_δ)² (∂v̄/∂δ at the measurement's K), and σ_K = σ_eff/|dv̄/dK|. σ_K is
+    /// `None` where there is no K or no σ; with `sigma_delta` = 0 the record is
+    /// [`KRecord::estimate`]'s and σ_K = σ_v/|dv̄/dK|.
+    pub fn estimate_with_slope(
+        model: &Model,
+        auto: Option<&Auto>,
+        scene: &Scene,
+        v: f64,
+        sigma_v: Option<f64>,
+        sigma_delta: f64,
+    ) -> (KRecord, Option<AutoRecord>, Option<f64>) {
+        let (e, choice, sigma_k) = estimate_with_slope(model, auto, scene, v, sigma_v, sigma_delta);
+        (
+            KRecord::new(&e, named_laws(scene)),
+            choice.map(AutoRecord::of_choice),
+            sigma_k,
+        )
     }
 
     /// The record of estimate `e`, with the three named laws' K (cos 2α, adjusted, impact).
@@ -680,6 +698,26 @@ impl KRecord {
             message,
         }
     }
+}
+
+/// K of cos 2α, the adjusted law and the impact law at `scene`'s ξ and ρ.
+fn named_laws(scene: &Scene) -> [f64; 3] {
+    let (alpha, rho) = (scene.alpha_rad(), scene.rho());
+    [
+        CollisionLaw::Cos2a,
+        CollisionLaw::Adjusted,
+        CollisionLaw::Impact,
+    ]
+    .map(|l| l.k(alpha, rho))
+}
+
+/// The column `fitbead k` adds after K's when rows carry slope errors: σ_K, the standard
+/// uncertainty of K from the velocity's and the slope's ([`KRecord::estimate_with_slope`]).
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub(crate) struct SigmaKRecord {
+    /// σ_K; empty where there is no K or no σ.
+    #[serde(rename = "sigma_K")]
+    pub sigma_k: Option<f64>,
 }
 
 impl AutoRecord {

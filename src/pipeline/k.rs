@@ -6,13 +6,14 @@
 //! other columns (trimmed; a name clashing with an output column renamed `in_NAME`).
 
 use crate::fit::k::auto::{self as kauto, KChoice};
+use crate::fit::k::slope::estimate_with_slope;
 use crate::fit::k::KEstimate;
 use crate::io::cells::{Cells, Repeat};
 use crate::io::measurements::{
     Implausible, Measured, MeasurementColumns, MeasurementDefaults, Plausibility, PlausiblePoint,
     SeriesLedger, StopSlopes,
 };
-use crate::io::records::{columns, AutoRecord, KRecord};
+use crate::io::records::{columns, AutoRecord, KRecord, SigmaKRecord};
 use crate::io::scenes::{Header, Row};
 use crate::io::stream::RowPlan;
 use crate::io::InputError;
@@ -40,11 +41,14 @@ struct KInput<'a> {
 }
 
 /// The columns of a K row in order, generated from the records: the measurement's own
-/// (`KInput`), [`KRecord`]'s, and [`AutoRecord`]'s when `auto`; the input's other columns
-/// follow them.
-pub(crate) fn output_columns(auto: bool) -> Vec<&'static str> {
+/// (`KInput`), [`KRecord`]'s, [`SigmaKRecord`]'s when rows carry slope errors (`slopes`), and
+/// [`AutoRecord`]'s when `auto`; the input's other columns follow them.
+pub(crate) fn output_columns(auto: bool, slopes: bool) -> Vec<&'static str> {
     let mut v = columns::<KInput>();
     v.extend(columns::<KRecord>());
+    if slopes {
+        v.extend(columns::<SigmaKRecord>());
+    }
     if auto {
         v.extend(columns::<AutoRecord>());
     }
@@ -215,18 +219,30 @@ impl KPlan {
     }
 
     fn own_columns(&self) -> impl Iterator<Item = &'static str> + '_ {
-        output_columns(self.settings.auto.is_some()).into_iter()
+        output_columns(self.settings.auto.is_some(), self.cols.has_slope_errors()).into_iter()
     }
 
-    /// Inverts one measurement with the settings' model, or the one auto chooses for it.
-    pub fn invert(&self, m: &Measured) -> (KEstimate, Option<KChoice>) {
-        kauto::estimate_with(
+    /// Inverts one measurement with the settings' model, or the one auto chooses for it,
+    /// with σ_K where rows carry slope errors ([`crate::fit::k::slope`]).
+    pub fn invert(&self, m: &Measured) -> (KEstimate, Option<KChoice>, Option<f64>) {
+        if self.cols.has_slope_errors() {
+            return estimate_with_slope(
+                &self.settings.model,
+                self.settings.auto.as_ref(),
+                &m.scene,
+                m.v,
+                m.sigma_v,
+                m.sigma_delta,
+            );
+        }
+        let (e, choice) = kauto::estimate_with(
             &self.settings.model,
             self.settings.auto.as_ref(),
             &m.scene,
             m.v,
             m.sigma_v,
-        )
+        );
+        (e, choice, None)
     }
 }
 
@@ -256,7 +272,7 @@ impl RowPlan for KPlan {
     }
 
     fn write(&self, row: &Row<'_>, m: Measured, cache: &mut KScratch, out: &mut Vec<u8>) -> KNote {
-        let (e, choice) = self.invert(&m);
+        let (e, choice, sigma_k) = self.invert(&m);
         let s = &m.scene;
         let laws = cache.laws(s);
         let mut w = Cells::new(out);
@@ -272,6 +288,9 @@ impl RowPlan for KPlan {
             &mut cache.input,
         );
         w.record_repeating(&KRecord::new(&e, laws), &mut cache.record);
+        if self.cols.has_slope_errors() {
+            w.record(&SigmaKRecord { sigma_k });
+        }
         if self.settings.auto.is_some() {
             w.record(&choice.map(AutoRecord::of_choice).unwrap_or_default());
         }
@@ -371,7 +390,11 @@ mod tests {
             "upper_limit",
             "message",
         ];
-        assert_eq!(output_columns(false), k);
-        assert_eq!(output_columns(true), [&k[..], &auto].concat());
+        assert_eq!(output_columns(false, false), k);
+        assert_eq!(output_columns(true, false), [&k[..], &auto].concat());
+        assert_eq!(
+            output_columns(true, true),
+            [&k[..], &["sigma_K"], &auto].concat()
+        );
     }
 }

@@ -105,18 +105,22 @@ impl TableRun {
 impl TableCommand {
     /// The columns the command writes, in order, generated from its records: `forward`'s
     /// after the input's own (every model's, then the contact model's or auto's); `k`'s, the
-    /// input's columns that have an output of their own, then K's (then auto's two under
-    /// auto), the input's other columns following them. `None` for md, whose columns follow
-    /// its settings.
+    /// input's columns that have an output of their own, then K's (then `sigma_K` when the
+    /// defaults give a slope uncertainty — a table with a `sigma_delta_deg` column gets it
+    /// too —, then auto's two under auto), the input's other columns following them. `None`
+    /// for md, whose columns follow its settings.
     pub fn columns(&self) -> Option<Vec<&'static str>> {
         match self {
             TableCommand::Forward { settings, .. } => {
                 Some(super::forward::plan::output_columns(settings.kind))
             }
             TableCommand::ForwardMd { .. } => None,
-            TableCommand::K { model, .. } => {
-                Some(kstream::output_columns(*model == ModelKind::Auto))
-            }
+            TableCommand::K {
+                model, defaults, ..
+            } => Some(kstream::output_columns(
+                *model == ModelKind::Auto,
+                defaults.sigma_delta_deg > 0.0,
+            )),
         }
     }
 

@@ -468,6 +468,7 @@ pub fn markdown(an: &Analysis, ctx: &ReportContext, method: &str) -> String {
     ));
     m.push_str(&si_units(ctx));
     m.push_str(&parameter_table(an));
+    m.push_str(&slopes_section(an));
     m.push_str(&bulk_friction_section(an));
     m.push_str(&energy_section(an));
     m.push_str(&regimes_section(an, ctx));
@@ -475,6 +476,82 @@ pub fn markdown(an: &Analysis, ctx: &ReportContext, method: &str) -> String {
     m.push_str(&model_choice_section(an));
     m.push_str(&figures_section(ctx));
     m.push_str(&fit_reports(an));
+    m
+}
+
+/// report.md's slopes measured with error (only when some point carries σ_δ > 0): how the fits
+/// use them, and every point whose adjusted slope moved by more than
+/// [`MOVED`](crate::fit::slopes::MOVED) σ_δ under each least-squares fit.
+fn slopes_section(an: &Analysis) -> String {
+    use crate::fit::slopes::MOVED;
+    let sd: Vec<f64> = an
+        .data
+        .points
+        .iter()
+        .map(|p| p.sigma_delta.to_degrees())
+        .filter(|s| *s > 0.0)
+        .collect();
+    if sd.is_empty() {
+        return String::new();
+    }
+    let (lo, hi) = sd
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(*v), b.max(*v))
+        });
+    let mut m = String::from("## Slopes measured with error\n\n");
+    m.push_str(&format!(
+        "{} of {} points carry a slope uncertainty σ_δ ({}). ",
+        sd.len(),
+        an.data.points.len(),
+        if lo == hi {
+            format!("{}°", fmt_sig(lo, 3))
+        } else {
+            format!("{}° … {}°", fmt_sig(lo, 3), fmt_sig(hi, 3))
+        }
+    ));
+    if an.mcmc {
+        m.push_str(
+            "Each point's likelihood is integrated over its true slope (a Gaussian around the \
+             measured one, zero where the bead has no steady state), so the posteriors above, \
+             and μ of eq 79 at their K, carry the slope errors.\n\n",
+        );
+        return m;
+    }
+    m.push_str(&format!(
+        "The least-squares fits adjust each slope too, by orthogonal distance regression \
+         (weighted by σ_δ, never outside the steady range), so the intervals above, and μ of \
+         eq 79 at their K, carry the slope errors. Adjusted slopes: columns `delta_fit_deg` and \
+         `delta_residual` = (δ_fit − δ)/σ_δ of [residuals.csv](residuals.csv).\n\n\
+         Points whose adjusted slope moved by more than {} σ_δ:\n\n",
+        fmt_f64(MOVED)
+    ));
+    let mut rows = String::new();
+    for f in an.fit_results() {
+        for p in &f.points {
+            let (Some(fit), Some(r)) = (p.delta_fit_deg, p.delta_residual) else {
+                continue;
+            };
+            if r.abs() > MOVED {
+                rows.push_str(&format!(
+                    "| {} | {} | {} | {} | {} |\n",
+                    table_cell(&f.stats.fit),
+                    table_cell(&p.series),
+                    fmt_sig(p.delta_deg, 6),
+                    fmt_sig(fit, 6),
+                    fmt_sig(r, 3)
+                ));
+            }
+        }
+    }
+    if rows.is_empty() {
+        m.push_str("none.\n\n");
+    } else {
+        m.push_str("| fit | series | δ measured (°) | δ adjusted (°) | (δ_fit − δ)/σ_δ |\n");
+        m.push_str("|---|---|---|---|---|\n");
+        m.push_str(&rows);
+        m.push('\n');
+    }
     m
 }
 

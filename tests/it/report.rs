@@ -334,3 +334,70 @@ fn report_writes_pdf_figures_with_the_font_embedded() {
     assert_eq!(svgs, 8);
     assert!(md.contains("(the paper's Fig. 4)"));
 }
+
+/// With slope errors report.md says how the fits used them and lists, per fit, exactly the
+/// points whose adjusted slope moved by more than 2σ_δ (residuals.csv's `delta_residual`), and
+/// Jan's μ intervals (bulk_friction.csv) are wider than those of the same points with the
+/// slopes taken as exact; without slope errors there is no such section.
+#[test]
+fn report_md_names_the_moved_slopes_and_mu_carries_them() {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/reference/odr/bead_stick.csv");
+    let text = std::fs::read_to_string(&data).unwrap();
+    let exact: String = text
+        .lines()
+        .map(|l| l.split(',').take(5).collect::<Vec<_>>().join(",") + "\n")
+        .collect();
+    let (with, without) = (tmpdir(), tmpdir());
+    let plain = write(without.path(), "exact.csv", &exact);
+    report_into(with.path(), &["--keep-going", data.to_str().unwrap()]);
+    report_into(without.path(), &["--keep-going", plain.to_str().unwrap()]);
+    let md = std::fs::read_to_string(with.path().join("report.md")).unwrap();
+    let at = md
+        .find("## Slopes measured with error")
+        .expect("slope section");
+    let section = &md[at..md[at..].find("## Bulk friction").unwrap() + at];
+    assert!(section.contains("24 of 24 points carry a slope uncertainty σ_δ (0.1°)"));
+    let listed: Vec<(String, String, f64)> = section
+        .lines()
+        .filter(|l| l.starts_with("| ") && !l.starts_with("| fit |"))
+        .map(|l| {
+            let c: Vec<&str> = l.split('|').map(str::trim).collect();
+            (c[1].to_string(), c[2].to_string(), num(c[3]))
+        })
+        .collect();
+    let (h, rows) = read_table(&with.path().join("residuals.csv"));
+    let moved: Vec<(String, String, f64)> = rows
+        .iter()
+        .filter(|r| num(&r[col(&h, "delta_residual")]).abs() > 2.0)
+        .map(|r| {
+            let d = num(&r[col(&h, "delta_deg")]);
+            (r[col(&h, "fit")].clone(), r[col(&h, "series")].clone(), d)
+        })
+        .collect();
+    assert_eq!(listed.len(), moved.len(), "{section}");
+    for ((f, s, d), (g, t, e)) in listed.iter().zip(&moved) {
+        assert!(
+            f == g && s == t && (d - e).abs() < 1e-4,
+            "{f} {s} {d} against {g} {t} {e}"
+        );
+    }
+    if moved.is_empty() {
+        assert!(section.contains("none."));
+    }
+    let md0 = std::fs::read_to_string(without.path().join("report.md")).unwrap();
+    assert!(!md0.contains("## Slopes measured with error"));
+    let width = |dir: &Path| -> Vec<f64> {
+        let (h, rows) = read_table(&dir.join("bulk_friction.csv"));
+        rows.iter()
+            .map(|r| num(&r[col(&h, "mu_jan_hi")]) - num(&r[col(&h, "mu_jan_lo")]))
+            .collect()
+    };
+    let (w1, w0) = (width(with.path()), width(without.path()));
+    assert!(!w1.is_empty() && w1.len() == w0.len());
+    for (a, b) in w1.iter().zip(&w0) {
+        assert!(
+            a > &(1.2 * b),
+            "μ interval {a} with slope errors, {b} without"
+        );
+    }
+}

@@ -24,13 +24,15 @@
 //!
 //! Layout: [`types`] holds what every path shares; `bracket` derives the bracket of K;
 //! `search` solves eq 69 in K; [`launch`] solves it in the launch speed where that applies;
-//! [`estimate`](mod@estimate) picks the path; [`auto`] picks the model per point.
+//! [`estimate`](mod@estimate) picks the path; [`auto`] picks the model per point; `slope` carries a slope's
+//! uncertainty into K's.
 
 pub mod auto;
 pub(crate) mod bracket;
 pub mod estimate;
 pub mod launch;
 pub(crate) mod search;
+pub(crate) mod slope;
 pub mod types;
 
 pub(crate) use bracket::bracket;

@@ -7,6 +7,7 @@ mod gradients;
 mod jaeger_posterior;
 mod k_edges;
 mod k_inversion;
+mod k_slope;
 mod sbc;
 
 /// A table of tests/reference/ (docs/ACCURACY.md#reference-tables says how each was made):

@@ -1655,6 +1655,7 @@ def simulate(
     beads: Optional[int] = None,
     spin: str = "roll",
     md_preset: str = "ristow",
+    sigma_delta: float = 0.0,
 ) -> Table:
     """Synthetic measurements inside regime B, reproducible from a seed (``fitbead simulate``).
 
@@ -1699,13 +1700,18 @@ def simulate(
         The contact model's spin rule: ``roll``, ``keep``, ``impact`` or ``factor=L``.
     md_preset : {"ristow", "steel"}
         The md model's parameter set.
+    sigma_delta : float, default 0
+        Standard uncertainty of the slope, degrees (``--sigma-delta``): the recorded slope
+        ``delta_deg`` is drawn around the true one, ``delta_true_deg``, at which the velocity
+        is made. 0: the slopes are exact.
 
     Returns
     -------
     Table
         The command line's CSV columns in its order: ``series``, ``xi``, ``delta_deg``,
         ``v``, ``sigma_v`` (NaN with no noise), ``v_true``; md adds ``v_md_stderr`` and
-        ``v_m_s``; the transient has the columns of ``simulate --v0``. ``to_pandas()`` gives
+        ``v_m_s``; ``sigma_delta`` above 0 adds ``sigma_delta_deg`` and
+        ``delta_true_deg``; the transient has the columns of ``simulate --v0``. ``to_pandas()`` gives
         a DataFrame.
 
     Raises
@@ -1739,6 +1745,7 @@ def simulate(
         beads=None if beads is None else int(beads),
         spin=spin,
         md_preset=md_preset,
+        sigma_delta=float(sigma_delta),
     )
     return _csv_table(text)
 

@@ -604,7 +604,7 @@ def design(fit: str = 'klaw', *, model: str | None = None, law: str = 'c=0.5', s
         named as the command line names it.
     '''
 
-def simulate(model: str = 'stickslip', *, law: str = 'adjusted', series: Sequence[float] = (0.8, 1.0, 1.6, 2.0), points: int = 9, noise: float = 0.02, seed: int = 1, rho: float = 0.4, f: float = 0.1, jan: Sequence[float] | None = None, jaeger: Sequence[float] | None = None, branch: str = 'upper', delta_range: tuple[float, float] | None = None, design: Any | None = None, v0: float | None = None, delta_deg: float | None = None, beads: int | None = None, spin: str = 'roll', md_preset: str = 'ristow') -> Table:
+def simulate(model: str = 'stickslip', *, law: str = 'adjusted', series: Sequence[float] = (0.8, 1.0, 1.6, 2.0), points: int = 9, noise: float = 0.02, seed: int = 1, rho: float = 0.4, f: float = 0.1, jan: Sequence[float] | None = None, jaeger: Sequence[float] | None = None, branch: str = 'upper', delta_range: tuple[float, float] | None = None, design: Any | None = None, v0: float | None = None, delta_deg: float | None = None, beads: int | None = None, spin: str = 'roll', md_preset: str = 'ristow', sigma_delta: float = 0.0) -> Table:
     """Synthetic measurements inside regime B, reproducible from a seed (``fitbead simulate``);
     the keyword arguments are the command line's flags, the rows those it writes."""
 

@@ -1770,7 +1770,7 @@ fn pipeline_error(e: fitbead::pipeline::RunError) -> PyErr {
 /// Synthetic measurements (`fitbead simulate`): the settings as its flags, the result as the
 /// CSV text it writes (see the Python `fitbead.simulate`).
 #[pyfunction]
-#[pyo3(signature = (model="stickslip", law="adjusted", series=vec![0.8, 1.0, 1.6, 2.0], points=9, noise=0.02, seed=1, rho=0.4, f=0.1, jan=None, jaeger=None, branch="upper", delta_range=None, design=None, v0=None, delta_deg=None, beads=None, spin="roll", md_preset="ristow"))]
+#[pyo3(signature = (model="stickslip", law="adjusted", series=vec![0.8, 1.0, 1.6, 2.0], points=9, noise=0.02, seed=1, rho=0.4, f=0.1, jan=None, jaeger=None, branch="upper", delta_range=None, design=None, v0=None, delta_deg=None, beads=None, spin="roll", md_preset="ristow", sigma_delta=0.0))]
 #[allow(clippy::too_many_arguments)]
 fn simulate(
     py: Python<'_>,
@@ -1792,6 +1792,7 @@ fn simulate(
     beads: Option<usize>,
     spin: &str,
     md_preset: &str,
+    sigma_delta: f64,
 ) -> PyResult<String> {
     use fitbead::models::md::{Md, MdParams, MdRunConfig};
     use fitbead::pipeline::SimulateSettings;
@@ -1835,6 +1836,7 @@ fn simulate(
             params,
             config: MdRunConfig::default(),
         },
+        sigma_delta,
         stop: Some(stop.clone()),
         ..SimulateSettings::default()
     };

@@ -235,3 +235,17 @@ def test_k_with_slope_errors_as_the_command_line(cli):
     velocity_only = numbers(want["sigma_v"]) / np.abs(numbers(want["dv_dK"]))
     assert (np.asarray(got["sigma_K"]) > velocity_only).all()
     assert "sigma_K" not in fitbead.invert_k("stick", fitbead.Dataset.default())
+
+
+def test_simulate_with_slope_errors_as_the_command_line(cli):
+    """simulate(sigma_delta=…) writes the command line's rows, bit for bit, with the columns
+    sigma_delta_deg and delta_true_deg."""
+    _, text, _ = cli("simulate", "--model", "stick", "--law", "c=0.5", "--series", "0.8,1", "--points", "5",
+                     "--noise", "0.01", "--sigma-delta", "0.1", "--seed", "3")
+    want = read_csv_text(text)
+    got = fitbead.simulate("stick", law="c=0.5", series=[0.8, 1.0], points=5, noise=0.01, sigma_delta=0.1, seed=3)
+    assert list(got) == list(want) and list(got)[-2:] == ["sigma_delta_deg", "delta_true_deg"]
+    for k in ("delta_deg", "v", "sigma_v", "sigma_delta_deg", "delta_true_deg"):
+        assert_bits_equal(k, got[k], want[k])
+    with pytest.raises(fitbead.FitbeadError, match="sigma-delta"):
+        fitbead.simulate("stick", sigma_delta=-1.0)

@@ -57,6 +57,14 @@ class BoundWarning(FitbeadWarning):
     """A fitted parameter sits on a bound of its box (its interval is one-sided)."""
 
 
+class ColumnWarning(FitbeadWarning):
+    """A column of the data that fitbead does not read looks misspelt or misnamed: close to
+    a known name (``sigma`` for ``sigma_v``), or named like an uncertainty (``sigma…``,
+    ``err…``, ``sd…``, ``std…``, ``unc…``) while the data lack the uncertainty column it
+    most likely means. Such a column is ignored, which can change the weighting silently;
+    ``strict_columns=True`` refuses any column fitbead does not read."""
+
+
 _PACKAGE_DIR = __file__.rsplit("/", 1)[0] if "/" in __file__ else ""
 
 
@@ -338,7 +346,8 @@ def invert_k(
     """The collisional parameter K of every measured point (eq 69; ``fitbead k``).
 
     Either arrays (``xi``, ``delta_deg``, ``v`` and optionally ``sigma_v``, ``rho``, ``f``,
-    broadcast together) or a :class:`Dataset` as the second argument.
+    broadcast together) or measurements as the second argument: a :class:`Dataset`, a CSV
+    path, a pandas DataFrame or a :class:`Table` (what :func:`simulate` returns).
 
     Parameters
     ----------
@@ -366,6 +375,8 @@ def invert_k(
     model = _model_name(model)
     if model not in K_MODELS:
         raise FitbeadError(f"model = {model!r}: expected one of {', '.join(K_MODELS)}")
+    if delta_deg is None and v is None and _is_data(xi):
+        xi = _dataset(xi)
     if isinstance(xi, Dataset):
         t = _table(xi._core.invert_k(model, tol=tol), (len(xi),))
         cols = xi.columns()
@@ -417,16 +428,21 @@ class Dataset:
             _warn(w, UnitWarning)
 
     @classmethod
-    def read_csv(cls, path: str, *, rho: float = 0.4, f: float = 0.1, g: float = 9.81) -> "Dataset":
+    def read_csv(
+        cls, path: str, *, rho: float = 0.4, f: float = 0.1, g: float = 9.81, strict_columns: bool = False
+    ) -> "Dataset":
         """Reads a measurement CSV as the command line does.
 
         Parameters
         ----------
         path : str or path-like
             The file: columns ``series,xi,delta_deg,v[,sigma_v][,rho][,f]`` (dimensionless
-            velocities) or ``v_m_s`` with ``R_m`` (SI).
+            velocities) or ``v_m_s`` with ``R_m`` (SI), optionally ``sigma_delta_deg``.
         rho, f, g : float
             Values for the columns the file leaves out; ``g`` in m/s² for SI files.
+        strict_columns : bool, default False
+            Refuse any column fitbead does not read (the command line's
+            ``--strict-columns``), instead of warning about those that look misnamed.
 
         Returns
         -------
@@ -442,8 +458,21 @@ class Dataset:
         UnitWarning
             Each of the command line's plausibility warnings (slopes in radians, velocities
             in m/s or mm/s in the dimensionless column, radii in millimetres).
+        ColumnWarning
+            A column fitbead does not read that looks misspelt or misnamed (``sigma`` for
+            ``sigma_v``), with the name it most likely means.
         """
-        return cls(_core._Dataset.from_csv(str(path), rho=rho, f=f, g=g))
+        return cls._checked(_core._Dataset.from_csv(str(path), rho=rho, f=f, g=g), strict_columns)
+
+    @classmethod
+    def _checked(cls, core: Any, strict_columns: bool) -> "Dataset":
+        """The data set of a file read, its columns checked as the command line checks them."""
+        if strict_columns:
+            core.check_strict_columns()
+        out = cls(core)
+        for w in core.column_warnings:
+            _warn(w, ColumnWarning)
+        return out
 
     @classmethod
     def default(cls) -> "Dataset":
@@ -496,11 +525,29 @@ class Dataset:
         )
 
     @classmethod
-    def from_pandas(cls, df: Any, *, rho: float = 0.4, f: float = 0.1, g: float = 9.81) -> "Dataset":
+    def from_pandas(
+        cls, df: Any, *, rho: float = 0.4, f: float = 0.1, g: float = 9.81, strict_columns: bool = False
+    ) -> "Dataset":
         """From a DataFrame with the CSV's columns, checked as the command line checks a file
-        (errors name the DataFrame's line as the CSV would have it: header on line 1)."""
+        (errors name the DataFrame's line as the CSV would have it: header on line 1).
+
+        Parameters
+        ----------
+        df : pandas.DataFrame
+            The columns of a measurement CSV (:meth:`read_csv`); the index is not used.
+        rho, f, g : float
+            Values for the columns the frame leaves out; ``g`` in m/s² for SI columns.
+        strict_columns : bool, default False
+            Refuse any column fitbead does not read, instead of warning (``ColumnWarning``)
+            about those that look misnamed.
+
+        Returns
+        -------
+        Dataset
+        """
         text = df.to_csv(index=False)
-        return cls(_core._Dataset.from_text(text, "<DataFrame>", rho=rho, f=f, g=g))
+        core = _core._Dataset.from_text(text, "<DataFrame>", rho=rho, f=f, g=g)
+        return cls._checked(core, strict_columns)
 
     @property
     def warnings(self) -> List[str]:
@@ -553,16 +600,55 @@ class Dataset:
         return f"Dataset({len(self)} points, series {self.labels})"
 
 
-def _dataset(data: Any) -> Dataset:
+def _dataset(data: Any, strict_columns: bool = False) -> Dataset:
+    """The data of a call: a Dataset as it is, None for the shipped data, a CSV path, a
+    pandas DataFrame or a :class:`Table` (what :func:`simulate` returns), the last three read
+    and checked as the command line reads a file."""
     if isinstance(data, Dataset):
         return data
     if data is None:
         return Dataset.default()
     if isinstance(data, str) or hasattr(data, "__fspath__"):
-        return Dataset.read_csv(str(data))
+        return Dataset.read_csv(str(data), strict_columns=strict_columns)
+    if isinstance(data, Table):
+        core = _core._Dataset.from_text(_table_csv(data), "<Table>")
+        return Dataset._checked(core, strict_columns)
     if hasattr(data, "to_csv") and hasattr(data, "columns"):
-        return Dataset.from_pandas(data)
-    raise FitbeadError("data: expected a Dataset, a CSV path or a pandas DataFrame")
+        return Dataset.from_pandas(data, strict_columns=strict_columns)
+    raise FitbeadError("data: expected a Dataset, a CSV path, a pandas DataFrame or a Table (simulate's)")
+
+
+def _is_data(x: Any) -> bool:
+    """Whether `x` is measurements as :func:`_dataset` takes them (not an array of ξ)."""
+    return (
+        isinstance(x, (Dataset, Table, str))
+        or hasattr(x, "__fspath__")
+        or (hasattr(x, "to_csv") and hasattr(x, "columns"))
+    )
+
+
+def _table_csv(t: "Table") -> str:
+    """A one-dimensional Table as CSV text: numbers written so that they read back to the same
+    float64 (``repr``), NaN as an empty cell, text as it is."""
+    import csv
+    import io
+
+    names = list(t)
+    cols = [np.asarray(t[n]).ravel() for n in names]
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(names)
+
+    def cell(x: Any) -> str:
+        if isinstance(x, (float, np.floating)):
+            return "" if math.isnan(x) else repr(float(x))
+        if isinstance(x, (int, np.integer)):
+            return str(int(x))
+        return str(x)
+
+    for i in range(len(cols[0]) if cols else 0):
+        w.writerow([cell(c[i]) for c in cols])
+    return buf.getvalue()
 
 
 def _nan(x: Any) -> float:
@@ -1158,10 +1244,15 @@ def _fitted(core: Any, context: Dict[str, Any]) -> FitResult:
 
 
 def _fit_data(
-    data: Any, rho: Optional[float], f: Optional[float], g: Optional[float], sigma_delta: Optional[float] = None
+    data: Any,
+    rho: Optional[float],
+    f: Optional[float],
+    g: Optional[float],
+    sigma_delta: Optional[float] = None,
+    strict_columns: bool = False,
 ) -> Dataset:
     """The data of a fit, read again with the defaults given for the columns rows leave out."""
-    d = _dataset(data)
+    d = _dataset(data, strict_columns)
     if rho is None and f is None and g is None and sigma_delta is None:
         return d
     return Dataset(d._core.with_defaults(rho=rho, f=f, g=g, sigma_delta=sigma_delta))
@@ -1235,13 +1326,15 @@ def fit_klaw(
     f: Optional[float] = None,
     g: Optional[float] = None,
     sigma_delta: Optional[float] = None,
+    strict_columns: bool = False,
 ) -> FitResult:
     """A law K(α) fitted to every series at once (``fitbead klaw``).
 
     Parameters
     ----------
-    data : Dataset, str, path or DataFrame, optional
-        The measurements (default: the shipped data).
+    data : Dataset, str, path, DataFrame or Table, optional
+        The measurements (default: the shipped data); a Table is what :func:`simulate`
+        returns.
     model : str, default "stickslip"
         The contact model: ``stick``, ``stick-approx``, ``slip``, ``slip-approx``,
         ``stickslip``, ``contact``, or ``auto`` (the most general model any point needs at
@@ -1287,6 +1380,10 @@ def fit_klaw(
         Standard uncertainty of the slope, degrees, for rows without a ``sigma_delta_deg``
         value (the command line's ``--sigma-delta``; default 0: slopes exact). Above 0 a
         least-squares fit is an orthogonal distance regression.
+    strict_columns : bool, default False
+        A path, DataFrame or Table as ``data``: refuse any column fitbead does not read (the
+        command line's ``--strict-columns``) instead of warning (:class:`ColumnWarning`) about
+        those that look misnamed.
 
     Returns
     -------
@@ -1301,10 +1398,10 @@ def fit_klaw(
 
     Warns
     -----
-    UnitWarning, ConvergenceWarning, BoundWarning
+    UnitWarning, ConvergenceWarning, BoundWarning, ColumnWarning
         The command line's warnings on the data and the fit.
     """
-    d = _fit_data(data, rho, f, g, sigma_delta)
+    d = _fit_data(data, rho, f, g, sigma_delta, strict_columns)
     fits, notes, text = _core.fit_klaw(
         d._core, model=_model_name(model), law=law, method=method, level=level, profile=profile, seed=seed, walkers=walkers,
         max_steps=max_steps, min_ess=min_ess, tol=tol, thin=thin, priors=_priors(priors), fit_scatter=fit_scatter,
@@ -1332,14 +1429,16 @@ def fit_jan(
     f: Optional[float] = None,
     g: Optional[float] = None,
     sigma_delta: Optional[float] = None,
+    strict_columns: bool = False,
 ) -> FitSet:
     """Jan's energy balance (eq 74): λ and μ per series (at least 3 points), then the global
     laws of eqs 75–76 (``fitbead jan``).
 
     Parameters
     ----------
-    data : Dataset, str, path or DataFrame, optional
-        The measurements (default: the shipped data).
+    data : Dataset, str, path, DataFrame or Table, optional
+        The measurements (default: the shipped data); a Table is what :func:`simulate`
+        returns.
     method : {"lsq", "mcmc"}, default "lsq"
         ``lsq`` (least squares; intervals from profile likelihood when ``profile``, else
         the covariance) or ``mcmc`` (a posterior run from the least-squares optimum).
@@ -1349,7 +1448,7 @@ def fit_jan(
         Least squares: profile-likelihood intervals (else the covariance's).
     seed, walkers, max_steps, min_ess, thin, priors, fit_scatter, draws
         MCMC settings, as in :func:`fit_klaw`.
-    rho, f, g : float, optional
+    rho, f, g, sigma_delta, strict_columns : optional
         As in :func:`fit_klaw`.
 
     Returns
@@ -1360,10 +1459,10 @@ def fit_jan(
 
     Warns
     -----
-    UnitWarning, ConvergenceWarning, BoundWarning
+    UnitWarning, ConvergenceWarning, BoundWarning, ColumnWarning
         The command line's warnings on the data and the fits.
     """
-    d = _fit_data(data, rho, f, g, sigma_delta)
+    d = _fit_data(data, rho, f, g, sigma_delta, strict_columns)
     fits, notes, text = _core.fit_jan(
         d._core, method=method, level=level, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps,
         min_ess=min_ess, thin=thin, priors=_priors(priors), fit_scatter=fit_scatter, draws=_draws_wanted(draws, method),
@@ -1391,14 +1490,16 @@ def fit_jaeger(
     f: Optional[float] = None,
     g: Optional[float] = None,
     sigma_delta: Optional[float] = None,
+    strict_columns: bool = False,
 ) -> FitSet:
     """Jaeger's heuristic law (eqs 80–84): a1, a2, a3 per series with at least 4 points
     (``fitbead jaeger``).
 
     Parameters
     ----------
-    data : Dataset, str, path or DataFrame, optional
-        The measurements (default: the shipped data).
+    data : Dataset, str, path, DataFrame or Table, optional
+        The measurements (default: the shipped data); a Table is what :func:`simulate`
+        returns.
     branch : {"upper", "lower"}, default "upper"
         The root of eq 84 when there are two.
     method : {"lsq", "mcmc"}, default "lsq"
@@ -1410,7 +1511,7 @@ def fit_jaeger(
         Least squares: profile-likelihood intervals (else the covariance's).
     seed, walkers, max_steps, min_ess, thin, priors, fit_scatter, draws
         MCMC settings, as in :func:`fit_klaw`.
-    rho, f, g : float, optional
+    rho, f, g, sigma_delta, strict_columns : optional
         As in :func:`fit_klaw`.
 
     Returns
@@ -1420,10 +1521,10 @@ def fit_jaeger(
 
     Warns
     -----
-    UnitWarning, ConvergenceWarning, BoundWarning
+    UnitWarning, ConvergenceWarning, BoundWarning, ColumnWarning
         The command line's warnings on the data and the fits.
     """
-    d = _fit_data(data, rho, f, g, sigma_delta)
+    d = _fit_data(data, rho, f, g, sigma_delta, strict_columns)
     fits, notes, text = _core.fit_jaeger(
         d._core, branch=branch, method=method, level=level, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps,
         min_ess=min_ess, thin=thin, priors=_priors(priors), fit_scatter=fit_scatter, draws=_draws_wanted(draws, method),
@@ -1690,9 +1791,10 @@ def simulate(
         Jaeger's root of eq 84.
     delta_range : (float, float), optional
         Slopes LO, HI in degrees, cut to the steady range.
-    design : str or path-like, optional
-        A design file (``series,xi,delta_deg,replicates``, as :meth:`Design.to_csv` writes
-        it): the data are made at its slopes.
+    design : Design, str or path-like, optional
+        A :class:`Design` (what :func:`design` returns) or a design file
+        (``series,xi,delta_deg,replicates``, as :meth:`Design.to_csv` writes it): the data
+        are made at its slopes.
     v0, delta_deg, beads : optional
         ``contact`` only: the launch speed, slope (degrees) and row beads (default 50) of the
         bead-by-bead transient.
@@ -1726,27 +1828,40 @@ def simulate(
     >>> list(sim)
     ['series', 'xi', 'delta_deg', 'v', 'sigma_v', 'v_true']
     """
-    text = _core.simulate(
-        model=_model_name(model),
-        law=law,
-        series=[float(x) for x in series],
-        points=int(points),
-        noise=float(noise),
-        seed=int(seed),
-        rho=float(rho),
-        f=float(f),
-        jan=None if jan is None else [float(x) for x in jan],
-        jaeger=None if jaeger is None else [float(x) for x in jaeger],
-        branch=branch,
-        delta_range=None if delta_range is None else (float(delta_range[0]), float(delta_range[1])),
-        design=None if design is None else str(design),
-        v0=None if v0 is None else float(v0),
-        delta_deg=None if delta_deg is None else float(delta_deg),
-        beads=None if beads is None else int(beads),
-        spin=spin,
-        md_preset=md_preset,
-        sigma_delta=float(sigma_delta),
-    )
+    scratch = None
+    if isinstance(design, Design):
+        import os
+        import tempfile
+
+        scratch = tempfile.TemporaryDirectory(prefix="fitbead-design-")
+        path = os.path.join(scratch.name, "design.csv")
+        design.to_csv(path)
+        design = path
+    try:
+        text = _core.simulate(
+            model=_model_name(model),
+            law=law,
+            series=[float(x) for x in series],
+            points=int(points),
+            noise=float(noise),
+            seed=int(seed),
+            rho=float(rho),
+            f=float(f),
+            jan=None if jan is None else [float(x) for x in jan],
+            jaeger=None if jaeger is None else [float(x) for x in jaeger],
+            branch=branch,
+            delta_range=None if delta_range is None else (float(delta_range[0]), float(delta_range[1])),
+            design=None if design is None else str(design),
+            v0=None if v0 is None else float(v0),
+            delta_deg=None if delta_deg is None else float(delta_deg),
+            beads=None if beads is None else int(beads),
+            spin=spin,
+            md_preset=md_preset,
+            sigma_delta=float(sigma_delta),
+        )
+    finally:
+        if scratch is not None:
+            scratch.cleanup()
     return _csv_table(text)
 
 

@@ -29,6 +29,9 @@ class ConvergenceWarning(FitbeadWarning):
     short of the target, or the run cut short)."""
 class BoundWarning(FitbeadWarning):
     """A fitted parameter sits on a bound of its box (its interval is one-sided)."""
+class ColumnWarning(FitbeadWarning):
+    """A column of the data that fitbead does not read looks misspelt or misnamed (close to a
+    known name, or named like an uncertainty); ``strict_columns=True`` refuses it."""
 
 def threads() -> int:
     """Number of threads the vectorised functions use (rayon's pool)."""
@@ -148,7 +151,7 @@ class Dataset:
     """
     def __init__(self, core: Any) -> None: ...
     @classmethod
-    def read_csv(cls, path: str, *, rho: float = 0.4, f: float = 0.1, g: float = 9.81) -> Dataset:
+    def read_csv(cls, path: str, *, rho: float = 0.4, f: float = 0.1, g: float = 9.81, strict_columns: bool = False) -> Dataset:
         """Reads a measurement CSV as the command line does.
 
         Parameters
@@ -185,7 +188,7 @@ class Dataset:
         least-squares fits are orthogonal distance regressions, and their residual tables
         gain ``delta_fit_deg`` and ``delta_residual``."""
     @classmethod
-    def from_pandas(cls, df: Any, *, rho: float = 0.4, f: float = 0.1, g: float = 9.81) -> Dataset:
+    def from_pandas(cls, df: Any, *, rho: float = 0.4, f: float = 0.1, g: float = 9.81, strict_columns: bool = False) -> Dataset:
         """From a DataFrame with the CSV's columns, checked as the command line checks a file
         (errors name the DataFrame's line as the CSV would have it: header on line 1)."""
     @property
@@ -398,7 +401,7 @@ class FitSet(list):
         ``residuals`` or ``correlations``, with the command line's columns (its CSV of the
         whole run), numeric dtypes and NaN for empty cells."""
 
-def fit_klaw(data: Any = None, *, model: str = 'stickslip', law: str = 'c', method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None, tol: float = 1e-10, skip_unsteady: bool = False, thin: int | None = None, priors: Any = None, fit_scatter: bool = False, draws: Any = None, rho: float | None = None, f: float | None = None, g: float | None = None, sigma_delta: float | None = None) -> FitResult:
+def fit_klaw(data: Any = None, *, model: str = 'stickslip', law: str = 'c', method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None, tol: float = 1e-10, skip_unsteady: bool = False, thin: int | None = None, priors: Any = None, fit_scatter: bool = False, draws: Any = None, rho: float | None = None, f: float | None = None, g: float | None = None, sigma_delta: float | None = None, strict_columns: bool = False) -> FitResult:
     '''A law K(α) fitted to every series at once (``fitbead klaw``).
 
     Parameters
@@ -443,7 +446,7 @@ def fit_klaw(data: Any = None, *, model: str = 'stickslip', law: str = 'c', meth
     UnitWarning, ConvergenceWarning, BoundWarning
         The command line\'s warnings on the data and the fit.
     '''
-def fit_jan(data: Any = None, *, method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None, thin: int | None = None, priors: Any = None, fit_scatter: bool = False, draws: Any = None, rho: float | None = None, f: float | None = None, g: float | None = None, sigma_delta: float | None = None) -> FitSet:
+def fit_jan(data: Any = None, *, method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None, thin: int | None = None, priors: Any = None, fit_scatter: bool = False, draws: Any = None, rho: float | None = None, f: float | None = None, g: float | None = None, sigma_delta: float | None = None, strict_columns: bool = False) -> FitSet:
     '''Jan\'s energy balance (eq 74): λ and μ per series (at least 3 points), then the global
     laws of eqs 75–76 (``fitbead jan``).
 
@@ -472,7 +475,7 @@ def fit_jan(data: Any = None, *, method: str = 'lsq', level: float = 0.95, profi
     UnitWarning, ConvergenceWarning, BoundWarning
         The command line\'s warnings on the data and the fits.
     '''
-def fit_jaeger(data: Any = None, *, branch: str = 'upper', method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None, thin: int | None = None, priors: Any = None, fit_scatter: bool = False, draws: Any = None, rho: float | None = None, f: float | None = None, g: float | None = None, sigma_delta: float | None = None) -> FitSet:
+def fit_jaeger(data: Any = None, *, branch: str = 'upper', method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None, thin: int | None = None, priors: Any = None, fit_scatter: bool = False, draws: Any = None, rho: float | None = None, f: float | None = None, g: float | None = None, sigma_delta: float | None = None, strict_columns: bool = False) -> FitSet:
     '''Jaeger\'s heuristic law (eqs 80–84): a1, a2, a3 per series with at least 4 points
     (``fitbead jaeger``).
 

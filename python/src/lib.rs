@@ -932,6 +932,26 @@ impl PyDataset {
         Ok(PyDataset::of_file(m))
     }
 
+    /// The columns fitbead does not read that look misspelt or misnamed (close to a known
+    /// name, or named like an uncertainty), as the command line warns about them.
+    #[getter]
+    fn column_warnings(&self) -> PyResult<Vec<String>> {
+        let cols = self
+            .file
+            .unknown_columns(false)
+            .map_err(|e| value_error(e.to_string()))?;
+        Ok(cols.iter().map(ToString::to_string).collect())
+    }
+
+    /// Refuses a column fitbead does not read, as `--strict-columns` does (the error names the
+    /// column and the known name it is close to).
+    fn check_strict_columns(&self) -> PyResult<()> {
+        self.file
+            .unknown_columns(true)
+            .map(|_| ())
+            .map_err(|e| value_error(e.to_string()))
+    }
+
     /// The shipped synthetic data set (data/default.csv).
     #[staticmethod]
     fn default_data() -> PyResult<Self> {

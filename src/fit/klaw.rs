@@ -1089,6 +1089,8 @@ fn score_impact(model: Model, data: &Dataset, fit_name: String) -> KLawFit {
             note,
             mcmc: None,
             slope_errors: false,
+            outliers: Vec::new(),
+            others_chi2: 0.0,
         },
         draws: None,
         correlation: None,

@@ -26,9 +26,10 @@ Quick start::
 
 Every array function broadcasts its array arguments (numpy rules), releases the GIL and runs
 in parallel over rows on rayon's threads (``RAYON_NUM_THREADS`` before the first call sets
-their number; :func:`threads` says it). Warnings the command line prints are Python warnings
-(:class:`FitbeadWarning` and its subclasses); errors are :class:`FitbeadError`, a
-``ValueError``.
+their number; :func:`threads` says it; a process forked after a call builds a pool of its
+own). Results pickle, and ``save``/:func:`load` keep them in a JSON file. Warnings the
+command line prints are Python warnings (:class:`FitbeadWarning` and its subclasses); errors
+are :class:`FitbeadError`, a ``ValueError``.
 """
 
 from ._api import (
@@ -55,6 +56,7 @@ from ._api import (
     fit_klaw,
     forward,
     invert_k,
+    load,
     regimes,
     report,
     simulate,
@@ -86,6 +88,7 @@ __all__ = [
     "fit_klaw",
     "forward",
     "invert_k",
+    "load",
     "regimes",
     "report",
     "simulate",

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import html as _html
 import math
+import os
 import warnings
 from dataclasses import dataclass, field
 from statistics import NormalDist
@@ -13,6 +14,8 @@ from typing import Any, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple
 import numpy as np
 
 from . import _fitbead as _core
+from . import _persist
+from ._persist import same as _same
 
 __version__: str = _core.version()
 
@@ -81,7 +84,9 @@ def _warn(message: str, category: type) -> None:
 
 
 def threads() -> int:
-    """Number of threads the vectorised functions use (rayon's pool)."""
+    """Number of threads the vectorised functions use (rayon's pool; in a process forked
+    after a fitbead call, the pool of its own that the process builds on its first call, of
+    the same size)."""
     return _core.threads()
 
 
@@ -104,6 +109,42 @@ class Table(dict):
     def __repr__(self) -> str:
         cols = ", ".join(self.keys())
         return f"Table(shape={self.shape}, columns=[{cols}])"
+
+    def __eq__(self, other: Any) -> bool:
+        """The same columns, each of one shape and dtype and equal element by element (floats
+        bit for bit, NaN equal to NaN), and against a Table the same ``shape`` and attributes
+        (``critical_xi``); against a plain dict the columns only."""
+        if isinstance(other, Table):
+            return _same(self, other) if type(self) is type(other) else False
+        if isinstance(other, dict):
+            return _same(dict(self), dict(other))
+        return NotImplemented
+
+    def __ne__(self, other: Any) -> bool:
+        eq = self.__eq__(other)
+        return eq if eq is NotImplemented else not eq
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def save(self, path: Any) -> None:
+        """Writes the table to a JSON file that :func:`load` reads back (the format:
+        :func:`load`): its columns with their dtypes and shapes, ``shape`` and
+        ``critical_xi``; written atomically.
+
+        Parameters
+        ----------
+        path : str or path-like
+            The file to write (replaced if it exists).
+
+        Raises
+        ------
+        FitbeadError
+            A column fitbead cannot save (a dtype other than float, integer, bool or text).
+        """
+        _save(path, "table", lambda: self._json("table"))
+
+    def _json(self, where: str) -> Dict[str, Any]:
+        return _persist.encode_table(self, self.shape, getattr(self, "critical_xi", _persist._MISSING), where)
 
 
 def _as_f64(name: str, x: Any) -> np.ndarray:
@@ -599,6 +640,66 @@ class Dataset:
     def __repr__(self) -> str:
         return f"Dataset({len(self)} points, series {self.labels})"
 
+    # ---- pickling, equality, saving -------------------------------------------------------
+
+    def __getstate__(self) -> Dict[str, Any]:
+        # What the data set was made from (CSV text and defaults, or arrays); unpickling makes
+        # it again the same way, without repeating its warnings.
+        return {"version": _persist.VERSION, "dataset": dict(self._core.state())}
+
+    def __setstate__(self, state: Dict[str, Any]) -> None:
+        _check_pickle(state, "Dataset")
+        self._core = _dataset_core(state["dataset"])
+
+    def __eq__(self, other: Any) -> bool:
+        """Made from the same thing: the same CSV text, source name and defaults, or the same
+        arrays (bit for bit)."""
+        if not isinstance(other, Dataset):
+            return NotImplemented
+        return _same(dict(self._core.state()), dict(other._core.state()))
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def save(self, path: Any) -> None:
+        """Writes the data set to a JSON file that :func:`load` reads back (the format:
+        :func:`load`): the CSV text it was read from with its name and the defaults, or the
+        arrays it was made from; written atomically.
+
+        Parameters
+        ----------
+        path : str or path-like
+            The file to write (replaced if it exists).
+        """
+        _save(path, "dataset", lambda: _persist.encode(dict(self._core.state()), "dataset"))
+
+
+def _dataset_core(state: Mapping[str, Any]) -> Any:
+    """The compiled data set made again from its state (``_Dataset.state()``)."""
+    if state["origin"] == "text":
+        rho, f, g, sd = (float(state[k]) for k in ("rho", "f", "g", "sigma_delta"))
+        core = _core._Dataset.from_text(state["text"], state["source"], rho=rho, f=f, g=g)
+        if sd != 0.0 or math.copysign(1.0, sd) < 0:
+            core = core.with_defaults(rho=rho, f=f, g=g, sigma_delta=sd)
+        return core
+    cols = [_flat(np.asarray(state[k], dtype=np.float64)) for k in _persist.DATASET_ARRAYS]
+    return _core._Dataset.from_arrays([str(s) for s in state["series"]], *cols)
+
+
+def _check_pickle(state: Any, what: str) -> None:
+    """A pickled state this fitbead can read: a dict of a version it knows."""
+    v = state.get("version") if isinstance(state, dict) else None
+    if not isinstance(v, int) or not 1 <= v <= _persist.VERSION:
+        raise FitbeadError(f"{what}: a pickle of version {v!r}; this fitbead reads 1 to {_persist.VERSION}")
+
+
+def _save(path: Any, kind: str, body: Any) -> None:
+    """Writes the JSON document of a ``kind`` result (``body()``) to ``path``; a value that
+    cannot be saved is a FitbeadError naming where it is."""
+    try:
+        _persist.write(path, kind, body(), __version__)
+    except _persist._Bad as e:
+        raise FitbeadError(f"{path}: cannot save: {e}") from None
+
 
 def _dataset(data: Any, strict_columns: bool = False) -> Dataset:
     """The data of a call: a Dataset as it is, None for the shipped data, a CSV path, a
@@ -712,6 +813,23 @@ class Param:
     record: Dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
     """The whole row as the command line writes it (keys: params.csv's columns)."""
 
+    def _fields(self) -> Tuple[Any, ...]:
+        return tuple(getattr(self, f) for f in self.__dataclass_fields__ if f != "record")
+
+    def __eq__(self, other: Any) -> bool:
+        """Every field but ``record`` equal, floats bit for bit and NaN equal to NaN."""
+        if not isinstance(other, Param):
+            return NotImplemented
+        return _same(self._fields(), other._fields())
+
+    def __hash__(self) -> int:
+        def key(x: Any) -> Any:
+            if isinstance(x, tuple):
+                return tuple(key(v) for v in x)
+            return "nan" if isinstance(x, float) and math.isnan(x) else x
+
+        return hash(key(self._fields()))
+
 
 def _param(r: Dict[str, Any], bounds: Tuple[float, float]) -> Param:
     """A :class:`Param` from one row of the parameter report (the keys of params.csv)."""
@@ -816,6 +934,46 @@ class FitResult:
         self.interrupted = False
         if d is not None:
             self.draws, self.log_posterior, self.burn_in, self.thin, self.interrupted = d
+
+    # ---- pickling, equality, saving -------------------------------------------------------
+
+    def _state(self) -> Dict[str, Any]:
+        """Everything the fit's core gives (parameter, statistics, residual and correlation
+        records, the points, the draws, the report): what makes the fit again."""
+        if isinstance(self._core, _persist.StoredFit):
+            return self._core.state()
+        return _persist.fit_state(self._core)
+
+    def __getstate__(self) -> Dict[str, Any]:
+        return {"version": _persist.VERSION, "fit": self._state(), "context": dict(self._context)}
+
+    def __setstate__(self, state: Dict[str, Any]) -> None:
+        _check_pickle(state, "FitResult")
+        self.__init__(_persist.StoredFit(state["fit"]), state["context"])  # type: ignore[misc]
+
+    def __eq__(self, other: Any) -> bool:
+        """The same fit: name, series, every record of the report (parameters, statistics,
+        residuals, correlations), the points, the draws and the report's text, floats bit for
+        bit (NaN equal to NaN)."""
+        if not isinstance(other, FitResult):
+            return NotImplemented
+        return _same(self._context, other._context) and _same(self._state(), other._state())
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def save(self, path: Any) -> None:
+        """Writes the fit to a JSON file that :func:`load` reads back as an equal fit (the
+        format: :func:`load`), draws included; written atomically.
+
+        Parameters
+        ----------
+        path : str or path-like
+            The file to write (replaced if it exists).
+        """
+        _save(path, "fit", lambda: self._json("fit"))
+
+    def _json(self, where: str) -> Dict[str, Any]:
+        return _persist.encode_fit(self._state(), self._context, where)
 
     def _warn(self) -> None:
         """Gives the command line's warnings on this fit as Python warnings."""
@@ -1205,6 +1363,32 @@ class FitSet(list):
         super().__init__(fits)
         self.notes: List[str] = list(notes)
 
+    def __eq__(self, other: Any) -> bool:
+        """The same fits in the same order (:meth:`FitResult.__eq__`), and against a FitSet
+        the same notes."""
+        if isinstance(other, FitSet):
+            return _same(self, other) if type(self) is type(other) else False
+        if isinstance(other, list):
+            return len(self) == len(other) and all(a == b for a, b in zip(self, other))
+        return NotImplemented
+
+    def __ne__(self, other: Any) -> bool:
+        eq = self.__eq__(other)
+        return eq if eq is NotImplemented else not eq
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def save(self, path: Any) -> None:
+        """Writes the fits and the notes to a JSON file that :func:`load` reads back as an equal
+        FitSet (the format: :func:`load`); written atomically.
+
+        Parameters
+        ----------
+        path : str or path-like
+            The file to write (replaced if it exists).
+        """
+        _save(path, "fitset", lambda: {"fits": [fr._json(f"fitset.fits[{i}]") for i, fr in enumerate(self)], "notes": list(self.notes)})
+
     def get(self, name: str, series: Optional[str] = None) -> Optional[FitResult]:
         """The fit named ``name`` (``jan-series``, ``jan-global``, ``jaeger``) for ``series``
         (a series label; ``all`` for a global fit), or the first fit of that name when
@@ -1288,7 +1472,6 @@ def _write_draws(path: Any, text: Optional[bytes]) -> None:
     """Writes the draws CSV to `path` atomically (a temporary file renamed over it)."""
     if path is None or text is None:
         return
-    import os
     import tempfile
 
     target = os.fspath(path)
@@ -1592,6 +1775,49 @@ class Design:
         """The design as a DataFrame (series, xi, delta_deg, replicates; needs pandas)."""
         return self.table.to_pandas()
 
+    def _raw(self) -> Dict[str, Any]:
+        """The dict the design is made from (as the compiled core gives it)."""
+
+        def rows(t: Table) -> Dict[str, Any]:
+            return {
+                "series": [str(x) for x in t["series"]],
+                "xi": [float(x) for x in t["xi"]],
+                "delta_deg": [float(x) for x in t["delta_deg"]],
+                "replicates": [int(x) for x in t["replicates"]],
+            }
+
+        return {
+            "design": rows(self.table),
+            "even": rows(self.even),
+            "errors": [{"parameter": k, **v} for k, v in self.errors.items()],
+            "target": self.target,
+            "efficiency": self.efficiency,
+            "gap": self.gap,
+            "discrimination": self.discrimination,
+            "points_needed": self.points_needed,
+            "ranges": list(self.ranges),
+            "bayes": self.bayes,
+        }
+
+    def __eq__(self, other: Any) -> bool:
+        """Every attribute equal, floats bit for bit (NaN equal to NaN)."""
+        if not isinstance(other, Design):
+            return NotImplemented
+        return _same(vars(self), vars(other))
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def save(self, path: Any) -> None:
+        """Writes the design to a JSON file that :func:`load` reads back as an equal Design
+        (the format: :func:`load`); written atomically.
+
+        Parameters
+        ----------
+        path : str or path-like
+            The file to write (replaced if it exists).
+        """
+        _save(path, "design", lambda: _persist.encode(self._raw(), "design"))
+
     def to_csv(self, path: str) -> None:
         """Writes the design as ``fitbead design --output`` does (for ``simulate --design``)."""
         lines = ["series,xi,delta_deg,replicates"]
@@ -1887,6 +2113,18 @@ class Report(dict):
     def __repr__(self) -> str:
         return f"Report(tables=[{', '.join(self)}])"
 
+    def __eq__(self, other: Any) -> bool:
+        """The same tables (:meth:`Table.__eq__`), files, markdown and summary."""
+        if not isinstance(other, Report):
+            return NotImplemented
+        return _same(self, other) if type(self) is type(other) else False
+
+    def __ne__(self, other: Any) -> bool:
+        eq = self.__eq__(other)
+        return eq if eq is NotImplemented else not eq
+
+    __hash__ = None  # type: ignore[assignment]
+
 
 def report(
     data: Any = None,
@@ -2006,3 +2244,83 @@ def work_precision(scenes: int = 2000, seed: int = 1) -> Table:
         the scenes only; the times are measured on this machine.
     """
     return _csv_table(_core.work_precision(scenes=int(scenes), seed=int(seed)))
+
+
+def load(path: Any) -> Union[FitResult, FitSet, Dataset, Table, Design]:
+    """Reads a result that ``save`` wrote: a :class:`FitResult`, :class:`FitSet`,
+    :class:`Dataset`, :class:`Table` or :class:`Design` equal to the one saved.
+
+    The file is one JSON document (UTF-8) that the ``json`` module reads without fitbead::
+
+        {"format": "fitbead-result", "version": 1, "kind": KIND,
+         "fitbead_version": "...", KIND: {...}}
+
+    with ``KIND`` one of ``fit``, ``fitset``, ``dataset``, ``table``, ``design``:
+
+    - ``fit``: ``name``, ``series``, ``context`` (what :meth:`FitResult.eval` needs: the
+      model or branch), ``params`` (one object per parameter, keyed by params.csv's columns),
+      ``param_bounds`` (``[low, high]`` per parameter), ``stats`` (stats.csv's columns),
+      ``residuals`` (residuals.csv's), ``correlations`` (correlations.csv's),
+      ``correlation`` (the matrix, or null), ``points`` (the fitted points by column),
+      ``draws`` (null, or ``chains`` ``[walker][kept step][parameter]``, ``log_posterior``
+      ``[walker][kept step]``, their ``shape``, ``burn_in``, ``thin``, ``interrupted``),
+      ``report`` (the fit report's text), ``absurd_misfit``, ``misfit_warning``,
+      ``chi2_p_value``;
+    - ``fitset``: ``fits`` (a list of ``fit`` objects) and ``notes``;
+    - ``dataset``: ``origin`` ``"text"`` with ``source``, ``text`` (the CSV) and the defaults
+      ``rho``, ``f``, ``g``, ``sigma_delta``; or ``origin`` ``"arrays"`` with ``series``
+      and the arrays of :meth:`Dataset.from_arrays`;
+    - ``table``: ``shape``, ``columns`` (by name: ``dtype``, ``shape``, ``values`` as nested
+      lists) and ``critical_xi`` where the table has one;
+    - ``design``: the attributes of :class:`Design`, its tables as ``design`` and ``even``
+      (lists by column).
+
+    Numbers are JSON numbers that read back the same doubles; one that is not finite is the
+    string ``"NaN"``, ``"Infinity"`` or ``"-Infinity"``; a report record's empty cell is
+    ``null``. A newer version than this fitbead reads is refused. For ArviZ's netCDF, use
+    ``fit.to_arviz().to_netcdf(path)``.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file ``save`` wrote.
+
+    Returns
+    -------
+    FitResult, FitSet, Dataset, Table or Design
+        The type that was saved; nothing is warned again (a loaded data set's warnings are in
+        its ``warnings``).
+
+    Raises
+    ------
+    FitbeadError
+        The file cannot be read, is not a fitbead result, has a version this fitbead does not
+        read, or is damaged: the message names the file and what is wrong.
+    """
+    try:
+        kind, body = _persist.read(path)
+        if kind == "fit":
+            ctx = _persist.decode_context(_persist._get(body, "context", "fit"), "fit.context")
+            return FitResult(_persist.StoredFit(_persist.decode_fit(body, "fit")), ctx)
+        if kind == "fitset":
+            fits = []
+            for i, x in enumerate(_persist._list(_persist._get(body, "fits", "fitset"), "fitset.fits")):
+                where = f"fitset.fits[{i}]"
+                ctx = _persist.decode_context(_persist._get(x, "context", where), f"{where}.context")
+                fits.append(FitResult(_persist.StoredFit(_persist.decode_fit(x, where)), ctx))
+            notes = [_persist._text(n, "fitset.notes") for n in _persist._list(_persist._get(body, "notes", "fitset"), "fitset.notes")]
+            return FitSet(fits, notes)
+        if kind == "table":
+            return _persist.decode_table(body, "table", Table)
+        if kind == "design":
+            return Design(_persist.decode_design(body, "design"))
+        state = _persist.decode_dataset(body, "dataset")
+        try:
+            core = _dataset_core(state)
+        except FitbeadError as e:
+            raise _persist._Bad(f"dataset: {e}") from None
+        d = Dataset.__new__(Dataset)
+        d._core = core
+        return d
+    except _persist._Bad as e:
+        raise FitbeadError(f"{os.fspath(path)}: {e}") from None

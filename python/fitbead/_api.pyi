@@ -46,6 +46,11 @@ class Table(dict):
     shape: tuple[int, ...]
     def to_pandas(self):
         """The columns as a pandas DataFrame (flattened; needs pandas)."""
+    def __eq__(self, other: object) -> bool: ...
+    def __ne__(self, other: object) -> bool: ...
+    __hash__: None  # type: ignore[assignment]
+    def save(self, path: Any) -> None:
+        """Writes the table to a JSON file that :func:`load` reads back."""
 
 def forward(model: str, xi: ArrayLike, delta_deg: ArrayLike, K: str | ArrayLike = 'adjusted', rho: ArrayLike = 0.4, f: ArrayLike = 0.1, *, mu: ArrayLike | None = None, a1: ArrayLike | None = None, a2: ArrayLike | None = None, a3: ArrayLike | None = None, c: float | None = None, branch: str = 'upper', spin: str = 'roll', tol: float = 1e-14, **params: Any) -> Table:
     '''The steady state of every scene under one model (``fitbead forward``).
@@ -216,6 +221,13 @@ class Dataset:
     def to_pandas(self):
         """The points as a DataFrame (needs pandas): the columns of :meth:`columns` but
         ``series_index``, the file's ``R_m`` and ``g`` (and ``v_m_s``, ``sigma_v_m_s``) kept."""
+    def __getstate__(self) -> dict[str, Any]: ...
+    def __setstate__(self, state: dict[str, Any]) -> None: ...
+    def __eq__(self, other: object) -> bool: ...
+    __hash__: None  # type: ignore[assignment]
+    def save(self, path: Any) -> None:
+        """Writes the data set (its CSV text and defaults, or its arrays) to a JSON file that
+        :func:`load` reads back."""
 
 @dataclass(frozen=True)
 class Param:
@@ -258,6 +270,8 @@ class Param:
     likelihood_sensitivity: float = ...
     prior_diagnosis: str = ...
     record: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
+    def __eq__(self, other: object) -> bool: ...
+    def __hash__(self) -> int: ...
 
 class FitResult:
     """One fit: parameters with errors and intervals, correlations, residuals, statistics.
@@ -278,6 +292,12 @@ class FitResult:
     burn_in: int
     interrupted: bool
     def __init__(self, core: Any, context: dict[str, Any] | None = None) -> None: ...
+    def __getstate__(self) -> dict[str, Any]: ...
+    def __setstate__(self, state: dict[str, Any]) -> None: ...
+    def __eq__(self, other: object) -> bool: ...
+    __hash__: None  # type: ignore[assignment]
+    def save(self, path: Any) -> None:
+        """Writes the fit (draws included) to a JSON file that :func:`load` reads back."""
     @property
     def param_names(self) -> list[str]:
         """The parameters' keys in the fit's order (the order of :attr:`covar`)."""
@@ -392,6 +412,11 @@ class FitSet(list):
     the run's notes. A list of :class:`FitResult`."""
     notes: list[str]
     def __init__(self, fits: Iterable[FitResult], notes: Iterable[str]) -> None: ...
+    def __eq__(self, other: object) -> bool: ...
+    def __ne__(self, other: object) -> bool: ...
+    __hash__: None  # type: ignore[assignment]
+    def save(self, path: Any) -> None:
+        """Writes the fits and the notes to a JSON file that :func:`load` reads back."""
     def get(self, name: str, series: str | None = None) -> FitResult | None:
         """The fit named ``name`` (``jan-series``, ``jan-global``, ``jaeger``) for ``series``
         (a series label; ``all`` for a global fit), or the first fit of that name when
@@ -547,6 +572,10 @@ class Design:
         """The design as a DataFrame (series, xi, delta_deg, replicates; needs pandas)."""
     def to_csv(self, path: str) -> None:
         """Writes the design as ``fitbead design --output`` does (for ``simulate --design``)."""
+    def __eq__(self, other: object) -> bool: ...
+    __hash__: None  # type: ignore[assignment]
+    def save(self, path: Any) -> None:
+        """Writes the design to a JSON file that :func:`load` reads back."""
 
 def design(fit: str = 'klaw', *, model: str | None = None, law: str = 'c=0.5', series: Sequence[float] = (0.8, 1.0, 1.6, 2.0), points: int = 9, noise: float | str = 0.02, delta_range: tuple[float, float] | None = None, criterion: str = 'd', target: str | None = None, vs: str | None = None, branch: str = 'upper', rho: float = 0.4, f: float = 0.1, prior: Mapping[str, str] | None = None, draws: int = 64, seed: int = 1, total: int | None = None) -> Design:
     '''Where to measure (``fitbead design``): locally optimal slopes for a fit's parameters,
@@ -617,6 +646,9 @@ class Report(dict):
     markdown: str
     files: dict[str, bytes]
     summary: str
+    def __eq__(self, other: object) -> bool: ...
+    def __ne__(self, other: object) -> bool: ...
+    __hash__: None  # type: ignore[assignment]
 
 def report(data: Any = None, out_dir: Any | None = None, method: str = 'lsq', *, format: str = 'svg', units: str = 'dimensionless', figure_width: str | float | None = None, level: float = 0.95, seed: int | None = None, min_ess: float | None = None, max_steps: int | None = None, keep_going: bool = False, g: float = 9.81) -> Report:
     """Every model fitted to one data set and the paper's comparisons (``fitbead report``): the
@@ -624,3 +656,7 @@ def report(data: Any = None, out_dir: Any | None = None, method: str = 'lsq', *,
 
 def work_precision(scenes: int = 2000, seed: int = 1) -> Table:
     """The work-precision table (``fitbead bench --output``)."""
+
+def load(path: Any) -> FitResult | FitSet | Dataset | Table | Design:
+    """Reads a result that ``save`` wrote (one JSON document: ``{"format": "fitbead-result",
+    "version": 1, "kind": ..., KIND: {...}}``), as the type saved."""

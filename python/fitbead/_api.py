@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import html as _html
 import math
+import re
 import os
 import warnings
 from dataclasses import dataclass, field
@@ -49,6 +50,14 @@ class MisfitWarning(FitbeadWarning):
     """A fit with σ given does not describe the data within their σ: the χ² tail probability
     P(χ²_dof ≥ χ²) is below 0.001, so its intervals, which assume the model holds, are too
     narrow."""
+
+
+class OutlierWarning(MisfitWarning):
+    """A few points lie far from the fitted curve (normalised residual beyond 4, and 4 robust
+    standard deviations from the others): the warning names each (series, slope, velocity,
+    residual) and the misfit of the others. A misread value, or a run that had not reached
+    its steady state, is the usual cause; the fit, which those points pull, is suspect until
+    they are checked."""
 
 
 class ConvergenceWarning(FitbeadWarning):
@@ -984,7 +993,8 @@ class FitResult:
         else:
             misfit = self._core.misfit_warning()
             if misfit:
-                _warn(f"{label}: {misfit}", MisfitWarning)
+                outliers = re.match(r"\d+ outlier\(s\)", misfit) is not None
+                _warn(f"{label}: {misfit}", OutlierWarning if outliers else MisfitWarning)
         if not self.stats.get("converged", True):
             why = self.stats.get("note") or self.stats.get("termination")
             _warn(f"{label}: not converged: {why}", ConvergenceWarning)
@@ -2148,7 +2158,7 @@ def report(
 
     Parameters
     ----------
-    data : Dataset, str, path-like or DataFrame, optional
+    data : Dataset, str, path-like, DataFrame or Table, optional
         The measurements (default: the shipped synthetic data set).
     out_dir : str or path-like, optional
         Directory for the tables, figures and report.md (created if missing); ``None`` writes

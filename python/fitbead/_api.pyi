@@ -24,6 +24,9 @@ class MisfitWarning(FitbeadWarning):
     """A fit with σ given does not describe the data within their σ: the χ² tail probability
     P(χ²_dof ≥ χ²) is below 0.001, so its intervals, which assume the model holds, are too
     narrow."""
+class OutlierWarning(MisfitWarning):
+    """A few points lie far from the fitted curve; the warning names each (series, slope,
+    velocity, normalised residual)."""
 class ConvergenceWarning(FitbeadWarning):
     """A fit stopped without converging (least squares: its termination; MCMC: R̂ or ESS
     short of the target, or the run cut short)."""

@@ -1538,7 +1538,9 @@ fn interruptible<T: Send>(
             *slot.0.lock().unwrap_or_else(|e| e.into_inner()) = Some(r);
             slot.1.notify_all();
         });
-        let mut interrupted = false;
+        // The exception a signal handler raised (KeyboardInterrupt for Ctrl-C, or the
+        // handler's own), given back unchanged once the work has stopped.
+        let mut interrupted: Option<PyErr> = None;
         loop {
             let got = py.detach(|| {
                 let g = slot.0.lock().unwrap_or_else(|e| e.into_inner());
@@ -1549,12 +1551,9 @@ fn interruptible<T: Send>(
                 g.take()
             });
             if let Some(r) = got {
-                return if interrupted {
-                    Err(PyKeyboardInterrupt::new_err(
-                        "fit interrupted (the run stopped cleanly)",
-                    ))
-                } else {
-                    r.map_err(PyRuntimeError::new_err)
+                return match interrupted {
+                    Some(e) => Err(e),
+                    None => r.map_err(PyRuntimeError::new_err),
                 };
             }
             if worker.is_finished() && slot.0.lock().map(|g| g.is_none()).unwrap_or(true) {
@@ -1563,9 +1562,11 @@ fn interruptible<T: Send>(
                     "the fit failed unexpectedly (panic)",
                 ));
             }
-            if !interrupted && py.check_signals().is_err() {
-                stop.store(true, Ordering::SeqCst);
-                interrupted = true;
+            if interrupted.is_none() {
+                if let Err(e) = py.check_signals() {
+                    stop.store(true, Ordering::SeqCst);
+                    interrupted = Some(e);
+                }
             }
         }
     })

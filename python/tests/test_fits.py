@@ -133,6 +133,25 @@ def test_keyboard_interrupt_stops_mcmc(data):
         signal.signal(signal.SIGINT, previous)
 
 
+def test_a_signal_handlers_own_exception_passes_through(data):
+    """A handler that raises (a timeout by SIGALRM) stops the run, and its exception, not a
+    KeyboardInterrupt, reaches the caller."""
+
+    def timeout(signum, frame):
+        raise TimeoutError("budget spent")
+
+    previous = signal.signal(signal.SIGALRM, timeout)
+    try:
+        signal.setitimer(signal.ITIMER_REAL, 0.3)
+        t0 = time.perf_counter()
+        with pytest.raises(TimeoutError, match="budget spent"):
+            fitbead.fit_jaeger(data, method="mcmc", min_ess=1e9, max_steps=1_000_000)
+        assert time.perf_counter() - t0 < 5.0
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+
+
 def test_bad_input_raises_with_the_cli_message(cli, tmp_path):
     bad = tmp_path / "bad.csv"
     bad.write_text("series,xi,delta_deg,v,sigma_v\na,1,12,0.3,0.01\na,1,13,-0.3,0.01\n")

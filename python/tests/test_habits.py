@@ -330,3 +330,29 @@ def test_simulated_tables_are_data():
     d = fitbead.design("klaw", model="stick", series=[1.0], points=4)
     at = fitbead.simulate("stick", law="c=0.5", series=[1.0], design=d, seed=5)
     assert sorted(set(np.round(at["delta_deg"], 9))) == sorted(set(np.round(d.table["delta_deg"], 9)))
+
+
+def test_one_outlier_is_named_not_blamed_on_units():
+    """One velocity at 3× its value: every fit it enters names it (OutlierWarning, with its
+    series, slope and value), and none calls it a unit mistake; every velocity at 100× is a
+    unit mistake (UnitWarning) with no outlier named."""
+    import pandas as pd
+
+    df = pd.read_csv(DEFAULT_DATA, dtype={"series": str})
+    one = df.copy()
+    one.loc[5, "v"] *= 3  # series 0.8, δ = 12.613°
+    with warnings.catch_warnings(record=True) as got:
+        warnings.simplefilter("always")
+        fitbead.fit_klaw(one, model="stick", law="c", profile=False)
+        fitbead.fit_jan(one, profile=False)
+    outliers = [str(w.message) for w in got if w.category is fitbead.OutlierWarning]
+    assert any(m.startswith("klaw-c [all]: 1 outlier(s)") and "delta 12.613 deg" in m for m in outliers), outliers
+    assert any(m.startswith("jan-series [0.8]: 1 outlier(s)") for m in outliers), outliers
+    assert not [w for w in got if w.category is fitbead.UnitWarning and "reduced chi2" in str(w.message)]
+    assert issubclass(fitbead.OutlierWarning, fitbead.MisfitWarning)
+    units = df.assign(v=df["v"] * 100, sigma_v=df["sigma_v"])
+    with warnings.catch_warnings(record=True) as got:
+        warnings.simplefilter("always")
+        fitbead.fit_jan(units, profile=False)
+    assert [w for w in got if w.category is fitbead.UnitWarning and "dimensionless" in str(w.message)]
+    assert not [w for w in got if w.category is fitbead.OutlierWarning]

@@ -307,13 +307,19 @@ impl StatsRow {
             let p = ChiSquared::new(dof as f64).map_or(f64::NAN, |d| d.sf(rest));
             format!(
                 "; the other points' chi2 at this fit, which {} pulls, = {} on {dof} degrees of \
-                 freedom (tail probability {})",
+                 freedom (tail probability {}{})",
                 if n == 1 { "it" } else { "they" },
                 fmt_sig(rest, 5),
                 if p > 0.0 {
                     fmt_sig(p, 2)
                 } else {
                     "< 1e-300".into()
+                },
+                if p < MISFIT_P_VALUE {
+                    ": they misfit too, and the intervals, which assume the model holds, are \
+                     too narrow"
+                } else {
+                    ""
                 }
             )
         };

@@ -27,9 +27,13 @@
 //!   δ (radians, step 1e-4 · δ) at the guess, or at each prior draw for a Bayesian design. The
 //!   weighted least squares with this variance is what the ODR fits of such data
 //!   ([`crate::inverse::odr`]) solve to first order, and it enters every criterion and every
-//!   predicted standard error. Near the ends of regime B, where v̄ changes steeply with δ
-//!   (the bead crawls over the top near δ_m, eq 32), the slope term dominates and the design
-//!   moves inward.
+//!   predicted standard error. Near the ends of regime B v̄ changes steeply with δ (near δ_m,
+//!   eq 32, the bead crawls over the top) and the slope term dominates σ²: where ∂v̄/∂p grows
+//!   less steeply the design moves inward. Near δ_m of a K-law fit both grow in the ratio
+//!   ∂δ_m/∂p, so the information of a point tends to (∂δ_m/∂p)²/σ_δ² instead of falling,
+//!   and a c-optimal design may stay at the lower end of its range, 2σ_δ or the margin
+//!   inside it. A prior draw at which a difference in δ leaves the steady state gives the
+//!   candidate no information, as a draw at which it is not steady.
 //! - **Fisher information** of n_j points at each candidate: M = Σ n_j g_j g_jᵀ with
 //!   g = (∂v̄/∂p)/σ; the predicted covariance of the least-squares estimate is M⁻¹.
 //! - **Criteria.** D: maximise log det M; c: minimise (M⁻¹)_kk of the target parameter k; T:

@@ -47,8 +47,8 @@ pub struct Args {
     pub delta_range: Option<SlopeRange>,
     /// Standard uncertainty of a set slope, degrees: each point's variance becomes
     /// σ_v² + (∂v̄/∂δ)² σ_δ² (the effective variance the fits with slope errors minimise), so
-    /// the design leaves the slopes where v̄ changes steeply, and the range keeps 2 σ_δ from
-    /// its ends so that a slope set 2 σ_δ off is still steady at the guess. 0: exact slopes.
+    /// a slope where v̄ changes steeply tells less, and the range keeps 2 σ_δ from its ends so
+    /// that a slope set 2 σ_δ off is still steady at the guess. 0: exact slopes.
     #[arg(long, value_name = "DEG", default_value_t = 0.0, value_parser = values::slope_sigma)]
     pub sigma_delta: f64,
     /// The fraction F of the range's width kept from each of its ends (0 <= F < 0.5; the

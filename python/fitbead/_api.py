@@ -1754,6 +1754,10 @@ class Design:
     bayes : tuple of int or None
         A Bayesian design: the prior draws averaged over and the draws redrawn (a series
         without a steady slope in its range).
+    steady : list of dict
+        Per row of ``table``, the range ``(low, high)`` of each parameter that moves its
+        series over which its slope stays steady (regime B), the others at the guess; an
+        end is None where the steady state holds to the end of the parameter's domain.
     """
 
     def __init__(self, raw: Mapping[str, Any]) -> None:
@@ -1780,6 +1784,9 @@ class Design:
         self.points_needed: Optional[Tuple[float, float]] = raw["points_needed"]
         self.ranges: List[Tuple[float, float]] = [tuple(r) for r in raw["ranges"]]  # type: ignore[misc]
         self.bayes: Optional[Tuple[int, int]] = None if raw.get("bayes") is None else tuple(raw["bayes"])  # type: ignore[assignment]
+        self.steady: List[Dict[str, Tuple[Optional[float], Optional[float]]]] = [
+            {k: (v[0], v[1]) for k, v in row.items()} for row in raw.get("steady", [])
+        ]
 
     def to_pandas(self):
         """The design as a DataFrame (series, xi, delta_deg, replicates; needs pandas)."""
@@ -1861,6 +1868,8 @@ def design(
     draws: int = 64,
     seed: int = 1,
     total: Optional[int] = None,
+    sigma_delta: float = 0.0,
+    margin: float = 0.05,
 ) -> Design:
     """Where to measure (``fitbead design``): locally optimal slopes for a fit's parameters,
     or slopes that tell two models apart, from the Fisher information at a guess.
@@ -1882,8 +1891,8 @@ def design(
         Relative noise σ = noise · v̄ (as ``simulate --noise``), or ``"abs=S"`` for an
         absolute σ of v̄.
     delta_range : (float, float), optional
-        Slopes in degrees (cut to regime B of the guess); default regime B kept 5 % of its
-        width from each end.
+        Slopes in degrees (cut to regime B of the guess); default regime B; either way kept
+        ``margin`` of its width (and 2 ``sigma_delta``) from each end.
     criterion : {"d", "c", "t"}
         D-optimal, c-optimal for ``target``, or T-optimal against ``vs``.
     target : str, optional
@@ -1908,6 +1917,13 @@ def design(
         Seed of the prior draws.
     total : int, optional
         Points over all series, shared out by the design (replaces ``points``).
+    sigma_delta : float, default 0
+        Standard uncertainty of a set slope, degrees (``--sigma-delta``): each point's
+        variance becomes σ_v² + (∂v̄/∂δ)² σ_δ² (the effective variance the fits with slope
+        errors minimise), and the ranges keep 2 σ_δ from their ends. 0: exact slopes.
+    margin : float, default 0.05
+        The fraction of each range's width kept from either end (``--margin``;
+        0 <= margin < 0.5).
 
     Returns
     -------
@@ -1944,6 +1960,8 @@ def design(
         draws=int(draws),
         seed=int(seed),
         total=None if total is None else int(total),
+        sigma_delta=float(sigma_delta),
+        margin=float(margin),
     )
     return Design(raw)
 

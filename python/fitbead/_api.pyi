@@ -559,6 +559,13 @@ class Design:
         points needed in all for power 0.8 at significance 0.05.
     ranges : list of (float, float)
         The slope range of each series, degrees.
+    bayes : tuple of int or None
+        A Bayesian design: the prior draws averaged over and the draws redrawn (a series
+        without a steady slope in its range).
+    steady : list of dict
+        Per row of ``table``, the range ``(low, high)`` of each parameter that moves its
+        series over which its slope stays steady (regime B), the others at the guess; an
+        end is None where the steady state holds to the end of the parameter's domain.
     '''
     table: Table
     even: Table
@@ -570,6 +577,7 @@ class Design:
     points_needed: tuple[float, float] | None
     ranges: list[tuple[float, float]]
     bayes: tuple[int, int] | None
+    steady: list[dict[str, tuple[float | None, float | None]]]
     def __init__(self, raw: Mapping[str, Any]) -> None: ...
     def to_pandas(self):
         """The design as a DataFrame (series, xi, delta_deg, replicates; needs pandas)."""
@@ -580,7 +588,7 @@ class Design:
     def save(self, path: Any) -> None:
         """Writes the design to a JSON file that :func:`load` reads back."""
 
-def design(fit: str = 'klaw', *, model: str | None = None, law: str = 'c=0.5', series: Sequence[float] = (0.8, 1.0, 1.6, 2.0), points: int = 9, noise: float | str = 0.02, delta_range: tuple[float, float] | None = None, criterion: str = 'd', target: str | None = None, vs: str | None = None, branch: str = 'upper', rho: float = 0.4, f: float = 0.1, prior: Mapping[str, str] | None = None, draws: int = 64, seed: int = 1, total: int | None = None) -> Design:
+def design(fit: str = 'klaw', *, model: str | None = None, law: str = 'c=0.5', series: Sequence[float] = (0.8, 1.0, 1.6, 2.0), points: int = 9, noise: float | str = 0.02, delta_range: tuple[float, float] | None = None, criterion: str = 'd', target: str | None = None, vs: str | None = None, branch: str = 'upper', rho: float = 0.4, f: float = 0.1, prior: Mapping[str, str] | None = None, draws: int = 64, seed: int = 1, total: int | None = None, sigma_delta: float = 0.0, margin: float = 0.05) -> Design:
     '''Where to measure (``fitbead design``): locally optimal slopes for a fit's parameters,
     or slopes that tell two models apart, from the Fisher information at a guess.
 
@@ -601,8 +609,8 @@ def design(fit: str = 'klaw', *, model: str | None = None, law: str = 'c=0.5', s
         Relative noise σ = noise · v̄ (as ``simulate --noise``), or ``"abs=S"`` for an
         absolute σ of v̄.
     delta_range : (float, float), optional
-        Slopes in degrees (cut to regime B of the guess); default regime B kept 5 % of its
-        width from each end.
+        Slopes in degrees (cut to regime B of the guess); default regime B; either way kept
+        ``margin`` of its width (and 2 ``sigma_delta``) from each end.
     criterion : {"d", "c", "t"}
         D-optimal, c-optimal for ``target``, or T-optimal against ``vs``.
     target : str, optional
@@ -627,6 +635,13 @@ def design(fit: str = 'klaw', *, model: str | None = None, law: str = 'c=0.5', s
         Seed of the prior draws.
     total : int, optional
         Points over all series, shared out by the design (replaces ``points``).
+    sigma_delta : float, default 0
+        Standard uncertainty of a set slope, degrees (``--sigma-delta``): each point's
+        variance becomes σ_v² + (∂v̄/∂δ)² σ_δ² (the effective variance the fits with slope
+        errors minimise), and the ranges keep 2 σ_δ from their ends. 0: exact slopes.
+    margin : float, default 0.05
+        The fraction of each range's width kept from either end (``--margin``;
+        0 <= margin < 0.5).
 
     Returns
     -------

@@ -1812,7 +1812,7 @@ fn output_columns(command: &str, model: &str, slopes: bool) -> PyResult<Vec<Stri
 /// An experimental design (`fitbead design`): the settings as the command line's flags, the
 /// result as a dict of plain values (rows as columns).
 #[pyfunction]
-#[pyo3(signature = (fit, model=None, law="c=0.5", series=vec![0.8, 1.0, 1.6, 2.0], points=9, noise=0.02, noise_absolute=false, delta_range=None, criterion="d", target=None, vs=None, branch="upper", rho=0.4, f=0.1, priors=vec![], draws=64, seed=1, total=None))]
+#[pyo3(signature = (fit, model=None, law="c=0.5", series=vec![0.8, 1.0, 1.6, 2.0], points=9, noise=0.02, noise_absolute=false, delta_range=None, criterion="d", target=None, vs=None, branch="upper", rho=0.4, f=0.1, priors=vec![], draws=64, seed=1, total=None, sigma_delta=0.0, margin=0.05))]
 #[allow(clippy::too_many_arguments)]
 fn design<'py>(
     py: Python<'py>,
@@ -1834,6 +1834,8 @@ fn design<'py>(
     draws: usize,
     seed: u64,
     total: Option<usize>,
+    sigma_delta: f64,
+    margin: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     use fitbead::design::{Criterion, DesignFit, DesignSettings};
     let priors = priors
@@ -1873,6 +1875,8 @@ fn design<'py>(
         draws,
         seed,
         total,
+        sigma_delta,
+        margin,
         ..DesignSettings::default()
     };
     let r = py
@@ -1916,6 +1920,15 @@ fn design<'py>(
     d.set_item("points_needed", r.points_needed)?;
     d.set_item("ranges", r.ranges.clone())?;
     d.set_item("bayes", r.bayes)?;
+    let steady = PyList::empty(py);
+    for ranges in &r.steady {
+        let x = PyDict::new(py);
+        for (name, lo, hi) in ranges {
+            x.set_item(name, (*lo, *hi))?;
+        }
+        steady.append(x)?;
+    }
+    d.set_item("steady", steady)?;
     Ok(d)
 }
 

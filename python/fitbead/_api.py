@@ -1399,14 +1399,61 @@ class FitSet(list):
         """
         _save(path, "fitset", lambda: {"fits": [fr._json(f"fitset.fits[{i}]") for i, fr in enumerate(self)], "notes": list(self.notes)})
 
-    def get(self, name: str, series: Optional[str] = None) -> Optional[FitResult]:
-        """The fit named ``name`` (``jan-series``, ``jan-global``, ``jaeger``) for ``series``
-        (a series label; ``all`` for a global fit), or the first fit of that name when
-        ``series`` is None."""
+    def get(self, name: str, series: Any = None, default: Any = None) -> Optional[FitResult]:
+        """The fit named ``name`` (``jan-series``, ``jan-global``, ``jaeger``) for ``series``,
+        or ``default`` when there is none.
+
+        Parameters
+        ----------
+        name : str
+            The fit's name.
+        series : str or float, optional
+            The series: its label, or a number matched against the labels read as numbers
+            and against the series' ξ (``1.0`` finds the series labelled ``"1"``); ``all``
+            for a global fit. None: the first fit of that name.
+        default : optional
+            What to return when no fit matches (None).
+        """
         for fr in self:
-            if fr.name == name and (series is None or fr.series == series):
+            if fr.name == name and (series is None or _same_series(fr, series)):
                 return fr
-        return None
+        return default
+
+    def __getitem__(self, key: Any) -> Any:
+        """A fit by position (as a list), by name (the first fit of that name) or by
+        ``(name, series)`` (as :meth:`get`); KeyError naming the fits there are when none
+        matches."""
+        if isinstance(key, (int, slice, np.integer)):
+            return list.__getitem__(self, key)
+        name, series = (key, None) if isinstance(key, str) else tuple(key)
+        fr = self.get(name, series)
+        if fr is None:
+            have = ", ".join(f"({f.name!r}, {f.series!r})" for f in self)
+            raise KeyError(f"no fit {key!r}; the fits are {have}")
+        return fr
+
+    def __contains__(self, key: Any) -> bool:
+        if isinstance(key, FitResult):
+            return list.__contains__(self, key)
+        try:
+            self[key]
+        except (KeyError, TypeError, ValueError):
+            return False
+        return True
+
+    def keys(self) -> List[Tuple[str, str]]:
+        """``(name, series)`` of every fit, in order."""
+        return [(f.name, f.series) for f in self]
+
+    def to_arviz(self):
+        """The posteriors of the run's fits as one ``arviz.InferenceData`` per fit, keyed by
+        ``name[series]`` (each as :meth:`FitResult.to_arviz`: a pointwise log likelihood for
+        ``az.compare``); needs MCMC fits."""
+        return {f"{f.name}[{f.series}]": f.to_arviz() for f in self}
+
+    def plot(self, **kwargs: Any):
+        """Every fit's :meth:`FitResult.plot`, one figure each; returns the figures."""
+        return [f.plot(**kwargs) for f in self]
 
     def __str__(self) -> str:
         parts = [str(fr) for fr in self]
@@ -1429,6 +1476,24 @@ class FitSet(list):
         if not frames:
             return _frame([], _core.record_columns(what))
         return pd.concat(frames, ignore_index=True)
+
+
+def _same_series(fr: "FitResult", series: Any) -> bool:
+    """Whether `fr` is the fit of `series`: its label, or a number equal to the label read as
+    a number or to the series' ξ."""
+    if isinstance(series, str):
+        return fr.series == series
+    try:
+        x = float(series)
+    except (TypeError, ValueError):
+        return False
+    try:
+        if float(fr.series) == x:
+            return True
+    except ValueError:
+        pass
+    xi = fr.residuals.get("xi")
+    return xi is not None and len(xi) > 0 and bool(np.all(np.asarray(xi, dtype=float) == x))
 
 
 def _fitted(core: Any, context: Dict[str, Any]) -> FitResult:
@@ -1814,6 +1879,7 @@ class Design:
             "points_needed": self.points_needed,
             "ranges": list(self.ranges),
             "bayes": self.bayes,
+            "steady": [{k: [lo, hi] for k, (lo, hi) in row.items()} for row in self.steady],
         }
 
     def __eq__(self, other: Any) -> bool:

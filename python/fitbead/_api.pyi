@@ -420,10 +420,19 @@ class FitSet(list):
     __hash__: None  # type: ignore[assignment]
     def save(self, path: Any) -> None:
         """Writes the fits and the notes to a JSON file that :func:`load` reads back."""
-    def get(self, name: str, series: str | None = None) -> FitResult | None:
+    def get(self, name: str, series: Any = None, default: Any = None) -> FitResult | None:
         """The fit named ``name`` (``jan-series``, ``jan-global``, ``jaeger``) for ``series``
         (a series label; ``all`` for a global fit), or the first fit of that name when
         ``series`` is None."""
+    def __getitem__(self, key: Any) -> Any:
+        """A fit by position, by name, or by ``(name, series)``; KeyError when none matches."""
+    def __contains__(self, key: Any) -> bool: ...
+    def keys(self) -> list[tuple[str, str]]:
+        """``(name, series)`` of every fit, in order."""
+    def to_arviz(self) -> dict[str, Any]:
+        """Each fit's ``arviz.InferenceData``, keyed by ``name[series]``."""
+    def plot(self, **kwargs: Any) -> list[Any]:
+        """Every fit's plot, one figure each."""
     def to_pandas(self, what: str = 'params'):
         """Every fit's table in one DataFrame (needs pandas): ``params``, ``stats``,
         ``residuals`` or ``correlations``, with the command line's columns (its CSV of the

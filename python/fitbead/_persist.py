@@ -501,6 +501,13 @@ def decode_design(x: Any, where: str) -> Dict[str, Any]:
         "points_needed": pair(_get(x, "points_needed", where), f"{where}.points_needed", _float),
         "ranges": [pair(r, f"{where}.ranges[{i}]", _float) for i, r in enumerate(_list(_get(x, "ranges", where), f"{where}.ranges"))],
         "bayes": pair(_get(x, "bayes", where), f"{where}.bayes", _int),
+        "steady": [
+            {
+                _text(k, f"{where}.steady[{i}]"): pair(v, f"{where}.steady[{i}].{k}", _opt_float)
+                for k, v in _typed(row, (dict,), "an object", f"{where}.steady[{i}]").items()
+            }
+            for i, row in enumerate(_list(x.get("steady", []) if isinstance(x, dict) else [], f"{where}.steady"))
+        ],
     }
 
 

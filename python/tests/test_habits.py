@@ -356,3 +356,18 @@ def test_one_outlier_is_named_not_blamed_on_units():
         fitbead.fit_jan(units, profile=False)
     assert [w for w in got if w.category is fitbead.UnitWarning and "dimensionless" in str(w.message)]
     assert not [w for w in got if w.category is fitbead.OutlierWarning]
+
+
+def test_fitset_is_a_mapping_by_name_and_series():
+    """FitSet["jan-global"], FitSet["jan-series", 1.0] (a number finds the series labelled
+    "1"), KeyError naming the fits there are, and positions as a list."""
+    fits = fitbead.fit_jan(profile=False)
+    assert fits["jan-global"].series == "all"
+    assert fits["jan-series", 1.0].series == "1"
+    assert fits.get("jan-series", 1.6) is fits["jan-series", "1.6"]
+    assert fits.get("jan-series", 7.0) is None and fits.get("nope", default=0) == 0
+    assert fits[0] is list(fits)[0] and len(fits[1:]) == len(fits) - 1
+    assert ("jan-series", "2") in fits and ("jan-series", "3") not in fits
+    assert fits.keys()[-1] == ("jan-global", "all")
+    with pytest.raises(KeyError, match="jan-global"):
+        fits["jan-series", 3.0]

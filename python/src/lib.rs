@@ -1032,11 +1032,9 @@ impl PyDataset {
     /// name, or named like an uncertainty), as the command line warns about them.
     #[getter]
     fn column_warnings(&self) -> PyResult<Vec<String>> {
-        let cols = self
-            .file
+        self.file
             .unknown_columns(false)
-            .map_err(|e| value_error(e.to_string()))?;
-        Ok(cols.iter().map(ToString::to_string).collect())
+            .map_err(|e| value_error(e.to_string()))
     }
 
     /// Refuses a column fitbead does not read, as `--strict-columns` does (the error names the

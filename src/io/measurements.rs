@@ -618,15 +618,13 @@ impl MeasurementFile {
     }
 
     /// The columns of the file that fitbead does not read, checked as the command line checks
-    /// a measurements file ([`crate::io::scenes::check_columns`]): with `strict`, the first of
-    /// them is an error; otherwise those that look like a misspelt or misnamed column (close
-    /// to a known name, or named like an uncertainty) are returned, for the caller to warn
-    /// about.
-    pub fn unknown_columns(
-        &self,
-        strict: bool,
-    ) -> Result<Vec<crate::io::scenes::UnknownColumn>, InputError> {
+    /// a measurements file: with `strict`, the first of them is an error; otherwise those that
+    /// look like a misspelt or misnamed column (close to a known name, or named like an
+    /// uncertainty) are returned as the command line's warnings (file, column and the name
+    /// meant), for the caller to give.
+    pub fn unknown_columns(&self, strict: bool) -> Result<Vec<String>, InputError> {
         crate::io::scenes::check_columns(&self.table, &MEASUREMENT_COLUMNS, strict)
+            .map(|cols| cols.iter().map(ToString::to_string).collect())
     }
 
     /// Parses and validates `bytes`, named `source` in errors.

@@ -217,7 +217,8 @@ fn the_tests_chi2_tail_matches_known_values() {
 /// misfit for each.
 struct FitRun {
     label: String,
-    /// (fit, series, χ², dof, warned)
+    /// (fit, series, χ², dof, warned): warned of a misfit, or of outliers (which name the
+    /// points that make the misfit).
     rows: Vec<(String, String, f64, usize, bool)>,
 }
 
@@ -242,13 +243,21 @@ fn run_pair(dir: &Path, sim: &[&str], fit: &[&str], label: &str) -> Option<FitRu
         .iter()
         .filter(|r| !r["chi2"].is_empty() && r["n_params"] != "0")
         .map(|r| {
-            let prefix = format!("warning: {} [{}]: misfit", r["fit"], r["series"]);
+            let prefix = format!("warning: {} [{}]: ", r["fit"], r["series"]);
+            let warned = err.lines().any(|l| {
+                l.split_once(prefix.as_str()).is_some_and(|(_, w)| {
+                    w.starts_with("misfit")
+                        || w.split_once(' ').is_some_and(|(n, rest)| {
+                            n.parse::<usize>().is_ok() && rest.starts_with("outlier(s)")
+                        })
+                })
+            });
             (
                 r["fit"].clone(),
                 r["series"].clone(),
                 num(r, "chi2"),
                 r["dof"].parse().unwrap(),
-                err.contains(&prefix),
+                warned,
             )
         })
         .collect();

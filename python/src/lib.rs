@@ -504,6 +504,25 @@ where
     Ok(())
 }
 
+/// [`fill`] without the GIL, stopped by a signal: the rows check a stop flag that a signal
+/// handler's exception raises (Ctrl-C's KeyboardInterrupt, or the handler's own), so a batch
+/// of any size ends within a row's time of it on every thread, and that exception is raised.
+fn fill_interruptible<F>(py: Python<'_>, n: usize, cols: &mut Columns, row: F) -> PyResult<()>
+where
+    F: Fn(usize, &mut RowSink<'_, '_>) -> Result<(), String> + Sync + Send,
+{
+    let stop = AtomicBool::new(false);
+    let r = interruptible(py, &stop, || {
+        fill(n, cols, |i, sink| {
+            if stop.load(Ordering::Relaxed) {
+                return Err("interrupted".into());
+            }
+            row(i, sink)
+        })
+    })?;
+    r.map_err(value_error)
+}
+
 fn opt(x: Option<f64>) -> f64 {
     x.unwrap_or(f64::NAN)
 }
@@ -689,23 +708,20 @@ fn forward<'py>(
     }
     let mut cols = Columns::of(f);
     forward_fields_checked().map_err(PyRuntimeError::new_err)?;
-    let r = py.detach(|| {
-        fill(n, &mut cols, |i, sink| {
-            let law = law_of(k_s, base_law, i)?;
-            let scene = scene_of(i, xi_s, d_s, rho_s, f_s, law)?;
-            let m = args.model(i, &scene)?;
-            let (common, c, a) = ForwardRecord::evaluate(&scene, &m);
-            visit_forward(&common, sink);
-            if contact {
-                sink.record(&c.unwrap_or_default());
-            }
-            if auto {
-                sink.record(&a.unwrap_or_default());
-            }
-            Ok(())
-        })
-    });
-    r.map_err(value_error)?;
+    fill_interruptible(py, n, &mut cols, |i, sink| {
+        let law = law_of(k_s, base_law, i)?;
+        let scene = scene_of(i, xi_s, d_s, rho_s, f_s, law)?;
+        let m = args.model(i, &scene)?;
+        let (common, c, a) = ForwardRecord::evaluate(&scene, &m);
+        visit_forward(&common, sink);
+        if contact {
+            sink.record(&c.unwrap_or_default());
+        }
+        if auto {
+            sink.record(&a.unwrap_or_default());
+        }
+        Ok(())
+    })?;
     cols.into_dict(py)
 }
 
@@ -758,15 +774,12 @@ fn invert_k<'py>(
     ])?;
     let n = xi_s.len();
     let mut cols = k_columns(auto.is_some(), false);
-    let r = py.detach(|| {
-        fill(n, &mut cols, |i, sink| {
-            let scene = scene_of(i, xi_s, d_s, rho_s, f_s, CollisionLaw::Value(0.5))?;
-            let measured = measured(i, v_s, s_s)?;
-            k_record(sink, &model, auto.as_ref(), &scene, measured, None);
-            Ok(())
-        })
-    });
-    r.map_err(value_error)?;
+    fill_interruptible(py, n, &mut cols, |i, sink| {
+        let scene = scene_of(i, xi_s, d_s, rho_s, f_s, CollisionLaw::Value(0.5))?;
+        let measured = measured(i, v_s, s_s)?;
+        k_record(sink, &model, auto.as_ref(), &scene, measured, None);
+        Ok(())
+    })?;
     cols.into_dict(py)
 }
 
@@ -1179,16 +1192,13 @@ impl PyDataset {
         let slopes = p.iter().any(|q| q.sigma_delta > 0.0);
         let mut cols = k_columns(auto.is_some(), slopes);
         let abs = self.has_sigma();
-        let r: Result<(), String> = py.detach(|| {
-            fill(p.len(), &mut cols, |i, sink| {
-                let q = &p[i];
-                let sigma = abs.then_some(q.sigma);
-                let slope = slopes.then_some(q.sigma_delta);
-                k_record(sink, &model, auto.as_ref(), &q.scene, (q.v, sigma), slope);
-                Ok(())
-            })
-        });
-        r.map_err(value_error)?;
+        fill_interruptible(py, p.len(), &mut cols, |i, sink| {
+            let q = &p[i];
+            let sigma = abs.then_some(q.sigma);
+            let slope = slopes.then_some(q.sigma_delta);
+            k_record(sink, &model, auto.as_ref(), &q.scene, (q.v, sigma), slope);
+            Ok(())
+        })?;
         cols.into_dict(py)
     }
 

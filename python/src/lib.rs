@@ -1287,11 +1287,16 @@ struct MethodArgs {
     stop: Arc<AtomicBool>,
 }
 
-/// The keywords of the posterior runs that are not the sampler's options.
+/// The keywords of the posterior runs that are not the sampler's options, and the controls
+/// of the parameters (`fix`, `init`, `bounds`, `scale_covar`).
 struct Sampling {
     thin: Option<usize>,
     priors: Vec<(String, String)>,
     fit_scatter: bool,
+    fix: Vec<(String, f64)>,
+    init: Vec<(String, f64)>,
+    bounds: Vec<(String, (f64, f64))>,
+    scale_covar: bool,
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -1322,9 +1327,19 @@ fn method_args(
                 profile,
                 stop: Some(stop.clone()),
                 progress: None,
+                scale_covar: sampling.scale_covar,
+                fix: sampling.fix,
+                init: sampling.init,
+                bounds: sampling.bounds,
             }
         }
         "mcmc" => {
+            if sampling.scale_covar {
+                return Err(value_error(
+                    "scale_covar: applies to method = 'lsq' only (a posterior run has no \
+                     covariance to scale)",
+                ));
+            }
             let mut s = McmcSettings::seeded(seed);
             if let Some(w) = walkers {
                 s.options.walkers = Some(w);
@@ -1347,6 +1362,9 @@ fn method_args(
                 s.priors.push((name, prior));
             }
             s.fit_scatter = sampling.fit_scatter;
+            s.fix = sampling.fix;
+            s.init = sampling.init;
+            s.bounds = sampling.bounds;
             Method::Mcmc(Box::new(s))
         }
         _ => {
@@ -1463,7 +1481,7 @@ fn run_fit(
 /// A K(α) law fitted across series (see the Python `fitbead.fit_klaw`): the law's fit and the
 /// impact law's (unless the law is impact), the notes, and the draws CSV when `draws`.
 #[pyfunction]
-#[pyo3(signature = (data, model="stickslip", law="c", method="lsq", level=0.95, profile=true, seed=1, walkers=None, max_steps=None, min_ess=None, tol=1e-10, thin=None, priors=vec![], fit_scatter=false, skip_unsteady=false, draws=false))]
+#[pyo3(signature = (data, model="stickslip", law="c", method="lsq", level=0.95, profile=true, seed=1, walkers=None, max_steps=None, min_ess=None, tol=1e-10, thin=None, priors=vec![], fit_scatter=false, skip_unsteady=false, draws=false, fix=vec![], init=vec![], bounds=vec![], scale_covar=false))]
 #[allow(clippy::too_many_arguments)]
 fn fit_klaw(
     py: Python<'_>,
@@ -1483,6 +1501,10 @@ fn fit_klaw(
     fit_scatter: bool,
     skip_unsteady: bool,
     draws: bool,
+    fix: Vec<(String, f64)>,
+    init: Vec<(String, f64)>,
+    bounds: Vec<(String, (f64, f64))>,
+    scale_covar: bool,
 ) -> PyResult<Fitted> {
     let (_, auto) = k_model(model, tol)?;
     let kind = if auto.is_some() {
@@ -1505,6 +1527,10 @@ fn fit_klaw(
         thin,
         priors,
         fit_scatter,
+        fix,
+        init,
+        bounds,
+        scale_covar,
     };
     let a = method_args(
         method, level, profile, seed, walkers, max_steps, min_ess, sampling,
@@ -1514,7 +1540,7 @@ fn fit_klaw(
 
 /// Jan's λ and μ per series and the global laws (see the Python `fitbead.fit_jan`).
 #[pyfunction]
-#[pyo3(signature = (data, method="lsq", level=0.95, profile=true, seed=1, walkers=None, max_steps=None, min_ess=None, thin=None, priors=vec![], fit_scatter=false, draws=false))]
+#[pyo3(signature = (data, method="lsq", level=0.95, profile=true, seed=1, walkers=None, max_steps=None, min_ess=None, thin=None, priors=vec![], fit_scatter=false, draws=false, fix=vec![], init=vec![], bounds=vec![], scale_covar=false))]
 #[allow(clippy::too_many_arguments)]
 fn fit_jan(
     py: Python<'_>,
@@ -1530,12 +1556,20 @@ fn fit_jan(
     priors: Vec<(String, String)>,
     fit_scatter: bool,
     draws: bool,
+    fix: Vec<(String, f64)>,
+    init: Vec<(String, f64)>,
+    bounds: Vec<(String, (f64, f64))>,
+    scale_covar: bool,
 ) -> PyResult<Fitted> {
     let command = FitCommand::Jan;
     let sampling = Sampling {
         thin,
         priors,
         fit_scatter,
+        fix,
+        init,
+        bounds,
+        scale_covar,
     };
     let a = method_args(
         method, level, profile, seed, walkers, max_steps, min_ess, sampling,
@@ -1545,7 +1579,7 @@ fn fit_jan(
 
 /// Jaeger's a1–a3 per series (see the Python `fitbead.fit_jaeger`).
 #[pyfunction]
-#[pyo3(signature = (data, branch="upper", method="lsq", level=0.95, profile=true, seed=1, walkers=None, max_steps=None, min_ess=None, thin=None, priors=vec![], fit_scatter=false, draws=false))]
+#[pyo3(signature = (data, branch="upper", method="lsq", level=0.95, profile=true, seed=1, walkers=None, max_steps=None, min_ess=None, thin=None, priors=vec![], fit_scatter=false, draws=false, fix=vec![], init=vec![], bounds=vec![], scale_covar=false))]
 #[allow(clippy::too_many_arguments)]
 fn fit_jaeger(
     py: Python<'_>,
@@ -1562,6 +1596,10 @@ fn fit_jaeger(
     priors: Vec<(String, String)>,
     fit_scatter: bool,
     draws: bool,
+    fix: Vec<(String, f64)>,
+    init: Vec<(String, f64)>,
+    bounds: Vec<(String, (f64, f64))>,
+    scale_covar: bool,
 ) -> PyResult<Fitted> {
     let b: JaegerBranch = branch
         .parse()
@@ -1571,6 +1609,10 @@ fn fit_jaeger(
         thin,
         priors,
         fit_scatter,
+        fix,
+        init,
+        bounds,
+        scale_covar,
     };
     let a = method_args(
         method, level, profile, seed, walkers, max_steps, min_ess, sampling,
@@ -1886,6 +1928,10 @@ fn report(
                 profile: true,
                 stop: Some(stop.clone()),
                 progress: None,
+                scale_covar: false,
+                fix: Vec::new(),
+                init: Vec::new(),
+                bounds: Vec::new(),
             }
         }
         "mcmc" => {

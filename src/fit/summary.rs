@@ -59,6 +59,9 @@ pub struct ParamRow {
     /// How much the posterior of this parameter moves when the prior or the likelihood is
     /// power-scaled (MCMC only).
     pub sensitivity: Option<PowerScaling>,
+    /// True when the parameter was held at `value`, not fitted (lmfit's `vary=False`): no
+    /// standard error or interval, and it counts no degree of freedom.
+    pub fixed: bool,
 }
 
 /// Power-scaling sensitivity of one parameter's posterior (`priorsense`'s diagnostic: the
@@ -166,6 +169,10 @@ pub struct StatsRow {
     /// True when the slopes were taken as measured with error: a least-squares fit is then
     /// an orthogonal distance regression (`method` = `odr`), and χ² its objective.
     pub slope_errors: bool,
+    /// True when the covariance of σ given was scaled by the reduced χ² all the same
+    /// (lmfit's `scale_covar=True`): standard errors and intervals are then those of relative
+    /// σ.
+    pub scale_covar: bool,
 }
 
 /// A fit with σ given whose reduced χ² exceeds this is flagged ([`StatsRow::absurd_misfit`]):
@@ -782,6 +789,7 @@ pub(crate) fn summarise_with_profiles<R: Residuals + ?Sized>(
                 lsq_value: Some(f.params[j]),
                 posterior: None,
                 sensitivity: None,
+                fixed: false,
             }
         })
         .collect();
@@ -806,6 +814,7 @@ pub(crate) fn summarise_with_profiles<R: Residuals + ?Sized>(
             note,
             mcmc: None,
             slope_errors: false,
+            scale_covar: f.scale_covar && f.sigma == SigmaKind::Absolute,
         },
         draws: None,
         correlation: f

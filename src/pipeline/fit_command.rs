@@ -3,6 +3,7 @@
 
 use super::fit_run::FitRun;
 use super::{jaeger, jan, klaw, setting_error, RunError};
+use crate::fit::controls::{ControlError, Controls};
 use crate::fit::klaw::KLaw;
 use crate::fit::slopes;
 use crate::fit::summary::{FitResult, McmcFailure};
@@ -83,7 +84,7 @@ impl FitCommand {
         progress: Option<Progress>,
         note: &mut dyn FnMut(&str),
     ) -> Result<FitRun, RunError> {
-        self.check(&method, level)?;
+        self.check(&method, level, &file.dataset.labels)?;
         if let Some(why) = slopes::unsupported(&method, file.dataset()) {
             return Err(setting_error("--method", "mcmc", why));
         }
@@ -122,8 +123,10 @@ impl FitCommand {
 }
 
 impl FitCommand {
-    /// Refuses a level outside (0, 1) and a prior on a parameter the fit does not have.
-    fn check(&self, method: &Method, level: f64) -> Result<(), RunError> {
+    /// Refuses a level outside (0, 1), a control (`fix`, `init`, `bounds`) of a parameter
+    /// the fit does not have or of a series not among `labels`, and a prior on a parameter
+    /// the fit does not have or holds.
+    fn check(&self, method: &Method, level: f64, labels: &[String]) -> Result<(), RunError> {
         if !(level > 0.0 && level < 1.0) {
             return Err(setting_error(
                 "--level",
@@ -131,11 +134,20 @@ impl FitCommand {
                 format!("confidence level {} is not in (0, 1)", fmt_f64(level)),
             ));
         }
+        let params = self.parameters();
+        let controls = Controls::of(method);
+        controls.check(params, labels).map_err(control_error)?;
         let Method::Mcmc(m) = method else {
             return Ok(());
         };
-        let params = self.parameters();
         for (name, prior) in &m.priors {
+            if controls.fix.iter().any(|(k, _)| k == name) {
+                return Err(setting_error(
+                    "--prior",
+                    &format!("{name}={prior}"),
+                    format!("{name} is held (--fix): it is not sampled and takes no prior"),
+                ));
+            }
             if name != SCALE_NAME && !params.contains(&name.as_str()) {
                 return Err(setting_error(
                     "--prior",
@@ -149,6 +161,11 @@ impl FitCommand {
         }
         Ok(())
     }
+}
+
+/// The error of a control that cannot be used, on its flag.
+pub(crate) fn control_error(e: ControlError) -> RunError {
+    setting_error(e.flag, &e.value, e.reason)
 }
 
 /// `method` with its least-squares runs counted on `progress` as a task labelled `label`,

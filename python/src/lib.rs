@@ -1164,6 +1164,17 @@ impl PyFitResult {
         self.inner.params.iter().map(|p| p.bounds).collect()
     }
 
+    /// The value each parameter's least-squares fit started from (None where the fit does not
+    /// say), in the order of `params`.
+    fn param_starts(&self) -> Vec<Option<f64>> {
+        self.inner.params.iter().map(|p| p.start).collect()
+    }
+
+    /// Whether each parameter was held at its value (`fix`), in the order of `params`.
+    fn param_fixed(&self) -> Vec<bool> {
+        self.inner.params.iter().map(|p| p.fixed).collect()
+    }
+
     /// Fit statistics, keyed by the columns of the statistics report (stats.csv): the same
     /// record the command line writes; an empty cell is None.
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
@@ -1618,6 +1629,20 @@ fn fit_jaeger(
         method, level, profile, seed, walkers, max_steps, min_ess, sampling,
     )?;
     run_fit(py, data, command, a, draws, false)
+}
+
+/// The quantile at probability `p` of Student's t on `dof` degrees of freedom (the scale of
+/// `FitResult.eval_uncertainty`, as lmfit's).
+#[pyfunction]
+fn t_quantile(p: f64, dof: f64) -> PyResult<f64> {
+    use statrs::distribution::{ContinuousCDF, StudentsT};
+    if !(p > 0.0 && p < 1.0) {
+        return Err(value_error(format!(
+            "p = {p}: expected a probability in (0, 1)"
+        )));
+    }
+    let t = StudentsT::new(0.0, 1.0, dof).map_err(|e| value_error(format!("dof = {dof}: {e}")))?;
+    Ok(t.inverse_cdf(p))
 }
 
 /// The columns of records `R`: the keys [`Cell::each`] visits, in order.
@@ -2088,6 +2113,7 @@ fn _fitbead(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fit_klaw, m)?)?;
     m.add_function(wrap_pyfunction!(fit_jan, m)?)?;
     m.add_function(wrap_pyfunction!(fit_jaeger, m)?)?;
+    m.add_function(wrap_pyfunction!(t_quantile, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
     m.add_function(wrap_pyfunction!(record_columns, m)?)?;
     m.add_function(wrap_pyfunction!(output_columns, m)?)?;

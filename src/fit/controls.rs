@@ -68,7 +68,12 @@ fn pair_text(key: &str, v: f64) -> String {
 
 /// `NAME=LO,HI` as the command line takes it.
 fn bounds_text(key: &str, (lo, hi): (f64, f64)) -> String {
-    format!("{}={},{}", clip(key, ECHO_CHARS), echo_f64(lo), echo_f64(hi))
+    format!(
+        "{}={},{}",
+        clip(key, ECHO_CHARS),
+        echo_f64(lo),
+        echo_f64(hi)
+    )
 }
 
 /// A control's key split into the parameter's name and the series it is limited to.
@@ -107,7 +112,10 @@ impl<'a> Controls<'a> {
     /// Every key with its flag and the control as given.
     fn keys(&self) -> Vec<(&'static str, &'a str, String)> {
         let fix = self.fix.iter().map(|(k, v)| ("--fix", k, pair_text(k, *v)));
-        let init = self.init.iter().map(|(k, v)| ("--init", k, pair_text(k, *v)));
+        let init = self
+            .init
+            .iter()
+            .map(|(k, v)| ("--init", k, pair_text(k, *v)));
         let bounds = self
             .bounds
             .iter()
@@ -131,7 +139,10 @@ impl<'a> Controls<'a> {
             let (name, series) = split_key(key);
             if !params.contains(&name) {
                 let mut why = if params.is_empty() {
-                    format!("no parameter '{}': this fit has none", clip(name, ECHO_CHARS))
+                    format!(
+                        "no parameter '{}': this fit has none",
+                        clip(name, ECHO_CHARS)
+                    )
                 } else {
                     format!(
                         "no parameter '{}' in this fit; expected one of {}",
@@ -191,7 +202,12 @@ impl<'a> Controls<'a> {
     ) -> Option<(&'l str, T)> {
         let mine = |k: &str, specific: bool| {
             let (n, s) = split_key(k);
-            n == name && (if specific { s == Some(series) } else { s.is_none() })
+            n == name
+                && (if specific {
+                    s == Some(series)
+                } else {
+                    s.is_none()
+                })
         };
         list.iter()
             .rev()
@@ -410,7 +426,10 @@ impl Plan {
     pub fn options(&self, opts: LsqOptions) -> LsqOptions {
         let scale_covar = self.scale_covar || opts.scale_covar;
         if self.all_free() && !self.bounded {
-            return LsqOptions { scale_covar, ..opts };
+            return LsqOptions {
+                scale_covar,
+                ..opts
+            };
         }
         LsqOptions {
             lower: Some(self.free_of(&self.lower)),
@@ -438,8 +457,8 @@ impl Plan {
             return Ok(());
         };
         let mut out = vec![0.0; problem.n_residuals()];
-        let ok = problem.residuals(&self.start(), &mut out).is_ok()
-            && out.iter().all(|r| r.is_finite());
+        let ok =
+            problem.residuals(&self.start(), &mut out).is_ok() && out.iter().all(|r| r.is_finite());
         if ok {
             return Ok(());
         }
@@ -473,6 +492,9 @@ impl Plan {
                 &summary.stats.note,
                 "covariance scaled by reduced chi-square (scale_covar)",
             );
+        }
+        for (row, &j) in summary.params.iter_mut().zip(&self.free) {
+            row.start = Some(self.start[j]);
         }
         if self.all_free() {
             return;
@@ -621,6 +643,7 @@ fn held_row(spec: &ParamSpec, value: f64, fit: &str, series: &str, level: f64) -
         posterior: None,
         sensitivity: None,
         fixed: true,
+        start: Some(value),
     }
 }
 
@@ -695,8 +718,7 @@ impl<M: OdrModel> OdrModel for Pinned<M> {
         if self.identity() {
             return self.inner.value(i, x, p);
         }
-        self.inner
-            .value(i, x, &expand(&self.pins, &self.free, p))
+        self.inner.value(i, x, &expand(&self.pins, &self.free, p))
     }
     fn derivatives(
         &self,

@@ -21,12 +21,12 @@
 //! (the velocity at the series' mean slope, the slope of the law there and a shape), where the
 //! ridge of a1 and a2 is straight; priors, draws and reported values are those of a1, a2, a3.
 
+use super::controls::{ControlError, Controls, Parameters, Plan};
 use super::data::Dataset;
 use super::jaeger_coordinates::JaegerCoordinates;
 pub(crate) use super::jaeger_coordinates::JaegerX;
 use super::posterior::{per_series, summarise_reparameterised, summarise_with, Method, Prior};
 use super::slopes::{self, SlopeCurve};
-use super::controls::{ControlError, Controls, Parameters, Plan};
 use super::summary::{distinct_points, observed_norm, FitResult, ParamSpec, Solved};
 use crate::inverse::{fit, CurveModel, Infeasible, LsqOptions, WeightedData};
 use crate::models::jaeger::Jaeger;
@@ -341,8 +341,7 @@ fn fit_jaeger_series(
         }
         let mut summary = plan.score(&problem, ("jaeger", label), &specs, level, data.sigma);
         summary.attach_points(data, &index);
-        let (bistable_points, has_minimum) =
-            describe(&mut summary, &x, &plan.expand(&[]), branch);
+        let (bistable_points, has_minimum) = describe(&mut summary, &x, &plan.expand(&[]), branch);
         return Ok(JaegerFit {
             summary,
             branch,

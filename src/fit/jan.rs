@@ -11,10 +11,10 @@
 //! (v̄²/cos δ = (2 sin α/λ)(tan δ − μ)); the global start is the straight lines of ln λ and
 //! ln μ against sin α through the per-series fits (the paper's values where those fail).
 
+use super::controls::{ControlError, Controls, Parameters, Plan};
 use super::data::Dataset;
 use super::posterior::{per_series, summarise_with, Method};
 use super::slopes::{self, SlopeCurve};
-use super::controls::{ControlError, Controls, Parameters, Plan};
 use super::summary::{distinct_points, observed_norm, FitResult, ParamSpec, Solved};
 use crate::inverse::{fit, CurveModel, Infeasible, LsqOptions, WeightedData};
 

@@ -426,6 +426,7 @@ fn scale_row(fit_name: &str, series: &str, s0: f64, level: f64, unit: &'static s
         posterior: None,
         sensitivity: None,
         fixed: false,
+        start: None,
     }
 }
 

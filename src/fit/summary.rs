@@ -62,6 +62,9 @@ pub struct ParamRow {
     /// True when the parameter was held at `value`, not fitted (lmfit's `vary=False`): no
     /// standard error or interval, and it counts no degree of freedom.
     pub fixed: bool,
+    /// The value the least-squares fit started from (lmfit's `init_value`; the value held for
+    /// a parameter held), when the fit says.
+    pub start: Option<f64>,
 }
 
 /// Power-scaling sensitivity of one parameter's posterior (`priorsense`'s diagnostic: the
@@ -790,6 +793,7 @@ pub(crate) fn summarise_with_profiles<R: Residuals + ?Sized>(
                 posterior: None,
                 sensitivity: None,
                 fixed: false,
+                start: None,
             }
         })
         .collect();

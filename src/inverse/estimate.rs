@@ -100,7 +100,12 @@ impl Fit {
         sigma: SigmaKind,
     ) -> Result<Fit, LsqError> {
         let (sol, solver, ls) = into_parts(result).map_err(|e| LsqError::Solver(e.to_string()))?;
-        Ok(finish(&mut solver.into_evaluator(), ls.view(), sol, (sigma, false)))
+        Ok(finish(
+            &mut solver.into_evaluator(),
+            ls.view(),
+            sol,
+            (sigma, false),
+        ))
     }
 }
 
@@ -132,7 +137,12 @@ pub fn fit<R: Residuals + ?Sized>(
     let ls = DynLeastSquares::new(&problem, start, opts)?;
     let (sol, mut ev, ls) =
         solve(ls, opts, &mut Spare::new()).map_err(|e| LsqError::Solver(e.to_string()))?;
-    Ok(finish(&mut ev, ls.view(), sol, (opts.sigma, opts.scale_covar)))
+    Ok(finish(
+        &mut ev,
+        ls.view(),
+        sol,
+        (opts.sigma, opts.scale_covar),
+    ))
 }
 
 /// The [`Fit`] of a solution: statistics, and the covariance from the Jacobian at the estimate

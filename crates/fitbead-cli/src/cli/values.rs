@@ -683,7 +683,11 @@ pub(crate) fn named_value(s: &str) -> Result<(String, f64), Refusal> {
     if name.is_empty() {
         return Err(Refusal::new("expected NAME=VALUE, e.g. a2=0: no name"));
     }
-    let v = number(value, f64::is_finite, "expected NAME=VALUE with a finite number")?;
+    let v = number(
+        value,
+        f64::is_finite,
+        "expected NAME=VALUE with a finite number",
+    )?;
     Ok((name.to_string(), v))
 }
 
@@ -728,10 +732,7 @@ mod tests {
         assert!(named_value("a2").is_err());
         assert!(named_value("a2=nan").is_err());
         assert!(named_value("=1").is_err());
-        assert_eq!(
-            named_bounds("c=0.3,0.9").unwrap(),
-            ("c".into(), (0.3, 0.9))
-        );
+        assert_eq!(named_bounds("c=0.3,0.9").unwrap(), ("c".into(), (0.3, 0.9)));
         assert_eq!(
             named_bounds("c=-inf,0.9").unwrap(),
             ("c".into(), (f64::NEG_INFINITY, 0.9))

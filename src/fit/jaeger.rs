@@ -269,6 +269,20 @@ fn specs(xi: f64) -> [ParamSpec; 3] {
     specs
 }
 
+/// Jaeger's abscissae (tan δ, cos δ, ε), the velocities and their σ of the points `pts`.
+fn series_data(pts: &[&super::data::Point]) -> (Vec<JaegerX>, Vec<f64>, Vec<f64>) {
+    let x = pts
+        .iter()
+        .map(|p| {
+            let (sd, cd) = p.scene.delta.sin_cos();
+            (sd / cd, cd, p.scene.eps)
+        })
+        .collect();
+    let y = pts.iter().map(|p| p.v).collect();
+    let sg = pts.iter().map(|p| p.sigma).collect();
+    (x, y, sg)
+}
+
 /// Jaeger's law fitted to series `s` (labelled `label`) of `data` on `model`'s branch, or the
 /// note saying why not.
 fn fit_jaeger_series(
@@ -287,15 +301,7 @@ fn fit_jaeger_series(
             pts.len()
         )));
     }
-    let x: Vec<JaegerX> = pts
-        .iter()
-        .map(|p| {
-            let (sd, cd) = p.scene.delta.sin_cos();
-            (sd / cd, cd, p.scene.eps)
-        })
-        .collect();
-    let y: Vec<f64> = pts.iter().map(|p| p.v).collect();
-    let sg: Vec<f64> = pts.iter().map(|p| p.sigma).collect();
+    let (x, y, sg) = series_data(&pts);
     let norm = observed_norm(y.iter().zip(&sg));
     let controls = Controls::of(method);
     let names = ["a1", "a2", "a3"];
@@ -341,13 +347,7 @@ fn fit_jaeger_series(
         }
         let mut summary = plan.score(&problem, ("jaeger", label), &specs, level, data.sigma);
         summary.attach_points(data, &index);
-        let (bistable_points, has_minimum) = describe(&mut summary, &x, &plan.expand(&[]), branch);
-        return Ok(JaegerFit {
-            summary,
-            branch,
-            bistable_points,
-            has_minimum,
-        });
+        return Ok(JaegerFit::described(summary, &x, &plan.expand(&[]), branch));
     }
     let pinned = plan.wrap(&problem);
     plan.check_start(&pinned)?;
@@ -390,14 +390,27 @@ fn fit_jaeger_series(
         summary
     });
     plan.restore(&mut summary, &specs, level);
-    let (bistable_points, has_minimum) =
-        describe(&mut summary, &x, &plan.expand(&f.params), branch);
-    Ok(JaegerFit {
-        summary,
-        branch,
-        bistable_points,
-        has_minimum,
-    })
+    let optimum = plan.expand(&f.params);
+    Ok(JaegerFit::described(summary, &x, &optimum, branch))
+}
+
+impl JaegerFit {
+    /// The fit of `summary` on `branch`, its notes saying what [`describe`] finds at its
+    /// values (`optimum` where a row is missing) on the points `x`.
+    fn described(
+        mut summary: FitResult,
+        x: &[JaegerX],
+        optimum: &[f64],
+        branch: JaegerBranch,
+    ) -> Self {
+        let (bistable_points, has_minimum) = describe(&mut summary, x, optimum, branch);
+        JaegerFit {
+            summary,
+            branch,
+            bistable_points,
+            has_minimum,
+        }
+    }
 }
 
 /// Notes the branch, the points in the bistable band of eq 90 and a resistance without a

@@ -196,6 +196,24 @@ pub(crate) fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFi
 /// (sin α, ln x, σ of ln x) of a parameter x of each converged series fit.
 type LogPoints = Vec<(f64, f64, f64)>;
 
+/// The linearised start (λ, μ) of a series' points `x`, `y`, `sg` whose least tan δ is
+/// `tmin`: the weighted line v̄²/cos δ = A (tan δ − μ), σ of v̄²/cos δ = 2 v̄ σ / cos δ.
+fn series_start(x: &[JanX], y: &[f64], sg: &[f64], tmin: f64) -> (f64, f64) {
+    let sa = x[0].0;
+    let lx: Vec<f64> = x.iter().map(|p| p.1 / p.2).collect();
+    let ly: Vec<f64> = x.iter().zip(y).map(|(p, v)| v * v / p.2).collect();
+    let ls: Vec<f64> = x
+        .iter()
+        .zip(y)
+        .zip(sg)
+        .map(|((p, v), s)| 2.0 * v * s / p.2)
+        .collect();
+    match line(&lx, &ly, &ls) {
+        Some((a, b)) if b > 0.0 => (2.0 * sa / b, (-a / b).clamp(0.0, 0.999 * tmin)),
+        _ => (crate::models::jan::Jan::paper_fit(sa.asin()).lambda, 0.0),
+    }
+}
+
 /// Jan's λ and μ of series `s` (eq 74), or `None` with a note saying why not; a converged fit
 /// adds its (sin α, ln λ, σ of ln λ) and (sin α, ln μ, σ of ln μ) to `pts`.
 fn fit_jan_series(
@@ -217,19 +235,7 @@ fn fit_jan_series(
     }
     let sa = x[0].0;
     let tmin = x.iter().map(|p| p.1 / p.2).fold(f64::INFINITY, f64::min);
-    // Linearised start: v̄²/cos δ = A (tan δ − μ), σ of v̄²/cos δ = 2 v̄ σ / cos δ.
-    let lx: Vec<f64> = x.iter().map(|p| p.1 / p.2).collect();
-    let ly: Vec<f64> = x.iter().zip(&y).map(|(p, v)| v * v / p.2).collect();
-    let ls: Vec<f64> = x
-        .iter()
-        .zip(&y)
-        .zip(&sg)
-        .map(|((p, v), s)| 2.0 * v * s / p.2)
-        .collect();
-    let (lam0, mu0) = match line(&lx, &ly, &ls) {
-        Some((a, b)) if b > 0.0 => (2.0 * sa / b, (-a / b).clamp(0.0, 0.999 * tmin)),
-        _ => (crate::models::jan::Jan::paper_fit(sa.asin()).lambda, 0.0),
-    };
+    let (lam0, mu0) = series_start(&x, &y, &sg, tmin);
     let distinct = distinct_points(x.iter().map(|p| [p.1, p.2]));
     let norm = observed_norm(y.iter().zip(&sg));
     let base = x.clone();
@@ -319,25 +325,31 @@ fn fit_jan_series(
         });
     plan.restore(&mut sum, &specs, level);
     if f.converged() {
-        let p = plan.expand(&f.params);
-        // A held parameter has no standard error: its points weigh as unit ones.
-        let se: Vec<f64> = match f.std_errors() {
-            Some(se) => plan
-                .expand(se)
-                .iter()
-                .zip(plan.pins())
-                .map(|(e, pin)| if pin.is_some() { f64::NAN } else { *e })
-                .collect(),
-            None => vec![1.0; 2],
-        };
-        if p[0] > 0.0 {
-            pts.0.push((sa, p[0].ln(), se[0] / p[0]));
-        }
-        if p[1] > 0.0 {
-            pts.1.push((sa, p[1].ln(), se[1] / p[1]));
-        }
+        log_points(&plan, &f, sa, pts);
     }
     Ok(Some(sum))
+}
+
+/// Adds the (sin α, ln x, σ of ln x) of λ and μ of a converged series fit `f` (made by
+/// `plan`) to `pts`; a held parameter has no standard error, and its point weighs as a unit
+/// one.
+fn log_points(plan: &Plan, f: &crate::inverse::Fit, sa: f64, pts: &mut (LogPoints, LogPoints)) {
+    let p = plan.expand(&f.params);
+    let se: Vec<f64> = match f.std_errors() {
+        Some(se) => plan
+            .expand(se)
+            .iter()
+            .zip(plan.pins())
+            .map(|(e, pin)| if pin.is_some() { f64::NAN } else { *e })
+            .collect(),
+        None => vec![1.0; 2],
+    };
+    if p[0] > 0.0 {
+        pts.0.push((sa, p[0].ln(), se[0] / p[0]));
+    }
+    if p[1] > 0.0 {
+        pts.1.push((sa, p[1].ln(), se[1] / p[1]));
+    }
 }
 
 /// The parameters of the global laws (eqs 75–76) with the paper's values.

@@ -973,23 +973,8 @@ pub(crate) fn fit_law_in(
         None => KLawProblem::new_until(model, data, law, method.stop().cloned())?,
     };
     let (lower, upper) = problem.feasible_box()?;
-    let start = problem.start()?;
     let specs = law_specs(&problem, law);
-    let names = vec![problem.param_name(); problem.n];
-    let series: Vec<&str> = match law {
-        KLaw::FreePerSeries => data.labels.iter().map(String::as_str).collect(),
-        _ => vec!["all"; problem.n],
-    };
-    let plan = Plan::new(
-        &Controls::of(method),
-        Parameters {
-            names: &names,
-            series: &series,
-            lower: &lower,
-            upper: &upper,
-            start: &start,
-        },
-    )?;
+    let plan = law_plan(&problem, method, &lower, &upper)?;
     let opts = plan.options(LsqOptions {
         lower: Some(lower),
         upper: Some(upper),
@@ -1042,19 +1027,7 @@ pub(crate) fn fit_law_in(
         (None, _) => summarise_with(method, solved),
     };
     plan.restore(&mut summary, &specs, level);
-    if law == KLaw::FreePerSeries {
-        for (j, row) in summary.params.iter_mut().take(problem.n).enumerate() {
-            row.series = data.labels[j].clone();
-        }
-    }
-    for row in summary.params.iter_mut() {
-        if row.at_bound {
-            row.note = format!(
-                "{} (the box ends are where a point leaves regime B)",
-                row.note
-            );
-        }
-    }
+    label_rows(&mut summary, &problem);
     let params: Vec<f64> = if slope_errors {
         summary
             .params
@@ -1075,6 +1048,50 @@ pub(crate) fn fit_law_in(
     Ok(KLawFit { law, summary, k })
 }
 
+/// The controls of `method` on the law of `problem`, whose box is `lower`, `upper`: each K
+/// of a law with one per series is of its series.
+fn law_plan(
+    problem: &KLawProblem<'_>,
+    method: &Method,
+    lower: &[f64],
+    upper: &[f64],
+) -> Result<Plan, KLawError> {
+    let start = problem.start()?;
+    let names = vec![problem.param_name(); problem.n];
+    let series: Vec<&str> = match problem.law {
+        KLaw::FreePerSeries => problem.data.labels.iter().map(String::as_str).collect(),
+        _ => vec!["all"; problem.n],
+    };
+    Ok(Plan::new(
+        &Controls::of(method),
+        Parameters {
+            names: &names,
+            series: &series,
+            lower,
+            upper,
+            start: &start,
+        },
+    )?)
+}
+
+/// Names the series of each K of a law with one per series in the rows of `summary`, and
+/// says where the box ends are in the note of a row on one.
+fn label_rows(summary: &mut FitResult, problem: &KLawProblem<'_>) {
+    if problem.law == KLaw::FreePerSeries {
+        for (j, row) in summary.params.iter_mut().take(problem.n).enumerate() {
+            row.series = problem.data.labels[j].clone();
+        }
+    }
+    for row in summary.params.iter_mut() {
+        if row.at_bound {
+            row.note = format!(
+                "{} (the box ends are where a point leaves regime B)",
+                row.note
+            );
+        }
+    }
+}
+
 /// The law of `problem` with every parameter held (`plan`): scored at the values held, or an
 /// error for a posterior run (nothing to sample).
 fn score_held(
@@ -1091,11 +1108,7 @@ fn score_held(
     let data = problem.data;
     let m = data.points.len();
     let mut summary = plan.score(problem, (fit_name, "all"), specs, level, data.sigma);
-    if problem.law == KLaw::FreePerSeries {
-        for (j, row) in summary.params.iter_mut().enumerate() {
-            row.series = data.labels[j].clone();
-        }
-    }
+    label_rows(&mut summary, problem);
     summary.attach_points(data, &(0..m).collect::<Vec<_>>());
     let params = plan.expand(&[]);
     let k = (0..m).map(|i| problem.k_of(i, &params)).collect();

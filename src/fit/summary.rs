@@ -658,7 +658,7 @@ fn undetermined(
              parameters; no standard errors or intervals"
         ));
     }
-    let no_dof = f.sigma == SigmaKind::Relative && f.dof == 0;
+    let no_dof = (f.sigma == SigmaKind::Relative || f.scale_covar) && f.dof == 0;
     if f.covariance.is_none() && !no_dof && !f.at_bound.iter().any(|b| *b) {
         return Some(
             "Jacobian rank deficient at the estimate: the data do not determine the \
@@ -747,12 +747,7 @@ pub(crate) fn summarise_with_profiles<R: Residuals + ?Sized>(
     if let Some(why) = &unknown {
         note = why.clone();
     } else if f.converged() && f.covariance.is_none() {
-        note = if f.sigma == SigmaKind::Relative && f.dof == 0 {
-            "no degree of freedom left to estimate the scatter (no sigma given): no covariance"
-                .into()
-        } else {
-            "Jacobian rank deficient at the estimate: no covariance".into()
-        };
+        note = no_covariance(f).into();
     }
     let (aic, bic) = aic_bic(f, observed_norm, &mut note);
     let mut evals = f.residual_evals;
@@ -828,6 +823,21 @@ pub(crate) fn summarise_with_profiles<R: Residuals + ?Sized>(
             .map(correlation_rows),
         residuals: f.residuals.clone(),
         points: Vec::new(),
+    }
+}
+
+/// Why the converged fit `f` has no covariance: no degree of freedom for the scale it
+/// estimates, or a Jacobian rank deficient at the estimate.
+fn no_covariance(f: &Fit) -> &'static str {
+    match f.sigma {
+        _ if f.dof > 0 => "Jacobian rank deficient at the estimate: no covariance",
+        SigmaKind::Relative => {
+            "no degree of freedom left to estimate the scatter (no sigma given): no covariance"
+        }
+        SigmaKind::Absolute if f.scale_covar => {
+            "no degree of freedom left to scale the covariance (scale_covar): no covariance"
+        }
+        SigmaKind::Absolute => "Jacobian rank deficient at the estimate: no covariance",
     }
 }
 

@@ -712,7 +712,7 @@ pub(crate) fn named_bounds(s: &str) -> Result<(String, (f64, f64)), Refusal> {
     if name.is_empty() {
         return Err(Refusal::new("expected NAME=LO,HI, e.g. c=0.3,0.9: no name"));
     }
-    if !(lo < hi) || lo == f64::INFINITY || hi == f64::NEG_INFINITY {
+    if lo >= hi || lo == f64::INFINITY || hi == f64::NEG_INFINITY {
         return Err(Refusal::new("expected LO < HI"));
     }
     Ok((name.to_string(), (lo, hi)))

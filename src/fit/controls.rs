@@ -138,7 +138,7 @@ impl<'a> Controls<'a> {
             };
             let (name, series) = split_key(key);
             if !params.contains(&name) {
-                let mut why = if params.is_empty() {
+                let why = if params.is_empty() {
                     format!(
                         "no parameter '{}': this fit has none",
                         clip(name, ECHO_CHARS)
@@ -150,9 +150,6 @@ impl<'a> Controls<'a> {
                         params.join(", ")
                     )
                 };
-                if let Some(n) = crate::io::scenes::nearest(name, params.iter().copied()) {
-                    why.push_str(&format!("; did you mean '{n}'?"));
-                }
                 return Err(fail(why));
             }
             if let Some(s) = series.filter(|s| !labels.iter().any(|l| l == s)) {

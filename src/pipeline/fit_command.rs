@@ -2,8 +2,8 @@
 //! returns a [`FitRun`](super::FitRun).
 
 use super::fit_run::FitRun;
-use super::{jaeger, jan, klaw, setting_error, RunError};
-use crate::fit::controls::{ControlError, Controls};
+use super::{control_error, jaeger, jan, klaw, setting_error, RunError};
+use crate::fit::controls::Controls;
 use crate::fit::klaw::KLaw;
 use crate::fit::slopes;
 use crate::fit::summary::{FitResult, McmcFailure};
@@ -136,7 +136,17 @@ impl FitCommand {
         }
         let params = self.parameters();
         let controls = Controls::of(method);
-        controls.check(params, labels).map_err(control_error)?;
+        controls.check(params, labels).map_err(|mut e| {
+            // A name the fit does not have: the one it most likely misspells.
+            let key = e.value.rsplit_once('=').map_or(e.value.as_str(), |k| k.0);
+            let name = key.split('[').next().unwrap_or(key);
+            if e.reason.starts_with("no parameter") {
+                if let Some(n) = crate::io::scenes::nearest(name, params.iter().copied()) {
+                    e.reason.push_str(&format!("; did you mean '{n}'?"));
+                }
+            }
+            control_error(e)
+        })?;
         let Method::Mcmc(m) = method else {
             return Ok(());
         };
@@ -161,11 +171,6 @@ impl FitCommand {
         }
         Ok(())
     }
-}
-
-/// The error of a control that cannot be used, on its flag.
-pub(crate) fn control_error(e: ControlError) -> RunError {
-    setting_error(e.flag, &e.value, e.reason)
 }
 
 /// `method` with its least-squares runs counted on `progress` as a task labelled `label`,

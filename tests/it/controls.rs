@@ -239,6 +239,10 @@ fn controls_that_cannot_be_used_exit_2_naming_flag_and_value() {
         ),
         (&["jaeger", "--fix", "a2=x"], &["'--fix'", "'a2=x'"]),
         (
+            &["jan", "--fix", "lamda=0.5"],
+            &["'--fix'", "no parameter 'lamda'", "did you mean 'lambda'?"],
+        ),
+        (
             &["jaeger", "--fix", "a2=-1"],
             &["'--fix'", "outside the box"],
         ),

@@ -268,8 +268,12 @@ class FitResult:
     """One fit: parameters with errors and intervals, correlations, residuals, statistics.
 
     ``print(result)`` shows the fit report the command line prints; in a notebook the report
-    renders as HTML. The lmfit habits hold: :attr:`params` by name, :attr:`covar`,
-    :attr:`residual`, :meth:`eval`, :meth:`eval_band`, :meth:`fit_report`, :meth:`plot`. For
+    renders as HTML. The lmfit habits hold: :attr:`params` by name (``value``, ``stderr``,
+    ``vary``, ``min``, ``max``, ``init_value``), :attr:`covar`, :attr:`residual`,
+    :attr:`chisqr`, :attr:`redchi`, :attr:`nfev`, :attr:`success`, :attr:`ndata`,
+    :attr:`nvarys`, :attr:`nfree`, :attr:`var_names`, :attr:`best_fit`, :attr:`init_values`,
+    :meth:`eval`, :meth:`eval_band`, :meth:`eval_uncertainty`, :meth:`conf_interval`,
+    :meth:`fit_report`, :meth:`plot`. For
     an MCMC fit, :attr:`draws` holds the posterior draws and :meth:`to_arviz` makes an
     ``arviz.InferenceData`` with a pointwise log likelihood (so ``az.loo`` and
     ``az.compare`` work).

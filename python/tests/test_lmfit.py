@@ -139,6 +139,20 @@ def test_conf_interval_has_lmfits_shape(data):
     assert two["mu"][2][1] == pytest.approx(p.profile_high, rel=1e-12)
 
 
+def test_held_parameters_under_mcmc_and_posterior_intervals(data):
+    """A posterior run samples the free parameters: the held one is a constant column of the
+    draws; conf_interval gives the posterior's central intervals in lmfit's shape."""
+    fits = quiet(fitbead.fit_jaeger, data, method="mcmc", seed=2, min_ess=200, fix={"a2": 0.0})
+    fit = fits.get("jaeger", "1")
+    k = fit.param_names.index("a2")
+    assert (fit.draws[:, :, k] == 0).all() and fit.var_names == ["a1", "a3"]
+    ci = fit.conf_interval(sigmas=[1, 2])
+    a1 = [v for _, v in ci["a1"]]
+    assert a1 == sorted(a1) and len(a1) == 5
+    flat = fit.draws[:, :, fit.param_names.index("a1")].ravel()
+    assert a1[0] == pytest.approx(np.quantile(flat, (1 - math.erf(2 / math.sqrt(2))) / 2))
+
+
 def _lmfit_jan(fit, scale_covar):
     """The reference: lmfit (1.x, ``Model.fit`` with ``leastsq``) fits Jan's eq 74 in closed
     form, v̄ = sqrt((2 sin α/λ)(sin δ − μ cos δ)), to the same series with weights 1/σ_v,

@@ -26,15 +26,17 @@ Quick start::
 
 Every array function broadcasts its array arguments (numpy rules), releases the GIL and runs
 in parallel over rows on rayon's threads (``RAYON_NUM_THREADS`` before the first call sets
-their number; :func:`threads` says it). Warnings the command line prints are Python warnings
-(:class:`FitbeadWarning` and its subclasses); errors are :class:`FitbeadError`, a
-``ValueError``.
+their number; :func:`threads` says it; a process forked after a call builds a pool of its
+own). Results pickle, and ``save``/:func:`load` keep them in a JSON file. Warnings the
+command line prints are Python warnings (:class:`FitbeadWarning` and its subclasses); errors
+are :class:`FitbeadError`, a ``ValueError``.
 """
 
 from ._api import (
     K_MODELS,
     MODELS,
     BoundWarning,
+    ColumnWarning,
     ConvergenceWarning,
     Dataset,
     Design,
@@ -43,6 +45,7 @@ from ._api import (
     FitResult,
     FitSet,
     MisfitWarning,
+    OutlierWarning,
     Param,
     Report,
     Table,
@@ -54,6 +57,7 @@ from ._api import (
     fit_klaw,
     forward,
     invert_k,
+    load,
     regimes,
     report,
     simulate,
@@ -65,6 +69,7 @@ __all__ = [
     "K_MODELS",
     "MODELS",
     "BoundWarning",
+    "ColumnWarning",
     "ConvergenceWarning",
     "Dataset",
     "Design",
@@ -73,6 +78,7 @@ __all__ = [
     "FitResult",
     "FitSet",
     "MisfitWarning",
+    "OutlierWarning",
     "Param",
     "Report",
     "Table",
@@ -84,6 +90,7 @@ __all__ = [
     "fit_klaw",
     "forward",
     "invert_k",
+    "load",
     "regimes",
     "report",
     "simulate",

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import html as _html
 import math
+import re
+import os
 import warnings
 from dataclasses import dataclass, field
 from statistics import NormalDist
@@ -13,6 +15,8 @@ from typing import Any, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple
 import numpy as np
 
 from . import _fitbead as _core
+from . import _persist
+from ._persist import same as _same
 
 __version__: str = _core.version()
 
@@ -48,6 +52,14 @@ class MisfitWarning(FitbeadWarning):
     narrow."""
 
 
+class OutlierWarning(MisfitWarning):
+    """A few points lie far from the fitted curve (normalised residual beyond 4, and 4 robust
+    standard deviations from the others): the warning names each (series, slope, velocity,
+    residual) and the misfit of the others. A misread value, or a run that had not reached
+    its steady state, is the usual cause; the fit, which those points pull, is suspect until
+    they are checked."""
+
+
 class ConvergenceWarning(FitbeadWarning):
     """A fit stopped without converging (least squares: its termination; MCMC: R̂ or ESS
     short of the target, or the run cut short)."""
@@ -55,6 +67,14 @@ class ConvergenceWarning(FitbeadWarning):
 
 class BoundWarning(FitbeadWarning):
     """A fitted parameter sits on a bound of its box (its interval is one-sided)."""
+
+
+class ColumnWarning(FitbeadWarning):
+    """A column of the data that fitbead does not read looks misspelt or misnamed: close to
+    a known name (``sigma`` for ``sigma_v``), or named like an uncertainty (``sigma…``,
+    ``err…``, ``sd…``, ``std…``, ``unc…``) while the data lack the uncertainty column it
+    most likely means. Such a column is ignored, which can change the weighting silently;
+    ``strict_columns=True`` refuses any column fitbead does not read."""
 
 
 _PACKAGE_DIR = __file__.rsplit("/", 1)[0] if "/" in __file__ else ""
@@ -73,7 +93,9 @@ def _warn(message: str, category: type) -> None:
 
 
 def threads() -> int:
-    """Number of threads the vectorised functions use (rayon's pool)."""
+    """Number of threads the vectorised functions use (rayon's pool; in a process forked
+    after a fitbead call, the pool of its own that the process builds on its first call, of
+    the same size)."""
     return _core.threads()
 
 
@@ -96,6 +118,42 @@ class Table(dict):
     def __repr__(self) -> str:
         cols = ", ".join(self.keys())
         return f"Table(shape={self.shape}, columns=[{cols}])"
+
+    def __eq__(self, other: Any) -> bool:
+        """The same columns, each of one shape and dtype and equal element by element (floats
+        bit for bit, NaN equal to NaN), and against a Table the same ``shape`` and attributes
+        (``critical_xi``); against a plain dict the columns only."""
+        if isinstance(other, Table):
+            return _same(self, other) if type(self) is type(other) else False
+        if isinstance(other, dict):
+            return _same(dict(self), dict(other))
+        return NotImplemented
+
+    def __ne__(self, other: Any) -> bool:
+        eq = self.__eq__(other)
+        return eq if eq is NotImplemented else not eq
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def save(self, path: Any) -> None:
+        """Writes the table to a JSON file that :func:`load` reads back (the format:
+        :func:`load`): its columns with their dtypes and shapes, ``shape`` and
+        ``critical_xi``; written atomically.
+
+        Parameters
+        ----------
+        path : str or path-like
+            The file to write (replaced if it exists).
+
+        Raises
+        ------
+        FitbeadError
+            A column fitbead cannot save (a dtype other than float, integer, bool or text).
+        """
+        _save(path, "table", lambda: self._json("table"))
+
+    def _json(self, where: str) -> Dict[str, Any]:
+        return _persist.encode_table(self, self.shape, getattr(self, "critical_xi", _persist._MISSING), where)
 
 
 def _as_f64(name: str, x: Any) -> np.ndarray:
@@ -338,7 +396,8 @@ def invert_k(
     """The collisional parameter K of every measured point (eq 69; ``fitbead k``).
 
     Either arrays (``xi``, ``delta_deg``, ``v`` and optionally ``sigma_v``, ``rho``, ``f``,
-    broadcast together) or a :class:`Dataset` as the second argument.
+    broadcast together) or measurements as the second argument: a :class:`Dataset`, a CSV
+    path, a pandas DataFrame or a :class:`Table` (what :func:`simulate` returns).
 
     Parameters
     ----------
@@ -366,6 +425,8 @@ def invert_k(
     model = _model_name(model)
     if model not in K_MODELS:
         raise FitbeadError(f"model = {model!r}: expected one of {', '.join(K_MODELS)}")
+    if delta_deg is None and v is None and _is_data(xi):
+        xi = _dataset(xi)
     if isinstance(xi, Dataset):
         t = _table(xi._core.invert_k(model, tol=tol), (len(xi),))
         cols = xi.columns()
@@ -417,16 +478,21 @@ class Dataset:
             _warn(w, UnitWarning)
 
     @classmethod
-    def read_csv(cls, path: str, *, rho: float = 0.4, f: float = 0.1, g: float = 9.81) -> "Dataset":
+    def read_csv(
+        cls, path: str, *, rho: float = 0.4, f: float = 0.1, g: float = 9.81, strict_columns: bool = False
+    ) -> "Dataset":
         """Reads a measurement CSV as the command line does.
 
         Parameters
         ----------
         path : str or path-like
             The file: columns ``series,xi,delta_deg,v[,sigma_v][,rho][,f]`` (dimensionless
-            velocities) or ``v_m_s`` with ``R_m`` (SI).
+            velocities) or ``v_m_s`` with ``R_m`` (SI), optionally ``sigma_delta_deg``.
         rho, f, g : float
             Values for the columns the file leaves out; ``g`` in m/s² for SI files.
+        strict_columns : bool, default False
+            Refuse any column fitbead does not read (the command line's
+            ``--strict-columns``), instead of warning about those that look misnamed.
 
         Returns
         -------
@@ -442,8 +508,21 @@ class Dataset:
         UnitWarning
             Each of the command line's plausibility warnings (slopes in radians, velocities
             in m/s or mm/s in the dimensionless column, radii in millimetres).
+        ColumnWarning
+            A column fitbead does not read that looks misspelt or misnamed (``sigma`` for
+            ``sigma_v``), with the name it most likely means.
         """
-        return cls(_core._Dataset.from_csv(str(path), rho=rho, f=f, g=g))
+        return cls._checked(_core._Dataset.from_csv(str(path), rho=rho, f=f, g=g), strict_columns)
+
+    @classmethod
+    def _checked(cls, core: Any, strict_columns: bool) -> "Dataset":
+        """The data set of a file read, its columns checked as the command line checks them."""
+        if strict_columns:
+            core.check_strict_columns()
+        out = cls(core)
+        for w in core.column_warnings:
+            _warn(w, ColumnWarning)
+        return out
 
     @classmethod
     def default(cls) -> "Dataset":
@@ -496,11 +575,29 @@ class Dataset:
         )
 
     @classmethod
-    def from_pandas(cls, df: Any, *, rho: float = 0.4, f: float = 0.1, g: float = 9.81) -> "Dataset":
+    def from_pandas(
+        cls, df: Any, *, rho: float = 0.4, f: float = 0.1, g: float = 9.81, strict_columns: bool = False
+    ) -> "Dataset":
         """From a DataFrame with the CSV's columns, checked as the command line checks a file
-        (errors name the DataFrame's line as the CSV would have it: header on line 1)."""
+        (errors name the DataFrame's line as the CSV would have it: header on line 1).
+
+        Parameters
+        ----------
+        df : pandas.DataFrame
+            The columns of a measurement CSV (:meth:`read_csv`); the index is not used.
+        rho, f, g : float
+            Values for the columns the frame leaves out; ``g`` in m/s² for SI columns.
+        strict_columns : bool, default False
+            Refuse any column fitbead does not read, instead of warning (``ColumnWarning``)
+            about those that look misnamed.
+
+        Returns
+        -------
+        Dataset
+        """
         text = df.to_csv(index=False)
-        return cls(_core._Dataset.from_text(text, "<DataFrame>", rho=rho, f=f, g=g))
+        core = _core._Dataset.from_text(text, "<DataFrame>", rho=rho, f=f, g=g)
+        return cls._checked(core, strict_columns)
 
     @property
     def warnings(self) -> List[str]:
@@ -552,17 +649,116 @@ class Dataset:
     def __repr__(self) -> str:
         return f"Dataset({len(self)} points, series {self.labels})"
 
+    # ---- pickling, equality, saving -------------------------------------------------------
 
-def _dataset(data: Any) -> Dataset:
+    def __getstate__(self) -> Dict[str, Any]:
+        # What the data set was made from (CSV text and defaults, or arrays); unpickling makes
+        # it again the same way, without repeating its warnings.
+        return {"version": _persist.VERSION, "dataset": dict(self._core.state())}
+
+    def __setstate__(self, state: Dict[str, Any]) -> None:
+        _check_pickle(state, "Dataset")
+        self._core = _dataset_core(state["dataset"])
+
+    def __eq__(self, other: Any) -> bool:
+        """Made from the same thing: the same CSV text, source name and defaults, or the same
+        arrays (bit for bit)."""
+        if not isinstance(other, Dataset):
+            return NotImplemented
+        return _same(dict(self._core.state()), dict(other._core.state()))
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def save(self, path: Any) -> None:
+        """Writes the data set to a JSON file that :func:`load` reads back (the format:
+        :func:`load`): the CSV text it was read from with its name and the defaults, or the
+        arrays it was made from; written atomically.
+
+        Parameters
+        ----------
+        path : str or path-like
+            The file to write (replaced if it exists).
+        """
+        _save(path, "dataset", lambda: _persist.encode(dict(self._core.state()), "dataset"))
+
+
+def _dataset_core(state: Mapping[str, Any]) -> Any:
+    """The compiled data set made again from its state (``_Dataset.state()``)."""
+    if state["origin"] == "text":
+        rho, f, g, sd = (float(state[k]) for k in ("rho", "f", "g", "sigma_delta"))
+        core = _core._Dataset.from_text(state["text"], state["source"], rho=rho, f=f, g=g)
+        if sd != 0.0 or math.copysign(1.0, sd) < 0:
+            core = core.with_defaults(rho=rho, f=f, g=g, sigma_delta=sd)
+        return core
+    cols = [_flat(np.asarray(state[k], dtype=np.float64)) for k in _persist.DATASET_ARRAYS]
+    return _core._Dataset.from_arrays([str(s) for s in state["series"]], *cols)
+
+
+def _check_pickle(state: Any, what: str) -> None:
+    """A pickled state this fitbead can read: a dict of a version it knows."""
+    v = state.get("version") if isinstance(state, dict) else None
+    if not isinstance(v, int) or not 1 <= v <= _persist.VERSION:
+        raise FitbeadError(f"{what}: a pickle of version {v!r}; this fitbead reads 1 to {_persist.VERSION}")
+
+
+def _save(path: Any, kind: str, body: Any) -> None:
+    """Writes the JSON document of a ``kind`` result (``body()``) to ``path``; a value that
+    cannot be saved is a FitbeadError naming where it is."""
+    try:
+        _persist.write(path, kind, body(), __version__)
+    except _persist._Bad as e:
+        raise FitbeadError(f"{path}: cannot save: {e}") from None
+
+
+def _dataset(data: Any, strict_columns: bool = False) -> Dataset:
+    """The data of a call: a Dataset as it is, None for the shipped data, a CSV path, a
+    pandas DataFrame or a :class:`Table` (what :func:`simulate` returns), the last three read
+    and checked as the command line reads a file."""
     if isinstance(data, Dataset):
         return data
     if data is None:
         return Dataset.default()
     if isinstance(data, str) or hasattr(data, "__fspath__"):
-        return Dataset.read_csv(str(data))
+        return Dataset.read_csv(str(data), strict_columns=strict_columns)
+    if isinstance(data, Table):
+        core = _core._Dataset.from_text(_table_csv(data), "<Table>")
+        return Dataset._checked(core, strict_columns)
     if hasattr(data, "to_csv") and hasattr(data, "columns"):
-        return Dataset.from_pandas(data)
-    raise FitbeadError("data: expected a Dataset, a CSV path or a pandas DataFrame")
+        return Dataset.from_pandas(data, strict_columns=strict_columns)
+    raise FitbeadError("data: expected a Dataset, a CSV path, a pandas DataFrame or a Table (simulate's)")
+
+
+def _is_data(x: Any) -> bool:
+    """Whether `x` is measurements as :func:`_dataset` takes them (not an array of ξ)."""
+    return (
+        isinstance(x, (Dataset, Table, str))
+        or hasattr(x, "__fspath__")
+        or (hasattr(x, "to_csv") and hasattr(x, "columns"))
+    )
+
+
+def _table_csv(t: "Table") -> str:
+    """A one-dimensional Table as CSV text: numbers written so that they read back to the same
+    float64 (``repr``), NaN as an empty cell, text as it is."""
+    import csv
+    import io
+
+    names = list(t)
+    cols = [np.asarray(t[n]).ravel() for n in names]
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(names)
+
+    def cell(x: Any) -> str:
+        if isinstance(x, (float, np.floating)):
+            return "" if math.isnan(x) else repr(float(x))
+        if isinstance(x, (int, np.integer)):
+            return str(int(x))
+        return str(x)
+
+    for i in range(len(cols[0]) if cols else 0):
+        w.writerow([cell(c[i]) for c in cols])
+    return buf.getvalue()
 
 
 def _nan(x: Any) -> float:
@@ -641,6 +837,23 @@ class Param:
     def max(self) -> float:
         """Upper end of the parameter's box (lmfit's ``max``)."""
         return self.bounds[1]
+
+    def _fields(self) -> Tuple[Any, ...]:
+        return tuple(getattr(self, f) for f in self.__dataclass_fields__ if f != "record")
+
+    def __eq__(self, other: Any) -> bool:
+        """Every field but ``record`` equal, floats bit for bit and NaN equal to NaN."""
+        if not isinstance(other, Param):
+            return NotImplemented
+        return _same(self._fields(), other._fields())
+
+    def __hash__(self) -> int:
+        def key(x: Any) -> Any:
+            if isinstance(x, tuple):
+                return tuple(key(v) for v in x)
+            return "nan" if isinstance(x, float) and math.isnan(x) else x
+
+        return hash(key(self._fields()))
 
 
 def _param(r: Dict[str, Any], bounds: Tuple[float, float], fixed: bool = False, start: Optional[float] = None) -> Param:
@@ -756,6 +969,46 @@ class FitResult:
         if d is not None:
             self.draws, self.log_posterior, self.burn_in, self.thin, self.interrupted = d
 
+    # ---- pickling, equality, saving -------------------------------------------------------
+
+    def _state(self) -> Dict[str, Any]:
+        """Everything the fit's core gives (parameter, statistics, residual and correlation
+        records, the points, the draws, the report): what makes the fit again."""
+        if isinstance(self._core, _persist.StoredFit):
+            return self._core.state()
+        return _persist.fit_state(self._core)
+
+    def __getstate__(self) -> Dict[str, Any]:
+        return {"version": _persist.VERSION, "fit": self._state(), "context": dict(self._context)}
+
+    def __setstate__(self, state: Dict[str, Any]) -> None:
+        _check_pickle(state, "FitResult")
+        self.__init__(_persist.StoredFit(state["fit"]), state["context"])  # type: ignore[misc]
+
+    def __eq__(self, other: Any) -> bool:
+        """The same fit: name, series, every record of the report (parameters, statistics,
+        residuals, correlations), the points, the draws and the report's text, floats bit for
+        bit (NaN equal to NaN)."""
+        if not isinstance(other, FitResult):
+            return NotImplemented
+        return _same(self._context, other._context) and _same(self._state(), other._state())
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def save(self, path: Any) -> None:
+        """Writes the fit to a JSON file that :func:`load` reads back as an equal fit (the
+        format: :func:`load`), draws included; written atomically.
+
+        Parameters
+        ----------
+        path : str or path-like
+            The file to write (replaced if it exists).
+        """
+        _save(path, "fit", lambda: self._json("fit"))
+
+    def _json(self, where: str) -> Dict[str, Any]:
+        return _persist.encode_fit(self._state(), self._context, where)
+
     def _warn(self) -> None:
         """Gives the command line's warnings on this fit as Python warnings."""
         absurd = self._core.absurd_misfit()
@@ -765,7 +1018,8 @@ class FitResult:
         else:
             misfit = self._core.misfit_warning()
             if misfit:
-                _warn(f"{label}: {misfit}", MisfitWarning)
+                outliers = re.match(r"\d+ outlier\(s\)", misfit) is not None
+                _warn(f"{label}: {misfit}", OutlierWarning if outliers else MisfitWarning)
         if not self.stats.get("converged", True):
             why = self.stats.get("note") or self.stats.get("termination")
             _warn(f"{label}: not converged: {why}", ConvergenceWarning)
@@ -1367,14 +1621,87 @@ class FitSet(list):
         super().__init__(fits)
         self.notes: List[str] = list(notes)
 
-    def get(self, name: str, series: Optional[str] = None) -> Optional[FitResult]:
-        """The fit named ``name`` (``jan-series``, ``jan-global``, ``jaeger``) for ``series``
-        (a series label; ``all`` for a global fit), or the first fit of that name when
-        ``series`` is None."""
+    def __eq__(self, other: Any) -> bool:
+        """The same fits in the same order (:meth:`FitResult.__eq__`), and against a FitSet
+        the same notes."""
+        if isinstance(other, FitSet):
+            return _same(self, other) if type(self) is type(other) else False
+        if isinstance(other, list):
+            return len(self) == len(other) and all(a == b for a, b in zip(self, other))
+        return NotImplemented
+
+    def __ne__(self, other: Any) -> bool:
+        eq = self.__eq__(other)
+        return eq if eq is NotImplemented else not eq
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def save(self, path: Any) -> None:
+        """Writes the fits and the notes to a JSON file that :func:`load` reads back as an equal
+        FitSet (the format: :func:`load`); written atomically.
+
+        Parameters
+        ----------
+        path : str or path-like
+            The file to write (replaced if it exists).
+        """
+        _save(path, "fitset", lambda: {"fits": [fr._json(f"fitset.fits[{i}]") for i, fr in enumerate(self)], "notes": list(self.notes)})
+
+    def get(self, name: str, series: Any = None, default: Any = None) -> Optional[FitResult]:
+        """The fit named ``name`` (``jan-series``, ``jan-global``, ``jaeger``) for ``series``,
+        or ``default`` when there is none.
+
+        Parameters
+        ----------
+        name : str
+            The fit's name.
+        series : str or float, optional
+            The series: its label, or a number matched against the labels read as numbers
+            and against the series' ξ (``1.0`` finds the series labelled ``"1"``); ``all``
+            for a global fit. None: the first fit of that name.
+        default : optional
+            What to return when no fit matches (None).
+        """
         for fr in self:
-            if fr.name == name and (series is None or fr.series == series):
+            if fr.name == name and (series is None or _same_series(fr, series)):
                 return fr
-        return None
+        return default
+
+    def __getitem__(self, key: Any) -> Any:
+        """A fit by position (as a list), by name (the first fit of that name) or by
+        ``(name, series)`` (as :meth:`get`); KeyError naming the fits there are when none
+        matches."""
+        if isinstance(key, (int, slice, np.integer)):
+            return list.__getitem__(self, key)
+        name, series = (key, None) if isinstance(key, str) else tuple(key)
+        fr = self.get(name, series)
+        if fr is None:
+            have = ", ".join(f"({f.name!r}, {f.series!r})" for f in self)
+            raise KeyError(f"no fit {key!r}; the fits are {have}")
+        return fr
+
+    def __contains__(self, key: Any) -> bool:
+        if isinstance(key, FitResult):
+            return list.__contains__(self, key)
+        try:
+            self[key]
+        except (KeyError, TypeError, ValueError):
+            return False
+        return True
+
+    def keys(self) -> List[Tuple[str, str]]:
+        """``(name, series)`` of every fit, in order."""
+        return [(f.name, f.series) for f in self]
+
+    def to_arviz(self):
+        """The posteriors of the run's fits as one ``arviz.InferenceData`` per fit, keyed by
+        ``name[series]`` (each as :meth:`FitResult.to_arviz`: a pointwise log likelihood for
+        ``az.compare``); needs MCMC fits."""
+        return {f"{f.name}[{f.series}]": f.to_arviz() for f in self}
+
+    def plot(self, **kwargs: Any):
+        """Every fit's :meth:`FitResult.plot`, one figure each; returns the figures."""
+        return [f.plot(**kwargs) for f in self]
 
     def __str__(self) -> str:
         parts = [str(fr) for fr in self]
@@ -1399,6 +1726,24 @@ class FitSet(list):
         return pd.concat(frames, ignore_index=True)
 
 
+def _same_series(fr: "FitResult", series: Any) -> bool:
+    """Whether `fr` is the fit of `series`: its label, or a number equal to the label read as
+    a number or to the series' ξ."""
+    if isinstance(series, str):
+        return fr.series == series
+    try:
+        x = float(series)
+    except (TypeError, ValueError):
+        return False
+    try:
+        if float(fr.series) == x:
+            return True
+    except ValueError:
+        pass
+    xi = fr.residuals.get("xi")
+    return xi is not None and len(xi) > 0 and bool(np.all(np.asarray(xi, dtype=float) == x))
+
+
 def _fitted(core: Any, context: Dict[str, Any]) -> FitResult:
     fr = FitResult(core, context)
     fr._warn()
@@ -1406,10 +1751,15 @@ def _fitted(core: Any, context: Dict[str, Any]) -> FitResult:
 
 
 def _fit_data(
-    data: Any, rho: Optional[float], f: Optional[float], g: Optional[float], sigma_delta: Optional[float] = None
+    data: Any,
+    rho: Optional[float],
+    f: Optional[float],
+    g: Optional[float],
+    sigma_delta: Optional[float] = None,
+    strict_columns: bool = False,
 ) -> Dataset:
     """The data of a fit, read again with the defaults given for the columns rows leave out."""
-    d = _dataset(data)
+    d = _dataset(data, strict_columns)
     if rho is None and f is None and g is None and sigma_delta is None:
         return d
     return Dataset(d._core.with_defaults(rho=rho, f=f, g=g, sigma_delta=sigma_delta))
@@ -1478,7 +1828,6 @@ def _write_draws(path: Any, text: Optional[bytes]) -> None:
     """Writes the draws CSV to `path` atomically (a temporary file renamed over it)."""
     if path is None or text is None:
         return
-    import os
     import tempfile
 
     target = os.fspath(path)
@@ -1516,6 +1865,7 @@ def fit_klaw(
     f: Optional[float] = None,
     g: Optional[float] = None,
     sigma_delta: Optional[float] = None,
+    strict_columns: bool = False,
     fix: Optional[Mapping[str, float]] = None,
     init: Optional[Mapping[str, float]] = None,
     bounds: Optional[Mapping[str, Tuple[Optional[float], Optional[float]]]] = None,
@@ -1525,8 +1875,9 @@ def fit_klaw(
 
     Parameters
     ----------
-    data : Dataset, str, path or DataFrame, optional
-        The measurements (default: the shipped data).
+    data : Dataset, str, path, DataFrame or Table, optional
+        The measurements (default: the shipped data); a Table is what :func:`simulate`
+        returns.
     model : str, default "stickslip"
         The contact model: ``stick``, ``stick-approx``, ``slip``, ``slip-approx``,
         ``stickslip``, ``contact``, or ``auto`` (the most general model any point needs at
@@ -1572,6 +1923,10 @@ def fit_klaw(
         Standard uncertainty of the slope, degrees, for rows without a ``sigma_delta_deg``
         value (the command line's ``--sigma-delta``; default 0: slopes exact). Above 0 a
         least-squares fit is an orthogonal distance regression.
+    strict_columns : bool, default False
+        A path, DataFrame or Table as ``data``: refuse any column fitbead does not read (the
+        command line's ``--strict-columns``) instead of warning (:class:`ColumnWarning`) about
+        those that look misnamed.
     fix : mapping, optional
         Parameters held at a value, ``{"a2": 0.0}`` (lmfit's ``vary=False``; the command
         line's ``--fix``): ``NAME`` in every fit that has it, ``"NAME[SERIES]"`` in that
@@ -1601,10 +1956,10 @@ def fit_klaw(
 
     Warns
     -----
-    UnitWarning, ConvergenceWarning, BoundWarning
+    UnitWarning, ConvergenceWarning, BoundWarning, ColumnWarning
         The command line's warnings on the data and the fit.
     """
-    d = _fit_data(data, rho, f, g, sigma_delta)
+    d = _fit_data(data, rho, f, g, sigma_delta, strict_columns)
     fits, notes, text = _core.fit_klaw(
         d._core, model=_model_name(model), law=law, method=method, level=level, profile=profile, seed=seed, walkers=walkers,
         max_steps=max_steps, min_ess=min_ess, tol=tol, thin=thin, priors=_priors(priors), fit_scatter=fit_scatter,
@@ -1638,6 +1993,7 @@ def fit_jan(
     f: Optional[float] = None,
     g: Optional[float] = None,
     sigma_delta: Optional[float] = None,
+    strict_columns: bool = False,
     fix: Optional[Mapping[str, float]] = None,
     init: Optional[Mapping[str, float]] = None,
     bounds: Optional[Mapping[str, Tuple[Optional[float], Optional[float]]]] = None,
@@ -1648,8 +2004,9 @@ def fit_jan(
 
     Parameters
     ----------
-    data : Dataset, str, path or DataFrame, optional
-        The measurements (default: the shipped data).
+    data : Dataset, str, path, DataFrame or Table, optional
+        The measurements (default: the shipped data); a Table is what :func:`simulate`
+        returns.
     method : {"lsq", "mcmc"}, default "lsq"
         ``lsq`` (least squares; intervals from profile likelihood when ``profile``, else
         the covariance) or ``mcmc`` (a posterior run from the least-squares optimum).
@@ -1659,7 +2016,7 @@ def fit_jan(
         Least squares: profile-likelihood intervals (else the covariance's).
     seed, walkers, max_steps, min_ess, thin, priors, fit_scatter, draws
         MCMC settings, as in :func:`fit_klaw`.
-    rho, f, g : float, optional
+    rho, f, g, sigma_delta, strict_columns : optional
         As in :func:`fit_klaw`.
     fix, init, bounds, scale_covar
         As in :func:`fit_klaw`; the names are ``lambda``, ``mu`` (per series) and
@@ -1673,10 +2030,10 @@ def fit_jan(
 
     Warns
     -----
-    UnitWarning, ConvergenceWarning, BoundWarning
+    UnitWarning, ConvergenceWarning, BoundWarning, ColumnWarning
         The command line's warnings on the data and the fits.
     """
-    d = _fit_data(data, rho, f, g, sigma_delta)
+    d = _fit_data(data, rho, f, g, sigma_delta, strict_columns)
     fits, notes, text = _core.fit_jan(
         d._core, method=method, level=level, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps,
         min_ess=min_ess, thin=thin, priors=_priors(priors), fit_scatter=fit_scatter, draws=_draws_wanted(draws, method),
@@ -1710,6 +2067,7 @@ def fit_jaeger(
     f: Optional[float] = None,
     g: Optional[float] = None,
     sigma_delta: Optional[float] = None,
+    strict_columns: bool = False,
     fix: Optional[Mapping[str, float]] = None,
     init: Optional[Mapping[str, float]] = None,
     bounds: Optional[Mapping[str, Tuple[Optional[float], Optional[float]]]] = None,
@@ -1720,8 +2078,9 @@ def fit_jaeger(
 
     Parameters
     ----------
-    data : Dataset, str, path or DataFrame, optional
-        The measurements (default: the shipped data).
+    data : Dataset, str, path, DataFrame or Table, optional
+        The measurements (default: the shipped data); a Table is what :func:`simulate`
+        returns.
     branch : {"upper", "lower"}, default "upper"
         The root of eq 84 when there are two.
     method : {"lsq", "mcmc"}, default "lsq"
@@ -1733,7 +2092,7 @@ def fit_jaeger(
         Least squares: profile-likelihood intervals (else the covariance's).
     seed, walkers, max_steps, min_ess, thin, priors, fit_scatter, draws
         MCMC settings, as in :func:`fit_klaw`.
-    rho, f, g : float, optional
+    rho, f, g, sigma_delta, strict_columns : optional
         As in :func:`fit_klaw`.
     fix, init, bounds, scale_covar
         As in :func:`fit_klaw`; the names are ``a1``, ``a2``, ``a3`` (``fix={"a2": 0}`` is
@@ -1746,10 +2105,10 @@ def fit_jaeger(
 
     Warns
     -----
-    UnitWarning, ConvergenceWarning, BoundWarning
+    UnitWarning, ConvergenceWarning, BoundWarning, ColumnWarning
         The command line's warnings on the data and the fits.
     """
-    d = _fit_data(data, rho, f, g, sigma_delta)
+    d = _fit_data(data, rho, f, g, sigma_delta, strict_columns)
     fits, notes, text = _core.fit_jaeger(
         d._core, branch=branch, method=method, level=level, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps,
         min_ess=min_ess, thin=thin, priors=_priors(priors), fit_scatter=fit_scatter, draws=_draws_wanted(draws, method),
@@ -1793,6 +2152,10 @@ class Design:
     bayes : tuple of int or None
         A Bayesian design: the prior draws averaged over and the draws redrawn (a series
         without a steady slope in its range).
+    steady : list of dict
+        Per row of ``table``, the range ``(low, high)`` of each parameter that moves its
+        series over which its slope stays steady (regime B), the others at the guess; an
+        end is None where the steady state holds to the end of the parameter's domain.
     """
 
     def __init__(self, raw: Mapping[str, Any]) -> None:
@@ -1819,10 +2182,57 @@ class Design:
         self.points_needed: Optional[Tuple[float, float]] = raw["points_needed"]
         self.ranges: List[Tuple[float, float]] = [tuple(r) for r in raw["ranges"]]  # type: ignore[misc]
         self.bayes: Optional[Tuple[int, int]] = None if raw.get("bayes") is None else tuple(raw["bayes"])  # type: ignore[assignment]
+        self.steady: List[Dict[str, Tuple[Optional[float], Optional[float]]]] = [
+            {k: (v[0], v[1]) for k, v in row.items()} for row in raw.get("steady", [])
+        ]
 
     def to_pandas(self):
         """The design as a DataFrame (series, xi, delta_deg, replicates; needs pandas)."""
         return self.table.to_pandas()
+
+    def _raw(self) -> Dict[str, Any]:
+        """The dict the design is made from (as the compiled core gives it)."""
+
+        def rows(t: Table) -> Dict[str, Any]:
+            return {
+                "series": [str(x) for x in t["series"]],
+                "xi": [float(x) for x in t["xi"]],
+                "delta_deg": [float(x) for x in t["delta_deg"]],
+                "replicates": [int(x) for x in t["replicates"]],
+            }
+
+        return {
+            "design": rows(self.table),
+            "even": rows(self.even),
+            "errors": [{"parameter": k, **v} for k, v in self.errors.items()],
+            "target": self.target,
+            "efficiency": self.efficiency,
+            "gap": self.gap,
+            "discrimination": self.discrimination,
+            "points_needed": self.points_needed,
+            "ranges": list(self.ranges),
+            "bayes": self.bayes,
+            "steady": [{k: [lo, hi] for k, (lo, hi) in row.items()} for row in self.steady],
+        }
+
+    def __eq__(self, other: Any) -> bool:
+        """Every attribute equal, floats bit for bit (NaN equal to NaN)."""
+        if not isinstance(other, Design):
+            return NotImplemented
+        return _same(vars(self), vars(other))
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def save(self, path: Any) -> None:
+        """Writes the design to a JSON file that :func:`load` reads back as an equal Design
+        (the format: :func:`load`); written atomically.
+
+        Parameters
+        ----------
+        path : str or path-like
+            The file to write (replaced if it exists).
+        """
+        _save(path, "design", lambda: _persist.encode(self._raw(), "design"))
 
     def to_csv(self, path: str) -> None:
         """Writes the design as ``fitbead design --output`` does (for ``simulate --design``)."""
@@ -1857,6 +2267,8 @@ def design(
     draws: int = 64,
     seed: int = 1,
     total: Optional[int] = None,
+    sigma_delta: float = 0.0,
+    margin: float = 0.05,
 ) -> Design:
     """Where to measure (``fitbead design``): locally optimal slopes for a fit's parameters,
     or slopes that tell two models apart, from the Fisher information at a guess.
@@ -1878,8 +2290,8 @@ def design(
         Relative noise σ = noise · v̄ (as ``simulate --noise``), or ``"abs=S"`` for an
         absolute σ of v̄.
     delta_range : (float, float), optional
-        Slopes in degrees (cut to regime B of the guess); default regime B kept 5 % of its
-        width from each end.
+        Slopes in degrees (cut to regime B of the guess); default regime B; either way kept
+        ``margin`` of its width (and 2 ``sigma_delta``) from each end.
     criterion : {"d", "c", "t"}
         D-optimal, c-optimal for ``target``, or T-optimal against ``vs``.
     target : str, optional
@@ -1904,6 +2316,13 @@ def design(
         Seed of the prior draws.
     total : int, optional
         Points over all series, shared out by the design (replaces ``points``).
+    sigma_delta : float, default 0
+        Standard uncertainty of a set slope, degrees (``--sigma-delta``): each point's
+        variance becomes σ_v² + (∂v̄/∂δ)² σ_δ² (the effective variance the fits with slope
+        errors minimise), and the ranges keep 2 σ_δ from their ends. 0: exact slopes.
+    margin : float, default 0.05
+        The fraction of each range's width kept from either end (``--margin``;
+        0 <= margin < 0.5).
 
     Returns
     -------
@@ -1940,6 +2359,8 @@ def design(
         draws=int(draws),
         seed=int(seed),
         total=None if total is None else int(total),
+        sigma_delta=float(sigma_delta),
+        margin=float(margin),
     )
     return Design(raw)
 
@@ -1988,6 +2409,7 @@ def simulate(
     beads: Optional[int] = None,
     spin: str = "roll",
     md_preset: str = "ristow",
+    sigma_delta: float = 0.0,
 ) -> Table:
     """Synthetic measurements inside regime B, reproducible from a seed (``fitbead simulate``).
 
@@ -2022,9 +2444,10 @@ def simulate(
         Jaeger's root of eq 84.
     delta_range : (float, float), optional
         Slopes LO, HI in degrees, cut to the steady range.
-    design : str or path-like, optional
-        A design file (``series,xi,delta_deg,replicates``, as :meth:`Design.to_csv` writes
-        it): the data are made at its slopes.
+    design : Design, str or path-like, optional
+        A :class:`Design` (what :func:`design` returns) or a design file
+        (``series,xi,delta_deg,replicates``, as :meth:`Design.to_csv` writes it): the data
+        are made at its slopes.
     v0, delta_deg, beads : optional
         ``contact`` only: the launch speed, slope (degrees) and row beads (default 50) of the
         bead-by-bead transient.
@@ -2032,13 +2455,18 @@ def simulate(
         The contact model's spin rule: ``roll``, ``keep``, ``impact`` or ``factor=L``.
     md_preset : {"ristow", "steel"}
         The md model's parameter set.
+    sigma_delta : float, default 0
+        Standard uncertainty of the slope, degrees (``--sigma-delta``): the recorded slope
+        ``delta_deg`` is drawn around the true one, ``delta_true_deg``, at which the velocity
+        is made. 0: the slopes are exact.
 
     Returns
     -------
     Table
         The command line's CSV columns in its order: ``series``, ``xi``, ``delta_deg``,
         ``v``, ``sigma_v`` (NaN with no noise), ``v_true``; md adds ``v_md_stderr`` and
-        ``v_m_s``; the transient has the columns of ``simulate --v0``. ``to_pandas()`` gives
+        ``v_m_s``; ``sigma_delta`` above 0 adds ``sigma_delta_deg`` and
+        ``delta_true_deg``; the transient has the columns of ``simulate --v0``. ``to_pandas()`` gives
         a DataFrame.
 
     Raises
@@ -2053,26 +2481,40 @@ def simulate(
     >>> list(sim)
     ['series', 'xi', 'delta_deg', 'v', 'sigma_v', 'v_true']
     """
-    text = _core.simulate(
-        model=_model_name(model),
-        law=law,
-        series=[float(x) for x in series],
-        points=int(points),
-        noise=float(noise),
-        seed=int(seed),
-        rho=float(rho),
-        f=float(f),
-        jan=None if jan is None else [float(x) for x in jan],
-        jaeger=None if jaeger is None else [float(x) for x in jaeger],
-        branch=branch,
-        delta_range=None if delta_range is None else (float(delta_range[0]), float(delta_range[1])),
-        design=None if design is None else str(design),
-        v0=None if v0 is None else float(v0),
-        delta_deg=None if delta_deg is None else float(delta_deg),
-        beads=None if beads is None else int(beads),
-        spin=spin,
-        md_preset=md_preset,
-    )
+    scratch = None
+    if isinstance(design, Design):
+        import os
+        import tempfile
+
+        scratch = tempfile.TemporaryDirectory(prefix="fitbead-design-")
+        path = os.path.join(scratch.name, "design.csv")
+        design.to_csv(path)
+        design = path
+    try:
+        text = _core.simulate(
+            model=_model_name(model),
+            law=law,
+            series=[float(x) for x in series],
+            points=int(points),
+            noise=float(noise),
+            seed=int(seed),
+            rho=float(rho),
+            f=float(f),
+            jan=None if jan is None else [float(x) for x in jan],
+            jaeger=None if jaeger is None else [float(x) for x in jaeger],
+            branch=branch,
+            delta_range=None if delta_range is None else (float(delta_range[0]), float(delta_range[1])),
+            design=None if design is None else str(design),
+            v0=None if v0 is None else float(v0),
+            delta_deg=None if delta_deg is None else float(delta_deg),
+            beads=None if beads is None else int(beads),
+            spin=spin,
+            md_preset=md_preset,
+            sigma_delta=float(sigma_delta),
+        )
+    finally:
+        if scratch is not None:
+            scratch.cleanup()
     return _csv_table(text)
 
 
@@ -2098,6 +2540,18 @@ class Report(dict):
     def __repr__(self) -> str:
         return f"Report(tables=[{', '.join(self)}])"
 
+    def __eq__(self, other: Any) -> bool:
+        """The same tables (:meth:`Table.__eq__`), files, markdown and summary."""
+        if not isinstance(other, Report):
+            return NotImplemented
+        return _same(self, other) if type(self) is type(other) else False
+
+    def __ne__(self, other: Any) -> bool:
+        eq = self.__eq__(other)
+        return eq if eq is NotImplemented else not eq
+
+    __hash__ = None  # type: ignore[assignment]
+
 
 def report(
     data: Any = None,
@@ -2121,7 +2575,7 @@ def report(
 
     Parameters
     ----------
-    data : Dataset, str, path-like or DataFrame, optional
+    data : Dataset, str, path-like, DataFrame or Table, optional
         The measurements (default: the shipped synthetic data set).
     out_dir : str or path-like, optional
         Directory for the tables, figures and report.md (created if missing); ``None`` writes
@@ -2217,3 +2671,83 @@ def work_precision(scenes: int = 2000, seed: int = 1) -> Table:
         the scenes only; the times are measured on this machine.
     """
     return _csv_table(_core.work_precision(scenes=int(scenes), seed=int(seed)))
+
+
+def load(path: Any) -> Union[FitResult, FitSet, Dataset, Table, Design]:
+    """Reads a result that ``save`` wrote: a :class:`FitResult`, :class:`FitSet`,
+    :class:`Dataset`, :class:`Table` or :class:`Design` equal to the one saved.
+
+    The file is one JSON document (UTF-8) that the ``json`` module reads without fitbead::
+
+        {"format": "fitbead-result", "version": 1, "kind": KIND,
+         "fitbead_version": "...", KIND: {...}}
+
+    with ``KIND`` one of ``fit``, ``fitset``, ``dataset``, ``table``, ``design``:
+
+    - ``fit``: ``name``, ``series``, ``context`` (what :meth:`FitResult.eval` needs: the
+      model or branch), ``params`` (one object per parameter, keyed by params.csv's columns),
+      ``param_bounds`` (``[low, high]`` per parameter), ``stats`` (stats.csv's columns),
+      ``residuals`` (residuals.csv's), ``correlations`` (correlations.csv's),
+      ``correlation`` (the matrix, or null), ``points`` (the fitted points by column),
+      ``draws`` (null, or ``chains`` ``[walker][kept step][parameter]``, ``log_posterior``
+      ``[walker][kept step]``, their ``shape``, ``burn_in``, ``thin``, ``interrupted``),
+      ``report`` (the fit report's text), ``absurd_misfit``, ``misfit_warning``,
+      ``chi2_p_value``;
+    - ``fitset``: ``fits`` (a list of ``fit`` objects) and ``notes``;
+    - ``dataset``: ``origin`` ``"text"`` with ``source``, ``text`` (the CSV) and the defaults
+      ``rho``, ``f``, ``g``, ``sigma_delta``; or ``origin`` ``"arrays"`` with ``series``
+      and the arrays of :meth:`Dataset.from_arrays`;
+    - ``table``: ``shape``, ``columns`` (by name: ``dtype``, ``shape``, ``values`` as nested
+      lists) and ``critical_xi`` where the table has one;
+    - ``design``: the attributes of :class:`Design`, its tables as ``design`` and ``even``
+      (lists by column).
+
+    Numbers are JSON numbers that read back the same doubles; one that is not finite is the
+    string ``"NaN"``, ``"Infinity"`` or ``"-Infinity"``; a report record's empty cell is
+    ``null``. A newer version than this fitbead reads is refused. For ArviZ's netCDF, use
+    ``fit.to_arviz().to_netcdf(path)``.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file ``save`` wrote.
+
+    Returns
+    -------
+    FitResult, FitSet, Dataset, Table or Design
+        The type that was saved; nothing is warned again (a loaded data set's warnings are in
+        its ``warnings``).
+
+    Raises
+    ------
+    FitbeadError
+        The file cannot be read, is not a fitbead result, has a version this fitbead does not
+        read, or is damaged: the message names the file and what is wrong.
+    """
+    try:
+        kind, body = _persist.read(path)
+        if kind == "fit":
+            ctx = _persist.decode_context(_persist._get(body, "context", "fit"), "fit.context")
+            return FitResult(_persist.StoredFit(_persist.decode_fit(body, "fit")), ctx)
+        if kind == "fitset":
+            fits = []
+            for i, x in enumerate(_persist._list(_persist._get(body, "fits", "fitset"), "fitset.fits")):
+                where = f"fitset.fits[{i}]"
+                ctx = _persist.decode_context(_persist._get(x, "context", where), f"{where}.context")
+                fits.append(FitResult(_persist.StoredFit(_persist.decode_fit(x, where)), ctx))
+            notes = [_persist._text(n, "fitset.notes") for n in _persist._list(_persist._get(body, "notes", "fitset"), "fitset.notes")]
+            return FitSet(fits, notes)
+        if kind == "table":
+            return _persist.decode_table(body, "table", Table)
+        if kind == "design":
+            return Design(_persist.decode_design(body, "design"))
+        state = _persist.decode_dataset(body, "dataset")
+        try:
+            core = _dataset_core(state)
+        except FitbeadError as e:
+            raise _persist._Bad(f"dataset: {e}") from None
+        d = Dataset.__new__(Dataset)
+        d._core = core
+        return d
+    except _persist._Bad as e:
+        raise FitbeadError(f"{os.fspath(path)}: {e}") from None

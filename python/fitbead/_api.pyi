@@ -24,11 +24,17 @@ class MisfitWarning(FitbeadWarning):
     """A fit with σ given does not describe the data within their σ: the χ² tail probability
     P(χ²_dof ≥ χ²) is below 0.001, so its intervals, which assume the model holds, are too
     narrow."""
+class OutlierWarning(MisfitWarning):
+    """A few points lie far from the fitted curve; the warning names each (series, slope,
+    velocity, normalised residual)."""
 class ConvergenceWarning(FitbeadWarning):
     """A fit stopped without converging (least squares: its termination; MCMC: R̂ or ESS
     short of the target, or the run cut short)."""
 class BoundWarning(FitbeadWarning):
     """A fitted parameter sits on a bound of its box (its interval is one-sided)."""
+class ColumnWarning(FitbeadWarning):
+    """A column of the data that fitbead does not read looks misspelt or misnamed (close to a
+    known name, or named like an uncertainty); ``strict_columns=True`` refuses it."""
 
 def threads() -> int:
     """Number of threads the vectorised functions use (rayon's pool)."""
@@ -43,6 +49,11 @@ class Table(dict):
     shape: tuple[int, ...]
     def to_pandas(self):
         """The columns as a pandas DataFrame (flattened; needs pandas)."""
+    def __eq__(self, other: object) -> bool: ...
+    def __ne__(self, other: object) -> bool: ...
+    __hash__: None  # type: ignore[assignment]
+    def save(self, path: Any) -> None:
+        """Writes the table to a JSON file that :func:`load` reads back."""
 
 def forward(model: str, xi: ArrayLike, delta_deg: ArrayLike, K: str | ArrayLike = 'adjusted', rho: ArrayLike = 0.4, f: ArrayLike = 0.1, *, mu: ArrayLike | None = None, a1: ArrayLike | None = None, a2: ArrayLike | None = None, a3: ArrayLike | None = None, c: float | None = None, branch: str = 'upper', spin: str = 'roll', tol: float = 1e-14, **params: Any) -> Table:
     '''The steady state of every scene under one model (``fitbead forward``).
@@ -148,7 +159,7 @@ class Dataset:
     """
     def __init__(self, core: Any) -> None: ...
     @classmethod
-    def read_csv(cls, path: str, *, rho: float = 0.4, f: float = 0.1, g: float = 9.81) -> Dataset:
+    def read_csv(cls, path: str, *, rho: float = 0.4, f: float = 0.1, g: float = 9.81, strict_columns: bool = False) -> Dataset:
         """Reads a measurement CSV as the command line does.
 
         Parameters
@@ -185,7 +196,7 @@ class Dataset:
         least-squares fits are orthogonal distance regressions, and their residual tables
         gain ``delta_fit_deg`` and ``delta_residual``."""
     @classmethod
-    def from_pandas(cls, df: Any, *, rho: float = 0.4, f: float = 0.1, g: float = 9.81) -> Dataset:
+    def from_pandas(cls, df: Any, *, rho: float = 0.4, f: float = 0.1, g: float = 9.81, strict_columns: bool = False) -> Dataset:
         """From a DataFrame with the CSV's columns, checked as the command line checks a file
         (errors name the DataFrame's line as the CSV would have it: header on line 1)."""
     @property
@@ -213,6 +224,13 @@ class Dataset:
     def to_pandas(self):
         """The points as a DataFrame (needs pandas): the columns of :meth:`columns` but
         ``series_index``, the file's ``R_m`` and ``g`` (and ``v_m_s``, ``sigma_v_m_s``) kept."""
+    def __getstate__(self) -> dict[str, Any]: ...
+    def __setstate__(self, state: dict[str, Any]) -> None: ...
+    def __eq__(self, other: object) -> bool: ...
+    __hash__: None  # type: ignore[assignment]
+    def save(self, path: Any) -> None:
+        """Writes the data set (its CSV text and defaults, or its arrays) to a JSON file that
+        :func:`load` reads back."""
 
 @dataclass(frozen=True)
 class Param:
@@ -255,6 +273,8 @@ class Param:
     likelihood_sensitivity: float = ...
     prior_diagnosis: str = ...
     record: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
+    def __eq__(self, other: object) -> bool: ...
+    def __hash__(self) -> int: ...
     vary: bool = ...
     init_value: float = ...
     @property
@@ -287,6 +307,12 @@ class FitResult:
     burn_in: int
     interrupted: bool
     def __init__(self, core: Any, context: dict[str, Any] | None = None) -> None: ...
+    def __getstate__(self) -> dict[str, Any]: ...
+    def __setstate__(self, state: dict[str, Any]) -> None: ...
+    def __eq__(self, other: object) -> bool: ...
+    __hash__: None  # type: ignore[assignment]
+    def save(self, path: Any) -> None:
+        """Writes the fit (draws included) to a JSON file that :func:`load` reads back."""
     @property
     def param_names(self) -> list[str]:
         """The parameters' keys in the fit's order (the order of :attr:`covar`)."""
@@ -473,16 +499,30 @@ class FitSet(list):
     the run's notes. A list of :class:`FitResult`."""
     notes: list[str]
     def __init__(self, fits: Iterable[FitResult], notes: Iterable[str]) -> None: ...
-    def get(self, name: str, series: str | None = None) -> FitResult | None:
+    def __eq__(self, other: object) -> bool: ...
+    def __ne__(self, other: object) -> bool: ...
+    __hash__: None  # type: ignore[assignment]
+    def save(self, path: Any) -> None:
+        """Writes the fits and the notes to a JSON file that :func:`load` reads back."""
+    def get(self, name: str, series: Any = None, default: Any = None) -> FitResult | None:
         """The fit named ``name`` (``jan-series``, ``jan-global``, ``jaeger``) for ``series``
         (a series label; ``all`` for a global fit), or the first fit of that name when
         ``series`` is None."""
+    def __getitem__(self, key: Any) -> Any:
+        """A fit by position, by name, or by ``(name, series)``; KeyError when none matches."""
+    def __contains__(self, key: Any) -> bool: ...
+    def keys(self) -> list[tuple[str, str]]:
+        """``(name, series)`` of every fit, in order."""
+    def to_arviz(self) -> dict[str, Any]:
+        """Each fit's ``arviz.InferenceData``, keyed by ``name[series]``."""
+    def plot(self, **kwargs: Any) -> list[Any]:
+        """Every fit's plot, one figure each."""
     def to_pandas(self, what: str = 'params'):
         """Every fit's table in one DataFrame (needs pandas): ``params``, ``stats``,
         ``residuals`` or ``correlations``, with the command line's columns (its CSV of the
         whole run), numeric dtypes and NaN for empty cells."""
 
-def fit_klaw(data: Any = None, *, model: str = 'stickslip', law: str = 'c', method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None, tol: float = 1e-10, skip_unsteady: bool = False, thin: int | None = None, priors: Any = None, fit_scatter: bool = False, draws: Any = None, rho: float | None = None, f: float | None = None, g: float | None = None, sigma_delta: float | None = None, fix: Mapping[str, float] | None = None, init: Mapping[str, float] | None = None, bounds: Mapping[str, tuple[float | None, float | None]] | None = None, scale_covar: bool = False) -> FitResult:
+def fit_klaw(data: Any = None, *, model: str = 'stickslip', law: str = 'c', method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None, tol: float = 1e-10, skip_unsteady: bool = False, thin: int | None = None, priors: Any = None, fit_scatter: bool = False, draws: Any = None, rho: float | None = None, f: float | None = None, g: float | None = None, sigma_delta: float | None = None, strict_columns: bool = False, fix: Mapping[str, float] | None = None, init: Mapping[str, float] | None = None, bounds: Mapping[str, tuple[float | None, float | None]] | None = None, scale_covar: bool = False) -> FitResult:
     '''A law K(α) fitted to every series at once (``fitbead klaw``).
 
     Parameters
@@ -535,7 +575,7 @@ def fit_klaw(data: Any = None, *, model: str = 'stickslip', law: str = 'c', meth
     UnitWarning, ConvergenceWarning, BoundWarning
         The command line\'s warnings on the data and the fit.
     '''
-def fit_jan(data: Any = None, *, method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None, thin: int | None = None, priors: Any = None, fit_scatter: bool = False, draws: Any = None, rho: float | None = None, f: float | None = None, g: float | None = None, sigma_delta: float | None = None, fix: Mapping[str, float] | None = None, init: Mapping[str, float] | None = None, bounds: Mapping[str, tuple[float | None, float | None]] | None = None, scale_covar: bool = False) -> FitSet:
+def fit_jan(data: Any = None, *, method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None, thin: int | None = None, priors: Any = None, fit_scatter: bool = False, draws: Any = None, rho: float | None = None, f: float | None = None, g: float | None = None, sigma_delta: float | None = None, strict_columns: bool = False, fix: Mapping[str, float] | None = None, init: Mapping[str, float] | None = None, bounds: Mapping[str, tuple[float | None, float | None]] | None = None, scale_covar: bool = False) -> FitSet:
     '''Jan\'s energy balance (eq 74): λ and μ per series (at least 3 points), then the global
     laws of eqs 75–76 (``fitbead jan``).
 
@@ -564,7 +604,7 @@ def fit_jan(data: Any = None, *, method: str = 'lsq', level: float = 0.95, profi
     UnitWarning, ConvergenceWarning, BoundWarning
         The command line\'s warnings on the data and the fits.
     '''
-def fit_jaeger(data: Any = None, *, branch: str = 'upper', method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None, thin: int | None = None, priors: Any = None, fit_scatter: bool = False, draws: Any = None, rho: float | None = None, f: float | None = None, g: float | None = None, sigma_delta: float | None = None, fix: Mapping[str, float] | None = None, init: Mapping[str, float] | None = None, bounds: Mapping[str, tuple[float | None, float | None]] | None = None, scale_covar: bool = False) -> FitSet:
+def fit_jaeger(data: Any = None, *, branch: str = 'upper', method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None, thin: int | None = None, priors: Any = None, fit_scatter: bool = False, draws: Any = None, rho: float | None = None, f: float | None = None, g: float | None = None, sigma_delta: float | None = None, strict_columns: bool = False, fix: Mapping[str, float] | None = None, init: Mapping[str, float] | None = None, bounds: Mapping[str, tuple[float | None, float | None]] | None = None, scale_covar: bool = False) -> FitSet:
     '''Jaeger\'s heuristic law (eqs 80–84): a1, a2, a3 per series with at least 4 points
     (``fitbead jaeger``).
 
@@ -620,6 +660,13 @@ class Design:
         points needed in all for power 0.8 at significance 0.05.
     ranges : list of (float, float)
         The slope range of each series, degrees.
+    bayes : tuple of int or None
+        A Bayesian design: the prior draws averaged over and the draws redrawn (a series
+        without a steady slope in its range).
+    steady : list of dict
+        Per row of ``table``, the range ``(low, high)`` of each parameter that moves its
+        series over which its slope stays steady (regime B), the others at the guess; an
+        end is None where the steady state holds to the end of the parameter's domain.
     '''
     table: Table
     even: Table
@@ -631,13 +678,18 @@ class Design:
     points_needed: tuple[float, float] | None
     ranges: list[tuple[float, float]]
     bayes: tuple[int, int] | None
+    steady: list[dict[str, tuple[float | None, float | None]]]
     def __init__(self, raw: Mapping[str, Any]) -> None: ...
     def to_pandas(self):
         """The design as a DataFrame (series, xi, delta_deg, replicates; needs pandas)."""
     def to_csv(self, path: str) -> None:
         """Writes the design as ``fitbead design --output`` does (for ``simulate --design``)."""
+    def __eq__(self, other: object) -> bool: ...
+    __hash__: None  # type: ignore[assignment]
+    def save(self, path: Any) -> None:
+        """Writes the design to a JSON file that :func:`load` reads back."""
 
-def design(fit: str = 'klaw', *, model: str | None = None, law: str = 'c=0.5', series: Sequence[float] = (0.8, 1.0, 1.6, 2.0), points: int = 9, noise: float | str = 0.02, delta_range: tuple[float, float] | None = None, criterion: str = 'd', target: str | None = None, vs: str | None = None, branch: str = 'upper', rho: float = 0.4, f: float = 0.1, prior: Mapping[str, str] | None = None, draws: int = 64, seed: int = 1, total: int | None = None) -> Design:
+def design(fit: str = 'klaw', *, model: str | None = None, law: str = 'c=0.5', series: Sequence[float] = (0.8, 1.0, 1.6, 2.0), points: int = 9, noise: float | str = 0.02, delta_range: tuple[float, float] | None = None, criterion: str = 'd', target: str | None = None, vs: str | None = None, branch: str = 'upper', rho: float = 0.4, f: float = 0.1, prior: Mapping[str, str] | None = None, draws: int = 64, seed: int = 1, total: int | None = None, sigma_delta: float = 0.0, margin: float = 0.05) -> Design:
     '''Where to measure (``fitbead design``): locally optimal slopes for a fit's parameters,
     or slopes that tell two models apart, from the Fisher information at a guess.
 
@@ -658,8 +710,8 @@ def design(fit: str = 'klaw', *, model: str | None = None, law: str = 'c=0.5', s
         Relative noise σ = noise · v̄ (as ``simulate --noise``), or ``"abs=S"`` for an
         absolute σ of v̄.
     delta_range : (float, float), optional
-        Slopes in degrees (cut to regime B of the guess); default regime B kept 5 % of its
-        width from each end.
+        Slopes in degrees (cut to regime B of the guess); default regime B; either way kept
+        ``margin`` of its width (and 2 ``sigma_delta``) from each end.
     criterion : {"d", "c", "t"}
         D-optimal, c-optimal for ``target``, or T-optimal against ``vs``.
     target : str, optional
@@ -684,6 +736,13 @@ def design(fit: str = 'klaw', *, model: str | None = None, law: str = 'c=0.5', s
         Seed of the prior draws.
     total : int, optional
         Points over all series, shared out by the design (replaces ``points``).
+    sigma_delta : float, default 0
+        Standard uncertainty of a set slope, degrees (``--sigma-delta``): each point's
+        variance becomes σ_v² + (∂v̄/∂δ)² σ_δ² (the effective variance the fits with slope
+        errors minimise), and the ranges keep 2 σ_δ from their ends. 0: exact slopes.
+    margin : float, default 0.05
+        The fraction of each range's width kept from either end (``--margin``;
+        0 <= margin < 0.5).
 
     Returns
     -------
@@ -696,7 +755,7 @@ def design(fit: str = 'klaw', *, model: str | None = None, law: str = 'c=0.5', s
         named as the command line names it.
     '''
 
-def simulate(model: str = 'stickslip', *, law: str = 'adjusted', series: Sequence[float] = (0.8, 1.0, 1.6, 2.0), points: int = 9, noise: float = 0.02, seed: int = 1, rho: float = 0.4, f: float = 0.1, jan: Sequence[float] | None = None, jaeger: Sequence[float] | None = None, branch: str = 'upper', delta_range: tuple[float, float] | None = None, design: Any | None = None, v0: float | None = None, delta_deg: float | None = None, beads: int | None = None, spin: str = 'roll', md_preset: str = 'ristow') -> Table:
+def simulate(model: str = 'stickslip', *, law: str = 'adjusted', series: Sequence[float] = (0.8, 1.0, 1.6, 2.0), points: int = 9, noise: float = 0.02, seed: int = 1, rho: float = 0.4, f: float = 0.1, jan: Sequence[float] | None = None, jaeger: Sequence[float] | None = None, branch: str = 'upper', delta_range: tuple[float, float] | None = None, design: Any | None = None, v0: float | None = None, delta_deg: float | None = None, beads: int | None = None, spin: str = 'roll', md_preset: str = 'ristow', sigma_delta: float = 0.0) -> Table:
     """Synthetic measurements inside regime B, reproducible from a seed (``fitbead simulate``);
     the keyword arguments are the command line's flags, the rows those it writes."""
 
@@ -706,6 +765,9 @@ class Report(dict):
     markdown: str
     files: dict[str, bytes]
     summary: str
+    def __eq__(self, other: object) -> bool: ...
+    def __ne__(self, other: object) -> bool: ...
+    __hash__: None  # type: ignore[assignment]
 
 def report(data: Any = None, out_dir: Any | None = None, method: str = 'lsq', *, format: str = 'svg', units: str = 'dimensionless', figure_width: str | float | None = None, level: float = 0.95, seed: int | None = None, min_ess: float | None = None, max_steps: int | None = None, keep_going: bool = False, g: float = 9.81) -> Report:
     """Every model fitted to one data set and the paper's comparisons (``fitbead report``): the
@@ -713,3 +775,7 @@ def report(data: Any = None, out_dir: Any | None = None, method: str = 'lsq', *,
 
 def work_precision(scenes: int = 2000, seed: int = 1) -> Table:
     """The work-precision table (``fitbead bench --output``)."""
+
+def load(path: Any) -> FitResult | FitSet | Dataset | Table | Design:
+    """Reads a result that ``save`` wrote (one JSON document: ``{"format": "fitbead-result",
+    "version": 1, "kind": ..., KIND: {...}}``), as the type saved."""

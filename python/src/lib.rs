@@ -30,7 +30,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;
 use std::collections::HashMap;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicPtr, AtomicU32, Ordering};
 use std::sync::{Arc, Condvar, Mutex};
 use std::time::Duration;
 
@@ -44,6 +44,49 @@ pyo3::create_exception!(
 
 fn value_error(msg: impl Into<String>) -> PyErr {
     FitbeadError::new_err(msg.into())
+}
+
+/// The process that loaded the module (0 until it is loaded).
+static LOAD_PID: AtomicU32 = AtomicU32::new(0);
+
+/// The thread pool of a process forked from the one that loaded the module, with that
+/// process's id (null until such a process needs one).
+static FORK_POOL: AtomicPtr<(u32, rayon::ThreadPool)> = AtomicPtr::new(std::ptr::null_mut());
+
+/// Runs `work` on rayon's threads: the global pool in the process that loaded the module; in
+/// a process forked from it, a pool of its own, built on first use (a fork copies the global
+/// pool's state but none of its threads, so work sent there would wait forever). The pool
+/// has the global pool's size (`RAYON_NUM_THREADS`, else one thread per core), one thread if
+/// that many cannot be started; an error says why none could be.
+fn on_pool<R: Send>(work: impl FnOnce() -> R + Send) -> Result<R, String> {
+    let pid = std::process::id();
+    let home = LOAD_PID.load(Ordering::Acquire);
+    if home == 0 || home == pid {
+        return Ok(work());
+    }
+    let mut cur = FORK_POOL.load(Ordering::Acquire);
+    // SAFETY: a non-null FORK_POOL points to a box this function leaked and never frees (a
+    // process forked from this one inherits the pointer, with its memory, and replaces it
+    // without dropping a pool whose threads it does not have).
+    if cur.is_null() || unsafe { (*cur).0 } != pid {
+        let built = rayon::ThreadPoolBuilder::new()
+            .build()
+            .or_else(|_| rayon::ThreadPoolBuilder::new().num_threads(1).build())
+            .map_err(|e| format!("no threads for the work in this forked process: {e}"))?;
+        let fresh = Box::into_raw(Box::new((pid, built)));
+        match FORK_POOL.compare_exchange(cur, fresh, Ordering::AcqRel, Ordering::Acquire) {
+            Ok(_) => cur = fresh,
+            Err(other) => {
+                // Another thread of this process stored its pool first: use that one.
+                // SAFETY: `fresh` came from Box::into_raw above and was never shared.
+                drop(unsafe { Box::from_raw(fresh) });
+                cur = other;
+            }
+        }
+    }
+    // SAFETY: as above: a box leaked and never freed.
+    let pool = unsafe { &(*cur).1 };
+    Ok(pool.install(work))
 }
 
 /// A contiguous view of a 1-D float64 array.
@@ -408,8 +451,8 @@ const TASK_ROWS: usize = 2048;
 
 /// Evaluates rows `0..n` in parallel tasks of [`TASK_ROWS`], each row writing its records
 /// into a [`RowSink`] (every field of `cols`, in order), and fills `cols` in row order:
-/// numbers written in place, texts coded per task and merged. The error of the lowest failing
-/// row is returned.
+/// numbers written in place, texts coded per task and merged, on rayon's threads
+/// ([`on_pool`]). The error of the lowest failing row is returned.
 fn fill<F>(n: usize, cols: &mut Columns, row: F) -> Result<(), String>
 where
     F: Fn(usize, &mut RowSink<'_, '_>) -> Result<(), String> + Sync,
@@ -427,30 +470,32 @@ where
         }
     }
     let (slots, text_names) = (&cols.slots, &cols.text_names);
-    let done: Vec<Result<Vec<TextColumn>, String>> = slices
-        .into_par_iter()
-        .enumerate()
-        .map(|(t, mut out)| {
-            let start = t * TASK_ROWS;
-            let mut texts: Vec<TextColumn> = text_names
-                .iter()
-                .map(|name| TextColumn::named(name))
-                .collect();
-            let len = (n - start).min(TASK_ROWS);
-            for j in 0..len {
-                let mut sink = RowSink {
-                    j,
-                    slot: 0,
-                    slots,
-                    nums: &mut out,
-                    texts: &mut texts,
-                };
-                row(start + j, &mut sink)?;
-                debug_assert_eq!(sink.slot, slots.len(), "a row writes every field");
-            }
-            Ok(texts)
-        })
-        .collect();
+    let done: Vec<Result<Vec<TextColumn>, String>> = on_pool(|| {
+        slices
+            .into_par_iter()
+            .enumerate()
+            .map(|(t, mut out)| {
+                let start = t * TASK_ROWS;
+                let mut texts: Vec<TextColumn> = text_names
+                    .iter()
+                    .map(|name| TextColumn::named(name))
+                    .collect();
+                let len = (n - start).min(TASK_ROWS);
+                for j in 0..len {
+                    let mut sink = RowSink {
+                        j,
+                        slot: 0,
+                        slots,
+                        nums: &mut out,
+                        texts: &mut texts,
+                    };
+                    row(start + j, &mut sink)?;
+                    debug_assert_eq!(sink.slot, slots.len(), "a row writes every field");
+                }
+                Ok(texts)
+            })
+            .collect()
+    })?;
     for r in done {
         for (c, part) in cols.texts.iter_mut().zip(r?) {
             c.append(part);
@@ -849,23 +894,82 @@ struct PyDataset {
     /// The measurement file the data were read from (its columns, line numbers and source,
     /// which the report uses).
     file: MeasurementFile,
+    /// What the data set was made from, to make it again (`state`).
+    origin: Origin,
 }
+
+/// What a [`PyDataset`] was made from: replayed through the same constructor, it gives the
+/// same data set (pickling, saved results).
+#[derive(Clone)]
+enum Origin {
+    /// Measurement CSV text named `source`, read with these defaults.
+    Text {
+        source: String,
+        text: Arc<str>,
+        defaults: MeasurementDefaults,
+    },
+    /// The arrays given to `from_arrays`: the series labels and the columns of
+    /// [`ARRAY_COLUMNS`], in its order; `text` is the measurement file written from them.
+    Arrays {
+        series: Vec<String>,
+        columns: Vec<Vec<f64>>,
+        text: Arc<str>,
+    },
+}
+
+/// The numeric arguments of `from_arrays`, in order.
+const ARRAY_COLUMNS: [&str; 7] = [
+    "xi",
+    "delta_deg",
+    "v",
+    "sigma_v",
+    "rho",
+    "f",
+    "sigma_delta_deg",
+];
 
 /// The name data given as arrays go by in warnings and reports (a line N is element N - 2).
 const ARRAYS_NAME: &str = "<arrays>";
 
 impl PyDataset {
-    fn of_file(m: MeasurementFile) -> Self {
+    /// The data set of measurement CSV `text`, read as `m` with `defaults`.
+    fn of_file(m: MeasurementFile, text: Arc<str>, defaults: MeasurementDefaults) -> Self {
         let warnings = m
             .plausibility()
             .iter()
             .map(|w| format!("{}: {w}", m.source()))
             .collect();
+        let origin = Origin::Text {
+            source: m.source().to_string(),
+            text,
+            defaults,
+        };
         PyDataset {
             inner: m.dataset().clone(),
             warnings,
             file: m,
+            origin,
         }
+    }
+
+    /// Parses CSV `bytes` named `source` with `defaults` (checked first).
+    fn parsed(source: &str, bytes: &[u8], defaults: MeasurementDefaults) -> PyResult<Self> {
+        let d = defaults.checked().map_err(|e| value_error(e.to_string()))?;
+        let m =
+            MeasurementFile::parse(source, bytes, &d).map_err(|e| value_error(e.to_string()))?;
+        // A table that parsed is UTF-8 (its cells are text).
+        let text = String::from_utf8_lossy(bytes);
+        Ok(PyDataset::of_file(m, Arc::from(text.as_ref()), d))
+    }
+}
+
+/// The defaults of the columns a file leaves out, with ρ, f and g given.
+fn defaults_of(rho: f64, f: f64, g: f64) -> MeasurementDefaults {
+    MeasurementDefaults {
+        rho,
+        f,
+        g,
+        ..MeasurementDefaults::default()
     }
 }
 
@@ -876,34 +980,25 @@ impl PyDataset {
     #[staticmethod]
     #[pyo3(signature = (path, rho=0.4, f=0.1, g=9.81))]
     fn from_csv(path: &str, rho: f64, f: f64, g: f64) -> PyResult<Self> {
-        let d = MeasurementDefaults {
-            rho,
-            f,
-            g,
-            ..MeasurementDefaults::default()
-        }
-        .checked()
-        .map_err(|e| value_error(e.to_string()))?;
-        let m = MeasurementFile::read(std::path::Path::new(path), &d)
+        let d = defaults_of(rho, f, g)
+            .checked()
             .map_err(|e| value_error(e.to_string()))?;
-        Ok(PyDataset::of_file(m))
+        let path = std::path::Path::new(path);
+        match std::fs::read(path) {
+            Ok(bytes) => PyDataset::parsed(&path.display().to_string(), &bytes, d),
+            // The reader's own message for a file it cannot read.
+            Err(_) => Err(value_error(match MeasurementFile::read(path, &d) {
+                Err(e) => e.to_string(),
+                Ok(_) => format!("{}: cannot read", path.display()),
+            })),
+        }
     }
 
     /// Parses CSV text (named `source` in errors), as `from_csv` reads a file.
     #[staticmethod]
     #[pyo3(signature = (text, source, rho=0.4, f=0.1, g=9.81))]
     fn from_text(text: &str, source: &str, rho: f64, f: f64, g: f64) -> PyResult<Self> {
-        let d = MeasurementDefaults {
-            rho,
-            f,
-            g,
-            ..MeasurementDefaults::default()
-        }
-        .checked()
-        .map_err(|e| value_error(e.to_string()))?;
-        let m = MeasurementFile::parse(source, text.as_bytes(), &d)
-            .map_err(|e| value_error(e.to_string()))?;
-        Ok(PyDataset::of_file(m))
+        PyDataset::parsed(source, text.as_bytes(), defaults_of(rho, f, g))
     }
 
     /// The same measurements read again with these defaults for the columns their rows leave
@@ -929,7 +1024,28 @@ impl PyDataset {
             .file
             .with_defaults(&d)
             .map_err(|e| value_error(e.to_string()))?;
-        Ok(PyDataset::of_file(m))
+        let (Origin::Text { text, .. } | Origin::Arrays { text, .. }) = &self.origin;
+        Ok(PyDataset::of_file(m, text.clone(), d))
+    }
+
+    /// The columns fitbead does not read that look misspelt or misnamed (close to a known
+    /// name, or named like an uncertainty), as the command line warns about them.
+    #[getter]
+    fn column_warnings(&self) -> PyResult<Vec<String>> {
+        let cols = self
+            .file
+            .unknown_columns(false)
+            .map_err(|e| value_error(e.to_string()))?;
+        Ok(cols.iter().map(ToString::to_string).collect())
+    }
+
+    /// Refuses a column fitbead does not read, as `--strict-columns` does (the error names the
+    /// column and the known name it is close to).
+    fn check_strict_columns(&self) -> PyResult<()> {
+        self.file
+            .unknown_columns(true)
+            .map(|_| ())
+            .map_err(|e| value_error(e.to_string()))
     }
 
     /// The shipped synthetic data set (data/default.csv).
@@ -945,6 +1061,11 @@ impl PyDataset {
             inner: RsDataset::default_data(),
             warnings: Vec::new(),
             file: m,
+            origin: Origin::Text {
+                source: MeasurementFile::DEFAULT_DATA_NAME.to_string(),
+                text: Arc::from(MeasurementFile::DEFAULT_DATA),
+                defaults: MeasurementDefaults::default(),
+            },
         })
     }
 
@@ -1033,10 +1154,16 @@ impl PyDataset {
             .iter()
             .map(|w| format!("{ARRAYS_NAME}: {w}"))
             .collect();
+        let origin = Origin::Arrays {
+            series,
+            columns: [xs, d, vs, ss, rs, fs, sd].map(<[f64]>::to_vec).to_vec(),
+            text: Arc::from(text),
+        };
         Ok(PyDataset {
             inner,
             warnings,
             file: m,
+            origin,
         })
     }
 
@@ -1074,6 +1201,40 @@ impl PyDataset {
             .iter()
             .filter_map(|c| self.file.column(c).map(|v| (c.to_string(), v)))
             .collect()
+    }
+
+    /// What the data set was made from, as plain values, to make it again: for measurement
+    /// CSV text, `{"origin": "text", "source", "text", "rho", "f", "g", "sigma_delta"}` (give
+    /// `from_text` the text, source, ρ, f, g, then `with_defaults` σ_δ); for arrays,
+    /// `{"origin": "arrays", "series", "xi", "delta_deg", "v", "sigma_v", "rho", "f",
+    /// "sigma_delta_deg"}` (give them to `from_arrays`).
+    fn state<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        match &self.origin {
+            Origin::Text {
+                source,
+                text,
+                defaults,
+            } => {
+                d.set_item("origin", "text")?;
+                d.set_item("source", source)?;
+                d.set_item("text", text.as_ref())?;
+                d.set_item("rho", defaults.rho)?;
+                d.set_item("f", defaults.f)?;
+                d.set_item("g", defaults.g)?;
+                d.set_item("sigma_delta", defaults.sigma_delta_deg)?;
+            }
+            Origin::Arrays {
+                series, columns, ..
+            } => {
+                d.set_item("origin", "arrays")?;
+                d.set_item("series", series)?;
+                for (name, c) in ARRAY_COLUMNS.iter().zip(columns) {
+                    d.set_item(name, PyArray1::from_slice(py, c))?;
+                }
+            }
+        }
+        Ok(d)
     }
 
     /// Number of points.
@@ -1391,22 +1552,24 @@ fn method_args(
     })
 }
 
-/// Runs `work` without the GIL on a scoped thread, checking for Ctrl-C every 100 ms; on an
-/// interrupt the stop flag is raised, the run finishes cleanly and `KeyboardInterrupt` is
-/// raised.
+/// Runs `work` without the GIL on a scoped thread (on rayon's threads through [`on_pool`]),
+/// checking for Ctrl-C every 100 ms; on an interrupt the stop flag is raised, the run finishes
+/// cleanly and `KeyboardInterrupt` is raised.
 fn interruptible<T: Send>(
     py: Python<'_>,
     stop: &AtomicBool,
     work: impl FnOnce() -> T + Send,
 ) -> PyResult<T> {
-    let slot: (Mutex<Option<T>>, Condvar) = (Mutex::new(None), Condvar::new());
+    let slot: (Mutex<Option<Result<T, String>>>, Condvar) = (Mutex::new(None), Condvar::new());
     std::thread::scope(|s| {
         let worker = s.spawn(|| {
-            let r = work();
+            let r = on_pool(work);
             *slot.0.lock().unwrap_or_else(|e| e.into_inner()) = Some(r);
             slot.1.notify_all();
         });
-        let mut interrupted = false;
+        // The exception a signal handler raised (KeyboardInterrupt for Ctrl-C, or the
+        // handler's own), given back unchanged once the work has stopped.
+        let mut interrupted: Option<PyErr> = None;
         loop {
             let got = py.detach(|| {
                 let g = slot.0.lock().unwrap_or_else(|e| e.into_inner());
@@ -1417,12 +1580,9 @@ fn interruptible<T: Send>(
                 g.take()
             });
             if let Some(r) = got {
-                return if interrupted {
-                    Err(PyKeyboardInterrupt::new_err(
-                        "fit interrupted (the run stopped cleanly)",
-                    ))
-                } else {
-                    Ok(r)
+                return match interrupted {
+                    Some(e) => Err(e),
+                    None => r.map_err(PyRuntimeError::new_err),
                 };
             }
             if worker.is_finished() && slot.0.lock().map(|g| g.is_none()).unwrap_or(true) {
@@ -1431,9 +1591,11 @@ fn interruptible<T: Send>(
                     "the fit failed unexpectedly (panic)",
                 ));
             }
-            if !interrupted && py.check_signals().is_err() {
-                stop.store(true, Ordering::SeqCst);
-                interrupted = true;
+            if interrupted.is_none() {
+                if let Err(e) = py.check_signals() {
+                    stop.store(true, Ordering::SeqCst);
+                    interrupted = Some(e);
+                }
             }
         }
     })
@@ -1717,7 +1879,7 @@ fn output_columns(command: &str, model: &str, slopes: bool) -> PyResult<Vec<Stri
 /// An experimental design (`fitbead design`): the settings as the command line's flags, the
 /// result as a dict of plain values (rows as columns).
 #[pyfunction]
-#[pyo3(signature = (fit, model=None, law="c=0.5", series=vec![0.8, 1.0, 1.6, 2.0], points=9, noise=0.02, noise_absolute=false, delta_range=None, criterion="d", target=None, vs=None, branch="upper", rho=0.4, f=0.1, priors=vec![], draws=64, seed=1, total=None))]
+#[pyo3(signature = (fit, model=None, law="c=0.5", series=vec![0.8, 1.0, 1.6, 2.0], points=9, noise=0.02, noise_absolute=false, delta_range=None, criterion="d", target=None, vs=None, branch="upper", rho=0.4, f=0.1, priors=vec![], draws=64, seed=1, total=None, sigma_delta=0.0, margin=0.05))]
 #[allow(clippy::too_many_arguments)]
 fn design<'py>(
     py: Python<'py>,
@@ -1739,6 +1901,8 @@ fn design<'py>(
     draws: usize,
     seed: u64,
     total: Option<usize>,
+    sigma_delta: f64,
+    margin: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     use fitbead::design::{Criterion, DesignFit, DesignSettings};
     let priors = priors
@@ -1778,10 +1942,13 @@ fn design<'py>(
         draws,
         seed,
         total,
+        sigma_delta,
+        margin,
         ..DesignSettings::default()
     };
     let r = py
-        .detach(|| fitbead::design::design(&settings))
+        .detach(|| on_pool(|| fitbead::design::design(&settings)))
+        .map_err(PyRuntimeError::new_err)?
         .map_err(|e| value_error(e.to_string()))?;
     let d = PyDict::new(py);
     let rows = |rows: &[fitbead::design::DesignRow]| -> PyResult<Bound<'py, PyDict>> {
@@ -1820,6 +1987,15 @@ fn design<'py>(
     d.set_item("points_needed", r.points_needed)?;
     d.set_item("ranges", r.ranges.clone())?;
     d.set_item("bayes", r.bayes)?;
+    let steady = PyList::empty(py);
+    for ranges in &r.steady {
+        let x = PyDict::new(py);
+        for (name, lo, hi) in ranges {
+            x.set_item(name, (*lo, *hi))?;
+        }
+        steady.append(x)?;
+    }
+    d.set_item("steady", steady)?;
     Ok(d)
 }
 
@@ -1837,7 +2013,7 @@ fn pipeline_error(e: fitbead::pipeline::RunError) -> PyErr {
 /// Synthetic measurements (`fitbead simulate`): the settings as its flags, the result as the
 /// CSV text it writes (see the Python `fitbead.simulate`).
 #[pyfunction]
-#[pyo3(signature = (model="stickslip", law="adjusted", series=vec![0.8, 1.0, 1.6, 2.0], points=9, noise=0.02, seed=1, rho=0.4, f=0.1, jan=None, jaeger=None, branch="upper", delta_range=None, design=None, v0=None, delta_deg=None, beads=None, spin="roll", md_preset="ristow"))]
+#[pyo3(signature = (model="stickslip", law="adjusted", series=vec![0.8, 1.0, 1.6, 2.0], points=9, noise=0.02, seed=1, rho=0.4, f=0.1, jan=None, jaeger=None, branch="upper", delta_range=None, design=None, v0=None, delta_deg=None, beads=None, spin="roll", md_preset="ristow", sigma_delta=0.0))]
 #[allow(clippy::too_many_arguments)]
 fn simulate(
     py: Python<'_>,
@@ -1859,6 +2035,7 @@ fn simulate(
     beads: Option<usize>,
     spin: &str,
     md_preset: &str,
+    sigma_delta: f64,
 ) -> PyResult<String> {
     use fitbead::models::md::{Md, MdParams, MdRunConfig};
     use fitbead::pipeline::SimulateSettings;
@@ -1902,6 +2079,7 @@ fn simulate(
             params,
             config: MdRunConfig::default(),
         },
+        sigma_delta,
         stop: Some(stop.clone()),
         ..SimulateSettings::default()
     };
@@ -2099,14 +2277,16 @@ fn version() -> &'static str {
     env!("CARGO_PKG_VERSION")
 }
 
-/// Threads rayon uses (set `RAYON_NUM_THREADS` before the first call to change it).
+/// Threads rayon uses (set `RAYON_NUM_THREADS` before the first call to change it): those of
+/// the pool the work of this process runs on ([`on_pool`]).
 #[pyfunction]
-fn threads() -> usize {
-    rayon::current_num_threads()
+fn threads() -> PyResult<usize> {
+    on_pool(rayon::current_num_threads).map_err(PyRuntimeError::new_err)
 }
 
 #[pymodule]
 fn _fitbead(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    LOAD_PID.store(std::process::id(), Ordering::Release);
     m.add_function(wrap_pyfunction!(forward, m)?)?;
     m.add_function(wrap_pyfunction!(invert_k, m)?)?;
     m.add_function(wrap_pyfunction!(regimes, m)?)?;

@@ -35,3 +35,25 @@ def test_dask_map_partitions_equals_one_call_bit_for_bit(monkeypatch):
             np.testing.assert_array_equal(g.view(np.uint64), np.ascontiguousarray(col, dtype=np.float64).view(np.uint64), err_msg=c)
     # Most rows are in range: the test inverts real K, not errors.
     assert (got["status"] == "ok").mean() > 0.9
+
+
+def test_dask_process_scheduler_fits_give_the_in_process_values():
+    """The documented pattern for sets of fits, ``dask.delayed(fitbead.fit_jan)(path)``, on
+    Dask's process scheduler (spawned workers: the results come back pickled) equals the fit in
+    this process: every record, point and the report, floats bit for bit."""
+    dask = pytest.importorskip("dask")
+    from conftest import DEFAULT_DATA
+
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        want = fitbead.fit_jan(str(DEFAULT_DATA))
+        jaeger = fitbead.fit_jaeger(str(DEFAULT_DATA))
+    tasks = [dask.delayed(fitbead.fit_jan)(str(DEFAULT_DATA)), dask.delayed(fitbead.fit_jaeger)(str(DEFAULT_DATA))]
+    got, got_jaeger = dask.compute(*tasks, scheduler="processes", num_workers=2)
+    assert type(got) is fitbead.FitSet and got == want and got_jaeger == jaeger
+    for g, w in zip(got, want):
+        for name, p in w.params.items():
+            assert np.float64(g.params[name].value).tobytes() == np.float64(p.value).tobytes(), name
+        assert g.report() == w.report()

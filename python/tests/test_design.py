@@ -59,3 +59,26 @@ def test_new_options_equal_the_command_line(cli):
     assert "mu of series 'xi=1'" in t.errors
     with pytest.raises(fitbead.FitbeadError, match="improper"):
         fitbead.design("klaw", prior={"c": "flat"})
+
+
+def test_slope_errors_and_margin_equal_the_command_line(cli):
+    """sigma_delta and margin through both doors; the steady range of c per chosen slope; the
+    default margin is 0.05; bad values name the setting."""
+    d = fitbead.design("klaw", criterion="c", target="c", sigma_delta=0.1, margin=0.08)
+    _, text, _ = cli(
+        "design", "--criterion", "c", "--target", "c", "--sigma-delta", "0.1", "--margin", "0.08", "--output", "-",
+    )
+    cols = read_csv_text(text)
+    np.testing.assert_array_equal(d.table["delta_deg"], [float(x) for x in cols["delta_deg"]])
+    assert len(d.steady) == len(d.table["xi"])
+    for row in d.steady:
+        lo, hi = row["c"]
+        assert lo < 0.5 < hi
+    a = fitbead.design("klaw", criterion="c", target="c")
+    b = fitbead.design("klaw", criterion="c", target="c", margin=0.05)
+    np.testing.assert_array_equal(a.table["delta_deg"], b.table["delta_deg"])
+    assert a.ranges == b.ranges
+    with pytest.raises(fitbead.FitbeadError, match="margin"):
+        fitbead.design("klaw", margin=0.5)
+    with pytest.raises(fitbead.FitbeadError, match="sigma-delta"):
+        fitbead.design("klaw", sigma_delta=-1.0)

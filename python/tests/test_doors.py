@@ -21,10 +21,7 @@ ELSEWHERE = {
     "help": "help()",
 }
 # Flags that have no Python keyword yet, with why.
-NOT_YET = {
-    # Column checks on reading: the ColumnWarning / strict_columns of the Python data readers.
-    "strict-columns": "column checks of the Python readers",
-}
+NOT_YET: dict = {}
 
 
 def flags(cli, command):

@@ -133,6 +133,25 @@ def test_keyboard_interrupt_stops_mcmc(data):
         signal.signal(signal.SIGINT, previous)
 
 
+def test_a_signal_handlers_own_exception_passes_through(data):
+    """A handler that raises (a timeout by SIGALRM) stops the run, and its exception, not a
+    KeyboardInterrupt, reaches the caller."""
+
+    def timeout(signum, frame):
+        raise TimeoutError("budget spent")
+
+    previous = signal.signal(signal.SIGALRM, timeout)
+    try:
+        signal.setitimer(signal.ITIMER_REAL, 0.3)
+        t0 = time.perf_counter()
+        with pytest.raises(TimeoutError, match="budget spent"):
+            fitbead.fit_jaeger(data, method="mcmc", min_ess=1e9, max_steps=1_000_000)
+        assert time.perf_counter() - t0 < 5.0
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+
+
 def test_bad_input_raises_with_the_cli_message(cli, tmp_path):
     bad = tmp_path / "bad.csv"
     bad.write_text("series,xi,delta_deg,v,sigma_v\na,1,12,0.3,0.01\na,1,13,-0.3,0.01\n")
@@ -235,3 +254,17 @@ def test_k_with_slope_errors_as_the_command_line(cli):
     velocity_only = numbers(want["sigma_v"]) / np.abs(numbers(want["dv_dK"]))
     assert (np.asarray(got["sigma_K"]) > velocity_only).all()
     assert "sigma_K" not in fitbead.invert_k("stick", fitbead.Dataset.default())
+
+
+def test_simulate_with_slope_errors_as_the_command_line(cli):
+    """simulate(sigma_delta=…) writes the command line's rows, bit for bit, with the columns
+    sigma_delta_deg and delta_true_deg."""
+    _, text, _ = cli("simulate", "--model", "stick", "--law", "c=0.5", "--series", "0.8,1", "--points", "5",
+                     "--noise", "0.01", "--sigma-delta", "0.1", "--seed", "3")
+    want = read_csv_text(text)
+    got = fitbead.simulate("stick", law="c=0.5", series=[0.8, 1.0], points=5, noise=0.01, sigma_delta=0.1, seed=3)
+    assert list(got) == list(want) and list(got)[-2:] == ["sigma_delta_deg", "delta_true_deg"]
+    for k in ("delta_deg", "v", "sigma_v", "sigma_delta_deg", "delta_true_deg"):
+        assert_bits_equal(k, got[k], want[k])
+    with pytest.raises(fitbead.FitbeadError, match="sigma-delta"):
+        fitbead.simulate("stick", sigma_delta=-1.0)

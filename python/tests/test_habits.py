@@ -285,3 +285,89 @@ def test_a_misfit_is_a_misfit_warning():
         warnings.simplefilter("error", fitbead.MisfitWarning)
         ok = fitbead.fit_klaw(d, model="stickslip", law="c")
     assert ok._core.chi2_p_value() > 1e-3
+
+
+def test_a_misnamed_sigma_column_is_a_column_warning_and_strict_refuses(tmp_path):
+    """Renaming sigma_v changes the weighting: the fit says so (ColumnWarning, with the name
+    meant), and strict_columns=True refuses the column, as --strict-columns does."""
+    import pandas as pd
+
+    df = pd.read_csv(DEFAULT_DATA, dtype={"series": str})
+    for name in ("sigma", "err_v", "SD"):
+        bad = df.rename(columns={"sigma_v": name})
+        with pytest.warns(fitbead.ColumnWarning, match=f"column '{name}'.*did you mean 'sigma_v'"):
+            fitbead.fit_klaw(bad, model="stick", law="c", profile=False)
+        with pytest.raises(fitbead.FitbeadError, match=f"'{name}'.*strict"):
+            fitbead.fit_klaw(bad, model="stick", law="c", strict_columns=True)
+        path = tmp_path / f"{name}.csv"
+        bad.to_csv(path, index=False)
+        with pytest.warns(fitbead.ColumnWarning, match="did you mean 'sigma_v'"):
+            fitbead.Dataset.read_csv(path)
+        with pytest.raises(fitbead.FitbeadError, match=f"{name}.csv"):
+            fitbead.Dataset.read_csv(path, strict_columns=True)
+    # A column far from every known name passes in silence, unless strict.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", fitbead.ColumnWarning)
+        fitbead.Dataset.from_pandas(df.assign(run_id=1))
+    with pytest.raises(fitbead.FitbeadError, match="'run_id'"):
+        fitbead.Dataset.from_pandas(df.assign(run_id=1), strict_columns=True)
+
+
+def test_simulated_tables_are_data():
+    """What simulate returns is data for the fits, the same as its DataFrame, and its extra
+    columns (v_true, delta_true_deg) are ones fitbead knows."""
+    sim = fitbead.simulate("stick", law="c=0.5", series=[0.8, 1.0], points=6, noise=0.01, sigma_delta=0.1, seed=4)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", fitbead.ColumnWarning)
+        a = fitbead.fit_klaw(sim, model="stick", law="c", strict_columns=True)
+    b = fitbead.fit_klaw(sim.to_pandas(), model="stick", law="c")
+    assert a.params["c"].value == b.params["c"].value
+    assert a.params["c"].stderr == b.params["c"].stderr
+    assert a.stats["method"] == "odr"
+    k = fitbead.invert_k("stick", sim)
+    assert "sigma_K" in k and np.array_equal(k["K"], fitbead.invert_k("stick", sim.to_pandas())["K"])
+    # A design is the slopes simulate makes data at, as its file is.
+    d = fitbead.design("klaw", model="stick", series=[1.0], points=4)
+    at = fitbead.simulate("stick", law="c=0.5", series=[1.0], design=d, seed=5)
+    assert sorted(set(np.round(at["delta_deg"], 9))) == sorted(set(np.round(d.table["delta_deg"], 9)))
+
+
+def test_one_outlier_is_named_not_blamed_on_units():
+    """One velocity at 3× its value: every fit it enters names it (OutlierWarning, with its
+    series, slope and value), and none calls it a unit mistake; every velocity at 100× is a
+    unit mistake (UnitWarning) with no outlier named."""
+    import pandas as pd
+
+    df = pd.read_csv(DEFAULT_DATA, dtype={"series": str})
+    one = df.copy()
+    one.loc[5, "v"] *= 3  # series 0.8, δ = 12.613°
+    with warnings.catch_warnings(record=True) as got:
+        warnings.simplefilter("always")
+        fitbead.fit_klaw(one, model="stick", law="c", profile=False)
+        fitbead.fit_jan(one, profile=False)
+    outliers = [str(w.message) for w in got if w.category is fitbead.OutlierWarning]
+    assert any(m.startswith("klaw-c [all]: 1 outlier(s)") and "delta 12.613 deg" in m for m in outliers), outliers
+    assert any(m.startswith("jan-series [0.8]: 1 outlier(s)") for m in outliers), outliers
+    assert not [w for w in got if w.category is fitbead.UnitWarning and "reduced chi2" in str(w.message)]
+    assert issubclass(fitbead.OutlierWarning, fitbead.MisfitWarning)
+    units = df.assign(v=df["v"] * 100, sigma_v=df["sigma_v"])
+    with warnings.catch_warnings(record=True) as got:
+        warnings.simplefilter("always")
+        fitbead.fit_jan(units, profile=False)
+    assert [w for w in got if w.category is fitbead.UnitWarning and "dimensionless" in str(w.message)]
+    assert not [w for w in got if w.category is fitbead.OutlierWarning]
+
+
+def test_fitset_is_a_mapping_by_name_and_series():
+    """FitSet["jan-global"], FitSet["jan-series", 1.0] (a number finds the series labelled
+    "1"), KeyError naming the fits there are, and positions as a list."""
+    fits = fitbead.fit_jan(profile=False)
+    assert fits["jan-global"].series == "all"
+    assert fits["jan-series", 1.0].series == "1"
+    assert fits.get("jan-series", 1.6) is fits["jan-series", "1.6"]
+    assert fits.get("jan-series", 7.0) is None and fits.get("nope", default=0) == 0
+    assert fits[0] is list(fits)[0] and len(fits[1:]) == len(fits) - 1
+    assert ("jan-series", "2") in fits and ("jan-series", "3") not in fits
+    assert fits.keys()[-1] == ("jan-global", "all")
+    with pytest.raises(KeyError, match="jan-global"):
+        fits["jan-series", 3.0]

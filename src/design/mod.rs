@@ -11,13 +11,29 @@
 //! - **Range.** Per series, regime B of the guess (the slopes where the model at the guess
 //!   has a steady state, [`crate::models::regimes::regime_b_interval`]; Jan and Jaeger, whose
 //!   range has no upper end, are cut to the onset + 12°), cut to the caller's range if one is
-//!   given, then kept a margin (5 % of its width) away from both ends, as `fitbead simulate`
-//!   spreads its points over 5 %–95 % of the range. No design point lies outside it.
+//!   given, then kept a margin away from both ends: the fraction `margin` of its width (5 % by
+//!   default, as `fitbead simulate` spreads its points over 5 %–95 % of the range; at least
+//!   0.01°, or 5 % if less, so that the difference steps at the ends stay steady) or, with
+//!   slope errors, 2σ_δ plus the 1e-4° a slope is rounded to, whichever is wider, so that a
+//!   chosen slope off by 2σ_δ is still steady at the guess. No design point lies outside it.
 //! - **Candidates.** An even grid of slopes over the range (200 per series), each rounded to
 //!   1e-4° as a measured slope is written. At each, v̄ at the guess, its σ (relative noise
 //!   σ = noise · v̄, as `simulate --noise`, or absolute) and the gradient ∂v̄/∂p by central
 //!   differences (step 1e-4 · max(|p|, 1e-3)), the Jacobian of the weighted least-squares
 //!   problem the fits solve.
+//! - **Slope errors** (`sigma_delta` σ_δ > 0): a slope set with error σ_δ moves v̄ by about
+//!   (∂v̄/∂δ) σ_δ, so each candidate's variance is the effective variance
+//!   σ² = σ_v² + (∂v̄/∂δ)² σ_δ² (Orear 1982), ∂v̄/∂δ by a central difference in
+//!   δ (radians, step 1e-4 · δ) at the guess, or at each prior draw for a Bayesian design. The
+//!   weighted least squares with this variance is what the ODR fits of such data
+//!   ([`crate::inverse::odr`]) solve to first order, and it enters every criterion and every
+//!   predicted standard error. Near the ends of regime B v̄ changes steeply with δ (near δ_m,
+//!   eq 32, the bead crawls over the top) and the slope term dominates σ²: where ∂v̄/∂p grows
+//!   less steeply the design moves inward. Near δ_m of a K-law fit both grow in the ratio
+//!   ∂δ_m/∂p, so the information of a point tends to (∂δ_m/∂p)²/σ_δ² instead of falling,
+//!   and a c-optimal design may stay at the lower end of its range, 2σ_δ or the margin
+//!   inside it. A prior draw at which a difference in δ leaves the steady state gives the
+//!   candidate no information, as a draw at which it is not steady.
 //! - **Fisher information** of n_j points at each candidate: M = Σ n_j g_j g_jᵀ with
 //!   g = (∂v̄/∂p)/σ; the predicted covariance of the least-squares estimate is M⁻¹.
 //! - **Criteria.** D: maximise log det M; c: minimise (M⁻¹)_kk of the target parameter k; T:
@@ -29,6 +45,10 @@
 //!   stratum by stratum) gives the stopping rule and the reported gap.
 //! - **Exact design**: neighbouring grid points that carry weight merge into one slope, and
 //!   the weights round to whole points by efficient rounding (Pukelsheim & Rieder 1992).
+//!
+//! The summary gives, per chosen slope, the range of each parameter (the others at the guess)
+//! over which the slope stays in regime B: how far the guess may be off before the bead stops
+//! or jumps there.
 //!
 //! For T, the points needed are those, in the design's proportions, at which the
 //! noncentrality λ = N · T/N_design of the one-degree-of-freedom χ² test of B reaches
@@ -53,7 +73,7 @@ mod text;
 
 use crate::inverse::posterior::Prior;
 use crate::models::{JaegerBranch, ModelKind};
-use crate::numfmt::fmt_f64;
+use crate::numfmt::{fmt_f64, fmt_sig};
 use crate::scene::CollisionLaw;
 use optimal::{information, variance_of, variances, Approx, Cand, Crit, Draw};
 use problem::Problem;
@@ -159,11 +179,19 @@ pub struct DesignSettings {
     /// Points over all series, shared out by the design (`points` is then unused); `None`:
     /// `points` per series.
     pub total: Option<usize>,
+    /// Standard uncertainty σ_δ of a set slope, degrees (≥ 0 and < 90): each point's variance
+    /// becomes σ_v² + (∂v̄/∂δ)² σ_δ², and the range keeps at least 2σ_δ from its ends. 0:
+    /// slopes exact.
+    pub sigma_delta: f64,
+    /// The fraction of the range's width kept from each of its ends (0 ≤ margin < 0.5;
+    /// default 0.05, the 5 %–95 % over which `simulate` spreads its points).
+    pub margin: f64,
 }
 
 impl Default for DesignSettings {
-    /// K-law c = 0.5 under stick/slip, the paper's four ξ, 9 points per series, 2 % noise, D,
-    /// locally optimal (64 draws, seed 1, should priors be added).
+    /// K-law c = 0.5 under stick/slip, the paper's four ξ, 9 points per series, 2 % noise,
+    /// exact slopes, ranges kept 5 % of their width from their ends, D, locally optimal (64
+    /// draws, seed 1, should priors be added).
     fn default() -> Self {
         DesignSettings {
             fit: DesignFit::KLaw,
@@ -185,6 +213,8 @@ impl Default for DesignSettings {
             draws: DEFAULT_DRAWS,
             seed: 1,
             total: None,
+            sigma_delta: 0.0,
+            margin: DEFAULT_MARGIN,
         }
     }
 }
@@ -249,6 +279,11 @@ pub struct DesignResult {
     /// redrawn because some series had no steady slope in its range there (or, for a μ
     /// target, K left (0, 1)); `None` for a locally optimal design.
     pub bayes: Option<(usize, usize)>,
+    /// Per row of `rows`, the range of each parameter that moves its series over which its
+    /// slope stays steady (in regime B), the others at the guess: (name, low, high), an end
+    /// `None` where the steady state holds to the end of the parameter's domain.
+    #[allow(clippy::type_complexity)]
+    pub steady: Vec<Vec<(String, Option<f64>, Option<f64>)>>,
 }
 
 /// A setting [`design`] cannot work with.
@@ -279,6 +314,13 @@ impl fmt::Display for DesignError {
 }
 
 impl std::error::Error for DesignError {}
+
+/// The fraction of a range's width kept from each end unless told otherwise.
+const DEFAULT_MARGIN: f64 = 0.05;
+/// The least a range keeps from its ends, degrees (unless 5 % of its width is less).
+const MIN_KEPT_DEG: f64 = 0.01;
+/// The step slopes are rounded to, degrees.
+const SLOPE_STEP_DEG: f64 = 1e-4;
 
 /// Most points per series.
 const MAX_POINTS: usize = 100_000;
@@ -367,6 +409,11 @@ pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
         _ => exact,
     };
     let (w, rows) = exact_rows(s, &cands, &exact);
+    let steady = exact
+        .iter()
+        .flatten()
+        .map(|&(j, _)| steady_ranges(&prob, &cands[j]))
+        .collect();
     let even: Vec<DesignRow> = even_cands
         .iter()
         .map(|c| row(s.series[c.series], c.delta, 1))
@@ -410,6 +457,7 @@ pub fn design(s: &DesignSettings) -> Result<DesignResult, DesignError> {
         sensitivity,
         sensitivity_label: sens_label,
         bayes,
+        steady,
     };
     scale_to_noise(s, &mut result);
     Ok(result)
@@ -588,6 +636,18 @@ fn exact_rows(
         }
     }
     (w, rows)
+}
+
+/// The range of each parameter that moves the series of candidate `c` over which its slope
+/// stays steady, the others at the guess ([`Problem::steady_range`]).
+fn steady_ranges(prob: &Problem, c: &Cand) -> Vec<(String, Option<f64>, Option<f64>)> {
+    (0..prob.names.len())
+        .filter(|&j| prob.touches(c.series, j))
+        .filter_map(|j| {
+            let (lo, hi) = prob.steady_range(c.series, c.delta, j)?;
+            Some((prob.names[j].clone(), lo, hi))
+        })
+        .collect()
 }
 
 /// A variance averaged over the draws (the expected posterior variance of a Bayesian
@@ -783,15 +843,17 @@ fn prior_draws(
     // A candidate at a draw, and whether that draw is steady there.
     let at = |theta: &[f64], c: &Cand| -> (Cand, bool) {
         let g = prob.velocity(c.series, c.delta, theta).and_then(|v| {
-            let sg = sigma(s, v);
+            let sg = effective_sigma(s, prob, c.series, c.delta, theta, v)?;
             prob.gradient_at(c.series, c.delta, theta)
-                .map(|g| g.iter().map(|x| x / sg).collect::<Vec<f64>>())
+                .map(|g| (g.iter().map(|x| x / sg).collect::<Vec<f64>>(), sg))
         });
         let steady = g.is_some();
+        let (g, sg) = g.unwrap_or_else(|| (vec![0.0; theta.len()], f64::INFINITY));
         let c = Cand {
             series: c.series,
             delta: c.delta,
-            g: g.unwrap_or_else(|| vec![0.0; theta.len()]),
+            g,
+            sigma: sg,
         };
         (c, steady)
     };
@@ -929,22 +991,7 @@ fn check(s: &DesignSettings) -> Result<(), DesignError> {
     if !(s.f.is_finite() && s.f >= 0.0) {
         return Err(DesignError::new("f", &fmt_f64(s.f), "must be >= 0"));
     }
-    if let Some((lo, hi)) = s.delta_range {
-        if !(lo.is_finite() && hi.is_finite() && lo < hi && lo > 0.0 && hi < 90.0) {
-            return Err(DesignError::new(
-                "delta-range",
-                &format!("{},{}", fmt_f64(lo), fmt_f64(hi)),
-                "expected LO,HI in degrees with 0 < LO < HI < 90",
-            ));
-        }
-    }
-    if s.grid < 10 || s.grid > 100_000 {
-        return Err(DesignError::new(
-            "grid",
-            &s.grid.to_string(),
-            "expected 10 to 100000 candidate slopes",
-        ));
-    }
+    check_slopes(s)?;
     match (s.criterion, s.vs) {
         (Criterion::T, None) => Err(DesignError::new(
             "vs",
@@ -960,6 +1007,41 @@ fn check(s: &DesignSettings) -> Result<(), DesignError> {
     }
 }
 
+/// The settings of the slopes: the caller's range, the slope error, the margin and the grid.
+fn check_slopes(s: &DesignSettings) -> Result<(), DesignError> {
+    if let Some((lo, hi)) = s.delta_range {
+        if !(lo.is_finite() && hi.is_finite() && lo < hi && lo > 0.0 && hi < 90.0) {
+            return Err(DesignError::new(
+                "delta-range",
+                &format!("{},{}", fmt_f64(lo), fmt_f64(hi)),
+                "expected LO,HI in degrees with 0 < LO < HI < 90",
+            ));
+        }
+    }
+    if !(s.sigma_delta.is_finite() && (0.0..90.0).contains(&s.sigma_delta)) {
+        return Err(DesignError::new(
+            "sigma-delta",
+            &fmt_f64(s.sigma_delta),
+            "must be a finite number of degrees >= 0 and < 90",
+        ));
+    }
+    if !(s.margin.is_finite() && (0.0..0.5).contains(&s.margin)) {
+        return Err(DesignError::new(
+            "margin",
+            &fmt_f64(s.margin),
+            "expected a fraction of the range's width with 0 <= F < 0.5",
+        ));
+    }
+    if s.grid < 10 || s.grid > 100_000 {
+        return Err(DesignError::new(
+            "grid",
+            &s.grid.to_string(),
+            "expected 10 to 100000 candidate slopes",
+        ));
+    }
+    Ok(())
+}
+
 fn no_range(xi: f64, why: &str) -> DesignError {
     DesignError::new(
         "series",
@@ -969,7 +1051,7 @@ fn no_range(xi: f64, why: &str) -> DesignError {
 }
 
 /// The slope range of each series (radians): regime B of the guess, cut to the caller's
-/// range, kept 5 % of its width from each end.
+/// range, kept [`kept_from_ends`] from each end.
 fn ranges(
     s: &DesignSettings,
     prob: &Problem,
@@ -1010,10 +1092,37 @@ fn ranges(
                     "the model and its rival at the guess have no steady slope in common",
                 ));
             }
-            let m = 0.05 * (hi - lo);
+            let m = kept_from_ends(s, hi - lo);
+            if !(lo + m < hi - m) {
+                return Err(DesignError::new(
+                    "sigma-delta",
+                    &fmt_f64(s.sigma_delta),
+                    format!(
+                        "series xi={}: its steady range {}-{} deg is too narrow to keep a slope \
+                         2 sigma_delta from both ends",
+                        fmt_f64(xi),
+                        fmt_sig(lo.to_degrees(), 5),
+                        fmt_sig(hi.to_degrees(), 5)
+                    ),
+                ));
+            }
             Ok((lo + m, hi - m))
         })
         .collect()
+}
+
+/// What a range of width `w` (radians) keeps from each of its ends (radians): the fraction
+/// `margin` of its width, but at least 0.01° (or the default 5 % of the width, if less), so
+/// that the slopes at the ends, and the difference steps about them, stay steady; with slope
+/// errors at least 2σ_δ and the rounding step of a slope (1e-4°), so that a design slope set
+/// 2σ_δ off is still inside.
+fn kept_from_ends(s: &DesignSettings, w: f64) -> f64 {
+    let m = (s.margin * w).max(MIN_KEPT_DEG.to_radians().min(DEFAULT_MARGIN * w));
+    if s.sigma_delta > 0.0 {
+        m.max((2.0 * s.sigma_delta + SLOPE_STEP_DEG).to_radians())
+    } else {
+        m
+    }
 }
 
 /// A slope rounded to 1e-4°, in radians.
@@ -1042,11 +1151,44 @@ fn sigma(s: &DesignSettings, v: f64) -> f64 {
     }
 }
 
-/// The predictions of a design made in units of the noise ([`sigma`]) for the noise of `s`:
-/// standard errors times the noise, the discrimination over its square (the points needed
-/// are scaled where they are counted).
+/// The unit of the σ the design works in: the noise, or with slope errors the noise and σ_δ
+/// (radians) in quadrature, so that neither term of the effective variance
+/// ([`effective_sigma`]) leaves the range of the information matrices.
+fn unit(s: &DesignSettings) -> f64 {
+    if s.sigma_delta > 0.0 {
+        s.noise.hypot(s.sigma_delta.to_radians())
+    } else {
+        s.noise
+    }
+}
+
+/// The σ of v̄ of series `k` at slope `d` (radians) under parameters `theta`, where v̄ is
+/// `v`, in units of [`unit`]: [`sigma`] without slope errors; with them the root of the
+/// effective variance σ_v² + (∂v̄/∂δ)² σ_δ² (δ and σ_δ in radians). `None` where the
+/// difference in δ leaves the steady state.
+fn effective_sigma(
+    s: &DesignSettings,
+    prob: &Problem,
+    k: usize,
+    d: f64,
+    theta: &[f64],
+    v: f64,
+) -> Option<f64> {
+    if s.sigma_delta > 0.0 {
+        let u = unit(s);
+        let slope = prob.slope_derivative(k, d, theta)?;
+        let sv = sigma(s, v) * (s.noise / u);
+        Some(sv.hypot(slope * s.sigma_delta.to_radians() / u))
+    } else {
+        Some(sigma(s, v))
+    }
+}
+
+/// The predictions of a design made in units of [`unit`] (the noise without slope errors)
+/// for the noise of `s`: standard errors times the unit, the discrimination over its square
+/// (the points needed are scaled where they are counted).
 fn scale_to_noise(s: &DesignSettings, r: &mut DesignResult) {
-    let n = s.noise;
+    let n = unit(s);
     for e in &mut r.errors {
         e.design = e.design.map(|x| x * n);
         e.even = e.even.map(|x| x * n);
@@ -1058,12 +1200,13 @@ fn scale_to_noise(s: &DesignSettings, r: &mut DesignResult) {
 /// is steady there.
 fn candidate(s: &DesignSettings, prob: &Problem, k: usize, d: f64) -> Option<Cand> {
     let v = prob.velocity(k, d, &prob.guess)?;
-    let sg = sigma(s, v);
+    let sg = effective_sigma(s, prob, k, d, &prob.guess, v)?;
     let g = prob.gradient(k, d)?;
     Some(Cand {
         series: k,
         delta: d,
         g: g.iter().map(|x| x / sg).collect(),
+        sigma: sg,
     })
 }
 
@@ -1159,7 +1302,6 @@ fn rival(s: &DesignSettings, prob: &Problem) -> Result<Problem, DesignError> {
 /// The rival's least-squares fit to the true curve at points `pts` with weights `w` (the
 /// rival's guess as the start): its parameters and χ² = min_θ Σ w (v̄_A − v̄_B(θ))²/σ².
 fn fit_rival(
-    s: &DesignSettings,
     truth: &Problem,
     rival: &Problem,
     pts: &[&Cand],
@@ -1183,7 +1325,7 @@ fn fit_rival(
         let v = truth.velocity(c.series, c.delta, &truth.guess)?;
         x.push((c.series, c.delta));
         y.push(v);
-        sg.push(sigma(s, v) / wj.sqrt());
+        sg.push(c.sigma / wj.sqrt());
     }
     let data = WeightedData::new(Curve(rival), x, y, Some(sg)).ok()?;
     let opts = LsqOptions {
@@ -1244,14 +1386,15 @@ fn discriminate(
         .collect();
     let wts: Vec<f64> = exact.iter().flatten().map(|&(_, n)| n as f64).collect();
     let ones = vec![1.0; even.len()];
-    let t_design = t_value(s, truth, rival, &pts, &wts).unwrap_or(f64::NAN);
-    let t_even = t_value(s, truth, rival, even, &ones).unwrap_or(f64::NAN);
+    let t_design = t_value(truth, rival, &pts, &wts).unwrap_or(f64::NAN);
+    let t_even = t_value(truth, rival, even, &ones).unwrap_or(f64::NAN);
     let total = total_points as f64;
-    // t is in units of the noise ([`sigma`]): the points needed scale as its square.
+    // t is in units of [`unit`]: the points needed scale as its square.
+    let u = unit(s);
     let need = |t: f64| {
         let per_point = t / total;
         if per_point > 0.0 {
-            (noncentrality(0.05, 0.8) / per_point * s.noise * s.noise).ceil()
+            (noncentrality(0.05, 0.8) / per_point * u * u).ceil()
         } else {
             f64::INFINITY
         }
@@ -1260,15 +1403,9 @@ fn discriminate(
 }
 
 /// T at an exact design: the rival's least χ² against the true curve.
-fn t_value(
-    s: &DesignSettings,
-    truth: &Problem,
-    rival: &Problem,
-    pts: &[Cand],
-    w: &[f64],
-) -> Option<f64> {
+fn t_value(truth: &Problem, rival: &Problem, pts: &[Cand], w: &[f64]) -> Option<f64> {
     let refs: Vec<&Cand> = pts.iter().collect();
-    fit_rival(s, truth, rival, &refs, w, &rival.guess).map(|r| r.1)
+    fit_rival(truth, rival, &refs, w, &rival.guess).map(|r| r.1)
 }
 
 /// The T-optimal approximate design (Atkinson–Fedorov), started from equal weights on every
@@ -1327,7 +1464,7 @@ fn t_design(
         let idx: Vec<usize> = (0..cands.len()).filter(|&j| w[j] > 0.0).collect();
         let pts: Vec<&Cand> = idx.iter().map(|&j| &cands[j]).collect();
         let wts: Vec<f64> = idx.iter().map(|&j| w[j]).collect();
-        let (t, _) = fit_rival(s, prob, &rival, &pts, &wts, &theta)?;
+        let (t, _) = fit_rival(prob, &rival, &pts, &wts, &theta)?;
         theta = t;
         Some(
             cands
@@ -1336,7 +1473,7 @@ fn t_design(
                 .map(|(c, va)| {
                     match (va, rival.velocity(c.series, c.delta, &theta)) {
                         (Some(a), Some(b)) => {
-                            let r = (a - b) / sigma(s, *a);
+                            let r = (a - b) / c.sigma;
                             r * r
                         }
                         // Where the rival has no steady state, nothing is learnt from its curve.

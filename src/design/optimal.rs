@@ -11,12 +11,14 @@
 
 use nalgebra::{DMatrix, DVector};
 
-/// One candidate point: its series, slope (radians) and scaled gradient g = (∂v̄/∂p)/σ.
+/// One candidate point: its series, slope (radians), scaled gradient g = (∂v̄/∂p)/σ and that
+/// σ (in the design's units; +∞ where the point tells nothing).
 #[derive(Debug, Clone)]
 pub(crate) struct Cand {
     pub series: usize,
     pub delta: f64,
     pub g: Vec<f64>,
+    pub sigma: f64,
 }
 
 /// An approximate design: weights, each candidate's sensitivity divided by its stratum's λ_s,
@@ -530,6 +532,7 @@ mod tests {
                     series: 0,
                     delta: x,
                     g: vec![1.0, x],
+                    sigma: 1.0,
                 }
             })
             .collect();
@@ -553,6 +556,7 @@ mod tests {
                     series: 0,
                     delta: x,
                     g: vec![1.0, x, x * x],
+                    sigma: 1.0,
                 }
             })
             .collect();
@@ -578,6 +582,7 @@ mod tests {
                     series: s,
                     delta: x,
                     g,
+                    sigma: 1.0,
                 });
             }
         }
@@ -606,6 +611,7 @@ mod tests {
                     series: s,
                     delta: x,
                     g,
+                    sigma: 1.0,
                 });
             }
         }
@@ -643,6 +649,7 @@ mod tests {
                     series: 0,
                     delta: x,
                     g: vec![1.0, x],
+                    sigma: 1.0,
                 }
             })
             .collect();
@@ -666,6 +673,7 @@ mod tests {
                     series: 0,
                     delta: x,
                     g: vec![x],
+                    sigma: 1.0,
                 }
             })
             .collect();

@@ -1,5 +1,6 @@
 //! The forward problem a design is made for: the fitted parameters, their guess, the mean
-//! velocity v̄(ξ, δ; p) of each series and its gradient in p by central differences.
+//! velocity v̄(ξ, δ; p) of each series, its gradient in p and its derivative in δ by central
+//! differences, and the range of each parameter over which a slope stays steady.
 
 use super::DesignError;
 use crate::fit::jaeger::paper_values;
@@ -7,7 +8,7 @@ use crate::fit::jan::PAPER_GLOBAL;
 use crate::models::jaeger::Jaeger;
 use crate::models::jan::Jan;
 use crate::models::regimes::{alpha_of_xi, bulk_friction_law, regime_b_interval};
-use crate::models::{ForwardModel, JaegerBranch, Model};
+use crate::models::{ForwardModel, JaegerBranch, Model, NotSteady};
 use crate::numfmt::fmt_f64;
 use crate::scene::{CollisionLaw, Scene};
 
@@ -42,6 +43,12 @@ pub(crate) struct Problem {
 const FD_STEP: f64 = 1e-4;
 /// Smallest scale of a parameter for its difference step.
 const FD_FLOOR: f64 = 1e-3;
+/// First step of the search for the end of a steady range, relative to max(|p|, 1).
+const STEADY_STEP: f64 = 0.01;
+/// Doublings of that step before a steady range counts as unbounded (a factor 2^40 ≈ 1e12).
+const STEADY_DOUBLINGS: usize = 40;
+/// Width of the bracket, relative to max(|p|, 1), at which a steady range's end is taken.
+const STEADY_TOL: f64 = 1e-7;
 
 impl Problem {
     /// The velocity of series `s` at slope `delta` (radians) under parameters `p`, or `None`
@@ -89,6 +96,82 @@ impl Problem {
     /// ∂v̄/∂p at (s, δ) and parameters `at`, with the steps of [`Problem::gradient`].
     pub fn gradient_at(&self, s: usize, delta: f64, at: &[f64]) -> Option<Vec<f64>> {
         self.differences(at, |j| self.touches(s, j), |p| self.velocity(s, delta, p))
+    }
+
+    /// ∂v̄/∂δ (per radian) of series `s` at slope `delta` (radians) and parameters `at`, by a
+    /// central difference with step 1e-4 · δ; `None` where a step leaves the steady state.
+    pub fn slope_derivative(&self, s: usize, delta: f64, at: &[f64]) -> Option<f64> {
+        let h = FD_STEP * delta.abs().max(FD_FLOOR);
+        let up = self.velocity(s, delta + h, at)?;
+        let down = self.velocity(s, delta - h, at)?;
+        Some((up - down) / (2.0 * h))
+    }
+
+    /// Whether the model of series `s` at slope `delta` under parameters `p` says the bead
+    /// has no steady state (it stops, lifts off, runs away or its final-velocity map has no
+    /// fixed point): false where it is steady, where `p` make no model or scene at all (K of
+    /// a law outside (0, 1), Jan's λ ≤ 0, …) and where the model cannot tell
+    /// ([`NotSteady::Invalid`]: v̄ out of the range of doubles, an approximation outside its
+    /// validity).
+    fn not_steady(&self, s: usize, delta: f64, p: &[f64]) -> bool {
+        let Some((model, law)) = self.model_at(s, p) else {
+            return false;
+        };
+        Scene::from_radians(self.series[s], delta, self.rho, self.f, law).is_ok_and(|scene| {
+            matches!(model.evaluate(&scene), Err(e) if !matches!(e, NotSteady::Invalid { .. }))
+        })
+    }
+
+    /// The range of parameter `j` over which series `s` at slope `delta` (radians) stays
+    /// steady, the other parameters at the guess: the ends (low, high) of the interval around
+    /// the guess, each `None` where the steady state holds to the end of the parameter's
+    /// domain (or over 1e12 times its scale): an end is one where the model has no steady
+    /// state (the bead stops or lifts off), not where the parameter leaves its domain or v̄
+    /// leaves the range of numbers. Each end is bracketed by steps doubling from 1 % of max(|p_j|, 1) and found by
+    /// bisection to 1e-7 of that scale. `None` where the guess itself is not steady there.
+    pub fn steady_range(
+        &self,
+        s: usize,
+        delta: f64,
+        j: usize,
+    ) -> Option<(Option<f64>, Option<f64>)> {
+        let steady = |x: f64| {
+            let mut p = self.guess.clone();
+            p[j] = x;
+            self.velocity(s, delta, &p).is_some()
+        };
+        let p0 = self.guess[j];
+        if !steady(p0) {
+            return None;
+        }
+        let scale = p0.abs().max(1.0);
+        let end = |dir: f64| -> Option<f64> {
+            let mut good = p0;
+            let mut step = STEADY_STEP * scale;
+            let mut bad = None;
+            for _ in 0..=STEADY_DOUBLINGS {
+                let x = p0 + dir * step;
+                if !steady(x) {
+                    bad = Some(x);
+                    break;
+                }
+                good = x;
+                step *= 2.0;
+            }
+            let mut bad = bad?;
+            while (bad - good).abs() > STEADY_TOL * scale {
+                let m = 0.5 * (good + bad);
+                if steady(m) {
+                    good = m;
+                } else {
+                    bad = m;
+                }
+            }
+            let mut p = self.guess.clone();
+            p[j] = bad;
+            self.not_steady(s, delta, &p).then_some(good)
+        };
+        Some((end(-1.0), end(1.0)))
     }
 
     /// Central differences of `f` at `at` in the parameters `touches` selects (the others
@@ -151,7 +234,7 @@ impl Problem {
     }
 
     /// Whether parameter `j` moves the velocities of series `s`.
-    fn touches(&self, s: usize, j: usize) -> bool {
+    pub fn touches(&self, s: usize, j: usize) -> bool {
         match self.kind {
             Kind::KFree(_) => j == s,
             Kind::Jaeger(_) => j / 3 == s,
@@ -253,4 +336,103 @@ pub(crate) fn problem(
         names,
         guess,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::design::DesignFit;
+
+    fn jan(series: &[f64]) -> Problem {
+        problem(
+            DesignFit::Jan,
+            Model::StickSlip,
+            CollisionLaw::C(0.5),
+            series,
+            0.4,
+            0.1,
+            JaegerBranch::Upper,
+        )
+        .unwrap()
+    }
+
+    /// Jan's eq 74 at one ξ: v̄ = sqrt((2 sin α/λ)(sin δ − μ cos δ)) is steady exactly while
+    /// μ < tan δ, for any λ > 0; μ ≥ 0 is the model's domain. dv̄/dδ = (sin α/λ)(cos δ +
+    /// μ sin δ)/v̄, differentiated by hand.
+    #[test]
+    fn jan_steady_range_and_slope_derivative_in_closed_form() {
+        let p = jan(&[1.0]);
+        let (lambda, mu) = (p.guess[0], p.guess[1]);
+        let sa = alpha_of_xi(1.0).sin();
+        for deg in [6.5, 9.0, 15.0] {
+            let d = f64::to_radians(deg);
+            assert_eq!(p.steady_range(0, d, 0), Some((None, None)), "{deg}");
+            let (lo, hi) = p.steady_range(0, d, 1).unwrap();
+            assert_eq!(lo, None, "{deg}");
+            let hi = hi.unwrap();
+            assert!((hi - d.tan()).abs() < 1e-6, "{deg}: {hi} vs {}", d.tan());
+            let v = p.velocity(0, d, &p.guess).unwrap();
+            let want = sa / lambda * (d.cos() + mu * d.sin()) / v;
+            let got = p.slope_derivative(0, d, &p.guess).unwrap();
+            assert!((got / want - 1.0).abs() < 1e-6, "{deg}: {got} vs {want}");
+        }
+        // Below the onset (tan δ < μ) the guess itself is not steady.
+        assert_eq!(p.steady_range(0, (0.5 * mu).atan(), 1), None);
+    }
+
+    /// Jan's laws across series: μ = μ0 e^{μ1 sin α} < tan δ bounds μ0 and μ1 above; λ0 and
+    /// λ1 only scale v̄ (λ1 → ±∞ drives λ out of the range of doubles, not out of regime B).
+    #[test]
+    fn jan_laws_steady_ranges() {
+        let p = jan(&[0.8, 1.0]);
+        let (mu0, mu1) = (p.guess[2], p.guess[3]);
+        let d = 12f64.to_radians();
+        let sa = alpha_of_xi(0.8).sin();
+        let r: Vec<_> = (0..4).map(|j| p.steady_range(0, d, j).unwrap()).collect();
+        assert_eq!(r[0], (None, None));
+        assert_eq!(r[1], (None, None));
+        let mu0_max = d.tan() / (mu1 * sa).exp();
+        let mu1_max = (d.tan() / mu0).ln() / sa;
+        assert!(
+            r[2].0.is_none() && (r[2].1.unwrap() - mu0_max).abs() < 1e-6,
+            "{:?}",
+            r[2]
+        );
+        assert!(
+            r[3].0.is_none() && (r[3].1.unwrap() / mu1_max - 1.0).abs() < 1e-6,
+            "{:?}",
+            r[3]
+        );
+    }
+
+    /// K law c under stick/slip at ξ = 0.8 and 9.6538° (the lower end of the c-optimal
+    /// design's range): the c range found by bisection in c agrees with regime B found by the
+    /// scan in δ (`regime_b_interval`): just inside either end, the slope lies in regime B of
+    /// that c; just outside, it does not. The lower end lies above c = 0.45 (the bead stops
+    /// there when c is 10 % below the guess).
+    #[test]
+    fn klaw_c_steady_range_matches_regime_b() {
+        let p = problem(
+            DesignFit::KLaw,
+            Model::StickSlip,
+            CollisionLaw::C(0.5),
+            &[0.8],
+            0.4,
+            0.1,
+            JaegerBranch::Upper,
+        )
+        .unwrap();
+        let d = 9.6538f64.to_radians();
+        let (lo, hi) = p.steady_range(0, d, 0).unwrap();
+        let (lo, hi) = (lo.unwrap(), hi.unwrap());
+        assert!(lo > 0.45 && lo < 0.5 && hi > 0.5, "{lo} {hi}");
+        let inside = |c: f64| {
+            regime_b_interval(&Model::StickSlip, 0.8, 0.4, 0.1, CollisionLaw::C(c))
+                .is_some_and(|(a, b)| a < d && d < b)
+        };
+        for (end, dir) in [(lo, 1.0), (hi, -1.0)] {
+            assert!(inside(end + dir * 1e-4), "{end}");
+            assert!(!inside(end - dir * 1e-4), "{end}");
+        }
+    }
 }

@@ -39,9 +39,17 @@ fn summary(s: &DesignSettings, r: &DesignResult) -> String {
         None => format!("{} points per series", s.points),
         Some(n) => format!("{n} points in all (shared out by the design)"),
     };
+    let slope_error = if s.sigma_delta > 0.0 {
+        format!(
+            ", slope error sigma_delta {} deg (effective variance)",
+            fmt_sig(s.sigma_delta, 3)
+        )
+    } else {
+        String::new()
+    };
     let _ = writeln!(
         o,
-        "design: {crit}, {budget}, noise {}{}",
+        "design: {crit}, {budget}, noise {}{}{slope_error}",
         fmt_sig(s.noise, 3),
         if s.noise_absolute {
             " (absolute)"
@@ -82,6 +90,7 @@ fn summary(s: &DesignSettings, r: &DesignResult) -> String {
             slopes.join(", ")
         );
     }
+    steady_lines(&mut o, r);
     let _ = writeln!(
         o,
         "predicted standard errors (design / evenly spaced slopes):"
@@ -137,4 +146,39 @@ fn summary(s: &DesignSettings, r: &DesignResult) -> String {
     }
     let _ = writeln!(o, "equivalence gap: {}", fmt_sig(r.gap, 2));
     o
+}
+
+/// Per chosen slope, the range of each parameter over which it stays steady, the others at
+/// the guess.
+fn steady_lines(o: &mut String, r: &DesignResult) {
+    use std::fmt::Write as _;
+    if r.steady.iter().all(Vec::is_empty) {
+        return;
+    }
+    let _ = writeln!(
+        o,
+        "per chosen slope, the range of each parameter (the others at the guess) over which it \
+         stays steady (regime B):"
+    );
+    for (row, ranges) in r.rows.iter().zip(&r.steady) {
+        let ranges: Vec<String> = ranges
+            .iter()
+            .map(|(name, lo, hi)| {
+                let g = |x: f64| fmt_sig(x, 4);
+                match (lo, hi) {
+                    (Some(a), Some(b)) => format!("{name} {} to {}", g(*a), g(*b)),
+                    (Some(a), None) => format!("{name} >= {}", g(*a)),
+                    (None, Some(b)) => format!("{name} <= {}", g(*b)),
+                    (None, None) => format!("{name} any"),
+                }
+            })
+            .collect();
+        let _ = writeln!(
+            o,
+            "  xi {} at {} deg: {}",
+            fmt_f64(row.xi),
+            fmt_f64(row.delta_deg),
+            ranges.join("; ")
+        );
+    }
 }

@@ -610,6 +610,8 @@ impl Plan {
                 mcmc: None,
                 slope_errors: false,
                 scale_covar: false,
+                outliers: Vec::new(),
+                others_chi2: 0.0,
             },
             draws: None,
             correlation: None,

@@ -1188,6 +1188,8 @@ fn score_impact(model: Model, data: &Dataset, fit_name: String) -> KLawFit {
             mcmc: None,
             slope_errors: false,
             scale_covar: false,
+            outliers: Vec::new(),
+            others_chi2: 0.0,
         },
         draws: None,
         correlation: None,

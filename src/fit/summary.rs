@@ -176,6 +176,44 @@ pub struct StatsRow {
     /// (lmfit's `scale_covar=True`): standard errors and intervals are then those of relative
     /// σ.
     pub scale_covar: bool,
+    /// The points whose normalised residual exceeds 4 in magnitude, when they are few enough
+    /// to be outliers rather than a misfit of the whole curve (at most a fifth of the points,
+    /// σ given; see [`FitResult::attach_points`]), each described by its series, slope,
+    /// velocity and normalised residual.
+    pub outliers: Vec<String>,
+    /// χ² of the other points (the outliers' share left out), when there are outliers.
+    pub others_chi2: f64,
+}
+
+/// A point whose normalised residual exceeds this in magnitude is named as an outlier: with
+/// σ right and the model holding, one point in about 16,000 lies that far out (two-sided
+/// normal tail at 4σ: 6.3e-5).
+pub(crate) const OUTLIER_RESIDUAL: f64 = 4.0;
+
+/// Outliers are named only while they are at most this fraction of the points (at least
+/// one): beyond it the whole curve misses, or the units are wrong, and the misfit and unit
+/// warnings say so instead.
+const OUTLIER_SHARE: f64 = 0.2;
+
+/// The median of `r` and its robust standard deviation, 1.4826 × the median absolute
+/// deviation (the normal's σ for normal residuals), at least 1 (the σ the residuals are
+/// normalised by); (0, 1) for no residuals.
+fn robust_scale(r: &[f64]) -> (f64, f64) {
+    fn median(mut x: Vec<f64>) -> f64 {
+        if x.is_empty() {
+            return 0.0;
+        }
+        x.sort_by(f64::total_cmp);
+        let n = x.len();
+        if n % 2 == 1 {
+            x[n / 2]
+        } else {
+            0.5 * (x[n / 2 - 1] + x[n / 2])
+        }
+    }
+    let m = median(r.to_vec());
+    let mad = median(r.iter().map(|x| (x - m).abs()).collect());
+    (m, (1.4826 * mad).max(1.0))
 }
 
 /// A fit with σ given whose reduced χ² exceeds this is flagged ([`StatsRow::absurd_misfit`]):
@@ -240,6 +278,9 @@ impl StatsRow {
         if self.termination == "infeasible" {
             return None;
         }
+        if let Some(w) = self.outlier_warning() {
+            return Some(w);
+        }
         let p = self.chi2_p_value()?;
         (p < MISFIT_P_VALUE).then(|| {
             let p_text = if p == 0.0 {
@@ -260,6 +301,48 @@ impl StatsRow {
         })
     }
 
+    /// The outliers' warning, if the fit has outliers ([`StatsRow::outliers`]): the points
+    /// named, and the misfit of the others (their χ² and its tail probability).
+    pub fn outlier_warning(&self) -> Option<String> {
+        if self.outliers.is_empty() {
+            return None;
+        }
+        let n = self.outliers.len();
+        let rest = self.others_chi2;
+        let dof = self.dof.saturating_sub(n);
+        let others = if dof == 0 {
+            String::new()
+        } else {
+            use statrs::distribution::{ChiSquared, ContinuousCDF};
+            let p = ChiSquared::new(dof as f64).map_or(f64::NAN, |d| d.sf(rest));
+            format!(
+                "; the other points' chi2 at this fit, which {} pulls, = {} on {dof} degrees of \
+                 freedom (tail probability {}{})",
+                if n == 1 { "it" } else { "they" },
+                fmt_sig(rest, 5),
+                if p > 0.0 {
+                    fmt_sig(p, 2)
+                } else {
+                    "< 1e-300".into()
+                },
+                if p < MISFIT_P_VALUE {
+                    ": they misfit too, and the intervals, which assume the model holds, are \
+                     too narrow"
+                } else {
+                    ""
+                }
+            )
+        };
+        Some(format!(
+            "{n} outlier(s), |normalised residual| > {}: {}{others}; check {} (a misread \
+             velocity or slope, a run that did not reach its steady state) before trusting \
+             the intervals",
+            fmt_f64(OUTLIER_RESIDUAL),
+            self.outliers.join("; "),
+            if n == 1 { "that point" } else { "those points" }
+        ))
+    }
+
     /// This row with [`StatsRow::misfit_warning`] appended to its note, as every report of
     /// it (the command line's stats.csv, the report, Python) shows it.
     pub fn with_misfit_note(&self) -> StatsRow {
@@ -274,10 +357,17 @@ impl StatsRow {
     /// `ABSURD_REDUCED_CHI2` with σ given (with unit weights χ² is in the units of v̄ and
     /// says nothing of units); `None` for a law scored without fitting.
     pub fn absurd_misfit(&self) -> Option<String> {
+        // With outliers named, what the others leave is what could be a unit mistake.
+        let n = self.outliers.len();
+        let reduced = if n == 0 {
+            self.reduced_chi2
+        } else {
+            self.others_chi2 / self.dof.saturating_sub(n).max(1) as f64
+        };
         (self.sigma == SigmaKind::Absolute
             && self.n_params > 0
-            && self.reduced_chi2.is_finite()
-            && self.reduced_chi2 > ABSURD_REDUCED_CHI2)
+            && reduced.is_finite()
+            && reduced > ABSURD_REDUCED_CHI2)
             .then(|| {
                 format!(
                     "reduced chi2 = {} with sigma given (over {}): are the velocities \
@@ -526,6 +616,54 @@ impl FitResult {
                 }
             })
             .collect();
+        self.name_outliers();
+    }
+
+    /// Fills [`StatsRow::outliers`] from the points: with σ given, those whose normalised
+    /// residual exceeds `OUTLIER_RESIDUAL` (4) in magnitude and lies as many robust standard
+    /// deviations from the median residual (1.4826 × the median absolute deviation, at least
+    /// 1), while they are at most a fifth of the points (at least one). The second test keeps
+    /// the points that one far outlier drags off the curve from being named with it.
+    fn name_outliers(&mut self) {
+        self.stats.outliers.clear();
+        self.stats.others_chi2 = 0.0;
+        if self.stats.sigma != SigmaKind::Absolute || !self.stats.chi2.is_finite() {
+            return;
+        }
+        let r: Vec<f64> = self
+            .points
+            .iter()
+            .map(|p| p.normalised_residual)
+            .filter(|r| r.is_finite())
+            .collect();
+        let (centre, spread) = robust_scale(&r);
+        let far: Vec<&PointFit> = self
+            .points
+            .iter()
+            .filter(|p| {
+                let r = p.normalised_residual;
+                r.abs() > OUTLIER_RESIDUAL && (r - centre).abs() > OUTLIER_RESIDUAL * spread
+            })
+            .collect();
+        let most = ((OUTLIER_SHARE * self.points.len() as f64).floor() as usize).max(1);
+        if far.is_empty() || far.len() > most {
+            return;
+        }
+        self.stats.others_chi2 = self
+            .points
+            .iter()
+            .filter(|p| !far.iter().any(|q| std::ptr::eq(*q, *p)))
+            .map(|p| p.normalised_residual * p.normalised_residual)
+            .sum();
+        for p in far {
+            self.stats.outliers.push(format!(
+                "series '{}', delta {} deg, v {} (normalised residual {})",
+                crate::numfmt::clip(&p.series, crate::numfmt::ECHO_CHARS),
+                fmt_sig(p.delta_deg, 6),
+                fmt_sig(p.v, 6),
+                fmt_sig(p.normalised_residual, 3)
+            ));
+        }
     }
 }
 
@@ -814,6 +952,8 @@ pub(crate) fn summarise_with_profiles<R: Residuals + ?Sized>(
             mcmc: None,
             slope_errors: false,
             scale_covar: f.scale_covar && f.sigma == SigmaKind::Absolute,
+            outliers: Vec::new(),
+            others_chi2: 0.0,
         },
         draws: None,
         correlation: f

@@ -28,10 +28,11 @@ pub(crate) const DEFAULT_DATA: &str = include_str!("../../data/default.csv");
 /// The name the default data set goes by in messages.
 pub(crate) const DEFAULT_DATA_NAME: &str = "<embedded default data: data/default.csv>";
 
-/// Every column a measurement file may have (module docs), with `delta_true_deg` (the true
-/// slope `fitbead simulate` writes beside a noisy one, not read); any other passes through
-/// `fitbead k` and is otherwise unused ([`super::scenes::check_columns`]).
-pub(crate) const MEASUREMENT_COLUMNS: [&str; 13] = [
+/// Every column a measurement file may have (module docs), with the columns `fitbead simulate`
+/// writes beside them and no reader uses: `delta_true_deg` and `v_true` (the true slope and
+/// velocity beside noisy ones) and `v_md_stderr` (the molecular dynamics' standard error); any
+/// other passes through `fitbead k` and is otherwise unused ([`super::scenes::check_columns`]).
+pub(crate) const MEASUREMENT_COLUMNS: [&str; 15] = [
     "xi",
     "delta_deg",
     "series",
@@ -45,6 +46,8 @@ pub(crate) const MEASUREMENT_COLUMNS: [&str; 13] = [
     "f",
     "sigma_delta_deg",
     "delta_true_deg",
+    "v_true",
+    "v_md_stderr",
 ];
 
 /// Values for the columns a measurement file may leave out.
@@ -612,6 +615,18 @@ impl MeasurementFile {
             rows,
             dataset,
         })
+    }
+
+    /// The columns of the file that fitbead does not read, checked as the command line checks
+    /// a measurements file ([`crate::io::scenes::check_columns`]): with `strict`, the first of
+    /// them is an error; otherwise those that look like a misspelt or misnamed column (close
+    /// to a known name, or named like an uncertainty) are returned, for the caller to warn
+    /// about.
+    pub fn unknown_columns(
+        &self,
+        strict: bool,
+    ) -> Result<Vec<crate::io::scenes::UnknownColumn>, InputError> {
+        crate::io::scenes::check_columns(&self.table, &MEASUREMENT_COLUMNS, strict)
     }
 
     /// Parses and validates `bytes`, named `source` in errors.

@@ -483,10 +483,38 @@ impl std::fmt::Display for UnknownColumn {
     }
 }
 
+/// Where a column named like an uncertainty (`sigma…`, `err…`, `sd…`, `std…`, `unc…`, any
+/// case) is not one fitbead reads, the known uncertainty column that it most likely means:
+/// the first `sigma_X` of `known` whose `X` the table has (`sigma_v` beside `v`, `sigma_v_m_s`
+/// beside `v_m_s`: the velocity's, which `known` lists first), when the table lacks it. A σ
+/// under another name would otherwise leave the points unweighted without a word.
+fn uncertainty_column<'a>(
+    t: &(impl Header + ?Sized),
+    name: &str,
+    known: &[&'a str],
+) -> Option<&'a str> {
+    let lower = name.trim().to_ascii_lowercase();
+    let looks = ["sigma", "err", "sd", "std", "unc"]
+        .iter()
+        .any(|p| lower.starts_with(p));
+    if !looks {
+        return None;
+    }
+    known
+        .iter()
+        .copied()
+        .find(|k| {
+            k.strip_prefix("sigma_")
+                .is_some_and(|of| t.col(of).is_some())
+        })
+        .filter(|k| t.col(k).is_none())
+}
+
 /// The columns of `t` that none of `known` resolves to (`find_column`). With `strict`, the
 /// first of them is an error (line 1, naming the column and the nearest known name);
-/// otherwise those close to a known name are returned, for the caller to warn about (other
-/// columns pass through on purpose, e.g. an `id`).
+/// otherwise those close to a known name, or named like an uncertainty while the table lacks
+/// a known uncertainty column, are returned, for the caller to warn about (other columns pass
+/// through on purpose, e.g. an `id`).
 pub fn check_columns(
     t: &(impl Header + ?Sized),
     known: &[&str],
@@ -498,7 +526,9 @@ pub fn check_columns(
         if used.contains(&i) {
             continue;
         }
-        let near = nearest(h, known.iter().copied()).map(str::to_string);
+        let near = nearest(h, known.iter().copied())
+            .or_else(|| uncertainty_column(t, h, known))
+            .map(str::to_string);
         if strict {
             let mut message =
                 String::from("not a column fitbead reads (refused by --strict-columns)");

@@ -306,6 +306,59 @@ fn a_misspelt_column_is_warned_about_and_refused_when_strict() {
     expect(&out, 0, &["'rh0'", "did you mean 'rho'?"], "rh0");
 }
 
+/// A column named like an uncertainty, in a file without the uncertainty column it most
+/// likely means, is warned about with that name (`sigma_v` beside `v`, `sigma_v_m_s` beside
+/// `v_m_s`); the columns `simulate` writes beside the measurement pass `--strict-columns`.
+#[test]
+fn an_uncertainty_under_another_name_is_named_and_simulated_columns_pass() {
+    let dir = tmpdir();
+    for (name, text, means) in [
+        ("err.csv", DATA.replacen("sigma_v", "err_v", 1), "sigma_v"),
+        ("sd.csv", DATA.replacen("sigma_v", "SD", 1), "sigma_v"),
+        (
+            "si.csv",
+            "xi,delta_deg,v_m_s,R_m,stdev\n0.8,12,0.05,0.0025,0.001\n".to_string(),
+            "sigma_v_m_s",
+        ),
+    ] {
+        let p = write(&dir, name, &text);
+        let out = fb(&["k", "--model", "stick", s(&p)]);
+        let did = format!("did you mean '{means}'?");
+        expect(&out, 0, &[name, &did], name);
+    }
+    // With sigma_v present, an `err` column is one fitbead does not read, and says nothing.
+    let p = write(
+        &dir,
+        "both.csv",
+        "xi,delta_deg,v,sigma_v,err_note\n0.8,10.9354,0.2766,0.0057,x\n",
+    );
+    let out = fb(&["k", "--model", "stick", "--output", "/dev/null", s(&p)]);
+    assert!(!stderr(&out).contains("err_note"), "{}", stderr(&out));
+    let sim = fb(&[
+        "simulate",
+        "--model",
+        "stick",
+        "--series",
+        "1",
+        "--points",
+        "4",
+        "--sigma-delta",
+        "0.1",
+    ]);
+    expect(&sim, 0, &[], "simulate");
+    let p = write(&dir, "sim.csv", &String::from_utf8(sim.stdout).unwrap());
+    let out = fb(&[
+        "k",
+        "--model",
+        "stick",
+        "--strict-columns",
+        "--output",
+        "/dev/null",
+        s(&p),
+    ]);
+    expect(&out, 0, &[], "simulated columns under --strict-columns");
+}
+
 #[test]
 fn header_names_match_in_any_case_and_outputs_keep_canonical_names() {
     let dir = tmpdir();

@@ -621,13 +621,67 @@ fn sigma_below_rounding_is_refused_and_an_absurd_velocity_warned() {
         &["line 3", "column 'sigma_v'", "(1e200)"],
         "v 1e200",
     );
+    // One point at 1e10 is an outlier, named as one, not a unit mistake.
     let out = klaw(&default_with(d.path(), "big.csv", 3, "1e10"));
     assert!(out.status.success(), "{}", stderr(&out));
+    let err = stderr(&out);
     assert!(
-        stderr(&out).contains("warning: klaw-c [all]: reduced chi2 ="),
-        "{}",
-        stderr(&out)
+        err.contains("warning: klaw-c [all]: 1 outlier(s)")
+            && err.contains("series '0.8', delta 11.2709 deg, v 10000000000"),
+        "{err}"
     );
+    assert!(!err.contains("are the velocities dimensionless"), "{err}");
+}
+
+/// One velocity at 3× its value is named as an outlier by every fit it enters (series,
+/// slope, value and normalised residual), without a unit warning; every velocity at 100× is a
+/// unit mistake, warned as one, with no outlier named.
+#[test]
+fn one_outlier_is_named_and_a_unit_mistake_stays_one() {
+    let d = tmpdir();
+    let text = std::fs::read_to_string(crate::common::root().join("data/default.csv")).unwrap();
+    let scaled = |line: usize, by: f64| -> String {
+        let mut out = String::new();
+        for (i, l) in text.lines().enumerate() {
+            let mut c: Vec<String> = l.split(',').map(String::from).collect();
+            if i > 0 && (line == 0 || i == line) {
+                c[3] = (c[3].parse::<f64>().unwrap() * by).to_string();
+            }
+            out.push_str(&c.join(","));
+            out.push('\n');
+        }
+        out
+    };
+    // Line 6 of the file: series 0.8, δ = 12.613°.
+    let one = write(d.path(), "one.csv", &scaled(6, 3.0));
+    let all = write(d.path(), "all.csv", &scaled(0, 100.0));
+    for cmd in [&["klaw", "--model", "stick"][..], &["jan"]] {
+        let run = |p: &Path| {
+            let mut args = cmd.to_vec();
+            args.extend(["--no-profile", s(p), "--output", "/dev/null"]);
+            fb(d.path(), &args)
+        };
+        let cmd = cmd[0];
+        let out = run(&one);
+        let err = stderr(&out);
+        assert!(out.status.success(), "{err}");
+        let named = err
+            .lines()
+            .filter(|l| l.contains("1 outlier(s)") && l.contains("delta 12.613 deg"))
+            .count();
+        assert!(named >= 2, "{cmd}: {err}");
+        assert!(
+            !err.contains("are the velocities dimensionless"),
+            "{cmd}: {err}"
+        );
+        let out = run(&all);
+        let err = stderr(&out);
+        assert!(
+            err.contains("are the velocities dimensionless"),
+            "{cmd}: {err}"
+        );
+        assert!(!err.contains("outlier"), "{cmd}: {err}");
+    }
 }
 
 /// Runs `args` in `dir` for at most `limit`; the output and how long it took.

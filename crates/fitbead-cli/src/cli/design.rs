@@ -42,9 +42,19 @@ pub struct Args {
     #[arg(long, default_value = "0.02", value_parser = values::design_noise)]
     pub noise: (f64, bool),
     /// Slopes LO,HI in degrees, cut to regime B of the guess [default: regime B of the guess];
-    /// the design keeps 5 % of the range's width from either end.
+    /// the design keeps --margin of the range's width (and 2 --sigma-delta) from either end.
     #[arg(long, value_parser = values::slope_range)]
     pub delta_range: Option<SlopeRange>,
+    /// Standard uncertainty of a set slope, degrees: each point's variance becomes
+    /// σ_v² + (∂v̄/∂δ)² σ_δ² (the effective variance the fits with slope errors minimise), so
+    /// a slope where v̄ changes steeply tells less, and the range keeps 2 σ_δ from its ends so
+    /// that a slope set 2 σ_δ off is still steady at the guess. 0: exact slopes.
+    #[arg(long, value_name = "DEG", default_value_t = 0.0, value_parser = values::slope_sigma)]
+    pub sigma_delta: f64,
+    /// The fraction F of the range's width kept from each of its ends (0 <= F < 0.5; the
+    /// default keeps the 5 %–95 % over which `simulate` spreads its points).
+    #[arg(long, value_name = "F", default_value_t = DesignSettings::default().margin, value_parser = values::margin)]
+    pub margin: f64,
     /// Criterion: d (D-optimal: all parameters), c (the smallest variance of --target) or t
     /// (model discrimination against --vs).
     #[arg(long, default_value = "d", value_parser = values::choice::<Criterion>())]
@@ -197,6 +207,8 @@ fn settings(a: &Args) -> Result<DesignSettings, CliError> {
         draws: a.draws,
         seed: a.seed,
         total: a.total,
+        sigma_delta: a.sigma_delta,
+        margin: a.margin,
         ..DesignSettings::default()
     })
 }

@@ -423,6 +423,15 @@ pub(crate) fn slope_sigma(s: &str) -> Result<f64, Refusal> {
     )
 }
 
+/// The fraction of a design's range kept from each end: finite, ≥ 0 and < 0.5.
+pub(crate) fn margin(s: &str) -> Result<f64, Refusal> {
+    number(
+        s,
+        |x| x.is_finite() && (0.0..0.5).contains(&x),
+        "expected a fraction of the range's width with 0 <= F < 0.5",
+    )
+}
+
 /// Gravity g > 0, m/s².
 pub(crate) fn gravity(s: &str) -> Result<f64, Refusal> {
     number(s, |x| x.is_finite() && x > 0.0, "g must be > 0")

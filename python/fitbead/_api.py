@@ -939,6 +939,9 @@ class FitResult:
     def __init__(self, core: Any, context: Optional[Dict[str, Any]] = None) -> None:
         self._core = core
         self._context: Dict[str, Any] = dict(context or {})
+        # How to make the fit again at another level (conf_interval): the fit function and its
+        # keywords, for a fit made here (not kept by pickling or saving).
+        self._refit: Optional[Tuple[Any, Dict[str, Any]]] = None
         self.name, self.series = core.name()
         rows = [
             _param(r, b, fixed, start)
@@ -1387,9 +1390,12 @@ class FitResult:
                 keys[i]: (float(np.quantile(flat[:, i], (1 - prob) / 2)), float(np.quantile(flat[:, i], (1 + prob) / 2)))
                 for i in self._varying()
             }
-        refit = self._context.get("refit")
+        refit = self._refit
         if refit is None:
-            raise FitbeadError(f"{self.name}: conf_interval needs a fit made by fit_klaw, fit_jan or fit_jaeger")
+            raise FitbeadError(
+                f"{self.name}: conf_interval needs the fit as fit_klaw, fit_jan or fit_jaeger made it (an unpickled or "
+                "loaded fit cannot be made again)"
+            )
         func, kwargs = refit
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -1744,10 +1750,17 @@ def _same_series(fr: "FitResult", series: Any) -> bool:
     return xi is not None and len(xi) > 0 and bool(np.all(np.asarray(xi, dtype=float) == x))
 
 
-def _fitted(core: Any, context: Dict[str, Any]) -> FitResult:
+def _fitted(core: Any, context: Dict[str, Any], refit: Optional[Tuple[Any, Dict[str, Any]]] = None) -> FitResult:
     fr = FitResult(core, context)
+    fr._refit = refit
     fr._warn()
     return fr
+
+
+def _controlled(context: Dict[str, Any], scale_covar: bool) -> Dict[str, Any]:
+    """`context` with ``scale_covar`` where it is on (a context holds text, numbers and
+    booleans only: it is saved with the fit)."""
+    return {**context, "scale_covar": True} if scale_covar else context
 
 
 def _fit_data(
@@ -1972,7 +1985,7 @@ def fit_klaw(
         min_ess=min_ess, tol=tol, skip_unsteady=skip_unsteady, thin=thin, priors=priors, fit_scatter=fit_scatter,
         fix=fix, init=init, bounds=bounds, scale_covar=scale_covar,
     )
-    return _fitted(fits[0], {"model": _model_name(model), "scale_covar": scale_covar, "refit": (fit_klaw, again)})
+    return _fitted(fits[0], _controlled({"model": _model_name(model)}, scale_covar), (fit_klaw, again))
 
 
 def fit_jan(
@@ -2044,8 +2057,8 @@ def fit_jan(
         data=d, method=method, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps, min_ess=min_ess, thin=thin,
         priors=priors, fit_scatter=fit_scatter, fix=fix, init=init, bounds=bounds, scale_covar=scale_covar,
     )
-    context = {"scale_covar": scale_covar, "refit": (fit_jan, again)}
-    return FitSet([_fitted(x, context) for x in fits], notes)
+    context = _controlled({}, scale_covar)
+    return FitSet([_fitted(x, context, (fit_jan, again)) for x in fits], notes)
 
 
 def fit_jaeger(
@@ -2120,8 +2133,8 @@ def fit_jaeger(
         min_ess=min_ess, thin=thin, priors=priors, fit_scatter=fit_scatter, fix=fix, init=init, bounds=bounds,
         scale_covar=scale_covar,
     )
-    context = {"branch": branch, "scale_covar": scale_covar, "refit": (fit_jaeger, again)}
-    return FitSet([_fitted(x, context) for x in fits], notes)
+    context = _controlled({"branch": branch}, scale_covar)
+    return FitSet([_fitted(x, context, (fit_jaeger, again)) for x in fits], notes)
 
 
 class Design:

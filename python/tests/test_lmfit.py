@@ -204,3 +204,19 @@ def test_scale_covar_is_lmfits(data, scale_covar):
         assert fit.scale_covar == scale_covar
         if scale_covar:
             assert "covariance scaled by reduced chi-square" in fit.fit_report()
+
+
+def test_held_parameters_survive_pickling_and_saving(data, tmp_path):
+    import pickle
+
+    fits = quiet(fitbead.fit_jaeger, data, profile=False, fix={"a2": 0.0}, scale_covar=True)
+    fit = fits.get("jaeger", "1")
+    again = pickle.loads(pickle.dumps(fit))
+    assert again == fit and again.var_names == ["a1", "a3"] and again.scale_covar
+    assert not again.params["a2"].vary and again.init_values == fit.init_values
+    path = tmp_path / "fit.json"
+    fit.save(path)
+    loaded = fitbead.load(path)
+    assert loaded == fit and not loaded.params["a2"].vary
+    with pytest.raises(fitbead.FitbeadError, match="made again"):
+        loaded.conf_interval()

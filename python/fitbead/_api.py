@@ -821,6 +821,22 @@ class Param:
     ``prior-driven`` or ``prior-data conflict`` where it is flagged (MCMC)."""
     record: Dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
     """The whole row as the command line writes it (keys: params.csv's columns)."""
+    vary: bool = True
+    """False for a parameter held at its value (``fix``): no stderr or interval (lmfit's
+    ``vary``)."""
+    init_value: float = math.nan
+    """The value the least-squares fit started from (lmfit's ``init_value``; NaN where the
+    fit does not say)."""
+
+    @property
+    def min(self) -> float:
+        """Lower end of the parameter's box (lmfit's ``min``)."""
+        return self.bounds[0]
+
+    @property
+    def max(self) -> float:
+        """Upper end of the parameter's box (lmfit's ``max``)."""
+        return self.bounds[1]
 
     def _fields(self) -> Tuple[Any, ...]:
         return tuple(getattr(self, f) for f in self.__dataclass_fields__ if f != "record")
@@ -840,7 +856,7 @@ class Param:
         return hash(key(self._fields()))
 
 
-def _param(r: Dict[str, Any], bounds: Tuple[float, float]) -> Param:
+def _param(r: Dict[str, Any], bounds: Tuple[float, float], fixed: bool = False, start: Optional[float] = None) -> Param:
     """A :class:`Param` from one row of the parameter report (the keys of params.csv)."""
     return Param(
         name=r["parameter"],
@@ -877,6 +893,8 @@ def _param(r: Dict[str, Any], bounds: Tuple[float, float]) -> Param:
         likelihood_sensitivity=_nan(r["likelihood_sensitivity"]),
         prior_diagnosis=r["prior_diagnosis"] or "",
         record=dict(r),
+        vary=not fixed,
+        init_value=_nan(start),
     )
 
 
@@ -907,8 +925,12 @@ class FitResult:
     """One fit: parameters with errors and intervals, correlations, residuals, statistics.
 
     ``print(result)`` shows the fit report the command line prints; in a notebook the report
-    renders as HTML. The lmfit habits hold: :attr:`params` by name, :attr:`covar`,
-    :attr:`residual`, :meth:`eval`, :meth:`eval_band`, :meth:`fit_report`, :meth:`plot`. For
+    renders as HTML. The lmfit habits hold: :attr:`params` by name (``value``, ``stderr``,
+    ``vary``, ``min``, ``max``, ``init_value``), :attr:`covar`, :attr:`residual`,
+    :attr:`chisqr`, :attr:`redchi`, :attr:`nfev`, :attr:`success`, :attr:`ndata`,
+    :attr:`nvarys`, :attr:`nfree`, :attr:`var_names`, :attr:`best_fit`, :attr:`init_values`,
+    :meth:`eval`, :meth:`eval_band`, :meth:`eval_uncertainty`, :meth:`conf_interval`,
+    :meth:`fit_report`, :meth:`plot`. For
     an MCMC fit, :attr:`draws` holds the posterior draws and :meth:`to_arviz` makes an
     ``arviz.InferenceData`` with a pointwise log likelihood (so ``az.loo`` and
     ``az.compare`` work).
@@ -917,8 +939,14 @@ class FitResult:
     def __init__(self, core: Any, context: Optional[Dict[str, Any]] = None) -> None:
         self._core = core
         self._context: Dict[str, Any] = dict(context or {})
+        # How to make the fit again at another level (conf_interval): the fit function and its
+        # keywords, for a fit made here (not kept by pickling or saving).
+        self._refit: Optional[Tuple[Any, Dict[str, Any]]] = None
         self.name, self.series = core.name()
-        rows = [_param(r, b) for r, b in zip(core.params(), core.param_bounds())]
+        rows = [
+            _param(r, b, fixed, start)
+            for r, b, fixed, start in zip(core.params(), core.param_bounds(), core.param_fixed(), core.param_starts())
+        ]
         names = [p.name for p in rows]
         unique = len(set(names)) == len(names)
         self.params: Dict[str, Param] = {(p.name if unique else f"{p.name}[{p.series}]"): p for p in rows}
@@ -1016,16 +1044,25 @@ class FitResult:
 
     @property
     def covar(self) -> Optional[np.ndarray]:
-        """Covariance matrix of the parameters (order of :attr:`param_names`): from the
-        least-squares covariance, or of the posterior draws (MCMC); None where a standard
-        error is missing (an undetermined fit)."""
-        se = np.array([p.stderr for p in self.params.values()], dtype=float)
+        """Covariance matrix of the parameters that vary (order of :attr:`var_names`, as
+        lmfit's; every parameter unless some are held by ``fix``): from the least-squares
+        covariance, or of the posterior draws (MCMC); None where a standard error is missing
+        (an undetermined fit)."""
+        idx = self._varying()
+        se = np.array([list(self.params.values())[i].stderr for i in idx], dtype=float)
         if se.size == 0 or np.isnan(se).any():
             return None
-        r = self.correlation if self.correlation is not None else (np.eye(1) if se.size == 1 else None)
-        if r is None:
+        if self.correlation is not None:
+            r = self.correlation[np.ix_(idx, idx)]
+        elif se.size == 1:
+            r = np.eye(1)
+        else:
             return None
         return r * np.outer(se, se)
+
+    def _varying(self) -> List[int]:
+        """Positions in :attr:`params` of the parameters that vary."""
+        return [i for i, p in enumerate(self.params.values()) if p.vary]
 
     @property
     def residual(self) -> np.ndarray:
@@ -1068,6 +1105,72 @@ class FitResult:
     @property
     def converged(self) -> bool:
         return self.stats["converged"]
+
+    # ---- lmfit's names ----------------------------------------------------------------------
+
+    @property
+    def chisqr(self) -> float:
+        """χ² at the estimate (lmfit's name for :attr:`chi2`)."""
+        return self.chi2
+
+    @property
+    def redchi(self) -> float:
+        """χ²/dof (lmfit's name for :attr:`reduced_chi2`)."""
+        return self.reduced_chi2
+
+    @property
+    def nfev(self) -> int:
+        """Residual evaluations, profiles included (lmfit's ``nfev``)."""
+        return int(self.stats["residual_evals"])
+
+    @property
+    def success(self) -> bool:
+        """Whether the fit converged (lmfit's ``success``)."""
+        return bool(self.converged)
+
+    @property
+    def ndata(self) -> int:
+        """Number of data points (lmfit's ``ndata``)."""
+        return int(self.stats["n_points"])
+
+    @property
+    def nvarys(self) -> int:
+        """Number of parameters that vary (lmfit's ``nvarys``)."""
+        return len(self.var_names)
+
+    @property
+    def nfree(self) -> int:
+        """Degrees of freedom, ndata − free parameters (lmfit's ``nfree``)."""
+        return int(self.stats["dof"])
+
+    @property
+    def var_names(self) -> List[str]:
+        """Keys of the parameters that vary, in the fit's order (lmfit's ``var_names``; the
+        order of :attr:`covar`)."""
+        keys = list(self.params)
+        return [keys[i] for i in self._varying()]
+
+    @property
+    def best_fit(self) -> np.ndarray:
+        """The fitted v̄ at the data points (lmfit's ``best_fit``)."""
+        return np.asarray(self.residuals["v_fit"], dtype=float)
+
+    @property
+    def best_values(self) -> Dict[str, float]:
+        """``{key: value}`` of every parameter (lmfit's ``best_values``)."""
+        return {k: p.value for k, p in self.params.items()}
+
+    @property
+    def init_values(self) -> Dict[str, float]:
+        """``{key: start}`` of the parameters whose start the fit gives (lmfit's
+        ``init_values``: the fit's own start, or ``init``)."""
+        return {k: p.init_value for k, p in self.params.items() if not math.isnan(p.init_value)}
+
+    @property
+    def scale_covar(self) -> bool:
+        """Whether the covariance was scaled by the reduced χ² (``scale_covar=True``, or data
+        without sigma_v, whose scale is always estimated)."""
+        return bool(self._context.get("scale_covar", False)) or self.stats.get("sigma") == "estimated"
 
     def __getitem__(self, name: str) -> Param:
         return self.params[name]
@@ -1185,24 +1288,130 @@ class FitResult:
             lo = np.nanquantile(curves, (1 - level) / 2, axis=0)
             hi = np.nanquantile(curves, (1 + level) / 2, axis=0)
         else:
-            cov = self.covar
-            if cov is None:
-                raise FitbeadError(f"{self.name}: no covariance (an undetermined fit): no band")
-            keep = [i for i, p in enumerate(self.params.values()) if p.name != "sigma_scale"]
-            jac = np.zeros((len(keep), v.size))
-            for row, i in enumerate(keep):
-                h = 1e-4 * cov[i, i] ** 0.5 if cov[i, i] > 0 else 1e-8 * max(abs(theta0[i]), 1.0)
-                up, dn = theta0.copy(), theta0.copy()
-                up[i] += h
-                dn[i] -= h
-                jac[row] = (self._curve(up[None, :], x, d, lab)[0] - self._curve(dn[None, :], x, d, lab)[0]) / (2 * h)
-            c = cov[np.ix_(keep, keep)]
-            sd = np.sqrt(np.einsum("ip,ij,jp->p", jac, c, jac))
+            sd = self._curve_sd(theta0, x, d, lab)
             z = NormalDist().inv_cdf((1 + level) / 2)
             lo, hi = v - z * sd, v + z * sd
         t = Table(xi=x.reshape(shape), delta_deg=d.reshape(shape), v=v.reshape(shape), v_low=lo.reshape(shape), v_high=hi.reshape(shape))
         t.shape = shape
         return t
+
+    def _curve_sd(self, theta0: np.ndarray, x: np.ndarray, d: np.ndarray, lab: Optional[np.ndarray]) -> np.ndarray:
+        """σ of the curve at the points (x, d) by the delta method: sqrt(J C Jᵀ), J the
+        derivatives of v̄ in the parameters that vary (central differences, step 10⁻⁴
+        standard errors), C :attr:`covar`; the scatter's scale does not enter the curve."""
+        cov = self.covar
+        if cov is None:
+            raise FitbeadError(f"{self.name}: no covariance (an undetermined fit): no band")
+        names = [list(self.params.values())[i].name for i in self._varying()]
+        pos = self._varying()
+        keep = [k for k, n in enumerate(names) if n != "sigma_scale"]
+        jac = np.zeros((len(keep), x.size))
+        for row, k in enumerate(keep):
+            i = pos[k]
+            h = 1e-4 * cov[k, k] ** 0.5 if cov[k, k] > 0 else 1e-8 * max(abs(theta0[i]), 1.0)
+            up, dn = theta0.copy(), theta0.copy()
+            up[i] += h
+            dn[i] -= h
+            jac[row] = (self._curve(up[None, :], x, d, lab)[0] - self._curve(dn[None, :], x, d, lab)[0]) / (2 * h)
+        c = cov[np.ix_(keep, keep)]
+        return np.sqrt(np.einsum("ip,ij,jp->p", jac, c, jac))
+
+    def eval_uncertainty(
+        self, sigma: float = 1, delta_deg: Optional[ArrayLike] = None, xi: Optional[ArrayLike] = None, *, series: Optional[str] = None
+    ) -> np.ndarray:
+        """Half-widths of the confidence band of the fitted curve (lmfit's
+        ``eval_uncertainty``): ``scale · sqrt(J C Jᵀ)`` with J the derivatives of v̄ in the
+        parameters that vary and C :attr:`covar`, at the data points (default) or at
+        ``delta_deg`` (and ``xi``, ``series`` as in :meth:`eval`).
+
+        ``sigma`` ≥ 1 is a number of standard deviations (probability erf(sigma/√2): 0.6827,
+        0.9545, 0.9973 for 1, 2, 3), ``sigma`` < 1 the probability itself; the scale is the
+        Student-t quantile at (1 + probability)/2 on :attr:`nfree` degrees of freedom, as
+        lmfit's rule (whatever the σ convention of the covariance).
+
+        Returns
+        -------
+        numpy.ndarray
+            One half-width per point (``best_fit ± dely`` is the band at the data).
+        """
+        if not (sigma > 0):
+            raise FitbeadError(f"sigma = {sigma}: expected a number of standard deviations (≥ 1) or a probability in (0, 1)")
+        prob = float(sigma) if sigma < 1 else math.erf(sigma / math.sqrt(2))
+        if self.nfree < 1:
+            raise FitbeadError(f"{self.name}: no degree of freedom left: no band")
+        scale = _core.t_quantile((1 + prob) / 2, float(self.nfree))
+        if delta_deg is None:
+            r = self.residuals
+            x = np.asarray(r["xi"], dtype=float)
+            d = np.asarray(r["delta_deg"], dtype=float)
+            lab = np.asarray(r["series"], dtype=object) if self.name == "klaw-free-per-series" else None
+            shape = x.shape
+        else:
+            shape, x, d, lab = self._points(delta_deg, xi, series)
+        theta0 = np.array([p.value for p in self.params.values()])
+        return (scale * self._curve_sd(theta0, x, d, lab)).reshape(shape)
+
+    def conf_interval(self, sigmas: Sequence[float] = (1, 2, 3)) -> Dict[str, List[Tuple[float, float]]]:
+        """Profile-likelihood intervals of the parameters that vary at several levels, in
+        lmfit's shape: ``{key: [(p3, low3), (p2, low2), (p1, low1), (0.0, value), (p1,
+        high1), (p2, high2), (p3, high3)]}`` for probabilities p = erf(sigma/√2) (a sigma < 1
+        is the probability itself), sorted.
+
+        Under least squares each level is the fit's profile interval at that level (the fit is
+        made again per level): with σ given the end is where Δχ² reaches the χ²₁ quantile;
+        without σ, or with ``scale_covar=True``, where it reaches χ²_min/dof times the F₁,dof
+        quantile (lmfit's F-test). An end the likelihood does not reach within the search is
+        ±inf (as lmfit's), an end on the parameter's box is the bound. Under MCMC the central
+        posterior intervals of the draws.
+        """
+        probs = sorted(float(s) if s < 1 else math.erf(s / math.sqrt(2)) for s in sigmas)
+        if not probs or not all(0 < p < 1 for p in probs):
+            raise FitbeadError(f"sigmas = {list(sigmas)}: expected positive numbers of standard deviations or probabilities")
+        keys = self.var_names
+        ends: Dict[str, List[Tuple[float, float, float]]] = {k: [] for k in keys}
+        for p in probs:
+            for k, (lo, hi) in self._interval_at(p).items():
+                if k in ends:
+                    ends[k].append((p, lo, hi))
+        out = {}
+        for k in keys:
+            lows = [(p, lo) for p, lo, _ in ends[k]]
+            highs = [(p, hi) for p, _, hi in ends[k]]
+            out[k] = lows[::-1] + [(0.0, self.params[k].value)] + highs
+        return out
+
+    def _interval_at(self, prob: float) -> Dict[str, Tuple[float, float]]:
+        """(low, high) of every parameter that varies at level `prob` (see
+        :meth:`conf_interval`)."""
+        if self.draws is not None:
+            flat = self.draws.reshape(-1, self.draws.shape[-1])
+            keys = list(self.params)
+            return {
+                keys[i]: (float(np.quantile(flat[:, i], (1 - prob) / 2)), float(np.quantile(flat[:, i], (1 + prob) / 2)))
+                for i in self._varying()
+            }
+        refit = self._refit
+        if refit is None:
+            raise FitbeadError(
+                f"{self.name}: conf_interval needs the fit as fit_klaw, fit_jan or fit_jaeger made it (an unpickled or "
+                "loaded fit cannot be made again)"
+            )
+        func, kwargs = refit
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            again = func(**{**kwargs, "level": prob, "profile": True})
+        if isinstance(again, FitSet):
+            again = again.get(self.name, self.series)
+        if again is None:
+            raise FitbeadError(f"{self.name} [{self.series}]: the fit could not be made again at level {prob}")
+        out = {}
+        for k, p in again.params.items():
+            if not p.vary:
+                continue
+            lo = _profile_end(p.profile_low, p.profile_low_status, -math.inf)
+            hi = _profile_end(p.profile_high, p.profile_high_status, math.inf)
+            out[k] = (lo, hi)
+        return out
 
     # ---- reports --------------------------------------------------------------------------
 
@@ -1210,9 +1419,13 @@ class FitResult:
         """The fit report (the command line's text)."""
         return self._core.report()
 
-    def fit_report(self) -> str:
-        """The fit report (lmfit's name for :meth:`report`)."""
-        return self.report()
+    def fit_report(self, min_correl: float = 0.1) -> str:
+        """The fit report (lmfit's name for :meth:`report`), its correlations those above
+        ``min_correl`` in magnitude (the command line's report shows those above 0.1)."""
+        text = self.report()
+        if min_correl == 0.1:
+            return text
+        return _with_correlations(text, self.correlations, self.var_names, min_correl)
 
     def __str__(self) -> str:
         return self.report()
@@ -1324,8 +1537,10 @@ class FitResult:
 
         Parameters
         ----------
-        ax : sequence of two matplotlib Axes, optional
-            Where to draw (curve, residuals); default: a new figure.
+        ax : matplotlib Axes, or a sequence of two, optional
+            Where to draw: one Axes gets the data, curves and bands only (as lmfit's
+            ``plot_fit``); two get the curves and the residuals; default: a new figure with
+            both.
         level : float
             Level of the band.
 
@@ -1335,8 +1550,12 @@ class FitResult:
         """
         import matplotlib.pyplot as plt
 
+        single = ax is not None and hasattr(ax, "errorbar")
         if ax is None:
             fig, ax = plt.subplots(2, 1, sharex=True, height_ratios=[3, 1], figsize=(6.4, 5.6))
+        elif single:
+            fig = ax.figure
+            ax = [ax, None]
         else:
             fig = ax[0].figure
         r = self.residuals
@@ -1355,14 +1574,49 @@ class FitResult:
             if band is not None:
                 ax[0].plot(grid, band["v"], color=color, lw=1.2)
                 ax[0].fill_between(grid, band["v_low"], band["v_high"], color=color, alpha=0.2, lw=0)
-            ax[1].plot(d, np.asarray(r["normalised_residual"])[m], "o", ms=4, color=color)
-        ax[1].axhline(0, color="0.5", lw=0.8)
+            if ax[1] is not None:
+                ax[1].plot(d, np.asarray(r["normalised_residual"])[m], "o", ms=4, color=color)
         ax[0].set_ylabel("mean velocity v̄ / √(g(R+r))")
-        ax[1].set_ylabel("residual / σ")
-        ax[1].set_xlabel("slope δ (degrees)")
+        if ax[1] is not None:
+            ax[1].axhline(0, color="0.5", lw=0.8)
+            ax[1].set_ylabel("residual / σ")
+            ax[1].set_xlabel("slope δ (degrees)")
+        else:
+            ax[0].set_xlabel("slope δ (degrees)")
         ax[0].set_title(f"{self.name}" + (f" [{self.series}]" if self.series not in ("", "all") else "") + f", band {level:.0%}")
         ax[0].legend(fontsize="small")
         return fig
+
+
+def _profile_end(value: float, status: str, beyond: float) -> float:
+    """An end of a profile interval as lmfit's ``conf_interval`` gives it: the end found (or
+    the box's bound, or the edge of the feasible region), ±inf where the likelihood does not
+    fall to the level within the search."""
+    if status in ("found", "bound", "edge") and not math.isnan(value):
+        return float(value)
+    return beyond
+
+
+def _with_correlations(text: str, correlations: Dict[Tuple[str, str], float], names: Sequence[str], min_correl: float) -> str:
+    """The fit report `text` with its correlations section made again for the pairs of
+    `names` above `min_correl` in magnitude (the command line's format)."""
+    lines = text.split("\n")
+    start = next((i for i, ln in enumerate(lines) if ln.startswith("[[Correlations]]")), None)
+    if start is not None:
+        end = next((j for j in range(start + 1, len(lines)) if lines[j].startswith("[[")), len(lines))
+        del lines[start:end]
+        at = start
+    else:
+        at = next((i for i, ln in enumerate(lines) if ln.startswith("[[Warnings]]")), None)
+        if at is None:
+            at = len(lines) - 1 if lines and lines[-1] == "" else len(lines)
+    pairs = [(r, a, b) for (a, b), r in correlations.items() if a in names and b in names and abs(r) > min_correl]
+    pairs.sort(key=lambda t: -abs(t[0]))
+    if pairs:
+        block = [f"[[Correlations]] (unreported correlations are < {min_correl:g})"]
+        block += [f"    C({a}, {b}) = {r:+.4f}" for r, a, b in pairs]
+        lines[at:at] = block
+    return "\n".join(lines)
 
 
 class FitSet(list):
@@ -1496,10 +1750,17 @@ def _same_series(fr: "FitResult", series: Any) -> bool:
     return xi is not None and len(xi) > 0 and bool(np.all(np.asarray(xi, dtype=float) == x))
 
 
-def _fitted(core: Any, context: Dict[str, Any]) -> FitResult:
+def _fitted(core: Any, context: Dict[str, Any], refit: Optional[Tuple[Any, Dict[str, Any]]] = None) -> FitResult:
     fr = FitResult(core, context)
+    fr._refit = refit
     fr._warn()
     return fr
+
+
+def _controlled(context: Dict[str, Any], scale_covar: bool) -> Dict[str, Any]:
+    """`context` with ``scale_covar`` where it is on (a context holds text, numbers and
+    booleans only: it is saved with the fit)."""
+    return {**context, "scale_covar": True} if scale_covar else context
 
 
 def _fit_data(
@@ -1531,6 +1792,39 @@ def _priors(priors: Any) -> List[Tuple[str, str]]:
         if not sep:
             raise FitbeadError(f"prior = '{p}': expected NAME=DIST, e.g. 'c=normal(0.5,0.1)'")
         out.append((name.strip(), dist.strip()))
+    return out
+
+
+def _named_values(what: str, given: Any) -> List[Tuple[str, float]]:
+    """``fix`` or ``init`` as (name, value) pairs, from a mapping ``{"a2": 0.0}`` or pairs."""
+    if given is None:
+        return []
+    items = given.items() if isinstance(given, Mapping) else given
+    out = []
+    for item in items:
+        try:
+            name, value = item
+            out.append((str(name), float(value)))
+        except (TypeError, ValueError):
+            raise FitbeadError(f"{what} = {given!r}: expected {{name: value}}, e.g. {{'a2': 0.0}}") from None
+    return out
+
+
+def _named_bounds(given: Any) -> List[Tuple[str, Tuple[float, float]]]:
+    """``bounds`` as (name, (low, high)) pairs, from ``{"c": (0.3, 0.9)}``; None for an open
+    side."""
+    if given is None:
+        return []
+    items = given.items() if isinstance(given, Mapping) else given
+    out = []
+    for item in items:
+        try:
+            name, (lo, hi) = item
+            lo = -math.inf if lo is None else float(lo)
+            hi = math.inf if hi is None else float(hi)
+        except (TypeError, ValueError):
+            raise FitbeadError(f"bounds = {given!r}: expected {{name: (low, high)}}, e.g. {{'c': (0.3, 0.9)}}") from None
+        out.append((str(name), (lo, hi)))
     return out
 
 
@@ -1585,6 +1879,10 @@ def fit_klaw(
     g: Optional[float] = None,
     sigma_delta: Optional[float] = None,
     strict_columns: bool = False,
+    fix: Optional[Mapping[str, float]] = None,
+    init: Optional[Mapping[str, float]] = None,
+    bounds: Optional[Mapping[str, Tuple[Optional[float], Optional[float]]]] = None,
+    scale_covar: bool = False,
 ) -> FitResult:
     """A law K(α) fitted to every series at once (``fitbead klaw``).
 
@@ -1642,6 +1940,21 @@ def fit_klaw(
         A path, DataFrame or Table as ``data``: refuse any column fitbead does not read (the
         command line's ``--strict-columns``) instead of warning (:class:`ColumnWarning`) about
         those that look misnamed.
+    fix : mapping, optional
+        Parameters held at a value, ``{"a2": 0.0}`` (lmfit's ``vary=False``; the command
+        line's ``--fix``): ``NAME`` in every fit that has it, ``"NAME[SERIES]"`` in that
+        series' fit alone. A held parameter is not fitted: no stderr or interval, no degree
+        of freedom (``vary`` is False on its :class:`Param`).
+    init : mapping, optional
+        Starting values, ``{"c": 0.6}`` (``--init``), instead of the fit's own start; each
+        must lie in the parameter's box.
+    bounds : mapping, optional
+        Bounds, ``{"c": (0.3, 0.9)}`` (``--bounds``; None leaves a side open), intersected
+        with the parameter's box.
+    scale_covar : bool, default False
+        Least squares: scale the covariance by the reduced χ² even with sigma_v given, as
+        lmfit's ``scale_covar=True`` (``--scale-covar``); without sigma_v it is scaled
+        already.
 
     Returns
     -------
@@ -1663,10 +1976,16 @@ def fit_klaw(
     fits, notes, text = _core.fit_klaw(
         d._core, model=_model_name(model), law=law, method=method, level=level, profile=profile, seed=seed, walkers=walkers,
         max_steps=max_steps, min_ess=min_ess, tol=tol, thin=thin, priors=_priors(priors), fit_scatter=fit_scatter,
-        skip_unsteady=skip_unsteady, draws=_draws_wanted(draws, method),
+        skip_unsteady=skip_unsteady, draws=_draws_wanted(draws, method), fix=_named_values("fix", fix),
+        init=_named_values("init", init), bounds=_named_bounds(bounds), scale_covar=scale_covar,
     )
     _write_draws(draws, text)
-    return _fitted(fits[0], {"model": _model_name(model)})
+    again = dict(
+        data=d, model=model, law=law, method=method, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps,
+        min_ess=min_ess, tol=tol, skip_unsteady=skip_unsteady, thin=thin, priors=priors, fit_scatter=fit_scatter,
+        fix=fix, init=init, bounds=bounds, scale_covar=scale_covar,
+    )
+    return _fitted(fits[0], _controlled({"model": _model_name(model)}, scale_covar), (fit_klaw, again))
 
 
 def fit_jan(
@@ -1688,6 +2007,10 @@ def fit_jan(
     g: Optional[float] = None,
     sigma_delta: Optional[float] = None,
     strict_columns: bool = False,
+    fix: Optional[Mapping[str, float]] = None,
+    init: Optional[Mapping[str, float]] = None,
+    bounds: Optional[Mapping[str, Tuple[Optional[float], Optional[float]]]] = None,
+    scale_covar: bool = False,
 ) -> FitSet:
     """Jan's energy balance (eq 74): λ and μ per series (at least 3 points), then the global
     laws of eqs 75–76 (``fitbead jan``).
@@ -1708,6 +2031,9 @@ def fit_jan(
         MCMC settings, as in :func:`fit_klaw`.
     rho, f, g, sigma_delta, strict_columns : optional
         As in :func:`fit_klaw`.
+    fix, init, bounds, scale_covar
+        As in :func:`fit_klaw`; the names are ``lambda``, ``mu`` (per series) and
+        ``lambda0``, ``lambda1``, ``mu0``, ``mu1`` (the global laws).
 
     Returns
     -------
@@ -1724,9 +2050,15 @@ def fit_jan(
     fits, notes, text = _core.fit_jan(
         d._core, method=method, level=level, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps,
         min_ess=min_ess, thin=thin, priors=_priors(priors), fit_scatter=fit_scatter, draws=_draws_wanted(draws, method),
+        fix=_named_values("fix", fix), init=_named_values("init", init), bounds=_named_bounds(bounds), scale_covar=scale_covar,
     )
     _write_draws(draws, text)
-    return FitSet([_fitted(x, {}) for x in fits], notes)
+    again = dict(
+        data=d, method=method, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps, min_ess=min_ess, thin=thin,
+        priors=priors, fit_scatter=fit_scatter, fix=fix, init=init, bounds=bounds, scale_covar=scale_covar,
+    )
+    context = _controlled({}, scale_covar)
+    return FitSet([_fitted(x, context, (fit_jan, again)) for x in fits], notes)
 
 
 def fit_jaeger(
@@ -1749,6 +2081,10 @@ def fit_jaeger(
     g: Optional[float] = None,
     sigma_delta: Optional[float] = None,
     strict_columns: bool = False,
+    fix: Optional[Mapping[str, float]] = None,
+    init: Optional[Mapping[str, float]] = None,
+    bounds: Optional[Mapping[str, Tuple[Optional[float], Optional[float]]]] = None,
+    scale_covar: bool = False,
 ) -> FitSet:
     """Jaeger's heuristic law (eqs 80–84): a1, a2, a3 per series with at least 4 points
     (``fitbead jaeger``).
@@ -1771,6 +2107,9 @@ def fit_jaeger(
         MCMC settings, as in :func:`fit_klaw`.
     rho, f, g, sigma_delta, strict_columns : optional
         As in :func:`fit_klaw`.
+    fix, init, bounds, scale_covar
+        As in :func:`fit_klaw`; the names are ``a1``, ``a2``, ``a3`` (``fix={"a2": 0}`` is
+        Jan's law, eq 74).
 
     Returns
     -------
@@ -1786,9 +2125,16 @@ def fit_jaeger(
     fits, notes, text = _core.fit_jaeger(
         d._core, branch=branch, method=method, level=level, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps,
         min_ess=min_ess, thin=thin, priors=_priors(priors), fit_scatter=fit_scatter, draws=_draws_wanted(draws, method),
+        fix=_named_values("fix", fix), init=_named_values("init", init), bounds=_named_bounds(bounds), scale_covar=scale_covar,
     )
     _write_draws(draws, text)
-    return FitSet([_fitted(x, {"branch": branch}) for x in fits], notes)
+    again = dict(
+        data=d, branch=branch, method=method, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps,
+        min_ess=min_ess, thin=thin, priors=priors, fit_scatter=fit_scatter, fix=fix, init=init, bounds=bounds,
+        scale_covar=scale_covar,
+    )
+    context = _controlled({"branch": branch}, scale_covar)
+    return FitSet([_fitted(x, context, (fit_jaeger, again)) for x in fits], notes)
 
 
 class Design:

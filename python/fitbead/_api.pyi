@@ -275,13 +275,25 @@ class Param:
     record: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
     def __eq__(self, other: object) -> bool: ...
     def __hash__(self) -> int: ...
+    vary: bool = ...
+    init_value: float = ...
+    @property
+    def min(self) -> float:
+        """Lower end of the parameter's box (lmfit's ``min``)."""
+    @property
+    def max(self) -> float:
+        """Upper end of the parameter's box (lmfit's ``max``)."""
 
 class FitResult:
     """One fit: parameters with errors and intervals, correlations, residuals, statistics.
 
     ``print(result)`` shows the fit report the command line prints; in a notebook the report
-    renders as HTML. The lmfit habits hold: :attr:`params` by name, :attr:`covar`,
-    :attr:`residual`, :meth:`eval`, :meth:`eval_band`, :meth:`fit_report`, :meth:`plot`. For
+    renders as HTML. The lmfit habits hold: :attr:`params` by name (``value``, ``stderr``,
+    ``vary``, ``min``, ``max``, ``init_value``), :attr:`covar`, :attr:`residual`,
+    :attr:`chisqr`, :attr:`redchi`, :attr:`nfev`, :attr:`success`, :attr:`ndata`,
+    :attr:`nvarys`, :attr:`nfree`, :attr:`var_names`, :attr:`best_fit`, :attr:`init_values`,
+    :meth:`eval`, :meth:`eval_band`, :meth:`eval_uncertainty`, :meth:`conf_interval`,
+    :meth:`fit_report`, :meth:`plot`. For
     an MCMC fit, :attr:`draws` holds the posterior draws and :meth:`to_arviz` makes an
     ``arviz.InferenceData`` with a pointwise log likelihood (so ``az.loo`` and
     ``az.compare`` work).
@@ -311,9 +323,10 @@ class FitResult:
         evaluates a Jan, Jaeger or K-law ``c`` fit."""
     @property
     def covar(self) -> np.ndarray | None:
-        """Covariance matrix of the parameters (order of :attr:`param_names`): from the
-        least-squares covariance, or of the posterior draws (MCMC); None where a standard
-        error is missing (an undetermined fit)."""
+        """Covariance matrix of the parameters that vary (order of :attr:`var_names`, as
+        lmfit's; every parameter unless some are held by ``fix``): from the least-squares
+        covariance, or of the posterior draws (MCMC); None where a standard error is missing
+        (an undetermined fit)."""
     @property
     def residual(self) -> np.ndarray:
         """The normalised residuals (v − v̄_fit)/σ of the fitted points (lmfit's
@@ -336,6 +349,45 @@ class FitResult:
     def bic(self) -> float: ...
     @property
     def converged(self) -> bool: ...
+    @property
+    def chisqr(self) -> float:
+        """χ² at the estimate (lmfit's name for :attr:`chi2`)."""
+    @property
+    def redchi(self) -> float:
+        """χ²/dof (lmfit's name for :attr:`reduced_chi2`)."""
+    @property
+    def nfev(self) -> int:
+        """Residual evaluations, profiles included (lmfit's ``nfev``)."""
+    @property
+    def success(self) -> bool:
+        """Whether the fit converged (lmfit's ``success``)."""
+    @property
+    def ndata(self) -> int:
+        """Number of data points (lmfit's ``ndata``)."""
+    @property
+    def nvarys(self) -> int:
+        """Number of parameters that vary (lmfit's ``nvarys``)."""
+    @property
+    def nfree(self) -> int:
+        """Degrees of freedom, ndata − free parameters (lmfit's ``nfree``)."""
+    @property
+    def var_names(self) -> list[str]:
+        """Keys of the parameters that vary, in the fit's order (lmfit's ``var_names``; the
+        order of :attr:`covar`)."""
+    @property
+    def best_fit(self) -> np.ndarray:
+        """The fitted v̄ at the data points (lmfit's ``best_fit``)."""
+    @property
+    def best_values(self) -> dict[str, float]:
+        """``{key: value}`` of every parameter (lmfit's ``best_values``)."""
+    @property
+    def init_values(self) -> dict[str, float]:
+        """``{key: start}`` of the parameters whose start the fit gives (lmfit's
+        ``init_values``: the fit's own start, or ``init``)."""
+    @property
+    def scale_covar(self) -> bool:
+        """Whether the covariance was scaled by the reduced χ² (``scale_covar=True``, or data
+        without sigma_v, whose scale is always estimated)."""
     def __getitem__(self, name: str) -> Param: ...
     def eval(self, delta_deg: ArrayLike, xi: ArrayLike | None = None, *, series: str | None = None) -> np.ndarray:
         """The fitted model's mean velocity v̄ at new slopes (lmfit's ``eval``).
@@ -368,10 +420,40 @@ class FitResult:
         Table
             ``xi``, ``delta_deg``, ``v`` (the fit's curve), ``v_low``, ``v_high``.
         """
+    def eval_uncertainty(self, sigma: float = 1, delta_deg: ArrayLike | None = None, xi: ArrayLike | None = None, *, series: str | None = None) -> np.ndarray:
+        """Half-widths of the confidence band of the fitted curve (lmfit's
+        ``eval_uncertainty``): ``scale · sqrt(J C Jᵀ)`` with J the derivatives of v̄ in the
+        parameters that vary and C :attr:`covar`, at the data points (default) or at
+        ``delta_deg`` (and ``xi``, ``series`` as in :meth:`eval`).
+
+        ``sigma`` ≥ 1 is a number of standard deviations (probability erf(sigma/√2): 0.6827,
+        0.9545, 0.9973 for 1, 2, 3), ``sigma`` < 1 the probability itself; the scale is the
+        Student-t quantile at (1 + probability)/2 on :attr:`nfree` degrees of freedom, as
+        lmfit's rule (whatever the σ convention of the covariance).
+
+        Returns
+        -------
+        numpy.ndarray
+            One half-width per point (``best_fit ± dely`` is the band at the data).
+        """
+    def conf_interval(self, sigmas: Sequence[float] = (1, 2, 3)) -> dict[str, list[tuple[float, float]]]:
+        """Profile-likelihood intervals of the parameters that vary at several levels, in
+        lmfit's shape: ``{key: [(p3, low3), (p2, low2), (p1, low1), (0.0, value), (p1,
+        high1), (p2, high2), (p3, high3)]}`` for probabilities p = erf(sigma/√2) (a sigma < 1
+        is the probability itself), sorted.
+
+        Under least squares each level is the fit's profile interval at that level (the fit is
+        made again per level): with σ given the end is where Δχ² reaches the χ²₁ quantile;
+        without σ, or with ``scale_covar=True``, where it reaches χ²_min/dof times the F₁,dof
+        quantile (lmfit's F-test). An end the likelihood does not reach within the search is
+        ±inf (as lmfit's), an end on the parameter's box is the bound. Under MCMC the central
+        posterior intervals of the draws.
+        """
     def report(self) -> str:
         """The fit report (the command line's text)."""
-    def fit_report(self) -> str:
-        """The fit report (lmfit's name for :meth:`report`)."""
+    def fit_report(self, min_correl: float = 0.1) -> str:
+        """The fit report (lmfit's name for :meth:`report`), its correlations those above
+        ``min_correl`` in magnitude (the command line's report shows those above 0.1)."""
     def to_pandas(self, what: str = 'params'):
         '''A DataFrame (needs pandas) with the command line\'s columns and numeric dtypes
         (NaN for an empty cell).
@@ -400,8 +482,10 @@ class FitResult:
 
         Parameters
         ----------
-        ax : sequence of two matplotlib Axes, optional
-            Where to draw (curve, residuals); default: a new figure.
+        ax : matplotlib Axes, or a sequence of two, optional
+            Where to draw: one Axes gets the data, curves and bands only (as lmfit's
+            ``plot_fit``); two get the curves and the residuals; default: a new figure with
+            both.
         level : float
             Level of the band.
 
@@ -438,7 +522,7 @@ class FitSet(list):
         ``residuals`` or ``correlations``, with the command line's columns (its CSV of the
         whole run), numeric dtypes and NaN for empty cells."""
 
-def fit_klaw(data: Any = None, *, model: str = 'stickslip', law: str = 'c', method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None, tol: float = 1e-10, skip_unsteady: bool = False, thin: int | None = None, priors: Any = None, fit_scatter: bool = False, draws: Any = None, rho: float | None = None, f: float | None = None, g: float | None = None, sigma_delta: float | None = None, strict_columns: bool = False) -> FitResult:
+def fit_klaw(data: Any = None, *, model: str = 'stickslip', law: str = 'c', method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None, tol: float = 1e-10, skip_unsteady: bool = False, thin: int | None = None, priors: Any = None, fit_scatter: bool = False, draws: Any = None, rho: float | None = None, f: float | None = None, g: float | None = None, sigma_delta: float | None = None, strict_columns: bool = False, fix: Mapping[str, float] | None = None, init: Mapping[str, float] | None = None, bounds: Mapping[str, tuple[float | None, float | None]] | None = None, scale_covar: bool = False) -> FitResult:
     '''A law K(α) fitted to every series at once (``fitbead klaw``).
 
     Parameters
@@ -466,6 +550,14 @@ def fit_klaw(data: Any = None, *, model: str = 'stickslip', law: str = 'c', meth
     min_ess : float, optional
         MCMC: the bulk and tail ESS every parameter must reach (with rank-normalised split-R̂
         ≤ 1.01) before the run stops (default 1000).
+    fix, init, bounds : mapping, optional
+        Parameters held at a value (``{"c": 0.5}``, lmfit\'s ``vary=False``), started at a
+        value (``{"c": 0.6}``) or bounded (``{"c": (0.3, 0.9)}``) by name: ``NAME`` in every fit
+        that has it, ``"NAME[SERIES]"`` in that series\' fit alone (the command line\'s
+        ``--fix``, ``--init``, ``--bounds``).
+    scale_covar : bool, default False
+        Least squares: scale the covariance by the reduced χ² even with sigma_v given (lmfit\'s
+        ``scale_covar=True``, ``--scale-covar``).
 
     Returns
     -------
@@ -483,7 +575,7 @@ def fit_klaw(data: Any = None, *, model: str = 'stickslip', law: str = 'c', meth
     UnitWarning, ConvergenceWarning, BoundWarning
         The command line\'s warnings on the data and the fit.
     '''
-def fit_jan(data: Any = None, *, method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None, thin: int | None = None, priors: Any = None, fit_scatter: bool = False, draws: Any = None, rho: float | None = None, f: float | None = None, g: float | None = None, sigma_delta: float | None = None, strict_columns: bool = False) -> FitSet:
+def fit_jan(data: Any = None, *, method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None, thin: int | None = None, priors: Any = None, fit_scatter: bool = False, draws: Any = None, rho: float | None = None, f: float | None = None, g: float | None = None, sigma_delta: float | None = None, strict_columns: bool = False, fix: Mapping[str, float] | None = None, init: Mapping[str, float] | None = None, bounds: Mapping[str, tuple[float | None, float | None]] | None = None, scale_covar: bool = False) -> FitSet:
     '''Jan\'s energy balance (eq 74): λ and μ per series (at least 3 points), then the global
     laws of eqs 75–76 (``fitbead jan``).
 
@@ -512,7 +604,7 @@ def fit_jan(data: Any = None, *, method: str = 'lsq', level: float = 0.95, profi
     UnitWarning, ConvergenceWarning, BoundWarning
         The command line\'s warnings on the data and the fits.
     '''
-def fit_jaeger(data: Any = None, *, branch: str = 'upper', method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None, thin: int | None = None, priors: Any = None, fit_scatter: bool = False, draws: Any = None, rho: float | None = None, f: float | None = None, g: float | None = None, sigma_delta: float | None = None, strict_columns: bool = False) -> FitSet:
+def fit_jaeger(data: Any = None, *, branch: str = 'upper', method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None, thin: int | None = None, priors: Any = None, fit_scatter: bool = False, draws: Any = None, rho: float | None = None, f: float | None = None, g: float | None = None, sigma_delta: float | None = None, strict_columns: bool = False, fix: Mapping[str, float] | None = None, init: Mapping[str, float] | None = None, bounds: Mapping[str, tuple[float | None, float | None]] | None = None, scale_covar: bool = False) -> FitSet:
     '''Jaeger\'s heuristic law (eqs 80–84): a1, a2, a3 per series with at least 4 points
     (``fitbead jaeger``).
 

@@ -83,6 +83,8 @@ class _FitResult:
     def name(self) -> Tuple[str, str]: ...
     def params(self) -> List[Dict[str, Any]]: ...
     def param_bounds(self) -> List[Tuple[float, float]]: ...
+    def param_fixed(self) -> List[bool]: ...
+    def param_starts(self) -> List[Optional[float]]: ...
     def stats(self) -> Dict[str, Any]: ...
     def correlation(self) -> Optional[List[List[float]]]: ...
     def points(self) -> Dict[str, Any]: ...
@@ -110,6 +112,10 @@ def fit_klaw(
     fit_scatter: bool = False,
     skip_unsteady: bool = False,
     draws: bool = False,
+    fix: List[Tuple[str, float]] = ...,
+    init: List[Tuple[str, float]] = ...,
+    bounds: List[Tuple[str, Tuple[float, float]]] = ...,
+    scale_covar: bool = False,
 ) -> Tuple[List[_FitResult], List[str], Optional[bytes]]: ...
 def fit_jan(
     data: _Dataset,
@@ -124,6 +130,10 @@ def fit_jan(
     priors: List[Tuple[str, str]] = ...,
     fit_scatter: bool = False,
     draws: bool = False,
+    fix: List[Tuple[str, float]] = ...,
+    init: List[Tuple[str, float]] = ...,
+    bounds: List[Tuple[str, Tuple[float, float]]] = ...,
+    scale_covar: bool = False,
 ) -> Tuple[List[_FitResult], List[str], Optional[bytes]]: ...
 def fit_jaeger(
     data: _Dataset,
@@ -139,7 +149,12 @@ def fit_jaeger(
     priors: List[Tuple[str, str]] = ...,
     fit_scatter: bool = False,
     draws: bool = False,
+    fix: List[Tuple[str, float]] = ...,
+    init: List[Tuple[str, float]] = ...,
+    bounds: List[Tuple[str, Tuple[float, float]]] = ...,
+    scale_covar: bool = False,
 ) -> Tuple[List[_FitResult], List[str], Optional[bytes]]: ...
+def t_quantile(p: float, dof: float) -> float: ...
 def simulate(model: str = "stickslip", **settings: Any) -> str: ...
 def report(
     data: _Dataset, out_dir: Optional[str] = None, method: str = "lsq", **settings: Any

@@ -254,6 +254,8 @@ def fit_state(core: Any) -> Dict[str, Any]:
         "series": core.name()[1],
         "params": core.params(),
         "param_bounds": [tuple(b) for b in core.param_bounds()],
+        "param_fixed": list(core.param_fixed()),
+        "param_starts": list(core.param_starts()),
         "stats": core.stats(),
         "residuals": core.residual_records(),
         "correlations": core.correlation_records(),
@@ -284,6 +286,12 @@ class StoredFit:
 
     def param_bounds(self):
         return [tuple(b) for b in self._s["param_bounds"]]
+
+    def param_fixed(self):
+        return list(self._s["param_fixed"])
+
+    def param_starts(self):
+        return list(self._s["param_starts"])
 
     def stats(self):
         return dict(self._s["stats"])
@@ -363,11 +371,20 @@ def decode_fit(x: Any, where: str) -> Dict[str, Any]:
             "interrupted": _bool(_get(d, "interrupted", wd), f"{wd}.interrupted"),
         }
     stats = _records([g("stats")], w("stats"))[0]
+    # Which parameters were held and where each fit started (absent from a file saved before
+    # fits could hold parameters: none held, no start said).
+    n = len(bounds)
+    fixed = [_bool(v, w("param_fixed")) for v in _list(x.get("param_fixed", [False] * n), w("param_fixed"))]
+    starts = [_opt_float(v, w("param_starts")) for v in _list(x.get("param_starts", [None] * n), w("param_starts"))]
+    if len(fixed) != n or len(starts) != n:
+        raise _Bad(f"{where}: param_fixed and param_starts need one entry per parameter ({n})")
     return {
         "name": _text(g("name"), w("name")),
         "series": _text(g("series"), w("series")),
         "params": _records(g("params"), w("params")),
         "param_bounds": bounds,
+        "param_fixed": fixed,
+        "param_starts": starts,
         "stats": stats,
         "residuals": residuals,
         "correlations": _records(g("correlations"), w("correlations")),

@@ -1333,6 +1333,17 @@ impl PyFitResult {
         self.inner.params.iter().map(|p| p.bounds).collect()
     }
 
+    /// The value each parameter's least-squares fit started from (None where the fit does not
+    /// say), in the order of `params`.
+    fn param_starts(&self) -> Vec<Option<f64>> {
+        self.inner.params.iter().map(|p| p.start).collect()
+    }
+
+    /// Whether each parameter was held at its value (`fix`), in the order of `params`.
+    fn param_fixed(&self) -> Vec<bool> {
+        self.inner.params.iter().map(|p| p.fixed).collect()
+    }
+
     /// Fit statistics, keyed by the columns of the statistics report (stats.csv): the same
     /// record the command line writes; an empty cell is None.
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
@@ -1456,11 +1467,16 @@ struct MethodArgs {
     stop: Arc<AtomicBool>,
 }
 
-/// The keywords of the posterior runs that are not the sampler's options.
+/// The keywords of the posterior runs that are not the sampler's options, and the controls
+/// of the parameters (`fix`, `init`, `bounds`, `scale_covar`).
 struct Sampling {
     thin: Option<usize>,
     priors: Vec<(String, String)>,
     fit_scatter: bool,
+    fix: Vec<(String, f64)>,
+    init: Vec<(String, f64)>,
+    bounds: Vec<(String, (f64, f64))>,
+    scale_covar: bool,
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -1491,9 +1507,19 @@ fn method_args(
                 profile,
                 stop: Some(stop.clone()),
                 progress: None,
+                scale_covar: sampling.scale_covar,
+                fix: sampling.fix,
+                init: sampling.init,
+                bounds: sampling.bounds,
             }
         }
         "mcmc" => {
+            if sampling.scale_covar {
+                return Err(value_error(
+                    "scale_covar: applies to method = 'lsq' only (a posterior run has no \
+                     covariance to scale)",
+                ));
+            }
             let mut s = McmcSettings::seeded(seed);
             if let Some(w) = walkers {
                 s.options.walkers = Some(w);
@@ -1516,6 +1542,9 @@ fn method_args(
                 s.priors.push((name, prior));
             }
             s.fit_scatter = sampling.fit_scatter;
+            s.fix = sampling.fix;
+            s.init = sampling.init;
+            s.bounds = sampling.bounds;
             Method::Mcmc(Box::new(s))
         }
         _ => {
@@ -1633,7 +1662,7 @@ fn run_fit(
 /// A K(α) law fitted across series (see the Python `fitbead.fit_klaw`): the law's fit and the
 /// impact law's (unless the law is impact), the notes, and the draws CSV when `draws`.
 #[pyfunction]
-#[pyo3(signature = (data, model="stickslip", law="c", method="lsq", level=0.95, profile=true, seed=1, walkers=None, max_steps=None, min_ess=None, tol=1e-10, thin=None, priors=vec![], fit_scatter=false, skip_unsteady=false, draws=false))]
+#[pyo3(signature = (data, model="stickslip", law="c", method="lsq", level=0.95, profile=true, seed=1, walkers=None, max_steps=None, min_ess=None, tol=1e-10, thin=None, priors=vec![], fit_scatter=false, skip_unsteady=false, draws=false, fix=vec![], init=vec![], bounds=vec![], scale_covar=false))]
 #[allow(clippy::too_many_arguments)]
 fn fit_klaw(
     py: Python<'_>,
@@ -1653,6 +1682,10 @@ fn fit_klaw(
     fit_scatter: bool,
     skip_unsteady: bool,
     draws: bool,
+    fix: Vec<(String, f64)>,
+    init: Vec<(String, f64)>,
+    bounds: Vec<(String, (f64, f64))>,
+    scale_covar: bool,
 ) -> PyResult<Fitted> {
     let (_, auto) = k_model(model, tol)?;
     let kind = if auto.is_some() {
@@ -1675,6 +1708,10 @@ fn fit_klaw(
         thin,
         priors,
         fit_scatter,
+        fix,
+        init,
+        bounds,
+        scale_covar,
     };
     let a = method_args(
         method, level, profile, seed, walkers, max_steps, min_ess, sampling,
@@ -1684,7 +1721,7 @@ fn fit_klaw(
 
 /// Jan's λ and μ per series and the global laws (see the Python `fitbead.fit_jan`).
 #[pyfunction]
-#[pyo3(signature = (data, method="lsq", level=0.95, profile=true, seed=1, walkers=None, max_steps=None, min_ess=None, thin=None, priors=vec![], fit_scatter=false, draws=false))]
+#[pyo3(signature = (data, method="lsq", level=0.95, profile=true, seed=1, walkers=None, max_steps=None, min_ess=None, thin=None, priors=vec![], fit_scatter=false, draws=false, fix=vec![], init=vec![], bounds=vec![], scale_covar=false))]
 #[allow(clippy::too_many_arguments)]
 fn fit_jan(
     py: Python<'_>,
@@ -1700,12 +1737,20 @@ fn fit_jan(
     priors: Vec<(String, String)>,
     fit_scatter: bool,
     draws: bool,
+    fix: Vec<(String, f64)>,
+    init: Vec<(String, f64)>,
+    bounds: Vec<(String, (f64, f64))>,
+    scale_covar: bool,
 ) -> PyResult<Fitted> {
     let command = FitCommand::Jan;
     let sampling = Sampling {
         thin,
         priors,
         fit_scatter,
+        fix,
+        init,
+        bounds,
+        scale_covar,
     };
     let a = method_args(
         method, level, profile, seed, walkers, max_steps, min_ess, sampling,
@@ -1715,7 +1760,7 @@ fn fit_jan(
 
 /// Jaeger's a1–a3 per series (see the Python `fitbead.fit_jaeger`).
 #[pyfunction]
-#[pyo3(signature = (data, branch="upper", method="lsq", level=0.95, profile=true, seed=1, walkers=None, max_steps=None, min_ess=None, thin=None, priors=vec![], fit_scatter=false, draws=false))]
+#[pyo3(signature = (data, branch="upper", method="lsq", level=0.95, profile=true, seed=1, walkers=None, max_steps=None, min_ess=None, thin=None, priors=vec![], fit_scatter=false, draws=false, fix=vec![], init=vec![], bounds=vec![], scale_covar=false))]
 #[allow(clippy::too_many_arguments)]
 fn fit_jaeger(
     py: Python<'_>,
@@ -1732,6 +1777,10 @@ fn fit_jaeger(
     priors: Vec<(String, String)>,
     fit_scatter: bool,
     draws: bool,
+    fix: Vec<(String, f64)>,
+    init: Vec<(String, f64)>,
+    bounds: Vec<(String, (f64, f64))>,
+    scale_covar: bool,
 ) -> PyResult<Fitted> {
     let b: JaegerBranch = branch
         .parse()
@@ -1741,11 +1790,29 @@ fn fit_jaeger(
         thin,
         priors,
         fit_scatter,
+        fix,
+        init,
+        bounds,
+        scale_covar,
     };
     let a = method_args(
         method, level, profile, seed, walkers, max_steps, min_ess, sampling,
     )?;
     run_fit(py, data, command, a, draws, false)
+}
+
+/// The quantile at probability `p` of Student's t on `dof` degrees of freedom (the scale of
+/// `FitResult.eval_uncertainty`, as lmfit's).
+#[pyfunction]
+fn t_quantile(p: f64, dof: f64) -> PyResult<f64> {
+    use statrs::distribution::{ContinuousCDF, StudentsT};
+    if !(p > 0.0 && p < 1.0) {
+        return Err(value_error(format!(
+            "p = {p}: expected a probability in (0, 1)"
+        )));
+    }
+    let t = StudentsT::new(0.0, 1.0, dof).map_err(|e| value_error(format!("dof = {dof}: {e}")))?;
+    Ok(t.inverse_cdf(p))
 }
 
 /// The columns of records `R`: the keys [`Cell::each`] visits, in order.
@@ -2072,6 +2139,10 @@ fn report(
                 profile: true,
                 stop: Some(stop.clone()),
                 progress: None,
+                scale_covar: false,
+                fix: Vec::new(),
+                init: Vec::new(),
+                bounds: Vec::new(),
             }
         }
         "mcmc" => {
@@ -2230,6 +2301,7 @@ fn _fitbead(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fit_klaw, m)?)?;
     m.add_function(wrap_pyfunction!(fit_jan, m)?)?;
     m.add_function(wrap_pyfunction!(fit_jaeger, m)?)?;
+    m.add_function(wrap_pyfunction!(t_quantile, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
     m.add_function(wrap_pyfunction!(record_columns, m)?)?;
     m.add_function(wrap_pyfunction!(output_columns, m)?)?;

@@ -21,11 +21,15 @@ use crate::inverse::posterior::{McmcSettings, Method};
 use crate::inverse::DEFAULT_LEVEL;
 use crate::models::{JaegerBranch, Model};
 
-/// The method and level every builder shares.
+/// The method, level and parameter controls every builder shares.
 #[derive(Debug, Clone)]
 struct Common {
     level: f64,
     method: Method,
+    fix: Vec<(String, f64)>,
+    init: Vec<(String, f64)>,
+    bounds: Vec<(String, (f64, f64))>,
+    scale_covar: bool,
 }
 
 impl Default for Common {
@@ -33,19 +37,57 @@ impl Default for Common {
         Common {
             level: DEFAULT_LEVEL,
             method: Method::lsq(true),
+            fix: Vec::new(),
+            init: Vec::new(),
+            bounds: Vec::new(),
+            scale_covar: false,
         }
     }
 }
 
 impl Common {
-    /// Refuses a level outside (0, 1) and a method that cannot fit `data`.
-    fn check(&self, data: &Dataset) -> Result<(), FitError> {
+    /// The method with the controls set on the builder.
+    fn method(&self) -> Method {
+        let mut m = self.method.clone();
+        match &mut m {
+            Method::Lsq {
+                fix,
+                init,
+                bounds,
+                scale_covar,
+                ..
+            } => {
+                fix.clone_from(&self.fix);
+                init.clone_from(&self.init);
+                bounds.clone_from(&self.bounds);
+                *scale_covar = self.scale_covar;
+            }
+            Method::Mcmc(s) => {
+                s.fix.clone_from(&self.fix);
+                s.init.clone_from(&self.init);
+                s.bounds.clone_from(&self.bounds);
+            }
+        }
+        m
+    }
+
+    /// Refuses a level outside (0, 1), a method that cannot fit `data`, a control of a
+    /// parameter not among `params` (or of a series not in `data`), and the covariance
+    /// scaled under a posterior run.
+    fn check(&self, data: &Dataset, params: &[&str]) -> Result<Method, FitError> {
         if !(self.level > 0.0 && self.level < 1.0) {
             return Err(FitError::Level(self.level));
         }
-        match super::slopes::unsupported(&self.method, data) {
+        if self.scale_covar && matches!(self.method, Method::Mcmc(_)) {
+            return Err(FitError::Method(
+                "scale_covar applies to least squares only".into(),
+            ));
+        }
+        let method = self.method();
+        super::controls::Controls::of(&method).check(params, &data.labels)?;
+        match super::slopes::unsupported(&method, data) {
             Some(why) => Err(FitError::Method(why)),
-            None => Ok(()),
+            None => Ok(method),
         }
     }
 }
@@ -68,6 +110,35 @@ macro_rules! common_setters {
         /// A posterior run (started from the least-squares optimum) instead of least squares.
         pub fn mcmc(mut self, settings: McmcSettings) -> Self {
             self.common.method = Method::Mcmc(Box::new(settings));
+            self
+        }
+
+        /// Holds parameter `name` at `value` (lmfit's `vary=False`): `NAME` in every fit that
+        /// has it, `NAME[SERIES]` in that series' fit alone. It is not fitted: no standard
+        /// error or interval, no degree of freedom.
+        pub fn fix(mut self, name: &str, value: f64) -> Self {
+            self.common.fix.push((name.to_string(), value));
+            self
+        }
+
+        /// Starts parameter `name` (`NAME` or `NAME[SERIES]`) at `value` instead of the fit's
+        /// own start; the value must lie in the parameter's box.
+        pub fn init(mut self, name: &str, value: f64) -> Self {
+            self.common.init.push((name.to_string(), value));
+            self
+        }
+
+        /// Bounds parameter `name` (`NAME` or `NAME[SERIES]`) to [`lower`, `upper`],
+        /// intersected with its box.
+        pub fn bounds(mut self, name: &str, lower: f64, upper: f64) -> Self {
+            self.common.bounds.push((name.to_string(), (lower, upper)));
+            self
+        }
+
+        /// Scales the covariance by the reduced χ² even with σ given (lmfit's
+        /// `scale_covar=True`; least squares only).
+        pub fn scale_covar(mut self, scale: bool) -> Self {
+            self.common.scale_covar = scale;
             self
         }
     };
@@ -96,14 +167,13 @@ impl KLawFitter {
 
     /// Fits the law to `data` (the impact law, with nothing to fit, is scored).
     pub fn fit(&self, data: &Dataset) -> Result<FitResult, FitError> {
-        self.common.check(data)?;
-        let f = fit_law_with(
-            self.model,
-            data,
-            self.law,
-            self.common.level,
-            &self.common.method,
-        )?;
+        let params: &[&str] = match self.law {
+            KLaw::C => &["c"],
+            KLaw::FreePerSeries => &["K"],
+            KLaw::Impact => &[],
+        };
+        let method = self.common.check(data, params)?;
+        let f = fit_law_with(self.model, data, self.law, self.common.level, &method)?;
         Ok(f.summary)
     }
 }
@@ -124,8 +194,12 @@ impl JanFitter {
 
     /// Fits every series with at least 3 points, then the global laws.
     pub fn fit(&self, data: &Dataset) -> Result<FitSet, FitError> {
-        self.common.check(data)?;
-        let j = fit_jan_with(data, self.common.level, &self.common.method);
+        let params = ["lambda", "mu", "lambda0", "lambda1", "mu0", "mu1"];
+        let method = self.common.check(data, &params)?;
+        let j = fit_jan_with(data, self.common.level, &method);
+        if let Some(e) = j.fault {
+            return Err(e.into());
+        }
         Ok(FitSet {
             fits: j.series.into_iter().flatten().chain(j.global).collect(),
             notes: j.notes,
@@ -159,8 +233,11 @@ impl JaegerFitter {
 
     /// Fits every series with at least 4 points.
     pub fn fit(&self, data: &Dataset) -> Result<FitSet, FitError> {
-        self.common.check(data)?;
-        let j = fit_jaeger_with(data, self.branch, self.common.level, &self.common.method);
+        let method = self.common.check(data, &["a1", "a2", "a3"])?;
+        let j = fit_jaeger_with(data, self.branch, self.common.level, &method);
+        if let Some(e) = j.fault {
+            return Err(e.into());
+        }
         Ok(FitSet {
             fits: j.series.into_iter().flatten().map(|f| f.summary).collect(),
             notes: j.notes,

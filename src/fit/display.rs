@@ -47,6 +47,13 @@ fn param_line(f: &mut fmt::Formatter<'_>, r: &FitResult, p: &ParamRow) -> fmt::R
         format!("{}[{}]", p.parameter, clip(&p.series, LABEL_CHARS))
     };
     write!(f, "    {name:<12} = {:>12}", num(p.value))?;
+    if p.fixed {
+        write!(f, " (fixed)")?;
+        if let Some(pv) = p.paper_value {
+            write!(f, "  paper: {}", num(pv))?;
+        }
+        return writeln!(f);
+    }
     match p.stderr {
         Some(se) if se.is_finite() => {
             write!(f, " +/- {:<10}", num(se))?;
@@ -91,6 +98,9 @@ impl fmt::Display for FitResult {
             f,
             "    sigma              = {}",
             match s.sigma {
+                SigmaKind::Absolute if s.scale_covar => {
+                    "given (relative weights): covariance scaled by reduced chi-square"
+                }
                 SigmaKind::Absolute => "given (absolute errors)",
                 SigmaKind::Relative => "not given: unit weights, scale from the scatter",
             }

@@ -20,4 +20,26 @@ pub enum FitError {
     /// A parameter name that the fit does not have.
     #[error(transparent)]
     NoSuchParameter(#[from] NoSuchParameter),
+    /// A control of the parameters (held, started or bounded) that cannot be used on these
+    /// data: the command line's flag (`--fix`, `--init`, `--bounds`), the control as given
+    /// (`NAME=VALUE`) and why.
+    #[error("{flag} {value}: {reason}")]
+    Setting {
+        /// The flag.
+        flag: String,
+        /// The control as given.
+        value: String,
+        /// Why it cannot be used.
+        reason: String,
+    },
+}
+
+impl From<super::controls::ControlError> for FitError {
+    fn from(e: super::controls::ControlError) -> Self {
+        FitError::Setting {
+            flag: e.flag.to_string(),
+            value: e.value,
+            reason: e.reason,
+        }
+    }
 }

@@ -21,6 +21,7 @@
 //! (the velocity at the series' mean slope, the slope of the law there and a shape), where the
 //! ridge of a1 and a2 is straight; priors, draws and reported values are those of a1, a2, a3.
 
+use super::controls::{ControlError, Controls, Parameters, Plan};
 use super::data::Dataset;
 use super::jaeger_coordinates::JaegerCoordinates;
 pub(crate) use super::jaeger_coordinates::JaegerX;
@@ -121,6 +122,8 @@ pub(crate) struct JaegerFits {
     pub series: Vec<Option<JaegerFit>>,
     /// Why a fit was not made.
     pub notes: Vec<String>,
+    /// A control of the method (`fix`, `init`, `bounds`) that cannot be used on these data.
+    pub fault: Option<ControlError>,
 }
 
 fn chi2(model: &JaegerModel, x: &[JaegerX], y: &[f64], s: &[f64], p: &[f64]) -> f64 {
@@ -135,15 +138,32 @@ fn chi2(model: &JaegerModel, x: &[JaegerX], y: &[f64], s: &[f64], p: &[f64]) -> 
 }
 
 /// The derived start (module docs).
+#[cfg(test)]
 pub(crate) fn start(model: &JaegerModel, x: &[JaegerX], y: &[f64], s: &[f64]) -> Option<[f64; 3]> {
+    start_held(model, x, y, s, [None; 3])
+}
+
+/// The derived start with the parameters of `held` at their values: the grid of a2 is the
+/// value held, and a held a1 or a3 leaves the other fitted alone.
+pub(crate) fn start_held(
+    model: &JaegerModel,
+    x: &[JaegerX],
+    y: &[f64],
+    s: &[f64],
+    held: [Option<f64>; 3],
+) -> Option<[f64; 3]> {
     let xx: Vec<f64> = x
         .iter()
         .zip(y)
         .map(|(q, v)| v * v * q.2 / (2.0 * q.1))
         .collect();
     let mut best: Option<([f64; 3], f64)> = None;
-    let grid =
-        std::iter::once(0.0).chain((0..=60).map(|i| 10f64.powf(-2.0 + 6.0 * i as f64 / 60.0)));
+    let grid: Vec<f64> = match held[1] {
+        Some(a2) => vec![a2],
+        None => std::iter::once(0.0)
+            .chain((0..=60).map(|i| 10f64.powf(-2.0 + 6.0 * i as f64 / 60.0)))
+            .collect(),
+    };
     for a2 in grid {
         // tan δ = a1 · 1/(1 + a2 X) + a3 · X: normal equations of the 2 × 2 problem.
         let (mut s11, mut s12, mut s22, mut b1, mut b2) = (0.0, 0.0, 0.0, 0.0, 0.0);
@@ -155,12 +175,20 @@ pub(crate) fn start(model: &JaegerModel, x: &[JaegerX], y: &[f64], s: &[f64]) ->
             b1 += c1 * q.0;
             b2 += c2 * q.0;
         }
-        let d = s11 * s22 - s12 * s12;
-        if !(d.abs() > 0.0) {
-            continue;
-        }
-        let a1 = ((s22 * b1 - s12 * b2) / d).max(0.0);
-        let a3 = (s11 * b2 - s12 * b1) / d;
+        let (a1, a3) = match (held[0], held[2]) {
+            (None, None) => {
+                let d = s11 * s22 - s12 * s12;
+                if !(d.abs() > 0.0) {
+                    continue;
+                }
+                ((s22 * b1 - s12 * b2) / d, (s11 * b2 - s12 * b1) / d)
+            }
+            // One of the pair held: the other by its own normal equation.
+            (Some(a1), None) => (a1, (b2 - s12 * a1) / s22),
+            (None, Some(a3)) => ((b1 - s12 * a3) / s11, a3),
+            (Some(a1), Some(a3)) => (a1, a3),
+        };
+        let a1 = if held[0].is_some() { a1 } else { a1.max(0.0) };
         if !(a3 > 0.0) {
             continue;
         }
@@ -187,21 +215,73 @@ pub(crate) fn fit_jaeger_with(
         fit_jaeger_series(data, s, label, model, level, method)
     });
     let mut notes = Vec::new();
+    let mut fault = None;
     let mut series = Vec::with_capacity(fits.len());
     for r in fits {
         match r {
             Ok(f) => series.push(Some(f)),
-            Err(Unfitted(note)) => {
+            Err(Unfitted::Note(note)) => {
                 notes.push(note);
+                series.push(None);
+            }
+            Err(Unfitted::Control(e)) => {
+                fault = fault.or(Some(e));
                 series.push(None);
             }
         }
     }
-    JaegerFits { series, notes }
+    JaegerFits {
+        series,
+        notes,
+        fault,
+    }
 }
 
-/// Why a series was not fitted, as its note (`series 'LABEL': …`).
-struct Unfitted(String);
+/// Why a series was not fitted: its note (`series 'LABEL': …`), or a control of the method
+/// that cannot be used on it.
+enum Unfitted {
+    Note(String),
+    Control(ControlError),
+}
+
+impl From<ControlError> for Unfitted {
+    fn from(e: ControlError) -> Self {
+        Unfitted::Control(e)
+    }
+}
+
+/// The parameters a1, a2, a3 with the paper's Fig. 9 values where ξ is one of its series.
+fn specs(xi: f64) -> [ParamSpec; 3] {
+    let paper = paper_values(xi);
+    let src = if paper.is_some() { "paper Fig. 9" } else { "" };
+    let mut specs = [("a1", 10.0), ("a2", 100.0), ("a3", 10.0)].map(|(name, scale)| ParamSpec {
+        name,
+        unit: "1 (Jaeger units, eq 81)",
+        paper_value: None,
+        paper_source: src,
+        default_prior: Some(Prior::half_normal(scale)),
+    });
+    if let Some(pv) = paper {
+        for k in 0..3 {
+            specs[k].paper_value = Some(pv[k]);
+        }
+    }
+    specs
+}
+
+/// Jaeger's abscissae (tan δ, cos δ, ε), the velocities and their σ of the points `pts`.
+fn series_data(pts: &[&super::data::Point]) -> (Vec<JaegerX>, Vec<f64>, Vec<f64>) {
+    let x = pts
+        .iter()
+        .map(|p| {
+            let (sd, cd) = p.scene.delta.sin_cos();
+            (sd / cd, cd, p.scene.eps)
+        })
+        .collect();
+    let y = pts.iter().map(|p| p.v).collect();
+    let sg = pts.iter().map(|p| p.sigma).collect();
+    (x, y, sg)
+}
 
 /// Jaeger's law fitted to series `s` (labelled `label`) of `data` on `model`'s branch, or the
 /// note saying why not.
@@ -216,95 +296,121 @@ fn fit_jaeger_series(
     let branch = model.0;
     let pts: Vec<_> = data.series(s).collect();
     if pts.len() < 4 {
-        return Err(Unfitted(format!(
+        return Err(Unfitted::Note(format!(
             "series '{label}': {} points, need at least 4 for a1, a2, a3",
             pts.len()
         )));
     }
-    let x: Vec<JaegerX> = pts
-        .iter()
-        .map(|p| {
-            let (sd, cd) = p.scene.delta.sin_cos();
-            (sd / cd, cd, p.scene.eps)
-        })
-        .collect();
-    let y: Vec<f64> = pts.iter().map(|p| p.v).collect();
-    let sg: Vec<f64> = pts.iter().map(|p| p.sigma).collect();
+    let (x, y, sg) = series_data(&pts);
     let norm = observed_norm(y.iter().zip(&sg));
-    let Some(p0) = start(&model, &x, &y, &sg) else {
-        return Err(Unfitted(format!(
+    let controls = Controls::of(method);
+    let names = ["a1", "a2", "a3"];
+    let lower = [0.0; 3];
+    let upper = [f64::INFINITY; 3];
+    // The start is derived with the values held in place.
+    let plan = Plan::new(
+        &controls,
+        Parameters {
+            names: &names,
+            series: &[label; 3],
+            lower: &lower,
+            upper: &upper,
+            start: &[0.0; 3],
+        },
+    )?;
+    let held = [plan.pins()[0], plan.pins()[1], plan.pins()[2]];
+    let Some(p0) = start_held(&model, &x, &y, &sg, held) else {
+        return Err(Unfitted::Note(format!(
             "series '{label}': no start with every point on the {} branch",
             branch_name(branch)
         )));
     };
+    let plan = plan.with_start(&p0);
     let problem = match WeightedData::new(model, x.clone(), y, Some(sg)) {
         Ok(p) => p,
         Err(e) => {
-            return Err(Unfitted(format!("series '{label}': {e}")));
+            return Err(Unfitted::Note(format!("series '{label}': {e}")));
         }
     };
-    let opts = LsqOptions {
-        lower: Some(vec![0.0, 0.0, 0.0]),
+    let opts = plan.options(LsqOptions {
+        lower: Some(lower.to_vec()),
         sigma: data.sigma,
         stop: method.stop().cloned(),
         progress: method.progress().cloned(),
         ..Default::default()
-    };
-    let f = match fit(&problem, &p0, &opts) {
+    });
+    let specs = specs(pts[0].scene.xi);
+    let index = data.series_index(s);
+    if plan.all_held() {
+        if matches!(method, Method::Mcmc(_)) {
+            return Err(plan.nothing_to_sample().into());
+        }
+        let mut summary = plan.score(&problem, ("jaeger", label), &specs, level, data.sigma);
+        summary.attach_points(data, &index);
+        return Ok(JaegerFit::described(summary, &x, &plan.expand(&[]), branch));
+    }
+    let pinned = plan.wrap(&problem);
+    plan.check_start(&pinned)?;
+    let f = match fit(&pinned, &plan.start(), &opts) {
         Ok(f) => f,
         Err(e) => {
-            return Err(Unfitted(format!("series '{label}': {e}")));
+            return Err(Unfitted::Note(format!("series '{label}': {e}")));
         }
     };
-    let paper = paper_values(pts[0].scene.xi);
-    let src = if paper.is_some() { "paper Fig. 9" } else { "" };
-    let specs = [("a1", 10.0), ("a2", 100.0), ("a3", 10.0)].map(|(name, scale)| ParamSpec {
-        name,
-        unit: "1 (Jaeger units, eq 81)",
-        paper_value: None,
-        paper_source: src,
-        default_prior: Some(Prior::half_normal(scale)),
-    });
-    let mut specs = specs;
-    if let Some(pv) = paper {
-        for k in 0..3 {
-            specs[k].paper_value = Some(pv[k]);
-        }
-    }
+    let free_specs = plan.free_of(&specs);
     let solved = Solved {
         name: "jaeger",
         series: label,
-        specs: &specs,
-        problem: &problem,
+        specs: &free_specs,
+        problem: &pinned,
         fit: &f,
         level,
         options: &opts,
         distinct: Some(distinct_points(x.iter().map(|q| [q.0, q.1, q.2]))),
         observed_norm: Some(norm),
     };
-    let index = data.series_index(s);
     let jm = JaegerModel(branch);
-    let curve = SlopeCurve {
+    let curve = plan.wrap(SlopeCurve {
         model: &jm,
         base: &x,
         at: at_slope,
-    };
+    });
     let odr = slopes::summarise(method, &solved, curve, data, &index, true);
     let mut summary = odr.unwrap_or_else(|| {
-        let mut summary = match JaegerCoordinates::for_series(&x, branch) {
+        // The sampling coordinates are those of all three parameters.
+        let coordinates = plan
+            .all_free()
+            .then(|| JaegerCoordinates::for_series(&x, branch))
+            .flatten();
+        let mut summary = match coordinates {
             Some(c) => summarise_reparameterised(method, solved, &c),
             None => summarise_with(method, solved),
         };
         summary.attach_points(data, &index);
         summary
     });
-    let (bistable_points, has_minimum) = describe(&mut summary, &x, &f.params, branch);
-    Ok(JaegerFit {
-        summary,
-        branch,
-        bistable_points,
-        has_minimum,
-    })
+    plan.restore(&mut summary, &specs, level);
+    let optimum = plan.expand(&f.params);
+    Ok(JaegerFit::described(summary, &x, &optimum, branch))
+}
+
+impl JaegerFit {
+    /// The fit of `summary` on `branch`, its notes saying what [`describe`] finds at its
+    /// values (`optimum` where a row is missing) on the points `x`.
+    fn described(
+        mut summary: FitResult,
+        x: &[JaegerX],
+        optimum: &[f64],
+        branch: JaegerBranch,
+    ) -> Self {
+        let (bistable_points, has_minimum) = describe(&mut summary, x, optimum, branch);
+        JaegerFit {
+            summary,
+            branch,
+            bistable_points,
+            has_minimum,
+        }
+    }
 }
 
 /// Notes the branch, the points in the bistable band of eq 90 and a resistance without a

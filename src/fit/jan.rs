@@ -11,6 +11,7 @@
 //! (v̄²/cos δ = (2 sin α/λ)(tan δ − μ)); the global start is the straight lines of ln λ and
 //! ln μ against sin α through the per-series fits (the paper's values where those fail).
 
+use super::controls::{ControlError, Controls, Parameters, Plan};
 use super::data::Dataset;
 use super::posterior::{per_series, summarise_with, Method};
 use super::slopes::{self, SlopeCurve};
@@ -93,6 +94,8 @@ pub(crate) struct JanFits {
     pub global: Option<FitResult>,
     /// Why a fit was not made.
     pub notes: Vec<String>,
+    /// A control of the method (`fix`, `init`, `bounds`) that cannot be used on these data.
+    pub fault: Option<ControlError>,
 }
 
 fn xs(data: &Dataset, s: Option<usize>) -> (Vec<JanX>, Vec<f64>, Vec<f64>) {
@@ -146,32 +149,70 @@ pub(crate) fn fit_jan_with(data: &Dataset, level: f64, method: &Method) -> JanFi
     });
     let mut notes = Vec::new();
     let mut per = Vec::new();
+    let mut fault = None;
     // (sin α, ln λ, weight σ of ln λ) and the same of μ, one per converged series fit.
     let mut pts: (LogPoints, LogPoints) = (Vec::new(), Vec::new());
     for (fit, n, p) in fits {
-        per.push(fit);
+        match fit {
+            Ok(f) => per.push(f),
+            Err(e) => {
+                per.push(None);
+                fault = fault.or(Some(e));
+            }
+        }
         notes.extend(n);
         pts.0.extend(p.0);
         pts.1.extend(p.1);
+    }
+    if fault.is_some() {
+        return JanFits {
+            series: per,
+            global: None,
+            notes,
+            fault,
+        };
     }
     let mut alphas: Vec<f64> = data.points.iter().map(|p| p.scene.sin_alpha).collect();
     alphas.sort_by(|a, b| a.total_cmp(b));
     alphas.dedup();
     let global = if alphas.len() < 2 {
         notes.push("global laws need series at two or more contact angles".into());
-        None
+        Ok(None)
     } else {
         fit_jan_global(data, level, method, &pts.0, &pts.1, &mut notes)
+    };
+    let (global, fault) = match global {
+        Ok(g) => (g, None),
+        Err(e) => (None, Some(e)),
     };
     JanFits {
         series: per,
         global,
         notes,
+        fault,
     }
 }
 
 /// (sin α, ln x, σ of ln x) of a parameter x of each converged series fit.
 type LogPoints = Vec<(f64, f64, f64)>;
+
+/// The linearised start (λ, μ) of a series' points `x`, `y`, `sg` whose least tan δ is
+/// `tmin`: the weighted line v̄²/cos δ = A (tan δ − μ), σ of v̄²/cos δ = 2 v̄ σ / cos δ.
+fn series_start(x: &[JanX], y: &[f64], sg: &[f64], tmin: f64) -> (f64, f64) {
+    let sa = x[0].0;
+    let lx: Vec<f64> = x.iter().map(|p| p.1 / p.2).collect();
+    let ly: Vec<f64> = x.iter().zip(y).map(|(p, v)| v * v / p.2).collect();
+    let ls: Vec<f64> = x
+        .iter()
+        .zip(y)
+        .zip(sg)
+        .map(|((p, v), s)| 2.0 * v * s / p.2)
+        .collect();
+    match line(&lx, &ly, &ls) {
+        Some((a, b)) if b > 0.0 => (2.0 * sa / b, (-a / b).clamp(0.0, 0.999 * tmin)),
+        _ => (crate::models::jan::Jan::paper_fit(sa.asin()).lambda, 0.0),
+    }
+}
 
 /// Jan's λ and μ of series `s` (eq 74), or `None` with a note saying why not; a converged fit
 /// adds its (sin α, ln λ, σ of ln λ) and (sin α, ln μ, σ of ln μ) to `pts`.
@@ -183,30 +224,18 @@ fn fit_jan_series(
     method: &Method,
     notes: &mut Vec<String>,
     pts: &mut (LogPoints, LogPoints),
-) -> Option<FitResult> {
+) -> Result<Option<FitResult>, ControlError> {
     let (x, y, sg) = xs(data, Some(s));
     if x.len() < 3 {
         notes.push(format!(
             "series '{label}': {} points, need at least 3 for λ and μ",
             x.len()
         ));
-        return None;
+        return Ok(None);
     }
     let sa = x[0].0;
     let tmin = x.iter().map(|p| p.1 / p.2).fold(f64::INFINITY, f64::min);
-    // Linearised start: v̄²/cos δ = A (tan δ − μ), σ of v̄²/cos δ = 2 v̄ σ / cos δ.
-    let lx: Vec<f64> = x.iter().map(|p| p.1 / p.2).collect();
-    let ly: Vec<f64> = x.iter().zip(&y).map(|(p, v)| v * v / p.2).collect();
-    let ls: Vec<f64> = x
-        .iter()
-        .zip(&y)
-        .zip(&sg)
-        .map(|((p, v), s)| 2.0 * v * s / p.2)
-        .collect();
-    let (lam0, mu0) = match line(&lx, &ly, &ls) {
-        Some((a, b)) if b > 0.0 => (2.0 * sa / b, (-a / b).clamp(0.0, 0.999 * tmin)),
-        _ => (crate::models::jan::Jan::paper_fit(sa.asin()).lambda, 0.0),
-    };
+    let (lam0, mu0) = series_start(&x, &y, &sg, tmin);
     let distinct = distinct_points(x.iter().map(|p| [p.1, p.2]));
     let norm = observed_norm(y.iter().zip(&sg));
     let base = x.clone();
@@ -214,24 +243,29 @@ fn fit_jan_series(
         Ok(p) => p,
         Err(e) => {
             notes.push(format!("series '{label}': {e}"));
-            return None;
+            return Ok(None);
         }
     };
-    let opts = LsqOptions {
-        lower: Some(vec![0.0, 0.0]),
-        upper: Some(vec![f64::INFINITY, tmin]),
+    let (lower, upper) = ([0.0, 0.0], [f64::INFINITY, tmin]);
+    let plan = Plan::new(
+        &Controls::of(method),
+        Parameters {
+            names: &["lambda", "mu"],
+            series: &[label, label],
+            lower: &lower,
+            upper: &upper,
+            start: &[lam0, mu0],
+        },
+    )?;
+    let opts = plan.options(LsqOptions {
+        lower: Some(lower.to_vec()),
+        upper: Some(upper.to_vec()),
         sigma: data.sigma,
         stop: method.stop().cloned(),
         progress: method.progress().cloned(),
         ..Default::default()
-    };
-    let f = match fit(&problem, &[lam0, mu0], &opts) {
-        Ok(f) => f,
-        Err(e) => {
-            notes.push(format!("series '{label}': {e}"));
-            return None;
-        }
-    };
+    });
+    let pinned = plan.wrap(&problem);
     let paper = crate::models::jan::Jan::paper_fit(sa.asin());
     let specs = [
         ParamSpec {
@@ -249,42 +283,116 @@ fn fit_jan_series(
             default_prior: None,
         },
     ];
+    let index = data.series_index(s);
+    if plan.all_held() {
+        if matches!(method, Method::Mcmc(_)) {
+            return Err(plan.nothing_to_sample());
+        }
+        let mut sum = plan.score(&problem, ("jan-series", label), &specs, level, data.sigma);
+        sum.attach_points(data, &index);
+        return Ok(Some(sum));
+    }
+    plan.check_start(&pinned)?;
+    let f = match fit(&pinned, &plan.start(), &opts) {
+        Ok(f) => f,
+        Err(e) => {
+            notes.push(format!("series '{label}': {e}"));
+            return Ok(None);
+        }
+    };
+    let free_specs = plan.free_of(&specs);
     let solved = Solved {
         name: "jan-series",
         series: label,
-        specs: &specs,
-        problem: &problem,
+        specs: &free_specs,
+        problem: &pinned,
         fit: &f,
         level,
         options: &opts,
         distinct: Some(distinct),
         observed_norm: Some(norm),
     };
-    let index = data.series_index(s);
-    let curve = SlopeCurve {
+    let curve = plan.wrap(SlopeCurve {
         model: &JanSeries,
         base: &base,
         at: at_slope,
-    };
-    let sum = slopes::summarise(method, &solved, curve, data, &index, true).unwrap_or_else(|| {
-        let mut sum = summarise_with(method, solved);
-        sum.attach_points(data, &index);
-        sum
     });
+    let mut sum =
+        slopes::summarise(method, &solved, curve, data, &index, true).unwrap_or_else(|| {
+            let mut sum = summarise_with(method, solved);
+            sum.attach_points(data, &index);
+            sum
+        });
+    plan.restore(&mut sum, &specs, level);
     if f.converged() {
-        let se = f.std_errors().map(|s| s.to_vec()).unwrap_or(vec![1.0; 2]);
-        if f.params[0] > 0.0 {
-            pts.0.push((sa, f.params[0].ln(), se[0] / f.params[0]));
-        }
-        if f.params[1] > 0.0 {
-            pts.1.push((sa, f.params[1].ln(), se[1] / f.params[1]));
-        }
+        log_points(&plan, &f, sa, pts);
     }
-    Some(sum)
+    Ok(Some(sum))
+}
+
+/// Adds the (sin α, ln x, σ of ln x) of λ and μ of a converged series fit `f` (made by
+/// `plan`) to `pts`; a held parameter has no standard error, and its point weighs as a unit
+/// one.
+fn log_points(plan: &Plan, f: &crate::inverse::Fit, sa: f64, pts: &mut (LogPoints, LogPoints)) {
+    let p = plan.expand(&f.params);
+    let se: Vec<f64> = match f.std_errors() {
+        Some(se) => plan
+            .expand(se)
+            .iter()
+            .zip(plan.pins())
+            .map(|(e, pin)| if pin.is_some() { f64::NAN } else { *e })
+            .collect(),
+        None => vec![1.0; 2],
+    };
+    if p[0] > 0.0 {
+        pts.0.push((sa, p[0].ln(), se[0] / p[0]));
+    }
+    if p[1] > 0.0 {
+        pts.1.push((sa, p[1].ln(), se[1] / p[1]));
+    }
+}
+
+/// The parameters of the global laws (eqs 75–76) with the paper's values.
+fn global_specs() -> [ParamSpec; 4] {
+    let spec = |name, k: usize, paper_source| ParamSpec {
+        name,
+        unit: "1",
+        paper_value: Some(PAPER_GLOBAL[k]),
+        paper_source,
+        default_prior: None,
+    };
+    [
+        spec("lambda0", 0, "paper eq 75"),
+        spec("lambda1", 1, "paper eq 75"),
+        spec("mu0", 2, "paper eq 76"),
+        spec("mu1", 3, "paper eq 76"),
+    ]
+}
+
+/// The straight line y = ln a + b x through the points (x, y, σ) `pts` as (a, b), or
+/// `paper` with fewer than two points or a degenerate line.
+fn log_line(pts: &[(f64, f64, f64)], paper: (f64, f64)) -> (f64, f64) {
+    let x: Vec<f64> = pts.iter().map(|p| p.0).collect();
+    let y: Vec<f64> = pts.iter().map(|p| p.1).collect();
+    let s: Vec<f64> = pts
+        .iter()
+        .map(|p| {
+            if p.2 > 0.0 && p.2.is_finite() {
+                p.2
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    match (pts.len() >= 2).then(|| line(&x, &y, &s)).flatten() {
+        Some((a, b)) => (a.exp(), b),
+        None => paper,
+    }
 }
 
 /// The global laws of eqs 75–76 fitted to every point, started from the lines through the
-/// series' ln λ and ln μ (`lam_pts`, `mu_pts`), or `None` with a note saying why not.
+/// series' ln λ and ln μ (`lam_pts`, `mu_pts`), or `None` with a note saying why not; an
+/// error for a control of `method` that cannot be used on them.
 fn fit_jan_global(
     data: &Dataset,
     level: f64,
@@ -292,113 +400,83 @@ fn fit_jan_global(
     lam_pts: &[(f64, f64, f64)],
     mu_pts: &[(f64, f64, f64)],
     notes: &mut Vec<String>,
-) -> Option<FitResult> {
-    let fit_line = |pts: &[(f64, f64, f64)], paper: (f64, f64)| {
-        let (x, y, s): (Vec<f64>, Vec<f64>, Vec<f64>) = (
-            pts.iter().map(|p| p.0).collect(),
-            pts.iter().map(|p| p.1).collect(),
-            pts.iter()
-                .map(|p| {
-                    if p.2 > 0.0 && p.2.is_finite() {
-                        p.2
-                    } else {
-                        1.0
-                    }
-                })
-                .collect(),
-        );
-        match (pts.len() >= 2).then(|| line(&x, &y, &s)).flatten() {
-            Some((a, b)) => (a.exp(), b),
-            None => paper,
-        }
-    };
-    let (l0, l1) = fit_line(lam_pts, (PAPER_GLOBAL[0], PAPER_GLOBAL[1]));
-    let (m0, m1) = fit_line(mu_pts, (PAPER_GLOBAL[2], PAPER_GLOBAL[3]));
+) -> Result<Option<FitResult>, ControlError> {
+    let (l0, l1) = log_line(lam_pts, (PAPER_GLOBAL[0], PAPER_GLOBAL[1]));
+    let (m0, m1) = log_line(mu_pts, (PAPER_GLOBAL[2], PAPER_GLOBAL[3]));
     let (x, y, sg) = xs(data, None);
     let norm = observed_norm(y.iter().zip(&sg));
-    let problem = WeightedData::new(JanGlobal, x.clone(), y, Some(sg)).ok();
-    let opts = LsqOptions {
-        lower: Some(vec![0.0, f64::NEG_INFINITY, 0.0, f64::NEG_INFINITY]),
+    let Ok(problem) = WeightedData::new(JanGlobal, x.clone(), y, Some(sg)) else {
+        notes.push("global laws: the data cannot form a weighted problem".into());
+        return Ok(None);
+    };
+    let lower = [0.0, f64::NEG_INFINITY, 0.0, f64::NEG_INFINITY];
+    let mut plan = Plan::new(
+        &Controls::of(method),
+        Parameters {
+            names: &["lambda0", "lambda1", "mu0", "mu1"],
+            series: &["all"; 4],
+            lower: &lower,
+            upper: &[f64::INFINITY; 4],
+            start: &[l0, l1, m0, m1],
+        },
+    )?;
+    let opts = plan.options(LsqOptions {
+        lower: Some(lower.to_vec()),
         sigma: data.sigma,
         stop: method.stop().cloned(),
         progress: method.progress().cloned(),
         ..Default::default()
-    };
+    });
     let feasible = |p: &[f64]| x.iter().all(|q| JanGlobal.value(q, p).is_ok());
-    // The start must keep μ(α) below every slope; shrink μ0 until it does.
-    let mut start = [l0, l1, m0, m1];
+    // The start must keep μ(α) below every slope; shrink μ0 until it does (unless μ0 is
+    // held or its start given).
     let mut tries = 0;
-    while !feasible(&start) && tries < 60 {
-        start[2] *= 0.5;
+    while !feasible(&plan.expand(&plan.start())) && tries < 60 && !plan.start_given(2) {
+        plan.scale_start(2, 0.5);
         tries += 1;
     }
-    let problem = problem.or_else(|| {
-        notes.push("global laws: the data cannot form a weighted problem".into());
-        None
+    let specs = global_specs();
+    let index: Vec<usize> = (0..data.points.len()).collect();
+    if plan.all_held() {
+        if matches!(method, Method::Mcmc(_)) {
+            return Err(plan.nothing_to_sample());
+        }
+        let mut sum = plan.score(&problem, ("jan-global", "all"), &specs, level, data.sigma);
+        sum.attach_points(data, &index);
+        return Ok(Some(sum));
+    }
+    let pinned = plan.wrap(&problem);
+    plan.check_start(&pinned)?;
+    let f = match fit(&pinned, &plan.start(), &opts) {
+        Ok(f) => f,
+        Err(e) => {
+            notes.push(format!("global laws: {e}"));
+            return Ok(None);
+        }
+    };
+    let free_specs = plan.free_of(&specs);
+    let solved = Solved {
+        name: "jan-global",
+        series: "all",
+        specs: &free_specs,
+        problem: &pinned,
+        fit: &f,
+        level,
+        options: &opts,
+        distinct: Some(distinct_points(x.iter().map(|p| [p.0, p.1, p.2]))),
+        observed_norm: Some(norm),
+    };
+    let curve = plan.wrap(SlopeCurve {
+        model: &JanGlobal,
+        base: &x,
+        at: at_slope,
     });
-    problem.and_then(|problem| {
-        let f = match fit(&problem, &start, &opts) {
-            Ok(f) => f,
-            Err(e) => {
-                notes.push(format!("global laws: {e}"));
-                return None;
-            }
-        };
-        let src75 = "paper eq 75";
-        let src76 = "paper eq 76";
-        let specs = [
-            ParamSpec {
-                name: "lambda0",
-                unit: "1",
-                paper_value: Some(PAPER_GLOBAL[0]),
-                paper_source: src75,
-                default_prior: None,
-            },
-            ParamSpec {
-                name: "lambda1",
-                unit: "1",
-                paper_value: Some(PAPER_GLOBAL[1]),
-                paper_source: src75,
-                default_prior: None,
-            },
-            ParamSpec {
-                name: "mu0",
-                unit: "1",
-                paper_value: Some(PAPER_GLOBAL[2]),
-                paper_source: src76,
-                default_prior: None,
-            },
-            ParamSpec {
-                name: "mu1",
-                unit: "1",
-                paper_value: Some(PAPER_GLOBAL[3]),
-                paper_source: src76,
-                default_prior: None,
-            },
-        ];
-        let solved = Solved {
-            name: "jan-global",
-            series: "all",
-            specs: &specs,
-            problem: &problem,
-            fit: &f,
-            level,
-            options: &opts,
-            distinct: Some(distinct_points(x.iter().map(|p| [p.0, p.1, p.2]))),
-            observed_norm: Some(norm),
-        };
-        let index: Vec<usize> = (0..data.points.len()).collect();
-        let curve = SlopeCurve {
-            model: &JanGlobal,
-            base: &x,
-            at: at_slope,
-        };
-        Some(
-            slopes::summarise(method, &solved, curve, data, &index, true).unwrap_or_else(|| {
-                let mut sum = summarise_with(method, solved);
-                sum.attach_points(data, &index);
-                sum
-            }),
-        )
-    })
+    let mut sum =
+        slopes::summarise(method, &solved, curve, data, &index, true).unwrap_or_else(|| {
+            let mut sum = summarise_with(method, solved);
+            sum.attach_points(data, &index);
+            sum
+        });
+    plan.restore(&mut sum, &specs, level);
+    Ok(Some(sum))
 }

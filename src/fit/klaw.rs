@@ -29,6 +29,7 @@
 //! that leaves regime B during the search makes the residuals [`Infeasible`] (a rejected
 //! step), never NaN.
 
+use super::controls::{ControlError, Controls, Parameters, Plan};
 use super::data::Dataset;
 use super::k::bracket::eval;
 use super::k::{bracket, dv_dk, estimate, KBracket};
@@ -38,7 +39,7 @@ use super::summary::{
     information_criteria, observed_norm, summarise_with_profiles, FitResult, ParamSpec, Solved,
     StatsRow,
 };
-use crate::inverse::estimate::information_criteria as fit_criteria;
+use crate::inverse::estimate::{covariance_scale, information_criteria as fit_criteria};
 use crate::inverse::{
     fit, profile_interval, Covariance, Fit, Infeasible, LsqOptions, OdrModel, ProfileInterval,
     Residuals, SigmaKind, Termination,
@@ -118,6 +119,26 @@ pub enum KLawError {
     },
     /// The caller's stop flag was raised before the fit could be made.
     Interrupted,
+    /// A control of the parameters (`fix`, `init`, `bounds`) that cannot be used on these
+    /// data: the command line's flag, the value as given and why.
+    Setting {
+        /// The flag (`--fix`, `--init`, `--bounds`).
+        flag: String,
+        /// The control as given (`NAME=VALUE`).
+        value: String,
+        /// Why it cannot be used.
+        reason: String,
+    },
+}
+
+impl From<ControlError> for KLawError {
+    fn from(e: ControlError) -> Self {
+        KLawError::Setting {
+            flag: e.flag.to_string(),
+            value: e.value,
+            reason: e.reason,
+        }
+    }
 }
 
 impl std::error::Error for KLawError {}
@@ -160,6 +181,11 @@ impl fmt::Display for KLawError {
             KLawError::Solver(s) => write!(f, "least-squares solver: {s}"),
             KLawError::NoPoints { param } => write!(f, "no point left to fit {param}"),
             KLawError::Interrupted => f.write_str("interrupted"),
+            KLawError::Setting {
+                flag,
+                value,
+                reason,
+            } => write!(f, "{flag} {value}: {reason}"),
         }
     }
 }
@@ -687,6 +713,7 @@ fn one_param_options(opts: &LsqOptions, j: usize, sigma: SigmaKind) -> LsqOption
         typical: one(&opts.typical),
         restarts: opts.restarts,
         sigma,
+        scale_covar: opts.scale_covar,
         polish: opts.polish,
         stop: opts.stop.clone(),
         progress: opts.progress.clone(),
@@ -731,6 +758,7 @@ fn separable_profiles(
                     .as_ref()
                     .map(|c| covariance_1(c.std_errors[j], c.scale)),
                 sigma: fit.sigma,
+                scale_covar: fit.scale_covar,
                 aic: fit.aic,
                 bic: fit.bic,
                 iterations: fit.iterations,
@@ -767,9 +795,12 @@ fn fit_per_series(
     let fits = (0..n)
         .into_par_iter()
         .map(|j| {
-            // σ is taken as given in each series' fit: the scale of unit weights is the
-            // joint χ²/(m − n), applied below.
-            let sub_opts = one_param_options(opts, j, SigmaKind::Absolute);
+            // σ is taken as given in each series' fit: the scale of unit weights (or of
+            // `scale_covar`) is the joint χ²/(m − n), applied below.
+            let sub_opts = LsqOptions {
+                scale_covar: false,
+                ..one_param_options(opts, j, SigmaKind::Absolute)
+            };
             fit(&problem.group(j), &start[j..=j], &sub_opts)
         })
         .collect::<Result<Vec<Fit>, _>>()
@@ -800,11 +831,7 @@ fn fit_per_series(
     } else {
         f64::INFINITY
     };
-    let scale = match opts.sigma {
-        SigmaKind::Absolute => Some(1.0),
-        SigmaKind::Relative if dof > 0 => Some(reduced_chi2),
-        SigmaKind::Relative => None,
-    };
+    let scale = covariance_scale(opts.sigma, opts.scale_covar, dof, reduced_chi2);
     let covariance = match scale {
         Some(s) if chi2.is_finite() => fits
             .iter()
@@ -835,6 +862,7 @@ fn fit_per_series(
         reduced_chi2,
         covariance,
         sigma: opts.sigma,
+        scale_covar: opts.scale_covar,
         aic,
         bic,
         iterations: most(|f| f.iterations),
@@ -945,52 +973,113 @@ pub(crate) fn fit_law_in(
         None => KLawProblem::new_until(model, data, law, method.stop().cloned())?,
     };
     let (lower, upper) = problem.feasible_box()?;
-    let start = problem.start()?;
-    let opts = LsqOptions {
+    let specs = law_specs(&problem, law);
+    let plan = law_plan(&problem, method, &lower, &upper)?;
+    let opts = plan.options(LsqOptions {
         lower: Some(lower),
         upper: Some(upper),
         sigma: data.sigma,
         stop: method.stop().cloned(),
         progress: progress.clone().map(Tally::new),
         ..Default::default()
-    };
+    });
+    let index: Vec<usize> = (0..m).collect();
+    if plan.all_held() {
+        return score_held(&problem, &plan, &fit_name, &specs, level, method);
+    }
+    let pinned = plan.wrap(&problem);
+    plan.check_start(&pinned)?;
+    let separable = law == KLaw::FreePerSeries && plan.all_free();
     let f = match method {
         // Independent parameters: each series fitted on its own.
-        Method::Lsq { .. } if law == KLaw::FreePerSeries => {
-            fit_per_series(&problem, &start, &opts)?
-        }
-        _ => fit(&problem, &start, &opts).map_err(|e| KLawError::Solver(e.to_string()))?,
+        Method::Lsq { .. } if separable => fit_per_series(&problem, &plan.start(), &opts)?,
+        _ => fit(&pinned, &plan.start(), &opts).map_err(|e| KLawError::Solver(e.to_string()))?,
     };
-    let specs = law_specs(&problem, law);
+    let free_specs = plan.free_of(&specs);
     let solved = Solved {
         name: &fit_name,
         series: "all",
-        specs: &specs,
-        problem: &problem,
+        specs: &free_specs,
+        problem: &pinned,
         fit: &f,
         level,
         options: &opts,
         distinct: None,
         observed_norm: Some(observed_norm(data.points.iter().map(|p| (&p.v, &p.sigma)))),
     };
-    let index: Vec<usize> = (0..m).collect();
-    let odr = slopes::summarise(method, &solved, Slopes(&problem), data, &index, false);
+    let odr = slopes::summarise(
+        method,
+        &solved,
+        plan.wrap(Slopes(&problem)),
+        data,
+        &index,
+        false,
+    );
     let slope_errors = odr.is_some();
     let mut summary = match (odr, method) {
         (Some(s), _) => s,
         // Independent parameters: each profiled on its own series.
-        (None, Method::Lsq { profile: true, .. })
-            if law == KLaw::FreePerSeries && problem.n > 1 =>
-        {
+        (None, Method::Lsq { profile: true, .. }) if separable && problem.n > 1 => {
             summarise_with_profiles(solved, |s| {
                 separable_profiles(&problem, s.fit, s.level, s.options)
             })
         }
         (None, _) => summarise_with(method, solved),
     };
-    if law == KLaw::FreePerSeries {
+    plan.restore(&mut summary, &specs, level);
+    label_rows(&mut summary, &problem);
+    let params: Vec<f64> = if slope_errors {
+        summary
+            .params
+            .iter()
+            .take(problem.n)
+            .map(|r| r.value)
+            .collect()
+    } else {
+        plan.expand(&f.params)
+    };
+    let k = (0..m).map(|i| problem.k_of(i, &params)).collect();
+    if slope_errors {
+        let note = wide_slope_errors(&problem, &params);
+        summary.stats.note = super::summary::join(&summary.stats.note, &note);
+    } else {
+        summary.attach_points(data, &index);
+    }
+    Ok(KLawFit { law, summary, k })
+}
+
+/// The controls of `method` on the law of `problem`, whose box is `lower`, `upper`: each K
+/// of a law with one per series is of its series.
+fn law_plan(
+    problem: &KLawProblem<'_>,
+    method: &Method,
+    lower: &[f64],
+    upper: &[f64],
+) -> Result<Plan, KLawError> {
+    let start = problem.start()?;
+    let names = vec![problem.param_name(); problem.n];
+    let series: Vec<&str> = match problem.law {
+        KLaw::FreePerSeries => problem.data.labels.iter().map(String::as_str).collect(),
+        _ => vec!["all"; problem.n],
+    };
+    Ok(Plan::new(
+        &Controls::of(method),
+        Parameters {
+            names: &names,
+            series: &series,
+            lower,
+            upper,
+            start: &start,
+        },
+    )?)
+}
+
+/// Names the series of each K of a law with one per series in the rows of `summary`, and
+/// says where the box ends are in the note of a row on one.
+fn label_rows(summary: &mut FitResult, problem: &KLawProblem<'_>) {
+    if problem.law == KLaw::FreePerSeries {
         for (j, row) in summary.params.iter_mut().take(problem.n).enumerate() {
-            row.series = data.labels[j].clone();
+            row.series = problem.data.labels[j].clone();
         }
     }
     for row in summary.params.iter_mut() {
@@ -1001,24 +1090,33 @@ pub(crate) fn fit_law_in(
             );
         }
     }
-    let params: Vec<f64> = if slope_errors {
-        summary
-            .params
-            .iter()
-            .take(problem.n)
-            .map(|r| r.value)
-            .collect()
-    } else {
-        f.params.clone()
-    };
-    let k = (0..m).map(|i| problem.k_of(i, &params)).collect();
-    if slope_errors {
-        let note = wide_slope_errors(&problem, &params);
-        summary.stats.note = super::summary::join(&summary.stats.note, &note);
-    } else {
-        summary.attach_points(data, &index);
+}
+
+/// The law of `problem` with every parameter held (`plan`): scored at the values held, or an
+/// error for a posterior run (nothing to sample).
+fn score_held(
+    problem: &KLawProblem<'_>,
+    plan: &Plan,
+    fit_name: &str,
+    specs: &[ParamSpec],
+    level: f64,
+    method: &Method,
+) -> Result<KLawFit, KLawError> {
+    if matches!(method, Method::Mcmc(_)) {
+        return Err(plan.nothing_to_sample().into());
     }
-    Ok(KLawFit { law, summary, k })
+    let data = problem.data;
+    let m = data.points.len();
+    let mut summary = plan.score(problem, (fit_name, "all"), specs, level, data.sigma);
+    label_rows(&mut summary, problem);
+    summary.attach_points(data, &(0..m).collect::<Vec<_>>());
+    let params = plan.expand(&[]);
+    let k = (0..m).map(|i| problem.k_of(i, &params)).collect();
+    Ok(KLawFit {
+        law: problem.law,
+        summary,
+        k,
+    })
 }
 
 /// The impact law scored on `data` (nothing to fit): χ², AIC, BIC of its residuals, or how
@@ -1089,6 +1187,7 @@ fn score_impact(model: Model, data: &Dataset, fit_name: String) -> KLawFit {
             note,
             mcmc: None,
             slope_errors: false,
+            scale_covar: false,
             outliers: Vec::new(),
             others_chi2: 0.0,
         },

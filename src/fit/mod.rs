@@ -4,6 +4,7 @@
 //! reads files, prints or knows the command line.
 
 pub mod builder;
+pub(crate) mod controls;
 pub mod data;
 mod display;
 pub mod error;

@@ -425,6 +425,8 @@ fn scale_row(fit_name: &str, series: &str, s0: f64, level: f64, unit: &'static s
         lsq_value: Some(s0),
         posterior: None,
         sensitivity: None,
+        fixed: false,
+        start: None,
     }
 }
 

@@ -59,6 +59,12 @@ pub struct ParamRow {
     /// How much the posterior of this parameter moves when the prior or the likelihood is
     /// power-scaled (MCMC only).
     pub sensitivity: Option<PowerScaling>,
+    /// True when the parameter was held at `value`, not fitted (lmfit's `vary=False`): no
+    /// standard error or interval, and it counts no degree of freedom.
+    pub fixed: bool,
+    /// The value the least-squares fit started from (lmfit's `init_value`; the value held for
+    /// a parameter held), when the fit says.
+    pub start: Option<f64>,
 }
 
 /// Power-scaling sensitivity of one parameter's posterior (`priorsense`'s diagnostic: the
@@ -166,6 +172,10 @@ pub struct StatsRow {
     /// True when the slopes were taken as measured with error: a least-squares fit is then
     /// an orthogonal distance regression (`method` = `odr`), and χ² its objective.
     pub slope_errors: bool,
+    /// True when the covariance of σ given was scaled by the reduced χ² all the same
+    /// (lmfit's `scale_covar=True`): standard errors and intervals are then those of relative
+    /// σ.
+    pub scale_covar: bool,
     /// The points whose normalised residual exceeds 4 in magnitude, when they are few enough
     /// to be outliers rather than a misfit of the whole curve (at most a fifth of the points,
     /// σ given; see [`FitResult::attach_points`]), each described by its series, slope,
@@ -786,7 +796,7 @@ fn undetermined(
              parameters; no standard errors or intervals"
         ));
     }
-    let no_dof = f.sigma == SigmaKind::Relative && f.dof == 0;
+    let no_dof = (f.sigma == SigmaKind::Relative || f.scale_covar) && f.dof == 0;
     if f.covariance.is_none() && !no_dof && !f.at_bound.iter().any(|b| *b) {
         return Some(
             "Jacobian rank deficient at the estimate: the data do not determine the \
@@ -875,12 +885,7 @@ pub(crate) fn summarise_with_profiles<R: Residuals + ?Sized>(
     if let Some(why) = &unknown {
         note = why.clone();
     } else if f.converged() && f.covariance.is_none() {
-        note = if f.sigma == SigmaKind::Relative && f.dof == 0 {
-            "no degree of freedom left to estimate the scatter (no sigma given): no covariance"
-                .into()
-        } else {
-            "Jacobian rank deficient at the estimate: no covariance".into()
-        };
+        note = no_covariance(f).into();
     }
     let (aic, bic) = aic_bic(f, observed_norm, &mut note);
     let mut evals = f.residual_evals;
@@ -920,6 +925,8 @@ pub(crate) fn summarise_with_profiles<R: Residuals + ?Sized>(
                 lsq_value: Some(f.params[j]),
                 posterior: None,
                 sensitivity: None,
+                fixed: false,
+                start: None,
             }
         })
         .collect();
@@ -944,6 +951,7 @@ pub(crate) fn summarise_with_profiles<R: Residuals + ?Sized>(
             note,
             mcmc: None,
             slope_errors: false,
+            scale_covar: f.scale_covar && f.sigma == SigmaKind::Absolute,
             outliers: Vec::new(),
             others_chi2: 0.0,
         },
@@ -955,6 +963,21 @@ pub(crate) fn summarise_with_profiles<R: Residuals + ?Sized>(
             .map(correlation_rows),
         residuals: f.residuals.clone(),
         points: Vec::new(),
+    }
+}
+
+/// Why the converged fit `f` has no covariance: no degree of freedom for the scale it
+/// estimates, or a Jacobian rank deficient at the estimate.
+fn no_covariance(f: &Fit) -> &'static str {
+    match f.sigma {
+        _ if f.dof > 0 => "Jacobian rank deficient at the estimate: no covariance",
+        SigmaKind::Relative => {
+            "no degree of freedom left to estimate the scatter (no sigma given): no covariance"
+        }
+        SigmaKind::Absolute if f.scale_covar => {
+            "no degree of freedom left to scale the covariance (scale_covar): no covariance"
+        }
+        SigmaKind::Absolute => "Jacobian rank deficient at the estimate: no covariance",
     }
 }
 

@@ -51,6 +51,9 @@ pub struct Fit {
     pub covariance: Option<Covariance>,
     /// Scaling convention used for the covariance.
     pub sigma: SigmaKind,
+    /// Whether the covariance of absolute σ was scaled by the reduced χ² all the same
+    /// ([`LsqOptions::scale_covar`]); its intervals are then those of relative σ.
+    pub scale_covar: bool,
     /// Akaike information criterion from the Gaussian likelihood, with k = n parameters and m
     /// residuals:
     /// * [`SigmaKind::Absolute`]: AIC = χ² + 2k (the constant Σ ln 2πσᵢ², the same for every
@@ -97,7 +100,12 @@ impl Fit {
         sigma: SigmaKind,
     ) -> Result<Fit, LsqError> {
         let (sol, solver, ls) = into_parts(result).map_err(|e| LsqError::Solver(e.to_string()))?;
-        Ok(finish(&mut solver.into_evaluator(), ls.view(), sol, sigma))
+        Ok(finish(
+            &mut solver.into_evaluator(),
+            ls.view(),
+            sol,
+            (sigma, false),
+        ))
     }
 }
 
@@ -129,11 +137,22 @@ pub fn fit<R: Residuals + ?Sized>(
     let ls = DynLeastSquares::new(&problem, start, opts)?;
     let (sol, mut ev, ls) =
         solve(ls, opts, &mut Spare::new()).map_err(|e| LsqError::Solver(e.to_string()))?;
-    Ok(finish(&mut ev, ls.view(), sol, opts.sigma))
+    Ok(finish(
+        &mut ev,
+        ls.view(),
+        sol,
+        (opts.sigma, opts.scale_covar),
+    ))
 }
 
-/// The [`Fit`] of a solution: statistics, and the covariance from the Jacobian at the estimate.
-fn finish(ev: &mut Evaluator, ls: View<'_>, sol: Solution, sigma: SigmaKind) -> Fit {
+/// The [`Fit`] of a solution: statistics, and the covariance from the Jacobian at the estimate
+/// under the σ convention and covariance scaling `(sigma, scale_covar)`.
+fn finish(
+    ev: &mut Evaluator,
+    ls: View<'_>,
+    sol: Solution,
+    (sigma, scale_covar): (SigmaKind, bool),
+) -> Fit {
     let (m, n) = (ev.m, ev.n);
     let dof = m - n;
     let chi2 = if sol.fnorm.is_finite() {
@@ -148,7 +167,7 @@ fn finish(ev: &mut Evaluator, ls: View<'_>, sol: Solution, sigma: SigmaKind) -> 
     };
     let covariance = if chi2.is_finite() {
         let mut jac = Mat::<f64>::zeros(m, n);
-        match covariance_scale(sigma, dof, reduced_chi2) {
+        match covariance_scale(sigma, scale_covar, dof, reduced_chi2) {
             Some(s) if ev.jacobian(ls, &sol.x, &sol.f, &mut jac) => {
                 covariance(&jac, s, rank_tolerance(ev.differenced, m, n))
             }
@@ -169,6 +188,7 @@ fn finish(ev: &mut Evaluator, ls: View<'_>, sol: Solution, sigma: SigmaKind) -> 
         reduced_chi2,
         covariance,
         sigma,
+        scale_covar,
         aic,
         bic,
         iterations: sol.iterations,
@@ -180,12 +200,17 @@ fn finish(ev: &mut Evaluator, ls: View<'_>, sol: Solution, sigma: SigmaKind) -> 
 }
 
 /// The factor of (JᵀJ)⁻¹ in the covariance: 1 for absolute σ, the reduced χ² for relative σ
-/// (`None` there without a degree of freedom).
-pub(crate) fn covariance_scale(sigma: SigmaKind, dof: usize, reduced_chi2: f64) -> Option<f64> {
+/// or when `scale_covar` asks for it (`None` there without a degree of freedom).
+pub(crate) fn covariance_scale(
+    sigma: SigmaKind,
+    scale_covar: bool,
+    dof: usize,
+    reduced_chi2: f64,
+) -> Option<f64> {
     match sigma {
-        SigmaKind::Absolute => Some(1.0),
-        SigmaKind::Relative if dof > 0 => Some(reduced_chi2),
-        SigmaKind::Relative => None,
+        SigmaKind::Absolute if !scale_covar => Some(1.0),
+        _ if dof > 0 => Some(reduced_chi2),
+        _ => None,
     }
 }
 

@@ -666,6 +666,7 @@ impl LevenbergMarquardt {
                 typical: None,
                 restarts: opts.restarts,
                 sigma: opts.sigma,
+                scale_covar: opts.scale_covar,
                 polish: opts.polish,
                 stop: opts.stop.clone(),
                 // Counted by an observer ([`super::ProgressObserver`]), not by the solver.

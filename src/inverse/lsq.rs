@@ -247,6 +247,12 @@ pub struct LsqOptions {
     pub restarts: usize,
     /// Scaling convention of the covariance.
     pub sigma: SigmaKind,
+    /// With [`SigmaKind::Absolute`], scale the covariance by the reduced χ² all the same, as
+    /// lmfit's `scale_covar=True` does: the σᵢ then give the relative weights only, and the
+    /// intervals are those of [`SigmaKind::Relative`] (Student-t on m − n degrees of freedom,
+    /// profile threshold s²·t²). Without effect under [`SigmaKind::Relative`], which scales
+    /// already. Default false.
+    pub scale_covar: bool,
     /// Refine a converged point by Gauss–Newton steps (see the module docs).
     pub polish: bool,
     /// Checked before every iteration and every trial step: once raised, the solver stops
@@ -277,6 +283,7 @@ impl Default for LsqOptions {
             typical: None,
             restarts: 0,
             sigma: SigmaKind::Absolute,
+            scale_covar: false,
             polish: true,
             stop: None,
             progress: None,

@@ -495,7 +495,10 @@ impl Odr {
             Some(TerminationReason::MaxItersReached) => Termination::MaxIterations,
             _ => Termination::Interrupted,
         });
-        Ok((solver.finish(&problem, termination, opts.sigma), problem))
+        Ok((
+            solver.finish(&problem, termination, (opts.sigma, opts.scale_covar)),
+            problem,
+        ))
     }
 
     /// Why the solver stopped, once it has.
@@ -801,7 +804,7 @@ impl Odr {
         &mut self,
         pr: &OdrProblem<M>,
         termination: Termination,
-        sigma: SigmaKind,
+        (sigma, scale_covar): (SigmaKind, bool),
     ) -> OdrFit {
         let (n, p) = (pr.n(), pr.p());
         let dof = n - p;
@@ -812,7 +815,7 @@ impl Odr {
         } else {
             f64::INFINITY
         };
-        let scale = covariance_scale(sigma, dof, reduced_chi2);
+        let scale = covariance_scale(sigma, scale_covar, dof, reduced_chi2);
         let covariance = match (started && chi2.is_finite(), scale) {
             (true, Some(scale)) => self.linearise(pr).and_then(|lin| {
                 let mut jac = Mat::<f64>::zeros(n, p);
@@ -857,6 +860,7 @@ impl Odr {
                 reduced_chi2,
                 covariance,
                 sigma,
+                scale_covar,
                 aic,
                 bic,
                 iterations: self.steps,

@@ -222,6 +222,19 @@ pub enum Method {
         /// Counts the residual and Jacobian evaluations of every solver run of the fit, profiles
         /// included ([`LsqOptions::progress`](super::LsqOptions)).
         progress: Option<Tally>,
+        /// Scale the covariance by the reduced χ² even with σ given, as lmfit's
+        /// `scale_covar=True` ([`LsqOptions::scale_covar`](super::LsqOptions)).
+        scale_covar: bool,
+        /// Parameters held at a value, by name: `NAME` holds it in every fit that has it
+        /// (every series), `NAME[SERIES]` in the fit of that series only. A held parameter is
+        /// not fitted: no standard error or interval, no degree of freedom.
+        fix: Vec<(String, f64)>,
+        /// Starting values by name (`NAME` or `NAME[SERIES]`), replacing the fit's own start;
+        /// each must lie in the parameter's box.
+        init: Vec<(String, f64)>,
+        /// Bounds (lower, upper) by name (`NAME` or `NAME[SERIES]`), intersected with the
+        /// parameter's box.
+        bounds: Vec<(String, (f64, f64))>,
     },
     /// Posterior sampling, started from the least-squares optimum (its stop flag,
     /// [`McmcOptions::stop`], stops the least-squares start as well).
@@ -235,6 +248,10 @@ impl Method {
             profile,
             stop: None,
             progress: None,
+            scale_covar: false,
+            fix: Vec::new(),
+            init: Vec::new(),
+            bounds: Vec::new(),
         }
     }
 
@@ -243,10 +260,22 @@ impl Method {
     /// is).
     pub fn with_progress(self, progress: Option<Tally>) -> Self {
         match self {
-            Method::Lsq { profile, stop, .. } => Method::Lsq {
+            Method::Lsq {
+                profile,
+                stop,
+                scale_covar,
+                fix,
+                init,
+                bounds,
+                ..
+            } => Method::Lsq {
                 profile,
                 stop,
                 progress,
+                scale_covar,
+                fix,
+                init,
+                bounds,
             },
             m => m,
         }
@@ -286,6 +315,13 @@ pub struct McmcSettings {
     pub fit_scatter: bool,
     /// Where to report the sampler's progress (steps run), if anywhere.
     pub progress: Option<Progress>,
+    /// Parameters held at a value, as [`Method::Lsq`]'s `fix`: not sampled.
+    pub fix: Vec<(String, f64)>,
+    /// Starting values of the least-squares optimum the sampler starts from, as
+    /// [`Method::Lsq`]'s `init`.
+    pub init: Vec<(String, f64)>,
+    /// Bounds by name, as [`Method::Lsq`]'s `bounds`: they cut the support of the priors.
+    pub bounds: Vec<(String, (f64, f64))>,
 }
 
 impl McmcSettings {

@@ -20,7 +20,9 @@
 //!   z the standard normal (1 + level)/2 quantile; the covariance interval is p̂ ± z·se;
 //! * σ relative ([`SigmaKind::Relative`]): threshold = s²·F₁,dof quantile = s²·t², with t the
 //!   Student-t (1 + level)/2 quantile on dof = m − n degrees of freedom and s² = χ²_min/dof;
-//!   the covariance interval is p̂ ± t·se.
+//!   the covariance interval is p̂ ± t·se. The same with σ absolute and the covariance scaled
+//!   by the reduced χ² all the same ([`LsqOptions::scale_covar`]): for one parameter this
+//!   threshold is lmfit's F-test, Δχ² = χ²_min·F₁,dof/dof.
 
 use faer::{Mat, MatMut};
 use statrs::distribution::{ContinuousCDF, Normal, StudentsT};
@@ -195,7 +197,7 @@ fn thresholds(fit: &Fit, level: f64) -> Result<(f64, f64), LsqError> {
     }
     let q = 0.5 * (1.0 + level);
     match fit.sigma {
-        SigmaKind::Absolute => {
+        SigmaKind::Absolute if !fit.scale_covar => {
             let z = Normal::new(0.0, 1.0)
                 .map_err(|_| LsqError::Option {
                     name: "level",
@@ -204,7 +206,7 @@ fn thresholds(fit: &Fit, level: f64) -> Result<(f64, f64), LsqError> {
                 .inverse_cdf(q);
             Ok((z, z * z))
         }
-        SigmaKind::Relative => {
+        _ => {
             if fit.dof == 0 {
                 return Err(LsqError::Option {
                     name: "sigma",

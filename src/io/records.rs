@@ -380,7 +380,8 @@ pub struct CorrelationRecord {
 
 impl CorrelationRecord {
     /// Every pair of parameters of every fit, each pair once in the order of the fit's
-    /// parameters; a fit without a correlation matrix has none.
+    /// parameters; a fit without a correlation matrix has none, and a parameter held fixed
+    /// is in no pair.
     pub fn of(fits: &[&FitResult]) -> Vec<Self> {
         let mut out = Vec::new();
         for f in fits {
@@ -389,6 +390,12 @@ impl CorrelationRecord {
             let n = names.len().min(c.len());
             for i in 0..n {
                 for j in i + 1..n {
+                    // A parameter held fixed has no correlation.
+                    if f.params.get(i).is_some_and(|p| p.fixed)
+                        || f.params.get(j).is_some_and(|p| p.fixed)
+                    {
+                        continue;
+                    }
                     out.push(CorrelationRecord {
                         fit: f.stats.fit.clone(),
                         series: f.stats.series.clone(),

@@ -2,7 +2,8 @@
 //! returns a [`FitRun`](super::FitRun).
 
 use super::fit_run::FitRun;
-use super::{jaeger, jan, klaw, setting_error, RunError};
+use super::{control_error, jaeger, jan, klaw, setting_error, RunError};
+use crate::fit::controls::Controls;
 use crate::fit::klaw::KLaw;
 use crate::fit::slopes;
 use crate::fit::summary::{FitResult, McmcFailure};
@@ -83,7 +84,7 @@ impl FitCommand {
         progress: Option<Progress>,
         note: &mut dyn FnMut(&str),
     ) -> Result<FitRun, RunError> {
-        self.check(&method, level)?;
+        self.check(&method, level, &file.dataset.labels)?;
         if let Some(why) = slopes::unsupported(&method, file.dataset()) {
             return Err(setting_error("--method", "mcmc", why));
         }
@@ -122,8 +123,10 @@ impl FitCommand {
 }
 
 impl FitCommand {
-    /// Refuses a level outside (0, 1) and a prior on a parameter the fit does not have.
-    fn check(&self, method: &Method, level: f64) -> Result<(), RunError> {
+    /// Refuses a level outside (0, 1), a control (`fix`, `init`, `bounds`) of a parameter
+    /// the fit does not have or of a series not among `labels`, and a prior on a parameter
+    /// the fit does not have or holds.
+    fn check(&self, method: &Method, level: f64, labels: &[String]) -> Result<(), RunError> {
         if !(level > 0.0 && level < 1.0) {
             return Err(setting_error(
                 "--level",
@@ -131,11 +134,30 @@ impl FitCommand {
                 format!("confidence level {} is not in (0, 1)", fmt_f64(level)),
             ));
         }
+        let params = self.parameters();
+        let controls = Controls::of(method);
+        controls.check(params, labels).map_err(|mut e| {
+            // A name the fit does not have: the one it most likely misspells.
+            let key = e.value.rsplit_once('=').map_or(e.value.as_str(), |k| k.0);
+            let name = key.split('[').next().unwrap_or(key);
+            if e.reason.starts_with("no parameter") {
+                if let Some(n) = crate::io::scenes::nearest(name, params.iter().copied()) {
+                    e.reason.push_str(&format!("; did you mean '{n}'?"));
+                }
+            }
+            control_error(e)
+        })?;
         let Method::Mcmc(m) = method else {
             return Ok(());
         };
-        let params = self.parameters();
         for (name, prior) in &m.priors {
+            if controls.fix.iter().any(|(k, _)| k == name) {
+                return Err(setting_error(
+                    "--prior",
+                    &format!("{name}={prior}"),
+                    format!("{name} is held (--fix): it is not sampled and takes no prior"),
+                ));
+            }
             if name != SCALE_NAME && !params.contains(&name.as_str()) {
                 return Err(setting_error(
                     "--prior",

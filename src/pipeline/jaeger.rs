@@ -19,6 +19,9 @@ pub(crate) fn run(
 ) -> Result<FitRun, RunError> {
     let (t, ds) = (&file.table, &file.dataset);
     let fits = fit_jaeger_with(ds, branch, level, method);
+    if let Some(e) = fits.fault {
+        return Err(super::control_error(e));
+    }
     let notes: Vec<String> = fits.notes.iter().map(|n| locate_note(t, ds, n)).collect();
     let curves: Vec<Curve> = fits
         .series

@@ -129,6 +129,14 @@ pub(crate) fn run(
         ));
     }
     let fail = |e: KLawError| {
+        if let KLawError::Setting {
+            flag,
+            value,
+            reason,
+        } = e
+        {
+            return setting_error(&flag, &value, reason);
+        }
         if method.stopped() {
             RunError::Interrupted
         } else {

@@ -97,3 +97,9 @@ pub(crate) fn setting_error(flag: &str, value: &str, message: impl Into<String>)
         message: message.into(),
     })
 }
+
+/// The error of a control of a fit's parameters (`--fix`, `--init`, `--bounds`) that cannot
+/// be used, on its flag.
+pub(crate) fn control_error(e: crate::fit::controls::ControlError) -> RunError {
+    setting_error(e.flag, &e.value, e.reason)
+}

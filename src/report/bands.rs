@@ -343,6 +343,8 @@ pub(crate) fn lsq_band(
     if used.iter().any(|&j| j >= theta.len()) {
         return None;
     }
+    // A parameter held fixed has no uncertainty to carry.
+    let used: Vec<usize> = used.into_iter().filter(|&j| !fit.params[j].fixed).collect();
     let level = fit.params.first().map_or(0.95, |r| r.level);
     let z = Normal::standard().inverse_cdf(0.5 + level / 2.0);
     // The covariance of the parameters the curve uses.

@@ -12,6 +12,7 @@ mod bench_cli;
 mod cli;
 mod cli_mcmc;
 mod contact;
+mod controls;
 mod cross_solvers;
 mod design;
 mod edges_cli;

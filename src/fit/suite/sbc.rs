@@ -94,6 +94,7 @@ fn sbc_klaw_c_stick() {
             priors: vec![("c".into(), prior.clone())],
             fit_scatter: false,
             progress: None,
+            ..Default::default()
         }));
         let fit = fit_law_with(Model::Stick, &ds, KLaw::C, 0.9, &method).unwrap();
         let s = &fit.summary;

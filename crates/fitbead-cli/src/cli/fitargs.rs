@@ -54,6 +54,29 @@ pub struct FitArgs {
     /// when absent.
     #[arg(long)]
     pub output_stats: Option<PathBuf>,
+    /// Hold a parameter at a value, NAME=VALUE, repeatable (lmfit's vary=False): NAME in every
+    /// fit that has it (every series), NAME[SERIES] in that series' fit alone. A held
+    /// parameter is not fitted: its row has the value, no stderr or interval (ci_method none)
+    /// and the note "fixed"; dof, AIC and BIC count the free parameters only. A fit with every
+    /// parameter held is scored at the values.
+    #[arg(long = "fix", value_name = "NAME=VALUE", value_parser = values::named_value)]
+    pub fix: Vec<(String, f64)>,
+    /// Start a parameter at a value instead of the fit's own start, NAME=VALUE (or
+    /// NAME[SERIES]=VALUE), repeatable; the value must lie in the parameter's box.
+    #[arg(long = "init", value_name = "NAME=VALUE", value_parser = values::named_value)]
+    pub init: Vec<(String, f64)>,
+    /// Bound a parameter, NAME=LO,HI (or NAME[SERIES]=LO,HI), repeatable; -inf and inf leave a
+    /// side open. The bounds are intersected with the parameter's box (where the model has a
+    /// value at every point).
+    #[arg(long = "bounds", value_name = "NAME=LO,HI", value_parser = values::named_bounds)]
+    pub bounds: Vec<(String, (f64, f64))>,
+    /// Least squares: scale the covariance by the reduced chi-square even with sigma_v given,
+    /// as lmfit's scale_covar=True (sigma_v then weighs the points, its scale is estimated
+    /// from the scatter); standard errors, covariance and profile intervals are then those of
+    /// data without sigma_v (Student-t on dof, profile threshold scaled by the reduced
+    /// chi-square, lmfit's F-test). Without sigma_v the covariance is scaled already.
+    #[arg(long)]
+    pub scale_covar: bool,
     /// Estimation method: lsq (least squares) or mcmc (posterior sampling by an affine-invariant
     /// ensemble sampler started from the least-squares optimum; value = posterior median,
     /// ci_low/ci_high = central posterior interval at --level, ci_method = posterior).
@@ -132,8 +155,19 @@ impl FitArgs {
                     profile: !self.no_profile,
                     stop: Some(super::stop_flag()),
                     progress: None,
+                    scale_covar: self.scale_covar,
+                    fix: self.fix.clone(),
+                    init: self.init.clone(),
+                    bounds: self.bounds.clone(),
                 },
             });
+        }
+        if self.scale_covar {
+            return Err(super::flag_error(
+                "--scale-covar",
+                "",
+                "applies to --method lsq only (a posterior run has no covariance to scale)",
+            ));
         }
         let mut options = McmcOptions::default();
         if let Some(s) = self.seed {
@@ -182,6 +216,9 @@ impl FitArgs {
                 progress: std::io::stderr()
                     .is_terminal()
                     .then(super::sampler_progress_bar),
+                fix: self.fix.clone(),
+                init: self.init.clone(),
+                bounds: self.bounds.clone(),
             })),
         })
     }

@@ -681,9 +681,75 @@ pub(crate) fn design_prior(s: &str) -> Result<NamedPrior, Refusal> {
     named_prior(s, s.rfind('='), "c=normal(0.5,0.1)")
 }
 
+/// `NAME=VALUE` of `--fix` and `--init`: the name before the last `=` (a series label of
+/// `NAME[SERIES]` may hold one), a finite number after it; the name is checked against the
+/// fit's parameters by the command.
+pub(crate) fn named_value(s: &str) -> Result<(String, f64), Refusal> {
+    let (name, value) = s
+        .rsplit_once('=')
+        .ok_or_else(|| Refusal::new("expected NAME=VALUE, e.g. a2=0"))?;
+    let name = name.trim();
+    if name.is_empty() {
+        return Err(Refusal::new("expected NAME=VALUE, e.g. a2=0: no name"));
+    }
+    let v = number(
+        value,
+        f64::is_finite,
+        "expected NAME=VALUE with a finite number",
+    )?;
+    Ok((name.to_string(), v))
+}
+
+/// `NAME=LO,HI` of `--bounds`: the name before the last `=`, two numbers with LO < HI after
+/// it (`-inf` and `inf` leave a side open).
+pub(crate) fn named_bounds(s: &str) -> Result<(String, (f64, f64)), Refusal> {
+    let (name, range) = s
+        .rsplit_once('=')
+        .ok_or_else(|| Refusal::new("expected NAME=LO,HI, e.g. c=0.3,0.9"))?;
+    let name = name.trim();
+    let Some((lo, hi)) = range.split_once(',') else {
+        return Err(Refusal::new("expected NAME=LO,HI, e.g. c=0.3,0.9"));
+    };
+    let bound = |t: &str| {
+        t.trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|v| !v.is_nan())
+            .ok_or_else(|| Refusal::of(t.trim(), "not a number (-inf and inf allowed)"))
+    };
+    let (lo, hi) = (bound(lo)?, bound(hi)?);
+    if name.is_empty() {
+        return Err(Refusal::new("expected NAME=LO,HI, e.g. c=0.3,0.9: no name"));
+    }
+    if lo >= hi || lo == f64::INFINITY || hi == f64::NEG_INFINITY {
+        return Err(Refusal::new("expected LO < HI"));
+    }
+    Ok((name.to_string(), (lo, hi)))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn named_values_and_bounds() {
+        assert_eq!(named_value("a2=0").unwrap(), ("a2".into(), 0.0));
+        assert_eq!(
+            named_value(" K[xi=1] = 0.5").unwrap(),
+            ("K[xi=1]".into(), 0.5)
+        );
+        assert!(named_value("a2").is_err());
+        assert!(named_value("a2=nan").is_err());
+        assert!(named_value("=1").is_err());
+        assert_eq!(named_bounds("c=0.3,0.9").unwrap(), ("c".into(), (0.3, 0.9)));
+        assert_eq!(
+            named_bounds("c=-inf,0.9").unwrap(),
+            ("c".into(), (f64::NEG_INFINITY, 0.9))
+        );
+        assert!(named_bounds("c=0.9,0.3").is_err());
+        assert!(named_bounds("c=0.3").is_err());
+        assert!(named_bounds("c=x,1").unwrap_err().part.as_deref() == Some("x"));
+    }
 
     #[test]
     fn choices_take_whole_names_in_any_case_and_spacing() {

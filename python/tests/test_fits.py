@@ -268,3 +268,27 @@ def test_simulate_with_slope_errors_as_the_command_line(cli):
         assert_bits_equal(k, got[k], want[k])
     with pytest.raises(fitbead.FitbeadError, match="sigma-delta"):
         fitbead.simulate("stick", sigma_delta=-1.0)
+
+
+@pytest.mark.parametrize("call", ["forward", "invert_k"])
+def test_ctrl_c_stops_a_large_batch_within_a_second(call):
+    """Ctrl-C during a batch of millions of rows raises KeyboardInterrupt within a second (the
+    rows check a stop flag), instead of when the batch ends."""
+    n = 3_000_000
+    d = np.linspace(8.0, 20.0, n)
+    if call == "forward":
+        run = lambda: fitbead.forward("contact", 1.0, d)  # noqa: E731
+    else:
+        run = lambda: fitbead.invert_k("stickslip", 1.0, d, np.full(n, 0.3))  # noqa: E731
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        timer = threading.Timer(0.3, _thread.interrupt_main)
+        t0 = time.perf_counter()
+        timer.start()
+        with pytest.raises(KeyboardInterrupt):
+            run()
+        elapsed = time.perf_counter() - t0
+        timer.cancel()
+        assert elapsed < 1.3, elapsed
+    finally:
+        signal.signal(signal.SIGINT, previous)

@@ -1778,6 +1778,20 @@ def _fit_data(
     return Dataset(d._core.with_defaults(rho=rho, f=f, g=g, sigma_delta=sigma_delta))
 
 
+def _counts(**given: Any) -> None:
+    """Refuses a sampler setting that is not a whole number in its range, naming it: ``seed``
+    ≥ 0, ``walkers``/``max_steps``/``thin`` ≥ 1 (None: the default) — instead of the
+    OverflowError or TypeError of the conversion to the library's unsigned integers."""
+    for name, x in given.items():
+        if x is None and name != "seed":
+            continue
+        low = 0 if name == "seed" else 1
+        ok = isinstance(x, (int, np.integer)) and not isinstance(x, bool) and low <= x < 2**64
+        if not ok:
+            why = "a run is reproducible from its seed: give one" if x is None else f"expected a whole number >= {low}"
+            raise FitbeadError(f"{name} = {x!r}: {why}")
+
+
 def _priors(priors: Any) -> List[Tuple[str, str]]:
     """Priors as (name, distribution) pairs, from a mapping or from ``NAME=DIST`` strings."""
     if priors is None:
@@ -1972,6 +1986,7 @@ def fit_klaw(
     UnitWarning, ConvergenceWarning, BoundWarning, ColumnWarning
         The command line's warnings on the data and the fit.
     """
+    _counts(seed=seed, walkers=walkers, max_steps=max_steps, thin=thin)
     d = _fit_data(data, rho, f, g, sigma_delta, strict_columns)
     fits, notes, text = _core.fit_klaw(
         d._core, model=_model_name(model), law=law, method=method, level=level, profile=profile, seed=seed, walkers=walkers,
@@ -2046,6 +2061,7 @@ def fit_jan(
     UnitWarning, ConvergenceWarning, BoundWarning, ColumnWarning
         The command line's warnings on the data and the fits.
     """
+    _counts(seed=seed, walkers=walkers, max_steps=max_steps, thin=thin)
     d = _fit_data(data, rho, f, g, sigma_delta, strict_columns)
     fits, notes, text = _core.fit_jan(
         d._core, method=method, level=level, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps,
@@ -2121,6 +2137,7 @@ def fit_jaeger(
     UnitWarning, ConvergenceWarning, BoundWarning, ColumnWarning
         The command line's warnings on the data and the fits.
     """
+    _counts(seed=seed, walkers=walkers, max_steps=max_steps, thin=thin)
     d = _fit_data(data, rho, f, g, sigma_delta, strict_columns)
     fits, notes, text = _core.fit_jaeger(
         d._core, branch=branch, method=method, level=level, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps,

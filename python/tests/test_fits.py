@@ -3,6 +3,7 @@ parameter values bit for bit; data from CSV, arrays and DataFrames; errors as th
 line words them; posteriors to ArviZ; Ctrl-C stops an MCMC run."""
 
 import _thread
+import re
 import signal
 import threading
 import time
@@ -292,3 +293,18 @@ def test_ctrl_c_stops_a_large_batch_within_a_second(call):
         assert elapsed < 1.3, elapsed
     finally:
         signal.signal(signal.SIGINT, previous)
+
+
+def test_bad_sampler_counts_name_the_setting():
+    """max_steps=-5, seed=None, thin=1.5 or walkers=True are refused as FitbeadError naming
+    the setting (not an OverflowError or TypeError of the conversion)."""
+    for kw, match in [
+        ({"max_steps": -5}, "max_steps = -5"),
+        ({"seed": None}, "seed = None"),
+        ({"seed": -1}, "seed = -1"),
+        ({"thin": 1.5}, "thin = 1.5"),
+        ({"walkers": True}, "walkers = True"),
+    ]:
+        for fit in (fitbead.fit_klaw, fitbead.fit_jan, fitbead.fit_jaeger):
+            with pytest.raises(fitbead.FitbeadError, match=re.escape(match)):
+                fit(method="mcmc", **kw)

@@ -21,7 +21,7 @@
 //! series alone; a parameter named both ways takes the series' control, and a name given twice
 //! the last.
 
-use super::summary::{information_criteria, FitResult, ParamRow, ParamSpec, StatsRow};
+use super::summary::{FitResult, ParamRow, ParamSpec};
 use crate::inverse::posterior::Method;
 use crate::inverse::{Infeasible, LsqOptions, OdrModel, Residuals, SigmaKind};
 use crate::numfmt::{clip, echo_f64, fmt_f64, ECHO_CHARS};
@@ -562,25 +562,12 @@ impl Plan {
         sigma: SigmaKind,
     ) -> FitResult {
         let full = self.expand(&[]);
-        let m = problem.n_residuals();
-        let mut r = vec![0.0; m];
+        let mut r = vec![0.0; problem.n_residuals()];
         let feasible = problem.residuals(&full, &mut r).is_ok() && r.iter().all(|x| x.is_finite());
-        let (chi2, termination, note) = if feasible {
-            let chi2 = r.iter().map(|x| x * x).sum::<f64>();
-            (chi2, "scored", String::new())
-        } else {
+        let infeasible = (!feasible).then(|| {
             r.fill(f64::NAN);
-            (
-                f64::INFINITY,
-                "infeasible",
-                "some point has no value under the model at the values held".to_string(),
-            )
-        };
-        let (aic, bic) = if feasible {
-            information_criteria(&r, sigma)
-        } else {
-            (f64::INFINITY, f64::INFINITY)
-        };
+            "some point has no value under the model at the values held".to_string()
+        });
         let params = specs
             .iter()
             .zip(&full)
@@ -588,36 +575,15 @@ impl Plan {
             .collect();
         let names: Vec<&str> = specs.iter().map(|s| s.name).collect();
         let held = format!("every parameter held fixed ({}): scored", names.join(", "));
-        FitResult {
+        let mut fit = FitResult::scored(
+            (name.to_string(), series.to_string()),
+            r,
+            sigma,
+            infeasible,
             params,
-            stats: StatsRow {
-                fit: name.to_string(),
-                series: series.to_string(),
-                n_points: m,
-                n_params: 0,
-                chi2,
-                dof: m,
-                reduced_chi2: if m > 0 { chi2 / m as f64 } else { f64::NAN },
-                aic,
-                bic,
-                termination: termination.into(),
-                converged: feasible,
-                iterations: 0,
-                residual_evals: 1,
-                sigma,
-                condition: None,
-                note: super::summary::join(&note, &held),
-                mcmc: None,
-                slope_errors: false,
-                scale_covar: false,
-                outliers: Vec::new(),
-                others_chi2: 0.0,
-            },
-            draws: None,
-            correlation: None,
-            residuals: r,
-            points: Vec::new(),
-        }
+        );
+        fit.stats.note = super::summary::join(&fit.stats.note, &held);
+        fit
     }
 }
 

@@ -35,10 +35,7 @@ use super::k::bracket::eval;
 use super::k::{bracket, dv_dk, estimate, KBracket};
 use super::posterior::{summarise_with, Method};
 use super::slopes;
-use super::summary::{
-    information_criteria, observed_norm, summarise_with_profiles, FitResult, ParamSpec, Solved,
-    StatsRow,
-};
+use super::summary::{observed_norm, summarise_with_profiles, FitResult, ParamSpec, Solved};
 use crate::inverse::estimate::{covariance_scale, information_criteria as fit_criteria};
 use crate::inverse::{
     fit, profile_interval, Covariance, Fit, Infeasible, LsqOptions, OdrModel, ProfileInterval,
@@ -1147,55 +1144,15 @@ fn score_impact(model: Model, data: &Dataset, fit_name: String) -> KLawFit {
         .collect();
     let out = r.iter().filter(|x| x.is_none()).count();
     let r: Vec<f64> = r.into_iter().map(|x| x.unwrap_or(f64::NAN)).collect();
-    let (chi2, note, termination) = if out == 0 {
-        (
-            r.iter().map(|x| x * x).sum::<f64>(),
-            String::new(),
-            "scored",
-        )
-    } else {
-        (
-            f64::INFINITY,
-            format!("{out} of {m} points have no steady state under the impact law"),
-            "infeasible",
-        )
-    };
-    let (aic, bic) = if chi2.is_finite() {
-        information_criteria(&r, data.sigma)
-    } else {
-        (f64::INFINITY, f64::INFINITY)
-    };
-    let reduced = if m > 0 { chi2 / m as f64 } else { f64::NAN };
-    let mut summary = FitResult {
-        params: Vec::new(),
-        stats: StatsRow {
-            fit: fit_name,
-            series: "all".into(),
-            n_points: m,
-            n_params: 0,
-            chi2,
-            dof: m,
-            reduced_chi2: reduced,
-            aic,
-            bic,
-            termination: termination.into(),
-            converged: chi2.is_finite(),
-            iterations: 0,
-            residual_evals: 1,
-            sigma: data.sigma,
-            condition: None,
-            note,
-            mcmc: None,
-            slope_errors: false,
-            scale_covar: false,
-            outliers: Vec::new(),
-            others_chi2: 0.0,
-        },
-        draws: None,
-        correlation: None,
-        residuals: r,
-        points: Vec::new(),
-    };
+    let infeasible =
+        (out > 0).then(|| format!("{out} of {m} points have no steady state under the impact law"));
+    let mut summary = FitResult::scored(
+        (fit_name, "all".into()),
+        r,
+        data.sigma,
+        infeasible,
+        Vec::new(),
+    );
     summary.attach_points(data, &(0..m).collect::<Vec<_>>());
     KLawFit {
         law: KLaw::Impact,

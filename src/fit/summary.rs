@@ -1083,6 +1083,65 @@ fn correlation_rows(c: &Covariance) -> Vec<Vec<f64>> {
         .collect()
 }
 
+impl FitResult {
+    /// A law scored with nothing fitted: residuals `r` (NaN where a point has no value), its
+    /// χ², AIC and BIC, termination `scored`; or, with `infeasible` the reason some point has
+    /// no value, χ² = AIC = BIC = ∞, termination `infeasible` and the reason as the note.
+    /// Every residual is a degree of freedom. `params`: the rows of the values scored at.
+    pub(crate) fn scored(
+        (fit, series): (String, String),
+        r: Vec<f64>,
+        sigma: SigmaKind,
+        infeasible: Option<String>,
+        params: Vec<ParamRow>,
+    ) -> FitResult {
+        let m = r.len();
+        let (chi2, termination, note) = match infeasible {
+            None => (
+                r.iter().map(|x| x * x).sum::<f64>(),
+                "scored",
+                String::new(),
+            ),
+            Some(why) => (f64::INFINITY, "infeasible", why),
+        };
+        let (aic, bic) = if chi2.is_finite() {
+            information_criteria(&r, sigma)
+        } else {
+            (f64::INFINITY, f64::INFINITY)
+        };
+        FitResult {
+            params,
+            stats: StatsRow {
+                fit,
+                series,
+                n_points: m,
+                n_params: 0,
+                chi2,
+                dof: m,
+                reduced_chi2: if m > 0 { chi2 / m as f64 } else { f64::NAN },
+                aic,
+                bic,
+                termination: termination.into(),
+                converged: chi2.is_finite(),
+                iterations: 0,
+                residual_evals: 1,
+                sigma,
+                condition: None,
+                note,
+                mcmc: None,
+                slope_errors: false,
+                scale_covar: false,
+                outliers: Vec::new(),
+                others_chi2: 0.0,
+            },
+            draws: None,
+            correlation: None,
+            residuals: r,
+            points: Vec::new(),
+        }
+    }
+}
+
 /// AIC and BIC of a parameter-free model with residuals `r` (conventions of [`Fit::aic`]).
 pub(crate) fn information_criteria(r: &[f64], sigma: SigmaKind) -> (f64, f64) {
     let m = r.len() as f64;

@@ -15,11 +15,14 @@
 //!   its default, 0.4 or 0.1); rows that do not parse or make no scene are skipped. MODEL:
 //!   stick (default) or stickslip.
 //!
+//! The contact times each row's estimate computed are counted too
+//! (`bench_internals::contacts_counted`), and their spread printed per class.
+//!
 //! Each class (the `status` and `lower_limit` that `fitbead k` would print) and each part of
 //! the floor is timed as a whole, three times over, on one thread; the best of the three is
 //! printed, in µs per row, with its share of the total.
 
-use fitbead::bench_internals::push_number_cells;
+use fitbead::bench_internals::{contacts_counted, push_number_cells};
 use fitbead::fit::k::{estimate, KEstimate, KFailure, LowerLimit};
 use fitbead::{CollisionLaw, Model, Scene};
 use std::collections::BTreeMap;
@@ -84,6 +87,23 @@ struct Measured {
     scene: Scene,
     v: f64,
     sigma: Option<f64>,
+    /// Contact times its estimate computed ([`contacts_counted`]).
+    contacts: u64,
+    /// Of those, the root search's for K itself (`KRoot::evals`; 0 without a root).
+    root_evals: u64,
+}
+
+/// Mean, median, 90th percentile and largest of `xs`.
+fn spread(mut xs: Vec<u64>) -> (f64, u64, u64, u64) {
+    xs.sort_unstable();
+    let n = xs.len().max(1);
+    let mean = xs.iter().sum::<u64>() as f64 / n as f64;
+    let at = |q: f64| {
+        xs.get(((q * (n - 1) as f64).round()) as usize)
+            .copied()
+            .unwrap_or(0)
+    };
+    (mean, at(0.5), at(0.9), xs.last().copied().unwrap_or(0))
 }
 
 /// The six cells parsed (an empty ρ or f its default, any other empty cell NaN).
@@ -122,7 +142,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             continue;
         }
         let sigma = s.is_finite().then_some(s);
+        let before = contacts_counted();
         let e = estimate(&model, &scene, v, sigma);
+        let contacts = contacts_counted() - before;
         rows.entry(class(&e)).or_default().push(Measured {
             line,
             cells,
@@ -130,6 +152,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             scene,
             v,
             sigma,
+            contacts,
+            root_evals: e.root.as_ref().map_or(0, |r| r.evals as u64),
         });
     }
     let n: usize = rows.values().map(Vec::len).sum();
@@ -153,6 +177,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
     }
     println!("all {:>40} {:8.3} µs/row", n, 1e6 * total / n as f64);
+    println!(
+        "contact times computed per row (K, K_lo, K_hi, dv̄/dK; then K's search alone): \
+         mean, median, 90 %, max"
+    );
+    for (name, rs) in &rows {
+        let (mean, p50, p90, max) = spread(rs.iter().map(|m| m.contacts).collect());
+        let r = spread(rs.iter().map(|m| m.root_evals).collect());
+        println!(
+            "{name:28} {mean:6.2} {p50:4} {p90:4} {max:5}   {:6.2} {:4} {:4} {:5}",
+            r.0, r.1, r.2, r.3
+        );
+    }
+    let all = spread(rows.values().flatten().map(|m| m.contacts).collect());
+    println!("all {:>30.2} {:4} {:4} {:5}", all.0, all.1, all.2, all.3);
 
     // The floor.
     let mut in_order: Vec<&Measured> = rows.values().flatten().collect();

@@ -3,6 +3,7 @@
 //! part of the library's API: these names may change with any release.
 
 pub use crate::fit::k::bracket::bracket;
+pub use crate::fit::k::contacts_counted;
 pub use crate::fit::k::search::solve;
 pub use crate::inverse::mcmc::diagnostics::autocovariance;
 

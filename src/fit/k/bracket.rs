@@ -34,6 +34,7 @@ pub(crate) fn eval(
     evals: &mut usize,
 ) -> Result<Steady, NotSteady> {
     *evals += 1;
+    super::count_contacts(1);
     match scene.with_k(k) {
         // The search needs v̄ and the final velocity only: stick/slip skips its map-slope
         // and second-fixed-point diagnostics (they cost more than the steady state).
@@ -56,6 +57,7 @@ fn eval_pair(
     if matches!(model, Model::Stick) && ka.is_finite() && kb.is_finite() {
         if let (Ok(a), Ok(b)) = (scene.with_k(ka), scene.with_k(kb)) {
             *evals += 2;
+            super::count_contacts(2);
             return stick::steady_pair(&a, &b);
         }
     }

@@ -12,9 +12,12 @@
 //! the top (Θ0 < 0). As the bead crawls over the top (y → 0, K → K_min) the contact time grows
 //! like −u/sqrt(2B): in u the equation is nearly linear at the slow end, smooth at the fast end
 //! (lift-off, y_d), and y keeps its digits where K itself no longer resolves the motion. The
-//! root is found by the secant method from the asinh approximation of eq 29 (its error in τ is
-//! 0.1–3 %), kept inside the bracket; K_lo and K_hi start from a second-order Taylor step off
-//! the root, with τ' and τ'' from the central difference that also gives dv̄/dK.
+//! root is found from the asinh approximation of eq 29 (its error in τ is 0.1–3 %), kept
+//! inside the bracket: by Newton's method where the bead rolls over the top, whose passes give
+//! dτ/du in closed form (Carlson's R_D beside R_F, [`Launch::over_top_times`]), else by the
+//! secant method. K_lo and K_hi start from a second-order Taylor step off the root; τ' there is
+//! the analytic one (and gives dv̄/dK) with τ'' from the last two Newton iterates, or both come
+//! from a central difference where the passes carry no derivative.
 //!
 //! The path applies when Θ0 < 0 (δ < α) and, for stick/slip, when the slip starts after the top
 //! at the crawl and K(w0) rises from the crawl: either all the way to lift-off (one fixed point
@@ -39,7 +42,7 @@ use crate::models::regimes::theta_g;
 use crate::models::stickslip::{self, Branch};
 use crate::models::{Model, NotSteady, Phases, Steady};
 use crate::scene::Scene;
-use crate::special::elliptic::{cos_integral, cos_integral_pair};
+use crate::special::elliptic::{cos_integral, cos_integral_pair, rf_dy_lanes};
 use crate::special::root::{brent, golden_max};
 
 /// Which contact mechanics the launch follows.
@@ -53,6 +56,9 @@ enum Mechanics {
 #[derive(Debug, Clone, Copy)]
 struct Pass {
     tau: f64,
+    /// dτ/du (u = ln y) where the pass computes it (rolling over the top,
+    /// [`Launch::over_top`]); NaN elsewhere.
+    dtau: f64,
     w0: f64,
     wf: f64,
     /// Θ_G (stick/slip).
@@ -244,6 +250,7 @@ impl<'a> Launch<'a> {
         match self.mech {
             Mechanics::Roll => Some(Pass {
                 tau: f64::NAN,
+                dtau: f64::NAN,
                 w0: w0sq.sqrt(),
                 wf: (w0sq + self.drop).sqrt(),
                 theta_g: None,
@@ -253,6 +260,7 @@ impl<'a> Launch<'a> {
                 let st = stickslip::launch(self.scene, w0sq, y).ok()?;
                 Some(Pass {
                     tau: f64::NAN,
+                    dtau: f64::NAN,
                     w0: w0sq.sqrt(),
                     wf: st.final_velocity,
                     theta_g: Some(st.theta_g),
@@ -317,9 +325,14 @@ impl<'a> Launch<'a> {
     /// One whole contact: speeds and time.
     fn pass(&self, y: f64, evals: &mut usize) -> Option<Pass> {
         *evals += 1;
+        super::count_contacts(1);
         let sc = self.scene;
         let w0sq = y + self.wc2;
         match self.mech {
+            Mechanics::Roll if self.over_top() => {
+                let [(tau, dtau)] = self.over_top_times([y]);
+                Self::roll_pass((tau, dtau), w0sq, w0sq + self.drop)
+            }
             Mechanics::Roll => {
                 let wf2 = w0sq + self.drop;
                 let tau = cos_integral(
@@ -330,19 +343,14 @@ impl<'a> Launch<'a> {
                     y,
                     sc.sin_delta_sin_alpha(),
                 );
-                (tau.is_finite() && tau > 0.0).then(|| Pass {
-                    tau,
-                    w0: w0sq.sqrt(),
-                    wf: wf2.sqrt(),
-                    theta_g: None,
-                    branch: None,
-                })
+                Self::roll_pass((tau, f64::NAN), w0sq, wf2)
             }
             Mechanics::RollSlip => {
                 let st = stickslip::launch(sc, w0sq, y).ok()?;
                 let tau = stickslip::launch_time(sc, w0sq, y, &st, 1e-14).ok()?;
                 Some(Pass {
                     tau,
+                    dtau: f64::NAN,
                     w0: w0sq.sqrt(),
                     wf: st.final_velocity,
                     theta_g: Some(st.theta_g),
@@ -387,25 +395,81 @@ impl<'a> Launch<'a> {
         match self.mech {
             Mechanics::RollSlip => [self.pass(ya, &mut n), self.pass(yb, &mut n)],
             Mechanics::Roll => {
+                super::count_contacts(2);
                 let sc = self.scene;
                 let w0sq = [ya + self.wc2, yb + self.wc2];
                 let wf2 = w0sq.map(|w| w + self.drop);
-                let tau = cos_integral_pair(
-                    sc.sc_half_0,
-                    sc.sc_half_f,
-                    [w0sq[0], wf2[0], ya],
-                    [w0sq[1], wf2[1], yb],
-                    sc.sin_delta_sin_alpha(),
-                );
-                [0, 1].map(|i| Self::roll_pass(tau[i], w0sq[i], wf2[i]))
+                let times = if self.over_top() {
+                    self.over_top_times([ya, yb])
+                } else {
+                    cos_integral_pair(
+                        sc.sc_half_0,
+                        sc.sc_half_f,
+                        [w0sq[0], wf2[0], ya],
+                        [w0sq[1], wf2[1], yb],
+                        sc.sin_delta_sin_alpha(),
+                    )
+                    .map(|t| (t, f64::NAN))
+                };
+                [0, 1].map(|i| Self::roll_pass(times[i], w0sq[i], wf2[i]))
             }
         }
     }
 
-    /// A rolling contact of time `tau` from squared speed `w0sq` to `wf2`, if the time is one.
-    fn roll_pass(tau: f64, w0sq: f64, wf2: f64) -> Option<Pass> {
+    /// Whether the passes roll over the top (Θ0 < 0 < Θf, the crawl path of rolling), where
+    /// [`Launch::over_top_times`] gives their times with dτ/du.
+    fn over_top(&self) -> bool {
+        self.mech == Mechanics::Roll && !self.past_top
+    }
+
+    /// The contact times τ and their derivatives dτ/du (u = ln y) of rolling launches over the
+    /// top at the squared top speeds `ys` (`N` of 1 or 2), their R_F side by side.
+    ///
+    /// Over the top τ = 2 Σ |sin(Θ/2)| R_F(cos²(Θ/2) y, y + c, y), summed over the halves on
+    /// either side of the top (Θ0's and Θf's; [`cos_integral`]), where c is the half's squared
+    /// speed less the top's: 2B sin²(Θ0/2) on Θ0's side, that plus the drop 2B sin δ sin α on
+    /// Θf's. R_F is homogeneous of degree −½ (x ∂_x + y ∂_y + z ∂_z = −R_F/2, DLMF 19.18.1), so
+    /// y d/dy R_F(a y, y + c, y) = −R_F/2 − c ∂_y R_F: one derivative per half, ∂_y R_F =
+    /// −R_D/6 ([`rf_dy_lanes`]), where three would serve otherwise. The difference cancels
+    /// only by the factor ln(1/y) of the crawl's logarithm: dτ/du keeps its relative accuracy
+    /// to a few ε ln(1/y).
+    fn over_top_times<const N: usize>(&self, ys: [f64; N]) -> [(f64, f64); N] {
+        let sc = self.scene;
+        let (h0, h1) = (sc.sc_half_0, sc.sc_half_f);
+        let (c0, c1) = (self.wc2, self.wc2 + self.drop);
+        let half = |h: crate::scene::SinCos, y: f64, c: f64| [h.c * h.c * y, y + c, y];
+        if N == 1 {
+            let y = ys[0];
+            let [(f1, d1), (f0, d0)] = rf_dy_lanes([half(h1, y, c1), half(h0, y, c0)]);
+            let t = (h1.s.abs(), h0.s.abs());
+            let tau = 2.0 * (t.0 * f1 + t.1 * f0);
+            let dtau = 2.0 * (t.0 * (-0.5 * f1 - c1 * d1) + t.1 * (-0.5 * f0 - c0 * d0));
+            return std::array::from_fn(|_| (tau, dtau));
+        }
+        let (ya, yb) = (ys[0], ys[N - 1]);
+        let r = rf_dy_lanes([
+            half(h1, ya, c1),
+            half(h0, ya, c0),
+            half(h1, yb, c1),
+            half(h0, yb, c0),
+        ]);
+        let (s1, s0) = (h1.s.abs(), h0.s.abs());
+        let time = |(f1, d1): (f64, f64), (f0, d0): (f64, f64)| {
+            (
+                2.0 * (s1 * f1 + s0 * f0),
+                2.0 * (s1 * (-0.5 * f1 - c1 * d1) + s0 * (-0.5 * f0 - c0 * d0)),
+            )
+        };
+        let (a, b) = (time(r[0], r[1]), time(r[2], r[3]));
+        std::array::from_fn(|i| if i == 0 { a } else { b })
+    }
+
+    /// A rolling contact of time `tau` (with dτ/du, NaN where not computed) from squared speed
+    /// `w0sq` to `wf2`, if the time is one.
+    fn roll_pass((tau, dtau): (f64, f64), w0sq: f64, wf2: f64) -> Option<Pass> {
         (tau.is_finite() && tau > 0.0).then(|| Pass {
             tau,
+            dtau,
             w0: w0sq.sqrt(),
             wf: wf2.sqrt(),
             theta_g: None,
@@ -420,7 +484,7 @@ impl<'a> Launch<'a> {
         mut secant: Secant,
         first: Option<Option<Pass>>,
         evals: &mut usize,
-    ) -> Option<(f64, Option<Pass>)> {
+    ) -> Option<Found> {
         let mut p = match first {
             Some(p) => p,
             None => self.pass(secant.x.exp(), evals),
@@ -435,11 +499,7 @@ impl<'a> Launch<'a> {
 
     /// Two independent [`Launch::solve`]s run side by side, each pair of their passes by
     /// [`Launch::pass_pair`]: the same results, to the last bit.
-    fn solve_two(
-        &self,
-        (a, b): (Secant, Secant),
-        evals: &mut usize,
-    ) -> [Option<(f64, Option<Pass>)>; 2] {
+    fn solve_two(&self, (a, b): (Secant, Secant), evals: &mut usize) -> [Option<Found>; 2] {
         let mut secants = [a, b];
         let [pa, pb] = self.pass_pair(secants[0].x.exp(), secants[1].x.exp());
         *evals += 2;
@@ -472,9 +532,23 @@ impl<'a> Launch<'a> {
 enum Step {
     /// The pass at this u.
     Eval(f64),
-    /// The end of the search: u and, when the last iterate was evaluated there, its pass;
-    /// `None` when it failed.
-    Done(Option<(f64, Option<Pass>)>),
+    /// The end of the search; `None` when it failed.
+    Done(Option<Found>),
+}
+
+/// The root of a [`Secant`] search.
+#[derive(Debug, Clone, Copy)]
+struct Found {
+    /// The root in u.
+    u: f64,
+    /// The pass at `u`, when the last iterate was evaluated there.
+    pass: Option<Pass>,
+    /// dτ/du at `u`: the pass's, or, at an unevaluated Newton iterate, the last pass's carried
+    /// to `u` by τ''; NaN where the passes give no derivative.
+    dtau: f64,
+    /// τ'' = d²τ/du² near `u`, from the last two passes' derivatives (or the search's given
+    /// curvature); NaN where unknown.
+    d2: f64,
 }
 
 /// The root search of τ(e^u) = τ* by the secant method, kept inside (−∞, u_d] with bisection
@@ -485,6 +559,10 @@ enum Step {
 /// estimated from the divided differences of the last three iterates — a secant iterate whose
 /// predicted error |C| |Δ_n| |Δ_{n−1}| (the secant method's error recursion) is below one ulp
 /// of u is returned without its own evaluation.
+///
+/// Where the passes carry dτ/du ([`Launch::over_top_times`]) the step is Newton's instead,
+/// with C from the last two derivatives (or `curv`), and a Newton iterate whose predicted
+/// error |C| Δ² is below a twentieth of an ulp of u is returned without its own evaluation.
 #[derive(Debug, Clone, Copy)]
 struct Secant {
     tau_star: f64,
@@ -501,6 +579,8 @@ struct Secant {
     x: f64,
     prev: Option<(f64, f64)>,
     before: Option<(f64, f64)>,
+    /// The last iterate with a derivative: (u, dτ/du).
+    dprev: Option<(f64, f64)>,
     /// Iterations done.
     it: usize,
 }
@@ -530,6 +610,7 @@ impl Secant {
             x,
             prev: None,
             before: None,
+            dprev: None,
             it: 0,
         })
     }
@@ -553,15 +634,23 @@ impl Secant {
         };
         let (x, tau_star) = (self.x, self.tau_star);
         let gx = p.tau - tau_star;
+        // Newton's step where the pass has the derivative, τ'' from the last one.
+        let d = p.dtau;
+        let newton = d.is_finite() && d < 0.0;
+        let d2 = match self.dprev {
+            Some((xp, dp)) if newton && xp != x => (d - dp) / (x - xp),
+            _ => self.curv.map_or(f64::NAN, |c| 2.0 * c * d),
+        };
+        let found = |u: f64, pass: Option<Pass>, dtau: f64| Found { u, pass, dtau, d2 };
         // |τ − τ*| at the rounding level of τ itself: no iterate can do better.
         if gx.abs() <= 4.0 * f64::EPSILON * tau_star {
             if let Some((xp, gp)) = self.prev.filter(|&(_, gp)| self.refine && gp != gx) {
                 let next = x - gx * (x - xp) / (gx - gp);
                 if next > self.lo && next < self.hi && next != x {
-                    return Step::Done(Some((next, None)));
+                    return Step::Done(Some(found(next, None, f64::NAN)));
                 }
             }
-            return Step::Done(Some((x, Some(p))));
+            return Step::Done(Some(found(x, Some(p), d)));
         }
         if gx > 0.0 {
             self.lo = x;
@@ -571,6 +660,7 @@ impl Secant {
         let (lo, hi) = (self.lo, self.hi);
         let tol = 4.0 * f64::EPSILON * x.abs().max(1.0);
         let mut next = match self.prev {
+            _ if newton => x - gx / d,
             Some((xp, gp)) if gp != gx && self.it < 30 => x - gx * (x - xp) / (gx - gp),
             None => x - gx / self.slope0,
             _ => f64::NAN,
@@ -582,6 +672,12 @@ impl Secant {
                 // The slow side is not bracketed yet: step down in u.
                 x - 2.0 * (1.0 + (x - self.prev.map_or(x, |q| q.0)).abs())
             };
+        } else if newton {
+            let c = 0.5 * d2 / d;
+            let dx = next - x;
+            if c.is_finite() && (c * dx * dx).abs() <= 0.05 * tol {
+                return Step::Done(Some(found(next, None, d + d2 * dx)));
+            }
         } else if let Some((xp, gp)) = self.prev {
             let c = self.curv.or_else(|| {
                 let (xb, gb) = self.before?;
@@ -591,16 +687,19 @@ impl Secant {
             });
             if let Some(c) = c.filter(|c| c.is_finite()) {
                 if (c * (next - x) * (x - xp)).abs() <= 0.5 * tol {
-                    return Step::Done(Some((next, None)));
+                    return Step::Done(Some(found(next, None, f64::NAN)));
                 }
             }
         }
         // The last step is the error of x: x is the root to within `tol`.
         if (next - x).abs() <= tol || hi - lo <= tol {
-            return Step::Done(Some((x, Some(p))));
+            return Step::Done(Some(found(x, Some(p), d)));
         }
         self.before = self.prev;
         self.prev = Some((x, gx));
+        if newton {
+            self.dprev = Some((x, d));
+        }
         self.x = next;
         self.it += 1;
         if self.it == MAX_ITERATIONS {
@@ -669,13 +768,12 @@ pub(crate) fn estimate(
     };
     let secant = Secant::new(tau_star, u0, s0, end, None)?;
     n_root += usize::from(first.is_some());
-    let (u, p) = l.solve(secant, first, &mut n_root)?;
-    let y = u.exp();
+    let root = l.solve(secant, first, &mut n_root)?;
     // Keep the crawl end to the general search: there K rounds to K_min.
-    if y < 1e-12 * l.wc2 {
+    if root.u.exp() < 1e-12 * l.wc2 {
         return None;
     }
-    l.conclude(&br, tau_star, (v, sigma_v), (u, p), n_root)
+    l.conclude(&br, tau_star, (v, sigma_v), root, n_root)
 }
 
 /// [`super::estimate()`](super::estimate::estimate) of a stick row whose contact starts past
@@ -734,12 +832,12 @@ fn above_range(l: &Launch<'_>, br: &KBracket, v: f64, sigma_v: Option<f64>) -> O
         let t = 2.0 * l.scene.sin_alpha / vs;
         let (u0, s0) = l.guess(t);
         let secant = Secant::new(t, u0, s0, (l.y_d.ln(), br.tau_hi), None)?;
-        let (u, p) = l.solve(secant, None, &mut 0)?;
-        let y = u.exp();
+        let found = l.solve(secant, None, &mut 0)?;
+        let y = found.u.exp();
         if y < 1e-12 * l.wc2 {
             return None;
         }
-        match p {
+        match found.pass {
             Some(p) => Some(p.k()),
             None => l.k_of_launch(y),
         }
@@ -811,9 +909,10 @@ impl Launch<'_> {
         br: &KBracket,
         tau_star: f64,
         (v, sigma_v): (f64, Option<f64>),
-        (u, p): (f64, Option<Pass>),
+        root: Found,
         mut n_root: usize,
     ) -> Option<KEstimate> {
+        let (u, p) = (root.u, root.pass);
         let (l, scene) = (self, self.scene);
         let sin_alpha = scene.sin_alpha;
         let u_d = l.y_d.ln();
@@ -830,7 +929,9 @@ impl Launch<'_> {
             },
         };
         let k = p.k();
-        let mut n_side = 2;
+        let mut n_side = 0;
+        // τ' at the root is the search's where its passes carry it (rolling over the top), and so
+        // is τ'' where K_lo and K_hi need it; elsewhere both come from central differences.
         // The differences' step in u: 1e-5, wider from rest past the top, where τ is flat in u
         // as K → 0 (τ' ≈ (τ − τ0)/2, τ0 the time from rest): there the step balances the
         // rounding of the central difference, ε τ/(h |τ'|), against its truncation,
@@ -842,7 +943,12 @@ impl Launch<'_> {
         } else {
             1e-5
         };
-        let (d1, d2) = tau_derivatives(l, (u, h), u_d, &p)?;
+        let (d1, d2) = if root.dtau.is_finite() && (sigma_v.is_none() || root.d2.is_finite()) {
+            (root.dtau, root.d2)
+        } else {
+            n_side += 2;
+            tau_derivatives(l, (u, h), u_d, &p)?
+        };
         let (dk, map_slope) = l.dk_du(y, &p)?;
         // v̄ = 2 sin α / τ: dv̄/du = −v̄ τ'/τ.
         let dv_dk = -(2.0 * sin_alpha / p.tau) * d1 / p.tau / dk;
@@ -1003,11 +1109,11 @@ impl SigmaEnds<'_> {
     }
 
     /// K of a search's result (its pass, or a launch at its u).
-    fn k_at(&self, r: Option<(f64, Option<Pass>)>) -> Option<f64> {
-        let (ue, pe) = r?;
-        match pe {
+    fn k_at(&self, r: Option<Found>) -> Option<f64> {
+        let r = r?;
+        match r.pass {
             Some(pe) => Some(pe.k()),
-            None => self.l.k_of_launch(ue.exp()),
+            None => self.l.k_of_launch(r.u.exp()),
         }
     }
 

@@ -41,3 +41,27 @@ pub use estimate::estimate;
 pub(crate) use search::dv_dk;
 pub(crate) use search::solve;
 pub use types::{KBracket, KEstimate, KFailure, KRoot, LowerLimit, UpperLimit};
+
+#[cfg(any(test, feature = "bench-internals"))]
+thread_local! {
+    /// Contact times computed by the K inversion on this thread ([`count_contacts`]).
+    static CONTACTS: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
+/// Adds `n` to this thread's count of contact times computed by the K inversion (one per
+/// forward evaluation that integrates a contact: [`launch`]'s passes, the general search's
+/// evaluations), read by [`contacts_counted`]. Compiled only for the tests and the
+/// `bench-internals` feature; elsewhere it is nothing.
+#[inline(always)]
+pub(crate) fn count_contacts(n: u64) {
+    #[cfg(any(test, feature = "bench-internals"))]
+    CONTACTS.with(|c| c.set(c.get() + n));
+    #[cfg(not(any(test, feature = "bench-internals")))]
+    let _ = n;
+}
+
+/// The contact times computed by the K inversion on this thread so far ([`count_contacts`]).
+#[cfg(any(test, feature = "bench-internals"))]
+pub fn contacts_counted() -> u64 {
+    CONTACTS.with(std::cell::Cell::get)
+}

@@ -146,7 +146,9 @@ pub struct KEstimate {
     pub k_lo: Option<f64>,
     /// K at v + σ (exact inverse); the bracket's upper end when v + σ is above its range.
     pub k_hi: Option<f64>,
-    /// dv̄/dK at the root (a second-order difference on steps uniform in ln(K − K_min)).
+    /// dv̄/dK at the root: analytic where the stick model's search runs in the launch speed over
+    /// the top, δ < α (relative error a few ε), else a second-order difference on steps
+    /// uniform in ln(K − K_min) (relative error up to about 1e-9; docs/GUIDE.md, `dv_dK`).
     pub dv_dk: Option<f64>,
     /// Θ_G at the root (radians): where rolling gives way to slip (eq 36); for the rolling
     /// models, where the steady rolling motion would need more friction than f.

@@ -5,6 +5,7 @@
 mod cross_solvers;
 mod gradients;
 mod jaeger_posterior;
+mod k_contacts;
 mod k_edges;
 mod k_inversion;
 mod k_slope;

@@ -116,7 +116,7 @@ def fit_klaw(
     init: List[Tuple[str, float]] = ...,
     bounds: List[Tuple[str, Tuple[float, float]]] = ...,
     scale_covar: bool = False,
-) -> Tuple[List[_FitResult], List[str], Optional[bytes]]: ...
+) -> Tuple[List[_FitResult], List[str], Optional[bytes], Optional[BaseException]]: ...
 def fit_jan(
     data: _Dataset,
     method: str = "lsq",
@@ -134,7 +134,7 @@ def fit_jan(
     init: List[Tuple[str, float]] = ...,
     bounds: List[Tuple[str, Tuple[float, float]]] = ...,
     scale_covar: bool = False,
-) -> Tuple[List[_FitResult], List[str], Optional[bytes]]: ...
+) -> Tuple[List[_FitResult], List[str], Optional[bytes], Optional[BaseException]]: ...
 def fit_jaeger(
     data: _Dataset,
     branch: str = "upper",
@@ -153,7 +153,7 @@ def fit_jaeger(
     init: List[Tuple[str, float]] = ...,
     bounds: List[Tuple[str, Tuple[float, float]]] = ...,
     scale_covar: bool = False,
-) -> Tuple[List[_FitResult], List[str], Optional[bytes]]: ...
+) -> Tuple[List[_FitResult], List[str], Optional[bytes], Optional[BaseException]]: ...
 def t_quantile(p: float, dof: float) -> float: ...
 def simulate(model: str = "stickslip", **settings: Any) -> str: ...
 def report(

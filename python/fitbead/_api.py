@@ -79,13 +79,14 @@ class ColumnWarning(FitbeadWarning):
 
 class Interrupted(KeyboardInterrupt):
     """Ctrl-C stopped a posterior run (``method="mcmc"``) of :func:`fit_klaw`,
-    :func:`fit_jan` or :func:`fit_jaeger`: a ``KeyboardInterrupt`` that keeps what the run
-    made, as the command line writes its outputs when interrupted.
+    :func:`fit_jan`, :func:`fit_jaeger` or :func:`report`: a ``KeyboardInterrupt`` that keeps
+    what the run made, as the command line writes its outputs when interrupted.
 
     ``result`` is the partial result, what the call would have returned (a
-    :class:`FitResult` or a :class:`FitSet`): the draws so far, ``interrupted`` True on each
-    fit sampled, every parameter row's note starting ``interrupted``, not converged (a
-    ``draws`` file, when asked for, is written first)::
+    :class:`FitResult`, a :class:`FitSet` or a :class:`Report`): the draws so far,
+    ``interrupted`` True on each fit (those the run had not started yet have no draws), every
+    parameter row's note starting ``interrupted``, not converged (a ``draws`` file or a
+    report directory, when asked for, is written first)::
 
         try:
             post = fitbead.fit_jaeger(data, method="mcmc", min_ess=4000)
@@ -111,11 +112,13 @@ def _stopped(signal: Optional[BaseException], result: Any) -> None:
     if signal is None:
         return
     if isinstance(signal, KeyboardInterrupt):
-        fits = result if isinstance(result, list) else [result]
-        sampled = sum(1 for f in fits if f.draws is not None and f.draws.size > 0)
-        raise Interrupted(
-            f"interrupted: the draws so far ({sampled} of {len(fits)} fits sampled) are in this exception's result", result
-        ) from None
+        if isinstance(result, Report):
+            what = "the report of the draws so far"
+        else:
+            fits = result if isinstance(result, list) else [result]
+            sampled = sum(1 for f in fits if f.draws is not None and f.draws.size > 0)
+            what = f"the draws so far ({sampled} of {len(fits)} fits sampled)"
+        raise Interrupted(f"interrupted: {what}, in this exception's result", result) from None
     raise signal
 
 
@@ -3036,6 +3039,9 @@ def report(
     ------
     FitbeadError
         Data or settings the command line refuses, with its message.
+    Interrupted
+        Ctrl-C during a posterior run: the report of the draws so far (written to
+        ``out_dir`` too) is the exception's ``result``.
 
     Warns
     -----
@@ -3047,7 +3053,7 @@ def report(
         A posterior run that did not converge, or was interrupted.
     """
     d = _dataset(data)
-    files, unit_warnings, misfit_warnings, convergence_warnings, interrupted, summary = _core.report(
+    files, unit_warnings, misfit_warnings, convergence_warnings, interrupted, summary, signal = _core.report(
         d._core,
         out_dir=None if out_dir is None else str(out_dir),
         method=method,
@@ -3076,6 +3082,7 @@ def report(
             out[name[: -len(".csv")]] = _csv_table(b.decode("utf-8"))
     out.markdown = out.files.get("report.md", b"").decode("utf-8")
     out.summary = summary
+    _stopped(signal, out)
     return out
 
 

@@ -37,9 +37,9 @@ class ColumnWarning(FitbeadWarning):
     known name, or named like an uncertainty); ``strict_columns=True`` refuses it."""
 
 class Interrupted(KeyboardInterrupt):
-    """Ctrl-C stopped a posterior run of fit_klaw, fit_jan or fit_jaeger: a
+    """Ctrl-C stopped a posterior run of fit_klaw, fit_jan, fit_jaeger or report: a
     ``KeyboardInterrupt`` whose ``result`` is the partial result (the draws so far, each fit
-    sampled marked ``interrupted``); a signal handler's own exception passes unchanged."""
+    marked ``interrupted``); a signal handler's own exception passes unchanged."""
     result: Any
     def __init__(self, message: str, result: Any = None) -> None: ...
 

@@ -2250,6 +2250,7 @@ fn report(
     Vec<String>,
     bool,
     String,
+    Option<PyErr>,
 )> {
     use fitbead::inverse::posterior::Method;
     use fitbead::pipeline::ReportSettings;
@@ -2317,8 +2318,14 @@ fn report(
     };
     let file = &data.file;
     let dir = out_dir.as_deref();
-    let r = interruptible(py, &stop, || settings.run(file, dir))?;
-    let out = r.map_err(pipeline_error)?;
+    // A signal that cut a posterior run short comes back with the report of the draws so
+    // far (written to `dir` as the command line writes it); where nothing was kept, it is
+    // raised.
+    let (out, signal) = match interruptible_keep(py, &stop, || settings.run(file, dir))? {
+        (Ok(out), signal) => (out, signal),
+        (Err(_), Some(e)) => return Err(e),
+        (Err(e), None) => return Err(pipeline_error(e)),
+    };
     // The warnings by kind: implausible misfits (unit mistakes), posterior runs that did not
     // converge.
     let absurd: Vec<String> = out
@@ -2343,6 +2350,7 @@ fn report(
         unconverged,
         out.interrupted,
         out.summary,
+        signal,
     ))
 }
 

@@ -102,6 +102,24 @@ def test_an_interrupted_klaw_run_returns_its_fit(data):
     assert isinstance(again, fitbead.Interrupted) and again.result == fit
 
 
+def test_an_interrupted_report_keeps_its_tables(data, tmp_path):
+    """report(method="mcmc") cut short by Ctrl-C: the report of the draws so far, in the
+    exception and in the directory, every posterior row marked interrupted."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        timer = threading.Timer(1.0, _thread.interrupt_main)
+        timer.start()
+        with pytest.raises(fitbead.Interrupted) as e:
+            quiet(fitbead.report, data, tmp_path / "r", method="mcmc", min_ess=1e9, max_steps=1_000_000)
+        timer.cancel()
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    rep = e.value.result
+    assert isinstance(rep, fitbead.Report)
+    assert set(rep["stats"]["mcmc_status"]) == {"interrupted"}
+    assert (tmp_path / "r" / "stats.csv").read_bytes() == rep.files["stats.csv"]
+
+
 # ---- velocities in m/s ---------------------------------------------------------------------
 
 

@@ -1363,6 +1363,11 @@ class FitResult:
         col = {n: th[:, i : i + 1] for i, n in enumerate(names)}
         xi2, d2 = xi[None, :], delta_deg[None, :]
         ctx = self._context
+        if ctx.get("mixed_material"):
+            raise FitbeadError(
+                f"{self.name}: the data's rows have several values of rho or f, and the curve is drawn for one: "
+                "fit the rows of each rho and f apart"
+            )
         rho, f = ctx.get("rho", 0.4), ctx.get("f", 0.1)
         if self.name.startswith("klaw-"):
             model = ctx["model"]
@@ -2125,6 +2130,16 @@ def _si_context(d: Dataset) -> Dict[str, float]:
     return out
 
 
+def _material_context(d: Dataset) -> Dict[str, Any]:
+    """ρ and f of the data's rows, which a K(α) law's curve is drawn with: ``rho`` and ``f``
+    where every row has the same, else ``mixed_material``."""
+    c = d.columns()
+    rho, f = np.unique(c["rho"]), np.unique(c["f"])
+    if rho.size == 1 and f.size == 1:
+        return {"rho": float(rho[0]), "f": float(f[0])}
+    return {"mixed_material": True}
+
+
 def _controlled(context: Dict[str, Any], scale_covar: bool) -> Dict[str, Any]:
     """`context` with ``scale_covar`` where it is on (a context holds text, numbers and
     booleans only: it is saved with the fit)."""
@@ -2372,7 +2387,7 @@ def fit_klaw(
         min_ess=min_ess, tol=tol, skip_unsteady=skip_unsteady, thin=thin, priors=priors, fit_scatter=fit_scatter,
         fix=fix, init=init, bounds=bounds, scale_covar=scale_covar,
     )
-    context = _controlled({"model": _model_name(model), **_si_context(d)}, scale_covar)
+    context = _controlled({"model": _model_name(model), **_material_context(d), **_si_context(d)}, scale_covar)
     out = _fitted(fits[0], context, (fit_klaw, again))
     _stopped(signal, out)
     return out

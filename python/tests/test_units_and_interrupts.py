@@ -203,6 +203,24 @@ def test_plot_in_si_units_draws_m_s():
     plt.close(fig)
 
 
+def test_a_klaw_curve_is_drawn_with_the_datas_rho_and_f(data):
+    """eval at the fitted points gives the fit's own v_fit with ρ and f other than the
+    defaults (they were 0.4 and 0.1 whatever the data said), also after pickling."""
+    for kw in ({"rho": 0.6}, {"f": 0.2}):
+        fit = quiet(fitbead.fit_klaw, data, model="stickslip", law="c", profile=False, **kw)
+        r = fit.residuals
+        for one in (fit, pickle.loads(pickle.dumps(fit))):
+            got = np.concatenate(
+                [one.eval(r["delta_deg"][r["series"] == s], float(r["xi"][r["series"] == s][0])) for s in dict.fromkeys(r["series"])]
+            )
+            np.testing.assert_allclose(got, r["v_fit"], rtol=1e-12)
+    series, xi, d, v, s = shipped()
+    mixed = fitbead.Dataset.from_arrays(xi, d, v, s, series=series, rho=np.where(xi > 1.2, 0.5, 0.4))
+    fit = quiet(fitbead.fit_klaw, mixed, model="stickslip", law="c", profile=False)
+    with pytest.raises(fitbead.FitbeadError, match="several values of rho or f"):
+        fit.eval([10.0], 1.0)
+
+
 # ---- counts, diagnostics, words --------------------------------------------------------------
 
 

@@ -77,6 +77,51 @@ class ColumnWarning(FitbeadWarning):
     ``strict_columns=True`` refuses any column fitbead does not read."""
 
 
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C stopped a posterior run (``method="mcmc"``) of :func:`fit_klaw`,
+    :func:`fit_jan`, :func:`fit_jaeger` or :func:`report`: a ``KeyboardInterrupt`` that keeps
+    what the run made, as the command line writes its outputs when interrupted.
+
+    ``result`` is the partial result, what the call would have returned (a
+    :class:`FitResult`, a :class:`FitSet` or a :class:`Report`): the draws so far,
+    ``interrupted`` True on each fit (those the run had not started yet have no draws), every
+    parameter row's note starting ``interrupted``, not converged (a ``draws`` file or a
+    report directory, when asked for, is written first)::
+
+        try:
+            post = fitbead.fit_jaeger(data, method="mcmc", min_ess=4000)
+        except fitbead.Interrupted as e:
+            post = e.result
+
+    An exception a signal handler of the program raises itself (a ``TimeoutError`` from a
+    SIGALRM handler) stops the run as Ctrl-C does and reaches the caller unchanged, without
+    the draws."""
+
+    def __init__(self, message: str, result: Any = None) -> None:
+        super().__init__(message)
+        self.result = result
+        """The partial result: the draws so far (see the class)."""
+
+    def __reduce__(self):
+        return (type(self), (str(self), self.result))
+
+
+def _stopped(signal: Optional[BaseException], result: Any) -> None:
+    """Raises the exception of the signal that stopped a fit (None: none did): Ctrl-C as
+    :class:`Interrupted` carrying ``result``, a handler's own exception unchanged."""
+    if signal is None:
+        return
+    if isinstance(signal, KeyboardInterrupt):
+        if isinstance(result, Report):
+            what = "the report of the draws so far"
+        else:
+            fits = result if isinstance(result, list) else [result]
+            sampled = sum(1 for f in fits if f.draws is not None and f.draws.size > 0)
+            what = f"the draws so far ({sampled} of {len(fits)} fits sampled)"
+        raise Interrupted(f"interrupted: {what}, in this exception's result", result) from None
+    raise signal
+
+
 _PACKAGE_DIR = __file__.rsplit("/", 1)[0] if "/" in __file__ else ""
 
 
@@ -451,11 +496,31 @@ def invert_k(
 def regimes(xi: ArrayLike = (0.8, 1.0, 1.6, 2.0), law: str = "adjusted", rho: float = 0.4) -> Table:
     """The regime limits of a collision law (``fitbead regimes``).
 
-    Returns the command line's columns: ``xi``, ``alpha_deg``, ``K``, ``delta_m_deg`` (δ_m,
-    eq 32: below it the bead stops), ``delta_d_deg`` (δ_d, eq 31: above it the bead lifts
-    off), ``mu_eq79`` (the bulk friction of eq 79), ``steady_range`` (``yes`` where δ_m <
-    δ_d) and ``critical_xi`` (the ξ below which no steady regime exists, NaN if there is
-    none); the table's attribute ``critical_xi`` holds it too (None if there is none).
+    Parameters
+    ----------
+    xi : array_like, default (0.8, 1.0, 1.6, 2.0)
+        Radius ratios ξ = r/R (flattened to one row each).
+    law : str, default "adjusted"
+        The collision law K(α): ``adjusted`` (the paper's fit), ``impact``, ``cos2a``, a
+        number (one K for every ξ) or ``c=VALUE`` (K = cos 2α + c sin²α sin 2α), as the
+        command line's ``--law``.
+    rho : float, default 0.4
+        Density ratio ρ.
+
+    Returns
+    -------
+    Table
+        The command line's columns: ``xi``, ``alpha_deg``, ``K``, ``delta_m_deg`` (δ_m,
+        eq 32: below it the bead stops), ``delta_d_deg`` (δ_d, eq 31: above it the bead
+        lifts off), ``mu_eq79`` (the bulk friction of eq 79), ``steady_range`` (``yes``
+        where δ_m < δ_d) and ``critical_xi`` (the ξ below which no steady regime exists,
+        NaN if there is none); the table's attribute ``critical_xi`` holds it too (None if
+        there is none).
+
+    Raises
+    ------
+    FitbeadError
+        An unknown law, ξ ≤ 0, ρ < 0, or a law whose K is not above 0 at some ξ.
     """
     x = _flat(np.atleast_1d(_as_f64("xi", xi)))
     raw, crit = _core.regimes(x, law=law, rho=float(rho))
@@ -534,27 +599,67 @@ class Dataset:
         cls,
         xi: ArrayLike,
         delta_deg: ArrayLike,
-        v: ArrayLike,
+        v: Optional[ArrayLike] = None,
         sigma_v: Optional[ArrayLike] = None,
         *,
         series: Optional[Iterable[Any]] = None,
         rho: ArrayLike = 0.4,
         f: ArrayLike = 0.1,
         sigma_delta_deg: ArrayLike = 0.0,
+        v_m_s: Optional[ArrayLike] = None,
+        sigma_v_m_s: Optional[ArrayLike] = None,
+        R_m: Optional[ArrayLike] = None,
+        g: ArrayLike = 9.81,
     ) -> "Dataset":
-        """From arrays (broadcast together). ``series`` labels group the points (default:
-        grouped by ξ); without ``sigma_v`` the fits weight relatively. ``sigma_delta_deg`` is
-        the standard uncertainty of each slope in degrees (0: exact); where it is above 0 the
-        least-squares fits are orthogonal distance regressions, and their residual tables
-        gain ``delta_fit_deg`` and ``delta_residual``.
+        """From arrays (broadcast together), dimensionless (``v``) or in SI units (``v_m_s``
+        with ``R_m``), with the names of the CSV's columns (:meth:`read_csv`).
+
+        Parameters
+        ----------
+        xi, delta_deg : array_like
+            Radius ratio ξ = r/R and slope δ in degrees, per point.
+        v, sigma_v : array_like, optional
+            Mean velocity v̄ / sqrt(g (R + r)) and its standard uncertainty (dimensionless).
+            Without ``sigma_v`` (or ``sigma_v_m_s``) the fits weight relatively.
+        series : iterable, optional
+            Labels grouping the points (default: grouped by ξ).
+        rho, f : array_like
+            Density ratio ρ and friction f per point (defaults 0.4, 0.1).
+        sigma_delta_deg : array_like, default 0
+            Standard uncertainty of each slope in degrees (0: exact); where it is above 0 the
+            least-squares fits are orthogonal distance regressions, and their residual tables
+            gain ``delta_fit_deg`` and ``delta_residual``.
+        v_m_s, sigma_v_m_s : array_like, optional
+            Instead of ``v`` and ``sigma_v``: the velocities and their uncertainty in m/s,
+            converted as the CSV reader does, v = v_m_s / sqrt(g R_m (1 + ξ)).
+        R_m : array_like, optional
+            With ``v_m_s``: the radius R of the row beads, metres.
+        g : array_like, default 9.81
+            With ``v_m_s``: the acceleration of gravity, m/s².
+
+        Returns
+        -------
+        Dataset
+
+        Raises
+        ------
+        FitbeadError
+            Velocities given both ways or neither, ``v_m_s`` without ``R_m``, ``sigma_v``
+            beside ``v_m_s`` (or ``sigma_v_m_s`` beside ``v``), or a value the CSV reader
+            refuses (its message; point ``i`` is "line" ``i + 2``).
 
         Warns
         -----
         UnitWarning
             The command line's plausibility warnings, as for :meth:`read_csv` (slopes in
-            radians, velocities in m/s or mm/s); the data are named ``<arrays>`` and the point
-            at index ``i`` is "line" ``i + 2``, as if written to a CSV file.
+            radians, velocities in m/s or mm/s, radii in millimetres); the data are named
+            ``<arrays>`` and the point at index ``i`` is "line" ``i + 2``, as if written to a
+            CSV file.
         """
+        if v_m_s is not None or R_m is not None or sigma_v_m_s is not None:
+            return cls._from_si_arrays(xi, delta_deg, v, sigma_v, series, rho, f, sigma_delta_deg, v_m_s, sigma_v_m_s, R_m, g)
+        if v is None:
+            raise FitbeadError("v: give the velocities, dimensionless (v) or in m/s (v_m_s with R_m)")
         shape, a = _broadcast(
             {
                 "xi": xi,
@@ -575,6 +680,41 @@ class Dataset:
         )
 
     @classmethod
+    def _from_si_arrays(
+        cls, xi: Any, delta_deg: Any, v: Any, sigma_v: Any, series: Any, rho: Any, f: Any, sigma_delta_deg: Any,
+        v_m_s: Any, sigma_v_m_s: Any, R_m: Any, g: Any,
+    ) -> "Dataset":
+        """From arrays in SI units: the points written as the CSV they would be (every number
+        in its shortest round-trip form) and read by the CSV reader, conversion and checks
+        included."""
+        import csv
+        import io
+
+        if v is not None:
+            raise FitbeadError("v: both v (dimensionless) and v_m_s with R_m (m/s) are given: keep one velocity")
+        if sigma_v is not None:
+            raise FitbeadError("sigma_v: it is dimensionless but the velocities are v_m_s (m/s): give sigma_v_m_s")
+        if v_m_s is None or R_m is None:
+            raise FitbeadError(f"{'R_m' if R_m is None else 'v_m_s'}: velocities in m/s need v_m_s with R_m (the row beads' radius, m)")
+        named = {"xi": xi, "delta_deg": delta_deg, "v_m_s": v_m_s, "R_m": R_m, "g": g, "rho": rho, "f": f}
+        if sigma_v_m_s is not None:
+            named["sigma_v_m_s"] = sigma_v_m_s
+        if np.any(np.asarray(sigma_delta_deg, dtype=float) != 0):
+            named["sigma_delta_deg"] = sigma_delta_deg
+        shape, a = _broadcast(named)
+        n = a["xi"].size  # type: ignore[union-attr]
+        labels = [""] * n if series is None else [str(s) for s in np.ravel(np.asarray(list(series), dtype=object))]
+        if len(labels) != n:
+            raise FitbeadError(f"series: {len(labels)} labels for {n} points")
+        out = io.StringIO()
+        w = csv.writer(out, lineterminator="\n")
+        w.writerow(["series", *named])
+        cols = [_flat(a[k]) for k in named]  # type: ignore[arg-type]
+        for i in range(n):
+            w.writerow([labels[i], *(repr(float(c[i])) for c in cols)])
+        return cls(_core._Dataset.from_text(out.getvalue(), "<arrays>", rho=0.4, f=0.1, g=9.81))
+
+    @classmethod
     def from_pandas(
         cls, df: Any, *, rho: float = 0.4, f: float = 0.1, g: float = 9.81, strict_columns: bool = False
     ) -> "Dataset":
@@ -584,9 +724,13 @@ class Dataset:
         Parameters
         ----------
         df : pandas.DataFrame
-            The columns of a measurement CSV (:meth:`read_csv`); the index is not used.
+            The columns of a measurement CSV (:meth:`read_csv`): ``series``, ``xi``,
+            ``delta_deg`` and ``v`` (dimensionless, optionally ``sigma_v``) or ``v_m_s``
+            with ``R_m`` (SI, optionally ``sigma_v_m_s`` and ``g``), optionally ``rho``,
+            ``f`` and ``sigma_delta_deg``; the index is not used.
         rho, f, g : float
-            Values for the columns the frame leaves out; ``g`` in m/s² for SI columns.
+            Values for the columns the frame leaves out (defaults 0.4, 0.1, 9.81); ``g`` in
+            m/s² for SI columns.
         strict_columns : bool, default False
             Refuse any column fitbead does not read, instead of warning (``ColumnWarning``)
             about those that look misnamed.
@@ -594,6 +738,16 @@ class Dataset:
         Returns
         -------
         Dataset
+
+        Raises
+        ------
+        FitbeadError
+            The CSV reader's message (line, column, value).
+
+        Warns
+        -----
+        UnitWarning, ColumnWarning
+            As :meth:`read_csv`.
         """
         text = df.to_csv(index=False)
         core = _core._Dataset.from_text(text, "<DataFrame>", rho=rho, f=f, g=g)
@@ -900,7 +1054,8 @@ def _param(r: Dict[str, Any], bounds: Tuple[float, float], fixed: bool = False, 
 
 def _frame(records: Sequence[Mapping[str, Any]], columns: Sequence[str]):
     """A DataFrame of report records with the command line's columns: a column of numbers
-    and empty cells is float64 with NaN (never object with None)."""
+    and empty cells is float64 with NaN (never object with None); a count
+    (:data:`_COUNT_COLUMNS`) with every cell given is int64."""
     import pandas as pd
 
     df = pd.DataFrame(list(records), columns=list(columns))
@@ -908,13 +1063,24 @@ def _frame(records: Sequence[Mapping[str, Any]], columns: Sequence[str]):
         vals = [x for x in df[c] if x is not None and not (isinstance(x, float) and math.isnan(x))]
         numeric = all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in vals)
         if numeric and (vals or df[c].isna().all()) and c not in _TEXT_COLUMNS:
-            df[c] = pd.to_numeric(df[c].astype(object).where(df[c].notna(), np.nan), errors="coerce").astype("float64")
+            col = pd.to_numeric(df[c].astype(object).where(df[c].notna(), np.nan), errors="coerce").astype("float64")
+            if c in _COUNT_COLUMNS and len(col) and col.notna().all() and bool((col == np.round(col)).all()):
+                col = col.astype("int64")
+            df[c] = col
     return df
 
 
 # Text columns of the reports that may be empty in every row of a table (kept as text).
 _TEXT_COLUMNS = frozenset(
-    ["prior_diagnosis", "note", "paper_source", "profile_low_status", "profile_high_status", "mcmc_status", "method", "ci_method", "unit"]
+    [
+        "prior_diagnosis", "note", "paper_source", "profile_low_status", "profile_high_status", "mcmc_status", "method",
+        "ci_method", "unit", "fit", "series", "parameter", "parameter_1", "parameter_2", "model",
+    ]
+)
+
+# Columns of the reports that count (points, parameters, steps, a rank): integers.
+_COUNT_COLUMNS = frozenset(
+    ["n_points", "n_params", "dof", "iterations", "residual_evals", "walkers", "steps", "burn_in", "draws", "rank", "replicates"]
 )
 
 # What each fit evaluates: fit name -> how its parameters make a curve.
@@ -1197,6 +1363,11 @@ class FitResult:
         col = {n: th[:, i : i + 1] for i, n in enumerate(names)}
         xi2, d2 = xi[None, :], delta_deg[None, :]
         ctx = self._context
+        if ctx.get("mixed_material"):
+            raise FitbeadError(
+                f"{self.name}: the data's rows have several values of rho or f, and the curve is drawn for one: "
+                "fit the rows of each rho and f apart"
+            )
         rho, f = ctx.get("rho", 0.4), ctx.get("f", 0.1)
         if self.name.startswith("klaw-"):
             model = ctx["model"]
@@ -1239,7 +1410,9 @@ class FitResult:
             lab = np.full(a["xi"].size, self.series, dtype=object)  # type: ignore[union-attr]
         return shape, a["xi"], a["delta_deg"], lab
 
-    def eval(self, delta_deg: ArrayLike, xi: Optional[ArrayLike] = None, *, series: Optional[str] = None) -> np.ndarray:
+    def eval(
+        self, delta_deg: ArrayLike, xi: Optional[ArrayLike] = None, *, series: Optional[str] = None, units: str = "dimensionless"
+    ) -> np.ndarray:
         """The fitted model's mean velocity v̄ at new slopes (lmfit's ``eval``).
 
         Parameters
@@ -1250,19 +1423,68 @@ class FitResult:
             Radius ratios (broadcast with ``delta_deg``); default: the ξ of the fit's series
             (or of ``series``).
         series : str, optional
-            For a fit with one K per series, the series whose K to use.
+            For a fit with one K per series, the series whose K to use; with
+            ``units="si"``, the series whose R_m and g convert to m/s.
+        units : {"dimensionless", "si"}, default "dimensionless"
+            ``dimensionless``: v̄ / sqrt(g (R + r)), the library's unit; ``si``: m/s, for a fit
+            of data given in m/s (``v_m_s`` with ``R_m``), as v̄·sqrt(g R_m (1 + ξ)) with the
+            R_m and g of the series (``series``, the fit's own, or the one all series
+            share).
 
         Returns
         -------
         numpy.ndarray
             v̄ (NaN where the model has no steady state), shaped as the broadcast arguments.
+
+        Raises
+        ------
+        FitbeadError
+            An unknown ``units``; ``units="si"`` for data given dimensionless, or with no one
+            R_m and g for the points asked (series that differ and no ``series``).
         """
+        si = _units(units)
         shape, x, d, lab = self._points(delta_deg, xi, series)
         theta = np.array([[p.value for p in self.params.values()]])
-        return self._curve(theta, x, d, lab)[0].reshape(shape)
+        v = self._curve(theta, x, d, lab)[0]
+        if si:
+            v = v * self._si_unit(x, series)
+        return v.reshape(shape)
+
+    def _si_unit(self, xi: np.ndarray, series: Optional[Any]) -> np.ndarray:
+        """The velocity unit sqrt(g R (1 + ξ)) in m/s at ``xi``, with the g·R of ``series``
+        (else of the fit's series, else the one every series of the fit shares)."""
+        gr = {k[4:-1]: float(v) for k, v in self._context.items() if k.startswith("g_R[") and k.endswith("]")}
+        if not gr:
+            raise FitbeadError(
+                f"units = 'si': the data of {self.name} were given dimensionless (column v): velocities in m/s need "
+                "data with v_m_s and R_m"
+            )
+        lab = str(series) if series is not None else (self.series if self.series not in ("", "all") else None)
+        if lab is not None:
+            if lab not in gr:
+                raise FitbeadError(
+                    f"units = 'si': series {lab} has rows of different R_m or g (or velocities not in m/s), so no one unit "
+                    "converts its velocities to m/s"
+                )
+            return np.sqrt(gr[lab] * (1.0 + xi))
+        fitted = list(dict.fromkeys(str(x) for x in self.residuals["series"]))
+        values = {gr.get(x) for x in fitted}
+        if len(values) != 1 or None in values:
+            raise FitbeadError(
+                f"units = 'si': the series of {self.name} do not share one R_m and g: give series= (one of "
+                f"{', '.join(fitted)})"
+            )
+        return np.sqrt(values.pop() * (1.0 + xi))
 
     def eval_band(
-        self, delta_deg: ArrayLike, xi: Optional[ArrayLike] = None, *, level: float = 0.95, series: Optional[str] = None, draws: int = 400
+        self,
+        delta_deg: ArrayLike,
+        xi: Optional[ArrayLike] = None,
+        *,
+        level: float = 0.95,
+        series: Optional[str] = None,
+        draws: int = 400,
+        units: str = "dimensionless",
     ) -> Table:
         """A confidence (least squares) or credible (MCMC) band of the fitted curve.
 
@@ -1271,11 +1493,35 @@ class FitResult:
         errors) and C :attr:`covar`. Under MCMC: the quantiles (1 ∓ level)/2 of v̄ over up to
         ``draws`` posterior draws evenly spaced through the kept ones.
 
+        Parameters
+        ----------
+        delta_deg : array_like
+            Slopes in degrees.
+        xi : array_like, optional
+            Radius ratios (broadcast with ``delta_deg``); default: the ξ of the fit's series
+            (or of ``series``).
+        level : float, default 0.95
+            Probability of the band, in (0, 1).
+        series : str, optional
+            As in :meth:`eval`: the series whose K (one K per series) or whose R_m and g
+            (``units="si"``) to use.
+        draws : int, default 400
+            MCMC: the most posterior draws the quantiles are taken over.
+        units : {"dimensionless", "si"}, default "dimensionless"
+            The unit of ``v``, ``v_low`` and ``v_high``, as in :meth:`eval`.
+
         Returns
         -------
         Table
             ``xi``, ``delta_deg``, ``v`` (the fit's curve), ``v_low``, ``v_high``.
+
+        Raises
+        ------
+        FitbeadError
+            A level outside (0, 1), no covariance (an undetermined least-squares fit), or
+            ``units`` as in :meth:`eval`.
         """
+        si = _units(units)
         if not (0.0 < level < 1.0):
             raise FitbeadError(f"level = {level}: expected a value in (0, 1)")
         shape, x, d, lab = self._points(delta_deg, xi, series)
@@ -1291,6 +1537,9 @@ class FitResult:
             sd = self._curve_sd(theta0, x, d, lab)
             z = NormalDist().inv_cdf((1 + level) / 2)
             lo, hi = v - z * sd, v + z * sd
+        if si:
+            unit = self._si_unit(x, series)
+            v, lo, hi = v * unit, lo * unit, hi * unit
         t = Table(xi=x.reshape(shape), delta_deg=d.reshape(shape), v=v.reshape(shape), v_low=lo.reshape(shape), v_high=hi.reshape(shape))
         t.shape = shape
         return t
@@ -1543,11 +1792,26 @@ class FitResult:
             both.
         level : float
             Level of the band.
+        units : {"dimensionless", "si"}, default "dimensionless"
+            Velocities (data, error bars, curves, bands) in the library's unit or in m/s
+            (``si``: for data given in m/s, each series with its own R_m and g, as in
+            :meth:`eval`); the residuals stay normalised by σ.
 
         Returns
         -------
         matplotlib.figure.Figure
+
+        Raises
+        ------
+        FitbeadError
+            An unknown ``units``, or ``si`` where the data were not given in m/s (as in
+            :meth:`eval`).
         """
+        si = _units(units)
+        r = self.residuals
+        labels = list(dict.fromkeys(r["series"]))
+        # The unit of each series, checked before anything is drawn.
+        scale = {lab: float(self._si_unit(np.asarray(r["xi"])[r["series"] == lab][:1], lab)[0]) if si else 1.0 for lab in labels}
         import matplotlib.pyplot as plt
 
         single = ax is not None and hasattr(ax, "errorbar")
@@ -1558,11 +1822,9 @@ class FitResult:
             ax = [ax, None]
         else:
             fig = ax[0].figure
-        r = self.residuals
-        labels = list(dict.fromkeys(r["series"]))
         for lab in labels:
             m = r["series"] == lab
-            d, v, s = np.asarray(r["delta_deg"])[m], np.asarray(r["v"])[m], np.asarray(r["sigma_v"])[m]
+            d, v, s = np.asarray(r["delta_deg"])[m], np.asarray(r["v"])[m] * scale[lab], np.asarray(r["sigma_v"])[m] * scale[lab]
             xi = float(np.asarray(r["xi"])[m][0])
             pts = ax[0].errorbar(d, v, yerr=None if np.isnan(s).all() else s, fmt="o", ms=4, capsize=2, label=f"ξ = {xi:g}")
             grid = np.linspace(d.min(), d.max(), 120)
@@ -1572,11 +1834,12 @@ class FitResult:
                 band = None
             color = pts[0].get_color()
             if band is not None:
-                ax[0].plot(grid, band["v"], color=color, lw=1.2)
-                ax[0].fill_between(grid, band["v_low"], band["v_high"], color=color, alpha=0.2, lw=0)
+                k = scale[lab]
+                ax[0].plot(grid, band["v"] * k, color=color, lw=1.2)
+                ax[0].fill_between(grid, band["v_low"] * k, band["v_high"] * k, color=color, alpha=0.2, lw=0)
             if ax[1] is not None:
                 ax[1].plot(d, np.asarray(r["normalised_residual"])[m], "o", ms=4, color=color)
-        ax[0].set_ylabel("mean velocity v̄ / √(g(R+r))")
+        ax[0].set_ylabel("mean velocity v̄ (m/s)" if si else "mean velocity v̄ / √(g(R+r))")
         if ax[1] is not None:
             ax[1].axhline(0, color="0.5", lw=0.8)
             ax[1].set_ylabel("residual / σ")
@@ -1699,11 +1962,39 @@ class FitSet(list):
         """``(name, series)`` of every fit, in order."""
         return [(f.name, f.series) for f in self]
 
-    def to_arviz(self):
-        """The posteriors of the run's fits as one ``arviz.InferenceData`` per fit, keyed by
-        ``name[series]`` (each as :meth:`FitResult.to_arviz`: a pointwise log likelihood for
-        ``az.compare``); needs MCMC fits."""
-        return {f"{f.name}[{f.series}]": f.to_arviz() for f in self}
+    def to_arviz(self, joined: bool = False):
+        """The posteriors of the run's fits as ``arviz.InferenceData`` (needs ArviZ and MCMC
+        fits).
+
+        Parameters
+        ----------
+        joined : bool, default False
+            False: one InferenceData per fit, keyed ``name[series]``, each as
+            :meth:`FitResult.to_arviz`. True: one per fit name, keyed by it
+            (``jan-series``, ``jan-global``; ``jaeger``), the fits of one name joined over
+            the points of all their series, so that ``az.compare`` weighs the per-series
+            fits against the global one on the same points (``az.compare`` needs the same
+            points in every model: a series with too few points for its own fit is left out
+            of the joined fits but not of the global one).
+
+        Returns
+        -------
+        dict of str to arviz.InferenceData
+
+        Notes
+        -----
+        The fits of one name are independent posteriors, so draw ``(w, s)`` of each series
+        together is a draw of their joint posterior: the joined ``posterior`` has each
+        parameter over ``(chain, draw, series)``, the ``log_likelihood`` ``v`` the pointwise
+        log likelihoods of every series (``point``: the series in the set's order, each in
+        its fit's order of points), ``sample_stats`` ``lp`` the sum of the log posteriors.
+        Runs of different lengths are joined over the last kept steps they all have, and
+        over the walkers they all have.
+        """
+        if not joined:
+            return {f"{f.name}[{f.series}]": f.to_arviz() for f in self}
+        names = list(dict.fromkeys(f.name for f in self))
+        return {name: _joined_arviz([f for f in self if f.name == name]) for name in names}
 
     def plot(self, **kwargs: Any):
         """Every fit's :meth:`FitResult.plot`, one figure each; returns the figures."""
@@ -1719,9 +2010,20 @@ class FitSet(list):
         return "".join(fr._repr_html_() for fr in self)
 
     def to_pandas(self, what: str = "params"):
-        """Every fit's table in one DataFrame (needs pandas): ``params``, ``stats``,
-        ``residuals`` or ``correlations``, with the command line's columns (its CSV of the
-        whole run), numeric dtypes and NaN for empty cells."""
+        """Every fit's table in one DataFrame (needs pandas), with the command line's columns
+        (its CSV of the whole run), numeric dtypes and NaN for empty cells.
+
+        Parameters
+        ----------
+        what : {"params", "stats", "residuals", "correlations"}, default "params"
+            Which table, as :meth:`FitResult.to_pandas` (the draws are per fit:
+            ``fits[i].to_pandas("draws")``).
+
+        Returns
+        -------
+        pandas.DataFrame
+            One fit's rows after another, in the order of the set.
+        """
         import pandas as pd
 
         if what == "draws":
@@ -1730,6 +2032,44 @@ class FitSet(list):
         if not frames:
             return _frame([], _core.record_columns(what))
         return pd.concat(frames, ignore_index=True)
+
+
+def _joined_arviz(fits: List[FitResult]):
+    """One ``arviz.InferenceData`` of the fits of one name, independent posteriors joined
+    draw by draw over their common walkers and last kept steps (see
+    :meth:`FitSet.to_arviz`)."""
+    import arviz as az
+
+    if len(fits) == 1:
+        return fits[0].to_arviz()
+    missing = [f"{f.name}[{f.series}]" for f in fits if f.draws is None]
+    if missing:
+        raise FitbeadError(f"no draws in {', '.join(missing)}: to_arviz needs MCMC fits (method='mcmc')")
+    walkers = min(f.draws.shape[0] for f in fits)  # type: ignore[union-attr]
+    steps = min(f.draws.shape[1] for f in fits)  # type: ignore[union-attr]
+    labels = [f.series for f in fits]
+    names = list(dict.fromkeys(n for f in fits for n in f.param_names))
+    post = {}
+    for n in names:
+        cols = []
+        for f in fits:
+            d = f.draws[:walkers, -steps:, :]  # type: ignore[index]
+            cols.append(d[:, :, f.param_names.index(n)] if n in f.param_names else np.full(d.shape[:2], np.nan))
+        post[n] = np.stack(cols, axis=-1)
+    ll = np.concatenate([f.log_likelihood()[:walkers, -steps:, :] for f in fits], axis=-1)
+    lp = sum(f.log_posterior[:walkers, -steps:] for f in fits)  # type: ignore[index]
+    col = lambda k: np.concatenate([np.asarray(f.residuals[k], dtype=float) for f in fits])  # noqa: E731
+    point_series = np.concatenate([np.asarray(f.residuals["series"], dtype=str) for f in fits])
+    return az.from_dict(
+        posterior=post,
+        log_likelihood={"v": ll},
+        sample_stats={"lp": lp},
+        observed_data={"v": col("v")},
+        constant_data={"xi": col("xi"), "delta_deg": col("delta_deg"), "sigma_v": col("sigma_v"), "point_series": point_series},
+        coords={"series": labels},
+        dims={**{n: ["series"] for n in names}, "v": ["point"], "xi": ["point"], "delta_deg": ["point"], "sigma_v": ["point"], "point_series": ["point"]},
+        attrs={"fit": fits[0].name, "series": ",".join(labels), "joined": 1},
+    )
 
 
 def _same_series(fr: "FitResult", series: Any) -> bool:
@@ -1755,6 +2095,49 @@ def _fitted(core: Any, context: Dict[str, Any], refit: Optional[Tuple[Any, Dict[
     fr._refit = refit
     fr._warn()
     return fr
+
+
+_UNITS = ("dimensionless", "si")
+
+
+def _units(units: Any) -> bool:
+    """Whether ``units`` asks for SI velocities (m/s); FitbeadError for an unknown value."""
+    if units not in _UNITS:
+        raise FitbeadError(f"units = {units!r}: expected 'dimensionless' or 'si'")
+    return units == "si"
+
+
+def _si_context(d: Dataset) -> Dict[str, float]:
+    """For data given in m/s (``v_m_s`` with ``R_m``): ``g_R[LABEL]``, the product g·R
+    (m²/s²) of each series whose rows share one R_m and one g, so that a velocity of the
+    series in m/s is v·sqrt(g R (1 + ξ)); empty for dimensionless data."""
+    fc = d.file_columns()
+    if "R_m" not in fc or "v_m_s" not in fc:
+        return {}
+    g_default = float(dict(d._core.state()).get("g", 9.81))
+    r = fc["R_m"]
+    g = fc.get("g", np.full(r.shape, np.nan))
+    g = np.where(np.isnan(g), g_default, g)
+    labels = d.columns()["series"]
+    out: Dict[str, float] = {}
+    for lab in dict.fromkeys(labels):
+        m = labels == lab
+        pairs = set(zip(r[m].tolist(), g[m].tolist()))
+        if len(pairs) == 1:
+            (rr, gg), = pairs
+            if not (math.isnan(rr) or math.isnan(gg)):
+                out[f"g_R[{lab}]"] = gg * rr
+    return out
+
+
+def _material_context(d: Dataset) -> Dict[str, Any]:
+    """ρ and f of the data's rows, which a K(α) law's curve is drawn with: ``rho`` and ``f``
+    where every row has the same, else ``mixed_material``."""
+    c = d.columns()
+    rho, f = np.unique(c["rho"]), np.unique(c["f"])
+    if rho.size == 1 and f.size == 1:
+        return {"rho": float(rho[0]), "f": float(f[0])}
+    return {"mixed_material": True}
 
 
 def _controlled(context: Dict[str, Any], scale_covar: bool) -> Dict[str, Any]:
@@ -1926,7 +2309,10 @@ def fit_klaw(
         MCMC: the walkers (default: the library's choice) and the step limit.
     min_ess : float, optional
         MCMC: the bulk and tail ESS every parameter must reach (with rank-normalised split-R̂
-        ≤ 1.01) before the run stops (default 1000).
+        ≤ 1.01) before the run stops (default 1000). The run is also at least 50
+        autocorrelation times long and is checked every 500 steps, so a ``min_ess`` below
+        the ESS those give (on the shipped data, thousands at 1,000 steps)
+        does not shorten it; ``stats["steps"]`` and ``stats["ess_min"]`` say what it did.
     tol : float, default 1e-10
         With ``model="auto"``: the target relative tolerance on v.
     skip_unsteady : bool, default False
@@ -1978,8 +2364,9 @@ def fit_klaw(
     ------
     FitbeadError
         Bad data or settings (the command line's message).
-    KeyboardInterrupt
-        Ctrl-C stops an MCMC run cleanly and raises.
+    Interrupted
+        Ctrl-C stops a run cleanly and raises; a posterior run's draws so far are the
+        exception's ``result`` (a ``KeyboardInterrupt`` where nothing was kept yet).
 
     Warns
     -----
@@ -1988,7 +2375,7 @@ def fit_klaw(
     """
     _counts(seed=seed, walkers=walkers, max_steps=max_steps, thin=thin)
     d = _fit_data(data, rho, f, g, sigma_delta, strict_columns)
-    fits, notes, text = _core.fit_klaw(
+    fits, notes, text, signal = _core.fit_klaw(
         d._core, model=_model_name(model), law=law, method=method, level=level, profile=profile, seed=seed, walkers=walkers,
         max_steps=max_steps, min_ess=min_ess, tol=tol, thin=thin, priors=_priors(priors), fit_scatter=fit_scatter,
         skip_unsteady=skip_unsteady, draws=_draws_wanted(draws, method), fix=_named_values("fix", fix),
@@ -2000,7 +2387,10 @@ def fit_klaw(
         min_ess=min_ess, tol=tol, skip_unsteady=skip_unsteady, thin=thin, priors=priors, fit_scatter=fit_scatter,
         fix=fix, init=init, bounds=bounds, scale_covar=scale_covar,
     )
-    return _fitted(fits[0], _controlled({"model": _model_name(model)}, scale_covar), (fit_klaw, again))
+    context = _controlled({"model": _model_name(model), **_material_context(d), **_si_context(d)}, scale_covar)
+    out = _fitted(fits[0], context, (fit_klaw, again))
+    _stopped(signal, out)
+    return out
 
 
 def fit_jan(
@@ -2056,6 +2446,14 @@ def fit_jan(
         ``jan-series`` fits (λ, μ) per series, then ``jan-global`` (λ0, λ1, μ0, μ1 of
         λ = λ0 e^{λ1 sin α}, μ = μ0 e^{μ1 sin α}).
 
+    Raises
+    ------
+    FitbeadError
+        Bad data or settings (the command line's message).
+    Interrupted
+        Ctrl-C, as in :func:`fit_klaw`: the run's draws so far are the exception's
+        ``result``, a FitSet.
+
     Warns
     -----
     UnitWarning, ConvergenceWarning, BoundWarning, ColumnWarning
@@ -2063,7 +2461,7 @@ def fit_jan(
     """
     _counts(seed=seed, walkers=walkers, max_steps=max_steps, thin=thin)
     d = _fit_data(data, rho, f, g, sigma_delta, strict_columns)
-    fits, notes, text = _core.fit_jan(
+    fits, notes, text, signal = _core.fit_jan(
         d._core, method=method, level=level, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps,
         min_ess=min_ess, thin=thin, priors=_priors(priors), fit_scatter=fit_scatter, draws=_draws_wanted(draws, method),
         fix=_named_values("fix", fix), init=_named_values("init", init), bounds=_named_bounds(bounds), scale_covar=scale_covar,
@@ -2073,8 +2471,10 @@ def fit_jan(
         data=d, method=method, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps, min_ess=min_ess, thin=thin,
         priors=priors, fit_scatter=fit_scatter, fix=fix, init=init, bounds=bounds, scale_covar=scale_covar,
     )
-    context = _controlled({}, scale_covar)
-    return FitSet([_fitted(x, context, (fit_jan, again)) for x in fits], notes)
+    context = _controlled(_si_context(d), scale_covar)
+    out = FitSet([_fitted(x, context, (fit_jan, again)) for x in fits], notes)
+    _stopped(signal, out)
+    return out
 
 
 def fit_jaeger(
@@ -2132,6 +2532,14 @@ def fit_jaeger(
     FitSet
         One ``jaeger`` fit per series.
 
+    Raises
+    ------
+    FitbeadError
+        Bad data or settings (the command line's message).
+    Interrupted
+        Ctrl-C, as in :func:`fit_klaw`: the run's draws so far are the exception's
+        ``result``, a FitSet.
+
     Warns
     -----
     UnitWarning, ConvergenceWarning, BoundWarning, ColumnWarning
@@ -2139,7 +2547,7 @@ def fit_jaeger(
     """
     _counts(seed=seed, walkers=walkers, max_steps=max_steps, thin=thin)
     d = _fit_data(data, rho, f, g, sigma_delta, strict_columns)
-    fits, notes, text = _core.fit_jaeger(
+    fits, notes, text, signal = _core.fit_jaeger(
         d._core, branch=branch, method=method, level=level, profile=profile, seed=seed, walkers=walkers, max_steps=max_steps,
         min_ess=min_ess, thin=thin, priors=_priors(priors), fit_scatter=fit_scatter, draws=_draws_wanted(draws, method),
         fix=_named_values("fix", fix), init=_named_values("init", init), bounds=_named_bounds(bounds), scale_covar=scale_covar,
@@ -2150,8 +2558,10 @@ def fit_jaeger(
         min_ess=min_ess, thin=thin, priors=priors, fit_scatter=fit_scatter, fix=fix, init=init, bounds=bounds,
         scale_covar=scale_covar,
     )
-    context = _controlled({"branch": branch}, scale_covar)
-    return FitSet([_fitted(x, context, (fit_jaeger, again)) for x in fits], notes)
+    context = _controlled({"branch": branch, **_si_context(d)}, scale_covar)
+    out = FitSet([_fitted(x, context, (fit_jaeger, again)) for x in fits], notes)
+    _stopped(signal, out)
+    return out
 
 
 class Design:
@@ -2398,7 +2808,8 @@ def design(
 def _csv_table(text: str) -> Table:
     """A CSV text of the command line as a :class:`Table`: one column per header name, in
     its order; a column whose every cell is a number or empty is float64 (NaN for empty),
-    any other, and ``series`` (labels, even those that read as numbers), an object array of
+    a count (``n_points``, ``rank``, ...) with every cell given int64, any other, and the
+    text columns (``series``: labels, even those that read as numbers), an object array of
     ``str``."""
     import csv
     import io
@@ -2409,11 +2820,14 @@ def _csv_table(text: str) -> Table:
     for j, name in enumerate(header):
         cells = [r[j] if j < len(r) else "" for r in body]
         col: Optional[np.ndarray] = None
-        if name != "series":
+        if name not in _TEXT_COLUMNS:
             try:
                 col = np.array([float(c) if c != "" else np.nan for c in cells], dtype=np.float64)
             except ValueError:
                 col = None
+        # A count with every cell given is int64.
+        if col is not None and name in _COUNT_COLUMNS and not np.isnan(col).any() and (col == np.round(col)).all():
+            col = col.astype(np.int64)
         t[name] = col if col is not None else np.array(cells, dtype=object)
     t.shape = (len(body),)
     return t
@@ -2640,6 +3054,9 @@ def report(
     ------
     FitbeadError
         Data or settings the command line refuses, with its message.
+    Interrupted
+        Ctrl-C during a posterior run: the report of the draws so far (written to
+        ``out_dir`` too) is the exception's ``result``.
 
     Warns
     -----
@@ -2651,7 +3068,7 @@ def report(
         A posterior run that did not converge, or was interrupted.
     """
     d = _dataset(data)
-    files, unit_warnings, misfit_warnings, convergence_warnings, interrupted, summary = _core.report(
+    files, unit_warnings, misfit_warnings, convergence_warnings, interrupted, summary, signal = _core.report(
         d._core,
         out_dir=None if out_dir is None else str(out_dir),
         method=method,
@@ -2680,6 +3097,7 @@ def report(
             out[name[: -len(".csv")]] = _csv_table(b.decode("utf-8"))
     out.markdown = out.files.get("report.md", b"").decode("utf-8")
     out.summary = summary
+    _stopped(signal, out)
     return out
 
 

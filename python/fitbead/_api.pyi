@@ -36,6 +36,13 @@ class ColumnWarning(FitbeadWarning):
     """A column of the data that fitbead does not read looks misspelt or misnamed (close to a
     known name, or named like an uncertainty); ``strict_columns=True`` refuses it."""
 
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C stopped a posterior run of fit_klaw, fit_jan, fit_jaeger or report: a
+    ``KeyboardInterrupt`` whose ``result`` is the partial result (the draws so far, each fit
+    marked ``interrupted``); a signal handler's own exception passes unchanged."""
+    result: Any
+    def __init__(self, message: str, result: Any = None) -> None: ...
+
 def threads() -> int:
     """Number of threads the vectorised functions use (rayon's pool)."""
 
@@ -143,11 +150,31 @@ def invert_k(model: str, xi: ArrayLike | Dataset, delta_deg: ArrayLike | None = 
 def regimes(xi: ArrayLike = (0.8, 1.0, 1.6, 2.0), law: str = 'adjusted', rho: float = 0.4) -> Table:
     """The regime limits of a collision law (``fitbead regimes``).
 
-    Returns the command line's columns: ``xi``, ``alpha_deg``, ``K``, ``delta_m_deg`` (δ_m,
-    eq 32: below it the bead stops), ``delta_d_deg`` (δ_d, eq 31: above it the bead lifts
-    off), ``mu_eq79`` (the bulk friction of eq 79), ``steady_range`` (``yes`` where δ_m <
-    δ_d) and ``critical_xi`` (the ξ below which no steady regime exists, NaN if there is
-    none); the table's attribute ``critical_xi`` holds it too (None if there is none).
+    Parameters
+    ----------
+    xi : array_like, default (0.8, 1.0, 1.6, 2.0)
+        Radius ratios ξ = r/R (flattened to one row each).
+    law : str, default "adjusted"
+        The collision law K(α): ``adjusted`` (the paper's fit), ``impact``, ``cos2a``, a
+        number (one K for every ξ) or ``c=VALUE`` (K = cos 2α + c sin²α sin 2α), as the
+        command line's ``--law``.
+    rho : float, default 0.4
+        Density ratio ρ.
+
+    Returns
+    -------
+    Table
+        The command line's columns: ``xi``, ``alpha_deg``, ``K``, ``delta_m_deg`` (δ_m,
+        eq 32: below it the bead stops), ``delta_d_deg`` (δ_d, eq 31: above it the bead
+        lifts off), ``mu_eq79`` (the bulk friction of eq 79), ``steady_range`` (``yes``
+        where δ_m < δ_d) and ``critical_xi`` (the ξ below which no steady regime exists,
+        NaN if there is none); the table's attribute ``critical_xi`` holds it too (None if
+        there is none).
+
+    Raises
+    ------
+    FitbeadError
+        An unknown law, ξ ≤ 0, ρ < 0, or a law whose K is not above 0 at some ξ.
     """
 
 class Dataset:
@@ -189,16 +216,85 @@ class Dataset:
     def default(cls) -> Dataset:
         """The shipped synthetic data set (36 points in 4 series; data/default.csv)."""
     @classmethod
-    def from_arrays(cls, xi: ArrayLike, delta_deg: ArrayLike, v: ArrayLike, sigma_v: ArrayLike | None = None, *, series: Iterable[Any] | None = None, rho: ArrayLike = 0.4, f: ArrayLike = 0.1, sigma_delta_deg: ArrayLike = 0.0) -> Dataset:
-        """From arrays (broadcast together). ``series`` labels group the points (default:
-        grouped by ξ); without ``sigma_v`` the fits weight relatively. ``sigma_delta_deg`` is
-        the standard uncertainty of each slope in degrees (0: exact); where it is above 0 the
-        least-squares fits are orthogonal distance regressions, and their residual tables
-        gain ``delta_fit_deg`` and ``delta_residual``."""
+    def from_arrays(cls, xi: ArrayLike, delta_deg: ArrayLike, v: ArrayLike | None = None, sigma_v: ArrayLike | None = None, *, series: Iterable[Any] | None = None, rho: ArrayLike = 0.4, f: ArrayLike = 0.1, sigma_delta_deg: ArrayLike = 0.0, v_m_s: ArrayLike | None = None, sigma_v_m_s: ArrayLike | None = None, R_m: ArrayLike | None = None, g: ArrayLike = 9.81) -> Dataset:
+        """From arrays (broadcast together), dimensionless (``v``) or in SI units (``v_m_s``
+        with ``R_m``), with the names of the CSV's columns (:meth:`read_csv`).
+
+        Parameters
+        ----------
+        xi, delta_deg : array_like
+            Radius ratio ξ = r/R and slope δ in degrees, per point.
+        v, sigma_v : array_like, optional
+            Mean velocity v̄ / sqrt(g (R + r)) and its standard uncertainty (dimensionless).
+            Without ``sigma_v`` (or ``sigma_v_m_s``) the fits weight relatively.
+        series : iterable, optional
+            Labels grouping the points (default: grouped by ξ).
+        rho, f : array_like
+            Density ratio ρ and friction f per point (defaults 0.4, 0.1).
+        sigma_delta_deg : array_like, default 0
+            Standard uncertainty of each slope in degrees (0: exact); where it is above 0 the
+            least-squares fits are orthogonal distance regressions, and their residual tables
+            gain ``delta_fit_deg`` and ``delta_residual``.
+        v_m_s, sigma_v_m_s : array_like, optional
+            Instead of ``v`` and ``sigma_v``: the velocities and their uncertainty in m/s,
+            converted as the CSV reader does, v = v_m_s / sqrt(g R_m (1 + ξ)).
+        R_m : array_like, optional
+            With ``v_m_s``: the radius R of the row beads, metres.
+        g : array_like, default 9.81
+            With ``v_m_s``: the acceleration of gravity, m/s².
+
+        Returns
+        -------
+        Dataset
+
+        Raises
+        ------
+        FitbeadError
+            Velocities given both ways or neither, ``v_m_s`` without ``R_m``, ``sigma_v``
+            beside ``v_m_s`` (or ``sigma_v_m_s`` beside ``v``), or a value the CSV reader
+            refuses (its message; point ``i`` is "line" ``i + 2``).
+
+        Warns
+        -----
+        UnitWarning
+            The command line's plausibility warnings, as for :meth:`read_csv` (slopes in
+            radians, velocities in m/s or mm/s, radii in millimetres); the data are named
+            ``<arrays>`` and the point at index ``i`` is "line" ``i + 2``, as if written to a
+            CSV file.
+        """
     @classmethod
     def from_pandas(cls, df: Any, *, rho: float = 0.4, f: float = 0.1, g: float = 9.81, strict_columns: bool = False) -> Dataset:
         """From a DataFrame with the CSV's columns, checked as the command line checks a file
-        (errors name the DataFrame's line as the CSV would have it: header on line 1)."""
+        (errors name the DataFrame's line as the CSV would have it: header on line 1).
+
+        Parameters
+        ----------
+        df : pandas.DataFrame
+            The columns of a measurement CSV (:meth:`read_csv`): ``series``, ``xi``,
+            ``delta_deg`` and ``v`` (dimensionless, optionally ``sigma_v``) or ``v_m_s``
+            with ``R_m`` (SI, optionally ``sigma_v_m_s`` and ``g``), optionally ``rho``,
+            ``f`` and ``sigma_delta_deg``; the index is not used.
+        rho, f, g : float
+            Values for the columns the frame leaves out (defaults 0.4, 0.1, 9.81); ``g`` in
+            m/s² for SI columns.
+        strict_columns : bool, default False
+            Refuse any column fitbead does not read, instead of warning (``ColumnWarning``)
+            about those that look misnamed.
+
+        Returns
+        -------
+        Dataset
+
+        Raises
+        ------
+        FitbeadError
+            The CSV reader's message (line, column, value).
+
+        Warns
+        -----
+        UnitWarning, ColumnWarning
+            As :meth:`read_csv`.
+        """
     @property
     def warnings(self) -> list[str]:
         """The plausibility warnings given when the data were read (also given as
@@ -389,7 +485,7 @@ class FitResult:
         """Whether the covariance was scaled by the reduced χ² (``scale_covar=True``, or data
         without sigma_v, whose scale is always estimated)."""
     def __getitem__(self, name: str) -> Param: ...
-    def eval(self, delta_deg: ArrayLike, xi: ArrayLike | None = None, *, series: str | None = None) -> np.ndarray:
+    def eval(self, delta_deg: ArrayLike, xi: ArrayLike | None = None, *, series: str | None = None, units: str = 'dimensionless') -> np.ndarray:
         """The fitted model's mean velocity v̄ at new slopes (lmfit's ``eval``).
 
         Parameters
@@ -400,14 +496,26 @@ class FitResult:
             Radius ratios (broadcast with ``delta_deg``); default: the ξ of the fit's series
             (or of ``series``).
         series : str, optional
-            For a fit with one K per series, the series whose K to use.
+            For a fit with one K per series, the series whose K to use; with
+            ``units="si"``, the series whose R_m and g convert to m/s.
+        units : {"dimensionless", "si"}, default "dimensionless"
+            ``dimensionless``: v̄ / sqrt(g (R + r)), the library's unit; ``si``: m/s, for a fit
+            of data given in m/s (``v_m_s`` with ``R_m``), as v̄·sqrt(g R_m (1 + ξ)) with the
+            R_m and g of the series (``series``, the fit's own, or the one all series
+            share).
 
         Returns
         -------
         numpy.ndarray
             v̄ (NaN where the model has no steady state), shaped as the broadcast arguments.
+
+        Raises
+        ------
+        FitbeadError
+            An unknown ``units``; ``units="si"`` for data given dimensionless, or with no one
+            R_m and g for the points asked (series that differ and no ``series``).
         """
-    def eval_band(self, delta_deg: ArrayLike, xi: ArrayLike | None = None, *, level: float = 0.95, series: str | None = None, draws: int = 400) -> Table:
+    def eval_band(self, delta_deg: ArrayLike, xi: ArrayLike | None = None, *, level: float = 0.95, series: str | None = None, draws: int = 400, units: str = 'dimensionless') -> Table:
         """A confidence (least squares) or credible (MCMC) band of the fitted curve.
 
         Under least squares: the delta method, v̄ ± z σ_v̄ with σ_v̄² = J C Jᵀ, J the
@@ -415,10 +523,33 @@ class FitResult:
         errors) and C :attr:`covar`. Under MCMC: the quantiles (1 ∓ level)/2 of v̄ over up to
         ``draws`` posterior draws evenly spaced through the kept ones.
 
+        Parameters
+        ----------
+        delta_deg : array_like
+            Slopes in degrees.
+        xi : array_like, optional
+            Radius ratios (broadcast with ``delta_deg``); default: the ξ of the fit's series
+            (or of ``series``).
+        level : float, default 0.95
+            Probability of the band, in (0, 1).
+        series : str, optional
+            As in :meth:`eval`: the series whose K (one K per series) or whose R_m and g
+            (``units="si"``) to use.
+        draws : int, default 400
+            MCMC: the most posterior draws the quantiles are taken over.
+        units : {"dimensionless", "si"}, default "dimensionless"
+            The unit of ``v``, ``v_low`` and ``v_high``, as in :meth:`eval`.
+
         Returns
         -------
         Table
             ``xi``, ``delta_deg``, ``v`` (the fit's curve), ``v_low``, ``v_high``.
+
+        Raises
+        ------
+        FitbeadError
+            A level outside (0, 1), no covariance (an undetermined least-squares fit), or
+            ``units`` as in :meth:`eval`.
         """
     def eval_uncertainty(self, sigma: float = 1, delta_deg: ArrayLike | None = None, xi: ArrayLike | None = None, *, series: str | None = None) -> np.ndarray:
         """Half-widths of the confidence band of the fitted curve (lmfit's
@@ -488,10 +619,20 @@ class FitResult:
             both.
         level : float
             Level of the band.
+        units : {"dimensionless", "si"}, default "dimensionless"
+            Velocities (data, error bars, curves, bands) in the library's unit or in m/s
+            (``si``: for data given in m/s, each series with its own R_m and g, as in
+            :meth:`eval`); the residuals stay normalised by σ.
 
         Returns
         -------
         matplotlib.figure.Figure
+
+        Raises
+        ------
+        FitbeadError
+            An unknown ``units``, or ``si`` where the data were not given in m/s (as in
+            :meth:`eval`).
         """
 
 class FitSet(list):
@@ -513,14 +654,52 @@ class FitSet(list):
     def __contains__(self, key: Any) -> bool: ...
     def keys(self) -> list[tuple[str, str]]:
         """``(name, series)`` of every fit, in order."""
-    def to_arviz(self) -> dict[str, Any]:
-        """Each fit's ``arviz.InferenceData``, keyed by ``name[series]``."""
+    def to_arviz(self, joined: bool = False) -> dict[str, Any]:
+        """The posteriors of the run's fits as ``arviz.InferenceData`` (needs ArviZ and MCMC
+        fits).
+
+        Parameters
+        ----------
+        joined : bool, default False
+            False: one InferenceData per fit, keyed ``name[series]``, each as
+            :meth:`FitResult.to_arviz`. True: one per fit name, keyed by it
+            (``jan-series``, ``jan-global``; ``jaeger``), the fits of one name joined over
+            the points of all their series, so that ``az.compare`` weighs the per-series
+            fits against the global one on the same points (``az.compare`` needs the same
+            points in every model: a series with too few points for its own fit is left out
+            of the joined fits but not of the global one).
+
+        Returns
+        -------
+        dict of str to arviz.InferenceData
+
+        Notes
+        -----
+        The fits of one name are independent posteriors, so draw ``(w, s)`` of each series
+        together is a draw of their joint posterior: the joined ``posterior`` has each
+        parameter over ``(chain, draw, series)``, the ``log_likelihood`` ``v`` the pointwise
+        log likelihoods of every series (``point``: the series in the set's order, each in
+        its fit's order of points), ``sample_stats`` ``lp`` the sum of the log posteriors.
+        Runs of different lengths are joined over the last kept steps they all have, and
+        over the walkers they all have.
+        """
     def plot(self, **kwargs: Any) -> list[Any]:
         """Every fit's plot, one figure each."""
     def to_pandas(self, what: str = 'params'):
-        """Every fit's table in one DataFrame (needs pandas): ``params``, ``stats``,
-        ``residuals`` or ``correlations``, with the command line's columns (its CSV of the
-        whole run), numeric dtypes and NaN for empty cells."""
+        """Every fit's table in one DataFrame (needs pandas), with the command line's columns
+        (its CSV of the whole run), numeric dtypes and NaN for empty cells.
+
+        Parameters
+        ----------
+        what : {"params", "stats", "residuals", "correlations"}, default "params"
+            Which table, as :meth:`FitResult.to_pandas` (the draws are per fit:
+            ``fits[i].to_pandas("draws")``).
+
+        Returns
+        -------
+        pandas.DataFrame
+            One fit's rows after another, in the order of the set.
+        """
 
 def fit_klaw(data: Any = None, *, model: str = 'stickslip', law: str = 'c', method: str = 'lsq', level: float = 0.95, profile: bool = True, seed: int = 1, walkers: int | None = None, max_steps: int | None = None, min_ess: float | None = None, tol: float = 1e-10, skip_unsteady: bool = False, thin: int | None = None, priors: Any = None, fit_scatter: bool = False, draws: Any = None, rho: float | None = None, f: float | None = None, g: float | None = None, sigma_delta: float | None = None, strict_columns: bool = False, fix: Mapping[str, float] | None = None, init: Mapping[str, float] | None = None, bounds: Mapping[str, tuple[float | None, float | None]] | None = None, scale_covar: bool = False) -> FitResult:
     '''A law K(α) fitted to every series at once (``fitbead klaw``).
@@ -549,7 +728,10 @@ def fit_klaw(data: Any = None, *, model: str = 'stickslip', law: str = 'c', meth
         MCMC: the walkers (default: the library\'s choice) and the step limit.
     min_ess : float, optional
         MCMC: the bulk and tail ESS every parameter must reach (with rank-normalised split-R̂
-        ≤ 1.01) before the run stops (default 1000).
+        ≤ 1.01) before the run stops (default 1000). The run is also at least 50
+        autocorrelation times long and is checked every 500 steps, so a ``min_ess`` below
+        the ESS those give (on the shipped data, thousands at 1,000 steps)
+        does not shorten it; ``stats["steps"]`` and ``stats["ess_min"]`` say what it did.
     fix, init, bounds : mapping, optional
         Parameters held at a value (``{"c": 0.5}``, lmfit\'s ``vary=False``), started at a
         value (``{"c": 0.6}``) or bounded (``{"c": (0.3, 0.9)}``) by name: ``NAME`` in every fit
@@ -567,8 +749,9 @@ def fit_klaw(data: Any = None, *, model: str = 'stickslip', law: str = 'c', meth
     ------
     FitbeadError
         Bad data or settings (the command line\'s message).
-    KeyboardInterrupt
-        Ctrl-C stops an MCMC run cleanly and raises.
+    Interrupted
+        Ctrl-C stops a run cleanly and raises; a posterior run\'s draws so far are the
+        exception\'s ``result`` (a ``KeyboardInterrupt`` where nothing was kept yet).
 
     Warns
     -----

@@ -43,7 +43,101 @@ pyo3::create_exception!(
 );
 
 fn value_error(msg: impl Into<String>) -> PyErr {
-    FitbeadError::new_err(msg.into())
+    FitbeadError::new_err(python_words(&msg.into()))
+}
+
+/// The keyword argument of the Python functions that the command line's flag `--NAME` sets.
+fn keyword(flag: &str) -> String {
+    match flag {
+        "prior" => "priors".into(),
+        "input" => "data".into(),
+        _ => flag.replace('-', "_"),
+    }
+}
+
+/// The library's message in the words of the Python functions: a setting is named by its
+/// keyword argument (`level = '2': …` for `<command line>, flag '--level', value '2': …`),
+/// and a flag quoted in the text as the keyword with its value where one follows
+/// (`vs=MODEL`, `fit='jaeger'`, `skip_unsteady=True`). The rest is the library's text.
+fn python_words(msg: &str) -> String {
+    const HEAD: &str = "<command line>, flag '--";
+    let mut out = String::with_capacity(msg.len());
+    let mut body = msg;
+    if let Some(rest) = msg.strip_prefix(HEAD) {
+        if let Some(end) = rest.find('\'') {
+            let kw = keyword(&rest[..end]);
+            let after = &rest[end + 1..];
+            let (value, tail) = match after.strip_prefix(", value '") {
+                Some(v) => match v.find("': ") {
+                    Some(q) => (Some(&v[..q]), &v[q + 1..]),
+                    None => (None, after),
+                },
+                None => (None, after),
+            };
+            out.push_str(&kw);
+            if let Some(v) = value {
+                out.push_str(" = '");
+                out.push_str(v);
+                out.push('\'');
+            }
+            body = tail;
+        }
+    }
+    let mut prev = ' ';
+    let mut i = 0;
+    while i < body.len() {
+        let rest = &body[i..];
+        let starts_flag = rest.starts_with("--")
+            && matches!(prev, ' ' | '(' | '`' | '"' | '\'')
+            && rest[2..].starts_with(|c: char| c.is_ascii_lowercase());
+        if !starts_flag {
+            let c = rest.chars().next().unwrap_or(' ');
+            out.push(c);
+            prev = c;
+            i += c.len_utf8();
+            continue;
+        }
+        let name_len = rest[2..]
+            .find(|c: char| !(c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-'))
+            .unwrap_or(rest.len() - 2);
+        let name = rest[2..2 + name_len].trim_end_matches('-');
+        let kw = keyword(name);
+        i += 2 + name.len();
+        out.push_str(&kw);
+        prev = 'x';
+        // The flag's argument, where one follows: a placeholder (MODEL), a word of a
+        // setting that takes text, or nothing for a switch.
+        let arg_rest = &body[i..];
+        let token = arg_rest
+            .strip_prefix(' ')
+            .map(|t| t.split([' ', ')', ';', ':']).next().unwrap_or(""))
+            .unwrap_or("");
+        let placeholder = token.chars().any(|c| c.is_ascii_uppercase())
+            && !token.chars().any(|c| c.is_ascii_lowercase());
+        let text_setting = matches!(
+            kw.as_str(),
+            "fit" | "vs" | "model" | "method" | "units" | "law" | "branch" | "spin" | "criterion"
+        ) && !token.is_empty()
+            && token
+                .chars()
+                .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || "-.=".contains(c));
+        if placeholder {
+            out.push('=');
+            out.push_str(token);
+            i += 1 + token.len();
+        } else if text_setting {
+            out.push_str("='");
+            out.push_str(token);
+            out.push('\'');
+            i += 1 + token.len();
+        } else if matches!(
+            kw.as_str(),
+            "skip_unsteady" | "strict_columns" | "scale_covar" | "fit_scatter" | "keep_going"
+        ) {
+            out.push_str("=True");
+        }
+    }
+    out
 }
 
 /// The process that loaded the module (0 until it is loaded).
@@ -1568,6 +1662,20 @@ fn interruptible<T: Send>(
     stop: &AtomicBool,
     work: impl FnOnce() -> T + Send,
 ) -> PyResult<T> {
+    match interruptible_keep(py, stop, work)? {
+        (_, Some(e)) => Err(e),
+        (r, None) => Ok(r),
+    }
+}
+
+/// [`interruptible`], keeping what the work made after an interrupt: that, and the
+/// exception a signal handler raised (KeyboardInterrupt for Ctrl-C, or the handler's own)
+/// when one did.
+fn interruptible_keep<T: Send>(
+    py: Python<'_>,
+    stop: &AtomicBool,
+    work: impl FnOnce() -> T + Send,
+) -> PyResult<(T, Option<PyErr>)> {
     let slot: (Mutex<Option<Result<T, String>>>, Condvar) = (Mutex::new(None), Condvar::new());
     std::thread::scope(|s| {
         let worker = s.spawn(|| {
@@ -1575,8 +1683,6 @@ fn interruptible<T: Send>(
             *slot.0.lock().unwrap_or_else(|e| e.into_inner()) = Some(r);
             slot.1.notify_all();
         });
-        // The exception a signal handler raised (KeyboardInterrupt for Ctrl-C, or the
-        // handler's own), given back unchanged once the work has stopped.
         let mut interrupted: Option<PyErr> = None;
         loop {
             let got = py.detach(|| {
@@ -1588,9 +1694,10 @@ fn interruptible<T: Send>(
                 g.take()
             });
             if let Some(r) = got {
-                return match interrupted {
-                    Some(e) => Err(e),
-                    None => r.map_err(PyRuntimeError::new_err),
+                return match (r, interrupted) {
+                    (Ok(r), e) => Ok((r, e)),
+                    (Err(_), Some(e)) => Err(e),
+                    (Err(msg), None) => Err(PyRuntimeError::new_err(msg)),
                 };
             }
             if worker.is_finished() && slot.0.lock().map(|g| g.is_none()).unwrap_or(true) {
@@ -1609,14 +1716,24 @@ fn interruptible<T: Send>(
     })
 }
 
-/// What a fit function returns to the Python layer: the fits, the run's notes, and the draws
-/// CSV when it was asked for.
-type Fitted = (Vec<PyFitResult>, Vec<String>, Option<Vec<u8>>);
+/// What a fit function returns to the Python layer: the fits, the run's notes, the draws
+/// CSV when it was asked for, and the exception of a signal (Ctrl-C's KeyboardInterrupt, or
+/// a handler's own) that cut a posterior run short, its draws so far kept in the fits.
+type Fitted = (
+    Vec<PyFitResult>,
+    Vec<String>,
+    Option<Vec<u8>>,
+    Option<PyErr>,
+);
 
 /// Runs the fit command `command` of the library on `data` without the GIL, interruptibly:
 /// the fits, their draws as the command line's `--draws` CSV when `draws`, and the run's
 /// notes. With `warn`, each note is also a `FitbeadWarning` (`fitbead COMMAND: note`, as the
 /// command line prints it), raised as it would be printed: before an error as well.
+///
+/// A signal during the run stops it; what it kept (a posterior run's draws so far, its rows
+/// marked interrupted) comes back with the signal's exception, which is raised where nothing
+/// was kept.
 fn run_fit(
     py: Python<'_>,
     data: &PyDataset,
@@ -1631,7 +1748,7 @@ fn run_fit(
         level,
         stop,
     } = a;
-    let (r, notes) = interruptible(py, &stop, || {
+    let ((r, notes), signal) = interruptible_keep(py, &stop, || {
         let mut notes = Vec::new();
         let r = command
             .run(file, method, level, None, &mut |n| {
@@ -1651,12 +1768,17 @@ fn run_fit(
             PyErr::warn(py, &category, &text, 2)?;
         }
     }
-    let (fits, d) = r.map_err(pipeline_error)?;
-    let fits = fits
-        .into_iter()
-        .map(|inner| PyFitResult { inner })
-        .collect();
-    Ok((fits, notes, d))
+    match (r, signal) {
+        (Ok((fits, d)), signal) => {
+            let fits = fits
+                .into_iter()
+                .map(|inner| PyFitResult { inner })
+                .collect();
+            Ok((fits, notes, d, signal))
+        }
+        (Err(_), Some(e)) => Err(e),
+        (Err(e), None) => Err(pipeline_error(e)),
+    }
 }
 
 /// A K(α) law fitted across series (see the Python `fitbead.fit_klaw`): the law's fit and the
@@ -1957,7 +2079,11 @@ fn design<'py>(
     let r = py
         .detach(|| on_pool(|| fitbead::design::design(&settings)))
         .map_err(PyRuntimeError::new_err)?
-        .map_err(|e| value_error(e.to_string()))?;
+        .map_err(|e| {
+            // The setting named as the keyword argument that gives it.
+            let name = keyword(e.setting);
+            value_error(format!("{name} = '{}': {}", e.value, e.message))
+        })?;
     let d = PyDict::new(py);
     let rows = |rows: &[fitbead::design::DesignRow]| -> PyResult<Bound<'py, PyDict>> {
         let t = PyDict::new(py);
@@ -2124,6 +2250,7 @@ fn report(
     Vec<String>,
     bool,
     String,
+    Option<PyErr>,
 )> {
     use fitbead::inverse::posterior::Method;
     use fitbead::pipeline::ReportSettings;
@@ -2191,8 +2318,14 @@ fn report(
     };
     let file = &data.file;
     let dir = out_dir.as_deref();
-    let r = interruptible(py, &stop, || settings.run(file, dir))?;
-    let out = r.map_err(pipeline_error)?;
+    // A signal that cut a posterior run short comes back with the report of the draws so
+    // far (written to `dir` as the command line writes it); where nothing was kept, it is
+    // raised.
+    let (out, signal) = match interruptible_keep(py, &stop, || settings.run(file, dir))? {
+        (Ok(out), signal) => (out, signal),
+        (Err(_), Some(e)) => return Err(e),
+        (Err(e), None) => return Err(pipeline_error(e)),
+    };
     // The warnings by kind: implausible misfits (unit mistakes), posterior runs that did not
     // converge.
     let absurd: Vec<String> = out
@@ -2217,6 +2350,7 @@ fn report(
         unconverged,
         out.interrupted,
         out.summary,
+        signal,
     ))
 }
 

@@ -80,5 +80,5 @@ def test_slope_errors_and_margin_equal_the_command_line(cli):
     assert a.ranges == b.ranges
     with pytest.raises(fitbead.FitbeadError, match="margin"):
         fitbead.design("klaw", margin=0.5)
-    with pytest.raises(fitbead.FitbeadError, match="sigma-delta"):
+    with pytest.raises(fitbead.FitbeadError, match="^sigma_delta = "):
         fitbead.design("klaw", sigma_delta=-1.0)

@@ -68,7 +68,7 @@ def test_auto_and_skip_unsteady_are_the_command_lines(cli, tmp_path):
 
     code, _, _ = cli("klaw", "--model", "slip", "--input", DEFAULT_DATA, check=False)
     assert code == 2
-    with pytest.raises(fitbead.FitbeadError, match="skip-unsteady"):
+    with pytest.raises(fitbead.FitbeadError, match="skip_unsteady=True"):
         fitbead.fit_klaw(DEFAULT_DATA, model="slip")
     p = tmp_path / "skip.csv"
     _, _, err = cli(

@@ -267,7 +267,7 @@ def test_simulate_with_slope_errors_as_the_command_line(cli):
     assert list(got) == list(want) and list(got)[-2:] == ["sigma_delta_deg", "delta_true_deg"]
     for k in ("delta_deg", "v", "sigma_v", "sigma_delta_deg", "delta_true_deg"):
         assert_bits_equal(k, got[k], want[k])
-    with pytest.raises(fitbead.FitbeadError, match="sigma-delta"):
+    with pytest.raises(fitbead.FitbeadError, match="^sigma_delta = "):
         fitbead.simulate("stick", sigma_delta=-1.0)
 
 

@@ -571,16 +571,15 @@ fn record_run(
     waic: Option<(f64, f64, f64)>,
 ) {
     let kept = res.chains.iter().map(Vec::len).sum::<usize>();
-    let rhat_max = res
-        .diagnostics
-        .iter()
-        .map(|d| d.rhat)
-        .fold(f64::NEG_INFINITY, f64::max);
-    let ess_min = res
-        .diagnostics
-        .iter()
-        .map(|d| d.ess_bulk.min(d.ess_tail))
-        .fold(f64::INFINITY, f64::min);
+    // A diagnostic that could not be estimated (too few draws: NaN) makes the extreme NaN
+    // too, as the note on the run says, rather than being passed over.
+    let rhat_max = extreme(res.diagnostics.iter().map(|d| d.rhat), f64::max);
+    let ess_min = extreme(
+        res.diagnostics
+            .iter()
+            .flat_map(|d| [d.ess_bulk, d.ess_tail]),
+        f64::min,
+    );
     let status = match res.reason {
         StopReason::Converged => "converged",
         StopReason::MaxSteps => "max_steps",
@@ -615,6 +614,16 @@ fn record_run(
 pub(crate) const MAX_STEPS_NOTE: &str =
     "stopped at the step cap, not converged: posterior from the draws so far, its sd and \
      interval unreliable";
+
+/// The largest or smallest (`pick`) of `xs`: NaN when any is NaN or there are none.
+fn extreme(xs: impl Iterator<Item = f64>, pick: fn(f64, f64) -> f64) -> f64 {
+    xs.map(|x| if x.is_nan() { None } else { Some(x) })
+        .try_fold(None, |acc: Option<f64>, x| {
+            x.map(|x| Some(acc.map_or(x, |a| pick(a, x))))
+        })
+        .flatten()
+        .unwrap_or(f64::NAN)
+}
 
 /// The note every parameter row of an interrupted posterior run starts with.
 pub(crate) const INTERRUPTED_NOTE: &str =

@@ -394,9 +394,11 @@ pub struct McmcStats {
     pub draws: usize,
     /// Fraction of proposals accepted.
     pub acceptance: f64,
-    /// Smallest bulk or tail ESS over the parameters.
+    /// Smallest bulk or tail ESS over the parameters; NaN where one could not be estimated
+    /// (too few draws).
     pub ess_min: f64,
-    /// Largest rank-normalised split-R̂ over the parameters.
+    /// Largest rank-normalised split-R̂ over the parameters; NaN where one could not be
+    /// estimated.
     pub rhat_max: f64,
     /// WAIC, its effective number of parameters p_waic and the standard error of WAIC (see
     /// [`super::posterior`]); `None` without draws.

@@ -41,6 +41,7 @@ use crate::inverse::{
     fit, profile_interval, Covariance, Fit, Infeasible, LsqOptions, OdrModel, ProfileInterval,
     Residuals, SigmaKind, Termination,
 };
+use crate::models::regimes::{regime_b_interval, REGIME_B_SCAN_STEP};
 use crate::models::Model;
 use crate::progress::{Progress, ProgressEvent, Tally};
 use faer::{Mat, MatMut};
@@ -255,8 +256,13 @@ fn law_specs(problem: &KLawProblem<'_>, law: KLaw) -> Vec<ParamSpec> {
 
 /// The series whose largest σ_δ is wider than their steady range of slopes at the law's
 /// parameters `p` (regime B at their ξ, ρ, f and K), as a note ("" when none): there, one
-/// standard uncertainty spans every slope at which the bead rolls steadily.
-fn wide_slope_errors(problem: &KLawProblem<'_>, p: &[f64]) -> String {
+/// standard uncertainty spans every slope at which the bead rolls steadily. `steady` holds
+/// slopes (radians, one per point of the data, in order) known to be steady at `p` — the
+/// adjusted slopes of an ODR fit at its estimate — or is empty. Regime B at one K being an
+/// interval of slopes, a series whose steady slopes span more than its σ_δ plus three steps
+/// of the scan of [`regime_b_interval`] (its refined ends can fall up to two steps inside the
+/// interval's) has a range wider than σ_δ, and is not scanned.
+fn wide_slope_errors(problem: &KLawProblem<'_>, p: &[f64], steady: &[f64]) -> String {
     let data = problem.data;
     let mut out = Vec::new();
     for (s, label) in data.labels.iter().enumerate() {
@@ -269,10 +275,17 @@ fn wide_slope_errors(problem: &KLawProblem<'_>, p: &[f64]) -> String {
         if sd == 0.0 {
             continue;
         }
+        let known: Option<Vec<f64>> = pts.iter().map(|&j| steady.get(j).copied()).collect();
+        if let Some(known) = known {
+            let lo = known.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = known.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            if hi - lo >= sd + 3.0 * REGIME_B_SCAN_STEP {
+                continue;
+            }
+        }
         let sc = &data.points[i].scene;
         let law = crate::scene::CollisionLaw::Value(problem.k_of(i, p));
-        let range =
-            crate::models::regimes::regime_b_interval(&problem.model, sc.xi, sc.rho, sc.f, law);
+        let range = regime_b_interval(&problem.model, sc.xi, sc.rho, sc.f, law);
         if let Some((lo, hi)) = range.filter(|(lo, hi)| sd > hi - lo) {
             out.push(format!(
                 "series '{}': sigma_delta {} deg is wider than its steady range of slopes ({} \
@@ -1037,7 +1050,16 @@ pub(crate) fn fit_law_in(
     };
     let k = (0..m).map(|i| problem.k_of(i, &params)).collect();
     if slope_errors {
-        let note = wide_slope_errors(&problem, &params);
+        // The adjusted slopes are steady at the estimate of an ODR fit, not at a posterior's.
+        let steady: Vec<f64> = match method {
+            Method::Lsq { .. } => summary
+                .points
+                .iter()
+                .map_while(|pt| pt.delta_fit_deg.map(f64::to_radians))
+                .collect(),
+            Method::Mcmc(_) => Vec::new(),
+        };
+        let note = wide_slope_errors(&problem, &params, &steady);
         summary.stats.note = super::summary::join(&summary.stats.note, &note);
     } else {
         summary.attach_points(data, &index);

@@ -54,7 +54,7 @@ pub(crate) struct SlopeFit<M> {
     pub options: LsqOptions,
 }
 
-impl<M: OdrModel> SlopeFit<M> {
+impl<M: OdrModel + Sync> SlopeFit<M> {
     /// The ODR fit of `model` to the points `index` of `data` (in the model's order), started
     /// from the least-squares optimum `lm`, with the options of that fit (`bounds` false drops
     /// its box: the box of a law is where every point is steady at its measured slope, and the
@@ -193,7 +193,9 @@ pub(crate) fn summarise<R: Residuals + ?Sized, M: OdrModel + Sync>(
             },
         )
     } else {
-        let reduced = sf.problem.reduced(sf.corrections(data, index));
+        let reduced = sf
+            .problem
+            .reduced(&sf.odr.fit.params, sf.corrections(data, index));
         summary::summarise(
             Solved {
                 name: solved.name,

@@ -27,10 +27,11 @@
 //!   the units of β and x.
 //! * **Two stages.** The parameters are first fitted with every input held at its measured
 //!   value (weighted least squares, δ = 0); then each correction is moved to its best value at
-//!   those parameters (a few Gauss–Newton steps per point), and the full iteration runs from
-//!   there. Starting the full iteration from δ = 0 at a distant start lets inputs far from
-//!   the curve dominate the first steps, which can then walk into a local minimum (SciPy's
-//!   Pearson example, either way round, from its start (1, 1)).
+//!   those parameters (a few safeguarded Newton steps per point, on a three-point stencil of
+//!   f_i in x), and the full iteration runs from there. Starting the full iteration from
+//!   δ = 0 at a distant start lets inputs far from the curve dominate the first steps, which
+//!   can then walk into a local minimum (SciPy's Pearson example, either way round, from its
+//!   start (1, 1)).
 //! * **Inputs that leave the model's domain.** A trial point where some f_i(x_i + δ_i; β) is
 //!   [`Infeasible`] (or not finite) is a rejected step, so that no accepted input ever leaves
 //!   the model's domain — for the bead fits, no adjusted slope leaves the steady range.
@@ -982,7 +983,7 @@ const FINAL: [Termination; 3] = [
     Termination::JacobianFailed,
 ];
 
-/// Most Gauss–Newton steps per correction when the corrections settle at the start.
+/// Most Newton steps per correction (`OdrProblem::correct`).
 const SETTLE: usize = 20;
 
 /// Fewest points per parallel task of the per-point work (each a few model evaluations).

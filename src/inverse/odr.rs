@@ -27,10 +27,11 @@
 //!   the units of β and x.
 //! * **Two stages.** The parameters are first fitted with every input held at its measured
 //!   value (weighted least squares, δ = 0); then each correction is moved to its best value at
-//!   those parameters (a few Gauss–Newton steps per point), and the full iteration runs from
-//!   there. Starting the full iteration from δ = 0 at a distant start lets inputs far from
-//!   the curve dominate the first steps, which can then walk into a local minimum (SciPy's
-//!   Pearson example, either way round, from its start (1, 1)).
+//!   those parameters (a few safeguarded Newton steps per point, on a three-point stencil of
+//!   f_i in x), and the full iteration runs from there. Starting the full iteration from
+//!   δ = 0 at a distant start lets inputs far from the curve dominate the first steps, which
+//!   can then walk into a local minimum (SciPy's Pearson example, either way round, from its
+//!   start (1, 1)).
 //! * **Inputs that leave the model's domain.** A trial point where some f_i(x_i + δ_i; β) is
 //!   [`Infeasible`] (or not finite) is a rejected step, so that no accepted input ever leaves
 //!   the model's domain — for the bead fits, no adjusted slope leaves the steady range.
@@ -55,7 +56,9 @@ use argmin::core::observers::ObserverMode;
 use argmin::core::{Error, Executor, Problem, Solver, State, TerminationReason, KV};
 use faer::Mat;
 use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
 use std::sync::atomic::Ordering;
+use std::sync::Mutex;
 
 use super::estimate::{covariance, covariance_scale, information_criteria, rank_tolerance, Fit};
 use super::lsq::{
@@ -241,9 +244,17 @@ impl<M: OdrModel> OdrProblem<M> {
     }
 
     /// The best correction of input i at parameters β, from `at` = (r_i, ρ_i, δ_i), a feasible
-    /// point: Gauss–Newton steps on r_i(δ)² + ρ_i(δ)², each halved until it lowers the sum
-    /// (at most `SETTLE` steps, stopping once a step gains less than 1e-15 of it); returns the
-    /// point reached, counting model evaluations into `evals`.
+    /// point: safeguarded Newton steps on φ(δ) = r_i(δ)² + ρ_i(δ)² (at most `SETTLE`), each
+    /// halved until it lowers φ. The derivatives of f_i in x are those of the quadratic through
+    /// three equally spaced values (the point and two at steps h = ε^{1/3}·max(|x|, σ_x,i),
+    /// central where both sides are feasible), or the model's [`OdrModel::derivatives`] (then
+    /// Gauss–Newton: f″ taken as 0); the curvature r′² + ρ′² + r·r″ of φ/2 falls back to the
+    /// Gauss–Newton r′² + ρ′² where it is below half of it. A step that stays within the
+    /// interpolated span ends the search there, with r_i from the quadratic (its error, of
+    /// order f‴h³, is below rounding), so that a start near the optimum costs two model
+    /// evaluations; any other step is evaluated, and the search ends once one gains less than
+    /// 1e-15 of φ. Returns the point reached, counting its
+    /// derivative evaluations into `evals`.
     fn correct(
         &self,
         i: usize,
@@ -261,16 +272,41 @@ impl<M: OdrModel> OdrProblem<M> {
             let xi = self.x[i] + delta;
             let f0 = self.y[i] - r / isy;
             *evals += 1;
-            let fx = match self.model.derivatives(i, xi, beta, &mut g) {
-                Some(Ok(fx)) => Some(fx),
+            let local = match self.model.derivatives(i, xi, beta, &mut g) {
+                Some(Ok(fx)) => Some(Local {
+                    f1: fx,
+                    f2: 0.0,
+                    span: (0.0, 0.0),
+                }),
                 Some(Err(_)) => None,
-                None => self.x_slope(i, xi, f0, beta),
+                None => {
+                    let h = STEP * xi.abs().max(self.sx[i]);
+                    quadratic(f0, h, |t| {
+                        self.model
+                            .value(i, xi + t, beta)
+                            .ok()
+                            .filter(|v| v.is_finite())
+                    })
+                }
             };
-            let Some(fx) = fx.filter(|v| v.is_finite()) else {
+            let Some(q) = local.filter(|q| q.f1.is_finite() && q.f2.is_finite()) else {
                 break;
             };
-            let d = -fx * isy;
-            let mut t = -(d * r + isx * rho) / (d * d + isx * isx);
+            // r′ and r″ (r = (y − f)/σ_y), the gradient and curvature of φ/2.
+            let (d, dd) = (-q.f1 * isy, -q.f2 * isy);
+            let grad = d * r + isx * rho;
+            let gauss = d * d + isx * isx;
+            let newton = gauss + r * dd;
+            let mut t = -grad / if newton >= 0.5 * gauss { newton } else { gauss };
+            if !t.is_finite() {
+                break;
+            }
+            if q.span.0 <= t && t <= q.span.1 {
+                delta += t;
+                r += t * (d + 0.5 * dd * t);
+                rho = delta * isx;
+                break;
+            }
             let before = r * r + rho * rho;
             let mut gain = 0.0;
             for _ in 0..30 {
@@ -293,12 +329,14 @@ impl<M: OdrModel> OdrProblem<M> {
     }
 
     /// The objective minimised over the corrections at each β, as least-squares residuals
-    /// (r_i, then ρ_i, at each input's best correction, searched from `delta`): what the
-    /// profile intervals of an ODR fit profile.
-    pub(crate) fn reduced(&self, delta: Vec<f64>) -> Reduced<'_, M> {
+    /// (r_i, then ρ_i, at each input's best correction): what the profile intervals of an ODR
+    /// fit profile. Each evaluation searches each correction from its optimum at the nearest
+    /// parameters evaluated so far (continuation), starting with the fit's `delta` at `beta`.
+    pub(crate) fn reduced(&self, beta: &[f64], delta: Vec<f64>) -> Reduced<'_, M> {
         Reduced {
             problem: self,
-            delta,
+            fitted: delta.clone(),
+            seen: Mutex::new(vec![(beta.to_vec(), delta)]),
         }
     }
 }
@@ -306,11 +344,32 @@ impl<M: OdrModel> OdrProblem<M> {
 /// [`OdrProblem::reduced`]: S(β, δ*(β)) as 2n residuals of β alone.
 pub(crate) struct Reduced<'a, M> {
     problem: &'a OdrProblem<M>,
-    /// The corrections each evaluation starts its search from (the fit's).
-    delta: Vec<f64>,
+    /// The fit's corrections: where a search starts when the nearest optimum is infeasible.
+    fitted: Vec<f64>,
+    /// The parameters evaluated so far and the optimal corrections there.
+    seen: Mutex<Vec<(Vec<f64>, Vec<f64>)>>,
 }
 
-impl<M: OdrModel> Residuals for Reduced<'_, M> {
+impl<M: OdrModel> Reduced<'_, M> {
+    /// The corrections at the evaluated parameters nearest to `p` (distances scaled by the
+    /// typical magnitudes).
+    fn nearest(&self, p: &[f64]) -> Vec<f64> {
+        let typical = &self.problem.setup.typical;
+        let distance = |q: &[f64]| -> f64 {
+            p.iter()
+                .zip(q)
+                .zip(typical)
+                .map(|((a, b), t)| ((a - b) / t.max(f64::MIN_POSITIVE)).powi(2))
+                .sum()
+        };
+        let seen = self.seen.lock().unwrap_or_else(|e| e.into_inner());
+        seen.iter()
+            .min_by(|a, b| distance(&a.0).total_cmp(&distance(&b.0)))
+            .map_or_else(|| self.fitted.clone(), |s| s.1.clone())
+    }
+}
+
+impl<M: OdrModel + Sync> Residuals for Reduced<'_, M> {
     fn n_params(&self) -> usize {
         self.problem.p()
     }
@@ -320,17 +379,28 @@ impl<M: OdrModel> Residuals for Reduced<'_, M> {
     fn residuals(&self, p: &[f64], out: &mut [f64]) -> Result<(), Infeasible> {
         let pr = self.problem;
         let n = pr.n();
-        let mut evals = 0;
-        for i in 0..n {
-            // From the fit's correction, else from the measured input.
-            let start = [self.delta[i], 0.0].into_iter().find_map(|d| {
-                let f = pr.model.value(i, pr.x[i] + d, p).ok()?;
-                Some(((pr.y[i] - f) * pr.inv_sy[i], d * pr.inv_sx[i], d))
-            });
-            let (r, rho, _) = pr.correct(i, p, start.ok_or(Infeasible)?, &mut evals);
-            out[i] = r;
-            out[n + i] = rho;
+        let near = self.nearest(p);
+        let points: Vec<(f64, f64, f64)> = (0..n)
+            .into_par_iter()
+            .with_min_len(MIN_CHUNK)
+            .map(|i| {
+                // From the nearest optimum, else the fit's correction, else the measured input.
+                let start = [near[i], self.fitted[i], 0.0].into_iter().find_map(|d| {
+                    let f = pr.model.value(i, pr.x[i] + d, p).ok()?;
+                    f.is_finite()
+                        .then(|| ((pr.y[i] - f) * pr.inv_sy[i], d * pr.inv_sx[i], d))
+                });
+                let mut evals = 0;
+                Ok(pr.correct(i, p, start.ok_or(Infeasible)?, &mut evals))
+            })
+            .collect::<Result<_, Infeasible>>()?;
+        let (r, rho) = out.split_at_mut(n);
+        for (i, &(ri, rhoi, _)) in points.iter().enumerate() {
+            r[i] = ri;
+            rho[i] = rhoi;
         }
+        let mut seen = self.seen.lock().unwrap_or_else(|e| e.into_inner());
+        seen.push((p.to_vec(), points.into_iter().map(|t| t.2).collect()));
         Ok(())
     }
 }
@@ -464,7 +534,7 @@ impl Odr {
     /// Returns the estimate ([`Fit`]: `chi2` is the whole objective S, `residuals` the weighted
     /// response residuals (y_i − f_i(x_i + δ_i; β))/σ_y,i, `dof` = n − p, the covariance
     /// ODRPACK's) and the adjusted inputs x_i + δ_i.
-    pub fn fit<M: OdrModel>(
+    pub fn fit<M: OdrModel + Sync>(
         problem: OdrProblem<M>,
         opts: &LsqOptions,
     ) -> Result<(Fit, Vec<f64>), LsqError> {
@@ -472,7 +542,7 @@ impl Odr {
     }
 
     /// As [`Odr::fit`], handing the problem back.
-    pub(crate) fn fit_keep<M: OdrModel>(
+    pub(crate) fn fit_keep<M: OdrModel + Sync>(
         problem: OdrProblem<M>,
         opts: &LsqOptions,
     ) -> Result<(OdrFit, OdrProblem<M>), LsqError> {
@@ -507,7 +577,7 @@ impl Odr {
     }
 
     /// Whether input i moves in the present stage.
-    fn moves<M: OdrModel>(&self, pr: &OdrProblem<M>, i: usize) -> bool {
+    fn moves<M: OdrModel + Sync>(&self, pr: &OdrProblem<M>, i: usize) -> bool {
         !self.frozen && pr.free(i)
     }
 
@@ -519,7 +589,7 @@ impl Odr {
 
     /// The point at (β, δ): the residuals, or `None` where some input leaves the model's
     /// domain (or a residual is not finite).
-    fn evaluate<M: OdrModel>(
+    fn evaluate<M: OdrModel + Sync>(
         &mut self,
         pr: &OdrProblem<M>,
         beta: Vec<f64>,
@@ -527,12 +597,16 @@ impl Odr {
     ) -> Option<Point> {
         self.nfev += 1;
         let n = pr.n();
+        let f: Vec<f64> = (0..n)
+            .into_par_iter()
+            .with_min_len(MIN_CHUNK)
+            .map(|i| pr.model.value(i, pr.x[i] + delta[i], &beta).ok())
+            .collect::<Option<_>>()?;
         let mut r = vec![0.0; n];
         let mut rho = vec![0.0; n];
         let mut s = 0.0;
         for i in 0..n {
-            let f = pr.model.value(i, pr.x[i] + delta[i], &beta).ok()?;
-            r[i] = (pr.y[i] - f) * pr.inv_sy[i];
+            r[i] = (pr.y[i] - f[i]) * pr.inv_sy[i];
             rho[i] = delta[i] * pr.inv_sx[i];
             s += r[i] * r[i] + rho[i] * rho[i];
         }
@@ -546,36 +620,47 @@ impl Odr {
     }
 
     /// The linearisation at the current point, or `None` where it cannot be formed.
-    fn linearise<M: OdrModel>(&mut self, pr: &OdrProblem<M>) -> Option<Linear> {
+    fn linearise<M: OdrModel + Sync>(&mut self, pr: &OdrProblem<M>) -> Option<Linear> {
         self.njev += 1;
         let (n, p) = (pr.n(), pr.p());
-        let mut a = vec![0.0; n * p];
-        let mut d = vec![0.0; n];
-        let mut g = vec![0.0; p];
-        let beta = self.cur.beta.clone();
-        for i in 0..n {
-            let xi = pr.x[i] + self.cur.delta[i];
-            let f0 = pr.y[i] - self.cur.r[i] / pr.inv_sy[i];
-            let fx = match pr.model.derivatives(i, xi, &beta, &mut g) {
-                Some(r) => r.ok()?,
-                None => {
-                    self.differenced = true;
-                    for j in 0..p {
-                        let h = STEP * beta[j].abs().max(pr.setup.typical[j]);
-                        let (lo, hi) = (pr.setup.lower[j], pr.setup.upper[j]);
+        let beta = &self.cur.beta;
+        let moves: Vec<bool> = (0..n).map(|i| self.moves(pr, i)).collect();
+        // Per point: ∂f_i/∂β, ∂f_i/∂x, and whether they were differenced.
+        let rows: Vec<Option<(Vec<f64>, f64, bool)>> = (0..n)
+            .into_par_iter()
+            .with_min_len(MIN_CHUNK)
+            .map(|i| {
+                let xi = pr.x[i] + self.cur.delta[i];
+                let f0 = pr.y[i] - self.cur.r[i] / pr.inv_sy[i];
+                let mut g = vec![0.0; p];
+                match pr.model.derivatives(i, xi, beta, &mut g) {
+                    Some(r) => r.ok().map(|fx| (g, fx, false)),
+                    None => {
                         let mut at = beta.clone();
-                        g[j] = difference(f0, h, lo - beta[j], hi - beta[j], |t| {
-                            at[j] = beta[j] + t;
-                            pr.model.value(i, xi, &at).ok()
-                        })?;
-                    }
-                    if self.moves(pr, i) {
-                        pr.x_slope(i, xi, f0, &beta)?
-                    } else {
-                        0.0
+                        for j in 0..p {
+                            let h = STEP * beta[j].abs().max(pr.setup.typical[j]);
+                            let (lo, hi) = (pr.setup.lower[j], pr.setup.upper[j]);
+                            g[j] = difference(f0, h, lo - beta[j], hi - beta[j], |t| {
+                                at[j] = beta[j] + t;
+                                pr.model.value(i, xi, &at).ok()
+                            })?;
+                            at[j] = beta[j];
+                        }
+                        let fx = if moves[i] {
+                            pr.x_slope(i, xi, f0, beta)?
+                        } else {
+                            0.0
+                        };
+                        Some((g, fx, true))
                     }
                 }
-            };
+            })
+            .collect();
+        self.differenced |= rows.iter().any(|r| r.as_ref().is_some_and(|r| r.2));
+        let mut a = vec![0.0; n * p];
+        let mut d = vec![0.0; n];
+        for (i, row) in rows.into_iter().enumerate() {
+            let (g, fx, _) = row?;
             for j in 0..p {
                 a[i * p + j] = -g[j] * pr.inv_sy[i];
             }
@@ -587,7 +672,7 @@ impl Odr {
 
     /// The step (s, t) for damping λ, and the predicted S; `None` when the damped normal
     /// matrix is not positive definite.
-    fn step<M: OdrModel>(
+    fn step<M: OdrModel + Sync>(
         &self,
         pr: &OdrProblem<M>,
         lambda: f64,
@@ -643,7 +728,7 @@ impl Odr {
     }
 
     /// Updates the scaling with the column norms of the current linearisation.
-    fn rescale<M: OdrModel>(&mut self, pr: &OdrProblem<M>) {
+    fn rescale<M: OdrModel + Sync>(&mut self, pr: &OdrProblem<M>) {
         let (n, p) = (pr.n(), pr.p());
         for j in 0..p {
             let c = (0..n)
@@ -660,7 +745,7 @@ impl Odr {
 
     /// One iteration: the linearisation, then trial steps until one is accepted or the
     /// iteration ends.
-    fn iterate<M: OdrModel>(&mut self, pr: &OdrProblem<M>) -> Option<Termination> {
+    fn iterate<M: OdrModel + Sync>(&mut self, pr: &OdrProblem<M>) -> Option<Termination> {
         if self.cur.s == 0.0 {
             return Some(Termination::ExactFit);
         }
@@ -743,7 +828,7 @@ impl Odr {
     /// Ends the first stage (module docs): the inputs move from now on, each correction
     /// starts from its best value at the present parameters ([`Odr::settle`]), and the damping
     /// starts afresh.
-    fn release<M: OdrModel>(&mut self, pr: &OdrProblem<M>) {
+    fn release<M: OdrModel + Sync>(&mut self, pr: &OdrProblem<M>) {
         self.frozen = false;
         self.settle(pr);
         self.lambda = LAMBDA0;
@@ -755,13 +840,22 @@ impl Odr {
     /// corrections, not from δ = 0, whose objective may be dominated by inputs far from the
     /// curve (the first steps then see every input pulled and can walk into a local minimum:
     /// SciPy's Pearson data with x and y exchanged).
-    fn settle<M: OdrModel>(&mut self, pr: &OdrProblem<M>) {
-        for i in 0..pr.n() {
-            let (r, rho, delta) = (self.cur.r[i], self.cur.rho[i], self.cur.delta[i]);
-            let (r, rho, delta) = pr.correct(i, &self.cur.beta, (r, rho, delta), &mut self.nfev);
+    fn settle<M: OdrModel + Sync>(&mut self, pr: &OdrProblem<M>) {
+        let cur = &self.cur;
+        let settled: Vec<((f64, f64, f64), usize)> = (0..pr.n())
+            .into_par_iter()
+            .with_min_len(MIN_CHUNK)
+            .map(|i| {
+                let mut evals = 0;
+                let at = (cur.r[i], cur.rho[i], cur.delta[i]);
+                (pr.correct(i, &cur.beta, at, &mut evals), evals)
+            })
+            .collect();
+        for (i, ((r, rho, delta), evals)) in settled.into_iter().enumerate() {
             self.cur.r[i] = r;
             self.cur.rho[i] = rho;
             self.cur.delta[i] = delta;
+            self.nfev += evals;
         }
         self.cur.s = self.cur.r.iter().chain(&self.cur.rho).map(|v| v * v).sum();
     }
@@ -800,7 +894,7 @@ impl Odr {
     }
 
     /// The [`OdrFit`] at the current point: statistics and ODRPACK's covariance.
-    fn finish<M: OdrModel>(
+    fn finish<M: OdrModel + Sync>(
         &mut self,
         pr: &OdrProblem<M>,
         termination: Termination,
@@ -889,8 +983,11 @@ const FINAL: [Termination; 3] = [
     Termination::JacobianFailed,
 ];
 
-/// Most Gauss–Newton steps per correction when the corrections settle at the start.
+/// Most Newton steps per correction (`OdrProblem::correct`).
 const SETTLE: usize = 20;
+
+/// Fewest points per parallel task of the per-point work (each a few model evaluations).
+const MIN_CHUNK: usize = 4;
 
 /// Step factor of the central differences, ε^{1/3}.
 const STEP: f64 = 6.055454452393343e-6;
@@ -926,7 +1023,55 @@ fn difference(
     }
 }
 
-impl<M: OdrModel> Solver<OdrProblem<M>, LmState> for Odr {
+/// The derivatives at 0 of the quadratic through three equally spaced values of g, and the
+/// span of steps they cover: f′ = `f1`, f″ = `f2`, steps in [`span.0`, `span.1`].
+#[derive(Debug, Clone, Copy)]
+struct Local {
+    f1: f64,
+    f2: f64,
+    span: (f64, f64),
+}
+
+/// [`Local`] of g, with g(0) = `f0`, from g(±h) (central), else g(h), g(2h) or g(−h), g(−2h)
+/// where one side is infeasible (`None`), else the first-order difference of the feasible side
+/// with f″ taken as 0 and an empty span; `None` where g(h) and g(−h) are both infeasible.
+fn quadratic(f0: f64, h: f64, mut g: impl FnMut(f64) -> Option<f64>) -> Option<Local> {
+    let h2 = h * h;
+    match (g(h), g(-h)) {
+        (Some(u), Some(d)) => Some(Local {
+            f1: (u - d) / (2.0 * h),
+            f2: (u - 2.0 * f0 + d) / h2,
+            span: (-h, h),
+        }),
+        (Some(u), None) => Some(match g(2.0 * h) {
+            Some(u2) => Local {
+                f1: (-3.0 * f0 + 4.0 * u - u2) / (2.0 * h),
+                f2: (f0 - 2.0 * u + u2) / h2,
+                span: (0.0, 2.0 * h),
+            },
+            None => Local {
+                f1: (u - f0) / h,
+                f2: 0.0,
+                span: (0.0, 0.0),
+            },
+        }),
+        (None, Some(d)) => Some(match g(-2.0 * h) {
+            Some(d2) => Local {
+                f1: (3.0 * f0 - 4.0 * d + d2) / (2.0 * h),
+                f2: (f0 - 2.0 * d + d2) / h2,
+                span: (-2.0 * h, 0.0),
+            },
+            None => Local {
+                f1: (f0 - d) / h,
+                f2: 0.0,
+                span: (0.0, 0.0),
+            },
+        }),
+        (None, None) => None,
+    }
+}
+
+impl<M: OdrModel + Sync> Solver<OdrProblem<M>, LmState> for Odr {
     fn name(&self) -> &str {
         "orthogonal distance regression (Boggs, Byrd & Schnabel 1987)"
     }

@@ -172,6 +172,9 @@ pub(crate) fn longest_run(flags: &[bool]) -> Option<(usize, usize)> {
     (best.1 > best.0).then_some(best)
 }
 
+/// Spacing (radians) of the scan of [`regime_b_interval`]: 89° over 2000.
+pub(crate) const REGIME_B_SCAN_STEP: f64 = 89.0 * std::f64::consts::PI / 180.0 / 2000.0;
+
 /// The slopes (radians) where `model` has a steady state at this ξ: the longest run of a
 /// 2000-point scan of (0°, 89°), its ends refined by bisection to 1e-12 rad.
 pub fn regime_b_interval(

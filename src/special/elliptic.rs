@@ -193,24 +193,25 @@ pub fn rf_dy_lanes<const N: usize>(a: [[f64; 3]; N]) -> [(f64, f64); N] {
     let spread = |t: [f64; 3], m: f64| (m - t[0]).abs().max((m - t[1]).abs()).max((m - t[2]).abs());
     let af0 = a.map(|[x, y, z]| (x + y + z) / 3.0);
     let ad0 = a.map(|[x, y, z]| (x + z + 3.0 * y) / 5.0);
-    let mut qf: [f64; N] = std::array::from_fn(|l| STOP * spread(a[l], af0[l]));
-    let mut qd: [f64; N] = std::array::from_fn(|l| RD_STOP * spread(a[l], ad0[l]));
-    let (mut n, mut af, mut ad) = (a, af0, ad0);
+    let qf: [f64; N] = std::array::from_fn(|l| STOP * spread(a[l], af0[l]));
+    let qd: [f64; N] = std::array::from_fn(|l| RD_STOP * spread(a[l], ad0[l]));
+    // Both means step as A ← (A + λ)/4, so after m steps 4^m A_F = g with g ← g + 4^m λ, and
+    // 4^m A_D = g − (A_F0 − A_D0): one running sum serves both stopping rules
+    // (Q / 4^m < |A| as Q < |4^m A|) and both series.
+    let shift: [f64; N] = std::array::from_fn(|l| af0[l] - ad0[l]);
+    let (mut n, mut g) = (a, af0);
     let mut f = [1.0f64; N];
     let mut sum = [0.0f64; N];
     let mut live = [true; N];
     for _ in 0..16 {
         for l in 0..N {
-            live[l] = !(qf[l] < af[l].abs() && qd[l] < ad[l].abs());
+            live[l] = !(qf[l] < g[l].abs() && qd[l] < (g[l] - shift[l]).abs());
             if live[l] {
                 let (rx, ry, rz) = (n[l][0].sqrt(), n[l][1].sqrt(), n[l][2].sqrt());
                 let lambda = rx * ry + rx * rz + ry * rz;
                 sum[l] += 1.0 / (f[l] * ry * (n[l][1] + lambda));
                 n[l] = n[l].map(|v| (v + lambda) / 4.0);
-                af[l] = (af[l] + lambda) / 4.0;
-                ad[l] = (ad[l] + lambda) / 4.0;
-                qf[l] /= 4.0;
-                qd[l] /= 4.0;
+                g[l] += f[l] * lambda;
                 f[l] *= 4.0;
             }
         }
@@ -220,8 +221,8 @@ pub fn rf_dy_lanes<const N: usize>(a: [[f64; 3]; N]) -> [(f64, f64); N] {
     }
     std::array::from_fn(|l| {
         let [x, _, z] = a[l];
-        let r_f = rf_series(a[l], af0[l], af[l], f[l]);
-        let r_d = rd_series([x, z], ad0[l], ad[l], f[l], sum[l]);
+        let r_f = rf_series(a[l], af0[l], g[l] / f[l], f[l]);
+        let r_d = rd_series([x, z], ad0[l], (g[l] - shift[l]) / f[l], f[l], sum[l]);
         (r_f, -r_d / 6.0)
     })
 }

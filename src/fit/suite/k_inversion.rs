@@ -409,14 +409,15 @@ fn launch_speed_path_agrees_with_the_search_in_k() {
 /// mpmath (tests/reference/dvdk_refs.csv, made by tests/reference/dvdk_refs.py: direct
 /// quadrature at 50 digits, central difference with h = 1e-20, at exactly the double K of each
 /// row). Relative error: launch path over the top (Θ0 < 0), whose dτ/du is analytic (R_F and
-/// R_D), ≤ 2e-14 (measured 4.7e-15); launch path past the top (central differences) ≤ 3e-10
+/// R_D; at a root the search did not evaluate, carried from its last pass by τ''), ≤ 1e-13
+/// (measured 2.5e-14); launch path past the top (central differences) ≤ 3e-10
 /// (measured 1.8e-11), search in K ≤ 1e-9 (measured 7.8e-10); except at K = 1e-4 K_d of the
 /// scene that starts past the top, where v̄ depends on K only through a difference of 6e-5 of
 /// itself: the launch path ≤ 2e-9 (measured 9.8e-10), the search in K (which no longer serves
 /// such rows) ≤ 1e-7 (measured 6.6e-8).
 #[test]
 fn dv_dk_matches_mpmath_at_hard_points() {
-    const OVER_TOP_DV_DK_TOL: f64 = 2e-14;
+    const OVER_TOP_DV_DK_TOL: f64 = 1e-13;
     const DV_DK_TOL: f64 = 3e-10;
     const SEARCH_DV_DK_TOL: f64 = 1e-9;
     const FLAT_DV_DK_TOL: f64 = 2e-9;

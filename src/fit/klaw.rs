@@ -1188,7 +1188,6 @@ mod quadrature_tests {
     use super::*;
     use crate::fit::slopes::{Integrated, SLOPE_NODES, SLOPE_NODES_PLAIN};
     use crate::inverse::Residuals;
-    use crate::io::measurements::MeasurementDefaults;
 
     /// The log-likelihood integrated over the slopes of `tests/reference/odr/bead_stick.csv`
     /// (σ_δ = 0.1°, law c) on the nodes centred on each integrand agrees with 400 plain
@@ -1202,7 +1201,7 @@ mod quadrature_tests {
             env!("CARGO_MANIFEST_DIR"),
             "/tests/reference/odr/bead_stick.csv"
         );
-        let d = Dataset::from_csv_with(path, &MeasurementDefaults::default()).unwrap();
+        let d = Dataset::from_csv(path).unwrap();
         let pr = KLawProblem::new(Model::Stick, &d, KLaw::C).unwrap();
         let index: Vec<usize> = (0..d.points.len()).collect();
         let rules =

@@ -14,7 +14,7 @@
 //! (lift-off, y_d), and y keeps its digits where K itself no longer resolves the motion. The
 //! root is found from the asinh approximation of eq 29 (its error in τ is 0.1–3 %), kept
 //! inside the bracket: where the bead rolls over the top, the search's single passes give
-//! dτ/du in closed form (Carlson's R_D beside R_F, [`Launch::over_top_times`]) and it takes
+//! dτ/du in closed form (Carlson's R_D beside R_F, `Launch::over_top_times`) and it takes
 //! Newton's steps; its first pass (taken beside the top's) and the paired passes of the K_lo
 //! and K_hi searches go without the derivative, which costs more beside four R_F than it saves
 //! there, and take the secant method's. K_lo and K_hi start from a second-order Taylor step off

@@ -414,6 +414,16 @@ mod tests {
         }
     }
 
+    /// Uniform draws in [0, 1) from Marsaglia's xorshift64 started at `seed`.
+    fn xorshift(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
     #[test]
     fn rf_matches_carlsons_published_values() {
         // B. C. Carlson, "Numerical computation of real or complex elliptic integrals",
@@ -444,13 +454,7 @@ mod tests {
             );
         }
         // The `ellip` crate (a port of Boost.Math) over 24 decades, and rescaled arguments.
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut uniform = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut uniform = xorshift(0x2545_f491_4f6c_dd1du64);
         let mut worst = 0.0f64;
         for i in 0..2000 {
             let e = |u: f64| 10f64.powf(-12.0 + 24.0 * u);
@@ -479,13 +483,7 @@ mod tests {
     /// R_F (step 1e-6 y, error ~1e-11).
     #[test]
     fn rf_dy_lanes_is_rf_and_its_derivative() {
-        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-        let mut uniform = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut uniform = xorshift(0x9e37_79b9_7f4a_7c15u64);
         let (mut worst_f, mut worst_d, mut worst_fd) = (0.0f64, 0.0f64, 0.0f64);
         for i in 0..1000 {
             let e = |u: f64| 10f64.powf(-12.0 + 24.0 * u);
@@ -534,13 +532,7 @@ mod tests {
             [1e31, 1.0, 2.0],
             [1.0, 1.0, 1.0],
         ];
-        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-        let mut uniform = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut uniform = xorshift(0x9e37_79b9_7f4a_7c15u64);
         for _ in 0..400 {
             let e = |u: f64| 10f64.powf(-12.0 + 24.0 * u);
             triples.push([e(uniform()), e(uniform()), e(uniform())]);

@@ -9,21 +9,11 @@
 //! change that costs contacts shows here. `cargo test --release --lib k_contacts --
 //! --nocapture`.
 
+use super::k_edges::random_scene;
 use crate::fit::k::{bracket, contacts_counted, estimate};
 use crate::models::{ForwardModel, Model};
-use crate::scene::{CollisionLaw, Scene};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-
-/// A random scene as `scripts/gen_measurements.py` draws them (ξ log-uniform in [0.5, 12],
-/// δ in [0.2°, 35°], ρ 0.4 or 0.5, f log-uniform in [0.01, 1]).
-fn random_scene(rng: &mut ChaCha8Rng) -> Scene {
-    let xi = (rng.random_range(0.5f64.ln()..12f64.ln())).exp();
-    let d = rng.random_range(0.2..35.0);
-    let rho = if rng.random_bool(0.5) { 0.4 } else { 0.5 };
-    let f = (rng.random_range(0.01f64.ln()..0.0)).exp();
-    Scene::new(xi, d, rho, f, CollisionLaw::Adjusted).unwrap()
-}
 
 /// Where in the bracket a set's K is drawn.
 #[derive(Clone, Copy, Debug)]

@@ -87,7 +87,7 @@ fn k_near_either_bracket_end_matches_mpmath_to_1e_13() {
 
 /// A random scene over ξ ∈ [0.5, 12] (log-uniform), δ ∈ [0.2°, 35°], ρ 0.4 or 0.5 and f
 /// log-uniform in [0.01, 1], as `scripts/gen_measurements.py` draws them.
-fn random_scene(rng: &mut ChaCha8Rng) -> Scene {
+pub(super) fn random_scene(rng: &mut ChaCha8Rng) -> Scene {
     let xi = (rng.random_range(0.5f64.ln()..12f64.ln())).exp();
     let d = rng.random_range(0.2..35.0);
     let rho = if rng.random_bool(0.5) { 0.4 } else { 0.5 };

@@ -1,7 +1,7 @@
 //! Forward-model benchmarks: one evaluation of each model on scenes across regime B.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use fitbead::bench_internals::{python_bench_scenes, rf, rf_lanes};
+use fitbead::bench_internals::{python_bench_scenes, rf, rf_dy_lanes, rf_lanes};
 use fitbead::{CollisionLaw, ForwardModel, Model, Scene};
 
 fn scenes() -> Vec<Scene> {
@@ -164,6 +164,24 @@ fn bench(c: &mut Criterion) {
         b.iter(|| black_box(four).map(|[x, y, z]| rf(x, y, z)))
     });
     g.bench_function("rf_lanes", |b| b.iter(|| rf_lanes(black_box(four))));
+    g.finish();
+    // The same side by side with ∂R_F/∂y (R_D's sum in the same duplication loop), as the K
+    // inversion's passes over the top take them: four lanes (a pair of passes) and two (one
+    // pass), with the triples the rolling contact forms across the top (c² y, y + c, y).
+    let across = [
+        [0.3 * 1e-4, 1e-4 + 0.2, 1e-4],
+        [0.7 * 1e-4, 1e-4 + 0.05, 1e-4],
+        [0.3 * 0.02, 0.02 + 0.2, 0.02],
+        [0.7 * 0.02, 0.02 + 0.05, 0.02],
+    ];
+    let two = [across[0], across[1]];
+    let mut g = c.benchmark_group("carlson-rf with dR_F/dy");
+    g.bench_function("rf_lanes x4", |b| b.iter(|| rf_lanes(black_box(across))));
+    g.bench_function("rf_dy_lanes x4", |b| {
+        b.iter(|| rf_dy_lanes(black_box(across)))
+    });
+    g.bench_function("rf_lanes x2", |b| b.iter(|| rf_lanes(black_box(two))));
+    g.bench_function("rf_dy_lanes x2", |b| b.iter(|| rf_dy_lanes(black_box(two))));
     g.finish();
 }
 

@@ -16,7 +16,7 @@ pub use crate::models::sample::{draw_scenes, Draw};
 pub use crate::models::slip::steady_tol as slip_steady_tol;
 pub use crate::models::stickquad::steady_quad as stick_steady_quad;
 pub use crate::models::stickslip::steady_tol as stickslip_steady_tol;
-pub use crate::special::elliptic::{cos_integral, cos_integral_pair, rf, rf_lanes};
+pub use crate::special::elliptic::{cos_integral, cos_integral_pair, rf, rf_dy_lanes, rf_lanes};
 pub use crate::special::root::{brent, Root};
 pub use crate::special::SinCos;
 

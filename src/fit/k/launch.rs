@@ -400,8 +400,11 @@ impl<'a> Launch<'a> {
                 let sc = self.scene;
                 let w0sq = [ya + self.wc2, yb + self.wc2];
                 let wf2 = w0sq.map(|w| w + self.drop);
-                // No derivative here: R_D's sum beside four R_F costs 1.73 times the four R_F
-                // alone (215 against 124 ns), beside two 1.37 times (132 against 96 ns).
+                // No derivative here: R_D's sum beside four R_F costs twice the four alone
+                // (211 against 105 ns), beside two 1.8 times (123 against 69 ns; criterion
+                // medians, `cargo bench --features bench-internals --bench forward --
+                // "carlson-rf with"`). Newton's steps on single passes, and no stencil for
+                // dv̄/dK, still pay for it: the whole row takes 0.94 of the secant's time.
                 let times = cos_integral_pair(
                     sc.sc_half_0,
                     sc.sc_half_f,

@@ -1,16 +1,37 @@
-"""Shared helpers: the command-line binary the bindings are checked against, and CSV reading."""
+"""Shared helpers: the command-line binary the bindings are checked against, CSV reading, and
+a Ctrl-C on a timer."""
 
+import _thread
+import contextlib
 import csv
 import io
 import os
 import pathlib
+import signal
 import subprocess
+import threading
 
 import numpy as np
 import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 DEFAULT_DATA = ROOT / "data" / "default.csv"
+
+
+@contextlib.contextmanager
+def ctrl_c_after(seconds):
+    """Ctrl-C (SIGINT to the main thread) `seconds` after the block starts. Python's own SIGINT
+    handler is installed for the block, also when the suite runs with SIGINT ignored (as a
+    background job of a non-interactive shell, where interrupt_main does nothing), and the
+    previous handler is restored after it; the timer is cancelled on leaving."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    timer = threading.Timer(seconds, _thread.interrupt_main)
+    try:
+        timer.start()
+        yield
+    finally:
+        timer.cancel()
+        signal.signal(signal.SIGINT, previous)
 
 
 def _binary() -> str:

@@ -2,17 +2,15 @@
 parameter values bit for bit; data from CSV, arrays and DataFrames; errors as the command
 line words them; posteriors to ArviZ; Ctrl-C stops an MCMC run."""
 
-import _thread
 import re
 import signal
-import threading
 import time
 
 import numpy as np
 import pytest
 
 import fitbead
-from conftest import DEFAULT_DATA, assert_bits_equal, numbers, read_csv_text
+from conftest import DEFAULT_DATA, assert_bits_equal, ctrl_c_after, numbers, read_csv_text
 
 
 @pytest.fixture(scope="module")
@@ -118,20 +116,11 @@ def test_mcmc_draws_and_arviz(data):
 
 
 def test_keyboard_interrupt_stops_mcmc(data):
-    # Python's own SIGINT handler, also when the suite runs with SIGINT ignored (as a background
-    # job of a non-interactive shell): interrupt_main does nothing for an ignored signal.
-    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
-    try:
-        timer = threading.Timer(0.3, _thread.interrupt_main)
-        t0 = time.perf_counter()
-        timer.start()
-        with pytest.raises(KeyboardInterrupt):
-            # A run that cannot converge (ESS 10⁹) and would take minutes: only the interrupt ends it.
-            fitbead.fit_jaeger(data, method="mcmc", min_ess=1e9, max_steps=1_000_000)
-        timer.cancel()
-        assert time.perf_counter() - t0 < 5.0
-    finally:
-        signal.signal(signal.SIGINT, previous)
+    t0 = time.perf_counter()
+    with ctrl_c_after(0.3), pytest.raises(KeyboardInterrupt):
+        # A run that cannot converge (ESS 10⁹) and would take minutes: only the interrupt ends it.
+        fitbead.fit_jaeger(data, method="mcmc", min_ess=1e9, max_steps=1_000_000)
+    assert time.perf_counter() - t0 < 5.0
 
 
 def test_a_signal_handlers_own_exception_passes_through(data):
@@ -281,18 +270,12 @@ def test_ctrl_c_stops_a_large_batch_within_a_second(call):
         run = lambda: fitbead.forward("contact", 1.0, d)  # noqa: E731
     else:
         run = lambda: fitbead.invert_k("stickslip", 1.0, d, np.full(n, 0.3))  # noqa: E731
-    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
-    try:
-        timer = threading.Timer(0.3, _thread.interrupt_main)
-        t0 = time.perf_counter()
-        timer.start()
+    t0 = time.perf_counter()
+    with ctrl_c_after(0.3):
         with pytest.raises(KeyboardInterrupt):
             run()
         elapsed = time.perf_counter() - t0
-        timer.cancel()
-        assert elapsed < 1.3, elapsed
-    finally:
-        signal.signal(signal.SIGINT, previous)
+    assert elapsed < 1.3, elapsed
 
 
 def test_bad_sampler_counts_name_the_setting():

@@ -3,12 +3,9 @@ arrays, in eval, eval_band and plot; counts as integers; a run too short to asse
 errors in the words of the keyword arguments; the joined log likelihoods of a FitSet; the
 numpydoc sections of the documented calls."""
 
-import _thread
 import inspect
 import math
 import pickle
-import signal
-import threading
 import time
 import warnings
 
@@ -16,7 +13,7 @@ import numpy as np
 import pytest
 
 import fitbead
-from conftest import DEFAULT_DATA
+from conftest import DEFAULT_DATA, ctrl_c_after
 
 G = 9.81
 
@@ -52,18 +49,11 @@ def test_an_interrupted_mcmc_keeps_its_draws(data, tmp_path):
     """Ctrl-C during a posterior run that would take minutes stops it within seconds and
     raises fitbead.Interrupted (a KeyboardInterrupt) carrying the fits with the draws so far,
     every one marked interrupted; the draws file asked for is written with those draws."""
-    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     path = tmp_path / "draws.csv"
-    try:
-        timer = threading.Timer(1.0, _thread.interrupt_main)
-        t0 = time.perf_counter()
-        timer.start()
-        with pytest.raises(fitbead.Interrupted) as e:
-            quiet(fitbead.fit_jaeger, data, method="mcmc", min_ess=1e9, max_steps=1_000_000, draws=path)
-        timer.cancel()
-        assert time.perf_counter() - t0 < 6.0
-    finally:
-        signal.signal(signal.SIGINT, previous)
+    t0 = time.perf_counter()
+    with ctrl_c_after(1.0), pytest.raises(fitbead.Interrupted) as e:
+        quiet(fitbead.fit_jaeger, data, method="mcmc", min_ess=1e9, max_steps=1_000_000, draws=path)
+    assert time.perf_counter() - t0 < 6.0
     assert isinstance(e.value, KeyboardInterrupt)
     assert "draws so far" in str(e.value)
     fits = e.value.result
@@ -86,15 +76,8 @@ def test_an_interrupted_mcmc_keeps_its_draws(data, tmp_path):
 
 
 def test_an_interrupted_klaw_run_returns_its_fit(data):
-    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
-    try:
-        timer = threading.Timer(1.0, _thread.interrupt_main)
-        timer.start()
-        with pytest.raises(fitbead.Interrupted) as e:
-            quiet(fitbead.fit_klaw, data, model="stick", method="mcmc", min_ess=1e9, max_steps=1_000_000)
-        timer.cancel()
-    finally:
-        signal.signal(signal.SIGINT, previous)
+    with ctrl_c_after(1.0), pytest.raises(fitbead.Interrupted) as e:
+        quiet(fitbead.fit_klaw, data, model="stick", method="mcmc", min_ess=1e9, max_steps=1_000_000)
     fit = e.value.result
     assert isinstance(fit, fitbead.FitResult) and fit.name == "klaw-c"
     assert fit.interrupted and fit.draws.shape[1] > 0
@@ -105,15 +88,8 @@ def test_an_interrupted_klaw_run_returns_its_fit(data):
 def test_an_interrupted_report_keeps_its_tables(data, tmp_path):
     """report(method="mcmc") cut short by Ctrl-C: the report of the draws so far, in the
     exception and in the directory, every posterior row marked interrupted."""
-    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
-    try:
-        timer = threading.Timer(1.0, _thread.interrupt_main)
-        timer.start()
-        with pytest.raises(fitbead.Interrupted) as e:
-            quiet(fitbead.report, data, tmp_path / "r", method="mcmc", min_ess=1e9, max_steps=1_000_000)
-        timer.cancel()
-    finally:
-        signal.signal(signal.SIGINT, previous)
+    with ctrl_c_after(1.0), pytest.raises(fitbead.Interrupted) as e:
+        quiet(fitbead.report, data, tmp_path / "r", method="mcmc", min_ess=1e9, max_steps=1_000_000)
     rep = e.value.result
     assert isinstance(rep, fitbead.Report)
     assert set(rep["stats"]["mcmc_status"]) == {"interrupted"}

@@ -51,9 +51,14 @@ pub fn rf(x: f64, y: f64, z: f64) -> f64 {
 #[cold]
 #[inline(never)]
 fn rf_rescaled(x: f64, y: f64, z: f64, scale: f64) -> f64 {
-    let k = -(scale.log2() / 2.0).round() as i32;
-    let h = 2f64.powi(k);
+    let h = rescale_root(scale);
     h * rf_in_range(x * h * h, y * h * h, z * h * h)
+}
+
+/// h = 2^k with λ = h² = 4^k bringing `scale` to about 1 (λ scale in [½, 2]): the square root of
+/// the factor by which [`rf`] and [`rd`] rescale arguments outside [1e-30, 1e30].
+fn rescale_root(scale: f64) -> f64 {
+    2f64.powi(-(scale.log2() / 2.0).round() as i32)
 }
 
 /// The duplication algorithm proper, for non-negative arguments at most one of which is zero
@@ -116,8 +121,7 @@ pub fn rd(x: f64, y: f64, z: f64) -> f64 {
     }
     let scale = x.max(y).max(z);
     if !(1e-30..=1e30).contains(&scale) {
-        let k = -scale.log2().div_euclid(2.0) as i32;
-        let h = 2f64.powi(k);
+        let h = rescale_root(scale);
         // λ = h², λ^{3/2} = h³ (in three factors: h³ alone may overflow).
         return h * h * h * rd_in_range(x * h * h, y * h * h, z * h * h);
     }

@@ -272,6 +272,15 @@ impl<'a> Launch<'a> {
         }
     }
 
+    /// K of a search's root: its pass's, or a launch's at its u where the root was not
+    /// evaluated.
+    fn k_of_found(&self, r: &Found) -> Option<f64> {
+        match r.pass {
+            Some(p) => Some(p.k()),
+            None => self.k_of_launch(r.u.exp()),
+        }
+    }
+
     fn k_of_launch(&self, y: f64) -> Option<f64> {
         self.launch(y).map(|p| p.k())
     }
@@ -818,14 +827,10 @@ fn above_range(l: &Launch<'_>, br: &KBracket, v: f64, sigma_v: Option<f64>) -> O
         let (u0, s0) = l.guess(t);
         let secant = Secant::new(t, u0, s0, (l.y_d.ln(), br.tau_hi), None)?;
         let found = l.solve(secant, None, &mut 0)?;
-        let y = found.u.exp();
-        if y < 1e-12 * l.wc2 {
+        if found.u.exp() < 1e-12 * l.wc2 {
             return None;
         }
-        match found.pass {
-            Some(p) => Some(p.k()),
-            None => l.k_of_launch(y),
-        }
+        l.k_of_found(&found)
     };
     let (k_lo, k_hi) = match sigma_v {
         Some(sg) => (Some(end_at(v - sg, "K_lo")?), Some(end_at(v + sg, "K_hi")?)),
@@ -914,7 +919,6 @@ impl Launch<'_> {
             },
         };
         let k = p.k();
-        let mut n_side = 0;
         // τ' at the root is the search's where its passes carry it (rolling over the top), and so
         // is τ'' where K_lo and K_hi need it; elsewhere both come from central differences.
         // The differences' step in u: 1e-5, wider from rest past the top, where τ is flat in u
@@ -931,7 +935,6 @@ impl Launch<'_> {
         let (d1, d2) = if root.dtau.is_finite() && (sigma_v.is_none() || root.d2.is_finite()) {
             (root.dtau, root.d2)
         } else {
-            n_side += 2;
             tau_derivatives(l, (u, h), u_d, &p)?
         };
         let (dk, map_slope) = l.dk_du(y, &p)?;
@@ -950,7 +953,7 @@ impl Launch<'_> {
             d2,
         };
         let (k_lo, k_hi) = match sigma_v {
-            Some(sg) => ends.interval(v, sg, &mut notes, &mut n_side)?,
+            Some(sg) => ends.interval(v, sg, &mut notes)?,
             None => (f64::NAN, f64::NAN),
         };
         if l.saddle {
@@ -1093,25 +1096,15 @@ impl SigmaEnds<'_> {
         })
     }
 
-    /// K of a search's result (its pass, or a launch at its u).
+    /// K of a search's result.
     fn k_at(&self, r: Option<Found>) -> Option<f64> {
-        let r = r?;
-        match r.pass {
-            Some(pe) => Some(pe.k()),
-            None => self.l.k_of_launch(r.u.exp()),
-        }
+        self.l.k_of_found(&r?)
     }
 
-    /// K_lo and K_hi at v ∓ `sg` (the two searches side by side), the searches' passes
-    /// counted in `n_side`.
-    fn interval(
-        &self,
-        v: f64,
-        sg: f64,
-        notes: &mut Vec<String>,
-        n_side: &mut usize,
-    ) -> Option<(f64, f64)> {
+    /// K_lo and K_hi at v ∓ `sg` (the two searches side by side).
+    fn interval(&self, v: f64, sg: f64, notes: &mut Vec<String>) -> Option<(f64, f64)> {
         let l = self.l;
+        let n_side = &mut 0;
         let lo = self.plan_end(v - sg, "K_lo", notes)?;
         let hi = self.plan_end(v + sg, "K_hi", notes)?;
         Some(match (lo, hi) {

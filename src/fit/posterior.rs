@@ -617,12 +617,14 @@ pub(crate) const MAX_STEPS_NOTE: &str =
 
 /// The largest or smallest (`pick`) of `xs`: NaN when any is NaN or there are none.
 fn extreme(xs: impl Iterator<Item = f64>, pick: fn(f64, f64) -> f64) -> f64 {
-    xs.map(|x| if x.is_nan() { None } else { Some(x) })
-        .try_fold(None, |acc: Option<f64>, x| {
-            x.map(|x| Some(acc.map_or(x, |a| pick(a, x))))
-        })
-        .flatten()
-        .unwrap_or(f64::NAN)
+    let mut out = f64::NAN;
+    for (i, x) in xs.enumerate() {
+        if x.is_nan() {
+            return f64::NAN;
+        }
+        out = if i == 0 { x } else { pick(out, x) };
+    }
+    out
 }
 
 /// The note every parameter row of an interrupted posterior run starts with.

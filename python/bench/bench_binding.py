@@ -14,8 +14,14 @@ binding / library − 1, and the extension's call alone (the rows computed into 
 columns, before `fitbead.forward` makes the text columns object arrays). --threads sets RAYON_NUM_THREADS for both; it must be set before
 fitbead is imported, so this script imports it only after setting it.
 """
-import argparse
 import os
+
+# One BLAS thread: scipy (imported with bench_forward) starts OpenBLAS's thread pools, whose
+# idle threads spin on the cores the two sides are timed on (6 % of a 1-thread run's samples).
+for _v in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_v, "1")
+
+import argparse
 import platform
 import statistics
 import subprocess

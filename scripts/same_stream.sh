@@ -11,7 +11,8 @@
 #   size.
 #   --big adds the large inputs (k stick on 5,000,000 simulated rows, forward stick on
 #   1,000,000), minutes of work.
-# Prints one line per differing case and a count; exits 1 when any case differs.
+# Prints one line per differing case and a count; exits 1 when any case differs. With KEEP=1,
+# scripts/same_stream_columns.py lists which cells of the differing cases changed, and by how much.
 set -u
 old=$1
 new=$2

@@ -87,14 +87,21 @@ fn batch(a: &Arrays, model: &Model) -> Result<Columns, String> {
     };
     let tasks = a.xi.len().div_ceil(TASK_ROWS);
     let mut parts: Vec<Part<'_>> = Vec::with_capacity(tasks);
-    let mut nums: Vec<_> = cols.nums.iter_mut().map(|c| c.chunks_mut(TASK_ROWS)).collect();
+    let mut nums: Vec<_> = cols
+        .nums
+        .iter_mut()
+        .map(|c| c.chunks_mut(TASK_ROWS))
+        .collect();
     let mut regime = cols.regime.chunks_mut(TASK_ROWS);
     let mut status = cols.status.chunks_mut(TASK_ROWS);
     let mut phases = cols.phases.chunks_mut(TASK_ROWS);
     let mut message = cols.message.chunks_mut(TASK_ROWS);
     for _ in 0..tasks {
         parts.push(Part {
-            nums: nums.iter_mut().map(|c| c.next().expect("a chunk")).collect(),
+            nums: nums
+                .iter_mut()
+                .map(|c| c.next().expect("a chunk"))
+                .collect(),
             regime: regime.next().expect("a chunk"),
             status: status.next().expect("a chunk"),
             phases: phases.next().expect("a chunk"),

@@ -85,7 +85,7 @@ fn batch(a: &Arrays, model: &Model) -> Result<Columns, String> {
         phases: vec![Cow::Borrowed(""); n],
         message: vec![Cow::Borrowed(""); n],
     };
-    let tasks = a.xi.len().div_ceil(TASK_ROWS);
+    let tasks = n.div_ceil(TASK_ROWS);
     let mut parts: Vec<Part<'_>> = Vec::with_capacity(tasks);
     let mut nums: Vec<_> = cols
         .nums

@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """What the Python binding adds over the library's own batch call: the stick forward model
-over N scenes, (a) by the Rust example `forward_batch` (the library called from Rust, the
-records collected on rayon's threads) and (b) by `fitbead.forward("stick", ...)` from numpy
-arrays, on the same arrays and the same number of threads.
+over N scenes, (a) by the Rust example `forward_batch` (the library called from Rust, each
+record written into new columns on rayon's threads) and (b) by `fitbead.forward("stick", ...)`
+from numpy arrays, on the same arrays and the same number of threads.
 
 Usage: bench_binding.py --example PATH [--n 1000000] [--runs 5] [--threads T] [--seed S]
 
@@ -10,9 +10,10 @@ PATH is the example's binary (`cargo build --release --example forward_batch`, t
 target/release/examples/forward_batch). The scenes are bench_forward.py's (seeded); they are
 written to a temporary file the example reads. Both sides run once as a warm-up, then --runs
 times; the best and the median wall times are printed with the binding's overhead,
-binding / library − 1, and the extension's call alone (the rows computed into numpy
-columns, before `fitbead.forward` makes the text columns object arrays). --threads sets RAYON_NUM_THREADS for both; it must be set before
-fitbead is imported, so this script imports it only after setting it.
+binding / library − 1, and the extension's call alone (the rows computed into numpy columns,
+before `fitbead.forward` makes the text columns object arrays). --threads sets
+RAYON_NUM_THREADS for both; it must be set before fitbead is imported, so this script imports
+it only after setting it.
 """
 import os
 

@@ -24,15 +24,13 @@ for _v in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 
 import argparse
 import platform
-import statistics
 import subprocess
 import sys
 import tempfile
-import time
 
 import numpy as np
 
-from bench_forward import scenes
+from bench_forward import scenes, timed
 
 
 def main():
@@ -72,17 +70,8 @@ def main():
             "stick", xi, dg, rho, f, k=k, law="adjusted", lam=None, mu=None, a1=None,
             a2=None, a3=None, branch="upper", spin="roll", tol=1e-14)
 
-    def timed(fn):
-        out = fn()
-        ts = []
-        for _ in range(a.runs):
-            t = time.perf_counter()
-            fn()
-            ts.append(time.perf_counter() - t)
-        return min(ts), statistics.median(ts), out
-
-    best_c, med_c, _ = timed(core)
-    best_b, med_b, res = timed(call)
+    best_c, med_c, _ = timed(core, a.runs)
+    best_b, med_b, res = timed(call, a.runs)
     steady = int(np.isfinite(np.asarray(res["v"], dtype=np.float64)).sum())
     print(f"(b) fitbead.forward: {fitbead.threads()} threads, best {best_b:.4f} s, median "
           f"{med_b:.4f} s ({1e9 * med_b / a.n:.1f} ns per scene); steady {steady}")
